@@ -1,0 +1,89 @@
+// The lighting stage's view of a scene: world-space triangle soup, materials, lights, sky.
+// Produced by the offline stage (bake/gltf_import), consumed by every backend.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "exitance/runtime/vec_math.h"
+
+namespace exitance {
+
+// Linear RGB texture, row 0 = top (glTF UV (0,0) is the top-left corner).
+struct Texture {
+  int width = 0;
+  int height = 0;
+  std::vector<float> rgb;  // width * height * 3, linear
+  enum class Wrap { Repeat, ClampToEdge, MirroredRepeat };
+  Wrap wrap_s = Wrap::Repeat;
+  Wrap wrap_t = Wrap::Repeat;
+};
+
+// KHR_texture_transform: uv' = T * R * S * uv
+struct TextureTransform {
+  Vec2 offset{0, 0};
+  float rotation = 0;
+  Vec2 scale{1, 1};
+  int tex_coord = 0;  // which TEXCOORD_n the texture reads (after override)
+};
+
+struct TextureBinding {
+  int texture = -1;  // index into Scene::textures, -1 = none
+  TextureTransform transform;
+};
+
+struct Material {
+  std::string name;
+  Vec3 base_color{1, 1, 1};  // linear factor
+  TextureBinding base_color_texture;
+  float metallic = 1.0f;  // glTF default
+  Vec3 emission{0, 0, 0};  // emissiveFactor * KHR_materials_emissive_strength
+  TextureBinding emissive_texture;
+  bool double_sided = false;
+};
+
+struct PunctualLight {
+  enum class Type { Point, Spot, Directional };
+  Type type = Type::Point;
+  std::string name;
+  Vec3 position{0, 0, 0};
+  Vec3 direction{0, 0, -1};  // direction the light travels (node -Z in world space)
+  Vec3 intensity{1, 1, 1};   // colour * intensity: W/sr for point/spot, W/m^2 for directional
+  float cos_inner = 1.0f;    // spot only
+  float cos_outer = 0.0f;    // spot only
+};
+
+struct Sky {
+  Vec3 constant{0, 0, 0};
+  // Optional equirectangular radiance map (row 0 = +Y pole). Multiplies nothing: if present it replaces `constant`.
+  Texture environment;
+  bool has_environment() const { return environment.width > 0; }
+};
+
+// One mesh instance (a glTF node with a mesh). Triangles [first_triangle, first_triangle + triangle_count).
+struct Instance {
+  int node = -1;
+  std::string name;
+  int mesh = -1;
+  uint32_t first_triangle = 0;
+  uint32_t triangle_count = 0;
+};
+
+// Unindexed triangle soup; every per-vertex array holds 3 entries per triangle.
+struct Scene {
+  std::vector<Vec3> positions;        // world space
+  std::vector<Vec3> normals;          // world space shading normals, unit length
+  std::vector<Vec2> uv0;              // TEXCOORD_0 (zeros when absent)
+  std::vector<Vec2> lightmap_uv;      // TEXCOORD_1 (or TEXCOORD_0 with --uv 0)
+  std::vector<uint32_t> triangle_material;
+  std::vector<uint32_t> triangle_instance;
+  std::vector<Material> materials;
+  std::vector<Texture> textures;
+  std::vector<Instance> instances;
+  std::vector<PunctualLight> lights;
+  Sky sky;
+
+  size_t triangle_count() const { return triangle_material.size(); }
+};
+
+}  // namespace exitance
