@@ -493,7 +493,7 @@ def build():
               note="node hierarchy must be disjoint trees")
     gltf_case("node_child_oob.gltf", mutate(lambda j: j["nodes"][0].update(children=[99])), 2, "node 0|node 99")
     gltf_case("scene_root_oob.gltf", mutate(lambda j: j["scenes"][0].update(nodes=[99])), 2, "scene 0|node 99")
-    gltf_case("scene_index_oob.gltf", mutate(lambda j: j.update(scene=3)), 2, "scene")
+    gltf_case("scene_index_oob.gltf", mutate(lambda j: j.update(scene=3)), 2, "scene 3|: scene")
     gltf_case("scene_no_nodes.gltf", mutate(lambda j: j["scenes"][0].pop("nodes")), 2, "no triangle",
               note="an empty scene: nothing to bake")
     gltf_case("mesh_index_oob.gltf", mutate(lambda j: j["nodes"][0].update(mesh=5)), 2, "node 0|mesh 5")
