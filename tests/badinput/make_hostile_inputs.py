@@ -319,6 +319,8 @@ def build():
     gltf_case("buffer_uri_dev_zero.gltf", mutate(lambda j: j["buffers"][0].update(uri="/dev/zero")), 2,
               "buffer 0|no triangle", note="endless device file: refuse it, or read byteLength zeros "
               "(then every triangle is degenerate); never hang")
+    gltf_case("buffer_uri_http.gltf", mutate(lambda j: j["buffers"][0].update(uri="http://127.0.0.1:9/x.bin")),
+              2, "buffer 0", note="remote URI: a baker must not fetch it")
     gltf_case("buffer_missing_uri.gltf", mutate(lambda j: j["buffers"][0].pop("uri")), 2, "buffer 0",
               note="a .gltf buffer without uri has no data (only a GLB's first buffer may)")
 
@@ -363,6 +365,12 @@ def build():
               mutate(lambda j: j["accessors"][A_IDX].update(count=4294967295)), 2, "accessor 3")
     gltf_case("accessor_count_zero.gltf", mutate(lambda j: j["accessors"][A_NRM].update(count=0)), 2,
               "accessor 1|mesh 0 primitive 0", note="count must be >= 1")
+    gltf_case("accessor_count_negative.gltf", mutate(lambda j: j["accessors"][A_POS].update(count=-1)), 2,
+              "accessor 0")
+    gltf_case("accessor_count_string.gltf", mutate(lambda j: j["accessors"][A_POS].update(count="24")), 2,
+              "accessor 0", note="schema: count is an integer")
+    gltf_case("accessor_count_fractional.gltf", mutate(lambda j: j["accessors"][A_NRM].update(count=23.5)), 2,
+              "accessor 1")
     gltf_case("accessor_bufferview_oob.gltf", mutate(lambda j: j["accessors"][A_NRM].update(bufferView=42)), 2,
               "accessor 1")
     gltf_case("componenttype_invalid.gltf", mutate(lambda j: j["accessors"][A_POS].update(componentType=5130)),
@@ -467,6 +475,8 @@ def build():
     s.j["textures"][0]["source"] = 4
     gltf_case("image_index_oob.gltf", s, 2, "texture 0|image 4")
     gltf_case("image_missing_file.gltf", with_texture(cube(), {"uri": "image_missing_file.png"}), 2, "image 0")
+    gltf_case("image_uri_path_traversal.gltf", with_texture(cube(), {"uri": "../../../../../../../../etc/passwd"}),
+              2, "image 0", note="escapes the scene folder; not an image either way")
     gltf_case("image_corrupt_datauri.gltf", with_texture(cube(), {
         "uri": "data:image/png;base64," + base64.b64encode(b"\x89PNG\r\n\x1a\n" + b"garbage" * 20).decode()}),
         2, "image 0", note="PNG signature followed by garbage")
