@@ -1,0 +1,64 @@
+#include "exitance/bake/image_decode.h"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
+#include <cmath>
+
+#include "exitance/bake/input_error.h"
+
+namespace exitance {
+namespace {
+
+constexpr long long kMaxTexels = 1ll << 27;  // 128 M texels: larger is a hostile header, not a texture
+
+float srgb_to_linear(float c) {
+  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+Texture read_all(OIIO::ImageInput& input, const std::string& file, const std::string& element) {
+  const OIIO::ImageSpec& spec = input.spec();
+  if (spec.width <= 0 || spec.height <= 0 || (long long)spec.width * spec.height > kMaxTexels || spec.nchannels <= 0)
+    throw InputError(file, element, "image size " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                                        " is not plausible");
+  std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+  if (!input.read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data()))
+    throw InputError(file, element, "image data does not decode: " + input.geterror());
+  Texture texture;
+  texture.width = spec.width;
+  texture.height = spec.height;
+  texture.rgb.resize(size_t(spec.width) * size_t(spec.height) * 3);
+  const size_t n = size_t(spec.nchannels);
+  for (size_t i = 0; i < size_t(spec.width) * size_t(spec.height); ++i)
+    for (size_t c = 0; c < 3; ++c) {
+      // Grey (1-2 channel) images replicate their first channel.
+      float v = pixels[i * n + (n >= 3 ? c : 0)];
+      texture.rgb[i * 3 + c] = std::isfinite(v) ? v : 0.0f;
+    }
+  return texture;
+}
+
+}  // namespace
+
+Texture decode_srgb_image(const std::vector<unsigned char>& bytes, const std::string& name_hint,
+                          const std::string& file, const std::string& element) {
+  if (bytes.empty()) throw InputError(file, element, "image has no data");
+  OIIO::Filesystem::IOMemReader reader(bytes.data(), bytes.size());
+  auto input = OIIO::ImageInput::open(name_hint, nullptr, &reader);
+  if (!input) throw InputError(file, element, "image data does not decode (" + OIIO::geterror() + ")");
+  const bool is_float = input->spec().format.is_floating_point();
+  Texture texture = read_all(*input, file, element);
+  if (!is_float)
+    for (float& v : texture.rgb) v = srgb_to_linear(std::clamp(v, 0.0f, 1.0f));
+  return texture;
+}
+
+Texture read_linear_image_file(const std::string& path, const std::string& element) {
+  auto input = OIIO::ImageInput::open(path);
+  if (!input) throw InputError(path, element, "cannot read image (" + OIIO::geterror() + ")");
+  Texture texture = read_all(*input, path, element);
+  for (float& v : texture.rgb) v = std::max(v, 0.0f);
+  return texture;
+}
+
+}  // namespace exitance

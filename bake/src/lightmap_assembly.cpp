@@ -1,0 +1,85 @@
+#include "exitance/bake/lightmap_assembly.h"
+
+#include <string>
+
+namespace exitance {
+
+void dilate_into_gutter(int width, int height, const std::vector<float>& coverage, std::vector<float*> channels,
+                        int passes) {
+  std::vector<uint8_t> filled(coverage.size());
+  for (size_t i = 0; i < coverage.size(); ++i) filled[i] = coverage[i] > 0 ? 1 : 0;
+  std::vector<size_t> newly;
+  std::vector<float> values;
+  for (int pass = 0; pass < passes; ++pass) {
+    newly.clear();
+    values.clear();
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) {
+        const size_t i = size_t(y) * size_t(width) + size_t(x);
+        if (filled[i]) continue;
+        std::vector<double> sum(channels.size(), 0.0);
+        int n = 0;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int nx = x + dx, ny = y + dy;
+            if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
+            const size_t j = size_t(ny) * size_t(width) + size_t(nx);
+            if (!filled[j]) continue;
+            for (size_t c = 0; c < channels.size(); ++c) sum[c] += channels[c][j];
+            ++n;
+          }
+        if (n == 0) continue;
+        newly.push_back(i);
+        for (double s : sum) values.push_back(float(s / n));
+      }
+    if (newly.empty()) break;
+    for (size_t k = 0; k < newly.size(); ++k) {
+      filled[newly[k]] = 1;
+      for (size_t c = 0; c < channels.size(); ++c) channels[c][newly[k]] = values[k * channels.size() + c];
+    }
+  }
+}
+
+std::vector<formats::LightmapImage> assemble_lightmap_pages(const TexelGBuffer& gbuffer, const LightmapEstimate& estimate,
+                                                            const AssemblyOptions& options) {
+  std::vector<std::string> layers = {"", "direct.", "indirect."};
+  if (options.bounce_layers)
+    for (int k = 0; k < estimate.recorded_bounces; ++k) layers.push_back("bounce" + std::to_string(k) + ".");
+  std::vector<formats::LightmapImage> pages(gbuffer.pages.size());
+  for (size_t p = 0; p < pages.size(); ++p) {
+    const AtlasPage& source = gbuffer.pages[p];
+    pages[p].width = source.width;
+    pages[p].height = source.height;
+    const size_t n = size_t(source.width) * size_t(source.height);
+    for (const std::string& layer : layers)
+      for (const char* c : {"R", "G", "B"}) pages[p].channels[layer + c].assign(n, 0.0f);
+    pages[p].channels["A"] = source.coverage;
+  }
+  for (size_t i = 0; i < gbuffer.texels.size(); ++i) {
+    const LiveTexel& texel = gbuffer.texels[i];
+    formats::LightmapImage& page = pages[texel.page];
+    const size_t at = size_t(texel.y) * size_t(page.width) + size_t(texel.x);
+    const Vec3 total = estimate.mean_total(i), direct = estimate.mean_direct(i);
+    const Vec3 indirect = total - direct;
+    const char* names[3] = {"R", "G", "B"};
+    for (int c = 0; c < 3; ++c) {
+      page.channels[names[c]][at] = total[c];
+      page.channels[std::string("direct.") + names[c]][at] = direct[c];
+      page.channels[std::string("indirect.") + names[c]][at] = std::max(0.0f, indirect[c]);
+    }
+    if (options.bounce_layers)
+      for (int k = 0; k < estimate.recorded_bounces; ++k) {
+        const Vec3 b = estimate.mean_bounce(k, i);
+        for (int c = 0; c < 3; ++c) page.channels["bounce" + std::to_string(k) + "." + names[c]][at] = b[c];
+      }
+  }
+  for (size_t p = 0; p < pages.size(); ++p) {
+    std::vector<float*> channels;
+    for (auto& [name, data] : pages[p].channels)
+      if (name != "A") channels.push_back(data.data());
+    dilate_into_gutter(pages[p].width, pages[p].height, gbuffer.pages[p].coverage, channels, options.dilation_texels);
+  }
+  return pages;
+}
+
+}  // namespace exitance

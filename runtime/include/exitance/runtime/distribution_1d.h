@@ -1,0 +1,42 @@
+// Piecewise-constant 1D distribution: sampling proportional to non-negative weights.
+#pragma once
+#include <algorithm>
+#include <cstddef>
+#include <vector>
+
+namespace exitance {
+
+class Distribution1D {
+ public:
+  Distribution1D() = default;
+  explicit Distribution1D(const std::vector<double>& weights) {
+    cdf_.resize(weights.size() + 1, 0.0);
+    for (size_t i = 0; i < weights.size(); ++i) cdf_[i + 1] = cdf_[i] + std::max(0.0, weights[i]);
+    total_ = cdf_.back();
+    if (total_ > 0)
+      for (double& c : cdf_) c /= total_;
+  }
+  bool empty() const { return !(total_ > 0); }
+  size_t size() const { return cdf_.empty() ? 0 : cdf_.size() - 1; }
+  double total() const { return total_; }
+  float pmf(size_t i) const { return float(cdf_[i + 1] - cdf_[i]); }
+
+  // Returns the chosen index; `remapped` is u rescaled to [0,1) inside the chosen cell.
+  size_t sample(float u, float* remapped = nullptr) const {
+    auto it = std::upper_bound(cdf_.begin(), cdf_.end(), double(u));
+    size_t i = size_t(std::max<std::ptrdiff_t>(0, (it - cdf_.begin()) - 1));
+    i = std::min(i, size() - 1);
+    while (pmf(i) == 0.0f && i > 0) --i;  // never return a zero-weight cell at a CDF plateau
+    if (remapped) {
+      const double width = cdf_[i + 1] - cdf_[i];
+      *remapped = width > 0 ? float(std::clamp((double(u) - cdf_[i]) / width, 0.0, 0.99999994)) : 0.5f;
+    }
+    return i;
+  }
+
+ private:
+  std::vector<double> cdf_;
+  double total_ = 0;
+};
+
+}  // namespace exitance

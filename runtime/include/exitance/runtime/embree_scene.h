@@ -1,0 +1,33 @@
+// Embree 3 BVH over the scene's triangle soup: closest hit and any hit for single rays.
+#pragma once
+#include <embree3/rtcore.h>
+
+#include "exitance/runtime/scene.h"
+
+namespace exitance {
+
+struct Hit {
+  bool found = false;
+  float distance = 0;
+  uint32_t triangle = 0;
+  float b1 = 0, b2 = 0;     // barycentrics of vertices 1 and 2
+  Vec3 geometric_normal;    // unit, from the winding (front side)
+};
+
+class EmbreeScene {
+ public:
+  explicit EmbreeScene(const Scene& scene);
+  ~EmbreeScene();
+  EmbreeScene(const EmbreeScene&) = delete;
+  EmbreeScene& operator=(const EmbreeScene&) = delete;
+
+  Hit intersect(Vec3 origin, Vec3 direction, float t_max) const;
+  bool occluded(Vec3 origin, Vec3 direction, float t_max) const;
+
+ private:
+  const Scene& scene_;
+  RTCDevice device_ = nullptr;
+  RTCScene rtc_scene_ = nullptr;
+};
+
+}  // namespace exitance

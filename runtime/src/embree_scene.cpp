@@ -1,0 +1,77 @@
+#include "exitance/runtime/embree_scene.h"
+
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace exitance {
+
+EmbreeScene::EmbreeScene(const Scene& scene) : scene_(scene) {
+  device_ = rtcNewDevice(nullptr);
+  if (!device_) throw std::runtime_error("Embree: cannot create a device (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
+  rtc_scene_ = rtcNewScene(device_);
+  rtcSetSceneBuildQuality(rtc_scene_, RTC_BUILD_QUALITY_HIGH);
+  rtcSetSceneFlags(rtc_scene_, RTC_SCENE_FLAG_ROBUST);
+  RTCGeometry geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+  const size_t triangles = scene.triangle_count();
+  float* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                               3 * sizeof(float), triangles * 3));
+  uint32_t* indices = static_cast<uint32_t*>(
+      rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), triangles));
+  if (!vertices || !indices) throw std::runtime_error("Embree: out of memory for geometry buffers");
+  for (size_t i = 0; i < triangles * 3; ++i) {
+    vertices[3 * i] = scene.positions[i].x;
+    vertices[3 * i + 1] = scene.positions[i].y;
+    vertices[3 * i + 2] = scene.positions[i].z;
+    indices[i] = uint32_t(i);
+  }
+  rtcCommitGeometry(geometry);
+  rtcAttachGeometry(rtc_scene_, geometry);
+  rtcReleaseGeometry(geometry);
+  rtcCommitScene(rtc_scene_);
+  if (rtcGetDeviceError(device_) != RTC_ERROR_NONE) throw std::runtime_error("Embree: scene build failed");
+}
+
+EmbreeScene::~EmbreeScene() {
+  if (rtc_scene_) rtcReleaseScene(rtc_scene_);
+  if (device_) rtcReleaseDevice(device_);
+}
+
+Hit EmbreeScene::intersect(Vec3 origin, Vec3 direction, float t_max) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rayhit{};
+  rayhit.ray.org_x = origin.x, rayhit.ray.org_y = origin.y, rayhit.ray.org_z = origin.z;
+  rayhit.ray.dir_x = direction.x, rayhit.ray.dir_y = direction.y, rayhit.ray.dir_z = direction.z;
+  rayhit.ray.tnear = 0.0f;
+  rayhit.ray.tfar = t_max;
+  rayhit.ray.mask = 0xFFFFFFFFu;
+  rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(rtc_scene_, &context, &rayhit);
+  Hit hit;
+  if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
+  hit.found = true;
+  hit.distance = rayhit.ray.tfar;
+  hit.triangle = rayhit.hit.primID;
+  hit.b1 = rayhit.hit.u;
+  hit.b2 = rayhit.hit.v;
+  // Recomputed from our own vertices so the front side follows glTF's counter-clockwise winding.
+  const Vec3* p = &scene_.positions[size_t(hit.triangle) * 3];
+  hit.geometric_normal = normalize(cross(p[1] - p[0], p[2] - p[0]));
+  return hit;
+}
+
+bool EmbreeScene::occluded(Vec3 origin, Vec3 direction, float t_max) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRay ray{};
+  ray.org_x = origin.x, ray.org_y = origin.y, ray.org_z = origin.z;
+  ray.dir_x = direction.x, ray.dir_y = direction.y, ray.dir_z = direction.z;
+  ray.tnear = 0.0f;
+  ray.tfar = t_max;
+  ray.mask = 0xFFFFFFFFu;
+  rtcOccluded1(rtc_scene_, &context, &ray);
+  return ray.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
+}
+
+}  // namespace exitance
