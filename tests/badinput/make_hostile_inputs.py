@@ -357,8 +357,10 @@ def build():
         j["accessors"][A_IDX]["count"] = 40
     gltf_case("accessor_indices_past_bufferview.gltf", mutate(past_buffer), 2, "accessor 3",
               note="40 indices in a 72-byte view (past the end of the buffer too)")
-    gltf_case("accessor_misaligned.gltf", mutate(lambda j: j["accessors"][A_UV1].update(byteOffset=2, count=23)),
-              2, "accessor 2", note="float accessor at byteOffset 2")
+    s = cube()  # the same TEXCOORD_1 floats, stored 2 bytes into a view of their own
+    s.j["accessors"][A_UV1].update(bufferView=s.view(b"\0\0" + pack("ff", cube_geometry()[2]), ARRAY_BUFFER),
+                                   byteOffset=2)
+    gltf_case("accessor_misaligned.gltf", s, 2, "accessor 2", note="float accessor at byteOffset 2")
     gltf_case("accessor_count_2pow31.gltf", mutate(lambda j: j["accessors"][A_POS].update(count=2147483648)),
               2, "accessor 0", note="giant declared count must not be allocated or overflow")
     gltf_case("accessor_count_2pow32_minus_1.gltf",
@@ -514,11 +516,12 @@ def build():
     s.j["nodes"][0]["matrix"] = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
     doc = s.gltf().replace(b'"matrix":[1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1]',
                            b'"matrix":[1,0,0,0,0,1,0,0,0,0,1,0,1e999,0,0,1]')
-    case("matrix_nonfinite.gltf", doc, 2, "node 0", note="1e999 overflows to +Inf")
+    case("matrix_nonfinite.gltf", doc, 2, "node 0|1e999",
+         note="1e999 overflows a double; naming the node or quoting the number both locate it")
     s = cube(); s.finish_buffer()
     doc = s.gltf().replace(b'"name":"Cube"}],"meshes"', b'"name":"Cube","translation":[0,-1e400,0]}],"meshes"')
     assert b"-1e400" in doc
-    case("translation_nonfinite.gltf", doc, 2, "node 0")
+    case("translation_nonfinite.gltf", doc, 2, "node 0|1e400")
     gltf_case("matrix_wrong_length.gltf", mutate(lambda j: j["nodes"][0].update(matrix=[1, 0, 0, 0, 1, 0, 0, 0, 1])),
               2, "node 0", note="9 numbers instead of 16")
     gltf_case("scale_zero.gltf", mutate(lambda j: j["nodes"][0].update(scale=[0, 0, 0])), 2, "no triangle",
