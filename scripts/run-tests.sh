@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Builds Release and runs the whole CTest suite, then builds with ASan+UBSan and reruns the
+# bad-input and stress tests under the sanitizers. Assumes scripts/install-deps.sh has run.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+jobs="$(nproc)"
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+cmake --build build -j"$jobs"
+ctest --test-dir build --output-on-failure -j"$jobs"
+
+cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEXITANCE_SANITIZE=ON
+cmake --build build-asan -j"$jobs"
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+ctest --test-dir build-asan --output-on-failure -j"$jobs" -L "badinput|stress|unit"

@@ -1,0 +1,147 @@
+// End-to-end: a glTF written by the sample scene builder goes through import, layout, raster,
+// lighting and the bundle writer; the EXR and manifest are read back and checked.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "exitance/bake/bake_pipeline.h"
+#include "exitance/bake/input_error.h"
+#include "exitance/formats/lightmap_exr.h"
+#include "scene_builder.h"
+
+namespace exitance {
+namespace {
+
+namespace fs = std::filesystem;
+using samples::Quad;
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("exitance-test-" + name + "-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// Two quads at different sizes: one 4x4 floor, one 1x2 raised tile, both facing up.
+fs::path write_two_plane_scene(const fs::path& dir) {
+  samples::SceneBuilder builder;
+  samples::Material grey;
+  grey.baseColor = {0.5f, 0.5f, 0.5f};
+  const auto material = builder.addMaterial(grey);
+  samples::MeshBuilder floor;
+  floor.addQuad(Quad::axisAligned({-2, 0, -2}, {2, 0, 2}, {0, 1, 0}), material);
+  builder.addMeshNode("Floor", floor);
+  samples::MeshBuilder tile;
+  tile.addQuad(Quad::axisAligned({10, 1, 10}, {11, 1, 12}, {0, 1, 0}), material);
+  builder.addMeshNode("Tile", tile);
+  const fs::path path = dir / "planes.gltf";
+  builder.write(path.string());
+  return path;
+}
+
+TEST(BakePipeline, PlanesUnderSkyRoundTrip) {
+  const fs::path dir = fresh_dir("planes");
+  BakeOptions options;
+  options.input = write_two_plane_scene(dir).string();
+  options.output = (dir / "out.bake").string();
+  options.sky = "0.25,0.5,1";
+  options.atlas.texel_density = 8;
+  options.lighting.spp = 8;
+  Diagnostics diagnostics;
+  const nlohmann::json report = run_bake(options, diagnostics);
+  EXPECT_GT(report["live_texels"].get<size_t>(), 100u);
+
+  std::ifstream manifest_file(dir / "out.bake" / "manifest.json");
+  const nlohmann::json manifest = nlohmann::json::parse(manifest_file);
+  EXPECT_EQ(manifest["format_version"], 1);
+  EXPECT_EQ(manifest["units"]["lightmap"], "irradiance_over_pi");
+  ASSERT_EQ(manifest["instances"].size(), 2u);
+  ASSERT_EQ(manifest["pages"].size(), 1u);
+  EXPECT_EQ(manifest["input"]["sha256"].get<std::string>().size(), 64u);
+
+  const formats::LightmapImage page =
+      formats::read_lightmap_exr((dir / "out.bake" / manifest["pages"][0]["file"].get<std::string>()).string());
+  EXPECT_EQ(page.width, manifest["pages"][0]["width"].get<int>());
+  const auto& r = page.channels.at("R");
+  const auto& b = page.channels.at("B");
+  const auto& a = page.channels.at("A");
+  size_t covered = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (a[i] <= 0) continue;
+    ++covered;
+    // Nothing occludes an upward plane from the sky: E/pi equals the sky radiance exactly.
+    ASSERT_NEAR(r[i], 0.25f, 1e-5f);
+    ASSERT_NEAR(b[i], 1.0f, 1e-5f);
+  }
+  EXPECT_EQ(covered, report["live_texels"].get<size_t>());
+
+  // scale_offset maps each instance's chart into its own rectangle: the centroid of its first
+  // triangle's lightmap UVs lands on a covered texel inside the rectangle.
+  Diagnostics import_diagnostics;
+  const Scene scene = import_gltf(options.input, {}, import_diagnostics);
+  ASSERT_EQ(scene.instances.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    const auto& instance = manifest["instances"][i];
+    const auto so = instance["scale_offset"];
+    const auto rect = instance["rect"];
+    const Vec2* uv = &scene.lightmap_uv[size_t(scene.instances[i].first_triangle) * 3];
+    const Vec2 centroid = (uv[0] + uv[1] + uv[2]) * (1.0f / 3.0f);
+    const float u = centroid.x * so[0].get<float>() + so[2].get<float>();
+    const float v = centroid.y * so[1].get<float>() + so[3].get<float>();
+    const int x = int(u * float(page.width)), y = int(v * float(page.height));
+    EXPECT_GE(x, rect[0].get<int>());
+    EXPECT_LT(x, rect[0].get<int>() + rect[2].get<int>());
+    EXPECT_GE(y, rect[1].get<int>());
+    EXPECT_LT(y, rect[1].get<int>() + rect[3].get<int>());
+    EXPECT_GT(a[size_t(y) * size_t(page.width) + size_t(x)], 0.0f) << instance["name"];
+  }
+  // The floor is 4x4 units and the tile 1x2 at 8 texels/unit: their rectangles scale with area.
+  const auto floor_rect = manifest["instances"][0]["rect"], tile_rect = manifest["instances"][1]["rect"];
+  EXPECT_NEAR(floor_rect[2].get<double>() * floor_rect[3].get<double>() /
+                  (tile_rect[2].get<double>() * tile_rect[3].get<double>()),
+              8.0, 1.5);
+  fs::remove_all(dir);
+}
+
+TEST(BakePipeline, BadInputLeavesEarlierBundleUntouched) {
+  const fs::path dir = fresh_dir("atomic");
+  BakeOptions options;
+  options.input = write_two_plane_scene(dir).string();
+  options.output = (dir / "out.bake").string();
+  options.atlas.texel_density = 4;
+  options.lighting.spp = 1;
+  Diagnostics diagnostics;
+  run_bake(options, diagnostics);
+  const auto before = fs::last_write_time(dir / "out.bake" / "manifest.json");
+  options.sky = "1,nan,1";
+  EXPECT_THROW(run_bake(options, diagnostics), InputError);
+  EXPECT_EQ(fs::last_write_time(dir / "out.bake" / "manifest.json"), before);
+  for (const auto& entry : fs::directory_iterator(dir))
+    EXPECT_EQ(entry.path().filename().string().find("out.bake."), std::string::npos) << "leftover " << entry.path();
+  fs::remove_all(dir);
+}
+
+TEST(BakePipeline, SameSeedSameResult) {
+  const fs::path dir = fresh_dir("seed");
+  BakeOptions options;
+  options.input = write_two_plane_scene(dir).string();
+  options.sky = "1,1,1";
+  options.atlas.texel_density = 4;
+  options.lighting.spp = 4;
+  options.lighting.seed = 42;
+  Diagnostics diagnostics;
+  options.output = (dir / "a.bake").string();
+  run_bake(options, diagnostics);
+  options.output = (dir / "b.bake").string();
+  run_bake(options, diagnostics);
+  const auto a = formats::read_lightmap_exr((dir / "a.bake" / "lightmap-0.exr").string());
+  const auto b = formats::read_lightmap_exr((dir / "b.bake" / "lightmap-0.exr").string());
+  EXPECT_EQ(a.channels, b.channels);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace exitance
