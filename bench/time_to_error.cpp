@@ -1,0 +1,136 @@
+// Time against error for the CPU reference on one scene: a long converged run (cached by
+// content hash outside the repository) is the reference; runs at doubling spp record seconds,
+// relMSE, MAE, worst-texel error and rays/s as CSV, and the time to reach a target relMSE.
+//
+//   bench_time_to_error SCENE.gltf [--sky R,G,B] [--texel-density T] [--reference-spp N]
+//                       [--max-spp N] [--target 0.01] [--cache DIR] [--csv FILE]
+//
+// relMSE = mean over live texels and channels of (x - r)^2 / (r^2 + 1e-3): the 1e-3 keeps
+// black texels from dominating (the usual regulariser of relMSE in rendering papers).
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include "exitance/bake/atlas_layout.h"
+#include "exitance/bake/bake_pipeline.h"
+#include "exitance/bake/bundle_writer.h"
+#include "exitance/bake/texel_raster.h"
+#include "exitance/bake/unocclude.h"
+#include "exitance/runtime/embree_scene.h"
+
+namespace fs = std::filesystem;
+using namespace exitance;
+
+namespace {
+
+struct ErrorFigures {
+  double rel_mse = 0, mae = 0, worst = 0;
+};
+
+ErrorFigures compare(const std::vector<float>& x, const std::vector<float>& reference) {
+  ErrorFigures e;
+  for (size_t i = 0; i < x.size(); ++i) {
+    const double d = double(x[i]) - reference[i];
+    e.rel_mse += d * d / (double(reference[i]) * reference[i] + 1e-3);
+    e.mae += std::fabs(d);
+    e.worst = std::max(e.worst, std::fabs(d) / (std::fabs(double(reference[i])) + 1e-2));
+  }
+  e.rel_mse /= double(x.size());
+  e.mae /= double(x.size());
+  return e;
+}
+
+std::vector<float> flatten(const LightmapEstimate& estimate) {
+  std::vector<float> values;
+  values.reserve(estimate.texels.size() * 3);
+  for (size_t i = 0; i < estimate.texels.size(); ++i) {
+    const Vec3 v = estimate.mean_total(i);
+    values.insert(values.end(), {v.x, v.y, v.z});
+  }
+  return values;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string scene_path, sky, csv_path, cache_dir;
+  float density = 8;
+  uint32_t reference_spp = 8192, max_spp = 1024;
+  double target = 0.01;
+  CLI::App app{"time against error of the CPU reference"};
+  app.add_option("scene", scene_path)->required();
+  app.add_option("--sky", sky);
+  app.add_option("--texel-density", density);
+  app.add_option("--reference-spp", reference_spp);
+  app.add_option("--max-spp", max_spp);
+  app.add_option("--target", target, "relMSE target (0.01 = 1 %)");
+  app.add_option("--cache", cache_dir, "reference cache folder (default ~/.cache/exitance)");
+  app.add_option("--csv", csv_path);
+  CLI11_PARSE(app, argc, argv);
+  if (cache_dir.empty()) cache_dir = std::string(std::getenv("HOME") ? std::getenv("HOME") : "/tmp") + "/.cache/exitance";
+
+  Diagnostics diagnostics;
+  Scene scene = import_gltf(scene_path, {}, diagnostics);
+  scene.sky = parse_sky_option(sky);
+  AtlasSettings atlas;
+  atlas.texel_density = density;
+  const AtlasLayout layout = layout_lightmap_atlas(scene, atlas, scene_path, diagnostics);
+  TexelGBuffer gbuffer = rasterize_texel_gbuffer(scene, layout, scene_path, diagnostics);
+  {
+    EmbreeScene embree(scene);
+    unocclude_texels(embree, gbuffer);
+  }
+  CpuReferenceIntegrator integrator(scene);
+
+  // Reference: keyed by scene bytes + settings, so a changed scene or setting rebuilds it.
+  const std::string key = sha256_of_file(scene_path).substr(0, 16) + "-d" + std::to_string(density) + "-s" +
+                          std::to_string(reference_spp) + "-sky" + sky;
+  fs::create_directories(cache_dir);
+  const fs::path cache_file = fs::path(cache_dir) / ("reference-" + key + ".f32");
+  std::vector<float> reference(gbuffer.texels.size() * 3);
+  if (std::ifstream in{cache_file, std::ios::binary}; in && fs::file_size(cache_file) == reference.size() * 4) {
+    in.read(reinterpret_cast<char*>(reference.data()), std::streamsize(reference.size() * 4));
+    std::cerr << "reference: cached " << cache_file << "\n";
+  } else {
+    IntegratorSettings settings;
+    settings.spp = reference_spp;
+    settings.seed = 0x5EED5EED;  // independent of the measured runs
+    const LightmapEstimate estimate = integrator.bake(gbuffer, settings);
+    reference = flatten(estimate);
+    std::ofstream out(cache_file, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(reference.data()), std::streamsize(reference.size() * 4));
+    std::cerr << "reference: " << reference_spp << " spp in " << estimate.seconds << " s -> " << cache_file << "\n";
+  }
+
+  std::ofstream csv_file;
+  if (!csv_path.empty()) csv_file.open(csv_path);
+  std::ostream& csv = csv_path.empty() ? std::cout : csv_file;
+  csv << "backend,integrator,scene,spp,seconds,rel_mse,mae,worst_texel_error,rays_per_second\n";
+  double previous_seconds = 0, previous_error = 0, time_to_target = -1;
+  for (uint32_t spp = 1; spp <= max_spp; spp *= 2) {
+    IntegratorSettings settings;
+    settings.spp = spp;
+    settings.seed = spp;
+    const LightmapEstimate estimate = integrator.bake(gbuffer, settings);
+    const ErrorFigures e = compare(flatten(estimate), reference);
+    csv << "cpu,reference," << fs::path(scene_path).stem().string() << "," << spp << "," << estimate.seconds << ","
+        << e.rel_mse << "," << e.mae << "," << e.worst << "," << double(estimate.rays) / estimate.seconds << "\n";
+    if (time_to_target < 0 && e.rel_mse <= target) {
+      // Log-log interpolation between the two runs that bracket the target.
+      time_to_target = previous_seconds > 0 ? std::exp(std::log(previous_seconds) +
+                                                       (std::log(target) - std::log(previous_error)) /
+                                                           (std::log(e.rel_mse) - std::log(previous_error)) *
+                                                           (std::log(estimate.seconds) - std::log(previous_seconds)))
+                                            : estimate.seconds;
+    }
+    previous_seconds = estimate.seconds;
+    previous_error = e.rel_mse;
+  }
+  std::cerr << "live texels " << gbuffer.texels.size() << "; time to relMSE " << target << ": "
+            << (time_to_target < 0 ? std::string("not reached") : std::to_string(time_to_target) + " s") << "\n";
+  return 0;
+}

@@ -1,0 +1,149 @@
+// Unit tests of the offline stage's geometry: texel/triangle clipping, atlas packing,
+// the G-buffer raster and the sampling helpers it relies on.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "exitance/bake/atlas_layout.h"
+#include "exitance/bake/lightmap_assembly.h"
+#include "exitance/bake/texel_raster.h"
+#include "exitance/runtime/distribution_1d.h"
+#include "exitance/runtime/environment_sampler.h"
+#include "exitance/runtime/ray_offset.h"
+#include "exitance/runtime/rng.h"
+#include "exitance/runtime/sampling.h"
+#include "support/test_scenes.h"
+
+namespace exitance {
+namespace {
+
+TEST(TexelClipping, FullPartialAndEmptyCoverage) {
+  const Vec2 big[3] = {{-10, -10}, {10, -10}, {0, 10}};
+  Vec2 c;
+  EXPECT_NEAR(clipped_texel_coverage(big, 0, 0, c), 1.0f, 1e-6f);
+  EXPECT_NEAR(c.x, 0.5f, 1e-6f);
+  // Lower-left half of the texel (both windings give the same area).
+  const Vec2 half_ccw[3] = {{0, 0}, {1, 0}, {0, 1}};
+  const Vec2 half_cw[3] = {{0, 0}, {0, 1}, {1, 0}};
+  EXPECT_NEAR(clipped_texel_coverage(half_ccw, 0, 0, c), 0.5f, 1e-6f);
+  EXPECT_NEAR(c.x, 1.0f / 3.0f, 1e-6f);
+  EXPECT_NEAR(clipped_texel_coverage(half_cw, 0, 0, c), 0.5f, 1e-6f);
+  EXPECT_EQ(clipped_texel_coverage(half_ccw, 3, 3, c), 0.0f);
+}
+
+TEST(AtlasLayout, RectanglesAreDisjointAndScaleWithArea) {
+  Scene scene;
+  const uint32_t m = testing::add_material(scene, {0.5f, 0.5f, 0.5f});
+  // Three instances of different sizes (each add_quad after a name change starts a new instance).
+  for (int i = 0; i < 3; ++i) {
+    const float s = float(1 << i);
+    testing::add_quad(scene, {0, float(i) * 10, 0}, {s, 0, 0}, {0, 0, s}, m);
+    scene.instances.back().name = "quad" + std::to_string(i);
+  }
+  ASSERT_EQ(scene.instances.size(), 3u);
+  AtlasSettings settings;
+  settings.texel_density = 16;
+  Diagnostics diagnostics;
+  const AtlasLayout layout = layout_lightmap_atlas(scene, settings, "test", diagnostics);
+  ASSERT_EQ(layout.rects.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(layout.rects[i].width, 16 << i);
+    EXPECT_EQ(layout.rects[i].height, 16 << i);
+    for (size_t j = i + 1; j < 3; ++j) {
+      const InstanceRect &a = layout.rects[i], &b = layout.rects[j];
+      const bool disjoint = a.page != b.page || a.x + a.width + 2 * settings.padding <= b.x ||
+                            b.x + b.width + 2 * settings.padding <= a.x ||
+                            a.y + a.height + 2 * settings.padding <= b.y || b.y + b.height + 2 * settings.padding <= a.y;
+      EXPECT_TRUE(disjoint) << i << " overlaps " << j;
+    }
+  }
+  const TexelGBuffer gbuffer = rasterize_texel_gbuffer(scene, layout, "test", diagnostics);
+  EXPECT_EQ(gbuffer.texels.size(), size_t(16 * 16 + 32 * 32 + 64 * 64));
+  EXPECT_TRUE(diagnostics.warnings.empty());
+  for (const LiveTexel& t : gbuffer.texels) {
+    EXPECT_NEAR(t.world_texel_size, 1.0f / 16.0f, 1e-4f);
+    EXPECT_NEAR(length(t.geometric_normal), 1.0f, 1e-5f);
+  }
+}
+
+TEST(AtlasLayout, OverlappingChartsAreReported) {
+  Scene scene;
+  const uint32_t m = testing::add_material(scene, {0.5f, 0.5f, 0.5f});
+  testing::add_quad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, m);
+  testing::add_quad(scene, {0, 1, 0}, {1, 0, 0}, {0, 0, 1}, m);  // same instance, same UVs
+  AtlasSettings settings;
+  settings.texel_density = 8;
+  Diagnostics diagnostics;
+  const AtlasLayout layout = layout_lightmap_atlas(scene, settings, "test", diagnostics);
+  rasterize_texel_gbuffer(scene, layout, "test", diagnostics);
+  ASSERT_EQ(diagnostics.warnings.size(), 1u);
+  EXPECT_NE(diagnostics.warnings[0].find("overlap"), std::string::npos);
+}
+
+TEST(Dilation, FillsGutterFromNeighbours) {
+  std::vector<float> coverage = {0, 0, 0, 0, 1, 0, 0, 0, 0};
+  std::vector<float> value = {0, 0, 0, 0, 5, 0, 0, 0, 0};
+  dilate_into_gutter(3, 3, coverage, {value.data()}, 2);
+  for (float v : value) EXPECT_EQ(v, 5.0f);
+}
+
+TEST(Sampling, CosineHemisphereIsNormalisedAndUpward) {
+  Pcg32 rng(1, 2, 3);
+  double mean_cos = 0;
+  const int n = 200000;
+  for (int i = 0; i < n; ++i) {
+    const Vec3 d = sample_cosine_hemisphere(rng.uniform(), rng.uniform());
+    ASSERT_GE(d.z, 0.0f);
+    ASSERT_NEAR(length(d), 1.0f, 1e-5f);
+    mean_cos += d.z;
+  }
+  // E[cos] under pdf cos/pi is 2/3.
+  EXPECT_NEAR(mean_cos / n, 2.0 / 3.0, 4.0 * 0.2357 / std::sqrt(double(n)));
+}
+
+TEST(Sampling, EnvironmentPdfMatchesItsSamples) {
+  Texture sky;
+  sky.width = 16;
+  sky.height = 8;
+  sky.rgb.resize(16 * 8 * 3);
+  for (size_t i = 0; i < sky.rgb.size(); ++i) sky.rgb[i] = float((i * 7919) % 13) + 0.1f;
+  EnvironmentSampler sampler(sky);
+  // Integral of pdf over the sphere = 1 (midpoint rule in (u,v) with the sin(theta) Jacobian).
+  double integral = 0;
+  const int nu = 256, nv = 128;
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const Vec2 uv{(float(i) + 0.5f) / nu, (float(j) + 0.5f) / nv};
+      const double sin_theta = std::sin(kPi * uv.y);
+      integral += sampler.pdf(equirect_to_direction(uv)) * sin_theta * (2 * kPi / nu) * (kPi / nv);
+    }
+  EXPECT_NEAR(integral, 1.0, 2e-3);
+  // Sampled directions report the pdf that pdf() gives them.
+  Pcg32 rng(9, 9, 9);
+  for (int i = 0; i < 1000; ++i) {
+    float pdf = 0;
+    const Vec3 d = sampler.sample(rng.uniform(), rng.uniform(), pdf);
+    ASSERT_NEAR(pdf, sampler.pdf(d), 1e-3f * pdf);
+  }
+}
+
+TEST(Sampling, DistributionSkipsZeroWeightCells) {
+  Distribution1D d({0.0, 1.0, 0.0, 3.0, 0.0});
+  for (float u : {0.0f, 0.1f, 0.25f, 0.26f, 0.9f, 0.9999f}) {
+    const size_t i = d.sample(u);
+    EXPECT_TRUE(i == 1 || i == 3) << u;
+  }
+  EXPECT_FLOAT_EQ(d.pmf(3), 0.75f);
+}
+
+TEST(RayOffset, LeavesTheSurfaceFarFromTheOrigin) {
+  for (float scale : {1e-3f, 1.0f, 1e5f}) {
+    const Vec3 p{scale, -scale, 0.5f * scale};
+    const Vec3 n = normalize(Vec3{0.2f, 1.0f, -0.3f});
+    const Vec3 q = offset_ray_origin(p, n);
+    EXPECT_GT(dot(q - p, n), 0.0f) << scale;
+  }
+}
+
+}  // namespace
+}  // namespace exitance
