@@ -20,7 +20,7 @@ UnoccludeReport unocclude_texels(const EmbreeScene& embree, TexelGBuffer& gbuffe
     Vec3 t, b;
     orthonormal_basis(texel.geometric_normal, t, b);
     // Start a hair above the surface; look sideways, tilted slightly up, within the texel footprint.
-    const Vec3 origin = offset_ray_origin(texel.position, texel.geometric_normal);
+    const Vec3 origin = offset_ray_origin(texel.position, texel.geometric_normal, embree.extent());
     float closest = reach;
     Vec3 push_to{};
     bool push = false;
@@ -34,7 +34,7 @@ UnoccludeReport unocclude_texels(const EmbreeScene& embree, TexelGBuffer& gbuffe
       push = dot(dir, hit.geometric_normal) > 0;
       if (push) {
         const Vec3 p = origin + dir * hit.distance;
-        const Vec3 beyond = offset_ray_origin(p, hit.geometric_normal);  // just past the back face
+        const Vec3 beyond = offset_ray_origin(p, hit.geometric_normal, embree.extent());  // just past the back face
         push_to = beyond + dir * (texel.world_texel_size * 0.01f);
       }
     }

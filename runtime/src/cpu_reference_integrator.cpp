@@ -71,7 +71,7 @@ struct CpuReferenceIntegrator::Impl {
   // from one sample of each light strategy. MIS partners are the cosine-sampled rays.
   Vec3 next_event(const SurfacePoint& x, Pcg32& rng, uint64_t& rays) const {
     Vec3 result{0, 0, 0};
-    const Vec3 origin = offset_ray_origin(x.position, x.geometric_normal);
+    const Vec3 origin = offset_ray_origin(x.position, x.geometric_normal, embree.extent());
     if (lights.has_area_lights()) {
       const float uc = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
       const AreaLightSample s = lights.sample_area_light(uc, u1, u2);
@@ -86,7 +86,7 @@ struct CpuReferenceIntegrator::Impl {
         if (m.double_sided) cos_l = std::fabs(cos_l);
         if (cos_x > 0 && dot(x.geometric_normal, wi) > 0 && cos_l > 0) {
           const Vec3 light_normal_toward_x = dot(s.normal, wi) < 0 ? s.normal : -s.normal;
-          const Vec3 target = offset_ray_origin(s.position, light_normal_toward_x);
+          const Vec3 target = offset_ray_origin(s.position, light_normal_toward_x, embree.extent());
           const Vec3 span = target - origin;
           const float span_length = length(span);
           ++rays;
@@ -150,7 +150,7 @@ struct CpuReferenceIntegrator::Impl {
       // A direction under the geometric surface would leave through the back: it carries no light here.
       if (!(cos_g > 0) || local.z <= 0) return;
       const float pdf_cosine = local.z * kInvPi;
-      const Vec3 origin = offset_ray_origin(x.position, x.geometric_normal);
+      const Vec3 origin = offset_ray_origin(x.position, x.geometric_normal, embree.extent());
       ++rays;
       const Hit hit = embree.intersect(origin, wi, kInfinity);
       if (!hit.found) {

@@ -1,5 +1,7 @@
 #include "exitance/runtime/embree_scene.h"
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -19,12 +21,16 @@ EmbreeScene::EmbreeScene(const Scene& scene) : scene_(scene) {
   uint32_t* indices = static_cast<uint32_t*>(
       rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), triangles));
   if (!vertices || !indices) throw std::runtime_error("Embree: out of memory for geometry buffers");
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
   for (size_t i = 0; i < triangles * 3; ++i) {
+    lo = min(lo, scene.positions[i]);
+    hi = max(hi, scene.positions[i]);
     vertices[3 * i] = scene.positions[i].x;
     vertices[3 * i + 1] = scene.positions[i].y;
     vertices[3 * i + 2] = scene.positions[i].z;
     indices[i] = uint32_t(i);
   }
+  if (triangles > 0) extent_ = std::max(max_component(hi - lo), 1e-30f);
   rtcCommitGeometry(geometry);
   rtcAttachGeometry(rtc_scene_, geometry);
   rtcReleaseGeometry(geometry);

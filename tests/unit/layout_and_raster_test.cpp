@@ -137,11 +137,13 @@ TEST(Sampling, DistributionSkipsZeroWeightCells) {
 }
 
 TEST(RayOffset, LeavesTheSurfaceFarFromTheOrigin) {
-  for (float scale : {1e-3f, 1.0f, 1e5f}) {
+  for (float scale : {0.0f, 1e-3f, 1.0f, 1e5f}) {
     const Vec3 p{scale, -scale, 0.5f * scale};
     const Vec3 n = normalize(Vec3{0.2f, 1.0f, -0.3f});
-    const Vec3 q = offset_ray_origin(p, n);
+    const Vec3 q = offset_ray_origin(p, n, 4.0f);
     EXPECT_GT(dot(q - p, n), 0.0f) << scale;
+    // Small against the geometry: a few ulps of |p| (at most ~1e-5 relative) plus 1e-6 of the scene.
+    EXPECT_LT(length(q - p), 2e-6f * std::max(scale, 1.0f) * 4.0f + 1e-5f * scale) << scale;
   }
 }
 

@@ -23,11 +23,14 @@ class EmbreeScene {
 
   Hit intersect(Vec3 origin, Vec3 direction, float t_max) const;
   bool occluded(Vec3 origin, Vec3 direction, float t_max) const;
+  // Largest side of the scene's bounding box: the scale of ray-offset error floors.
+  float extent() const { return extent_; }
 
  private:
   const Scene& scene_;
   RTCDevice device_ = nullptr;
   RTCScene rtc_scene_ = nullptr;
+  float extent_ = 1.0f;
 };
 
 }  // namespace exitance
