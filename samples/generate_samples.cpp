@@ -19,6 +19,8 @@ constexpr SampleScene kScenes[] = {
     {"cornell_room", exitance::samples::buildCornellRoom},
     {"courtyard", exitance::samples::buildCourtyard},
     {"building", exitance::samples::buildBuilding},
+    {"ajar_room", exitance::samples::buildAjarRoom},
+    {"thin_walls", exitance::samples::buildThinWalls},
 };
 
 int usage() {

@@ -11,5 +11,9 @@ void buildCornellRoom(SceneBuilder& scene);
 void buildCourtyard(SceneBuilder& scene);
 // Multi-storey building of furnished rooms with many lights, over 200 000 triangles.
 void buildBuilding(SceneBuilder& scene);
+// A room lit only through the gap of a door left ajar (the "Veach ajar" case).
+void buildAjarRoom(SceneBuilder& scene);
+// Two rooms sharing a 5 mm wall, one lit, one dark: light-leak measurement.
+void buildThinWalls(SceneBuilder& scene);
 
 }  // namespace exitance::samples
