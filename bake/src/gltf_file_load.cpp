@@ -4,7 +4,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 
+#include "exitance/bake/gltf_json_validation.h"
 #include "exitance/bake/input_error.h"
 
 namespace exitance {
@@ -35,8 +37,14 @@ std::vector<unsigned char> read_file(const std::string& path) {
   return bytes;
 }
 
+// Where the chunks of a .glb file lie (after check_glb_container).
+struct GlbChunks {
+  size_t json_offset = 0, json_length = 0;
+  uint64_t bin_length = 0;  // 0: no BIN chunk
+};
+
 // The container checks tinygltf leaves to chance: every size is compared with the real file.
-void check_glb_container(const std::vector<unsigned char>& bytes, const std::string& path) {
+GlbChunks check_glb_container(const std::vector<unsigned char>& bytes, const std::string& path) {
   if (bytes.size() < 12) throw InputError(path, "glb header", "file is shorter than the 12-byte header");
   if (read_u32(bytes, 0) != kGlbMagic) throw InputError(path, "glb header", "wrong magic (not \"glTF\")");
   const uint32_t version = read_u32(bytes, 4);
@@ -50,6 +58,7 @@ void check_glb_container(const std::vector<unsigned char>& bytes, const std::str
   if (read_u32(bytes, 16) != kChunkJson) throw InputError(path, "glb chunk 0", "first chunk is not JSON");
   if (json_length == 0 || json_length > length - 20)
     throw InputError(path, "glb chunk 0", "JSON chunk length " + std::to_string(json_length) + " runs past the file");
+  GlbChunks chunks{20, json_length, 0};
   size_t offset = 20 + size_t(json_length);
   offset = (offset + 3) & ~size_t(3);
   if (offset + 8 <= length) {
@@ -57,7 +66,59 @@ void check_glb_container(const std::vector<unsigned char>& bytes, const std::str
     const uint32_t bin_type = read_u32(bytes, offset + 4);
     if (bin_type == kChunkBin && bin_length > length - offset - 8)
       throw InputError(path, "glb chunk 1", "BIN chunk length " + std::to_string(bin_length) + " runs past the file");
+    if (bin_type == kChunkBin) chunks.bin_length = bin_length;
   }
+  return chunks;
+}
+
+// One line, printable: nlohmann's message without its "[json.exception.parse_error.101] " tag.
+std::string json_error_text(const std::string& what) {
+  std::string text = what.rfind("[json.exception.", 0) == 0 && what.find("] ") != std::string::npos
+                         ? what.substr(what.find("] ") + 2)
+                         : what;
+  for (char& c : text)
+    if (static_cast<unsigned char>(c) < 0x20) c = ' ';
+  return text;
+}
+
+nlohmann::json parse_json(const unsigned char* begin, const unsigned char* end, const std::string& path) {
+  try {
+    return nlohmann::json::parse(begin, end);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path, "glTF", "JSON " + json_error_text(e.what()));
+  }
+}
+
+// tinygltf opens external files through these callbacks: only the files the validator resolved
+// and checked (regular files, sizes known) can be opened, and no more than the bytes it allows.
+std::string normal_path(const std::string& path) { return std::filesystem::path(path).lexically_normal().string(); }
+
+bool readable_file_exists(const std::string& path, void* user) {
+  return static_cast<const GltfExternalFiles*>(user)->readable.count(normal_path(path)) > 0;
+}
+
+std::string unexpanded_path(const std::string& path, void*) { return path; }  // no ~ or $VAR expansion
+
+bool read_readable_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+  const auto& readable = static_cast<const GltfExternalFiles*>(user)->readable;
+  const auto found = readable.find(normal_path(path));
+  if (found == readable.end()) {
+    if (err) *err = "not a file this glTF may read";
+    return false;
+  }
+  std::ifstream in(found->first, std::ios::binary);
+  out->resize(size_t(found->second));
+  if (!in.read(reinterpret_cast<char*>(out->data()), std::streamsize(out->size()))) {
+    out->clear();
+    if (err) *err = "cannot be read";
+    return false;
+  }
+  return true;
+}
+
+bool refuse_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err = "writing is not allowed";
+  return false;
 }
 
 // Keeps the encoded bytes; decoding waits until a material actually needs the image.
@@ -86,14 +147,23 @@ tinygltf::Model load_gltf_model(const std::string& path, Diagnostics& diagnostic
   std::vector<unsigned char> bytes = read_file(path);
   const bool is_glb = bytes.size() >= 4 && read_u32(bytes, 0) == kGlbMagic;
   const std::string extension = std::filesystem::path(path).extension().string();
-  if (!is_glb && (extension == ".glb" || extension == ".GLB")) check_glb_container(bytes, path);
-  if (is_glb) check_glb_container(bytes, path);
+  std::optional<GlbChunks> glb;
+  if (is_glb || extension == ".glb" || extension == ".GLB") glb = check_glb_container(bytes, path);
+
+  // Our own schema checks first, on the JSON tinygltf is about to read.
+  const unsigned char* json_begin = bytes.data() + (glb ? glb->json_offset : 0);
+  const nlohmann::json document =
+      parse_json(json_begin, json_begin + (glb ? glb->json_length : bytes.size()), path);
+  const std::string base_dir = std::filesystem::path(path).parent_path().string();
+  GltfExternalFiles files = validate_gltf_json(document, path, base_dir,
+                                               glb ? std::optional<uint64_t>(glb->bin_length) : std::nullopt);
 
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(keep_image_bytes, nullptr);
+  loader.SetFsCallbacks(
+      tinygltf::FsCallbacks{readable_file_exists, unexpanded_path, read_readable_file, refuse_write, &files});
   tinygltf::Model model;
   std::string err, warn;
-  const std::string base_dir = std::filesystem::path(path).parent_path().string();
   bool ok = false;
   try {
     if (is_glb) {
@@ -106,19 +176,12 @@ tinygltf::Model load_gltf_model(const std::string& path, Diagnostics& diagnostic
     throw InputError(path, "glTF", std::string("parser failed: ") + e.what());
   }
   if (!ok) throw InputError(path, "glTF", first_line(err.empty() ? warn : err));
-  // tinygltf downgrades missing external files to warnings; a missing buffer is fatal for us.
+  // The validator already resolved every buffer; this only guards against a tinygltf surprise.
   for (size_t i = 0; i < model.buffers.size(); ++i)
     if (model.buffers[i].data.empty())
       throw InputError(path, "buffer " + std::to_string(i), "has no data (missing or unreadable uri '" +
                                                                 model.buffers[i].uri + "')");
   if (!warn.empty()) diagnostics.warn(path + ": glTF: " + first_line(warn));
-
-  const std::string& version = model.asset.version;
-  if (version.empty() || version[0] != '2')
-    throw InputError(path, "asset", "unsupported glTF version '" + version + "' (need 2.x)");
-  for (const std::string& required : model.extensionsRequired)
-    if (!is_supported_gltf_extension(required))
-      throw InputError(path, "extensionsRequired", "extension " + required + " is not supported");
   return model;
 }
 
