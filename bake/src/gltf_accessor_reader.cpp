@@ -171,7 +171,7 @@ void check_count_plausible(const tinygltf::Model& model, const tinygltf::Accesso
 }  // namespace
 
 std::vector<float> read_accessor_floats(const tinygltf::Model& model, int index, int expected_components,
-                                        const std::string& file, const std::string& usage) {
+                                        const std::string& file, const std::string& usage, NonFinite non_finite) {
   const tinygltf::Accessor& accessor = checked_accessor(model, index, file, usage);
   const std::string element = "accessor " + std::to_string(index);
   const int components = type_components(accessor.type);
@@ -195,8 +195,9 @@ std::vector<float> read_accessor_floats(const tinygltf::Model& model, int index,
                              accessor.normalized);
   }
   if (accessor.sparse.isSparse) apply_sparse(model, accessor, components, out, file, element);
-  for (float v : out)
-    if (!std::isfinite(v)) throw InputError(file, element, "holds a NaN or infinite value (" + usage + ")");
+  if (non_finite == NonFinite::Reject)
+    for (float v : out)
+      if (!std::isfinite(v)) throw InputError(file, element, "holds a NaN or infinite value (" + usage + ")");
   return out;
 }
 

@@ -111,6 +111,7 @@ std::vector<uint32_t> triangle_list(int mode, const std::vector<uint32_t>& indic
 struct RepairCounts {
   size_t degenerate_triangles = 0;
   size_t recomputed_normals = 0;
+  size_t non_finite_normals = 0;
   size_t renormalized_normals = 0;
 };
 
@@ -155,6 +156,9 @@ class SceneFlattener {
     if (repairs_.recomputed_normals)
       diagnostics_.warn(file_ + ": " + std::to_string(repairs_.recomputed_normals) +
                         " zero or missing vertex normals replaced by face normals");
+    if (repairs_.non_finite_normals)
+      diagnostics_.warn(file_ + ": " + std::to_string(repairs_.non_finite_normals) +
+                        " NaN or infinite vertex normals replaced by face normals");
     if (repairs_.renormalized_normals)
       diagnostics_.warn(file_ + ": " + std::to_string(repairs_.renormalized_normals) + " vertex normals renormalized");
   }
@@ -197,20 +201,21 @@ class SceneFlattener {
       throw InputError(file_, element,
                        "has no " + uv_name + " lightmap UVs" +
                            (options_.lightmap_uv_set == 1 ? " (use --uv 0 to bake with TEXCOORD_0)" : ""));
-    auto read_optional = [&](const std::string& name, int components) {
+    auto read_optional = [&](const std::string& name, int components, NonFinite non_finite) {
       const int index = attribute(primitive, name);
       std::vector<float> values;
       if (index >= 0) {
-        values = read_accessor_floats(model_, index, components, file_, name);
+        values = read_accessor_floats(model_, index, components, file_, name, non_finite);
         if (values.size() / size_t(components) != vertex_count)
           throw InputError(file_, "accessor " + std::to_string(index),
                            name + " count differs from POSITION count " + std::to_string(vertex_count));
       }
       return values;
     };
-    const std::vector<float> normals = read_optional("NORMAL", 3);
-    const std::vector<float> uv0 = read_optional("TEXCOORD_0", 2);
-    const std::vector<float> lightmap_uv = read_optional(uv_name, 2);
+    // NaN/Inf normals are repaired per vertex (shading_normal); NaN/Inf UVs cannot be.
+    const std::vector<float> normals = read_optional("NORMAL", 3, NonFinite::Keep);
+    const std::vector<float> uv0 = read_optional("TEXCOORD_0", 2, NonFinite::Reject);
+    const std::vector<float> lightmap_uv = read_optional(uv_name, 2, NonFinite::Reject);
 
     std::vector<uint32_t> indices;
     if (primitive.indices >= 0) {
@@ -262,6 +267,10 @@ class SceneFlattener {
       return face_normal;
     }
     const Vec3 local = to_vec3(normals, vi);
+    if (!is_finite(local)) {
+      ++repairs_.non_finite_normals;
+      return face_normal;
+    }
     const float local_length = length(local);
     if (!(local_length > 1e-6f)) {
       ++repairs_.recomputed_normals;
