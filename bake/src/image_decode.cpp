@@ -4,6 +4,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "exitance/bake/input_error.h"
 
@@ -11,6 +12,41 @@ namespace exitance {
 namespace {
 
 constexpr long long kMaxTexels = 1ll << 27;  // 128 M texels: larger is a hostile header, not a texture
+
+// OIIO 2.4's PNG reader installs an error handler that records the message for geterror() and then
+// *returns*; libpng treats a returning handler as "not handled" and falls back to png_default_error,
+// which fprintf()s "libpng error: ..." to the C stderr stream before longjmp-ing. No OIIO attribute
+// turns that off, so while OIIO decodes, the C `stderr` stream points at /dev/null. Only the stdio
+// stream is swapped: file descriptor 2 is untouched, so sanitizer reports (written straight to the
+// descriptor) and our own std::cerr output still appear. The errors reach the user through
+// geterror(), in our one-line InputError.
+class QuietCStderr {
+ public:
+  QuietCStderr() : saved_(stderr), sink_(std::fopen("/dev/null", "w")) {
+    if (!sink_) return;
+    std::fflush(saved_);
+    stderr = sink_;
+  }
+  ~QuietCStderr() {
+    if (!sink_) return;
+    stderr = saved_;
+    std::fclose(sink_);
+  }
+  QuietCStderr(const QuietCStderr&) = delete;
+  QuietCStderr& operator=(const QuietCStderr&) = delete;
+
+ private:
+  FILE* saved_;
+  FILE* sink_;
+};
+
+// OIIO joins several messages with newlines; the contract is one error line.
+std::string one_line(std::string text) {
+  for (char& c : text)
+    if (c == '\n' || c == '\r') c = ' ';
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  return text;
+}
 
 float srgb_to_linear(float c) {
   return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
@@ -23,7 +59,7 @@ Texture read_all(OIIO::ImageInput& input, const std::string& file, const std::st
                                         " is not plausible");
   std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
   if (!input.read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data()))
-    throw InputError(file, element, "image data does not decode: " + input.geterror());
+    throw InputError(file, element, "image data does not decode (" + one_line(input.geterror()) + ")");
   Texture texture;
   texture.width = spec.width;
   texture.height = spec.height;
@@ -44,8 +80,9 @@ Texture decode_srgb_image(const std::vector<unsigned char>& bytes, const std::st
                           const std::string& file, const std::string& element) {
   if (bytes.empty()) throw InputError(file, element, "image has no data");
   OIIO::Filesystem::IOMemReader reader(bytes.data(), bytes.size());
+  const QuietCStderr quiet;
   auto input = OIIO::ImageInput::open(name_hint, nullptr, &reader);
-  if (!input) throw InputError(file, element, "image data does not decode (" + OIIO::geterror() + ")");
+  if (!input) throw InputError(file, element, "image data does not decode (" + one_line(OIIO::geterror()) + ")");
   const bool is_float = input->spec().format.is_floating_point();
   Texture texture = read_all(*input, file, element);
   if (!is_float)
@@ -54,8 +91,9 @@ Texture decode_srgb_image(const std::vector<unsigned char>& bytes, const std::st
 }
 
 Texture read_linear_image_file(const std::string& path, const std::string& element) {
+  const QuietCStderr quiet;
   auto input = OIIO::ImageInput::open(path);
-  if (!input) throw InputError(path, element, "cannot read image (" + OIIO::geterror() + ")");
+  if (!input) throw InputError(path, element, "cannot read image (" + one_line(OIIO::geterror()) + ")");
   Texture texture = read_all(*input, path, element);
   for (float& v : texture.rgb) v = std::max(v, 0.0f);
   return texture;
