@@ -1,0 +1,88 @@
+// Vulkan compute backend (DESIGN §5): a wavefront path tracer of lightmap texels that computes
+// the same estimator as the CPU reference (cpu_reference_integrator.h), so both agree within
+// statistical error. Stages: generate -> extend (closest hit) -> shade (emission + MIS, NEE,
+// cosine bounce, Russian roulette) -> connect (shadow rays, any hit); see runtime/src/vulkan/.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "exitance/runtime/cpu_reference_integrator.h"
+#include "exitance/runtime/scene.h"
+#include "exitance/runtime/texel_gbuffer.h"
+
+namespace exitance {
+
+enum class VulkanDeviceType { Other, Integrated, Discrete, Virtual, Cpu };
+const char* to_string(VulkanDeviceType type);
+
+struct VulkanDeviceInfo {
+  uint32_t index = 0;  // position in vkEnumeratePhysicalDevices; what VulkanDeviceOptions::device_index takes
+  std::string name;
+  VulkanDeviceType type = VulkanDeviceType::Other;
+  uint32_t api_version = 0;
+  bool usable = false;          // has every feature the backend needs (compute queue, int64, fp64, subgroup ballot)
+  std::string missing_feature;  // why not, when !usable
+};
+
+// Lists the Vulkan physical devices; empty when there is no loader, no driver or no device.
+std::vector<VulkanDeviceInfo> enumerate_vulkan_devices();
+
+struct VulkanDeviceOptions {
+  int device_index = -1;   // -1: prefer a discrete GPU, then integrated, then any (lavapipe)
+  bool validation = false; // enable VK_LAYER_KHRONOS_validation + a debug messenger
+  // Receives every validation/debug message (warnings and errors), including those at teardown.
+  std::function<void(const std::string&)> on_validation_message;
+  // Paths in flight = threads of the largest dispatch; 0 = automatic (1 Mi on a GPU, 16 Ki on a CPU device).
+  uint32_t max_paths = 0;
+  // Wavefront iterations (shade+generate+connect+extend) recorded per submission; 0 = automatic.
+  uint32_t iterations_per_submit = 0;
+  double fence_timeout_seconds = 20.0;  // a submission that does not finish in this time -> exception
+  bool collect_stage_statistics = false;  // timestamps + lane counters per stage (bench only; slower)
+};
+
+// Per-stage figures of the last bake (filled when collect_stage_statistics is on).
+struct VulkanStageStatistics {
+  std::string stage;
+  double seconds = 0;        // GPU time summed over all dispatches of the stage
+  uint64_t items = 0;        // queue entries processed (paths or rays)
+  uint64_t rays = 0;         // rays traced by the stage
+  double lane_efficiency = 0;  // active lanes / launched lanes (traversal stages: inside the traversal loop)
+};
+
+class VulkanIntegrator {
+ public:
+  // Throws std::runtime_error when no usable Vulkan device exists, and for scenes the backend does
+  // not support yet (textured materials, environment-map skies): never a silently wrong result.
+  static std::unique_ptr<VulkanIntegrator> create(const Scene& scene, const VulkanDeviceOptions& options = {});
+  ~VulkanIntegrator();
+  VulkanIntegrator(const VulkanIntegrator&) = delete;
+  VulkanIntegrator& operator=(const VulkanIntegrator&) = delete;
+
+  // Same contract and fields as CpuReferenceIntegrator::bake. Supported settings: spp (0 needs a
+  // time budget), time_budget_seconds, target_relative_error (checked between batches),
+  // max_bounces, seed, recorded_bounces, russian_roulette_start, safety_bounce_cap, progress.
+  // Throws std::runtime_error on device loss, out of memory or a fence timeout.
+  LightmapEstimate bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const;
+
+  const VulkanDeviceInfo& device() const;
+  uint32_t max_paths() const;
+  size_t path_state_bytes_per_path() const;  // SoA path state + queues + shadow rays, per path slot
+  size_t bvh_bytes() const;
+  uint32_t bvh_node_count() const;
+  const std::vector<VulkanStageStatistics>& stage_statistics() const;  // of the last bake
+
+  // Traversal-only throughput: `ray_count` incoherent rays (uniform origins in the scene bounds,
+  // uniform directions), closest hit; returns rays per second of GPU time (timestamps).
+  double measure_incoherent_traversal(uint32_t ray_count, int repetitions = 5) const;
+
+  struct Impl;
+
+ private:
+  explicit VulkanIntegrator(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace exitance

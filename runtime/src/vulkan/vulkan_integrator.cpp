@@ -1,0 +1,684 @@
+// Host side of the wavefront path tracer (shaders/wavefront/*.comp). One bake is a sequence of
+// batches; a batch is a set of work items (texel, sample) = a slice of the live texel list times a
+// range of sample indices. Path slots pull work items in order (generate, and regeneration inside
+// shade) until the batch is exhausted, then drain (the cool-down), so every texel gets exactly the
+// samples of the batch. Each work item owns a result slot (one writer), and the reduce kernel adds
+// the batch's samples to per-texel double sums in sample order.
+#include "exitance/runtime/vulkan/vulkan_integrator.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+
+#include "exitance/runtime/light_sampler.h"
+#include "exitance/runtime/material_eval.h"
+#include "exitance/runtime/sampling.h"
+#include "exitance_spirv/bench_rays.h"
+#include "exitance_spirv/connect.h"
+#include "exitance_spirv/extend.h"
+#include "exitance_spirv/generate.h"
+#include "exitance_spirv/prepare.h"
+#include "exitance_spirv/reduce.h"
+#include "exitance_spirv/shade.h"
+#include "gpu_bvh.h"
+#include "vulkan_context.h"
+
+namespace exitance {
+using namespace exitance::vulkan;
+
+namespace {
+
+// Must match shaders/include/bindings.glsl.
+enum Binding : uint32_t {
+  kParams, kNodes, kLeafTris, kTriShading, kMaterials, kEmitterCdf, kEmitterTris, kPunctual, kPunctualCdf, kTexels,
+  kBatchTexels, kCounters, kIndirect, kPathWork, kPathDepth, kPathRng, kPathThroughput, kPathRayO, kPathRayD, kPathHit,
+  kShadowRays, kRayQueue, kShadowQueue, kResults, kAccTotal, kAccBounce, kAccSamples, kBindingCount
+};
+
+struct GpuParams {
+  float sky[4];
+  float scene_extent;
+  uint32_t emitter_count, punctual_count, recorded;
+  int32_t max_bounces, rr_start, safety_cap;
+  uint32_t path_capacity;
+  uint32_t seed_lo, seed_hi, batch_texel_offset, batch_texel_count;
+  uint32_t batch_sample_begin, batch_sample_count, batch_work_total, collect_stats;
+  uint32_t texel_count_total, pad0, pad1, pad2;
+  float bench_lo[4];
+  float bench_hi[4];
+};
+static_assert(sizeof(GpuParams) == 128);
+
+enum Counter : uint32_t {
+  kRayCount0 = 0, kShadowCount = 2, kNextWork = 3, kNonfinite = 4, kRaysPrimary = 5, kRaysBounce = 6, kRaysShadow = 7,
+  kStatExtendActive = 16, kStatExtendLaunched = 18, kStatConnectActive = 20, kStatConnectLaunched = 22,
+  kStatShadeItems = 24, kStatShadeLanes = 26, kCounterCount = 32
+};
+
+enum Kernel { kGenerate, kShade, kExtend, kConnect, kPrepare, kReduce, kBenchRays, kKernelCount };
+const char* const kKernelNames[kKernelCount] = {"generate", "shade", "extend", "connect", "prepare", "reduce", "traversal-only"};
+
+constexpr uint32_t kGroupSize = 64;
+constexpr int kMaxRecordedBounces = 16;
+
+struct PushConstants {
+  uint32_t cur;
+  uint32_t mode;
+};
+
+uint64_t stat64(const uint32_t* c, uint32_t slot) { return uint64_t(c[slot]) | (uint64_t(c[slot + 1]) << 32); }
+
+}  // namespace
+
+struct VulkanIntegrator::Impl {
+  const Scene& scene;
+  VulkanDeviceOptions options;
+  std::unique_ptr<Context> ctx;
+  GpuBvh bvh;
+  uint32_t paths = 0;
+  uint32_t iterations_per_submit = 8;
+  float scene_extent = 1.0f;
+  Vec3 scene_lo{0, 0, 0}, scene_hi{0, 0, 0};
+  uint32_t emitter_count = 0, punctual_count = 0;
+
+  std::array<Buffer, kBindingCount> buffers{};
+  Buffer readback;  // counters after each submission
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+  VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
+  VkDescriptorPool descriptor_pool = VK_NULL_HANDLE;
+  VkDescriptorSet descriptor_set = VK_NULL_HANDLE;
+  std::array<VkPipeline, kKernelCount> pipelines{};
+  VkQueryPool query_pool = VK_NULL_HANDLE;
+  static constexpr uint32_t kMaxQueries = 1024;
+
+  // Per-bake buffer capacities (re-created when a bake needs more).
+  size_t texel_capacity = 0, result_capacity = 0, bounce_layers = 0;
+  mutable std::vector<VulkanStageStatistics> stats;
+
+  explicit Impl(const Scene& s, const VulkanDeviceOptions& o) : scene(s), options(o) {}
+
+  ~Impl() {
+    if (!ctx) return;
+    VkDevice d = ctx->device();
+    if (!ctx->lost()) vkDeviceWaitIdle(d);
+    for (VkPipeline p : pipelines)
+      if (p) vkDestroyPipeline(d, p, nullptr);
+    if (query_pool) vkDestroyQueryPool(d, query_pool, nullptr);
+    if (descriptor_pool) vkDestroyDescriptorPool(d, descriptor_pool, nullptr);
+    if (pipeline_layout) vkDestroyPipelineLayout(d, pipeline_layout, nullptr);
+    if (set_layout) vkDestroyDescriptorSetLayout(d, set_layout, nullptr);
+    for (Buffer& b : buffers) ctx->destroy(b);
+    ctx->destroy(readback);
+  }
+
+  Buffer& buf(Binding b) { return buffers[b]; }
+
+  void make_buffer(Binding b, VkDeviceSize size, VkBufferUsageFlags extra = 0) {
+    ctx->destroy(buffers[b]);
+    const VkDeviceSize limit = ctx->properties().limits.maxStorageBufferRange;
+    if (size > limit)
+      throw std::runtime_error("Vulkan backend: a buffer of " + std::to_string(size) + " bytes exceeds this device's " +
+                               "maxStorageBufferRange (" + std::to_string(limit) + "); use fewer paths or texels per bake");
+    buffers[b] = ctx->create_buffer(size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | extra, false);
+  }
+
+  template <typename T>
+  void make_and_upload(Binding b, const std::vector<T>& data) {
+    make_buffer(b, data.size() * sizeof(T));
+    ctx->upload(buffers[b], data.data(), data.size() * sizeof(T));
+  }
+
+  void write_descriptors() {
+    std::array<VkDescriptorBufferInfo, kBindingCount> infos{};
+    std::array<VkWriteDescriptorSet, kBindingCount> writes{};
+    for (uint32_t i = 0; i < kBindingCount; ++i) {
+      infos[i] = {buffers[i].buffer, 0, VK_WHOLE_SIZE};
+      writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+      writes[i].dstSet = descriptor_set;
+      writes[i].dstBinding = i;
+      writes[i].descriptorCount = 1;
+      writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      writes[i].pBufferInfo = &infos[i];
+    }
+    vkUpdateDescriptorSets(ctx->device(), kBindingCount, writes.data(), 0, nullptr);
+  }
+
+  void create_pipelines() {
+    VkDevice d = ctx->device();
+    std::array<VkDescriptorSetLayoutBinding, kBindingCount> bindings{};
+    for (uint32_t i = 0; i < kBindingCount; ++i)
+      bindings[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+    VkDescriptorSetLayoutCreateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    set_info.bindingCount = kBindingCount;
+    set_info.pBindings = bindings.data();
+    check(vkCreateDescriptorSetLayout(d, &set_info, nullptr, &set_layout), "vkCreateDescriptorSetLayout");
+    VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(PushConstants)};
+    VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    layout_info.setLayoutCount = 1;
+    layout_info.pSetLayouts = &set_layout;
+    layout_info.pushConstantRangeCount = 1;
+    layout_info.pPushConstantRanges = &range;
+    check(vkCreatePipelineLayout(d, &layout_info, nullptr, &pipeline_layout), "vkCreatePipelineLayout");
+    VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount};
+    VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    pool_info.maxSets = 1;
+    pool_info.poolSizeCount = 1;
+    pool_info.pPoolSizes = &pool_size;
+    check(vkCreateDescriptorPool(d, &pool_info, nullptr, &descriptor_pool), "vkCreateDescriptorPool");
+    VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    alloc.descriptorPool = descriptor_pool;
+    alloc.descriptorSetCount = 1;
+    alloc.pSetLayouts = &set_layout;
+    check(vkAllocateDescriptorSets(d, &alloc, &descriptor_set), "vkAllocateDescriptorSets");
+
+    const std::array<std::pair<const uint32_t*, size_t>, kKernelCount> code = {{
+        {spirv_generate, sizeof(spirv_generate)}, {spirv_shade, sizeof(spirv_shade)},
+        {spirv_extend, sizeof(spirv_extend)}, {spirv_connect, sizeof(spirv_connect)},
+        {spirv_prepare, sizeof(spirv_prepare)}, {spirv_reduce, sizeof(spirv_reduce)},
+        {spirv_bench_rays, sizeof(spirv_bench_rays)}}};
+    const uint32_t stack_size = std::max<uint32_t>(bvh.stack_entries + 1, 8);
+    VkSpecializationMapEntry entry{0, 0, sizeof(uint32_t)};
+    VkSpecializationInfo spec{1, &entry, sizeof(uint32_t), &stack_size};
+    for (int k = 0; k < kKernelCount; ++k) {
+      VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+      module_info.codeSize = code[size_t(k)].second;
+      module_info.pCode = code[size_t(k)].first;
+      VkShaderModule module;
+      check(vkCreateShaderModule(d, &module_info, nullptr, &module), "vkCreateShaderModule");
+      VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+      info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+      info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+      info.stage.module = module;
+      info.stage.pName = "main";
+      info.stage.pSpecializationInfo = &spec;
+      info.layout = pipeline_layout;
+      const VkResult r = vkCreateComputePipelines(d, VK_NULL_HANDLE, 1, &info, nullptr, &pipelines[size_t(k)]);
+      vkDestroyShaderModule(d, module, nullptr);
+      check(r, (std::string("creating the ") + kKernelNames[k] + " pipeline").c_str());
+    }
+    if (ctx->timestamps()) {
+      VkQueryPoolCreateInfo q{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+      q.queryType = VK_QUERY_TYPE_TIMESTAMP;
+      q.queryCount = kMaxQueries;
+      check(vkCreateQueryPool(d, &q, nullptr, &query_pool), "vkCreateQueryPool");
+    }
+  }
+
+  // Scene upload: BVH, per-triangle shading data, materials, light distributions.
+  void upload_scene() {
+    const size_t triangles = scene.triangle_count();
+    Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+    for (const Vec3& p : scene.positions) lo = min(lo, p), hi = max(hi, p);
+    if (triangles > 0) scene_extent = std::max(max_component(hi - lo), 1e-30f);  // as EmbreeScene::extent()
+    scene_lo = lo, scene_hi = hi;
+
+    std::vector<float> nodes(bvh.nodes.size() * 28);
+    std::memcpy(nodes.data(), bvh.nodes.data(), nodes.size() * 4);
+    make_and_upload(kNodes, nodes);
+    std::vector<float> leaf(bvh.triangles.size() * 12);
+    if (!leaf.empty()) std::memcpy(leaf.data(), bvh.triangles.data(), leaf.size() * 4);
+    make_and_upload(kLeafTris, leaf);
+
+    const LightSampler lights(scene);
+    std::vector<float> shading(std::max<size_t>(triangles, 1) * 24, 0.0f);
+    for (size_t t = 0; t < triangles; ++t) {
+      float* s = &shading[t * 24];
+      for (int k = 0; k < 3; ++k) {
+        const Vec3 p = scene.positions[t * 3 + size_t(k)], n = scene.normals[t * 3 + size_t(k)];
+        s[4 * k] = p.x, s[4 * k + 1] = p.y, s[4 * k + 2] = p.z;
+        s[12 + 4 * k] = n.x, s[12 + 4 * k + 1] = n.y, s[12 + 4 * k + 2] = n.z;
+      }
+      const uint32_t material = scene.triangle_material[t];
+      std::memcpy(&s[3], &material, 4);
+      s[7] = lights.area_pdf(uint32_t(t));
+    }
+    make_and_upload(kTriShading, shading);
+
+    std::vector<float> materials(std::max<size_t>(scene.materials.size(), 1) * 8, 0.0f);
+    for (size_t m = 0; m < scene.materials.size(); ++m) {
+      const Material& mat = scene.materials[m];
+      // diffuse_albedo() without textures: clamp(base_color * (1 - metallic), 0, 1).
+      const Vec3 albedo = min(max(mat.base_color * (1.0f - mat.metallic), Vec3{0, 0, 0}), Vec3{1, 1, 1});
+      const Vec3 emission = max_component(mat.emission) > 0.0f ? mat.emission : Vec3{0, 0, 0};
+      float* v = &materials[m * 8];
+      v[0] = albedo.x, v[1] = albedo.y, v[2] = albedo.z, v[3] = mat.double_sided ? 1.0f : 0.0f;
+      v[4] = emission.x, v[5] = emission.y, v[6] = emission.z;
+    }
+    make_and_upload(kMaterials, materials);
+
+    // Emitter distribution: the same weights and CDF as LightSampler / Distribution1D.
+    std::vector<uint32_t> emitter_tris;
+    std::vector<double> powers;
+    for (uint32_t t = 0; t < triangles; ++t) {
+      if (!is_emissive(scene, t)) continue;
+      const Material& m = scene.materials[scene.triangle_material[t]];
+      const Vec3* p = &scene.positions[size_t(t) * 3];
+      const double area = 0.5 * double(length(cross(p[1] - p[0], p[2] - p[0])));
+      const double power = area * double(luminance(m.emission)) * (m.double_sided ? 2.0 : 1.0);
+      if (!(power > 0) || !(area > 0)) continue;
+      emitter_tris.push_back(t);
+      powers.push_back(power);
+    }
+    emitter_count = uint32_t(emitter_tris.size());
+    make_and_upload(kEmitterCdf, cdf_of(powers));
+    make_and_upload(kEmitterTris, emitter_tris.empty() ? std::vector<uint32_t>{0} : emitter_tris);
+
+    std::vector<double> light_powers;
+    std::vector<float> punctual(std::max<size_t>(scene.lights.size(), 1) * 12, 0.0f);
+    const double radius = lights.scene_radius();
+    for (size_t i = 0; i < scene.lights.size(); ++i) {
+      const PunctualLight& l = scene.lights[i];
+      const double intensity = luminance(l.intensity);
+      uint32_t type = 0;
+      switch (l.type) {
+        case PunctualLight::Type::Point: light_powers.push_back(4.0 * kPi * intensity); type = 0; break;
+        case PunctualLight::Type::Spot: light_powers.push_back(2.0 * kPi * (1.0 - l.cos_outer) * intensity); type = 1; break;
+        case PunctualLight::Type::Directional: light_powers.push_back(kPi * radius * radius * intensity); type = 2; break;
+      }
+      float* v = &punctual[i * 12];
+      v[0] = l.position.x, v[1] = l.position.y, v[2] = l.position.z;
+      std::memcpy(&v[3], &type, 4);
+      v[4] = l.direction.x, v[5] = l.direction.y, v[6] = l.direction.z, v[7] = l.cos_inner;
+      v[8] = l.intensity.x, v[9] = l.intensity.y, v[10] = l.intensity.z, v[11] = l.cos_outer;
+    }
+    // An all-zero punctual distribution never samples (Distribution1D::empty -> pmf 0 -> probability 0).
+    punctual_count = uint32_t(scene.lights.size());
+    make_and_upload(kPunctual, punctual);
+    make_and_upload(kPunctualCdf, cdf_of(light_powers));
+  }
+
+  // Distribution1D's normalised CDF (size n + 1), computed the same way.
+  static std::vector<double> cdf_of(const std::vector<double>& weights) {
+    std::vector<double> cdf(weights.size() + 1, 0.0);
+    for (size_t i = 0; i < weights.size(); ++i) cdf[i + 1] = cdf[i] + std::max(0.0, weights[i]);
+    const double total = cdf.back();
+    if (total > 0)
+      for (double& c : cdf) c /= total;
+    if (cdf.size() < 2) cdf.resize(2, 0.0);
+    return cdf;
+  }
+
+  void allocate_path_state() {
+    make_buffer(kParams, sizeof(GpuParams));
+    make_buffer(kCounters, kCounterCount * 4);
+    make_buffer(kIndirect, 16 * 4, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+    make_buffer(kPathWork, size_t(paths) * 4);
+    make_buffer(kPathDepth, size_t(paths) * 4);
+    make_buffer(kPathRng, size_t(paths) * 16);
+    make_buffer(kPathThroughput, size_t(paths) * 16);
+    make_buffer(kPathRayO, size_t(paths) * 16);
+    make_buffer(kPathRayD, size_t(paths) * 16);
+    make_buffer(kPathHit, size_t(paths) * 16);
+    make_buffer(kShadowRays, size_t(paths) * 64);
+    make_buffer(kRayQueue, size_t(paths) * 8);
+    make_buffer(kShadowQueue, size_t(paths) * 4);
+    readback = ctx->create_buffer(kCounterCount * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+    for (Binding b : {kTexels, kBatchTexels, kResults, kAccTotal, kAccBounce, kAccSamples}) make_buffer(b, 16);
+  }
+
+  size_t path_bytes() const { return 4 + 4 + 16 + 16 + 16 + 16 + 16 + 64 + 8 + 4; }
+
+  // ---- command recording ----
+  void barrier(VkCommandBuffer cmd) const {
+    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT |
+                      VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT |
+                             VK_PIPELINE_STAGE_TRANSFER_BIT,
+                         0, 1, &b, 0, nullptr, 0, nullptr);
+  }
+
+  struct Recorder {
+    const Impl& impl;
+    VkCommandBuffer cmd;
+    bool timing;
+    uint32_t queries = 0;
+    std::vector<int> query_kernel;  // kernel that ended at query i (i >= 1)
+
+    void start() {
+      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, impl.pipeline_layout, 0, 1, &impl.descriptor_set, 0, nullptr);
+      if (timing) {
+        vkCmdResetQueryPool(cmd, impl.query_pool, 0, kMaxQueries);
+        vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, impl.query_pool, queries++);
+        query_kernel.push_back(-1);
+      }
+    }
+    void stamp(int kernel) {
+      if (!timing || queries >= kMaxQueries) return;
+      vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, impl.query_pool, queries++);
+      query_kernel.push_back(kernel);
+    }
+    void bind(Kernel k, uint32_t cur, uint32_t mode) {
+      vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, impl.pipelines[k]);
+      PushConstants pc{cur, mode};
+      vkCmdPushConstants(cmd, impl.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
+    }
+    void dispatch(Kernel k, uint32_t groups, uint32_t cur, uint32_t mode = 0) {
+      bind(k, cur, mode);
+      vkCmdDispatch(cmd, groups, 1, 1);
+      impl.barrier(cmd);
+      stamp(k);
+    }
+    void dispatch_indirect(Kernel k, uint32_t slot, uint32_t cur) {
+      bind(k, cur, 0);
+      vkCmdDispatchIndirect(cmd, impl.buffers[kIndirect].buffer, VkDeviceSize(slot) * 12);
+      impl.barrier(cmd);
+      stamp(k);
+    }
+    // prepare(1) -> connect -> extend over the ray queue `cur ^ 1`.
+    void connect_and_extend(uint32_t cur) {
+      dispatch(kPrepare, 1, cur, 1);
+      dispatch_indirect(kConnect, 1, cur);
+      dispatch_indirect(kExtend, 2, cur);
+    }
+    // One wavefront iteration reading ray queue `cur`.
+    void iteration(uint32_t cur) {
+      dispatch(kPrepare, 1, cur, 0);
+      dispatch_indirect(kShade, 0, cur);
+      connect_and_extend(cur);
+    }
+    void copy_counters() {
+      VkBufferCopy region{0, 0, kCounterCount * 4};
+      vkCmdCopyBuffer(cmd, impl.buffers[kCounters].buffer, impl.readback.buffer, 1, &region);
+    }
+  };
+
+  void finish(Recorder& r) {
+    ctx->submit_and_wait(r.cmd);
+    if (!r.timing || r.queries < 2) return;
+    std::vector<uint64_t> ts(r.queries);
+    check(vkGetQueryPoolResults(ctx->device(), query_pool, 0, r.queries, ts.size() * 8, ts.data(), 8,
+                                VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+          "vkGetQueryPoolResults");
+    const double period = double(ctx->properties().limits.timestampPeriod) * 1e-9;
+    for (uint32_t i = 1; i < r.queries; ++i) {
+      const int k = r.query_kernel[i];
+      if (k < 0) continue;
+      stats[size_t(k)].seconds += double(ts[i] - ts[i - 1]) * period;
+    }
+  }
+
+  const uint32_t* counters() const { return static_cast<const uint32_t*>(readback.mapped); }
+
+  void set_params(VkCommandBuffer cmd, const GpuParams& p) {
+    vkCmdUpdateBuffer(cmd, buffers[kParams].buffer, 0, sizeof(p), &p);
+    barrier(cmd);
+  }
+
+  void ensure_bake_buffers(size_t texel_count, int recorded, size_t max_work) {
+    const size_t result_floats = max_work * size_t(recorded + 1) * 3;
+    if (texel_count > texel_capacity || size_t(recorded) != bounce_layers) {
+      make_buffer(kTexels, texel_count * 48);
+      make_buffer(kBatchTexels, texel_count * 4);
+      make_buffer(kAccTotal, texel_count * 6 * 8);
+      make_buffer(kAccBounce, size_t(recorded) * texel_count * 3 * 8);
+      make_buffer(kAccSamples, texel_count * 4);
+      texel_capacity = texel_count;
+      bounce_layers = size_t(recorded);
+    }
+    if (result_floats > result_capacity) {
+      make_buffer(kResults, result_floats * 4);
+      result_capacity = result_floats;
+    }
+    write_descriptors();
+  }
+
+  void reset_stats() const {
+    stats.assign(kKernelCount, {});
+    for (int k = 0; k < kKernelCount; ++k) stats[size_t(k)].stage = kKernelNames[k];
+  }
+
+  LightmapEstimate bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings);
+  double traversal_bench(uint32_t ray_count, int repetitions);
+};
+
+LightmapEstimate VulkanIntegrator::Impl::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  const size_t texel_count = gbuffer.texels.size();
+  LightmapEstimate estimate;
+  estimate.recorded_bounces = std::clamp(settings.recorded_bounces, 1, kMaxRecordedBounces);
+  const int K = estimate.recorded_bounces;
+  estimate.texels.resize(texel_count);
+  estimate.bounces.assign(size_t(K) * texel_count * 3, 0.0);
+  reset_stats();
+  if (texel_count == 0) return estimate;
+  if (texel_count >= (1ull << 31)) throw std::runtime_error("Vulkan backend: too many texels");
+
+  // Work items per batch: enough to keep every path slot busy between drains, bounded by memory.
+  const size_t limit_items = size_t(ctx->properties().limits.maxStorageBufferRange) / (size_t(K + 1) * 12);
+  const size_t max_work = std::max<size_t>(1, std::min<size_t>({size_t(paths) * 4, limit_items, size_t(1) << 30}));
+  ensure_bake_buffers(texel_count, K, max_work);
+
+  std::vector<float> texels(texel_count * 12, 0.0f);
+  for (size_t i = 0; i < texel_count; ++i) {
+    const LiveTexel& t = gbuffer.texels[i];
+    float* v = &texels[i * 12];
+    v[0] = t.position.x, v[1] = t.position.y, v[2] = t.position.z;
+    v[4] = t.geometric_normal.x, v[5] = t.geometric_normal.y, v[6] = t.geometric_normal.z;
+    v[8] = t.shading_normal.x, v[9] = t.shading_normal.y, v[10] = t.shading_normal.z;
+  }
+  ctx->upload(buffers[kTexels], texels.data(), texels.size() * 4);
+  std::vector<uint32_t> active(texel_count);
+  for (size_t i = 0; i < texel_count; ++i) active[i] = uint32_t(i);
+  ctx->upload(buffers[kBatchTexels], active.data(), active.size() * 4);
+  {
+    VkCommandBuffer cmd = ctx->begin();
+    for (Binding b : {kAccTotal, kAccBounce, kAccSamples}) vkCmdFillBuffer(cmd, buffers[b].buffer, 0, VK_WHOLE_SIZE, 0);
+    ctx->submit_and_wait(cmd);
+  }
+
+  GpuParams params{};
+  params.sky[0] = scene.sky.constant.x, params.sky[1] = scene.sky.constant.y, params.sky[2] = scene.sky.constant.z;
+  params.scene_extent = scene_extent;
+  params.emitter_count = emitter_count;
+  params.punctual_count = punctual_count;
+  params.recorded = uint32_t(K);
+  params.max_bounces = settings.max_bounces;
+  params.rr_start = settings.russian_roulette_start;
+  params.safety_cap = settings.safety_bounce_cap;
+  params.path_capacity = paths;
+  params.seed_lo = uint32_t(settings.seed), params.seed_hi = uint32_t(settings.seed >> 32);
+  params.collect_stats = options.collect_stage_statistics ? 1u : 0u;
+  params.texel_count_total = uint32_t(texel_count);
+
+  const bool timing = options.collect_stage_statistics && query_pool != VK_NULL_HANDLE;
+  uint64_t rays_primary = 0, rays_bounce = 0, rays_shadow = 0, nonfinite = 0;
+  uint64_t extend_busy = 0, extend_launched = 0, connect_busy = 0, connect_launched = 0, shade_items = 0, shade_lanes = 0;
+
+  auto run_batch = [&](uint32_t offset, uint32_t n, uint32_t sample_begin, uint32_t samples) {
+    params.batch_texel_offset = offset;
+    params.batch_texel_count = n;
+    params.batch_sample_begin = sample_begin;
+    params.batch_sample_count = samples;
+    params.batch_work_total = n * samples;
+    const VkDeviceSize result_bytes = VkDeviceSize(n) * samples * uint32_t(K + 1) * 12;
+    Recorder r{*this, ctx->begin(), timing};
+    r.start();
+    set_params(r.cmd, params);
+    vkCmdFillBuffer(r.cmd, buffers[kCounters].buffer, 0, VK_WHOLE_SIZE, 0);
+    vkCmdFillBuffer(r.cmd, buffers[kResults].buffer, 0, result_bytes, 0);
+    barrier(r.cmd);
+    r.dispatch(kGenerate, (paths + kGroupSize - 1) / kGroupSize, 1);  // fills ray queue 0
+    r.connect_and_extend(1);
+    uint32_t cur = 0;
+    r.copy_counters();
+    finish(r);
+    while (counters()[kRayCount0 + cur] > 0) {
+      Recorder more{*this, ctx->begin(), timing};
+      more.start();
+      for (uint32_t i = 0; i < iterations_per_submit; ++i, cur ^= 1u) more.iteration(cur);
+      more.copy_counters();
+      finish(more);
+    }
+    Recorder reduce{*this, ctx->begin(), timing};
+    reduce.start();
+    reduce.dispatch(kReduce, (n + kGroupSize - 1) / kGroupSize, 0);
+    reduce.copy_counters();
+    finish(reduce);
+    const uint32_t* c = counters();
+    rays_primary += c[kRaysPrimary], rays_bounce += c[kRaysBounce], rays_shadow += c[kRaysShadow];
+    nonfinite += c[kNonfinite];
+    extend_busy += stat64(c, kStatExtendActive), extend_launched += stat64(c, kStatExtendLaunched);
+    connect_busy += stat64(c, kStatConnectActive), connect_launched += stat64(c, kStatConnectLaunched);
+    shade_items += stat64(c, kStatShadeItems), shade_lanes += stat64(c, kStatShadeLanes);
+  };
+
+  const uint32_t spp_limit = settings.spp == 0 ? std::numeric_limits<uint32_t>::max() : settings.spp;
+  const bool timed = settings.time_budget_seconds > 0;
+  uint32_t done = 0;
+  std::vector<uint8_t> converged(texel_count, 0);
+  while (done < spp_limit && !active.empty()) {
+    const size_t n_active = active.size();
+    const uint32_t chunk = uint32_t(std::min(n_active, max_work));
+    uint32_t pass = uint32_t(std::min<size_t>(spp_limit - done, std::max<size_t>(1, max_work / chunk)));
+    if (timed || settings.target_relative_error > 0) pass = std::min(pass, done < 4 ? 1u : (done < 64 ? 4u : 16u));
+    for (size_t offset = 0; offset < n_active; offset += chunk) {
+      const uint32_t n = uint32_t(std::min<size_t>(chunk, n_active - offset));
+      run_batch(uint32_t(offset), n, done, pass);
+    }
+    done += pass;
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    if (settings.progress) {
+      const double by_spp = settings.spp ? double(done) / double(settings.spp) : 0.0;
+      const double by_time = timed ? elapsed / settings.time_budget_seconds : 0.0;
+      settings.progress(std::min(1.0, std::max(by_spp, by_time)), rays_primary + rays_bounce + rays_shadow);
+    }
+    if (timed && elapsed >= settings.time_budget_seconds) break;
+    if (settings.target_relative_error > 0 && done >= 16 && done < spp_limit) {
+      // Drop converged texels from the work list (same test as the reference).
+      std::vector<double> sums(texel_count * 6);
+      std::vector<uint32_t> samples(texel_count);
+      ctx->download(buffers[kAccTotal], sums.data(), sums.size() * 8);
+      ctx->download(buffers[kAccSamples], samples.data(), samples.size() * 4);
+      std::vector<uint32_t> still;
+      for (uint32_t i : active) {
+        TexelAccumulator a;
+        for (int c = 0; c < 3; ++c) a.total[c] = sums[i * 6 + size_t(c)], a.total_squared[c] = sums[i * 6 + 3 + size_t(c)];
+        a.samples = samples[i];
+        LightmapEstimate one;
+        one.texels = {a};
+        const Vec3 mean = one.mean_total(0), var = one.variance_of_mean(0);
+        const float lum = luminance(mean);
+        if (!(lum > 0 && std::sqrt(luminance(var)) <= settings.target_relative_error * lum)) still.push_back(i);
+      }
+      if (still.size() != active.size()) {
+        active = std::move(still);
+        if (!active.empty()) ctx->upload(buffers[kBatchTexels], active.data(), active.size() * 4);
+      }
+    }
+  }
+
+  std::vector<double> sums(texel_count * 6);
+  std::vector<uint32_t> samples(texel_count);
+  ctx->download(buffers[kAccTotal], sums.data(), sums.size() * 8);
+  ctx->download(buffers[kAccSamples], samples.data(), samples.size() * 4);
+  ctx->download(buffers[kAccBounce], estimate.bounces.data(), estimate.bounces.size() * 8);
+  for (size_t i = 0; i < texel_count; ++i) {
+    TexelAccumulator& a = estimate.texels[i];
+    for (int c = 0; c < 3; ++c) {
+      a.total[c] = sums[i * 6 + size_t(c)];
+      a.total_squared[c] = sums[i * 6 + 3 + size_t(c)];
+      a.direct[c] = estimate.bounces[i * 3 + size_t(c)];  // layer 0 is the direct light
+    }
+    a.samples = samples[i];
+  }
+  estimate.rays = rays_primary + rays_bounce + rays_shadow;
+  estimate.nonfinite_samples = nonfinite;
+  estimate.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+
+  stats[kExtend].rays = stats[kExtend].items = rays_primary + rays_bounce;
+  stats[kExtend].lane_efficiency = extend_launched ? double(extend_busy) / double(extend_launched) : 0.0;
+  stats[kConnect].rays = rays_shadow;
+  stats[kConnect].lane_efficiency = connect_launched ? double(connect_busy) / double(connect_launched) : 0.0;
+  stats[kShade].items = shade_items;
+  stats[kShade].lane_efficiency = shade_lanes ? double(shade_items) / double(shade_lanes) : 0.0;
+  VulkanStageStatistics primary{"rays: primary", 0, rays_primary, rays_primary, 0};
+  VulkanStageStatistics bounce{"rays: bounce", 0, rays_bounce, rays_bounce, 0};
+  stats.push_back(primary);
+  stats.push_back(bounce);
+  return estimate;
+}
+
+double VulkanIntegrator::Impl::traversal_bench(uint32_t ray_count, int repetitions) {
+  reset_stats();
+  ensure_bake_buffers(std::max<size_t>(texel_capacity, 1), int(std::max<size_t>(bounce_layers, 1)), 1);
+  GpuParams params{};
+  params.path_capacity = paths;
+  params.batch_work_total = ray_count;
+  params.collect_stats = 1;
+  params.seed_lo = 12345;
+  params.bench_lo[0] = scene_lo.x, params.bench_lo[1] = scene_lo.y, params.bench_lo[2] = scene_lo.z;
+  params.bench_hi[0] = scene_hi.x, params.bench_hi[1] = scene_hi.y, params.bench_hi[2] = scene_hi.z;
+  if (!query_pool) throw std::runtime_error("Vulkan backend: this device has no timestamp queries");
+  double best = 0;
+  uint64_t busy = 0, launched = 0;
+  for (int rep = 0; rep < std::max(1, repetitions); ++rep) {
+    stats[kBenchRays].seconds = 0;
+    Recorder r{*this, ctx->begin(), true};
+    r.start();
+    set_params(r.cmd, params);
+    vkCmdFillBuffer(r.cmd, buffers[kCounters].buffer, 0, VK_WHOLE_SIZE, 0);
+    barrier(r.cmd);
+    r.stamp(-1);
+    r.dispatch(kBenchRays, (ray_count + kGroupSize - 1) / kGroupSize, 0);
+    r.copy_counters();
+    finish(r);
+    const double seconds = stats[kBenchRays].seconds;
+    if (seconds > 0) best = std::max(best, double(ray_count) / seconds);
+    busy = stat64(counters(), kStatExtendActive), launched = stat64(counters(), kStatExtendLaunched);
+  }
+  stats[kBenchRays].rays = ray_count;
+  stats[kBenchRays].items = counters()[kRaysPrimary];  // rays that hit something
+  stats[kBenchRays].seconds = double(ray_count) / std::max(best, 1e-30);
+  stats[kBenchRays].lane_efficiency = launched ? double(busy) / double(launched) : 0.0;
+  return best;
+}
+
+std::unique_ptr<VulkanIntegrator> VulkanIntegrator::create(const Scene& scene, const VulkanDeviceOptions& options) {
+  if (scene.sky.has_environment())
+    throw std::runtime_error("Vulkan backend: environment-map skies are not supported yet (use the cpu backend)");
+  for (const Material& m : scene.materials)
+    if (m.base_color_texture.texture >= 0 || m.emissive_texture.texture >= 0)
+      throw std::runtime_error("Vulkan backend: textured materials are not supported yet (material '" + m.name +
+                               "'; use the cpu backend)");
+  auto impl = std::make_unique<Impl>(scene, options);
+  impl->ctx = std::make_unique<Context>(options);
+  const bool cpu_device = impl->ctx->info().type == VulkanDeviceType::Cpu;
+  impl->paths = options.max_paths ? options.max_paths : (cpu_device ? (1u << 14) : (1u << 20));
+  impl->paths = std::max<uint32_t>(impl->paths, kGroupSize);
+  impl->iterations_per_submit = options.iterations_per_submit ? options.iterations_per_submit : 8;
+  impl->bvh = build_gpu_bvh(scene);
+  impl->upload_scene();
+  impl->allocate_path_state();
+  impl->create_pipelines();
+  impl->write_descriptors();
+  return std::unique_ptr<VulkanIntegrator>(new VulkanIntegrator(std::move(impl)));
+}
+
+VulkanIntegrator::VulkanIntegrator(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+VulkanIntegrator::~VulkanIntegrator() = default;
+
+LightmapEstimate VulkanIntegrator::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const {
+  if (settings.spp == 0 && !(settings.time_budget_seconds > 0) && !(settings.target_relative_error > 0))
+    throw std::invalid_argument("Vulkan backend: spp 0 needs a time budget or a target error");
+  return impl_->bake(gbuffer, settings);
+}
+
+const VulkanDeviceInfo& VulkanIntegrator::device() const { return impl_->ctx->info(); }
+uint32_t VulkanIntegrator::max_paths() const { return impl_->paths; }
+size_t VulkanIntegrator::path_state_bytes_per_path() const { return impl_->path_bytes(); }
+size_t VulkanIntegrator::bvh_bytes() const { return impl_->bvh.nodes.size() * 112 + impl_->bvh.triangles.size() * 48; }
+uint32_t VulkanIntegrator::bvh_node_count() const { return uint32_t(impl_->bvh.nodes.size()); }
+const std::vector<VulkanStageStatistics>& VulkanIntegrator::stage_statistics() const { return impl_->stats; }
+double VulkanIntegrator::measure_incoherent_traversal(uint32_t ray_count, int repetitions) const {
+  return impl_->traversal_bench(ray_count, repetitions);
+}
+
+}  // namespace exitance

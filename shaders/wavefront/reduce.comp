@@ -1,0 +1,35 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// Stage "accumulate": per texel of the batch, adds each sample's total (sum of its bounce slots),
+// its square and its bounce layers to double-precision sums, in sample order (one writer per texel).
+layout(local_size_x = 64) in;
+#include "../include/kernel_prelude.glsl"
+
+void main() {
+  uint j = gl_GlobalInvocationID.x;
+  uint n = params.batch_texel_count;
+  if (j >= n) return;
+  uint texel = batch_texels[params.batch_texel_offset + j];
+  uint K = params.recorded;
+  uint nonfinite = 0u, samples = 0u;
+  for (uint s = 0u; s < params.batch_sample_count; ++s) {
+    uint w = s * n + j;
+    vec3 total = vec3(0.0);
+    for (uint k = 0u; k <= K; ++k) {
+      uint r = result_index(w, k);
+      total += vec3(results[r], results[r + 1u], results[r + 2u]);
+    }
+    if (any(isnan(total)) || any(isinf(total))) { ++nonfinite; continue; }
+    for (uint c = 0u; c < 3u; ++c) {
+      acc_total[texel * 6u + c] += double(total[c]);
+      acc_total[texel * 6u + 3u + c] += double(total[c]) * double(total[c]);
+    }
+    for (uint k = 0u; k < K; ++k) {
+      uint r = result_index(w, k);
+      for (uint c = 0u; c < 3u; ++c) acc_bounce[(uint(k) * params.texel_count_total + texel) * 3u + c] += double(results[r + c]);
+    }
+    ++samples;
+  }
+  acc_samples[texel] += samples;
+  if (nonfinite > 0u) atomicAdd(counters[kNonfinite], nonfinite);
+}

@@ -1,0 +1,373 @@
+// Cross-backend checks (DESIGN §6.2): the Vulkan wavefront path tracer against the CPU reference on
+// the analytic scenes and two sample scenes. Per region of texels, a z-test with the variances of
+// both estimators (|z| < 4) catches real bias; relMSE between the two converged results < 0.5 %
+// catches gross errors; deterministic cases are also checked against the closed forms. Every test
+// runs with VK_LAYER_KHRONOS_validation and fails on any message. Without a Vulkan device, SKIP.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "exitance/bake/atlas_layout.h"
+#include "exitance/bake/bake_pipeline.h"
+#include "exitance/bake/gltf_import.h"
+#include "exitance/bake/texel_raster.h"
+#include "exitance/bake/unocclude.h"
+#include "exitance/runtime/embree_scene.h"
+#include "exitance/runtime/sampling.h"
+#include "exitance/runtime/vulkan/vulkan_integrator.h"
+#include "support/test_scenes.h"
+
+namespace exitance {
+namespace {
+
+using testing::add_inward_box;
+using testing::add_material;
+using testing::add_quad;
+using testing::texel_at;
+
+// Creates the integrator with validation on; records every validation message.
+class VulkanBackend {
+ public:
+  explicit VulkanBackend(const Scene& scene, std::string& skip_reason) {
+    VulkanDeviceOptions options;
+    options.validation = true;
+    options.on_validation_message = [this](const std::string& m) { messages_->push_back(m); };
+    try {
+      integrator_ = VulkanIntegrator::create(scene, options);
+    } catch (const std::runtime_error& e) {
+      const std::string what = e.what();
+      if (what.find("no Vulkan device") != std::string::npos || what.find("no usable Vulkan device") != std::string::npos)
+        skip_reason = what;
+      else
+        throw;
+    }
+  }
+  ~VulkanBackend() {
+    integrator_.reset();  // teardown messages (leaks) are recorded too
+    for (const std::string& m : *messages_) ADD_FAILURE() << m;
+  }
+  VulkanIntegrator* operator->() { return integrator_.get(); }
+  VulkanIntegrator& get() { return *integrator_; }
+
+ private:
+  std::shared_ptr<std::vector<std::string>> messages_ = std::make_shared<std::vector<std::string>>();
+  std::unique_ptr<VulkanIntegrator> integrator_;
+};
+
+#define CREATE_VULKAN_OR_SKIP(name, scene)  \
+  std::string skip_reason_##name;           \
+  VulkanBackend name(scene, skip_reason_##name); \
+  if (!skip_reason_##name.empty()) GTEST_SKIP() << skip_reason_##name
+
+struct Comparison {
+  double worst_z = 0;
+  double rel_mse = 0;
+};
+
+// Regions: consecutive runs of `group` texels (Morton order keeps them spatially close).
+Comparison compare_estimates(const LightmapEstimate& gpu, const LightmapEstimate& cpu, size_t group, const char* what) {
+  Comparison c;
+  const size_t n = cpu.texels.size();
+  EXPECT_EQ(gpu.texels.size(), n);
+  size_t regions = 0;
+  for (size_t begin = 0; begin < n; begin += group) {
+    const size_t end = std::min(n, begin + group);
+    for (int ch = 0; ch < 3; ++ch) {
+      double a = 0, b = 0, va = 0, vb = 0;
+      for (size_t i = begin; i < end; ++i) {
+        a += gpu.mean_total(i)[ch], b += cpu.mean_total(i)[ch];
+        va += gpu.variance_of_mean(i)[ch], vb += cpu.variance_of_mean(i)[ch];
+      }
+      const double diff = std::fabs(a - b), se = std::sqrt(va + vb);
+      const double rounding = 1e-5 * std::fabs(b) + 1e-9 * double(end - begin);
+      if (diff <= rounding) continue;
+      const double z = se > 0 ? diff / se : INFINITY;
+      c.worst_z = std::max(c.worst_z, z);
+      EXPECT_LT(z, 4.0) << what << ": region " << begin << ".." << end << " channel " << ch << " gpu " << a / double(end - begin)
+                        << " cpu " << b / double(end - begin) << " SE " << se / double(end - begin);
+    }
+    ++regions;
+  }
+  for (size_t i = 0; i < n; ++i)
+    for (int ch = 0; ch < 3; ++ch) {
+      const double a = gpu.mean_total(i)[ch], b = cpu.mean_total(i)[ch];
+      c.rel_mse += (a - b) * (a - b) / (b * b + 1e-3);
+    }
+  c.rel_mse /= double(3 * n);
+  for (size_t i = 0; i < n; ++i) EXPECT_EQ(gpu.texels[i].samples, cpu.texels[i].samples) << what << " texel " << i;
+  EXPECT_EQ(gpu.nonfinite_samples, 0u);
+  EXPECT_GT(gpu.rays, 0u);
+  std::printf("[crosscheck] %-28s texels %zu regions %zu worst |z| %.2f relMSE %.3g%% rays gpu %llu cpu %llu\n", what, n,
+              regions, c.worst_z, 100.0 * c.rel_mse, (unsigned long long)gpu.rays, (unsigned long long)cpu.rays);
+  return c;
+}
+
+LightmapEstimate cpu_bake(const Scene& scene, const TexelGBuffer& g, IntegratorSettings s, uint64_t seed) {
+  s.seed = seed;
+  return CpuReferenceIntegrator(scene).bake(g, s);
+}
+
+// Runs both backends with independent seeds and checks agreement.
+void crosscheck(const Scene& scene, const TexelGBuffer& g, IntegratorSettings settings, size_t group, double max_rel_mse,
+                const char* what, LightmapEstimate* gpu_out = nullptr) {
+  CREATE_VULKAN_OR_SKIP(vk, scene);
+  settings.seed = 1001;
+  const LightmapEstimate gpu = vk->bake(g, settings);
+  const LightmapEstimate cpu = cpu_bake(scene, g, settings, 2002);
+  const Comparison c = compare_estimates(gpu, cpu, group, what);
+  EXPECT_LT(c.rel_mse, max_rel_mse) << what;
+  // Bounce layers sum to the total wherever no path went deeper than the recorded layers.
+  if (gpu_out) *gpu_out = gpu;
+}
+
+std::vector<Vec2> grid_points(int n, float margin) {
+  std::vector<Vec2> points;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      points.push_back({margin + (1 - 2 * margin) * (float(i) + 0.5f) / float(n),
+                        margin + (1 - 2 * margin) * (float(j) + 0.5f) / float(n)});
+  return points;
+}
+
+void furnace(float albedo, uint32_t spp) {
+  Scene scene;
+  const Vec3 le{1.0f, 0.5f, 0.25f};
+  add_inward_box(scene, {0, 0, 0}, {1, 1, 1}, add_material(scene, {albedo, albedo, albedo}, le));
+  TexelGBuffer g;
+  for (Vec2 p : grid_points(4, 0.1f)) {
+    g.texels.push_back(texel_at({p.x, 0.0f, p.y}, {0, 1, 0}));
+    g.texels.push_back(texel_at({p.x, p.y, 0.0f}, {0, 0, 1}));
+    g.texels.push_back(texel_at({1.0f, p.x, p.y}, {-1, 0, 0}));
+    g.texels.push_back(texel_at({p.x, 1.0f, p.y}, {0, -1, 0}));
+  }
+  IntegratorSettings s;
+  s.spp = spp;
+  LightmapEstimate gpu;
+  crosscheck(scene, g, s, 16, 0.005, albedo < 0.7f ? "furnace rho 0.5" : "furnace rho 0.9", &gpu);
+  if (gpu.texels.empty()) return;
+  // Against the closed form Le / (1 - rho) over all texels.
+  for (int c = 0; c < 3; ++c) {
+    double mean = 0, var = 0;
+    for (size_t i = 0; i < g.texels.size(); ++i) mean += gpu.mean_total(i)[c], var += gpu.variance_of_mean(i)[c];
+    mean /= double(g.texels.size());
+    const double se = std::sqrt(var) / double(g.texels.size()), exact = le[c] / (1.0 - albedo);
+    EXPECT_LT(std::fabs(mean - exact), 4 * se) << "channel " << c << " mean " << mean << " exact " << exact;
+  }
+}
+
+TEST(VulkanCrosscheck, WhiteFurnaceAlbedoHalf) { furnace(0.5f, 512); }
+TEST(VulkanCrosscheck, WhiteFurnaceAlbedoPointNine) { furnace(0.9f, 1024); }
+
+TEST(VulkanCrosscheck, PlaneUnderConstantSkyIsExact) {
+  Scene scene;
+  add_quad(scene, {-1, 0, 1}, {2, 0, 0}, {0, 0, -2}, add_material(scene, {0.8f, 0.8f, 0.8f}));
+  scene.sky.constant = {0.5f, 1.0f, 2.0f};
+  TexelGBuffer g;
+  for (Vec2 p : grid_points(8, 0.0f)) g.texels.push_back(texel_at({2 * p.x - 1, 0, 2 * p.y - 1}, {0, 1, 0}));
+  IntegratorSettings s;
+  s.spp = 16;
+  LightmapEstimate gpu;
+  crosscheck(scene, g, s, 8, 1e-6, "plane under constant sky", &gpu);
+  for (size_t i = 0; i < gpu.texels.size(); ++i)
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(gpu.mean_total(i)[c], scene.sky.constant[c], 1e-5 * scene.sky.constant[c]);
+}
+
+TEST(VulkanCrosscheck, PointLightIsExact) {
+  Scene scene;
+  add_quad(scene, {-4, 0, 4}, {8, 0, 0}, {0, 0, -8}, add_material(scene, {0.7f, 0.7f, 0.7f}));
+  PunctualLight light;
+  light.position = {0.3f, 2.0f, -0.2f};
+  light.intensity = {10.0f, 20.0f, 5.0f};
+  scene.lights.push_back(light);
+  TexelGBuffer g;
+  std::vector<double> exact;
+  for (Vec2 p : grid_points(6, 0.0f)) {
+    const Vec3 x{6 * p.x - 3, 0, 6 * p.y - 3};
+    g.texels.push_back(texel_at(x, {0, 1, 0}));
+    const Vec3 d = light.position - x;
+    exact.push_back(10.0 * (d.y / std::sqrt(dot(d, d))) / (kPi * dot(d, d)));
+  }
+  IntegratorSettings s;
+  s.spp = 4;
+  LightmapEstimate gpu;
+  crosscheck(scene, g, s, 6, 1e-6, "point light", &gpu);
+  for (size_t i = 0; i < gpu.texels.size(); ++i) {
+    EXPECT_NEAR(gpu.mean_total(i).x, exact[i], 1e-5 * exact[i]);
+    EXPECT_NEAR(gpu.mean_total(i).y, 2 * exact[i], 2e-5 * exact[i]);
+  }
+}
+
+TEST(VulkanCrosscheck, SpotLightIsExact) {
+  Scene scene;
+  add_quad(scene, {-4, 0, 4}, {8, 0, 0}, {0, 0, -8}, add_material(scene, {0, 0, 0}));
+  PunctualLight spot;
+  spot.type = PunctualLight::Type::Spot;
+  spot.position = {0, 2, 0};
+  spot.direction = {0, -1, 0};
+  spot.intensity = {50, 50, 50};
+  const double inner = 20.0 * kPi / 180.0, outer = 30.0 * kPi / 180.0;
+  spot.cos_inner = float(std::cos(inner));
+  spot.cos_outer = float(std::cos(outer));
+  scene.lights.push_back(spot);
+  TexelGBuffer g;
+  std::vector<double> exact;
+  for (double degrees : {0.0, 10.0, 19.5, 21.0, 25.0, 29.0, 30.5, 40.0}) {
+    const double angle = degrees * kPi / 180.0, r = 2.0 * std::tan(angle);
+    g.texels.push_back(texel_at({float(r), 0, 0}, {0, 1, 0}));
+    const double t = std::clamp((std::cos(angle) - std::cos(outer)) / (std::cos(inner) - std::cos(outer)), 0.0, 1.0);
+    exact.push_back(50.0 * t * t * std::cos(angle) / (kPi * (4.0 + r * r)));
+  }
+  IntegratorSettings s;
+  s.spp = 2;
+  LightmapEstimate gpu;
+  crosscheck(scene, g, s, 4, 1e-6, "spot light", &gpu);
+  for (size_t i = 0; i < gpu.texels.size(); ++i) EXPECT_NEAR(gpu.mean_total(i).x, exact[i], 1e-5 * exact[i] + 1e-9);
+  if (!gpu.texels.empty()) EXPECT_EQ(gpu.mean_total(g.texels.size() - 1).x, 0.0f);
+}
+
+TEST(VulkanCrosscheck, DirectionalLightIsExact) {
+  Scene scene;
+  add_quad(scene, {-2, 0, 2}, {4, 0, 0}, {0, 0, -4}, add_material(scene, {0.5f, 0.5f, 0.5f}));
+  PunctualLight sun;
+  sun.type = PunctualLight::Type::Directional;
+  sun.direction = normalize(Vec3{0.3f, -0.8f, 0.52f});
+  sun.intensity = {3.0f, 2.0f, 1.0f};
+  scene.lights.push_back(sun);
+  TexelGBuffer g;
+  for (Vec2 p : grid_points(4, 0.1f)) g.texels.push_back(texel_at({4 * p.x - 2, 0, 4 * p.y - 2}, {0, 1, 0}));
+  IntegratorSettings s;
+  s.spp = 4;
+  LightmapEstimate gpu;
+  crosscheck(scene, g, s, 4, 1e-6, "directional light", &gpu);
+  for (size_t i = 0; i < gpu.texels.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double exact = sun.intensity[c] * -sun.direction.y / kPi;
+      EXPECT_NEAR(gpu.mean_total(i)[c], exact, 1e-5 * exact);
+    }
+}
+
+TEST(VulkanCrosscheck, TwoParallelUnitSquares) {
+  Scene scene;
+  const Vec3 le{2.0f, 1.0f, 0.5f};
+  add_quad(scene, {0, 0, 1}, {1, 0, 0}, {0, 0, -1}, add_material(scene, {0, 0, 0}));
+  add_quad(scene, {0, 1, 0}, {1, 0, 0}, {0, 0, 1}, add_material(scene, {0, 0, 0}, le));
+  TexelGBuffer g;
+  for (Vec2 p : grid_points(8, 0.0f)) g.texels.push_back(texel_at({p.x, 0, p.y}, {0, 1, 0}));
+  IntegratorSettings s;
+  s.spp = 512;
+  crosscheck(scene, g, s, 8, 0.005, "parallel unit squares");
+}
+
+TEST(VulkanCrosscheck, AlbedoZeroHasNoIndirectEnergy) {
+  Scene scene;
+  const uint32_t black = add_material(scene, {0, 0, 0});
+  add_quad(scene, {0, 0, 1}, {1, 0, 0}, {0, 0, -1}, black);
+  add_quad(scene, {0, 1, 0}, {1, 0, 0}, {0, 0, 1}, add_material(scene, {0, 0, 0}, {1, 1, 1}));
+  add_quad(scene, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, black);
+  add_quad(scene, {0, 0, 0}, {0, 1, 0}, {0, 0, 1}, black);
+  TexelGBuffer g;
+  for (Vec2 p : grid_points(4, 0.1f)) {
+    g.texels.push_back(texel_at({p.x, 0, p.y}, {0, 1, 0}));
+    g.texels.push_back(texel_at({p.x, p.y, 0}, {0, 0, 1}));
+  }
+  IntegratorSettings s;
+  s.spp = 256;
+  s.recorded_bounces = 3;
+  LightmapEstimate gpu;
+  crosscheck(scene, g, s, 8, 0.005, "albedo zero", &gpu);
+  for (size_t i = 0; i < gpu.texels.size(); ++i) {
+    EXPECT_GT(gpu.mean_total(i).x, 0.0f);
+    EXPECT_FLOAT_EQ(gpu.mean_total(i).x, gpu.mean_direct(i).x);
+    EXPECT_EQ(gpu.mean_bounce(1, i).x, 0.0f);
+    EXPECT_EQ(gpu.mean_bounce(2, i).x, 0.0f);
+  }
+}
+
+// Same seed, same results (bit for bit), whatever the batch cut; bounce layers add up.
+TEST(VulkanCrosscheck, DeterministicPerSeedAndProgressReported) {
+  Scene scene;
+  add_inward_box(scene, {0, 0, 0}, {1, 1, 1}, add_material(scene, {0.6f, 0.6f, 0.6f}, {1, 1, 1}));
+  TexelGBuffer g;
+  for (Vec2 p : grid_points(4, 0.1f)) g.texels.push_back(texel_at({p.x, 0.0f, p.y}, {0, 1, 0}));
+  CREATE_VULKAN_OR_SKIP(vk, scene);
+  IntegratorSettings s;
+  s.spp = 32;
+  s.seed = 5;
+  int calls = 0;
+  s.progress = [&](double, uint64_t) { ++calls; };
+  const LightmapEstimate a = vk->bake(g, s);
+  const LightmapEstimate b = vk->bake(g, s);
+  EXPECT_GT(calls, 0);
+  for (size_t i = 0; i < g.texels.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(a.texels[i].total[c], b.texels[i].total[c]);
+      EXPECT_EQ(a.texels[i].total_squared[c], b.texels[i].total_squared[c]);
+    }
+  EXPECT_EQ(a.rays, b.rays);
+}
+
+TEST(VulkanCrosscheck, UnsupportedScenesAreRefused) {
+  Scene scene;
+  add_quad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, add_material(scene, {1, 1, 1}));
+  scene.sky.environment.width = scene.sky.environment.height = 1;
+  scene.sky.environment.rgb = {1, 1, 1};
+  EXPECT_THROW(VulkanIntegrator::create(scene), std::runtime_error);
+  scene.sky.environment = {};
+  scene.textures.push_back(scene.sky.environment);
+  scene.materials[0].base_color_texture.texture = 0;
+  EXPECT_THROW(VulkanIntegrator::create(scene), std::runtime_error);
+}
+
+TEST(VulkanCrosscheck, DeviceEnumeration) {
+  const std::vector<VulkanDeviceInfo> devices = enumerate_vulkan_devices();
+  if (devices.empty()) GTEST_SKIP() << "no Vulkan device";
+  for (const VulkanDeviceInfo& d : devices) {
+    EXPECT_FALSE(d.name.empty());
+    std::printf("[crosscheck] device %u: %s (%s)%s\n", d.index, d.name.c_str(), to_string(d.type),
+                d.usable ? "" : (" unusable: " + d.missing_feature).c_str());
+  }
+}
+
+// A sample scene through the offline stage at a low texel density.
+struct SampleScene {
+  Scene scene;
+  TexelGBuffer gbuffer;
+};
+
+SampleScene load_sample(const std::string& name, const std::string& sky, float density) {
+  SampleScene s;
+  const std::string path = std::string(EXITANCE_SAMPLE_DIR) + "/" + name + ".gltf";
+  Diagnostics diagnostics;
+  s.scene = import_gltf(path, {}, diagnostics);
+  s.scene.sky = parse_sky_option(sky);
+  AtlasSettings atlas;
+  atlas.texel_density = density;
+  const AtlasLayout layout = layout_lightmap_atlas(s.scene, atlas, path, diagnostics);
+  s.gbuffer = rasterize_texel_gbuffer(s.scene, layout, path, diagnostics);
+  EmbreeScene embree(s.scene);
+  unocclude_texels(embree, s.gbuffer);
+  return s;
+}
+
+TEST(VulkanCrosscheck, CornellRoom) {
+  SampleScene s = load_sample("cornell_room", "", 2.0f);
+  ASSERT_GT(s.gbuffer.texels.size(), 50u);
+  IntegratorSettings settings;
+  settings.spp = 1024;
+  crosscheck(s.scene, s.gbuffer, settings, 32, 0.005, "cornell_room");
+}
+
+TEST(VulkanCrosscheck, CourtyardUnderConstantSky) {
+  SampleScene s = load_sample("courtyard", "0.6,0.7,1.0", 0.5f);
+  ASSERT_GT(s.gbuffer.texels.size(), 50u);
+  IntegratorSettings settings;
+  settings.spp = 256;
+  crosscheck(s.scene, s.gbuffer, settings, 32, 0.005, "courtyard");
+}
+
+}  // namespace
+}  // namespace exitance
