@@ -154,7 +154,7 @@ class Validator {
       : doc_(document), file_(file), base_dir_(base_dir), glb_bin_size_(glb_bin_size) {}
 
   GltfExternalFiles run() {
-    if (!doc_.is_object()) throw InputError(file_, "glTF", "the top level is " + describe(doc_) + ", not a JSON object");
+    if (!doc_.is_object()) raise("glTF", "the top level is " + describe(doc_) + ", not a JSON object");
     check_asset();
     check_extension_lists();
     extensions(doc_, Where{"glTF", ""});
@@ -177,11 +177,20 @@ class Validator {
 
  private:
   // ---- reporting and typed member access -------------------------------------------------------
+  // Keys and strings come from the file: control characters would break the one-line error.
+  [[noreturn]] void raise(const std::string& element, const std::string& problem) const {
+    auto printable = [](std::string text) {
+      for (char& c : text)
+        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+      return text;
+    };
+    throw InputError(file_, printable(element), printable(problem));
+  }
   [[noreturn]] void fail(const Where& w, const std::string& key, const std::string& problem) const {
-    throw InputError(file_, w.element, w.path + key + " " + problem);
+    raise(w.element, w.path + key + " " + problem);
   }
   [[noreturn]] void fail(const Where& w, const std::string& problem) const {
-    throw InputError(file_, w.element, (w.path.empty() ? "" : w.path.substr(0, w.path.size() - 1) + " ") + problem);
+    raise(w.element, (w.path.empty() ? "" : w.path.substr(0, w.path.size() - 1) + " ") + problem);
   }
 
   static const json* find(const json& object, const std::string& key) {
@@ -312,10 +321,10 @@ class Validator {
     static const json empty = json::array();
     const json* v = find(doc_, key);
     if (!v) return empty;
-    if (!v->is_array()) throw InputError(file_, key, "must be an array, not " + describe(*v));
+    if (!v->is_array()) raise(key, "must be an array, not " + describe(*v));
     for (size_t i = 0; i < v->size(); ++i)
       if (!(*v)[i].is_object())
-        throw InputError(file_, singular(key) + " " + std::to_string(i), "must be a JSON object, not " + describe((*v)[i]));
+        raise(singular(key) + " " + std::to_string(i), "must be a JSON object, not " + describe((*v)[i]));
     return *v;
   }
 
@@ -333,7 +342,7 @@ class Validator {
   void check_asset() const {
     const Where w{"asset", ""};
     const json* asset = find(doc_, "asset");
-    if (!asset) throw InputError(file_, "asset", "is missing (every glTF 2.0 file has one)");
+    if (!asset) raise("asset", "is missing (every glTF 2.0 file has one)");
     if (!asset->is_object()) fail(w, "must be a JSON object, not " + describe(*asset));
     const std::string version = *string(*asset, w, "version", true);
     const auto parsed = parse_version(version);
@@ -356,11 +365,11 @@ class Validator {
     const Where w{key, ""};
     const json* v = find(doc_, key);
     if (!v) return out;
-    if (!v->is_array()) throw InputError(file_, key, "must be an array, not " + describe(*v));
+    if (!v->is_array()) raise(key, "must be an array, not " + describe(*v));
     for (const json& item : *v) {
-      if (!item.is_string()) throw InputError(file_, key, "must hold strings only, not " + describe(item));
+      if (!item.is_string()) raise(key, "must hold strings only, not " + describe(item));
       if (!out.insert(item.get<std::string>()).second)
-        throw InputError(file_, key, "lists " + item.get<std::string>() + " twice");
+        raise(key, "lists " + shown(item.get<std::string>()) + " twice");
     }
     return out;
   }
@@ -369,9 +378,9 @@ class Validator {
     const std::set<std::string> used = string_set("extensionsUsed");
     for (const std::string& name : string_set("extensionsRequired")) {
       if (!is_supported_gltf_extension(name))
-        throw InputError(file_, "extensionsRequired", "extension " + name + " is not supported");
+        raise("extensionsRequired", "extension " + shown(name) + " is not supported");
       if (!used.count(name))
-        throw InputError(file_, "extensionsRequired", "extension " + name + " is not listed in extensionsUsed");
+        raise("extensionsRequired", "extension " + shown(name) + " is not listed in extensionsUsed");
     }
   }
 
@@ -411,11 +420,10 @@ class Validator {
     }
     if (const json* scene = find(doc_, "scene")) {
       if (!scene->is_number_integer())
-        throw InputError(file_, "scene", "must be an integer index, not " + describe(*scene));
-      if (!scene->is_number_unsigned())  // nlohmann stores non-negative integers as unsigned
-        throw InputError(file_, "scene", scene->dump() + " must be >= 0");
+        raise("scene", "must be an integer index, not " + describe(*scene));
+      if (!scene->is_number_unsigned() && scene->get<int64_t>() < 0) raise("scene", scene->dump() + " must be >= 0");
       if (scene->get<uint64_t>() >= scenes.size())
-        throw InputError(file_, "scene " + scene->dump(),
+        raise("scene " + scene->dump(),
                          "does not exist (the file has " + std::to_string(scenes.size()) + " scenes)");
     }
   }

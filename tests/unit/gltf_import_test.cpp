@@ -1,0 +1,225 @@
+// Unit tests of the glTF importer's front door: validate_gltf_json (schema, references, sizes,
+// overflow-safe bounds) and the NaN-normal repair in import_gltf.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+#include <unistd.h>
+
+#include "exitance/bake/gltf_import.h"
+#include "exitance/bake/gltf_json_validation.h"
+#include "exitance/bake/input_error.h"
+
+namespace exitance {
+namespace {
+
+using json = nlohmann::json;
+
+std::string base64(const std::vector<unsigned char>& bytes) {
+  static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (size_t i = 0; i < bytes.size(); i += 3) {
+    const uint32_t b = uint32_t(bytes[i]) << 16 | (i + 1 < bytes.size() ? uint32_t(bytes[i + 1]) << 8 : 0) |
+                       (i + 2 < bytes.size() ? uint32_t(bytes[i + 2]) : 0);
+    out += table[(b >> 18) & 63];
+    out += table[(b >> 12) & 63];
+    out += i + 1 < bytes.size() ? table[(b >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? table[b & 63] : '=';
+  }
+  return out;
+}
+
+void append_floats(std::vector<unsigned char>& bytes, const std::vector<float>& values) {
+  const size_t at = bytes.size();
+  bytes.resize(at + values.size() * 4);
+  std::memcpy(bytes.data() + at, values.data(), values.size() * 4);
+}
+
+// One triangle: POSITION (36 bytes), NORMAL (36 bytes), TEXCOORD_1 (24 bytes) in one data-uri buffer.
+json triangle_document(const std::vector<float>& normals = {0, 0, 1, 0, 0, 1, 0, 0, 1}) {
+  std::vector<unsigned char> data;
+  append_floats(data, {0, 0, 0, 1, 0, 0, 0, 1, 0});
+  append_floats(data, normals);
+  append_floats(data, {0, 0, 1, 0, 0, 1});
+  json document = json::parse(R"({
+    "asset": {"version": "2.0"},
+    "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_1": 2}}]}],
+    "accessors": [
+      {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"},
+      {"bufferView": 0, "byteOffset": 36, "componentType": 5126, "count": 3, "type": "VEC3"},
+      {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}],
+    "bufferViews": [{"buffer": 0, "byteLength": 72}, {"buffer": 0, "byteOffset": 72, "byteLength": 24}],
+    "buffers": [{"byteLength": 96}]
+  })");
+  document["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64(data);
+  return document;
+}
+
+// The element named by the InputError validation throws ("" when the document passes).
+std::string failing_element(const json& document, std::optional<uint64_t> glb_bin = std::nullopt,
+                            const std::string& base_dir = "") {
+  try {
+    validate_gltf_json(document, "test.gltf", base_dir, glb_bin);
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), "test.gltf");
+    return e.element();
+  }
+  return "";
+}
+
+TEST(GltfJsonValidation, AcceptsAValidTriangle) { EXPECT_EQ(failing_element(triangle_document()), ""); }
+
+TEST(GltfJsonValidation, WrongTypesNameTheirElement) {
+  json d = triangle_document();
+  d["accessors"][1]["count"] = "3";
+  EXPECT_EQ(failing_element(d), "accessor 1");
+  d = triangle_document();
+  d["accessors"][0]["bufferView"] = 0.0;  // tinygltf would silently drop a fractional optional index
+  EXPECT_EQ(failing_element(d), "accessor 0");
+  d = triangle_document();
+  d["meshes"][0]["primitives"] = json::object();
+  EXPECT_EQ(failing_element(d), "mesh 0");
+  d = triangle_document();
+  d["scenes"][0]["name"] = 42;
+  EXPECT_EQ(failing_element(d), "scene 0");
+  d = triangle_document();
+  d["scene"] = "hello";
+  EXPECT_EQ(failing_element(d), "scene");
+  d = triangle_document();
+  d["scene"] = 2;
+  EXPECT_EQ(failing_element(d), "scene 2");
+}
+
+TEST(GltfJsonValidation, AssetVersionAndRequiredExtensions) {
+  json d = triangle_document();
+  d["asset"]["minVersion"] = "2.1";
+  d["asset"]["version"] = "2.1";
+  EXPECT_EQ(failing_element(d), "asset");
+  d = triangle_document();
+  d["asset"].erase("version");
+  EXPECT_EQ(failing_element(d), "asset");
+  d = triangle_document();
+  d["extensionsRequired"] = {"KHR_texture_transform"};  // supported, but not listed as used
+  EXPECT_EQ(failing_element(d), "extensionsRequired");
+  d["extensionsUsed"] = {"KHR_texture_transform"};
+  EXPECT_EQ(failing_element(d), "");
+  d["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+  EXPECT_EQ(failing_element(d), "extensionsRequired");
+}
+
+TEST(GltfJsonValidation, HugeOffsetsAndCountsDoNotWrap) {
+  json d = triangle_document();
+  d["bufferViews"][1]["byteOffset"] = std::numeric_limits<uint64_t>::max() - 8;
+  EXPECT_EQ(failing_element(d), "bufferView 1");
+  d = triangle_document();
+  d["bufferViews"][1]["byteOffset"] = int64_t(1) << 62;
+  EXPECT_EQ(failing_element(d), "bufferView 1");
+  d = triangle_document();
+  d["accessors"][2]["count"] = int64_t(1) << 61;  // stride * count would overflow 64 bits
+  EXPECT_EQ(failing_element(d), "accessor 2");
+  d = triangle_document();
+  d["bufferViews"][0]["byteStride"] = 252;
+  d["accessors"][0]["count"] = std::numeric_limits<int64_t>::max();
+  EXPECT_EQ(failing_element(d), "accessor 0");
+}
+
+TEST(GltfJsonValidation, AccessorAlignmentAndTypes) {
+  json d = triangle_document();
+  d["accessors"][1]["byteOffset"] = 34;
+  EXPECT_EQ(failing_element(d), "accessor 1");
+  d = triangle_document();
+  d["accessors"][2]["componentType"] = 5123;  // TEXCOORD as unsigned short must be normalized
+  EXPECT_EQ(failing_element(d), "mesh 0 primitive 0");
+  d["accessors"][2]["normalized"] = true;
+  EXPECT_EQ(failing_element(d), "");
+  d = triangle_document();
+  d["accessors"][0]["componentType"] = 5130;
+  EXPECT_EQ(failing_element(d), "accessor 0");
+}
+
+TEST(GltfJsonValidation, BufferSources) {
+  json d = triangle_document();
+  d["buffers"][0]["byteLength"] = 97;  // the data uri holds 96 bytes
+  EXPECT_EQ(failing_element(d), "buffer 0");
+  d = triangle_document();
+  d["buffers"][0]["uri"] = "data:application/octet-stream;base64,@@not*base64";
+  EXPECT_EQ(failing_element(d), "buffer 0");
+  for (const char* uri : {".", "/dev/zero", "http://127.0.0.1/x.bin", "missing.bin"}) {
+    d = triangle_document();
+    d["buffers"][0]["uri"] = uri;
+    EXPECT_EQ(failing_element(d, std::nullopt, std::filesystem::temp_directory_path().string()), "buffer 0") << uri;
+  }
+  d = triangle_document();
+  d["buffers"][0].erase("uri");
+  EXPECT_EQ(failing_element(d), "buffer 0");           // .gltf: a buffer needs a uri
+  EXPECT_EQ(failing_element(d, 96), "");               // .glb: BIN chunk large enough
+  EXPECT_EQ(failing_element(d, 40), "buffer 0");       // BIN chunk too short
+  EXPECT_EQ(failing_element(d, 0), "buffer 0");        // no BIN chunk at all
+}
+
+TEST(GltfJsonValidation, SceneGraphAndPrimitiveRules) {
+  json d = triangle_document();
+  d["nodes"][0]["matrix"] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  d["nodes"][0]["translation"] = {1, 0, 0};
+  EXPECT_EQ(failing_element(d), "node 0");
+  d = triangle_document();
+  d["nodes"][0]["children"] = {7};
+  EXPECT_EQ(failing_element(d), "node 0");
+  d = triangle_document();
+  d["meshes"][0]["primitives"] = json::array();
+  EXPECT_EQ(failing_element(d), "mesh 0");
+  d = triangle_document();
+  d["accessors"][0]["count"] = 2;  // POSITION count differs from the others and is not a multiple of 3
+  EXPECT_EQ(failing_element(d), "mesh 0 primitive 0");
+  d = triangle_document();
+  d["materials"] = json::parse(R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": -1}}}])");
+  EXPECT_EQ(failing_element(d), "material 0");
+}
+
+TEST(GltfImport, NonFiniteNormalsAreRepairedWithAWarning) {
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  const auto dir = std::filesystem::temp_directory_path() / ("gltf_import_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "nan_normal.gltf").string();
+  std::ofstream(path) << triangle_document({nan, 0, 1, inf, 0, 1, 0, 0, 1}).dump();
+  Diagnostics diagnostics;
+  const Scene scene = import_gltf(path, ImportOptions{}, diagnostics);
+  std::filesystem::remove_all(dir);
+  ASSERT_EQ(scene.triangle_count(), 1u);
+  for (const Vec3& n : scene.normals) {
+    EXPECT_TRUE(is_finite(n));
+    EXPECT_NEAR(length(n), 1.0f, 1e-5f);
+  }
+  bool warned = false;
+  for (const std::string& w : diagnostics.warnings) warned = warned || w.find("NaN or infinite") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
+TEST(GltfImport, NonFinitePositionIsAnErrorNamingTheAccessor) {
+  const auto dir = std::filesystem::temp_directory_path() / ("gltf_import_test_pos_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "nan_position.gltf").string();
+  json d = triangle_document();
+  std::vector<unsigned char> data;
+  append_floats(data, {std::numeric_limits<float>::quiet_NaN(), 0, 0, 1, 0, 0, 0, 1, 0});
+  append_floats(data, {0, 0, 1, 0, 0, 1, 0, 0, 1});
+  append_floats(data, {0, 0, 1, 0, 0, 1});
+  d["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64(data);
+  std::ofstream(path) << d.dump();
+  Diagnostics diagnostics;
+  try {
+    import_gltf(path, ImportOptions{}, diagnostics);
+    ADD_FAILURE() << "NaN POSITION was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.element(), "accessor 0");
+  }
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace exitance
