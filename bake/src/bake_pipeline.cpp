@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "exitance/bake/bundle_writer.h"
+#include "exitance/bake/geometry_checks.h"
 #include "exitance/bake/image_decode.h"
 #include "exitance/bake/input_error.h"
 #include "exitance/bake/lightmap_assembly.h"
@@ -88,11 +89,15 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   CpuReferenceIntegrator integrator(scene);
   seconds["bvh"] = timer.lap();
   size_t moved = 0;
+  GeometryCheckReport geometry;
   {
     EmbreeScene embree(scene);
     moved = unocclude_texels(embree, gbuffer).moved;
+    seconds["unocclude"] = timer.lap();
+    geometry = check_scene_geometry(scene, embree, gbuffer);
+    for (std::string& line : describe_geometry_problems(geometry, scene, options.input)) diagnostics.warn(line);
+    seconds["checks"] = timer.lap();
   }
-  seconds["unocclude"] = timer.lap();
 
   IntegratorSettings lighting = options.lighting;
   lighting.progress = [&](double fraction, uint64_t rays) { report("lighting", fraction, rays); };
@@ -174,6 +179,9 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                                 {"mean", gbuffer.texels.empty() ? 0.0 : double(sample_sum) / double(gbuffer.texels.size())}};
   stats["estimated_relative_error"] = relative_error_count ? relative_error_sum / double(relative_error_count) : 0.0;
   stats["unoccluded_texels"] = moved;
+  stats["enclosed_texels"] = geometry.enclosed_texels;
+  stats["coplanar_texels"] = geometry.coplanar_texels;
+  stats["enclosed_lights"] = geometry.enclosed_lights;
   stats["nonfinite_samples"] = estimate.nonfinite_samples;
   stats["skipped"] = {{"texels_outside_charts", gbuffer.skipped_texels},
                       {"probes", "not implemented yet"},

@@ -7,13 +7,57 @@
 #include <string>
 
 namespace exitance {
+namespace {
+
+// Intersection context carrying the instance whose triangles a filter rejects.
+struct InstanceFilterContext {
+  RTCIntersectContext context;  // first member: Embree passes a pointer to it
+  const std::vector<uint32_t>* triangle_instance;
+  uint32_t ignored_instance;
+};
+
+void reject_ignored_instance(const RTCFilterFunctionNArguments* args) {
+  const auto* filter = reinterpret_cast<const InstanceFilterContext*>(args->context);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    const unsigned triangle = RTCHitN_primID(args->hit, args->N, i);
+    if ((*filter->triangle_instance)[triangle] == filter->ignored_instance) args->valid[i] = 0;
+  }
+}
+
+Hit make_hit(const Scene& scene, const RTCRayHit& rayhit) {
+  Hit hit;
+  if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
+  hit.found = true;
+  hit.distance = rayhit.ray.tfar;
+  hit.triangle = rayhit.hit.primID;
+  hit.b1 = rayhit.hit.u;
+  hit.b2 = rayhit.hit.v;
+  // Recomputed from our own vertices so the front side follows glTF's counter-clockwise winding.
+  const Vec3* p = &scene.positions[size_t(hit.triangle) * 3];
+  hit.geometric_normal = normalize(cross(p[1] - p[0], p[2] - p[0]));
+  return hit;
+}
+
+RTCRayHit make_ray(Vec3 origin, Vec3 direction, float t_max) {
+  RTCRayHit rayhit{};
+  rayhit.ray.org_x = origin.x, rayhit.ray.org_y = origin.y, rayhit.ray.org_z = origin.z;
+  rayhit.ray.dir_x = direction.x, rayhit.ray.dir_y = direction.y, rayhit.ray.dir_z = direction.z;
+  rayhit.ray.tnear = 0.0f;
+  rayhit.ray.tfar = t_max;
+  rayhit.ray.mask = 0xFFFFFFFFu;
+  rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  return rayhit;
+}
+
+}  // namespace
 
 EmbreeScene::EmbreeScene(const Scene& scene) : scene_(scene) {
   device_ = rtcNewDevice(nullptr);
   if (!device_) throw std::runtime_error("Embree: cannot create a device (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
   rtc_scene_ = rtcNewScene(device_);
   rtcSetSceneBuildQuality(rtc_scene_, RTC_BUILD_QUALITY_HIGH);
-  rtcSetSceneFlags(rtc_scene_, RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneFlags(rtc_scene_, RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION));
   RTCGeometry geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
   const size_t triangles = scene.triangle_count();
   float* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
@@ -46,25 +90,20 @@ EmbreeScene::~EmbreeScene() {
 Hit EmbreeScene::intersect(Vec3 origin, Vec3 direction, float t_max) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  RTCRayHit rayhit{};
-  rayhit.ray.org_x = origin.x, rayhit.ray.org_y = origin.y, rayhit.ray.org_z = origin.z;
-  rayhit.ray.dir_x = direction.x, rayhit.ray.dir_y = direction.y, rayhit.ray.dir_z = direction.z;
-  rayhit.ray.tnear = 0.0f;
-  rayhit.ray.tfar = t_max;
-  rayhit.ray.mask = 0xFFFFFFFFu;
-  rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  RTCRayHit rayhit = make_ray(origin, direction, t_max);
   rtcIntersect1(rtc_scene_, &context, &rayhit);
-  Hit hit;
-  if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
-  hit.found = true;
-  hit.distance = rayhit.ray.tfar;
-  hit.triangle = rayhit.hit.primID;
-  hit.b1 = rayhit.hit.u;
-  hit.b2 = rayhit.hit.v;
-  // Recomputed from our own vertices so the front side follows glTF's counter-clockwise winding.
-  const Vec3* p = &scene_.positions[size_t(hit.triangle) * 3];
-  hit.geometric_normal = normalize(cross(p[1] - p[0], p[2] - p[0]));
-  return hit;
+  return make_hit(scene_, rayhit);
+}
+
+Hit EmbreeScene::intersect_other_instances(Vec3 origin, Vec3 direction, float t_max, uint32_t ignored_instance) const {
+  InstanceFilterContext filter;
+  rtcInitIntersectContext(&filter.context);
+  filter.context.filter = reject_ignored_instance;
+  filter.triangle_instance = &scene_.triangle_instance;
+  filter.ignored_instance = ignored_instance;
+  RTCRayHit rayhit = make_ray(origin, direction, t_max);
+  rtcIntersect1(rtc_scene_, &filter.context, &rayhit);
+  return make_hit(scene_, rayhit);
 }
 
 bool EmbreeScene::occluded(Vec3 origin, Vec3 direction, float t_max) const {

@@ -23,6 +23,8 @@ class EmbreeScene {
 
   Hit intersect(Vec3 origin, Vec3 direction, float t_max) const;
   bool occluded(Vec3 origin, Vec3 direction, float t_max) const;
+  // Closest hit ignoring the triangles of one mesh instance (for scene checks, not lighting).
+  Hit intersect_other_instances(Vec3 origin, Vec3 direction, float t_max, uint32_t ignored_instance) const;
   // Largest side of the scene's bounding box: the scale of ray-offset error floors.
   float extent() const { return extent_; }
 

@@ -1,0 +1,27 @@
+// Scene problems a baker should point out before spending rays on them: texels enclosed by
+// geometry, texels on coplanar overlapping surfaces (z-fighting), punctual lights shut inside
+// closed geometry, and emitters that can never be sampled.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "exitance/runtime/embree_scene.h"
+#include "exitance/runtime/scene.h"
+#include "exitance/runtime/texel_gbuffer.h"
+
+namespace exitance {
+
+struct GeometryCheckReport {
+  size_t enclosed_texels = 0;        // most hemisphere rays hit back faces
+  size_t coplanar_texels = 0;        // another surface lies in the texel's plane
+  std::vector<int> enclosed_lights;  // indices into Scene::lights
+  size_t unsampled_emitters = 0;     // emissive triangles with zero area
+};
+
+GeometryCheckReport check_scene_geometry(const Scene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer);
+
+// One warning line per kind of problem found (empty when the scene is clean).
+std::vector<std::string> describe_geometry_problems(const GeometryCheckReport& report, const Scene& scene,
+                                                    const std::string& file);
+
+}  // namespace exitance
