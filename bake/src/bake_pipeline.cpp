@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "exitance/bake/backend_choice.h"
 #include "exitance/bake/bundle_writer.h"
 #include "exitance/bake/geometry_checks.h"
 #include "exitance/bake/image_decode.h"
@@ -86,7 +87,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   seconds["raster"] = timer.lap();
 
   report("bvh", 0, 0);
-  CpuReferenceIntegrator integrator(scene);
+  const LightingBackend backend = choose_lighting_backend(scene, options.backend, diagnostics);
   seconds["bvh"] = timer.lap();
   size_t moved = 0;
   GeometryCheckReport geometry;
@@ -101,7 +102,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
 
   IntegratorSettings lighting = options.lighting;
   lighting.progress = [&](double fraction, uint64_t rays) { report("lighting", fraction, rays); };
-  const LightmapEstimate estimate = integrator.bake(gbuffer, lighting);
+  const LightmapEstimate estimate = backend.bake(gbuffer, lighting);
   seconds["lighting"] = timer.lap();
   if (estimate.nonfinite_samples > 0)
     diagnostics.warn(options.input + ": " + std::to_string(estimate.nonfinite_samples) +
@@ -132,7 +133,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   manifest["generator"] = "exitance 0.1.0";
   manifest["input"] = {{"file", input_path.filename().string()}, {"sha256", sha256_of_file(options.input)}};
   manifest["units"] = {{"lightmap", "irradiance_over_pi"}, {"probes", "incident_radiance_sh_l2"}, {"length", "scene"}};
-  manifest["settings"] = {{"backend", "cpu"},
+  manifest["settings"] = {{"backend", backend.name},
                           {"spp", options.lighting.spp},
                           {"time_budget_seconds", options.lighting.time_budget_seconds},
                           {"target_error", options.lighting.target_relative_error},
@@ -170,6 +171,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   const double lighting_seconds = estimate.seconds;
   json stats;
   stats["seconds"] = seconds;
+  stats["device"] = backend.device;
   stats["triangles"] = scene.triangle_count();
   stats["instances"] = scene.instances.size();
   stats["live_texels"] = gbuffer.texels.size();

@@ -2,10 +2,12 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 
 #include "exitance/bake/bake_pipeline.h"
 #include "exitance/bake/input_error.h"
+#include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "progress_bar.h"
 
 namespace {
@@ -27,8 +29,13 @@ int main(int argc, char** argv) {
   CLI::App app{"Exitance lightmap baker: bake SCENE.{gltf,glb} [-o OUT] [options]"};
   app.add_option("scene", options.input, "input glTF 2.0 scene (.gltf or .glb)")->required();
   app.add_option("-o,--out", options.output, "output bundle folder (default: SCENE.bake next to the input)");
-  app.add_option("--backend", options.backend, "auto | vulkan | cpu")
+  app.add_option("--backend", options.backend.name,
+                 "auto | vulkan | cpu (auto: a GPU if one exists, else the CPU reference)")
       ->check(CLI::IsMember({"auto", "vulkan", "cpu"}));
+  app.add_option("--device", options.backend.device_index, "Vulkan device index (see --list-devices)")
+      ->check(CLI::NonNegativeNumber);
+  bool list_devices = false;
+  app.add_flag("--list-devices", list_devices, "print the Vulkan devices and exit");
   app.add_option("--texel-density", options.atlas.texel_density,
                  "lightmap texels per scene unit (default: 64, lowered for large scenes)")
       ->check(CLI::PositiveNumber);
@@ -55,6 +62,14 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"auto", "off", "svo", "grid"}));
   bool json_report = false;
   app.add_flag("--json", json_report, "print the run report as JSON on stdout");
+  // --list-devices needs no scene: parse it before the required positional is enforced.
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--list-devices") {
+      for (const auto& d : exitance::enumerate_vulkan_devices())
+        std::cout << d.index << ": " << d.name << " (" << exitance::to_string(d.type) << ")"
+                  << (d.usable ? "" : " unusable: " + d.missing_feature) << "\n";
+      return 0;
+    }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -68,12 +83,8 @@ int main(int argc, char** argv) {
   }
 
   exitance::Diagnostics diagnostics;
-  if (options.backend == "vulkan") {
-    std::cerr << "bake: error: the Vulkan backend is not part of this build yet; use --backend cpu\n";
-    return 1;
-  }
-  if (options.backend == "auto")
-    diagnostics.warn("--backend auto: no Vulkan backend in this build, using the CPU reference (Embree)");
+  const char* validation = std::getenv("EXITANCE_VULKAN_VALIDATION");
+  options.backend.validation = validation && std::string(validation) == "1";
   if (probes != "auto" && probes != "none") diagnostics.warn("--probes: probe baking is not implemented yet; ignored");
   if (!directional.empty()) diagnostics.warn("--directional: directional lightmaps are not implemented yet; ignored");
   if (guiding == "svo" || guiding == "grid") {

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "exitance/bake/atlas_layout.h"
+#include "exitance/bake/backend_choice.h"
 #include "exitance/bake/diagnostics.h"
 #include "exitance/bake/gltf_import.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
@@ -17,7 +18,7 @@ struct BakeOptions {
   std::string input;
   std::string output;          // empty = SCENE.bake next to the input
   std::string sky;             // "R,G,B" or an equirectangular image path; empty = black
-  std::string backend = "auto";
+  BackendRequest backend;
   ImportOptions import;
   AtlasSettings atlas;
   IntegratorSettings lighting;
