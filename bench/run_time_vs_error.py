@@ -26,10 +26,10 @@ SCENES = [
 ]
 
 
-def run_scene(build, name, sky, density, reference_spp, max_spp, max_seconds, target):
+def run_scene(build, backends, name, sky, density, reference_spp, max_spp, max_seconds, target):
     tool = os.path.join(build, "bench", "bench_time_to_error")
     scene = os.path.join(build, "samples", name + ".gltf")
-    command = [tool, scene, "--name", name, "--texel-density", str(density), "--reference-spp", str(reference_spp),
+    command = [tool, scene, "--backends", backends, "--name", name, "--texel-density", str(density), "--reference-spp", str(reference_spp),
                "--max-spp", str(max_spp), "--max-seconds", str(max_seconds), "--target", str(target)]
     if sky:
         command += ["--sky", sky]
@@ -61,6 +61,7 @@ def main():
     parser.add_argument("--target", type=float, default=0.01)
     parser.add_argument("--max-seconds", type=float, default=60)
     parser.add_argument("--only", default="")
+    parser.add_argument("--backends", default="cpu,vulkan")
     parser.add_argument("--quick", action="store_true", help="4x fewer reference and ladder samples")
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
@@ -71,7 +72,7 @@ def main():
             continue
         if args.quick:
             reference_spp, max_spp = max(64, reference_spp // 4), max(16, max_spp // 4)
-        rows, command = run_scene(args.build, name, sky, density, reference_spp, max_spp, args.max_seconds, args.target)
+        rows, command = run_scene(args.build, args.backends, name, sky, density, reference_spp, max_spp, args.max_seconds, args.target)
         all_rows += rows
         commands.append(" ".join(command))
 

@@ -2,7 +2,7 @@
 // content hash outside the repository) is the reference; runs at doubling spp record seconds,
 // relMSE, MAE, worst-texel error and rays/s as CSV, and the time to reach a target relMSE.
 //
-//   bench_time_to_error SCENE.gltf [--name NAME] [--sky R,G,B] [--texel-density T]
+//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--name NAME] [--sky R,G,B] [--texel-density T]
 //                       [--reference-spp N] [--max-spp N] [--max-seconds S] [--target 0.01]
 //                       [--cache DIR] [--csv FILE]
 //
@@ -20,6 +20,7 @@
 #include <iostream>
 
 #include "exitance/bake/atlas_layout.h"
+#include "exitance/bake/backend_choice.h"
 #include "exitance/bake/bake_pipeline.h"
 #include "exitance/bake/bundle_writer.h"
 #include "exitance/bake/texel_raster.h"
@@ -64,13 +65,14 @@ std::vector<float> flatten(const LightmapEstimate& estimate) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string scene_path, scene_name, sky, csv_path, cache_dir;
+  std::string scene_path, scene_name, sky, csv_path, cache_dir, backends = "cpu";
   double max_seconds = 120;
   float density = 8;
   uint32_t reference_spp = 8192, max_spp = 1024;
   double target = 0.01;
   CLI::App app{"time against error of the CPU reference"};
   app.add_option("scene", scene_path)->required();
+  app.add_option("--backends", backends, "comma-separated: cpu, vulkan (the reference is always cpu)");
   app.add_option("--name", scene_name, "scene name in the CSV (default: file stem)");
   app.add_option("--max-seconds", max_seconds, "stop the ladder after a run longer than this");
   app.add_option("--sky", sky);
@@ -96,6 +98,19 @@ int main(int argc, char** argv) {
     unocclude_texels(embree, gbuffer);
   }
   CpuReferenceIntegrator integrator(scene);
+  std::vector<LightingBackend> measured;
+  for (size_t start = 0; start < backends.size();) {
+    const size_t comma = std::min(backends.find(',', start), backends.size());
+    BackendRequest request;
+    request.name = backends.substr(start, comma - start);
+    try {
+      measured.push_back(choose_lighting_backend(scene, request, diagnostics));
+      std::cerr << "backend " << request.name << ": " << measured.back().device << "\n";
+    } catch (const std::exception& e) {
+      std::cerr << "backend " << request.name << " skipped: " << e.what() << "\n";
+    }
+    start = comma + 1;
+  }
 
   // Reference: keyed by scene bytes + settings, so a changed scene or setting rebuilds it.
   const std::string key = "v2-" + sha256_of_file(scene_path).substr(0, 16) + "-d" + std::to_string(density) + "-s" +
@@ -129,33 +144,40 @@ int main(int argc, char** argv) {
   std::ostream& csv = csv_path.empty() ? std::cout : csv_file;
   csv << "backend,integrator,scene,live_texels,spp,seconds,rel_mse,raw_rel_mse,reference_rel_mse,mae,worst_texel_error,"
          "rays_per_second\n";
-  double previous_seconds = 0, previous_error = 0, time_to_target = -1;
-  for (uint32_t spp = 1; spp <= max_spp; spp *= 2) {
-    IntegratorSettings settings;
-    settings.spp = spp;
-    settings.seed = spp;
-    const LightmapEstimate estimate = integrator.bake(gbuffer, settings);
-    std::vector<float> result = flatten(estimate);
-    result.resize(values);
-    ErrorFigures e = compare(result, reference_mean);
-    const double raw = e.rel_mse;
-    e.rel_mse = std::max(raw - reference_noise, 1e-12);
-    csv << "cpu,path_tracing," << scene_name << "," << gbuffer.texels.size() << "," << spp << "," << estimate.seconds
-        << "," << e.rel_mse << "," << raw << "," << reference_noise << "," << e.mae << "," << e.worst << ","
-        << double(estimate.rays) / estimate.seconds << std::endl;
-    if (time_to_target < 0 && e.rel_mse <= target) {
-      // Log-log interpolation between the two runs that bracket the target.
-      time_to_target = previous_seconds > 0 ? std::exp(std::log(previous_seconds) +
-                                                       (std::log(target) - std::log(previous_error)) /
-                                                           (std::log(e.rel_mse) - std::log(previous_error)) *
-                                                           (std::log(estimate.seconds) - std::log(previous_seconds)))
-                                            : estimate.seconds;
+  for (const LightingBackend& backend : measured) {
+    {  // Warm-up, not recorded: lavapipe and GPU drivers compile pipelines at the first dispatch.
+      IntegratorSettings warm_up;
+      warm_up.spp = 1;
+      backend.bake(gbuffer, warm_up);
     }
-    previous_seconds = estimate.seconds;
-    previous_error = e.rel_mse;
-    if (estimate.seconds > max_seconds) break;
+    double previous_seconds = 0, previous_error = 0, time_to_target = -1;
+    for (uint32_t spp = 1; spp <= max_spp; spp *= 2) {
+      IntegratorSettings settings;
+      settings.spp = spp;
+      settings.seed = spp;
+      const LightmapEstimate estimate = backend.bake(gbuffer, settings);
+      std::vector<float> result = flatten(estimate);
+      result.resize(values);
+      ErrorFigures e = compare(result, reference_mean);
+      const double raw = e.rel_mse;
+      e.rel_mse = std::max(raw - reference_noise, 1e-12);
+      csv << backend.name << ",path_tracing," << scene_name << "," << gbuffer.texels.size() << "," << spp << ","
+          << estimate.seconds << "," << e.rel_mse << "," << raw << "," << reference_noise << "," << e.mae << ","
+          << e.worst << "," << double(estimate.rays) / estimate.seconds << std::endl;
+      if (time_to_target < 0 && e.rel_mse <= target) {
+        // Log-log interpolation between the two runs that bracket the target.
+        time_to_target = previous_seconds > 0
+                             ? std::exp(std::log(previous_seconds) + (std::log(target) - std::log(previous_error)) /
+                                                                         (std::log(e.rel_mse) - std::log(previous_error)) *
+                                                                         (std::log(estimate.seconds) - std::log(previous_seconds)))
+                             : estimate.seconds;
+      }
+      previous_seconds = estimate.seconds;
+      previous_error = e.rel_mse;
+      if (estimate.seconds > max_seconds) break;
+    }
+    std::cerr << backend.name << ": live texels " << gbuffer.texels.size() << "; time to relMSE " << target << ": "
+              << (time_to_target < 0 ? std::string("not reached") : std::to_string(time_to_target) + " s") << "\n";
   }
-  std::cerr << "live texels " << gbuffer.texels.size() << "; time to relMSE " << target << ": "
-            << (time_to_target < 0 ? std::string("not reached") : std::to_string(time_to_target) + " s") << "\n";
   return 0;
 }

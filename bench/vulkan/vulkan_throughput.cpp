@@ -3,7 +3,11 @@
 // per-stage figures and a traversal-only kernel's incoherent rays/s.
 //
 //   bench_vulkan_throughput SCENE.gltf [--sky R,G,B] [--texel-density T] [--spp N] [--cpu-spp N]
-//                           [--max-paths N] [--traversal-rays N] [--skip-cpu]
+//                           [--max-paths N] [--traversal-rays N] [--skip-cpu] [--write-replay FILE]
+//
+// --write-replay FILE: writes the scene, the live texels and the GPU BVH (bench/vulkan/replay_format.h)
+// and exits; bench_vulkan_replay (bench/vulkan/build_replay.sh) then runs the GPU half of this bench
+// on a machine that has nothing but a Vulkan driver.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -15,11 +19,14 @@
 #include "exitance/bake/unocclude.h"
 #include "exitance/runtime/embree_scene.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
+#include "../../runtime/src/vulkan/gpu_bvh.h"
+#include "replay_format.h"
+#include "report.h"
 
 using namespace exitance;
 
 int main(int argc, char** argv) {
-  std::string scene_path, sky;
+  std::string scene_path, sky, replay_path;
   float density = 4;
   uint32_t spp = 16, cpu_spp = 0, max_paths = 0, traversal_rays = 1u << 22;
   bool skip_cpu = false;
@@ -32,6 +39,7 @@ int main(int argc, char** argv) {
   app.add_option("--max-paths", max_paths);
   app.add_option("--traversal-rays", traversal_rays);
   app.add_flag("--skip-cpu", skip_cpu);
+  app.add_option("--write-replay", replay_path, "write a replay file for bench_vulkan_replay and exit");
   CLI11_PARSE(app, argc, argv);
 
   Diagnostics diagnostics;
@@ -48,12 +56,17 @@ int main(int argc, char** argv) {
   std::printf("scene %s: %zu triangles, %zu live texels, %u spp\n", scene_path.c_str(), scene.triangle_count(),
               gbuffer.texels.size(), spp);
 
+  if (!replay_path.empty()) {
+    const vulkan::GpuBvh bvh = vulkan::build_gpu_bvh(scene);
+    replay::write_replay(replay_path, {scene_path, density}, scene, gbuffer, bvh);
+    std::printf("wrote %s (BVH4 %zu nodes, stack bound %u)\n", replay_path.c_str(), bvh.nodes.size(), bvh.stack_entries);
+    return 0;
+  }
+
   VulkanDeviceOptions options;
   options.max_paths = max_paths;
   auto vk = VulkanIntegrator::create(scene, options);
-  std::printf("device: %s (%s); paths in flight %u; path state %zu B/path; BVH4 %u nodes, %.1f MB\n",
-              vk->device().name.c_str(), to_string(vk->device().type), vk->max_paths(), vk->path_state_bytes_per_path(),
-              vk->bvh_node_count(), double(vk->bvh_bytes()) / 1e6);
+  bench::print_device_line(*vk);
   IntegratorSettings settings;
   settings.spp = spp;
   settings.seed = 1;
@@ -79,15 +92,6 @@ int main(int argc, char** argv) {
   auto vk_stats = VulkanIntegrator::create(scene, options);
   settings.spp = spp;
   const LightmapEstimate instrumented = vk_stats->bake(gbuffer, settings);
-  std::printf("\n| stage | GPU s | items | rays | rays/s | lane efficiency |\n|---|---|---|---|---|---|\n");
-  for (const VulkanStageStatistics& s : vk_stats->stage_statistics())
-    std::printf("| %s | %.4f | %llu | %llu | %.3g | %.1f %% |\n", s.stage.c_str(), s.seconds, (unsigned long long)s.items,
-                (unsigned long long)s.rays, s.seconds > 0 ? double(s.rays) / s.seconds : 0.0, 100.0 * s.lane_efficiency);
-  std::printf("instrumented total %.3f s\n", instrumented.seconds);
-  const double traversal = vk_stats->measure_incoherent_traversal(traversal_rays, 3);
-  for (const VulkanStageStatistics& s : vk_stats->stage_statistics())
-    if (s.stage == "traversal-only")
-      std::printf("traversal-only: %u incoherent rays, %.3g rays/s, lane efficiency %.1f %%\n", traversal_rays, traversal,
-                  100.0 * s.lane_efficiency);
+  bench::print_stage_figures(*vk_stats, instrumented, traversal_rays, 3);
   return 0;
 }

@@ -1,0 +1,81 @@
+// bench_vulkan_replay: the GPU half of bench_vulkan_throughput, from a replay file written by
+// `bench_vulkan_throughput SCENE --write-replay FILE` (bench/vulkan/replay_format.h). Needs only
+// the Vulkan loader and a driver, so it runs on the GPU machine (build: bench/vulkan/build_replay.sh).
+//
+//   bench_vulkan_replay FILE [--spp N] [--max-paths N] [--traversal-rays N] [--iterations-per-submit N]
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include "exitance/runtime/vulkan/vulkan_integrator.h"
+#include "replay_format.h"
+#include "report.h"
+
+using namespace exitance;
+
+namespace exitance::vulkan {
+extern GpuBvh* g_replay_bvh;
+}
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: %s FILE [--spp N] [--max-paths N] [--traversal-rays N] [--iterations-per-submit N]\n",
+                 argv[0]);
+    return 2;
+  }
+  std::string path = argv[1];
+  uint32_t spp = 256, max_paths = 0, traversal_rays = 1u << 24, iterations = 0;
+  bool skip_instrumented = false;
+  for (int i = 2; i < argc; ++i) {
+    auto next = [&]() -> uint32_t {
+      if (i + 1 >= argc) { std::fprintf(stderr, "missing value after %s\n", argv[i]); std::exit(2); }
+      return uint32_t(std::strtoul(argv[++i], nullptr, 10));
+    };
+    if (!std::strcmp(argv[i], "--spp")) spp = next();
+    else if (!std::strcmp(argv[i], "--max-paths")) max_paths = next();
+    else if (!std::strcmp(argv[i], "--traversal-rays")) traversal_rays = next();
+    else if (!std::strcmp(argv[i], "--iterations-per-submit")) iterations = next();
+    else if (!std::strcmp(argv[i], "--skip-instrumented")) skip_instrumented = true;
+    else { std::fprintf(stderr, "unknown option %s\n", argv[i]); return 2; }
+  }
+  try {
+    replay::ReplayInfo info;
+    Scene scene;
+    TexelGBuffer gbuffer;
+    vulkan::GpuBvh bvh;
+    replay::read_replay(path, info, scene, gbuffer, bvh);
+    vulkan::g_replay_bvh = &bvh;
+    std::printf("scene %s (replay %s): %zu triangles, %zu live texels at density %g, %u spp\n", info.scene_name.c_str(),
+                path.c_str(), scene.triangle_count(), gbuffer.texels.size(), double(info.texel_density), spp);
+    VulkanDeviceOptions options;
+    options.max_paths = max_paths;
+    options.iterations_per_submit = iterations;
+    options.fence_timeout_seconds = 60;
+    IntegratorSettings settings;
+    settings.seed = 1;
+    {
+      auto vk = VulkanIntegrator::create(scene, options);
+      bench::print_device_line(*vk);
+      IntegratorSettings warm = settings;
+      warm.spp = 1;
+      vk->bake(gbuffer, warm);
+      settings.spp = spp;
+      const LightmapEstimate gpu = vk->bake(gbuffer, settings);
+      std::printf("vulkan bake: %.3f s, %llu rays, %.3g rays/s end to end (%llu non-finite samples)\n", gpu.seconds,
+                  (unsigned long long)gpu.rays, double(gpu.rays) / gpu.seconds, (unsigned long long)gpu.nonfinite_samples);
+      double mean = 0;
+      for (size_t i = 0; i < gpu.texels.size(); ++i) mean += luminance(gpu.mean_total(i));
+      std::printf("mean texel luminance (E/pi) %.6g\n", gbuffer.texels.empty() ? 0.0 : mean / double(gpu.texels.size()));
+    }
+    options.collect_stage_statistics = true;
+    auto vk_stats = VulkanIntegrator::create(scene, options);
+    LightmapEstimate instrumented;
+    if (!skip_instrumented) instrumented = vk_stats->bake(gbuffer, settings);
+    bench::print_stage_figures(*vk_stats, instrumented, traversal_rays, 5);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_vulkan_replay: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
