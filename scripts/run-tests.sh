@@ -9,7 +9,9 @@ cmake --build build -j"$jobs"
 ctest --test-dir build --output-on-failure -j"$jobs"
 
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEXITANCE_SANITIZE=ON
-cmake --build build-asan -j"$jobs"
+# Only what the sanitizer run executes: the bake command and the unit/stress test programs.
+cmake --build build-asan -j"$jobs" --target bake stress_tests geometry_warning_tests layout_tests gltf_import_tests \
+  pipeline_tests
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
