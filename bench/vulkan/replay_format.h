@@ -16,7 +16,7 @@
 
 #include "exitance/runtime/scene.h"
 #include "exitance/runtime/texel_gbuffer.h"
-#include "gpu_bvh.h"
+#include "../../runtime/src/vulkan/gpu_bvh.h"
 
 namespace exitance::replay {
 

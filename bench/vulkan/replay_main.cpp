@@ -3,6 +3,7 @@
 // the Vulkan loader and a driver, so it runs on the GPU machine (build: bench/vulkan/build_replay.sh).
 //
 //   bench_vulkan_replay FILE [--spp N] [--max-paths N] [--traversal-rays N] [--iterations-per-submit N]
+//                       [--work-per-path N] [--node-layout auto|float|quantized] [--skip-instrumented]
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -20,13 +21,15 @@ extern GpuBvh* g_replay_bvh;
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: %s FILE [--spp N] [--max-paths N] [--traversal-rays N] [--iterations-per-submit N]\n",
+    std::fprintf(stderr, "usage: %s FILE [--spp N] [--max-paths N] [--traversal-rays N] [--iterations-per-submit N] "
+                 "[--work-per-path N] [--node-layout auto|float|quantized] [--skip-instrumented]\n",
                  argv[0]);
     return 2;
   }
   std::string path = argv[1];
-  uint32_t spp = 256, max_paths = 0, traversal_rays = 1u << 24, iterations = 0;
+  uint32_t spp = 256, max_paths = 0, traversal_rays = 1u << 24, iterations = 0, work_per_path = 0;
   bool skip_instrumented = false;
+  VulkanNodeLayout layout = VulkanNodeLayout::Automatic;
   for (int i = 2; i < argc; ++i) {
     auto next = [&]() -> uint32_t {
       if (i + 1 >= argc) { std::fprintf(stderr, "missing value after %s\n", argv[i]); std::exit(2); }
@@ -36,6 +39,11 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--max-paths")) max_paths = next();
     else if (!std::strcmp(argv[i], "--traversal-rays")) traversal_rays = next();
     else if (!std::strcmp(argv[i], "--iterations-per-submit")) iterations = next();
+    else if (!std::strcmp(argv[i], "--work-per-path")) work_per_path = next();
+    else if (!std::strcmp(argv[i], "--node-layout") && i + 1 < argc) {
+      const std::string v = argv[++i];
+      layout = v == "float" ? VulkanNodeLayout::Float : v == "quantized" ? VulkanNodeLayout::Quantized : VulkanNodeLayout::Automatic;
+    }
     else if (!std::strcmp(argv[i], "--skip-instrumented")) skip_instrumented = true;
     else { std::fprintf(stderr, "unknown option %s\n", argv[i]); return 2; }
   }
@@ -51,6 +59,8 @@ int main(int argc, char** argv) {
     VulkanDeviceOptions options;
     options.max_paths = max_paths;
     options.iterations_per_submit = iterations;
+    options.work_items_per_path = work_per_path;
+    options.node_layout = layout;
     options.fence_timeout_seconds = 60;
     IntegratorSettings settings;
     settings.seed = 1;

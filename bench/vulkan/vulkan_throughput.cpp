@@ -4,6 +4,7 @@
 //
 //   bench_vulkan_throughput SCENE.gltf [--sky R,G,B] [--texel-density T] [--spp N] [--cpu-spp N]
 //                           [--max-paths N] [--traversal-rays N] [--skip-cpu] [--write-replay FILE]
+//                           [--node-layout auto|float|quantized]
 //
 // --write-replay FILE: writes the scene, the live texels and the GPU BVH (bench/vulkan/replay_format.h)
 // and exits; bench_vulkan_replay (bench/vulkan/build_replay.sh) then runs the GPU half of this bench
@@ -26,7 +27,7 @@
 using namespace exitance;
 
 int main(int argc, char** argv) {
-  std::string scene_path, sky, replay_path;
+  std::string scene_path, sky, replay_path, node_layout = "auto";
   float density = 4;
   uint32_t spp = 16, cpu_spp = 0, max_paths = 0, traversal_rays = 1u << 22;
   bool skip_cpu = false;
@@ -39,6 +40,8 @@ int main(int argc, char** argv) {
   app.add_option("--max-paths", max_paths);
   app.add_option("--traversal-rays", traversal_rays);
   app.add_flag("--skip-cpu", skip_cpu);
+  app.add_option("--node-layout", node_layout, "BVH4 node layout: auto, float or quantized")
+      ->check(CLI::IsMember({"auto", "float", "quantized"}));
   app.add_option("--write-replay", replay_path, "write a replay file for bench_vulkan_replay and exit");
   CLI11_PARSE(app, argc, argv);
 
@@ -65,6 +68,9 @@ int main(int argc, char** argv) {
 
   VulkanDeviceOptions options;
   options.max_paths = max_paths;
+  options.node_layout = node_layout == "float"       ? VulkanNodeLayout::Float
+                        : node_layout == "quantized" ? VulkanNodeLayout::Quantized
+                                                     : VulkanNodeLayout::Automatic;
   auto vk = VulkanIntegrator::create(scene, options);
   bench::print_device_line(*vk);
   IntegratorSettings settings;

@@ -24,7 +24,7 @@ layout(std430, set = 0, binding = 0) buffer ParamsBuffer {
   vec4 bench_hi;
 } params;
 
-layout(std430, set = 0, binding = 1) readonly buffer NodeBuffer { vec4 nodes[]; };        // 7 vec4 per BVH4 node
+layout(std430, set = 0, binding = 1) readonly buffer NodeBuffer { uvec4 nodes[]; };       // BVH4 nodes: 4 uvec4 quantized or 7 float (bvh.glsl)
 layout(std430, set = 0, binding = 2) readonly buffer LeafTriBuffer { vec4 leaf_tris[]; }; // 3 vec4 per triangle
 layout(std430, set = 0, binding = 3) readonly buffer TriShadingBuffer { vec4 tri_shading[]; };  // 6 vec4 per scene triangle
 layout(std430, set = 0, binding = 4) readonly buffer MaterialBuffer { vec4 materials[]; };      // 2 vec4 per material

@@ -81,6 +81,11 @@ struct VulkanIntegrator::Impl {
   GpuBvh bvh;
   uint32_t paths = 0;
   uint32_t iterations_per_submit = 8;
+  uint32_t work_per_path = 4;
+  // Node layout: quantized 64-byte nodes pay on CPU devices (lavapipe: fewer gathered words per
+  // node), float 112-byte nodes on GPUs (the H100 traversal is bound by instructions, not by node
+  // bytes: the BVH stays in L2). Measured: bench/results/vulkan-{lavapipe,gpu}.md.
+  bool quantized_nodes = false;
   float scene_extent = 1.0f;
   Vec3 scene_lo{0, 0, 0}, scene_hi{0, 0, 0};
   uint32_t emitter_count = 0, punctual_count = 0;
@@ -180,9 +185,10 @@ struct VulkanIntegrator::Impl {
         {spirv_extend, sizeof(spirv_extend)}, {spirv_connect, sizeof(spirv_connect)},
         {spirv_prepare, sizeof(spirv_prepare)}, {spirv_reduce, sizeof(spirv_reduce)},
         {spirv_bench_rays, sizeof(spirv_bench_rays)}}};
-    const uint32_t stack_size = std::max<uint32_t>(bvh.stack_entries + 1, 8);
-    VkSpecializationMapEntry entry{0, 0, sizeof(uint32_t)};
-    VkSpecializationInfo spec{1, &entry, sizeof(uint32_t), &stack_size};
+    // Specialization: 0 = traversal stack bound, 1 = node layout (quantized or float; bvh.glsl).
+    const uint32_t spec_values[2] = {std::max<uint32_t>(bvh.stack_entries + 1, 8), quantized_nodes ? 1u : 0u};
+    const VkSpecializationMapEntry entries[2] = {{0, 0, sizeof(uint32_t)}, {1, sizeof(uint32_t), sizeof(uint32_t)}};
+    VkSpecializationInfo spec{2, entries, sizeof(spec_values), spec_values};
     for (int k = 0; k < kKernelCount; ++k) {
       VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
       module_info.codeSize = code[size_t(k)].second;
@@ -216,9 +222,13 @@ struct VulkanIntegrator::Impl {
     if (triangles > 0) scene_extent = std::max(max_component(hi - lo), 1e-30f);  // as EmbreeScene::extent()
     scene_lo = lo, scene_hi = hi;
 
-    std::vector<float> nodes(bvh.nodes.size() * 28);
-    std::memcpy(nodes.data(), bvh.nodes.data(), nodes.size() * 4);
-    make_and_upload(kNodes, nodes);
+    if (quantized_nodes) {
+      make_and_upload(kNodes, quantize_bvh4_nodes(bvh.nodes));
+    } else {
+      std::vector<uint32_t> nodes(bvh.nodes.size() * 28);
+      std::memcpy(nodes.data(), bvh.nodes.data(), nodes.size() * 4);
+      make_and_upload(kNodes, nodes);
+    }
     std::vector<float> leaf(bvh.triangles.size() * 12);
     if (!leaf.empty()) std::memcpy(leaf.data(), bvh.triangles.data(), leaf.size() * 4);
     make_and_upload(kLeafTris, leaf);
@@ -453,7 +463,7 @@ LightmapEstimate VulkanIntegrator::Impl::bake(const TexelGBuffer& gbuffer, const
 
   // Work items per batch: enough to keep every path slot busy between drains, bounded by memory.
   const size_t limit_items = size_t(ctx->properties().limits.maxStorageBufferRange) / (size_t(K + 1) * 12);
-  const size_t max_work = std::max<size_t>(1, std::min<size_t>({size_t(paths) * 4, limit_items, size_t(1) << 30}));
+  const size_t max_work = std::max<size_t>(1, std::min<size_t>({size_t(paths) * work_per_path, limit_items, size_t(1) << 30}));
   ensure_bake_buffers(texel_count, K, max_work);
 
   std::vector<float> texels(texel_count * 12, 0.0f);
@@ -653,7 +663,10 @@ std::unique_ptr<VulkanIntegrator> VulkanIntegrator::create(const Scene& scene, c
   const bool cpu_device = impl->ctx->info().type == VulkanDeviceType::Cpu;
   impl->paths = options.max_paths ? options.max_paths : (cpu_device ? (1u << 14) : (1u << 20));
   impl->paths = std::max<uint32_t>(impl->paths, kGroupSize);
-  impl->iterations_per_submit = options.iterations_per_submit ? options.iterations_per_submit : 8;
+  impl->iterations_per_submit = options.iterations_per_submit ? options.iterations_per_submit : (cpu_device ? 8u : 32u);
+  impl->quantized_nodes = options.node_layout == VulkanNodeLayout::Automatic ? cpu_device
+                                                                            : options.node_layout == VulkanNodeLayout::Quantized;
+  impl->work_per_path = options.work_items_per_path ? options.work_items_per_path : (cpu_device ? 4u : 16u);
   impl->bvh = build_gpu_bvh(scene);
   impl->upload_scene();
   impl->allocate_path_state();
@@ -674,7 +687,10 @@ LightmapEstimate VulkanIntegrator::bake(const TexelGBuffer& gbuffer, const Integ
 const VulkanDeviceInfo& VulkanIntegrator::device() const { return impl_->ctx->info(); }
 uint32_t VulkanIntegrator::max_paths() const { return impl_->paths; }
 size_t VulkanIntegrator::path_state_bytes_per_path() const { return impl_->path_bytes(); }
-size_t VulkanIntegrator::bvh_bytes() const { return impl_->bvh.nodes.size() * 112 + impl_->bvh.triangles.size() * 48; }
+size_t VulkanIntegrator::bvh_bytes() const {
+  return impl_->bvh.nodes.size() * (impl_->quantized_nodes ? kQuantizedNodeWords * 4 : sizeof(GpuBvhNode)) +
+         impl_->bvh.triangles.size() * 48;
+}
 uint32_t VulkanIntegrator::bvh_node_count() const { return uint32_t(impl_->bvh.nodes.size()); }
 const std::vector<VulkanStageStatistics>& VulkanIntegrator::stage_statistics() const { return impl_->stats; }
 double VulkanIntegrator::measure_incoherent_traversal(uint32_t ray_count, int repetitions) const {

@@ -30,6 +30,10 @@ struct VulkanDeviceInfo {
 // Lists the Vulkan physical devices; empty when there is no loader, no driver or no device.
 std::vector<VulkanDeviceInfo> enumerate_vulkan_devices();
 
+// BVH4 node layout in GPU memory: 112-byte float nodes, or 64-byte nodes with 8-bit quantized
+// child bounds (conservative). Automatic: quantized on CPU devices (lavapipe), float on GPUs.
+enum class VulkanNodeLayout { Automatic, Float, Quantized };
+
 struct VulkanDeviceOptions {
   int device_index = -1;   // -1: prefer a discrete GPU, then integrated, then any (lavapipe)
   bool validation = false; // enable VK_LAYER_KHRONOS_validation + a debug messenger
@@ -37,8 +41,14 @@ struct VulkanDeviceOptions {
   std::function<void(const std::string&)> on_validation_message;
   // Paths in flight = threads of the largest dispatch; 0 = automatic (1 Mi on a GPU, 16 Ki on a CPU device).
   uint32_t max_paths = 0;
-  // Wavefront iterations (shade+generate+connect+extend) recorded per submission; 0 = automatic.
+  // Wavefront iterations (shade+generate+connect+extend) recorded per submission; 0 = automatic
+  // (32 on a GPU, 8 on a CPU device).
   uint32_t iterations_per_submit = 0;
+  // Work items (texel, sample) per batch = paths x this; a batch ends with a drain (the last paths
+  // finish while slots idle), so more items per batch means fewer drains, for more result memory
+  // (recorded_bounces + 1) x 12 bytes per item. 0 = automatic (16 on a GPU, 4 on a CPU device).
+  uint32_t work_items_per_path = 0;
+  VulkanNodeLayout node_layout = VulkanNodeLayout::Automatic;
   double fence_timeout_seconds = 20.0;  // a submission that does not finish in this time -> exception
   bool collect_stage_statistics = false;  // timestamps + lane counters per stage (bench only; slower)
 };
