@@ -36,6 +36,7 @@ class Context {
   VkQueue queue() const { return queue_; }
   const VulkanDeviceInfo& info() const { return info_; }
   const VkPhysicalDeviceProperties& properties() const { return properties_; }
+  const VkPhysicalDeviceMemoryProperties& memory_properties() const { return memory_properties_; }
   uint32_t subgroup_size() const { return subgroup_size_; }
   bool timestamps() const { return timestamp_valid_bits_ > 0; }
 

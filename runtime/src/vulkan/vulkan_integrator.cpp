@@ -661,12 +661,21 @@ std::unique_ptr<VulkanIntegrator> VulkanIntegrator::create(const Scene& scene, c
   auto impl = std::make_unique<Impl>(scene, options);
   impl->ctx = std::make_unique<Context>(options);
   const bool cpu_device = impl->ctx->info().type == VulkanDeviceType::Cpu;
-  impl->paths = options.max_paths ? options.max_paths : (cpu_device ? (1u << 14) : (1u << 20));
+  // Paths in flight: on a GPU, more paths hide more latency and shorten the drains at batch ends
+  // (H100, 1 M live texels: 1 Mi paths 1.46 s, 4 Mi paths 1.20 s; bench/results/vulkan-gpu.md);
+  // 4 Mi paths take about 1.7 GB (path state + results), so only where the device has 16 GiB or more.
+  VkDeviceSize device_local = 0;
+  const VkPhysicalDeviceMemoryProperties& memory = impl->ctx->memory_properties();
+  for (uint32_t h = 0; h < memory.memoryHeapCount; ++h)
+    if (memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
+      device_local = std::max(device_local, memory.memoryHeaps[h].size);
+  const uint32_t gpu_paths = device_local >= (VkDeviceSize(16) << 30) ? (1u << 22) : (1u << 20);
+  impl->paths = options.max_paths ? options.max_paths : (cpu_device ? (1u << 14) : gpu_paths);
   impl->paths = std::max<uint32_t>(impl->paths, kGroupSize);
   impl->iterations_per_submit = options.iterations_per_submit ? options.iterations_per_submit : (cpu_device ? 8u : 32u);
   impl->quantized_nodes = options.node_layout == VulkanNodeLayout::Automatic ? cpu_device
                                                                             : options.node_layout == VulkanNodeLayout::Quantized;
-  impl->work_per_path = options.work_items_per_path ? options.work_items_per_path : (cpu_device ? 4u : 16u);
+  impl->work_per_path = options.work_items_per_path ? options.work_items_per_path : 4u;
   impl->bvh = build_gpu_bvh(scene);
   impl->upload_scene();
   impl->allocate_path_state();

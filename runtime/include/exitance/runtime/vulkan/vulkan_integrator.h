@@ -39,14 +39,16 @@ struct VulkanDeviceOptions {
   bool validation = false; // enable VK_LAYER_KHRONOS_validation + a debug messenger
   // Receives every validation/debug message (warnings and errors), including those at teardown.
   std::function<void(const std::string&)> on_validation_message;
-  // Paths in flight = threads of the largest dispatch; 0 = automatic (1 Mi on a GPU, 16 Ki on a CPU device).
+  // Paths in flight = threads of the largest dispatch; 0 = automatic (4 Mi on a GPU with 16 GiB or
+  // more of device memory, else 1 Mi; 16 Ki on a CPU device).
   uint32_t max_paths = 0;
   // Wavefront iterations (shade+generate+connect+extend) recorded per submission; 0 = automatic
   // (32 on a GPU, 8 on a CPU device).
   uint32_t iterations_per_submit = 0;
   // Work items (texel, sample) per batch = paths x this; a batch ends with a drain (the last paths
   // finish while slots idle), so more items per batch means fewer drains, for more result memory
-  // (recorded_bounces + 1) x 12 bytes per item. 0 = automatic (16 on a GPU, 4 on a CPU device).
+  // (recorded_bounces + 1) x 12 bytes per item. 0 = automatic (4; on the H100 larger batches made
+  // the shade stage slower than the drains they saved).
   uint32_t work_items_per_path = 0;
   VulkanNodeLayout node_layout = VulkanNodeLayout::Automatic;
   double fence_timeout_seconds = 20.0;  // a submission that does not finish in this time -> exception
