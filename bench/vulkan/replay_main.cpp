@@ -4,12 +4,15 @@
 //
 //   bench_vulkan_replay FILE [--spp N] [--max-paths N] [--traversal-rays N] [--iterations-per-submit N]
 //                       [--work-per-path N] [--node-layout auto|float|quantized] [--skip-instrumented]
+//                       [--reference FILE]   (cross-check against a CPU reference written by
+//                                             bench_vulkan_throughput --write-reference; exit 3 on |z| >= 4)
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
 
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
+#include "reference_comparison.h"
 #include "replay_format.h"
 #include "report.h"
 
@@ -29,6 +32,7 @@ int main(int argc, char** argv) {
   std::string path = argv[1];
   uint32_t spp = 256, max_paths = 0, traversal_rays = 1u << 24, iterations = 0, work_per_path = 0;
   bool skip_instrumented = false;
+  std::string reference_path;
   VulkanNodeLayout layout = VulkanNodeLayout::Automatic;
   for (int i = 2; i < argc; ++i) {
     auto next = [&]() -> uint32_t {
@@ -45,6 +49,7 @@ int main(int argc, char** argv) {
       layout = v == "float" ? VulkanNodeLayout::Float : v == "quantized" ? VulkanNodeLayout::Quantized : VulkanNodeLayout::Automatic;
     }
     else if (!std::strcmp(argv[i], "--skip-instrumented")) skip_instrumented = true;
+    else if (!std::strcmp(argv[i], "--reference") && i + 1 < argc) reference_path = argv[++i];
     else { std::fprintf(stderr, "unknown option %s\n", argv[i]); return 2; }
   }
   try {
@@ -77,6 +82,16 @@ int main(int argc, char** argv) {
       double mean = 0;
       for (size_t i = 0; i < gpu.texels.size(); ++i) mean += luminance(gpu.mean_total(i));
       std::printf("mean texel luminance (E/pi) %.6g\n", gbuffer.texels.empty() ? 0.0 : mean / double(gpu.texels.size()));
+      if (!reference_path.empty()) {
+        const replay::ReferenceComparison c = replay::compare_with_reference(reference_path, gpu, 32);
+        std::printf("cross-check vs CPU reference: %zu regions x 3 channels, max |z| %.2f, relMSE %.3g "
+                    "(noise alone %.3g)\n", c.regions, c.max_abs_z, c.rel_mse, c.noise_rel_mse);
+        if (!(c.max_abs_z < 4.0) || !(c.rel_mse < 0.005)) {
+          std::fprintf(stderr, "bench_vulkan_replay: cross-check FAILED\n");
+          return 3;
+        }
+        if (skip_instrumented && traversal_rays == 0) return 0;
+      }
     }
     options.collect_stage_statistics = true;
     auto vk_stats = VulkanIntegrator::create(scene, options);

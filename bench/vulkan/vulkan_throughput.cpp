@@ -21,6 +21,7 @@
 #include "exitance/runtime/embree_scene.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "../../runtime/src/vulkan/gpu_bvh.h"
+#include "reference_comparison.h"
 #include "replay_format.h"
 #include "report.h"
 
@@ -43,6 +44,10 @@ int main(int argc, char** argv) {
   app.add_option("--node-layout", node_layout, "BVH4 node layout: auto, float or quantized")
       ->check(CLI::IsMember({"auto", "float", "quantized"}));
   app.add_option("--write-replay", replay_path, "write a replay file for bench_vulkan_replay and exit");
+  std::string reference_path;
+  app.add_option("--write-reference", reference_path,
+                 "with --write-replay: also bake the CPU reference at --cpu-spp (seed 7) and write it for "
+                 "bench_vulkan_replay --reference");
   CLI11_PARSE(app, argc, argv);
 
   Diagnostics diagnostics;
@@ -63,6 +68,15 @@ int main(int argc, char** argv) {
     const vulkan::GpuBvh bvh = vulkan::build_gpu_bvh(scene);
     replay::write_replay(replay_path, {scene_path, density}, scene, gbuffer, bvh);
     std::printf("wrote %s (BVH4 %zu nodes, stack bound %u)\n", replay_path.c_str(), bvh.nodes.size(), bvh.stack_entries);
+    if (!reference_path.empty()) {
+      IntegratorSettings reference_settings;
+      reference_settings.spp = cpu_spp ? cpu_spp : spp;
+      reference_settings.seed = 7;  // independent of the replay's seed 1
+      const LightmapEstimate reference = CpuReferenceIntegrator(scene).bake(gbuffer, reference_settings);
+      replay::write_reference(reference_path, reference);
+      std::printf("wrote %s (CPU reference, %u spp, %.1f s)\n", reference_path.c_str(), reference_settings.spp,
+                  reference.seconds);
+    }
     return 0;
   }
 
