@@ -8,10 +8,11 @@ spp="${3:-16}"
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
 "$build/bake/bake" "$build/samples/building.gltf" -o "$out/building.bake" --backend cpu \
-  --texel-density "$density" --spp "$spp" --json 2>/dev/null |
-  python3 -c '
+  --texel-density "$density" --spp "$spp" --json 2>/dev/null >"$out/report.json"
+python3 - "$out/report.json" <<'PY'
 import json, sys
-r = json.load(sys.stdin)
-print(f"triangles {r[\"triangles\"]}, live texels {r[\"live_texels\"]}, spp {r[\"samples_per_texel\"][\"mean\"]:.0f}, "
-      f"rays {r[\"rays\"]}, lighting {r[\"seconds\"][\"lighting\"]:.2f} s, {r[\"rays_per_second\"] / 1e6:.2f} Mrays/s, "
-      f"device: {r[\"device\"]}")'
+r = json.load(open(sys.argv[1]))
+print("triangles %d, live texels %d, spp %.0f, rays %d, lighting %.2f s, %.2f Mrays/s, device: %s" % (
+    r["triangles"], r["live_texels"], r["samples_per_texel"]["mean"], r["rays"], r["seconds"]["lighting"],
+    r["rays_per_second"] / 1e6, r["device"]))
+PY

@@ -18,7 +18,7 @@ import time
 
 # name, sky, texel density, reference spp, max spp of the ladder
 SCENES = [
-    ("cornell_room", "", 8, 16384, 2048),
+    ("cornell_room", "", 4, 16384, 2048),
     ("courtyard", "0.5,0.6,0.8", 2, 4096, 1024),
     ("ajar_room", "", 4, 32768, 4096),
     ("building", "", 0.5, 512, 256),
