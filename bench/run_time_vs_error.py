@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Time against error over the bench scene suite (DESIGN §7).
 
 Runs bench_time_to_error for every backend x integrator x scene, writes one CSV, draws a
@@ -6,7 +6,9 @@ log-log plot of relMSE against seconds per scene (matplotlib), and a Markdown ta
 time to reach the target relMSE and of relMSE at equal time, as ratios to the CPU reference
 measured in the same run. References are cached by content hash in ~/.cache/exitance.
 
-  python3 bench/run_time_vs_error.py --build build --out bench/results [--quick]
+  /usr/bin/python3 bench/run_time_vs_error.py --build build --out bench/results [--quick]
+
+(Debian's python3 has python3-matplotlib; a pyenv python3 on PATH may not.)
 """
 import argparse
 import csv
@@ -109,7 +111,7 @@ def main():
     fig.savefig(png_path, dpi=110)
 
     lines = [f"# Time against error ({stamp})", "",
-             "Produced by:", "", "```", "python3 bench/run_time_vs_error.py " + " ".join(sys.argv[1:]), "```", "",
+             "Produced by:", "", "```", "/usr/bin/python3 bench/run_time_vs_error.py " + " ".join(sys.argv[1:]), "```", "",
              "which ran:", "", "```"] + commands + ["```", "",
              f"relMSE = mean over texels and channels of (x - r)^2 / (r^2 + 1e-3), minus the reference's own expected "
              f"relMSE (column reference_rel_mse of {os.path.basename(csv_path)}). Machine: 2 shared cores; absolute "
