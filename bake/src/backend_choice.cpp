@@ -70,7 +70,8 @@ LightingBackend choose_lighting_backend(const Scene& scene, const BackendRequest
   if (!has_gpu) {
     diagnostics.warn(devices.empty()
                          ? "--backend auto: no Vulkan device; using the CPU reference (Embree)"
-                         : "--backend auto: only a CPU Vulkan device (lavapipe, measured 0.21x Embree here); "
+                         : "--backend auto: only a CPU Vulkan device (lavapipe measured 0.1-0.2x Embree's rays/s on 2 cores, "
+                           "bench/results/vulkan-lavapipe.md); "
                            "using the CPU reference (Embree)");
     return cpu_backend(scene);
   }

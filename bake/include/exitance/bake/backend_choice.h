@@ -24,7 +24,7 @@ struct LightingBackend {
 };
 
 // auto: a GPU Vulkan device when one exists and supports the scene; otherwise the CPU reference,
-// because on this project's CPU machines lavapipe measured 0.21x Embree's rays/s
+// because on this project's 2-core CPU machines lavapipe measured 0.1-0.2x Embree's rays/s
 // (bench/results/vulkan-lavapipe.md). Notices go to `diagnostics`. Throws std::runtime_error
 // when `vulkan` is requested and impossible.
 LightingBackend choose_lighting_backend(const Scene& scene, const BackendRequest& request, Diagnostics& diagnostics);
