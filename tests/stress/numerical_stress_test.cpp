@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "support/test_scenes.h"
 
 namespace exitance {
@@ -54,12 +55,39 @@ Room make_room(float scale, Vec3 offset) {
   return room;
 }
 
-LightmapEstimate bake(const Room& room, uint32_t spp, uint64_t seed) {
-  IntegratorSettings settings;
-  settings.spp = spp;
-  settings.seed = seed;
-  return CpuReferenceIntegrator(room.scene).bake(room.texels, settings);
-}
+// Every stress test runs on each backend: the CPU reference and the Vulkan compute backend
+// (lavapipe in CI, validation layers on; any validation message fails the test).
+class Stress : public ::testing::TestWithParam<std::string> {
+ protected:
+  void SetUp() override {
+    if (GetParam() != "vulkan") return;
+    bool usable = false;
+    for (const VulkanDeviceInfo& d : enumerate_vulkan_devices()) usable = usable || d.usable;
+    if (!usable) GTEST_SKIP() << "no usable Vulkan device";
+  }
+
+  LightmapEstimate bake_scene(const Scene& scene, const TexelGBuffer& texels, const IntegratorSettings& settings) {
+    if (GetParam() == "cpu") return CpuReferenceIntegrator(scene).bake(texels, settings);
+    std::vector<std::string> messages;
+    VulkanDeviceOptions options;
+    options.validation = true;
+    options.on_validation_message = [&messages](const std::string& m) { messages.push_back(m); };
+    LightmapEstimate estimate;
+    {
+      const auto integrator = VulkanIntegrator::create(scene, options);
+      estimate = integrator->bake(texels, settings);
+    }
+    EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: " << messages.front();
+    return estimate;
+  }
+
+  LightmapEstimate bake(const Room& room, uint32_t spp, uint64_t seed) {
+    IntegratorSettings settings;
+    settings.spp = spp;
+    settings.seed = seed;
+    return bake_scene(room.scene, room.texels, settings);
+  }
+};
 
 // Largest |z| over texels of the difference between two independent estimates.
 double max_abs_z(const LightmapEstimate& a, const LightmapEstimate& b, size_t& compared) {
@@ -80,7 +108,7 @@ void expect_finite(const LightmapEstimate& e) {
   for (size_t i = 0; i < e.texels.size(); ++i) ASSERT_TRUE(is_finite(e.mean_total(i))) << "texel " << i;
 }
 
-TEST(Stress, ScaleInvariance) {
+TEST_P(Stress, ScaleInvariance) {
   const LightmapEstimate base = bake(make_room(1.0f, {}), 256, 1);
   for (float scale : {1e-3f, 1e4f}) {
     const LightmapEstimate scaled = bake(make_room(scale, {}), 256, 2);
@@ -89,11 +117,11 @@ TEST(Stress, ScaleInvariance) {
     const double z = max_abs_z(base, scaled, compared);
     // 192 texel-channels: the largest of that many |z| exceeds 4.5 with probability < 0.2 %.
     EXPECT_LT(z, 4.5) << "scale " << scale;
-    std::printf("[stress] scale %-6g max |z| over %zu texel-channels = %.2f\n", scale, compared, z);
+    std::printf("[stress %s] scale %-6g max |z| over %zu texel-channels = %.2f\n", GetParam().c_str(), scale, compared, z);
   }
 }
 
-TEST(Stress, FarFromOriginNoSelfIntersection) {
+TEST_P(Stress, FarFromOriginNoSelfIntersection) {
   const LightmapEstimate base = bake(make_room(1.0f, {}), 1024, 3);
   const LightmapEstimate moved = bake(make_room(1.0f, {1e5f, 1e5f, -1e5f}), 1024, 4);
   expect_finite(moved);
@@ -109,13 +137,13 @@ TEST(Stress, FarFromOriginNoSelfIntersection) {
     }
   rel_mse /= double(n);
   noise /= double(n);
-  std::printf("[stress] offset 1e5: relMSE vs unmoved %.3g (expected from noise alone %.3g)\n", rel_mse, noise);
+  std::printf("[stress %s] offset 1e5: relMSE vs unmoved %.3g (expected from noise alone %.3g)\n", GetParam().c_str(), rel_mse, noise);
   EXPECT_LT(rel_mse, 0.01);
   // Systematic self-intersection shows up as error well beyond the noise of the two estimates.
   EXPECT_LT(rel_mse, 2.0 * noise + 1e-4);
 }
 
-TEST(Stress, FurnaceAlbedo099IsUnbiased) {
+TEST_P(Stress, FurnaceAlbedo099IsUnbiased) {
   Scene scene;
   add_inward_box(scene, {0, 0, 0}, {1, 1, 1}, add_material(scene, {0.99f, 0.99f, 0.99f}, {1, 1, 1}));
   TexelGBuffer gbuffer;
@@ -123,18 +151,18 @@ TEST(Stress, FurnaceAlbedo099IsUnbiased) {
   IntegratorSettings settings;
   settings.spp = 256;
   settings.seed = 5;
-  const LightmapEstimate e = CpuReferenceIntegrator(scene).bake(gbuffer, settings);
+  const LightmapEstimate e = bake_scene(scene, gbuffer, settings);
   double mean = 0, variance = 0;
   for (size_t i = 0; i < e.texels.size(); ++i) mean += e.mean_total(i).x, variance += e.variance_of_mean(i).x;
   mean /= double(e.texels.size());
   const double se = std::sqrt(variance) / double(e.texels.size());
-  std::printf("[stress] furnace rho=0.99: exact 100 estimate %.4g SE %.3g z %+.2f (rays %llu; bounce cap %d)\n", mean,
+  std::printf("[stress %s] furnace rho=0.99: exact 100 estimate %.4g SE %.3g z %+.2f (rays %llu; bounce cap %d)\n", GetParam().c_str(), mean,
               se, (mean - 100.0) / se, static_cast<unsigned long long>(e.rays), settings.safety_bounce_cap);
   EXPECT_LT(std::fabs(mean - 100.0), 4.0 * se);
   EXPECT_LT(se, 1.0);
 }
 
-TEST(Stress, TinyVeryBrightEmitter) {
+TEST_P(Stress, TinyVeryBrightEmitter) {
   Room room = make_room(1.0f, {});
   // Area 1e-4 (1 cm x 1 cm), radiance 1e8, facing down from 3.5 m.
   const uint32_t hot = add_material(room.scene, {0, 0, 0}, {1e8f, 1e8f, 1e8f});
@@ -150,13 +178,13 @@ TEST(Stress, TinyVeryBrightEmitter) {
     ASSERT_TRUE(std::isfinite(se));
     if (m > 0) worst = std::max(worst, se / m), noisy += se / m > 0.25 ? 1 : 0;
   }
-  std::printf("[stress] tiny bright emitter: %zu of %zu texels with relative SE > 0.25, worst %.3f\n", noisy,
+  std::printf("[stress %s] tiny bright emitter: %zu of %zu texels with relative SE > 0.25, worst %.3f\n", GetParam().c_str(), noisy,
               e.texels.size(), worst);
   // The emitter is sampled by next-event estimation; MIS keeps its contribution finite-variance.
   EXPECT_LT(worst, 0.5);
 }
 
-TEST(Stress, DegenerateGeometryAndHiddenLights) {
+TEST_P(Stress, DegenerateGeometryAndHiddenLights) {
   Room room = make_room(1.0f, {});
   Scene& s = room.scene;
   const uint32_t white = add_material(s, {0.7f, 0.7f, 0.7f});
@@ -186,11 +214,11 @@ TEST(Stress, DegenerateGeometryAndHiddenLights) {
     if (se > 0) z_sum += d / se, ++n;
   }
   const double mean_z = z_sum / std::sqrt(double(n));  // sum of n unit normals / sqrt(n) is a unit normal
-  std::printf("[stress] degenerate geometry + hidden light: combined z vs plain room %+.2f over %zu texels\n", mean_z, n);
+  std::printf("[stress %s] degenerate geometry + hidden light: combined z vs plain room %+.2f over %zu texels\n", GetParam().c_str(), mean_z, n);
   EXPECT_LT(std::fabs(mean_z), 4.0);
 }
 
-TEST(Stress, ThinWallDoesNotLeak) {
+TEST_P(Stress, ThinWallDoesNotLeak) {
   // Two rooms side by side sharing a wall 1/10 of a 5 cm texel thick; only the left room is lit.
   Scene scene;
   const uint32_t white = add_material(scene, {0.8f, 0.8f, 0.8f});
@@ -208,13 +236,16 @@ TEST(Stress, ThinWallDoesNotLeak) {
   }
   IntegratorSettings settings;
   settings.spp = 128;
-  const LightmapEstimate e = CpuReferenceIntegrator(scene).bake(gbuffer, settings);
+  const LightmapEstimate e = bake_scene(scene, gbuffer, settings);
   expect_finite(e);
   double leak = 0;
   for (size_t i = 0; i < e.texels.size(); ++i) leak = std::max(leak, double(luminance(e.mean_total(i))));
-  std::printf("[stress] thin wall (t = %.3g): largest E/pi in the dark room %.3g\n", t, leak);
+  std::printf("[stress %s] thin wall (t = %.3g): largest E/pi in the dark room %.3g\n", GetParam().c_str(), t, leak);
   EXPECT_EQ(leak, 0.0);
 }
+
+INSTANTIATE_TEST_SUITE_P(Backends, Stress, ::testing::Values("cpu", "vulkan"),
+                         [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
 
 }  // namespace
 }  // namespace exitance
