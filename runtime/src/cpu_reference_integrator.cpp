@@ -268,36 +268,4 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   return estimate;
 }
 
-Vec3 LightmapEstimate::mean_total(size_t texel) const {
-  const TexelAccumulator& a = texels[texel];
-  if (a.samples == 0) return {0, 0, 0};
-  return {float(a.total[0] / a.samples), float(a.total[1] / a.samples), float(a.total[2] / a.samples)};
-}
-
-Vec3 LightmapEstimate::mean_direct(size_t texel) const {
-  const TexelAccumulator& a = texels[texel];
-  if (a.samples == 0) return {0, 0, 0};
-  return {float(a.direct[0] / a.samples), float(a.direct[1] / a.samples), float(a.direct[2] / a.samples)};
-}
-
-Vec3 LightmapEstimate::mean_bounce(int bounce, size_t texel) const {
-  const TexelAccumulator& a = texels[texel];
-  if (a.samples == 0 || bounce < 0 || bounce >= recorded_bounces) return {0, 0, 0};
-  const size_t base = (size_t(bounce) * texels.size() + texel) * 3;
-  return {float(bounces[base] / a.samples), float(bounces[base + 1] / a.samples), float(bounces[base + 2] / a.samples)};
-}
-
-Vec3 LightmapEstimate::variance_of_mean(size_t texel) const {
-  const TexelAccumulator& a = texels[texel];
-  if (a.samples < 2) return {0, 0, 0};
-  Vec3 v;
-  for (int c = 0; c < 3; ++c) {
-    const double n = a.samples;
-    const double mean = a.total[c] / n;
-    const double sample_variance = std::max(0.0, (a.total_squared[c] - n * mean * mean) / (n - 1));
-    v[c] = float(sample_variance / n);
-  }
-  return v;
-}
-
 }  // namespace exitance
