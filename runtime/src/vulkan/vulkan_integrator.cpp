@@ -260,34 +260,21 @@ struct VulkanIntegrator::Impl {
     }
     make_and_upload(kMaterials, materials);
 
-    // Emitter distribution: the same weights and CDF as LightSampler / Distribution1D.
-    std::vector<uint32_t> emitter_tris;
-    std::vector<double> powers;
-    for (uint32_t t = 0; t < triangles; ++t) {
-      if (!is_emissive(scene, t)) continue;
-      const Material& m = scene.materials[scene.triangle_material[t]];
-      const Vec3* p = &scene.positions[size_t(t) * 3];
-      const double area = 0.5 * double(length(cross(p[1] - p[0], p[2] - p[0])));
-      const double power = area * double(luminance(m.emission)) * (m.double_sided ? 2.0 : 1.0);
-      if (!(power > 0) || !(area > 0)) continue;
-      emitter_tris.push_back(t);
-      powers.push_back(power);
-    }
+    // Emitter and punctual-light choice: LightSampler's own distributions, uploaded as CDFs, so both
+    // backends pick lights with identical probabilities.
+    const std::vector<uint32_t>& emitter_tris = lights.emitter_triangles();
     emitter_count = uint32_t(emitter_tris.size());
-    make_and_upload(kEmitterCdf, cdf_of(powers));
+    make_and_upload(kEmitterCdf, padded_cdf(lights.emitter_distribution()));
     make_and_upload(kEmitterTris, emitter_tris.empty() ? std::vector<uint32_t>{0} : emitter_tris);
 
-    std::vector<double> light_powers;
     std::vector<float> punctual(std::max<size_t>(scene.lights.size(), 1) * 12, 0.0f);
-    const double radius = lights.scene_radius();
     for (size_t i = 0; i < scene.lights.size(); ++i) {
       const PunctualLight& l = scene.lights[i];
-      const double intensity = luminance(l.intensity);
       uint32_t type = 0;
       switch (l.type) {
-        case PunctualLight::Type::Point: light_powers.push_back(4.0 * kPi * intensity); type = 0; break;
-        case PunctualLight::Type::Spot: light_powers.push_back(2.0 * kPi * (1.0 - l.cos_outer) * intensity); type = 1; break;
-        case PunctualLight::Type::Directional: light_powers.push_back(kPi * radius * radius * intensity); type = 2; break;
+        case PunctualLight::Type::Point: type = 0; break;
+        case PunctualLight::Type::Spot: type = 1; break;
+        case PunctualLight::Type::Directional: type = 2; break;
       }
       float* v = &punctual[i * 12];
       v[0] = l.position.x, v[1] = l.position.y, v[2] = l.position.z;
@@ -298,16 +285,12 @@ struct VulkanIntegrator::Impl {
     // An all-zero punctual distribution never samples (Distribution1D::empty -> pmf 0 -> probability 0).
     punctual_count = uint32_t(scene.lights.size());
     make_and_upload(kPunctual, punctual);
-    make_and_upload(kPunctualCdf, cdf_of(light_powers));
+    make_and_upload(kPunctualCdf, padded_cdf(lights.punctual_distribution()));
   }
 
-  // Distribution1D's normalised CDF (size n + 1), computed the same way.
-  static std::vector<double> cdf_of(const std::vector<double>& weights) {
-    std::vector<double> cdf(weights.size() + 1, 0.0);
-    for (size_t i = 0; i < weights.size(); ++i) cdf[i + 1] = cdf[i] + std::max(0.0, weights[i]);
-    const double total = cdf.back();
-    if (total > 0)
-      for (double& c : cdf) c /= total;
+  // A distribution's CDF for a GPU buffer, which must hold at least two entries.
+  static std::vector<double> padded_cdf(const Distribution1D& distribution) {
+    std::vector<double> cdf = distribution.cdf();
     if (cdf.size() < 2) cdf.resize(2, 0.0);
     return cdf;
   }

@@ -20,6 +20,8 @@ class Distribution1D {
   size_t size() const { return cdf_.empty() ? 0 : cdf_.size() - 1; }
   double total() const { return total_; }
   float pmf(size_t i) const { return float(cdf_[i + 1] - cdf_[i]); }
+  // Normalised CDF, size() + 1 entries (all zero when every weight is zero).
+  const std::vector<double>& cdf() const { return cdf_; }
 
   // Returns the chosen index; `remapped` is u rescaled to [0,1) inside the chosen cell.
   size_t sample(float u, float* remapped = nullptr) const {

@@ -28,6 +28,10 @@ class LightSampler {
   const PunctualLight& sample_punctual(float u, float& probability) const;
 
   const EnvironmentSampler& environment() const { return environment_; }
+  // The distributions themselves, for backends that sample on another device.
+  const std::vector<uint32_t>& emitter_triangles() const { return emitter_triangles_; }
+  const Distribution1D& emitter_distribution() const { return emitters_; }
+  const Distribution1D& punctual_distribution() const { return punctual_; }
   float scene_radius() const { return scene_radius_; }
 
  private:
