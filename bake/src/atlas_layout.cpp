@@ -21,9 +21,8 @@ std::vector<InstanceMeasure> measure_instances(const Scene& scene) {
     const Instance& instance = scene.instances[i];
     InstanceMeasure& m = measures[i];
     for (uint32_t t = instance.first_triangle; t < instance.first_triangle + instance.triangle_count; ++t) {
-      const Vec3* p = &scene.positions[size_t(t) * 3];
       const Vec2* uv = &scene.lightmap_uv[size_t(t) * 3];
-      m.world_area += 0.5 * double(length(cross(p[1] - p[0], p[2] - p[0])));
+      m.world_area += triangle_area(scene, t);
       const Vec2 e1 = uv[1] - uv[0], e2 = uv[2] - uv[0];
       m.uv_area += 0.5 * std::fabs(double(e1.x) * e2.y - double(e1.y) * e2.x);
       for (int k = 0; k < 3; ++k) {
@@ -40,8 +39,7 @@ std::vector<InstanceMeasure> measure_instances(const Scene& scene) {
 float automatic_texel_density(const Scene& scene, size_t max_total_texels) {
   double area = 0;
   for (size_t t = 0; t < scene.triangle_count(); ++t) {
-    const Vec3* p = &scene.positions[t * 3];
-    area += 0.5 * double(length(cross(p[1] - p[0], p[2] - p[0])));
+    area += triangle_area(scene, t);
   }
   const double preferred = 64.0;
   // Charts fill roughly half their rectangles; keep the texel total under the budget.

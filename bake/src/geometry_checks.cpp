@@ -60,8 +60,7 @@ GeometryCheckReport check_scene_geometry(const Scene& scene, const EmbreeScene& 
 
   for (uint32_t t = 0; t < scene.triangle_count(); ++t) {
     if (!is_emissive(scene, t)) continue;
-    const Vec3* p = &scene.positions[size_t(t) * 3];
-    if (!(length(cross(p[1] - p[0], p[2] - p[0])) > 0.0f)) ++report.unsampled_emitters;
+    if (!(triangle_area(scene, t) > 0.0f)) ++report.unsampled_emitters;
   }
   return report;
 }

@@ -104,8 +104,7 @@ TexelGBuffer rasterize_texel_gbuffer(const Scene& scene, const AtlasLayout& layo
       }
       const Vec2 e1 = tri[1] - tri[0], e2 = tri[2] - tri[0];
       const float texel_area = 0.5f * std::fabs(e1.x * e2.y - e1.y * e2.x);
-      const Vec3* p = &scene.positions[size_t(t) * 3];
-      const float world_area = 0.5f * length(cross(p[1] - p[0], p[2] - p[0]));
+      const float world_area = triangle_area(scene, t);
       triangle_texel_size[t] = texel_area > 0 ? std::sqrt(world_area / texel_area) : 0.0f;
       if (!(texel_area > 0)) continue;  // zero-area chart triangle: nothing to raster
       const int x0 = std::max(0, int(std::floor(std::min({tri[0].x, tri[1].x, tri[2].x}))));
@@ -162,7 +161,7 @@ TexelGBuffer rasterize_texel_gbuffer(const Scene& scene, const AtlasLayout& layo
         texel.x = uint32_t(x);
         texel.y = uint32_t(y);
         texel.position = pos[0] * (1 - b1 - b2) + pos[1] * b1 + pos[2] * b2;
-        texel.geometric_normal = normalize(cross(pos[1] - pos[0], pos[2] - pos[0]));
+        texel.geometric_normal = triangle_normal(scene, t);
         Vec3 n = nrm[0] * (1 - b1 - b2) + nrm[1] * b1 + nrm[2] * b2;
         const float n_length = length(n);
         n = n_length > 0 ? n / n_length : texel.geometric_normal;

@@ -34,8 +34,7 @@ Hit make_hit(const Scene& scene, const RTCRayHit& rayhit) {
   hit.b1 = rayhit.hit.u;
   hit.b2 = rayhit.hit.v;
   // Recomputed from our own vertices so the front side follows glTF's counter-clockwise winding.
-  const Vec3* p = &scene.positions[size_t(hit.triangle) * 3];
-  hit.geometric_normal = normalize(cross(p[1] - p[0], p[2] - p[0]));
+  hit.geometric_normal = triangle_normal(scene, hit.triangle);
   return hit;
 }
 

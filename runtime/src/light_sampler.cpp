@@ -17,8 +17,7 @@ LightSampler::LightSampler(const Scene& scene)
   for (uint32_t t = 0; t < scene.triangle_count(); ++t) {
     if (!is_emissive(scene, t)) continue;
     const Material& m = scene.materials[scene.triangle_material[t]];
-    const Vec3* p = &scene.positions[size_t(t) * 3];
-    const double area = 0.5 * double(length(cross(p[1] - p[0], p[2] - p[0])));
+    const double area = triangle_area(scene, t);
     Vec3 mean = m.emission;
     if (m.emissive_texture.texture >= 0) mean = mean * texture_mean(scene.textures[size_t(m.emissive_texture.texture)]);
     const double power = area * double(luminance(mean)) * (m.double_sided ? 2.0 : 1.0);
@@ -29,9 +28,7 @@ LightSampler::LightSampler(const Scene& scene)
   emitters_ = Distribution1D(powers);
   for (size_t i = 0; i < emitter_triangles_.size(); ++i) {
     const uint32_t t = emitter_triangles_[i];
-    const Vec3* p = &scene.positions[size_t(t) * 3];
-    const float area = 0.5f * length(cross(p[1] - p[0], p[2] - p[0]));
-    triangle_area_pdf_[t] = emitters_.pmf(i) / area;
+    triangle_area_pdf_[t] = emitters_.pmf(i) / triangle_area(scene, t);
   }
 
   std::vector<double> light_powers;
@@ -56,7 +53,7 @@ AreaLightSample LightSampler::sample_area_light(float u_choose, float u1, float 
   AreaLightSample s;
   sample_triangle_barycentrics(u1, u2, s.b1, s.b2);
   s.position = p[0] * (1.0f - s.b1 - s.b2) + p[1] * s.b1 + p[2] * s.b2;
-  s.normal = normalize(cross(p[1] - p[0], p[2] - p[0]));
+  s.normal = triangle_normal(scene_, t);
   s.triangle = t;
   s.pdf_area = triangle_area_pdf_[t];
   return s;

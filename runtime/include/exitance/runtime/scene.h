@@ -86,4 +86,14 @@ struct Scene {
   size_t triangle_count() const { return triangle_material.size(); }
 };
 
+// World-space area and front-side unit normal (counter-clockwise winding) of triangle t.
+inline float triangle_area(const Scene& scene, size_t t) {
+  const Vec3* p = &scene.positions[t * 3];
+  return 0.5f * length(cross(p[1] - p[0], p[2] - p[0]));
+}
+inline Vec3 triangle_normal(const Scene& scene, size_t t) {
+  const Vec3* p = &scene.positions[t * 3];
+  return normalize(cross(p[1] - p[0], p[2] - p[0]));
+}
+
 }  // namespace exitance
