@@ -19,13 +19,9 @@
 #include <fstream>
 #include <iostream>
 
-#include "exitance/bake/atlas_layout.h"
 #include "exitance/bake/backend_choice.h"
-#include "exitance/bake/bake_pipeline.h"
 #include "exitance/bake/bundle_writer.h"
-#include "exitance/bake/texel_raster.h"
-#include "exitance/bake/unocclude.h"
-#include "exitance/runtime/embree_scene.h"
+#include "exitance/bake/prepared_scene.h"
 
 namespace fs = std::filesystem;
 using namespace exitance;
@@ -87,16 +83,11 @@ int main(int argc, char** argv) {
   if (cache_dir.empty()) cache_dir = std::string(std::getenv("HOME") ? std::getenv("HOME") : "/tmp") + "/.cache/exitance";
 
   Diagnostics diagnostics;
-  Scene scene = import_gltf(scene_path, {}, diagnostics);
-  scene.sky = parse_sky_option(sky);
   AtlasSettings atlas;
   atlas.texel_density = density;
-  const AtlasLayout layout = layout_lightmap_atlas(scene, atlas, scene_path, diagnostics);
-  TexelGBuffer gbuffer = rasterize_texel_gbuffer(scene, layout, scene_path, diagnostics);
-  {
-    EmbreeScene embree(scene);
-    unocclude_texels(embree, gbuffer);
-  }
+  const PreparedScene prepared = prepare_scene_for_lighting(scene_path, sky, atlas, diagnostics);
+  const Scene& scene = prepared.scene;
+  const TexelGBuffer& gbuffer = prepared.gbuffer;
   CpuReferenceIntegrator integrator(scene);
   std::vector<LightingBackend> measured;
   for (size_t start = 0; start < backends.size();) {

@@ -13,12 +13,7 @@
 
 #include <cstdio>
 
-#include "exitance/bake/atlas_layout.h"
-#include "exitance/bake/bake_pipeline.h"
-#include "exitance/bake/gltf_import.h"
-#include "exitance/bake/texel_raster.h"
-#include "exitance/bake/unocclude.h"
-#include "exitance/runtime/embree_scene.h"
+#include "exitance/bake/prepared_scene.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "../../runtime/src/vulkan/gpu_bvh.h"
 #include "reference_comparison.h"
@@ -51,16 +46,11 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   Diagnostics diagnostics;
-  Scene scene = import_gltf(scene_path, {}, diagnostics);
-  scene.sky = parse_sky_option(sky);
   AtlasSettings atlas;
   atlas.texel_density = density;
-  const AtlasLayout layout = layout_lightmap_atlas(scene, atlas, scene_path, diagnostics);
-  TexelGBuffer gbuffer = rasterize_texel_gbuffer(scene, layout, scene_path, diagnostics);
-  {
-    EmbreeScene embree(scene);
-    unocclude_texels(embree, gbuffer);
-  }
+  const PreparedScene prepared = prepare_scene_for_lighting(scene_path, sky, atlas, diagnostics);
+  const Scene& scene = prepared.scene;
+  const TexelGBuffer& gbuffer = prepared.gbuffer;
   std::printf("scene %s: %zu triangles, %zu live texels, %u spp\n", scene_path.c_str(), scene.triangle_count(),
               gbuffer.texels.size(), spp);
 

@@ -11,22 +11,19 @@
 #include <string>
 #include <vector>
 
-#include "exitance/bake/atlas_layout.h"
-#include "exitance/bake/bake_pipeline.h"
-#include "exitance/bake/gltf_import.h"
-#include "exitance/bake/texel_raster.h"
-#include "exitance/bake/unocclude.h"
-#include "exitance/runtime/embree_scene.h"
+#include "exitance/bake/prepared_scene.h"
 #include "exitance/runtime/sampling.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
-#include "support/test_scenes.h"
+#include "support/analytic_scenes.h"
 
 namespace exitance {
 namespace {
 
+using testing::AnalyticScene;
 using testing::add_inward_box;
 using testing::add_material;
 using testing::add_quad;
+using testing::grid_points;
 using testing::texel_at;
 
 // Creates the integrator with validation on; records every validation message.
@@ -124,37 +121,20 @@ void crosscheck(const Scene& scene, const TexelGBuffer& g, IntegratorSettings se
   if (gpu_out) *gpu_out = gpu;
 }
 
-std::vector<Vec2> grid_points(int n, float margin) {
-  std::vector<Vec2> points;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i)
-      points.push_back({margin + (1 - 2 * margin) * (float(i) + 0.5f) / float(n),
-                        margin + (1 - 2 * margin) * (float(j) + 0.5f) / float(n)});
-  return points;
-}
-
 void furnace(float albedo, uint32_t spp) {
-  Scene scene;
-  const Vec3 le{1.0f, 0.5f, 0.25f};
-  add_inward_box(scene, {0, 0, 0}, {1, 1, 1}, add_material(scene, {albedo, albedo, albedo}, le));
-  TexelGBuffer g;
-  for (Vec2 p : grid_points(4, 0.1f)) {
-    g.texels.push_back(texel_at({p.x, 0.0f, p.y}, {0, 1, 0}));
-    g.texels.push_back(texel_at({p.x, p.y, 0.0f}, {0, 0, 1}));
-    g.texels.push_back(texel_at({1.0f, p.x, p.y}, {-1, 0, 0}));
-    g.texels.push_back(texel_at({p.x, 1.0f, p.y}, {0, -1, 0}));
-  }
+  const AnalyticScene a = testing::white_furnace(albedo);
+  const TexelGBuffer& g = a.gbuffer;
   IntegratorSettings s;
   s.spp = spp;
   LightmapEstimate gpu;
-  crosscheck(scene, g, s, 16, 0.005, albedo < 0.7f ? "furnace rho 0.5" : "furnace rho 0.9", &gpu);
+  crosscheck(a.scene, g, s, 16, 0.005, albedo < 0.7f ? "furnace rho 0.5" : "furnace rho 0.9", &gpu);
   if (gpu.texels.empty()) return;
   // Against the closed form Le / (1 - rho) over all texels.
   for (int c = 0; c < 3; ++c) {
     double mean = 0, var = 0;
     for (size_t i = 0; i < g.texels.size(); ++i) mean += gpu.mean_total(i)[c], var += gpu.variance_of_mean(i)[c];
     mean /= double(g.texels.size());
-    const double se = std::sqrt(var) / double(g.texels.size()), exact = le[c] / (1.0 - albedo);
+    const double se = std::sqrt(var) / double(g.texels.size()), exact = a.colour[c] * a.exact[0];
     EXPECT_LT(std::fabs(mean - exact), 4 * se) << "channel " << c << " mean " << mean << " exact " << exact;
   }
 }
@@ -163,122 +143,64 @@ TEST(VulkanCrosscheck, WhiteFurnaceAlbedoHalf) { furnace(0.5f, 512); }
 TEST(VulkanCrosscheck, WhiteFurnaceAlbedoPointNine) { furnace(0.9f, 1024); }
 
 TEST(VulkanCrosscheck, PlaneUnderConstantSkyIsExact) {
-  Scene scene;
-  add_quad(scene, {-1, 0, 1}, {2, 0, 0}, {0, 0, -2}, add_material(scene, {0.8f, 0.8f, 0.8f}));
-  scene.sky.constant = {0.5f, 1.0f, 2.0f};
-  TexelGBuffer g;
-  for (Vec2 p : grid_points(8, 0.0f)) g.texels.push_back(texel_at({2 * p.x - 1, 0, 2 * p.y - 1}, {0, 1, 0}));
+  const AnalyticScene a = testing::plane_under_constant_sky();
   IntegratorSettings s;
   s.spp = 16;
   LightmapEstimate gpu;
-  crosscheck(scene, g, s, 8, 1e-6, "plane under constant sky", &gpu);
+  crosscheck(a.scene, a.gbuffer, s, 8, 1e-6, "plane under constant sky", &gpu);
   for (size_t i = 0; i < gpu.texels.size(); ++i)
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(gpu.mean_total(i)[c], scene.sky.constant[c], 1e-5 * scene.sky.constant[c]);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(gpu.mean_total(i)[c], a.colour[c], 1e-5 * a.colour[c]);
 }
 
 TEST(VulkanCrosscheck, PointLightIsExact) {
-  Scene scene;
-  add_quad(scene, {-4, 0, 4}, {8, 0, 0}, {0, 0, -8}, add_material(scene, {0.7f, 0.7f, 0.7f}));
-  PunctualLight light;
-  light.position = {0.3f, 2.0f, -0.2f};
-  light.intensity = {10.0f, 20.0f, 5.0f};
-  scene.lights.push_back(light);
-  TexelGBuffer g;
-  std::vector<double> exact;
-  for (Vec2 p : grid_points(6, 0.0f)) {
-    const Vec3 x{6 * p.x - 3, 0, 6 * p.y - 3};
-    g.texels.push_back(texel_at(x, {0, 1, 0}));
-    const Vec3 d = light.position - x;
-    exact.push_back(10.0 * (d.y / std::sqrt(dot(d, d))) / (kPi * dot(d, d)));
-  }
+  const AnalyticScene a = testing::point_light_over_plane();
   IntegratorSettings s;
   s.spp = 4;
   LightmapEstimate gpu;
-  crosscheck(scene, g, s, 6, 1e-6, "point light", &gpu);
+  crosscheck(a.scene, a.gbuffer, s, 6, 1e-6, "point light", &gpu);
   for (size_t i = 0; i < gpu.texels.size(); ++i) {
-    EXPECT_NEAR(gpu.mean_total(i).x, exact[i], 1e-5 * exact[i]);
-    EXPECT_NEAR(gpu.mean_total(i).y, 2 * exact[i], 2e-5 * exact[i]);
+    EXPECT_NEAR(gpu.mean_total(i).x, a.exact[i], 1e-5 * a.exact[i]);
+    EXPECT_NEAR(gpu.mean_total(i).y, 2 * a.exact[i], 2e-5 * a.exact[i]);
   }
 }
 
 TEST(VulkanCrosscheck, SpotLightIsExact) {
-  Scene scene;
-  add_quad(scene, {-4, 0, 4}, {8, 0, 0}, {0, 0, -8}, add_material(scene, {0, 0, 0}));
-  PunctualLight spot;
-  spot.type = PunctualLight::Type::Spot;
-  spot.position = {0, 2, 0};
-  spot.direction = {0, -1, 0};
-  spot.intensity = {50, 50, 50};
-  const double inner = 20.0 * kPi / 180.0, outer = 30.0 * kPi / 180.0;
-  spot.cos_inner = float(std::cos(inner));
-  spot.cos_outer = float(std::cos(outer));
-  scene.lights.push_back(spot);
-  TexelGBuffer g;
-  std::vector<double> exact;
-  for (double degrees : {0.0, 10.0, 19.5, 21.0, 25.0, 29.0, 30.5, 40.0}) {
-    const double angle = degrees * kPi / 180.0, r = 2.0 * std::tan(angle);
-    g.texels.push_back(texel_at({float(r), 0, 0}, {0, 1, 0}));
-    const double t = std::clamp((std::cos(angle) - std::cos(outer)) / (std::cos(inner) - std::cos(outer)), 0.0, 1.0);
-    exact.push_back(50.0 * t * t * std::cos(angle) / (kPi * (4.0 + r * r)));
-  }
+  const AnalyticScene a = testing::spot_light_cone_edges();
   IntegratorSettings s;
   s.spp = 2;
   LightmapEstimate gpu;
-  crosscheck(scene, g, s, 4, 1e-6, "spot light", &gpu);
-  for (size_t i = 0; i < gpu.texels.size(); ++i) EXPECT_NEAR(gpu.mean_total(i).x, exact[i], 1e-5 * exact[i] + 1e-9);
-  if (!gpu.texels.empty()) EXPECT_EQ(gpu.mean_total(g.texels.size() - 1).x, 0.0f);
+  crosscheck(a.scene, a.gbuffer, s, 4, 1e-6, "spot light", &gpu);
+  for (size_t i = 0; i < gpu.texels.size(); ++i) EXPECT_NEAR(gpu.mean_total(i).x, a.exact[i], 1e-5 * a.exact[i] + 1e-9);
+  if (!gpu.texels.empty()) EXPECT_EQ(gpu.mean_total(a.gbuffer.texels.size() - 1).x, 0.0f);
 }
 
 TEST(VulkanCrosscheck, DirectionalLightIsExact) {
-  Scene scene;
-  add_quad(scene, {-2, 0, 2}, {4, 0, 0}, {0, 0, -4}, add_material(scene, {0.5f, 0.5f, 0.5f}));
-  PunctualLight sun;
-  sun.type = PunctualLight::Type::Directional;
-  sun.direction = normalize(Vec3{0.3f, -0.8f, 0.52f});
-  sun.intensity = {3.0f, 2.0f, 1.0f};
-  scene.lights.push_back(sun);
-  TexelGBuffer g;
-  for (Vec2 p : grid_points(4, 0.1f)) g.texels.push_back(texel_at({4 * p.x - 2, 0, 4 * p.y - 2}, {0, 1, 0}));
+  const AnalyticScene a = testing::directional_light_on_plane();
   IntegratorSettings s;
   s.spp = 4;
   LightmapEstimate gpu;
-  crosscheck(scene, g, s, 4, 1e-6, "directional light", &gpu);
+  crosscheck(a.scene, a.gbuffer, s, 4, 1e-6, "directional light", &gpu);
   for (size_t i = 0; i < gpu.texels.size(); ++i)
     for (int c = 0; c < 3; ++c) {
-      const double exact = sun.intensity[c] * -sun.direction.y / kPi;
+      const double exact = a.colour[c] * a.exact[i];
       EXPECT_NEAR(gpu.mean_total(i)[c], exact, 1e-5 * exact);
     }
 }
 
 TEST(VulkanCrosscheck, TwoParallelUnitSquares) {
-  Scene scene;
-  const Vec3 le{2.0f, 1.0f, 0.5f};
-  add_quad(scene, {0, 0, 1}, {1, 0, 0}, {0, 0, -1}, add_material(scene, {0, 0, 0}));
-  add_quad(scene, {0, 1, 0}, {1, 0, 0}, {0, 0, 1}, add_material(scene, {0, 0, 0}, le));
-  TexelGBuffer g;
-  for (Vec2 p : grid_points(8, 0.0f)) g.texels.push_back(texel_at({p.x, 0, p.y}, {0, 1, 0}));
+  const AnalyticScene a = testing::two_parallel_unit_squares();
   IntegratorSettings s;
   s.spp = 512;
-  crosscheck(scene, g, s, 8, 0.005, "parallel unit squares");
+  crosscheck(a.scene, a.gbuffer, s, 8, 0.005, "parallel unit squares");
 }
 
 TEST(VulkanCrosscheck, AlbedoZeroHasNoIndirectEnergy) {
-  Scene scene;
-  const uint32_t black = add_material(scene, {0, 0, 0});
-  add_quad(scene, {0, 0, 1}, {1, 0, 0}, {0, 0, -1}, black);
-  add_quad(scene, {0, 1, 0}, {1, 0, 0}, {0, 0, 1}, add_material(scene, {0, 0, 0}, {1, 1, 1}));
-  add_quad(scene, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, black);
-  add_quad(scene, {0, 0, 0}, {0, 1, 0}, {0, 0, 1}, black);
-  TexelGBuffer g;
-  for (Vec2 p : grid_points(4, 0.1f)) {
-    g.texels.push_back(texel_at({p.x, 0, p.y}, {0, 1, 0}));
-    g.texels.push_back(texel_at({p.x, p.y, 0}, {0, 0, 1}));
-  }
+  const AnalyticScene a = testing::albedo_zero_room();
   IntegratorSettings s;
   s.spp = 256;
   s.recorded_bounces = 3;
   LightmapEstimate gpu;
-  crosscheck(scene, g, s, 8, 0.005, "albedo zero", &gpu);
+  crosscheck(a.scene, a.gbuffer, s, 8, 0.005, "albedo zero", &gpu);
   for (size_t i = 0; i < gpu.texels.size(); ++i) {
     EXPECT_GT(gpu.mean_total(i).x, 0.0f);
     EXPECT_FLOAT_EQ(gpu.mean_total(i).x, gpu.mean_direct(i).x);
@@ -333,28 +255,15 @@ TEST(VulkanCrosscheck, DeviceEnumeration) {
 }
 
 // A sample scene through the offline stage at a low texel density.
-struct SampleScene {
-  Scene scene;
-  TexelGBuffer gbuffer;
-};
-
-SampleScene load_sample(const std::string& name, const std::string& sky, float density) {
-  SampleScene s;
-  const std::string path = std::string(EXITANCE_SAMPLE_DIR) + "/" + name + ".gltf";
+PreparedScene load_sample(const std::string& name, const std::string& sky, float density) {
   Diagnostics diagnostics;
-  s.scene = import_gltf(path, {}, diagnostics);
-  s.scene.sky = parse_sky_option(sky);
   AtlasSettings atlas;
   atlas.texel_density = density;
-  const AtlasLayout layout = layout_lightmap_atlas(s.scene, atlas, path, diagnostics);
-  s.gbuffer = rasterize_texel_gbuffer(s.scene, layout, path, diagnostics);
-  EmbreeScene embree(s.scene);
-  unocclude_texels(embree, s.gbuffer);
-  return s;
+  return prepare_scene_for_lighting(std::string(EXITANCE_SAMPLE_DIR) + "/" + name + ".gltf", sky, atlas, diagnostics);
 }
 
 TEST(VulkanCrosscheck, CornellRoom) {
-  SampleScene s = load_sample("cornell_room", "", 2.0f);
+  PreparedScene s = load_sample("cornell_room", "", 2.0f);
   ASSERT_GT(s.gbuffer.texels.size(), 50u);
   IntegratorSettings settings;
   settings.spp = 1024;
@@ -362,7 +271,7 @@ TEST(VulkanCrosscheck, CornellRoom) {
 }
 
 TEST(VulkanCrosscheck, CourtyardUnderConstantSky) {
-  SampleScene s = load_sample("courtyard", "0.6,0.7,1.0", 0.5f);
+  PreparedScene s = load_sample("courtyard", "0.6,0.7,1.0", 0.5f);
   ASSERT_GT(s.gbuffer.texels.size(), 50u);
   IntegratorSettings settings;
   settings.spp = 256;
