@@ -189,6 +189,34 @@ struct CpuReferenceIntegrator::Impl {
       x.shading_normal = dot(n, x.geometric_normal) > 0.05f ? n : x.geometric_normal;
     }
   }
+
+  // Incident radiance at `origin` from direction -`direction` (see ProbeEstimate in the header).
+  Vec3 radiance_along_ray(Vec3 origin, Vec3 direction, const IntegratorSettings& settings, Pcg32& rng,
+                          uint64_t& rays, bool& backface) const {
+    backface = false;
+    ++rays;
+    const Hit hit = embree.intersect(origin, direction, kInfinity);
+    if (!hit.found) return sky_radiance(direction);
+    const Material& material = scene.materials[scene.triangle_material[hit.triangle]];
+    const bool front = dot(direction, hit.geometric_normal) < 0;
+    if (!front && !material.double_sided) {
+      backface = true;
+      return {0, 0, 0};
+    }
+    Vec3 radiance = emitted_radiance(scene, hit.triangle, hit.b1, hit.b2);
+    const Vec3 albedo = diffuse_albedo(scene, hit.triangle, hit.b1, hit.b2);
+    if (max_component(albedo) <= 0) return radiance;
+    SurfacePoint x;
+    x.geometric_normal = front ? hit.geometric_normal : -hit.geometric_normal;
+    x.position = surface_position(scene, hit.triangle, hit.b1, hit.b2);
+    Vec3 n = interpolated_normal(scene, hit.triangle, hit.b1, hit.b2);
+    if (!front) n = -n;
+    x.shading_normal = dot(n, x.geometric_normal) > 0.05f ? n : x.geometric_normal;
+    PathContributions contributions;
+    contributions.recorded = 0;
+    trace(x, settings, rng, contributions, rays);
+    return radiance + albedo * contributions.total();
+  }
 };
 
 CpuReferenceIntegrator::CpuReferenceIntegrator(const Scene& scene) : impl_(new Impl(scene)) {}
@@ -261,6 +289,62 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     if (settings.target_relative_error > 0 &&
         std::all_of(converged.begin(), converged.end(), [](uint8_t c) { return c != 0; }))
       break;
+  }
+  estimate.rays = rays_per_thread.combine(std::plus<uint64_t>());
+  estimate.nonfinite_samples = nonfinite_per_thread.combine(std::plus<uint64_t>());
+  estimate.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return estimate;
+}
+
+ProbeEstimate CpuReferenceIntegrator::bake_probes(const std::vector<Vec3>& positions,
+                                                  const IntegratorSettings& settings) const {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  const size_t probe_count = positions.size();
+  ProbeEstimate estimate;
+  estimate.sh_sum.assign(probe_count, std::array<double, 27>{});
+  estimate.samples.assign(probe_count, 0);
+  estimate.backface_hits.assign(probe_count, 0);
+  tbb::combinable<uint64_t> rays_per_thread([] { return uint64_t(0); });
+  tbb::combinable<uint64_t> nonfinite_per_thread([] { return uint64_t(0); });
+  const uint32_t spp = settings.spp == 0 ? std::numeric_limits<uint32_t>::max() : settings.spp;
+  const bool timed = settings.time_budget_seconds > 0;
+  uint32_t done = 0;
+  while (done < spp) {
+    // One complete stratified set per pass, so stopping on the time budget never leaves strata out.
+    const uint32_t pass = std::min<uint32_t>(spp - done, kProbeStratifiedSetSize);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, probe_count, 1), [&](const tbb::blocked_range<size_t>& range) {
+      uint64_t& rays = rays_per_thread.local();
+      uint64_t& nonfinite = nonfinite_per_thread.local();
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        for (uint32_t s = done; s < done + pass; ++s) {
+          Pcg32 rng(settings.seed, kProbeRngStreamBase + i, s);
+          const float u1 = rng.uniform();
+          const float u2 = rng.uniform();
+          const Vec3 direction = probe_direction(s - done, pass, u1, u2);
+          bool backface = false;
+          const Vec3 radiance = impl_->radiance_along_ray(positions[i], direction, settings, rng, rays, backface);
+          if (backface) ++estimate.backface_hits[i];
+          if (!is_finite(radiance)) {
+            ++nonfinite;
+            continue;
+          }
+          const ShBasis y = sh_basis(direction);
+          for (int k = 0; k < kShCoefficients; ++k)
+            for (int c = 0; c < 3; ++c)
+              estimate.sh_sum[i][size_t(k) * 3 + size_t(c)] += double(radiance[c]) * double(y[k]) * (4.0 * kPi);
+          ++estimate.samples[i];
+        }
+      }
+    });
+    done += pass;
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    if (settings.progress) {
+      const double by_spp = settings.spp ? double(done) / double(settings.spp) : 0.0;
+      const double by_time = timed ? elapsed / settings.time_budget_seconds : 0.0;
+      settings.progress(std::min(1.0, std::max(by_spp, by_time)), rays_per_thread.combine(std::plus<uint64_t>()));
+    }
+    if (timed && elapsed >= settings.time_budget_seconds) break;
   }
   estimate.rays = rays_per_thread.combine(std::plus<uint64_t>());
   estimate.nonfinite_samples = nonfinite_per_thread.combine(std::plus<uint64_t>());

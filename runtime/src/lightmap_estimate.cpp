@@ -38,4 +38,13 @@ Vec3 LightmapEstimate::variance_of_mean(size_t texel) const {
   return v;
 }
 
+ShRgb ProbeEstimate::mean(size_t probe) const {
+  ShRgb sh{};
+  const uint32_t n = samples[probe];
+  if (n == 0) return sh;
+  for (int i = 0; i < kShCoefficients; ++i)
+    for (int c = 0; c < 3; ++c) sh[i][c] = float(sh_sum[probe][size_t(i) * 3 + size_t(c)] / n);
+  return sh;
+}
+
 }  // namespace exitance

@@ -1,12 +1,14 @@
 // The CPU reference: an unbiased, deliberately simple path tracer of incident irradiance
 // (stored as E/pi) at lightmap texels, on Embree. Every faster backend is checked against it.
 #pragma once
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <functional>
 #include <vector>
 
 #include "exitance/runtime/scene.h"
+#include "exitance/runtime/spherical_harmonics.h"
 #include "exitance/runtime/texel_gbuffer.h"
 
 namespace exitance {
@@ -53,11 +55,38 @@ struct SurfacePoint {
   Vec3 shading_normal;
 };
 
+// Light probes: per probe, `spp` rays in uniform sphere directions, stratified in sets of
+// kProbeStratifiedSetSize consecutive samples (sample s of a set starting at b with n samples uses
+// probe_direction(s - b, n, u1, u2) from sampling.h; n = min(set size, spp - b)); random numbers
+// Pcg32(seed, kProbeRngStreamBase + probe, s), u1 then u2 drawn first. Each ray's incident
+// radiance L(w) is: the sky on a miss; on a front face (or a double-sided one) Le at the hit, at full
+// weight (a probe is no surface: there is no next-event estimation at it, so nothing to MIS with),
+// plus albedo times one path sample of E/pi at the hit, exactly the lightmap texel estimator started
+// there (same bounce limits, counted from the hit); 0 on the back face of a single-sided surface.
+// Projected to L2 SH with weight 4*pi/spp.
+constexpr uint64_t kProbeRngStreamBase = 1ull << 40;
+constexpr uint32_t kProbeStratifiedSetSize = 256;
+
+struct ProbeEstimate {
+  // Per probe: sum over samples of L(w) * Y_i(w) * 4pi at [i * 3 + c] (divide by samples).
+  std::vector<std::array<double, 27>> sh_sum;
+  std::vector<uint32_t> samples;         // per probe
+  std::vector<uint32_t> backface_hits;   // per probe: rays that hit the back of a single-sided surface
+  uint64_t rays = 0;
+  double seconds = 0;
+  uint64_t nonfinite_samples = 0;
+
+  ShRgb mean(size_t probe) const;  // SH coefficients of incident radiance
+};
+
 class CpuReferenceIntegrator {
  public:
   CpuReferenceIntegrator(const Scene& scene);
   ~CpuReferenceIntegrator();
   LightmapEstimate bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const;
+  // Uses spp (0 needs a time budget), time_budget_seconds, max_bounces, seed, russian_roulette_start,
+  // safety_bounce_cap, progress; probes are independent of the lightmap bake.
+  ProbeEstimate bake_probes(const std::vector<Vec3>& positions, const IntegratorSettings& settings) const;
 
  private:
   struct Impl;

@@ -1,6 +1,8 @@
 // Sampling routines shared by every integrator (and, later, the shaders).
 #pragma once
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "exitance/runtime/vec_math.h"
 
@@ -44,6 +46,21 @@ inline Vec3 uniform_sphere(float u1, float u2) {
   const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
   const float phi = 2.0f * kPi * u2;
   return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+// Direction of probe sample `index` out of `count`: the first m*m samples (m = floor(sqrt(count)))
+// are stratified over an m x m grid of the equal-area (z, phi) square, one jittered sample per
+// cell; the rest are uniform. Probe rays and their SH projection use it on both backends.
+inline Vec3 probe_direction(uint32_t index, uint32_t count, float u1, float u2) {
+  uint32_t m = uint32_t(std::sqrt(float(count)));
+  while ((m + 1) * (m + 1) <= count) ++m;
+  while (m > 0 && m * m > count) --m;
+  if (index < m * m) {
+    const float inv = 1.0f / float(m);
+    u1 = (float(index % m) + u1) * inv;
+    u2 = (float(index / m) + u2) * inv;
+  }
+  return uniform_sphere(std::min(u1, 0.99999994f), std::min(u2, 0.99999994f));
 }
 
 // Power heuristic with beta = 2 (Veach 1997) for one sample from each of two strategies.
