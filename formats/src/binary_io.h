@@ -1,0 +1,76 @@
+// Little-endian field (de)serialisation and whole-file I/O shared by probes_file.cpp and
+// svo_file.cpp. Fields are assembled byte by byte so the files are the same on any host and no
+// struct layout or alignment leaks into the format.
+#pragma once
+#include <bit>
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "exitance/formats/format_error.h"
+
+namespace exitance::formats::binary_io {
+
+class LittleEndianWriter {
+ public:
+  explicit LittleEndianWriter(std::vector<uint8_t>& out) : out_(out) {}
+  // resize + memcpy rather than vector::insert, which trips a GCC 12 -Wstringop-overflow false positive.
+  void bytes(const void* data, size_t size) {
+    if (size == 0) return;
+    const size_t old_size = out_.size();
+    out_.resize(old_size + size);
+    std::memcpy(out_.data() + old_size, data, size);
+  }
+  void u8(uint8_t v) { out_.push_back(v); }
+  void u16(uint16_t v) { for (int i = 0; i < 2; ++i) out_.push_back(uint8_t(v >> (8 * i))); }
+  void u32(uint32_t v) { for (int i = 0; i < 4; ++i) out_.push_back(uint8_t(v >> (8 * i))); }
+  void u64(uint64_t v) { for (int i = 0; i < 8; ++i) out_.push_back(uint8_t(v >> (8 * i))); }
+  void f32(float v) { u32(std::bit_cast<uint32_t>(v)); }
+
+ private:
+  std::vector<uint8_t>& out_;
+};
+
+// Reads fields from a span whose length the caller has already checked; still bounds-checks every
+// read so a mistake in that check becomes a FormatError, not an out-of-bounds read.
+class LittleEndianReader {
+ public:
+  LittleEndianReader(const uint8_t* data, size_t size, const std::string& name)
+      : data_(data), size_(size), name_(name) {}
+  uint8_t u8() { return *take(1); }
+  uint16_t u16() {
+    const uint8_t* p = take(2);
+    return uint16_t(p[0] | (p[1] << 8));
+  }
+  uint32_t u32() {
+    const uint8_t* p = take(4);
+    return uint32_t(p[0]) | (uint32_t(p[1]) << 8) | (uint32_t(p[2]) << 16) | (uint32_t(p[3]) << 24);
+  }
+  uint64_t u64() {
+    const uint64_t low = u32();
+    return low | (uint64_t(u32()) << 32);
+  }
+  float f32() { return std::bit_cast<float>(u32()); }
+  void skip(size_t n) { take(n); }
+  size_t position() const { return position_; }
+
+ private:
+  const uint8_t* take(size_t n) {
+    if (n > size_ - position_) throw FormatError(name_ + ": unexpected end of data at byte " + std::to_string(position_));
+    const uint8_t* p = data_ + position_;
+    position_ += n;
+    return p;
+  }
+  const uint8_t* data_;
+  size_t size_;
+  size_t position_ = 0;
+  const std::string& name_;
+};
+
+// Whole file into memory; throws FileAccessError when it cannot be opened or read.
+std::vector<uint8_t> read_whole_file(const std::string& path);
+// Throws FileAccessError when the file cannot be written completely.
+void write_whole_file(const std::string& path, const std::vector<uint8_t>& bytes);
+
+}  // namespace exitance::formats::binary_io

@@ -1,0 +1,35 @@
+// The framing probes.bin and svo.bin share (probes_format.md, svo_format.md): an 8-byte magic, a
+// u32 format version, a u32 header size, format-specific header fields, then the last 16 header
+// bytes are the u64 payload size, the CRC-32 of the payload and the CRC-32 of the header bytes
+// before it; the payload follows the header and ends the file.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace exitance::formats::framing {
+
+struct FileKind {
+  const char* magic;  // 8 bytes, may contain NULs
+  uint32_t version;
+  uint32_t header_size;
+};
+
+struct FramedView {
+  const uint8_t* header;  // header_size bytes
+  const uint8_t* payload;
+  uint64_t payload_size;
+};
+
+// Checks, in this order, and throws FormatError naming the first problem: enough bytes for the
+// magic, the magic, the version (older / newer), the header size, enough bytes for the header,
+// the header CRC, the payload size against the file size (truncated or trailing bytes), the
+// payload CRC. Fuzzing builds (FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION) skip the two CRC
+// comparisons so the fuzzer reaches the structural checks behind them.
+FramedView open_frame(const uint8_t* data, size_t size, const FileKind& kind, const std::string& name);
+
+// header_fields: the bytes from offset 16 up to header_size - 16 (after magic, version and size).
+std::vector<uint8_t> build_frame(const FileKind& kind, const std::vector<uint8_t>& header_fields,
+                                 const std::vector<uint8_t>& payload);
+
+}  // namespace exitance::formats::framing
