@@ -1,0 +1,126 @@
+// manifest.json parsing: the DESIGN §4 shape is read field by field; every wrong type, missing
+// field, out-of-range index and other version is one FormatError naming the field.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "byte_patching.h"
+#include "exitance/loader/manifest.h"
+#include "test_bundle.h"
+
+namespace exitance::loader {
+namespace {
+
+using nlohmann::json;
+using test::expect_format_error;
+
+json full_manifest() { return test::make_manifest(test::make_linear_probe_grid(), test::make_test_octree()); }
+Manifest parse(const json& j) { return parse_manifest(j.dump(), "manifest.json"); }
+
+TEST(LoaderManifest, ReadsTheDesignShape) {
+  const Manifest m = parse(full_manifest());
+  EXPECT_EQ(m.format_version, 1u);
+  EXPECT_EQ(m.generator, "exitance tests");
+  ASSERT_EQ(m.pages.size(), 2u);
+  EXPECT_EQ(m.pages[0].file, "lightmap-0.exr");
+  EXPECT_EQ(m.pages[0].width, uint32_t(test::kPage0Width));
+  EXPECT_EQ(m.pages[0].height, uint32_t(test::kPage0Height));
+  EXPECT_EQ(m.pages[0].channels, (std::vector<std::string>{"A", "B", "G", "R"}));
+  ASSERT_EQ(m.instances.size(), 2u);
+  EXPECT_EQ(m.instances[1].node, 3u);
+  EXPECT_EQ(m.instances[1].name, "Wall");
+  EXPECT_EQ(m.instances[1].mesh, 1u);
+  EXPECT_EQ(m.instances[1].page, 1u);
+  EXPECT_EQ(m.instances[0].scale_offset, test::kInstance0ScaleOffset);
+  ASSERT_TRUE(m.instances[0].rect.has_value());
+  EXPECT_EQ(*m.instances[0].rect, (std::array<uint32_t, 4>{2, 2, 4, 2}));
+  EXPECT_FALSE(m.instances[1].rect.has_value());
+  ASSERT_TRUE(m.probes.has_value());
+  EXPECT_EQ(m.probes->file, "probes.bin");
+  EXPECT_EQ(m.probes->origin, (std::array<float, 3>{-1, 0, 2}));
+  EXPECT_EQ(m.probes->spacing, (std::array<float, 3>{0.5f, 1, 2}));
+  EXPECT_EQ(m.probes->counts, (std::array<uint32_t, 3>{3, 2, 2}));
+  EXPECT_EQ(m.probes->sh_order, 2u);
+  ASSERT_TRUE(m.svo.has_value());
+  EXPECT_EQ(m.svo->bounds_min, (std::array<float, 3>{0, 0, 0}));
+  EXPECT_EQ(m.svo->bounds_max, (std::array<float, 3>{8, 8, 8}));
+  EXPECT_EQ(m.svo->depth, 2u);
+}
+
+TEST(LoaderManifest, ProbesAndSvoAreOptional) {
+  json j = full_manifest();
+  j.erase("probes");
+  j["svo"] = nullptr;
+  const Manifest m = parse(j);
+  EXPECT_FALSE(m.probes.has_value());
+  EXPECT_FALSE(m.svo.has_value());
+}
+
+TEST(LoaderManifest, OtherVersionsAreRefusedByName) {
+  json j = full_manifest();
+  j["format_version"] = 2;
+  expect_format_error([&] { parse(j); }, "manifest.json: format version 2 is newer than this loader (1)");
+  j["format_version"] = 0;
+  expect_format_error([&] { parse(j); }, "manifest.json: format version 0 is older than this loader supports (1)");
+  j["format_version"] = "1";
+  expect_format_error([&] { parse(j); }, "manifest.json: format_version: expected an integer, got string");
+}
+
+TEST(LoaderManifest, NotJsonIsRefused) {
+  expect_format_error([] { parse_manifest("{\"format_version\": 1,", "manifest.json"); }, "manifest.json: not valid JSON");
+  expect_format_error([] { parse_manifest("", "manifest.json"); }, "not valid JSON");
+  expect_format_error([] { parse_manifest("[1, 2]", "manifest.json"); }, "top level: expected an object, got array");
+  expect_format_error([] { parse_manifest(std::string(100000, '['), "manifest.json"); }, "not valid JSON");
+}
+
+struct EditCase {
+  const char* name;
+  void (*edit)(json&);
+  const char* expected;
+};
+
+const EditCase kEditCases[] = {
+    {"no pages", [](json& j) { j.erase("pages"); }, "manifest.json: pages: missing"},
+    {"pages not an array", [](json& j) { j["pages"] = json::object(); }, "pages: expected an array, got object"},
+    {"page not an object", [](json& j) { j["pages"][1] = 7; }, "pages[1]: expected an object, got number"},
+    {"width as string", [](json& j) { j["pages"][0]["width"] = "8"; }, "pages[0].width: expected an integer, got string"},
+    {"width zero", [](json& j) { j["pages"][0]["width"] = 0; }, "pages[0].width: 0 is outside 1..65536"},
+    {"height negative", [](json& j) { j["pages"][0]["height"] = -4; }, "pages[0].height: -4 is negative"},
+    {"height fractional", [](json& j) { j["pages"][0]["height"] = 4.5; }, "pages[0].height: expected an integer, got number"},
+    {"channel not a string", [](json& j) { j["pages"][0]["channels"][2] = 1; }, "pages[0].channels[2]: expected a string"},
+    {"absolute file", [](json& j) { j["pages"][0]["file"] = "/etc/passwd"; }, "pages[0].file: \"/etc/passwd\" is not a path relative"},
+    {"escaping file", [](json& j) { j["pages"][0]["file"] = "../x.exr"; }, "pages[0].file: \"../x.exr\" leaves the bundle folder"},
+    {"empty file", [](json& j) { j["pages"][0]["file"] = ""; }, "pages[0].file: empty file name"},
+    {"nul in file", [](json& j) { j["pages"][0]["file"] = std::string("a\0b", 3); }, "pages[0].file: contains a NUL"},
+    {"no instances", [](json& j) { j.erase("instances"); }, "instances: missing"},
+    {"instance page out of range", [](json& j) { j["instances"][1]["page"] = 2; }, "instances[1].page: 2 is not a page (2 pages)"},
+    {"instance page huge", [](json& j) { j["instances"][0]["page"] = 1e30; }, "instances[0].page: expected an integer"},
+    {"instance name missing", [](json& j) { j["instances"][0].erase("name"); }, "instances[0].name: missing"},
+    {"scale_offset short", [](json& j) { j["instances"][0]["scale_offset"] = {1, 1, 0}; }, "instances[0].scale_offset: expected 4 elements, got 3"},
+    {"scale_offset overflow", [](json& j) { j["instances"][0]["scale_offset"][0] = 1e300; }, "instances[0].scale_offset[0]: not a finite 32-bit float"},
+    {"scale_offset null", [](json& j) { j["instances"][0]["scale_offset"][3] = nullptr; }, "instances[0].scale_offset[3]: expected a number, got null"},
+    {"rect wrong", [](json& j) { j["instances"][0]["rect"] = "x"; }, "instances[0].rect: expected an array, got string"},
+    {"node negative", [](json& j) { j["instances"][0]["node"] = -1; }, "instances[0].node: -1 is negative"},
+    {"probes not an object", [](json& j) { j["probes"] = 3; }, "probes: expected an object, got number"},
+    {"probe counts zero", [](json& j) { j["probes"]["counts"][1] = 0; }, "probes.counts[1]: 0 is outside 1.."},
+    {"probe counts overflow", [](json& j) { j["probes"]["counts"] = {65536, 65536, 65536}; }, "probes.counts: more than 67108864 probes"},
+    {"probe spacing zero", [](json& j) { j["probes"]["spacing"][2] = 0; }, "probes.spacing[2]: not positive"},
+    {"probe origin missing", [](json& j) { j["probes"].erase("origin"); }, "probes.origin: missing"},
+    {"sh order", [](json& j) { j["probes"]["sh_order"] = 3; }, "probes.sh_order: 3 is outside 2..2"},
+    {"svo depth", [](json& j) { j["svo"]["depth"] = 17; }, "svo.depth: 17 is outside 0..16"},
+    {"svo bounds shape", [](json& j) { j["svo"]["bounds"] = {0, 0, 0}; }, "svo.bounds: expected 2 elements, got 3"},
+    {"svo bounds inverted", [](json& j) { j["svo"]["bounds"][1][0] = -1; }, "svo.bounds: maximum not above minimum"},
+    {"svo file type", [](json& j) { j["svo"]["file"] = json::array(); }, "svo.file: expected a string, got array"},
+};
+
+TEST(LoaderManifest, EachWrongFieldIsRefusedByName) {
+  for (const EditCase& c : kEditCases) {
+    SCOPED_TRACE(c.name);
+    json j = full_manifest();
+    c.edit(j);
+    expect_format_error([&] { parse(j); }, c.expected);
+  }
+}
+
+}  // namespace
+}  // namespace exitance::loader
