@@ -303,6 +303,7 @@ ProbeEstimate CpuReferenceIntegrator::bake_probes(const std::vector<Vec3>& posit
   const size_t probe_count = positions.size();
   ProbeEstimate estimate;
   estimate.sh_sum.assign(probe_count, std::array<double, 27>{});
+  estimate.axis_irradiance_sum.assign(probe_count, std::array<double, 18>{});
   estimate.samples.assign(probe_count, 0);
   estimate.backface_hits.assign(probe_count, 0);
   tbb::combinable<uint64_t> rays_per_thread([] { return uint64_t(0); });
@@ -333,6 +334,12 @@ ProbeEstimate CpuReferenceIntegrator::bake_probes(const std::vector<Vec3>& posit
           for (int k = 0; k < kShCoefficients; ++k)
             for (int c = 0; c < 3; ++c)
               estimate.sh_sum[i][size_t(k) * 3 + size_t(c)] += double(radiance[c]) * double(y[k]) * (4.0 * kPi);
+          for (int axis = 0; axis < 6; ++axis) {
+            const float cosine = (axis % 2 ? -1.0f : 1.0f) * direction[axis / 2];
+            if (cosine <= 0) continue;
+            for (int c = 0; c < 3; ++c)
+              estimate.axis_irradiance_sum[i][size_t(axis) * 3 + size_t(c)] += double(radiance[c]) * cosine * 4.0;
+          }
           ++estimate.samples[i];
         }
       }

@@ -47,4 +47,11 @@ ShRgb ProbeEstimate::mean(size_t probe) const {
   return sh;
 }
 
+Vec3 ProbeEstimate::mean_axis_irradiance_over_pi(size_t probe, int axis) const {
+  if (probe >= axis_irradiance_sum.size() || samples[probe] == 0) return {0, 0, 0};
+  const auto& a = axis_irradiance_sum[probe];
+  const double n = samples[probe];
+  return {float(a[size_t(axis) * 3] / n), float(a[size_t(axis) * 3 + 1] / n), float(a[size_t(axis) * 3 + 2] / n)};
+}
+
 }  // namespace exitance

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace exitance {
 
@@ -47,6 +48,11 @@ void SvoExitanceCache::store_into(formats::SparseVoxelOctree& svo) const {
   if (&svo != &svo_ && svo.nodes.size() != svo_.nodes.size())
     throw std::invalid_argument("store_into: not the octree this cache was built for");
   const size_t n = svo.nodes.size();
+  // The filters below rely on breadth-first order: every parent before its children.
+  for (size_t i = 1; i < n; ++i)
+    if (svo.nodes[i].parent >= i)
+      throw std::logic_error("SVO node " + std::to_string(i) + ": parent " + std::to_string(svo.nodes[i].parent) +
+                             " does not precede it");
   std::vector<SideValue> filtered(published_.begin(), published_.end());
   for (size_t i = 0; i < n; ++i)
     if (svo.nodes[i].level != svo.depth) filtered[2 * i] = filtered[2 * i + 1] = SideValue{};

@@ -70,6 +70,11 @@ constexpr uint32_t kProbeStratifiedSetSize = 256;
 struct ProbeEstimate {
   // Per probe: sum over samples of L(w) * Y_i(w) * 4pi at [i * 3 + c] (divide by samples).
   std::vector<std::array<double, 27>> sh_sum;
+  // Per probe, CPU reference only (empty elsewhere): sum over samples of L(w) * max(0, w . a) * 4
+  // for the six axes a = +x, -x, +y, -y, +z, -z at [axis * 3 + c]; divided by samples it is an
+  // unbiased E/pi for those normals (an ambient cube), free of SH truncation, which tests use to
+  // check the probe radiance itself and to measure the L2 approximation.
+  std::vector<std::array<double, 18>> axis_irradiance_sum;
   std::vector<uint32_t> samples;         // per probe
   std::vector<uint32_t> backface_hits;   // per probe: rays that hit the back of a single-sided surface
   uint64_t rays = 0;
@@ -77,6 +82,7 @@ struct ProbeEstimate {
   uint64_t nonfinite_samples = 0;
 
   ShRgb mean(size_t probe) const;  // SH coefficients of incident radiance
+  Vec3 mean_axis_irradiance_over_pi(size_t probe, int axis) const;  // axis 0..5 as above; 0 when absent
 };
 
 class CpuReferenceIntegrator {
