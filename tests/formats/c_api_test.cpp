@@ -9,6 +9,7 @@
 #include "exitance/loader/bundle.h"
 #include "exitance/loader/exitance_loader.h"
 #include "test_bundle.h"
+#include "test_manifest.h"
 
 namespace exitance::loader {
 namespace {
@@ -17,7 +18,7 @@ TEST(LoaderCApi, MatchesTheClosedFormsThroughC) {
   const std::string dir = test::fresh_directory("c-api");
   const auto grid = test::make_linear_probe_grid();
   const auto svo = test::make_test_octree();
-  test::write_bundle(dir, test::make_manifest(grid, svo), grid, svo);
+  test::write_bundle(dir, test::make_manifest(grid, svo).dump(2), grid, svo);
 
   const float point[3] = {-0.4f, 0.7f, 3.1f}, normal[3] = {0, 1, 0};
   const float u = 0.3f, v = 0.6f;
@@ -65,7 +66,7 @@ TEST(LoaderCApi, MatchesTheClosedFormsThroughC) {
 TEST(LoaderCApi, SvoLookupAndMissingProbesThroughC) {
   const std::string dir = test::fresh_directory("c-api-svo");
   const auto svo = test::make_test_octree();
-  test::write_bundle(dir, test::make_manifest(std::nullopt, svo), std::nullopt, svo);
+  test::write_bundle(dir, test::make_manifest(std::nullopt, svo).dump(2), std::nullopt, svo);
   const float point[3] = {3, 1, 1}, normal[3] = {0, -1, 0};
   CApiWalkthrough r;
   ASSERT_EQ(c_api_walkthrough(dir.c_str(), 0.5f, 0.5f, point, normal, 2, &r), 0);
@@ -80,7 +81,7 @@ TEST(LoaderCApi, SvoLookupAndMissingProbesThroughC) {
 
 TEST(LoaderCApi, CorruptBundleIsAnInvalidFileError) {
   const std::string dir = test::fresh_directory("c-api-corrupt");
-  test::write_bundle(dir, test::make_manifest(std::nullopt, std::nullopt), std::nullopt, std::nullopt);
+  test::write_bundle(dir, test::make_manifest(std::nullopt, std::nullopt).dump(2), std::nullopt, std::nullopt);
   { std::ofstream(dir + "/manifest.json") << "{\"format_version\": 1, \"pages\": 3}"; }
   ExitanceBundle* bundle = nullptr;
   EXPECT_EQ(exitance_bundle_open(dir.c_str(), &bundle), EXITANCE_ERROR_INVALID_FILE);

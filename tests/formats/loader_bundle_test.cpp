@@ -12,6 +12,7 @@
 #include "exitance/formats/svo_file.h"
 #include "exitance/loader/bundle.h"
 #include "test_bundle.h"
+#include "test_manifest.h"
 
 namespace exitance::loader {
 namespace {
@@ -26,13 +27,13 @@ std::string full_bundle(const std::string& name) {
   const std::string dir = test::fresh_directory(name);
   const auto grid = test::make_linear_probe_grid();
   const auto svo = test::make_test_octree();
-  test::write_bundle(dir, test::make_manifest(grid, svo), grid, svo);
+  test::write_bundle(dir, test::make_manifest(grid, svo).dump(2), grid, svo);
   return dir;
 }
 
 std::string bundle_with(const std::string& name, const formats::ProbeGrid& grid) {
   const std::string dir = test::fresh_directory(name);
-  test::write_bundle(dir, test::make_manifest(grid, std::nullopt), grid, std::nullopt);
+  test::write_bundle(dir, test::make_manifest(grid, std::nullopt).dump(2), grid, std::nullopt);
   return dir;
 }
 
@@ -312,7 +313,7 @@ TEST(LoaderBundle, CorruptBinaryFilesAreRefused) {
 
 TEST(LoaderBundle, BundleWithoutProbesOrSvoLoads) {
   const std::string dir = test::fresh_directory("lightmaps-only");
-  test::write_bundle(dir, test::make_manifest(std::nullopt, std::nullopt), std::nullopt, std::nullopt);
+  test::write_bundle(dir, test::make_manifest(std::nullopt, std::nullopt).dump(2), std::nullopt, std::nullopt);
   const Bundle bundle = Bundle::open(dir);
   EXPECT_FALSE(bundle.has_probes());
   EXPECT_FALSE(bundle.has_svo());

@@ -4,6 +4,7 @@
 #include <exception>
 
 #include "test_bundle.h"
+#include "test_manifest.h"
 
 int main(int argc, char** argv) {
   if (argc != 2) {
@@ -15,8 +16,8 @@ int main(int argc, char** argv) {
     const std::string dir = argv[1];
     const auto grid = t::make_linear_probe_grid();
     const auto svo = t::make_test_octree();
-    t::write_bundle(dir + "/full", t::make_manifest(grid, svo), grid, svo);
-    t::write_bundle(dir + "/lightmaps_only", t::make_manifest(std::nullopt, std::nullopt), std::nullopt, std::nullopt);
+    t::write_bundle(dir + "/full", t::make_manifest(grid, svo).dump(2), grid, svo);
+    t::write_bundle(dir + "/lightmaps_only", t::make_manifest(std::nullopt, std::nullopt).dump(2), std::nullopt, std::nullopt);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "make_loader_test_bundle: %s\n", e.what());
     return 1;

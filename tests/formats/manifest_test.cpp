@@ -7,6 +7,7 @@
 #include "byte_patching.h"
 #include "exitance/loader/manifest.h"
 #include "test_bundle.h"
+#include "test_manifest.h"
 
 namespace exitance::loader {
 namespace {

@@ -103,32 +103,7 @@ formats::SparseVoxelOctree make_test_octree() {
   return svo;
 }
 
-nlohmann::json make_manifest(const std::optional<formats::ProbeGrid>& probes,
-                             const std::optional<formats::SparseVoxelOctree>& svo) {
-  using nlohmann::json;
-  json manifest = {
-      {"format_version", 1},
-      {"generator", "exitance tests"},
-      {"units", {{"lightmap", "irradiance_over_pi"}, {"probes", "incident_radiance_sh_l2"}, {"length", "scene"}}},
-      {"pages", json::array({json{{"file", "lightmap-0.exr"}, {"width", kPage0Width}, {"height", kPage0Height},
-                                  {"channels", {"A", "B", "G", "R"}}},
-                             json{{"file", "lightmap-1.exr"}, {"width", 4}, {"height", 4}, {"channels", {"A", "B", "G", "R"}}}})},
-      {"instances", json::array({json{{"node", 0}, {"name", "Floor"}, {"mesh", 0}, {"page", 0},
-                                      {"scale_offset", kInstance0ScaleOffset}, {"rect", {2, 2, 4, 2}}},
-                                 json{{"node", 3}, {"name", "Wall"}, {"mesh", 1}, {"page", 1},
-                                      {"scale_offset", {1.0f, 1.0f, 0.0f, 0.0f}}}})},
-      {"stats", {{"rays", 0}}}};
-  if (probes)
-    manifest["probes"] = {{"file", "probes.bin"}, {"origin", probes->origin}, {"spacing", probes->spacing},
-                          {"counts", probes->counts}, {"sh_order", probes->sh_order}};
-  if (svo) {
-    const std::array<float, 3> far{svo->origin[0] + svo->size, svo->origin[1] + svo->size, svo->origin[2] + svo->size};
-    manifest["svo"] = {{"file", "svo.bin"}, {"bounds", {svo->origin, far}}, {"depth", svo->depth}};
-  }
-  return manifest;
-}
-
-void write_bundle(const std::string& directory, const nlohmann::json& manifest,
+void write_bundle(const std::string& directory, const std::string& manifest_text,
                   const std::optional<formats::ProbeGrid>& probes, const std::optional<formats::SparseVoxelOctree>& svo) {
   fs::create_directories(directory);
   formats::write_lightmap_exr(directory + "/lightmap-0.exr", make_page0());
@@ -136,7 +111,7 @@ void write_bundle(const std::string& directory, const nlohmann::json& manifest,
   if (probes) formats::write_probes_file(directory + "/probes.bin", *probes);
   if (svo) formats::write_svo_file(directory + "/svo.bin", *svo);
   std::ofstream file(directory + "/manifest.json");
-  file << manifest.dump(2) << "\n";
+  file << manifest_text << "\n";
   if (!file) throw std::runtime_error("cannot write " + directory + "/manifest.json");
 }
 

@@ -3,7 +3,6 @@
 // SH coefficients are affine in the probe position, and a depth-2 octree with known nodes.
 #pragma once
 #include <array>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -40,12 +39,9 @@ std::array<float, 3> svo_front(int node);
 std::array<float, 3> svo_back(int node);
 constexpr float kSvoExitanceScale = 2.0f;
 
-// The manifest DESIGN §4 describes, for the pieces given.
-nlohmann::json make_manifest(const std::optional<formats::ProbeGrid>& probes,
-                             const std::optional<formats::SparseVoxelOctree>& svo);
-
-// Writes manifest.json, lightmap-0.exr, lightmap-1.exr and, when given, probes.bin and svo.bin.
-void write_bundle(const std::string& directory, const nlohmann::json& manifest,
+// Writes manifest.json (the given text; test_manifest.h makes one), lightmap-0.exr,
+// lightmap-1.exr and, when given, probes.bin and svo.bin.
+void write_bundle(const std::string& directory, const std::string& manifest_text,
                   const std::optional<formats::ProbeGrid>& probes, const std::optional<formats::SparseVoxelOctree>& svo);
 
 // A fresh empty folder under the system temp folder, unique per process and name.
