@@ -5,8 +5,9 @@ SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 packages=(
   build-essential cmake ninja-build pkg-config git python3
+  clang libclang-rt-14-dev
   libembree-dev libtbb-dev
-  libopenvdb-dev
+  libopenvdb-dev libopenvdb-tools
   libopenexr-dev libopenimageio-dev openimageio-tools
   libtinygltf-dev libstb-dev nlohmann-json3-dev libcli11-dev
   libcgal-dev
