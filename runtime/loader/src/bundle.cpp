@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <new>
 #include <sstream>
 #include <stdexcept>
 
@@ -63,6 +64,8 @@ formats::LightmapImage load_page(const fs::path& directory, const PageInfo& page
   formats::LightmapImage image;
   try {
     image = formats::read_lightmap_exr(path.string());
+  } catch (const std::bad_alloc&) {
+    throw;  // out of memory stays out of memory (the C API reports it apart)
   } catch (const std::exception& e) {  // OpenEXR's own messages, already naming the file
     throw FormatError(e.what());
   }
