@@ -36,11 +36,17 @@ float float_at_or_above(double x) {
   return f;
 }
 
+// Twice the area-weighted normal of triangle t, from its world positions in double.
+Double3 world_cross(const Scene& scene, size_t t) {
+  const Vec3* p = &scene.positions[t * 3];
+  const Double3 a{p[0].x, p[0].y, p[0].z}, b{p[1].x, p[1].y, p[1].z}, c{p[2].x, p[2].y, p[2].z};
+  return cross(b - a, c - a);
+}
+
 bool triangle_is_usable(const Scene& scene, size_t t) {
   const Vec3* p = &scene.positions[t * 3];
   if (!is_finite(p[0]) || !is_finite(p[1]) || !is_finite(p[2])) return false;
-  const Double3 a{p[0].x, p[0].y, p[0].z}, b{p[1].x, p[1].y, p[1].z}, c{p[2].x, p[2].y, p[2].z};
-  const double area2 = norm(cross(b - a, c - a));
+  const double area2 = norm(world_cross(scene, t));
   return area2 > 0 && std::isfinite(area2);
 }
 
@@ -140,11 +146,23 @@ VoxelizeOutput voxelize_triangles(const Scene& scene, const std::vector<uint8_t>
       }
       const Double3 n = cross(v[1] - v[0], v[2] - v[0]);
       const double n_length = norm(n);
-      out.triangle_normals[t] = {{n[0] / n_length, n[1] / n_length, n[2] / n_length},
-                                 std::min(0.5 * n_length, kMaxAreaInLeaf)};
       auto emit = [&](int x, int y, int z) {
         keys.push_back(layout.key(morton::encode(uint32_t(x), uint32_t(y), uint32_t(z)), uint32_t(t)));
       };
+      if (!(n_length > 0)) {
+        // Far below a leaf (its area underflows in grid units): its direction comes from the world
+        // positions (non-zero, the triangle is usable), its weight is negligible, and the few cells
+        // of its bounding box are conservative.
+        const Double3 world = world_cross(scene, t);
+        const double world_length = norm(world);
+        out.triangle_normals[t] = {{world[0] / world_length, world[1] / world_length, world[2] / world_length}, 1e-300};
+        for (int x = lo[0]; x <= hi[0]; ++x)
+          for (int y = lo[1]; y <= hi[1]; ++y)
+            for (int z = lo[2]; z <= hi[2]; ++z) emit(x, y, z);
+        continue;
+      }
+      out.triangle_normals[t] = {{n[0] / n_length, n[1] / n_length, n[2] / n_length},
+                                 std::min(0.5 * n_length, kMaxAreaInLeaf)};
       if (lo[0] == hi[0] && lo[1] == hi[1] && lo[2] == hi[2]) {  // inside one leaf: no test needed
         emit(lo[0], lo[1], lo[2]);
         continue;

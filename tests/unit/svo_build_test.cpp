@@ -372,6 +372,18 @@ TEST(SvoBuild, EmptyAndDegenerateScenes) {
   EXPECT_EQ(stats.triangles_voxelized, 1u);
   expect_well_formed(one);
 
+  // A triangle far below a leaf (its area vanishes in grid units) keeps its own normal, +x here.
+  Scene tiny;
+  add_triangle(tiny, {0, 0, 0}, {0, 1e-20f, 0}, {0, 0, 1e-20f});
+  add_triangle(tiny, {5, 5, 5}, {6, 5, 5}, {5, 6, 5});
+  const formats::SparseVoxelOctree with_tiny = build_sparse_voxel_octree(tiny, {6}, &stats);
+  EXPECT_EQ(stats.triangles_voxelized, 2u);
+  expect_well_formed(with_tiny);
+  const uint32_t tiny_leaf = formats::svo_find_node(with_tiny, {0, 0, 0}, 6);
+  ASSERT_NE(tiny_leaf, formats::kSvoNoParent);
+  EXPECT_EQ(with_tiny.nodes[tiny_leaf].level, 6);
+  EXPECT_GT(formats::decode_octahedral_normal(with_tiny.nodes[tiny_leaf].normal_oct)[0], 0.999f);
+
   EXPECT_THROW(build_sparse_voxel_octree(bad, {0}), std::invalid_argument);
   EXPECT_THROW(build_sparse_voxel_octree(bad, {13}), std::invalid_argument);
 }
