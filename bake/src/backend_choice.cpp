@@ -21,6 +21,9 @@ LightingBackend cpu_backend(const Scene& scene) {
   backend.name = "cpu";
   backend.device = "Embree 3 CPU reference on " + std::to_string(tbb::info::default_concurrency()) + " threads";
   backend.bake = [integrator](const TexelGBuffer& g, const IntegratorSettings& s) { return integrator->bake(g, s); };
+  backend.bake_probes = [integrator](const std::vector<Vec3>& p, const IntegratorSettings& s) {
+    return integrator->bake_probes(p, s);
+  };
   backend.keep_alive = integrator;
   return backend;
 }

@@ -12,9 +12,17 @@
 #include "exitance/bake/image_decode.h"
 #include "exitance/bake/input_error.h"
 #include "exitance/bake/lightmap_assembly.h"
+#include "exitance/bake/probe_placement.h"
+#include "exitance/bake/radiance_vdb.h"
+#include "exitance/bake/svo_build.h"
 #include "exitance/bake/texel_raster.h"
 #include "exitance/bake/unocclude.h"
+#include "exitance/formats/probes_file.h"
+#include "exitance/formats/svo_file.h"
 #include "exitance/runtime/embree_scene.h"
+#include "exitance/runtime/material_eval.h"
+#include "exitance/runtime/sampling.h"
+#include "exitance/runtime/svo_exitance.h"
 
 namespace exitance {
 
@@ -35,6 +43,38 @@ class StageTimer {
  private:
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
+
+// Barycentrics (b1, b2) of p's projection onto triangle t.
+void barycentrics_on_triangle(const Scene& scene, uint32_t t, Vec3 p, float& b1, float& b2) {
+  const Vec3* v = &scene.positions[size_t(t) * 3];
+  const Vec3 e1 = v[1] - v[0], e2 = v[2] - v[0], d = p - v[0];
+  const float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), d1 = dot(d, e1), d2 = dot(d, e2);
+  const float det = d11 * d22 - d12 * d12;
+  b1 = b2 = 1.0f / 3.0f;
+  if (!(std::fabs(det) > 0)) return;
+  b1 = std::clamp((d22 * d1 - d12 * d2) / det, 0.0f, 1.0f);
+  b2 = std::clamp((d11 * d2 - d12 * d1) / det, 0.0f, 1.0f - b1);
+}
+
+// Radiant exitance M = pi * L_o = pi * (Le + albedo * E/pi) of every lit texel, deposited into the
+// octree's leaves with the texel's surface area as weight (texels sample surfaces uniformly by
+// area, so each leaf side gets the area-average exitance of the surface inside it).
+void fill_svo_exitance(formats::SparseVoxelOctree& svo, const Scene& scene, const TexelGBuffer& gbuffer,
+                       const LightmapEstimate& estimate) {
+  SvoExitanceCache cache(svo);
+  for (size_t i = 0; i < gbuffer.texels.size(); ++i) {
+    const LiveTexel& t = gbuffer.texels[i];
+    if (estimate.texels[i].samples == 0) continue;
+    float b1, b2;
+    barycentrics_on_triangle(scene, t.triangle, t.position, b1, b2);
+    const Vec3 outgoing = emitted_radiance(scene, t.triangle, b1, b2) + t.albedo * estimate.mean_total(i);
+    cache.deposit({t.position, t.geometric_normal, outgoing * kPi, t.world_texel_size * t.world_texel_size});
+  }
+  cache.publish(1.0f);
+  cache.store_into(svo);
+}
+
+json vec3_json(const std::array<float, 3>& v) { return json::array({v[0], v[1], v[2]}); }
 
 }  // namespace
 
@@ -91,13 +131,40 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   seconds["bvh"] = timer.lap();
   size_t moved = 0;
   GeometryCheckReport geometry;
-  {
-    EmbreeScene embree(scene);
-    moved = unocclude_texels(embree, gbuffer).moved;
-    seconds["unocclude"] = timer.lap();
-    geometry = check_scene_geometry(scene, embree, gbuffer);
-    for (std::string& line : describe_geometry_problems(geometry, scene, options.input)) diagnostics.warn(line);
-    seconds["checks"] = timer.lap();
+  const EmbreeScene embree(scene);
+  moved = unocclude_texels(embree, gbuffer).moved;
+  seconds["unocclude"] = timer.lap();
+  geometry = check_scene_geometry(scene, embree, gbuffer);
+  for (std::string& line : describe_geometry_problems(geometry, scene, options.input)) diagnostics.warn(line);
+  seconds["checks"] = timer.lap();
+
+  // Voxelize before lighting so a bad --voxel-resolution fails before the long stage.
+  formats::SparseVoxelOctree svo;
+  SvoBuildStatistics svo_stats;
+  if (options.svo_enabled) {
+    report("voxelize", 0, 0);
+    SvoBuildSettings svo_settings;
+    try {
+      svo_settings.depth = options.voxel_resolution ? svo_depth_from_resolution(options.voxel_resolution)
+                                                    : default_svo_depth(scene, layout.texel_density);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(std::to_string(options.voxel_resolution), "--voxel-resolution", e.what());
+    }
+    svo = build_sparse_voxel_octree(scene, svo_settings, &svo_stats);
+    seconds["voxelize"] = timer.lap();
+  }
+
+  ProbePlacement placement;
+  if (options.probes_enabled) {
+    report("probe placement", 0, 0);
+    ProbePlacementSettings probe_settings;
+    probe_settings.spacing = options.probe_spacing;
+    try {
+      placement = place_probes(scene, embree, options.svo_enabled ? &svo : nullptr, probe_settings);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(std::to_string(options.probe_spacing), "--probes", e.what());
+    }
+    seconds["probe_placement"] = timer.lap();
   }
 
   IntegratorSettings lighting = options.lighting;
@@ -107,6 +174,47 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   if (estimate.nonfinite_samples > 0)
     diagnostics.warn(options.input + ": " + std::to_string(estimate.nonfinite_samples) +
                      " path samples were NaN/Inf and were discarded (please report this scene)");
+
+  if (options.svo_enabled) {
+    report("exitance", 0, 0);
+    fill_svo_exitance(svo, scene, gbuffer, estimate);
+    seconds["exitance"] = timer.lap();
+  }
+
+  ProbeEstimate probe_estimate;
+  std::string probe_backend = backend.name;
+  if (options.probes_enabled) {
+    std::vector<Vec3> positions;
+    std::vector<size_t> traced;  // grid index of each traced probe
+    for (size_t i = 0; i < placement.grid.probes.size(); ++i) {
+      const formats::ProbeRecord& r = placement.grid.probes[i];
+      if (!formats::probe_is_usable(r)) continue;
+      positions.push_back({r.position[0], r.position[1], r.position[2]});
+      traced.push_back(i);
+    }
+    IntegratorSettings probe_lighting = options.lighting;
+    probe_lighting.spp = options.probe_spp;
+    probe_lighting.time_budget_seconds = 0;
+    probe_lighting.target_relative_error = 0;
+    probe_lighting.progress = [&](double fraction, uint64_t rays) { report("probes", fraction, rays); };
+    if (backend.bake_probes) {
+      probe_estimate = backend.bake_probes(positions, probe_lighting);
+    } else {
+      probe_backend = "cpu";
+      probe_estimate = CpuReferenceIntegrator(scene).bake_probes(positions, probe_lighting);
+    }
+    for (size_t k = 0; k < traced.size(); ++k) {
+      ShRgb sh = probe_estimate.mean(k);
+      if (options.probe_sh_window > 0) sh_apply_hanning_window(sh, options.probe_sh_window);
+      formats::ProbeRecord& r = placement.grid.probes[traced[k]];
+      for (int i = 0; i < kShCoefficients; ++i)
+        for (int c = 0; c < 3; ++c) r.sh[size_t(i) * 3 + size_t(c)] = is_finite(sh[i]) ? sh[i][c] : 0.0f;
+    }
+    seconds["probes"] = timer.lap();
+    if (probe_estimate.nonfinite_samples > 0)
+      diagnostics.warn(options.input + ": " + std::to_string(probe_estimate.nonfinite_samples) +
+                       " probe samples were NaN/Inf and were discarded (please report this scene)");
+  }
 
   report("write", 0, 0);
   AssemblyOptions assembly;
@@ -145,7 +253,11 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                           {"lightmap_uv", options.import.lightmap_uv_set},
                           {"russian_roulette_start", options.lighting.russian_roulette_start},
                           {"safety_bounce_cap", options.lighting.safety_bounce_cap},
-                          {"sky", options.sky}};
+                          {"sky", options.sky},
+                          {"probes", options.probes_enabled ? json(placement.grid.spacing[0]) : json("none")},
+                          {"probe_spp", options.probe_spp},
+                          {"probe_dering_window", options.probe_sh_window},
+                          {"voxel_resolution", options.svo_enabled ? json(svo.resolution()) : json("none")}};
   json page_list = json::array();
   std::vector<std::string> layer_channels;
   for (size_t p = 0; p < pages.size(); ++p) {
@@ -168,6 +280,25 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                          {"rect", {r.x, r.y, r.width, r.height}}});
   }
   manifest["instances"] = instances;
+  if (options.probes_enabled)
+    manifest["probes"] = {{"file", "probes.bin"},
+                          {"origin", vec3_json(placement.grid.origin)},
+                          {"spacing", vec3_json(placement.grid.spacing)},
+                          {"counts", {placement.grid.counts[0], placement.grid.counts[1], placement.grid.counts[2]}},
+                          {"sh_order", 2},
+                          {"valid", placement.valid},
+                          {"moved", placement.moved},
+                          {"invalid", placement.invalid},
+                          {"skipped", placement.skipped}};
+  if (options.svo_enabled) {
+    const std::array<float, 3> hi{svo.origin[0] + svo.size, svo.origin[1] + svo.size, svo.origin[2] + svo.size};
+    manifest["svo"] = {{"file", "svo.bin"},
+                       {"vdb", "radiance.vdb"},
+                       {"bounds", {vec3_json(svo.origin), vec3_json(hi)}},
+                       {"depth", svo.depth},
+                       {"nodes", svo.nodes.size()},
+                       {"units", "radiant_exitance"}};
+  }
   const double lighting_seconds = estimate.seconds;
   json stats;
   stats["seconds"] = seconds;
@@ -185,15 +316,46 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   stats["coplanar_texels"] = geometry.coplanar_texels;
   stats["enclosed_lights"] = geometry.enclosed_lights;
   stats["nonfinite_samples"] = estimate.nonfinite_samples;
-  stats["skipped"] = {{"texels_outside_charts", gbuffer.skipped_texels},
-                      {"probes", "not implemented yet"},
-                      {"svo", "not implemented yet"}};
+  json skipped = {{"texels_outside_charts", gbuffer.skipped_texels}};
+  if (options.probes_enabled) {
+    skipped["probes_far_from_geometry"] = placement.skipped;
+    skipped["probes_inside_geometry"] = placement.invalid;
+    stats["probes"] = {{"backend", probe_backend},
+                       {"grid", placement.grid.probes.size()},
+                       {"valid", placement.valid},
+                       {"moved", placement.moved},
+                       {"invalid_inside_geometry", placement.invalid},
+                       {"skipped_far_from_geometry", placement.skipped},
+                       {"rays_per_probe", options.probe_spp},
+                       {"rays", probe_estimate.rays},
+                       {"rays_per_second",
+                        probe_estimate.seconds > 0 ? double(probe_estimate.rays) / probe_estimate.seconds : 0.0},
+                       {"nonfinite_samples", probe_estimate.nonfinite_samples}};
+  } else {
+    skipped["probes"] = "--probes none";
+  }
+  if (options.svo_enabled) {
+    stats["svo"] = {{"depth", svo.depth},
+                    {"nodes", svo_stats.nodes},
+                    {"leaves", svo_stats.leaves},
+                    {"bytes_per_node", svo_stats.bytes_per_node},
+                    {"bytes", svo_stats.total_bytes},
+                    {"build_seconds", svo_stats.total_seconds}};
+  } else {
+    skipped["svo"] = "--voxel-resolution none";
+  }
+  stats["skipped"] = skipped;
   stats["warnings"] = diagnostics.warnings.size();
   manifest["stats"] = stats;
 
   write_bundle_atomically(out, [&](const fs::path& dir) {
     for (size_t p = 0; p < pages.size(); ++p)
       formats::write_lightmap_exr((dir / ("lightmap-" + std::to_string(p) + ".exr")).string(), pages[p]);
+    if (options.probes_enabled) formats::write_probes_file((dir / "probes.bin").string(), placement.grid);
+    if (options.svo_enabled) {
+      formats::write_svo_file((dir / "svo.bin").string(), svo);
+      write_radiance_vdb((dir / "radiance.vdb").string(), svo);
+    }
     std::ofstream file(dir / "manifest.json");
     file << manifest.dump(2) << "\n";
     if (!file) throw std::runtime_error("cannot write " + (dir / "manifest.json").string());

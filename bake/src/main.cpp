@@ -1,6 +1,7 @@
 // `bake SCENE.{gltf,glb} [-o OUT] [options]`: see docs/cli.md and DESIGN §3.
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -55,8 +56,14 @@ int main(int argc, char** argv) {
   app.add_option("--sky", options.sky, "sky radiance: R,G,B or an equirectangular image (EXR/HDR)");
   app.add_option("--seed", options.lighting.seed, "random seed; results are deterministic per seed and backend");
   app.add_flag("--bounce-layers", options.bounce_layers, "also write bounce<k>.R/G/B debug layers");
-  std::string probes = "auto", directional, guiding = "auto";
-  app.add_option("--probes", probes, "probe grid spacing or none (probes are not implemented yet)");
+  std::string probes = "auto", voxels = "auto", directional, guiding = "auto";
+  app.add_option("--probes", probes, "light-probe grid spacing in scene units, auto (largest extent / 12) or none");
+  app.add_option("--probe-spp", options.probe_spp, "rays per light probe")->check(CLI::Range(1u, 1u << 24));
+  app.add_option("--probe-dering", options.probe_sh_window,
+                 "Hanning window width for the probes' SH (e.g. 3; 0 = off, the default)")
+      ->check(CLI::Range(0.0f, 16.0f));
+  app.add_option("--voxel-resolution", voxels,
+                 "SVO leaves per axis: a power of two 2..4096, auto (leaves about 4 texels wide) or none");
   app.add_option("--directional", directional, "sh1: L1 directional lightmaps (not implemented yet)");
   app.add_option("--guiding", guiding, "auto | off | svo | grid (only off is implemented yet)")
       ->check(CLI::IsMember({"auto", "off", "svo", "grid"}));
@@ -85,7 +92,36 @@ int main(int argc, char** argv) {
   exitance::Diagnostics diagnostics;
   const char* validation = std::getenv("EXITANCE_VULKAN_VALIDATION");
   options.backend.validation = validation && std::string(validation) == "1";
-  if (probes != "auto" && probes != "none") diagnostics.warn("--probes: probe baking is not implemented yet; ignored");
+  if (probes == "none") {
+    options.probes_enabled = false;
+  } else if (probes != "auto") {
+    size_t used = 0;
+    float spacing = -1;
+    try {
+      spacing = std::stof(probes, &used);
+    } catch (...) {
+    }
+    if (used != probes.size() || !(spacing > 0) || !std::isfinite(spacing)) {
+      std::cerr << "bake: error: --probes " << probes << ": expected a positive spacing, auto or none\n";
+      return 2;
+    }
+    options.probe_spacing = spacing;
+  }
+  if (voxels == "none") {
+    options.svo_enabled = false;
+  } else if (voxels != "auto") {
+    size_t used = 0;
+    unsigned long resolution = 0;
+    try {
+      resolution = std::stoul(voxels, &used);
+    } catch (...) {
+    }
+    if (used != voxels.size() || resolution < 2 || resolution > 4096 || (resolution & (resolution - 1))) {
+      std::cerr << "bake: error: --voxel-resolution " << voxels << ": expected a power of two 2..4096, auto or none\n";
+      return 2;
+    }
+    options.voxel_resolution = uint32_t(resolution);
+  }
   if (!directional.empty()) diagnostics.warn("--directional: directional lightmaps are not implemented yet; ignored");
   if (guiding == "svo" || guiding == "grid") {
     std::cerr << "bake: error: --guiding " << guiding << " is not implemented yet (use off)\n";

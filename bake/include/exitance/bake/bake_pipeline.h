@@ -23,6 +23,14 @@ struct BakeOptions {
   AtlasSettings atlas;
   IntegratorSettings lighting;
   bool bounce_layers = false;
+  // Light probes (--probes): spacing in scene units, 0 = automatic; probes_enabled false = none.
+  bool probes_enabled = true;
+  float probe_spacing = 0;
+  uint32_t probe_spp = 512;       // rays per probe (--probe-spp)
+  float probe_sh_window = 0;      // Hanning deringing window width (--probe-dering), 0 = off
+  // Sparse voxel octree with radiant exitance (svo.bin, radiance.vdb): --voxel-resolution.
+  bool svo_enabled = true;
+  uint32_t voxel_resolution = 0;  // power of two; 0 = automatic (leaves about 4 texels wide)
   // Stage reporting for the progress bar: (stage name, fraction done, rays so far).
   std::function<void(const std::string&, double, uint64_t)> progress;
 };
