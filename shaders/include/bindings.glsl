@@ -19,10 +19,16 @@ layout(std430, set = 0, binding = 0) buffer ParamsBuffer {
   uint batch_work_total;    // n * samples
   uint collect_stats;
   uint texel_count_total;   // live texels of the whole bake (bounce accumulator stride)
-  uint pad0, pad1, pad2;
+  uint pad0;
+  uint probe_spp;           // probes: samples per probe of the whole bake (0xFFFFFFFF: until the time budget)
+  uint pad2;
   vec4 bench_lo;            // traversal bench: scene bounds
   vec4 bench_hi;
 } params;
+
+// Specialization constant 2: true in the probe variants of generate and shade (work items are light
+// probes, see regenerate and shade.comp); false compiles the probe code out of the lightmap kernels.
+layout(constant_id = 2) const bool kProbeMode = false;
 
 layout(std430, set = 0, binding = 1) readonly buffer NodeBuffer { uvec4 nodes[]; };       // BVH4 nodes: 4 uvec4 quantized or 7 float (bvh.glsl)
 layout(std430, set = 0, binding = 2) readonly buffer LeafTriBuffer { vec4 leaf_tris[]; }; // 3 vec4 per triangle
@@ -52,6 +58,8 @@ layout(std430, set = 0, binding = 23) buffer ResultBuffer { float results[]; }; 
 layout(std430, set = 0, binding = 24) buffer AccumulatorBuffer { double acc_total[]; }; // [texel][total rgb, squared rgb]
 layout(std430, set = 0, binding = 25) buffer BounceAccumulatorBuffer { double acc_bounce[]; };  // [k][texel][rgb]
 layout(std430, set = 0, binding = 26) buffer SampleCountBuffer { uint acc_samples[]; };
+layout(std430, set = 0, binding = 27) buffer ProbeShBuffer { double acc_probe_sh[]; };       // [probe][coefficient][rgb]
+layout(std430, set = 0, binding = 28) buffer ProbeCountBuffer { uint acc_probe_counts[]; };  // [probe][samples, back faces]
 
 // Counter slots.
 const uint kRayCount0 = 0u;       // ray queue sizes, ping-pong
@@ -90,7 +98,12 @@ uint queue_append(uint counter_slot) {
   return base + subgroupBallotExclusiveBitCount(ballot);
 }
 
+// Texels: per work item, slots 0..K of E/pi by bounce. Probes (K = 1): slot 0 the radiance met by the
+// probe ray (sky or emission), slot 1 the path estimate of E/pi at its hit, then after all the
+// batch's slots, per work item, the hit's albedo (x < 0: back face) and the ray direction.
 uint result_index(uint work, uint slot) { return (work * (params.recorded + 1u) + slot) * 3u; }
+
+uint probe_extra_index(uint work) { return params.batch_work_total * 6u + work * 6u; }
 
 void add_result(uint work, uint depth, vec3 value) {
   uint i = result_index(work, min(depth, params.recorded));

@@ -32,3 +32,24 @@ float power_heuristic(float pdf_a, float pdf_b) {
   if (isinf(a)) return 1.0;
   return a / (a + b);
 }
+
+vec3 uniform_sphere(float u1, float u2) {
+  float z = 1.0 - 2.0 * u1;
+  float r = sqrt(max(0.0, 1.0 - z * z));
+  float phi = 2.0 * kPi * u2;
+  return vec3(r * cos(phi), r * sin(phi), z);
+}
+
+// Probe sample `index` of a stratified set of `count` (sampling.h probe_direction): the first m*m
+// samples jittered over an m x m grid of the equal-area (z, phi) square, the rest uniform.
+vec3 probe_direction(uint index, uint count, float u1, float u2) {
+  uint m = uint(sqrt(float(count)));
+  while ((m + 1u) * (m + 1u) <= count) ++m;
+  while (m > 0u && m * m > count) --m;
+  if (index < m * m) {
+    float inv = 1.0 / float(m);
+    u1 = (float(index % m) + u1) * inv;
+    u2 = (float(index / m) + u2) * inv;
+  }
+  return uniform_sphere(min(u1, 0.99999994), min(u2, 0.99999994));
+}

@@ -3,6 +3,10 @@
 // Stage "shade": at each extension ray's hit: sky on a miss, emission with MIS, absorption by back
 // faces, bounce limits, albedo, Russian roulette; then next-event estimation and the cosine-sampled
 // continuation at the new vertex. Finished paths are regenerated from the batch's work.
+// Probe batches (the kProbeMode variant): depth 0 is the ray from the probe: emission at full weight
+// (nothing to MIS with), 0 and a back-face mark on single-sided back faces, and the hit's albedo kept
+// apart (the reference multiplies the hit's whole E/pi estimate by it); the path from the hit is the
+// texel estimator with its depth counted from 1, so bounce limits and roulette use depth - 1.
 layout(local_size_x = 64) in;
 #include "../include/kernel_prelude.glsl"
 
@@ -23,6 +27,7 @@ void main() {
   rng.increment = rs.y;
 
   bool continues = false;
+  bool probe_ray = kProbeMode && depth == 0u;
   SurfacePoint x;
   if (tri == kInvalid) {
     add_result(work, depth, throughput * params.sky.xyz);
@@ -36,20 +41,30 @@ void main() {
       if (max_component(le) > 0.0) {
         float cos_l = abs(dot(wi, ng));
         float pdf_light = tri_area_pdf(tri) * hit.x * hit.x / cos_l;
-        add_result(work, depth, throughput * le * power_heuristic(pdf_cosine, pdf_light));
+        add_result(work, depth, throughput * le * (probe_ray ? 1.0 : power_heuristic(pdf_cosine, pdf_light)));
       }
     }
     continues = front || double_sided;
-    if (continues && params.max_bounces >= 0 && int(depth) + 1 > params.max_bounces) continues = false;
-    if (continues && int(depth) + 1 >= params.safety_cap) continues = false;
-    if (continues) {
-      throughput *= material_albedo(m);
-      if (int(depth) + 1 >= params.rr_start) {
-        float survive = min(1.0, max_component(throughput));
-        if (!(survive > 0.0) || pcg_uniform(rng) >= survive) continues = false;
-        else throughput = throughput / survive;
-      } else if (max_component(throughput) <= 0.0) {
-        continues = false;
+    if (probe_ray) {
+      vec3 albedo = continues ? material_albedo(m) : vec3(-1.0);
+      uint e = probe_extra_index(work);
+      results[e] = albedo.x;
+      results[e + 1u] = albedo.y;
+      results[e + 2u] = albedo.z;
+      if (!(max_component(albedo) > 0.0)) continues = false;
+    } else {
+      int bounce = kProbeMode ? int(depth) - 1 : int(depth);  // depth of the vertex as the texel estimator counts it
+      if (continues && params.max_bounces >= 0 && bounce + 1 > params.max_bounces) continues = false;
+      if (continues && bounce + 1 >= params.safety_cap) continues = false;
+      if (continues) {
+        throughput *= material_albedo(m);
+        if (bounce + 1 >= params.rr_start) {
+          float survive = min(1.0, max_component(throughput));
+          if (!(survive > 0.0) || pcg_uniform(rng) >= survive) continues = false;
+          else throughput = throughput / survive;
+        } else if (max_component(throughput) <= 0.0) {
+          continues = false;
+        }
       }
     }
     if (continues) {

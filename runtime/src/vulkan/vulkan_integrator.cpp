@@ -4,6 +4,11 @@
 // shade) until the batch is exhausted, then drain (the cool-down), so every texel gets exactly the
 // samples of the batch. Each work item owns a result slot (one writer), and the reduce kernel adds
 // the batch's samples to per-texel double sums in sample order.
+// Light probes (bake_probes) run through the same kernels as work items (probe, sample) of probe
+// batches, in variants of generate and shade specialised for probes (kProbeMode, so the lightmap
+// kernels compile without the probe code): regenerate emits the probe's stratified sphere ray, shade
+// weighs what it meets as the reference's radiance_along_ray does and continues into the texel
+// estimator at the hit, and reduce_probes projects each sample onto L2 SH into per-probe double sums.
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 
 #include <algorithm>
@@ -23,6 +28,7 @@
 #include "exitance_spirv/generate.h"
 #include "exitance_spirv/prepare.h"
 #include "exitance_spirv/reduce.h"
+#include "exitance_spirv/reduce_probes.h"
 #include "exitance_spirv/shade.h"
 #include "gpu_bvh.h"
 #include "vulkan_context.h"
@@ -36,7 +42,8 @@ namespace {
 enum Binding : uint32_t {
   kParams, kNodes, kLeafTris, kTriShading, kMaterials, kEmitterCdf, kEmitterTris, kPunctual, kPunctualCdf, kTexels,
   kBatchTexels, kCounters, kIndirect, kPathWork, kPathDepth, kPathRng, kPathThroughput, kPathRayO, kPathRayD, kPathHit,
-  kShadowRays, kRayQueue, kShadowQueue, kResults, kAccTotal, kAccBounce, kAccSamples, kBindingCount
+  kShadowRays, kRayQueue, kShadowQueue, kResults, kAccTotal, kAccBounce, kAccSamples, kProbeSh, kProbeCounts,
+  kBindingCount
 };
 
 struct GpuParams {
@@ -47,7 +54,7 @@ struct GpuParams {
   uint32_t path_capacity;
   uint32_t seed_lo, seed_hi, batch_texel_offset, batch_texel_count;
   uint32_t batch_sample_begin, batch_sample_count, batch_work_total, collect_stats;
-  uint32_t texel_count_total, pad0, pad1, pad2;
+  uint32_t texel_count_total, pad0, probe_spp, pad2;
   float bench_lo[4];
   float bench_hi[4];
 };
@@ -59,8 +66,17 @@ enum Counter : uint32_t {
   kStatShadeItems = 24, kStatShadeLanes = 26, kCounterCount = 32
 };
 
-enum Kernel { kGenerate, kShade, kExtend, kConnect, kPrepare, kReduce, kBenchRays, kKernelCount };
-const char* const kKernelNames[kKernelCount] = {"generate", "shade", "extend", "connect", "prepare", "reduce", "traversal-only"};
+// Pipelines. The first kStageCount are the stages of the statistics; the probe variants of generate
+// and shade (specialization constant 2 set) count as those stages.
+enum Kernel {
+  kGenerate, kShade, kExtend, kConnect, kPrepare, kReduce, kBenchRays, kReduceProbes, kGenerateProbes, kShadeProbes,
+  kKernelCount
+};
+constexpr int kStageCount = kGenerateProbes;
+const char* const kKernelNames[kKernelCount] = {"generate", "shade",          "extend",        "connect",
+                                                "prepare",  "reduce",         "traversal-only", "reduce probes",
+                                                "generate (probes)", "shade (probes)"};
+int stage_of(int kernel) { return kernel == kGenerateProbes ? kGenerate : kernel == kShadeProbes ? kShade : kernel; }
 
 constexpr uint32_t kGroupSize = 64;
 constexpr int kMaxRecordedBounces = 16;
@@ -184,12 +200,17 @@ struct VulkanIntegrator::Impl {
         {spirv_generate, sizeof(spirv_generate)}, {spirv_shade, sizeof(spirv_shade)},
         {spirv_extend, sizeof(spirv_extend)}, {spirv_connect, sizeof(spirv_connect)},
         {spirv_prepare, sizeof(spirv_prepare)}, {spirv_reduce, sizeof(spirv_reduce)},
-        {spirv_bench_rays, sizeof(spirv_bench_rays)}}};
-    // Specialization: 0 = traversal stack bound, 1 = node layout (quantized or float; bvh.glsl).
-    const uint32_t spec_values[2] = {std::max<uint32_t>(bvh.stack_entries + 1, 8), quantized_nodes ? 1u : 0u};
-    const VkSpecializationMapEntry entries[2] = {{0, 0, sizeof(uint32_t)}, {1, sizeof(uint32_t), sizeof(uint32_t)}};
-    VkSpecializationInfo spec{2, entries, sizeof(spec_values), spec_values};
+        {spirv_bench_rays, sizeof(spirv_bench_rays)}, {spirv_reduce_probes, sizeof(spirv_reduce_probes)},
+        {spirv_generate, sizeof(spirv_generate)}, {spirv_shade, sizeof(spirv_shade)}}};
+    // Specialization: 0 = traversal stack bound, 1 = node layout (quantized or float; bvh.glsl),
+    // 2 = probe work items (bindings.glsl kProbeMode).
+    const uint32_t stack_bound = std::max<uint32_t>(bvh.stack_entries + 1, 8);
+    const VkSpecializationMapEntry entries[3] = {
+        {0, 0, sizeof(uint32_t)}, {1, sizeof(uint32_t), sizeof(uint32_t)}, {2, 2 * sizeof(uint32_t), sizeof(VkBool32)}};
     for (int k = 0; k < kKernelCount; ++k) {
+      const uint32_t spec_values[3] = {stack_bound, quantized_nodes ? 1u : 0u,
+                                       (k == kGenerateProbes || k == kShadeProbes) ? 1u : 0u};
+      const VkSpecializationInfo spec{3, entries, sizeof(spec_values), spec_values};
       VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
       module_info.codeSize = code[size_t(k)].second;
       module_info.pCode = code[size_t(k)].first;
@@ -310,7 +331,8 @@ struct VulkanIntegrator::Impl {
     make_buffer(kRayQueue, size_t(paths) * 8);
     make_buffer(kShadowQueue, size_t(paths) * 4);
     readback = ctx->create_buffer(kCounterCount * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
-    for (Binding b : {kTexels, kBatchTexels, kResults, kAccTotal, kAccBounce, kAccSamples}) make_buffer(b, 16);
+    for (Binding b : {kTexels, kBatchTexels, kResults, kAccTotal, kAccBounce, kAccSamples, kProbeSh, kProbeCounts})
+      make_buffer(b, 16);
   }
 
   size_t path_bytes() const { return 4 + 4 + 16 + 16 + 16 + 16 + 16 + 64 + 8 + 4; }
@@ -332,7 +354,8 @@ struct VulkanIntegrator::Impl {
     VkCommandBuffer cmd;
     bool timing;
     uint32_t queries = 0;
-    std::vector<int> query_kernel;  // kernel that ended at query i (i >= 1)
+    std::vector<int> query_kernel;  // stage that ended at query i (i >= 1)
+    bool probes = false;            // probe batch: the probe variants of generate and shade
 
     void start() {
       vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, impl.pipeline_layout, 0, 1, &impl.descriptor_set, 0, nullptr);
@@ -345,7 +368,7 @@ struct VulkanIntegrator::Impl {
     void stamp(int kernel) {
       if (!timing || queries >= kMaxQueries) return;
       vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, impl.query_pool, queries++);
-      query_kernel.push_back(kernel);
+      query_kernel.push_back(stage_of(kernel));
     }
     void bind(Kernel k, uint32_t cur, uint32_t mode) {
       vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, impl.pipelines[k]);
@@ -373,7 +396,7 @@ struct VulkanIntegrator::Impl {
     // One wavefront iteration reading ray queue `cur`.
     void iteration(uint32_t cur) {
       dispatch(kPrepare, 1, cur, 0);
-      dispatch_indirect(kShade, 0, cur);
+      dispatch_indirect(probes ? kShadeProbes : kShade, 0, cur);
       connect_and_extend(cur);
     }
     void copy_counters() {
@@ -423,11 +446,22 @@ struct VulkanIntegrator::Impl {
   }
 
   void reset_stats() const {
-    stats.assign(kKernelCount, {});
-    for (int k = 0; k < kKernelCount; ++k) stats[size_t(k)].stage = kKernelNames[k];
+    stats.assign(kStageCount, {});
+    for (int k = 0; k < kStageCount; ++k) stats[size_t(k)].stage = kKernelNames[k];
   }
 
+  // Sums of a bake's counter read-backs.
+  struct BatchTotals {
+    uint64_t rays_primary = 0, rays_bounce = 0, rays_shadow = 0, nonfinite = 0;
+    uint64_t extend_busy = 0, extend_launched = 0, connect_busy = 0, connect_launched = 0, shade_items = 0, shade_lanes = 0;
+    uint64_t rays() const { return rays_primary + rays_bounce + rays_shadow; }
+  };
+  void run_wavefront_batch(const GpuParams& params, VkDeviceSize result_bytes, bool probes, bool timing,
+                           BatchTotals& totals);
+  void record_stats(const BatchTotals& totals) const;
+
   LightmapEstimate bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings);
+  ProbeEstimate bake_probes(const std::vector<Vec3>& positions, const IntegratorSettings& settings);
   double traversal_bench(uint32_t ray_count, int repetitions);
 };
 
@@ -482,8 +516,7 @@ LightmapEstimate VulkanIntegrator::Impl::bake(const TexelGBuffer& gbuffer, const
   params.texel_count_total = uint32_t(texel_count);
 
   const bool timing = options.collect_stage_statistics && query_pool != VK_NULL_HANDLE;
-  uint64_t rays_primary = 0, rays_bounce = 0, rays_shadow = 0, nonfinite = 0;
-  uint64_t extend_busy = 0, extend_launched = 0, connect_busy = 0, connect_launched = 0, shade_items = 0, shade_lanes = 0;
+  BatchTotals totals;
 
   auto run_batch = [&](uint32_t offset, uint32_t n, uint32_t sample_begin, uint32_t samples) {
     params.batch_texel_offset = offset;
@@ -491,36 +524,7 @@ LightmapEstimate VulkanIntegrator::Impl::bake(const TexelGBuffer& gbuffer, const
     params.batch_sample_begin = sample_begin;
     params.batch_sample_count = samples;
     params.batch_work_total = n * samples;
-    const VkDeviceSize result_bytes = VkDeviceSize(n) * samples * uint32_t(K + 1) * 12;
-    Recorder r{*this, ctx->begin(), timing};
-    r.start();
-    set_params(r.cmd, params);
-    vkCmdFillBuffer(r.cmd, buffers[kCounters].buffer, 0, VK_WHOLE_SIZE, 0);
-    vkCmdFillBuffer(r.cmd, buffers[kResults].buffer, 0, result_bytes, 0);
-    barrier(r.cmd);
-    r.dispatch(kGenerate, (paths + kGroupSize - 1) / kGroupSize, 1);  // fills ray queue 0
-    r.connect_and_extend(1);
-    uint32_t cur = 0;
-    r.copy_counters();
-    finish(r);
-    while (counters()[kRayCount0 + cur] > 0) {
-      Recorder more{*this, ctx->begin(), timing};
-      more.start();
-      for (uint32_t i = 0; i < iterations_per_submit; ++i, cur ^= 1u) more.iteration(cur);
-      more.copy_counters();
-      finish(more);
-    }
-    Recorder reduce{*this, ctx->begin(), timing};
-    reduce.start();
-    reduce.dispatch(kReduce, (n + kGroupSize - 1) / kGroupSize, 0);
-    reduce.copy_counters();
-    finish(reduce);
-    const uint32_t* c = counters();
-    rays_primary += c[kRaysPrimary], rays_bounce += c[kRaysBounce], rays_shadow += c[kRaysShadow];
-    nonfinite += c[kNonfinite];
-    extend_busy += stat64(c, kStatExtendActive), extend_launched += stat64(c, kStatExtendLaunched);
-    connect_busy += stat64(c, kStatConnectActive), connect_launched += stat64(c, kStatConnectLaunched);
-    shade_items += stat64(c, kStatShadeItems), shade_lanes += stat64(c, kStatShadeLanes);
+    run_wavefront_batch(params, VkDeviceSize(n) * samples * uint32_t(K + 1) * 12, false, timing, totals);
   };
 
   const uint32_t spp_limit = settings.spp == 0 ? std::numeric_limits<uint32_t>::max() : settings.spp;
@@ -541,7 +545,7 @@ LightmapEstimate VulkanIntegrator::Impl::bake(const TexelGBuffer& gbuffer, const
     if (settings.progress) {
       const double by_spp = settings.spp ? double(done) / double(settings.spp) : 0.0;
       const double by_time = timed ? elapsed / settings.time_budget_seconds : 0.0;
-      settings.progress(std::min(1.0, std::max(by_spp, by_time)), rays_primary + rays_bounce + rays_shadow);
+      settings.progress(std::min(1.0, std::max(by_spp, by_time)), totals.rays());
     }
     if (timed && elapsed >= settings.time_budget_seconds) break;
     if (settings.target_relative_error > 0 && done >= 16 && done < spp_limit) {
@@ -582,20 +586,162 @@ LightmapEstimate VulkanIntegrator::Impl::bake(const TexelGBuffer& gbuffer, const
     }
     a.samples = samples[i];
   }
-  estimate.rays = rays_primary + rays_bounce + rays_shadow;
-  estimate.nonfinite_samples = nonfinite;
+  estimate.rays = totals.rays();
+  estimate.nonfinite_samples = totals.nonfinite;
   estimate.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  record_stats(totals);
+  return estimate;
+}
 
-  stats[kExtend].rays = stats[kExtend].items = rays_primary + rays_bounce;
-  stats[kExtend].lane_efficiency = extend_launched ? double(extend_busy) / double(extend_launched) : 0.0;
-  stats[kConnect].rays = rays_shadow;
-  stats[kConnect].lane_efficiency = connect_launched ? double(connect_busy) / double(connect_launched) : 0.0;
-  stats[kShade].items = shade_items;
-  stats[kShade].lane_efficiency = shade_lanes ? double(shade_items) / double(shade_lanes) : 0.0;
-  VulkanStageStatistics primary{"rays: primary", 0, rays_primary, rays_primary, 0};
-  VulkanStageStatistics bounce{"rays: bounce", 0, rays_bounce, rays_bounce, 0};
+// One batch: generate, wavefront iterations until every path slot is idle, then reduce over the
+// batch's n texels (or probes). `result_bytes`: the part of the result buffer the batch writes.
+void VulkanIntegrator::Impl::run_wavefront_batch(const GpuParams& params, VkDeviceSize result_bytes, bool probes,
+                                                 bool timing, BatchTotals& totals) {
+  const uint32_t n = params.batch_texel_count;
+  Recorder r{*this, ctx->begin(), timing};
+  r.probes = probes;
+  r.start();
+  set_params(r.cmd, params);
+  vkCmdFillBuffer(r.cmd, buffers[kCounters].buffer, 0, VK_WHOLE_SIZE, 0);
+  vkCmdFillBuffer(r.cmd, buffers[kResults].buffer, 0, result_bytes, 0);
+  barrier(r.cmd);
+  r.dispatch(probes ? kGenerateProbes : kGenerate, (paths + kGroupSize - 1) / kGroupSize, 1);  // fills ray queue 0
+  r.connect_and_extend(1);
+  uint32_t cur = 0;
+  r.copy_counters();
+  finish(r);
+  while (counters()[kRayCount0 + cur] > 0) {
+    Recorder more{*this, ctx->begin(), timing};
+    more.probes = probes;
+    more.start();
+    for (uint32_t i = 0; i < iterations_per_submit; ++i, cur ^= 1u) more.iteration(cur);
+    more.copy_counters();
+    finish(more);
+  }
+  Recorder reduce{*this, ctx->begin(), timing};
+  reduce.start();
+  reduce.dispatch(probes ? kReduceProbes : kReduce, (n + kGroupSize - 1) / kGroupSize, 0);
+  reduce.copy_counters();
+  finish(reduce);
+  const uint32_t* c = counters();
+  totals.rays_primary += c[kRaysPrimary], totals.rays_bounce += c[kRaysBounce], totals.rays_shadow += c[kRaysShadow];
+  totals.nonfinite += c[kNonfinite];
+  totals.extend_busy += stat64(c, kStatExtendActive), totals.extend_launched += stat64(c, kStatExtendLaunched);
+  totals.connect_busy += stat64(c, kStatConnectActive), totals.connect_launched += stat64(c, kStatConnectLaunched);
+  totals.shade_items += stat64(c, kStatShadeItems), totals.shade_lanes += stat64(c, kStatShadeLanes);
+}
+
+void VulkanIntegrator::Impl::record_stats(const BatchTotals& t) const {
+  stats[kExtend].rays = stats[kExtend].items = t.rays_primary + t.rays_bounce;
+  stats[kExtend].lane_efficiency = t.extend_launched ? double(t.extend_busy) / double(t.extend_launched) : 0.0;
+  stats[kConnect].rays = t.rays_shadow;
+  stats[kConnect].lane_efficiency = t.connect_launched ? double(t.connect_busy) / double(t.connect_launched) : 0.0;
+  stats[kShade].items = t.shade_items;
+  stats[kShade].lane_efficiency = t.shade_lanes ? double(t.shade_items) / double(t.shade_lanes) : 0.0;
+  VulkanStageStatistics primary{"rays: primary", 0, t.rays_primary, t.rays_primary, 0};
+  VulkanStageStatistics bounce{"rays: bounce", 0, t.rays_bounce, t.rays_bounce, 0};
   stats.push_back(primary);
   stats.push_back(bounce);
+}
+
+ProbeEstimate VulkanIntegrator::Impl::bake_probes(const std::vector<Vec3>& positions, const IntegratorSettings& settings) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  const size_t probe_count = positions.size();
+  ProbeEstimate estimate;
+  estimate.sh_sum.assign(probe_count, std::array<double, 27>{});
+  estimate.samples.assign(probe_count, 0);
+  estimate.backface_hits.assign(probe_count, 0);
+  reset_stats();
+  if (probe_count == 0) return estimate;
+  if (probe_count >= (1ull << 31)) throw std::runtime_error("Vulkan backend: too many probes");
+
+  // Per work item: 2 result slots (12 bytes each), then albedo and direction (24 bytes).
+  constexpr size_t kProbeItemBytes = 48;
+  const size_t limit_items = size_t(ctx->properties().limits.maxStorageBufferRange) / kProbeItemBytes;
+  const size_t max_work = std::max<size_t>(1, std::min<size_t>({size_t(paths) * work_per_path, limit_items, size_t(1) << 30}));
+  const auto grow = [&](Binding b, size_t bytes) {
+    if (buffers[b].size < bytes) make_buffer(b, bytes);
+  };
+  grow(kTexels, probe_count * 48);
+  grow(kBatchTexels, probe_count * 4);
+  grow(kProbeSh, probe_count * 27 * 8);
+  grow(kProbeCounts, probe_count * 2 * 4);
+  grow(kResults, max_work * kProbeItemBytes);
+  result_capacity = std::max<size_t>(result_capacity, buffers[kResults].size / 4);
+  write_descriptors();
+
+  std::vector<float> records(probe_count * 12, 0.0f);  // texel records with the position only
+  for (size_t i = 0; i < probe_count; ++i)
+    records[i * 12] = positions[i].x, records[i * 12 + 1] = positions[i].y, records[i * 12 + 2] = positions[i].z;
+  ctx->upload(buffers[kTexels], records.data(), records.size() * 4);
+  std::vector<uint32_t> order(probe_count);
+  for (size_t i = 0; i < probe_count; ++i) order[i] = uint32_t(i);
+  ctx->upload(buffers[kBatchTexels], order.data(), order.size() * 4);
+  {
+    VkCommandBuffer cmd = ctx->begin();
+    for (Binding b : {kProbeSh, kProbeCounts}) vkCmdFillBuffer(cmd, buffers[b].buffer, 0, VK_WHOLE_SIZE, 0);
+    ctx->submit_and_wait(cmd);
+  }
+
+  const uint32_t spp_limit = settings.spp == 0 ? std::numeric_limits<uint32_t>::max() : settings.spp;
+  GpuParams params{};
+  params.sky[0] = scene.sky.constant.x, params.sky[1] = scene.sky.constant.y, params.sky[2] = scene.sky.constant.z;
+  params.scene_extent = scene_extent;
+  params.emitter_count = emitter_count;
+  params.punctual_count = punctual_count;
+  params.recorded = 1;  // slot 0: what the probe ray meets; slot 1: E/pi at its hit
+  params.max_bounces = settings.max_bounces;
+  params.rr_start = settings.russian_roulette_start;
+  params.safety_cap = settings.safety_bounce_cap;
+  params.path_capacity = paths;
+  params.seed_lo = uint32_t(settings.seed), params.seed_hi = uint32_t(settings.seed >> 32);
+  params.collect_stats = options.collect_stage_statistics ? 1u : 0u;
+  params.texel_count_total = uint32_t(probe_count);
+  params.probe_spp = spp_limit;
+
+  const bool timing = options.collect_stage_statistics && query_pool != VK_NULL_HANDLE;
+  BatchTotals totals;
+  const bool timed = settings.time_budget_seconds > 0;
+  const uint32_t chunk = uint32_t(std::min(probe_count, max_work));
+  uint32_t done = 0;
+  while (done < spp_limit) {
+    uint32_t pass = uint32_t(std::min<size_t>(spp_limit - done, std::max<size_t>(1, max_work / chunk)));
+    // With a time budget, passes end on stratified-set boundaries and the budget is only checked
+    // there, so a stopped run never leaves a set's strata out (as the reference).
+    if (timed) pass = std::min(pass, kProbeStratifiedSetSize - done % kProbeStratifiedSetSize);
+    for (size_t offset = 0; offset < probe_count; offset += chunk) {
+      const uint32_t n = uint32_t(std::min<size_t>(chunk, probe_count - offset));
+      params.batch_texel_offset = uint32_t(offset);
+      params.batch_texel_count = n;
+      params.batch_sample_begin = done;
+      params.batch_sample_count = pass;
+      params.batch_work_total = n * pass;
+      run_wavefront_batch(params, VkDeviceSize(n) * pass * kProbeItemBytes, true, timing, totals);
+    }
+    done += pass;
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    if (settings.progress) {
+      const double by_spp = settings.spp ? double(done) / double(settings.spp) : 0.0;
+      const double by_time = timed ? elapsed / settings.time_budget_seconds : 0.0;
+      settings.progress(std::min(1.0, std::max(by_spp, by_time)), totals.rays());
+    }
+    if (timed && done % kProbeStratifiedSetSize == 0 && elapsed >= settings.time_budget_seconds) break;
+  }
+
+  std::vector<double> sums(probe_count * 27);
+  std::vector<uint32_t> counts(probe_count * 2);
+  ctx->download(buffers[kProbeSh], sums.data(), sums.size() * 8);
+  ctx->download(buffers[kProbeCounts], counts.data(), counts.size() * 4);
+  for (size_t i = 0; i < probe_count; ++i) {
+    std::copy(sums.begin() + std::ptrdiff_t(i * 27), sums.begin() + std::ptrdiff_t(i * 27 + 27), estimate.sh_sum[i].begin());
+    estimate.samples[i] = counts[i * 2];
+    estimate.backface_hits[i] = counts[i * 2 + 1];
+  }
+  estimate.rays = totals.rays();
+  estimate.nonfinite_samples = totals.nonfinite;
+  estimate.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  record_stats(totals);
   return estimate;
 }
 
@@ -674,6 +820,12 @@ LightmapEstimate VulkanIntegrator::bake(const TexelGBuffer& gbuffer, const Integ
   if (settings.spp == 0 && !(settings.time_budget_seconds > 0) && !(settings.target_relative_error > 0))
     throw std::invalid_argument("Vulkan backend: spp 0 needs a time budget or a target error");
   return impl_->bake(gbuffer, settings);
+}
+
+ProbeEstimate VulkanIntegrator::bake_probes(const std::vector<Vec3>& positions, const IntegratorSettings& settings) const {
+  if (settings.spp == 0 && !(settings.time_budget_seconds > 0))
+    throw std::invalid_argument("Vulkan backend: probes with spp 0 need a time budget");
+  return impl_->bake_probes(positions, settings);
 }
 
 const VulkanDeviceInfo& VulkanIntegrator::device() const { return impl_->ctx->info(); }

@@ -2,6 +2,7 @@
 // the same estimator as the CPU reference (cpu_reference_integrator.h), so both agree within
 // statistical error. Stages: generate -> extend (closest hit) -> shade (emission + MIS, NEE,
 // cosine bounce, Russian roulette) -> connect (shadow rays, any hit); see runtime/src/vulkan/.
+// Light probes (bake_probes) run through the same kernels.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -78,6 +79,13 @@ class VulkanIntegrator {
   // max_bounces, seed, recorded_bounces, russian_roulette_start, safety_bounce_cap, progress.
   // Throws std::runtime_error on device loss, out of memory or a fence timeout.
   LightmapEstimate bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const;
+
+  // Light probes: same contract and fields as CpuReferenceIntegrator::bake_probes (ProbeEstimate:
+  // stratified sphere rays, incident radiance projected to L2 SH), same random streams. Supported
+  // settings: spp (0 needs a time budget), time_budget_seconds (checked only when every probe has a
+  // complete stratified set), max_bounces, seed, russian_roulette_start, safety_bounce_cap, progress.
+  // Independent of bake(); throws as bake() does.
+  ProbeEstimate bake_probes(const std::vector<Vec3>& positions, const IntegratorSettings& settings) const;
 
   const VulkanDeviceInfo& device() const;
   uint32_t max_paths() const;
