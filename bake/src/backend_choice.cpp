@@ -51,6 +51,14 @@ LightingBackend vulkan_backend(const Scene& scene, const BackendRequest& request
                                " messages, first: " + messages->lines.front());
     return estimate;
   };
+  backend.bake_probes = [integrator, messages](const std::vector<Vec3>& positions, const IntegratorSettings& s) {
+    ProbeEstimate estimate = integrator->bake_probes(positions, s);
+    std::lock_guard<std::mutex> lock(messages->mutex);
+    if (!messages->lines.empty())
+      throw std::runtime_error("Vulkan validation reported " + std::to_string(messages->lines.size()) +
+                               " messages, first: " + messages->lines.front());
+    return estimate;
+  };
   backend.keep_alive = integrator;
   return backend;
 }

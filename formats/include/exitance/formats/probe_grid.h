@@ -4,6 +4,7 @@
 // (index l*(l+1)+m), evaluated on world directions.
 #pragma once
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
