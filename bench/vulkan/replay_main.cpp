@@ -6,6 +6,9 @@
 //                       [--work-per-path N] [--node-layout auto|float|quantized] [--skip-instrumented]
 //                       [--reference FILE]   (cross-check against a CPU reference written by
 //                                             bench_vulkan_throughput --write-reference; exit 3 on |z| >= 4)
+//                       [--probes NX,NY,NZ [--probe-spp N]]  (also bake a probe grid at the centres of
+//                                             NX x NY x NZ cells of the scene bounds; probe rays/s)
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -33,6 +36,7 @@ int main(int argc, char** argv) {
   uint32_t spp = 256, max_paths = 0, traversal_rays = 1u << 24, iterations = 0, work_per_path = 0;
   bool skip_instrumented = false;
   std::string reference_path;
+  uint32_t probe_counts[3] = {0, 0, 0}, probe_spp = 256;
   VulkanNodeLayout layout = VulkanNodeLayout::Automatic;
   for (int i = 2; i < argc; ++i) {
     auto next = [&]() -> uint32_t {
@@ -50,6 +54,10 @@ int main(int argc, char** argv) {
     }
     else if (!std::strcmp(argv[i], "--skip-instrumented")) skip_instrumented = true;
     else if (!std::strcmp(argv[i], "--reference") && i + 1 < argc) reference_path = argv[++i];
+    else if (!std::strcmp(argv[i], "--probes") && i + 1 < argc) {
+      if (std::sscanf(argv[++i], "%u,%u,%u", &probe_counts[0], &probe_counts[1], &probe_counts[2]) != 3) return 2;
+    }
+    else if (!std::strcmp(argv[i], "--probe-spp")) probe_spp = next();
     else { std::fprintf(stderr, "unknown option %s\n", argv[i]); return 2; }
   }
   try {
@@ -82,6 +90,28 @@ int main(int argc, char** argv) {
       double mean = 0;
       for (size_t i = 0; i < gpu.texels.size(); ++i) mean += luminance(gpu.mean_total(i));
       std::printf("mean texel luminance (E/pi) %.6g\n", gbuffer.texels.empty() ? 0.0 : mean / double(gpu.texels.size()));
+      if (probe_counts[0] * probe_counts[1] * probe_counts[2] > 0) {
+        Vec3 lo = scene.positions.front(), hi = lo;
+        for (const Vec3& p : scene.positions)
+          for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+        std::vector<Vec3> probes;
+        for (uint32_t z = 0; z < probe_counts[2]; ++z)
+          for (uint32_t y = 0; y < probe_counts[1]; ++y)
+            for (uint32_t x = 0; x < probe_counts[0]; ++x) {
+              const uint32_t c[3] = {x, y, z};
+              Vec3 p;
+              for (int a = 0; a < 3; ++a) p[a] = lo[a] + (hi[a] - lo[a]) * (float(c[a]) + 0.5f) / float(probe_counts[a]);
+              probes.push_back(p);
+            }
+        IntegratorSettings probe_settings = settings;
+        probe_settings.spp = 1;
+        vk->bake_probes(probes, probe_settings);  // warm-up
+        probe_settings.spp = probe_spp;
+        const ProbeEstimate e = vk->bake_probes(probes, probe_settings);
+        std::printf("vulkan probes: %zu probes x %u spp: %.3f s, %llu rays, %.3g rays/s end to end (%llu non-finite)\n",
+                    probes.size(), probe_spp, e.seconds, (unsigned long long)e.rays, double(e.rays) / e.seconds,
+                    (unsigned long long)e.nonfinite_samples);
+      }
       if (!reference_path.empty()) {
         const replay::ReferenceComparison c = replay::compare_with_reference(reference_path, gpu, 32);
         std::printf("cross-check vs CPU reference: %zu regions x 3 channels, max |z| %.2f, relMSE %.3g "
