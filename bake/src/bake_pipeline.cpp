@@ -148,7 +148,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
       svo_settings.depth = options.voxel_resolution ? svo_depth_from_resolution(options.voxel_resolution)
                                                     : default_svo_depth(scene, layout.texel_density);
     } catch (const std::invalid_argument& e) {
-      throw InputError(std::to_string(options.voxel_resolution), "--voxel-resolution", e.what());
+      throw InputError(options.input, "--voxel-resolution", e.what());
     }
     svo = build_sparse_voxel_octree(scene, svo_settings, &svo_stats);
     seconds["voxelize"] = timer.lap();
@@ -162,7 +162,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
     try {
       placement = place_probes(scene, embree, options.svo_enabled ? &svo : nullptr, probe_settings);
     } catch (const std::invalid_argument& e) {
-      throw InputError(std::to_string(options.probe_spacing), "--probes", e.what());
+      throw InputError(options.input, "--probes", e.what());
     }
     seconds["probe_placement"] = timer.lap();
   }

@@ -124,6 +124,39 @@ TEST(BakePipeline, BadInputLeavesEarlierBundleUntouched) {
   fs::remove_all(dir);
 }
 
+// Probe and voxel settings that cannot work are bad input: one error naming the option, nothing written.
+TEST(BakePipeline, ImpossibleProbeOrVoxelSettingsAreInputErrors) {
+  const fs::path dir = fresh_dir("settings");
+  BakeOptions options;
+  options.input = write_two_plane_scene(dir).string();
+  options.output = (dir / "out.bake").string();
+  options.atlas.texel_density = 4;
+  options.lighting.spp = 1;
+  Diagnostics diagnostics;
+  options.probe_spacing = 1e-4f;  // ~1e14 probes
+  try {
+    run_bake(options, diagnostics);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.element(), "--probes");
+    EXPECT_NE(std::string(e.what()).find("larger spacing"), std::string::npos) << e.what();
+  }
+  options.probe_spacing = 0;
+  options.voxel_resolution = 3;
+  EXPECT_THROW(run_bake(options, diagnostics), InputError);
+  EXPECT_FALSE(fs::exists(dir / "out.bake"));
+  // Both products off: a lightmap-only bundle.
+  options.voxel_resolution = 0;
+  options.probes_enabled = false;
+  options.svo_enabled = false;
+  run_bake(options, diagnostics);
+  EXPECT_TRUE(fs::exists(dir / "out.bake" / "manifest.json"));
+  EXPECT_FALSE(fs::exists(dir / "out.bake" / "probes.bin"));
+  EXPECT_FALSE(fs::exists(dir / "out.bake" / "svo.bin"));
+  EXPECT_FALSE(fs::exists(dir / "out.bake" / "radiance.vdb"));
+  fs::remove_all(dir);
+}
+
 TEST(BakePipeline, SameSeedSameResult) {
   const fs::path dir = fresh_dir("seed");
   BakeOptions options;
