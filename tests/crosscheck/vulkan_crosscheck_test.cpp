@@ -15,6 +15,7 @@
 #include "exitance/runtime/sampling.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "support/analytic_scenes.h"
+#include "support/validated_vulkan_backend.h"
 
 namespace exitance {
 namespace {
@@ -25,40 +26,6 @@ using testing::add_material;
 using testing::add_quad;
 using testing::grid_points;
 using testing::texel_at;
-
-// Creates the integrator with validation on; records every validation message.
-class VulkanBackend {
- public:
-  explicit VulkanBackend(const Scene& scene, std::string& skip_reason) {
-    VulkanDeviceOptions options;
-    options.validation = true;
-    options.on_validation_message = [this](const std::string& m) { messages_->push_back(m); };
-    try {
-      integrator_ = VulkanIntegrator::create(scene, options);
-    } catch (const std::runtime_error& e) {
-      const std::string what = e.what();
-      if (what.find("no Vulkan device") != std::string::npos || what.find("no usable Vulkan device") != std::string::npos)
-        skip_reason = what;
-      else
-        throw;
-    }
-  }
-  ~VulkanBackend() {
-    integrator_.reset();  // teardown messages (leaks) are recorded too
-    for (const std::string& m : *messages_) ADD_FAILURE() << m;
-  }
-  VulkanIntegrator* operator->() { return integrator_.get(); }
-  VulkanIntegrator& get() { return *integrator_; }
-
- private:
-  std::shared_ptr<std::vector<std::string>> messages_ = std::make_shared<std::vector<std::string>>();
-  std::unique_ptr<VulkanIntegrator> integrator_;
-};
-
-#define CREATE_VULKAN_OR_SKIP(name, scene)  \
-  std::string skip_reason_##name;           \
-  VulkanBackend name(scene, skip_reason_##name); \
-  if (!skip_reason_##name.empty()) GTEST_SKIP() << skip_reason_##name
 
 struct Comparison {
   double worst_z = 0;

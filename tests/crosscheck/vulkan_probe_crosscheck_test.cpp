@@ -18,6 +18,8 @@
 #include "exitance/runtime/spherical_harmonics.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "support/analytic_scenes.h"
+#include "support/independent_estimates.h"
+#include "support/validated_vulkan_backend.h"
 
 namespace exitance {
 namespace {
@@ -27,41 +29,6 @@ using testing::AnalyticScene;
 constexpr double kZLimit = 4.0;
 constexpr int kCopies = 32;
 
-// Creates the integrator with validation on; records every validation message (as
-// vulkan_crosscheck_test.cpp does).
-class VulkanBackend {
- public:
-  explicit VulkanBackend(const Scene& scene, std::string& skip_reason, uint32_t max_paths = 0) {
-    VulkanDeviceOptions options;
-    options.max_paths = max_paths;
-    options.validation = true;
-    options.on_validation_message = [this](const std::string& m) { messages_->push_back(m); };
-    try {
-      integrator_ = VulkanIntegrator::create(scene, options);
-    } catch (const std::runtime_error& e) {
-      const std::string what = e.what();
-      if (what.find("no Vulkan device") != std::string::npos || what.find("no usable Vulkan device") != std::string::npos)
-        skip_reason = what;
-      else
-        throw;
-    }
-  }
-  ~VulkanBackend() {
-    integrator_.reset();  // teardown messages (leaks) are recorded too
-    for (const std::string& m : *messages_) ADD_FAILURE() << m;
-  }
-  VulkanIntegrator* operator->() { return integrator_.get(); }
-
- private:
-  std::shared_ptr<std::vector<std::string>> messages_ = std::make_shared<std::vector<std::string>>();
-  std::unique_ptr<VulkanIntegrator> integrator_;
-};
-
-#define CREATE_VULKAN_OR_SKIP(name, scene, ...)                            \
-  std::string skip_reason_##name;                                          \
-  VulkanBackend name(scene, skip_reason_##name __VA_OPT__(, ) __VA_ARGS__); \
-  if (!skip_reason_##name.empty()) GTEST_SKIP() << skip_reason_##name
-
 std::vector<Vec3> with_copies(const std::vector<Vec3>& positions) {
   std::vector<Vec3> probes;
   for (const Vec3& p : positions)
@@ -70,20 +37,13 @@ std::vector<Vec3> with_copies(const std::vector<Vec3>& positions) {
 }
 
 // Mean and standard error over the copies of position `p` of quantity(SH of one copy).
-struct Summary {
-  double mean = 0, standard_error = 0;
-};
+using Summary = testing::MeanAndError;
 
 template <typename F>
 Summary summarise(const ProbeEstimate& e, size_t position, F quantity) {
   std::vector<double> values;
   for (int r = 0; r < kCopies; ++r) values.push_back(quantity(e.mean(position * kCopies + size_t(r))));
-  Summary s;
-  for (double v : values) s.mean += v / kCopies;
-  double variance = 0;
-  for (double v : values) variance += (v - s.mean) * (v - s.mean) / (kCopies - 1);
-  s.standard_error = std::sqrt(variance / kCopies);
-  return s;
+  return testing::mean_and_standard_error(values);
 }
 
 void expect_sane(const ProbeEstimate& e, size_t probes, uint32_t spp, const char* what) {
