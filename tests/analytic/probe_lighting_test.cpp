@@ -8,6 +8,7 @@
 
 #include "exitance/runtime/sampling.h"
 #include "support/analytic_scenes.h"
+#include "support/independent_estimates.h"
 
 namespace exitance {
 namespace {
@@ -15,9 +16,7 @@ namespace {
 constexpr double kZLimit = 4.0;
 constexpr int kRepeats = 16;
 
-struct RepeatedValue {
-  double mean = 0, standard_error = 0;
-};
+using RepeatedValue = testing::MeanAndError;
 
 // Runs `repeats` probe bakes with seeds 1..repeats and summarises quantity(estimate) over them.
 RepeatedValue repeat_probe_bake(const Scene& scene, const std::vector<Vec3>& probes, uint32_t spp,
@@ -32,12 +31,7 @@ RepeatedValue repeat_probe_bake(const Scene& scene, const std::vector<Vec3>& pro
     EXPECT_EQ(estimate.nonfinite_samples, 0u);
     values.push_back(quantity(estimate));
   }
-  RepeatedValue v;
-  for (double x : values) v.mean += x / kRepeats;
-  double variance = 0;
-  for (double x : values) variance += (x - v.mean) * (x - v.mean) / (kRepeats - 1);
-  v.standard_error = std::sqrt(variance / kRepeats);
-  return v;
+  return testing::mean_and_standard_error(values);
 }
 
 void expect_close(const RepeatedValue& v, double exact, double max_relative_se, const char* what) {

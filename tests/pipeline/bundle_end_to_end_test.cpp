@@ -11,6 +11,7 @@
 #include "exitance/bake/bake_pipeline.h"
 #include "exitance/loader/bundle.h"
 #include "scene_builder.h"
+#include "support/independent_estimates.h"
 
 namespace exitance {
 namespace {
@@ -35,24 +36,9 @@ fs::path write_furnace(const fs::path& dir) {
   return path;
 }
 
-struct MeanAndError {
-  double mean = 0, standard_error = 0;
-  size_t count = 0;
-};
-
-MeanAndError summarise(const std::vector<double>& v) {
-  MeanAndError m;
-  m.count = v.size();
-  for (double x : v) m.mean += x / double(v.size());
-  double var = 0;
-  for (double x : v) var += (x - m.mean) * (x - m.mean) / double(v.size() - 1);
-  m.standard_error = std::sqrt(var / double(v.size()));
-  return m;
-}
-
 void expect_mean(const std::vector<double>& values, double exact, double max_relative_se, const char* what) {
   ASSERT_GE(values.size(), 8u) << what;
-  const MeanAndError m = summarise(values);
+  const testing::MeanAndError m = testing::mean_and_standard_error(values);
   std::printf("[bundle] %-28s n %zu exact %.6g mean %.6g SE %.3g z %+.2f\n", what, m.count, exact, m.mean,
               m.standard_error, m.standard_error > 0 ? (m.mean - exact) / m.standard_error : 0.0);
   EXPECT_LE(std::fabs(m.mean - exact), 4.0 * m.standard_error + 1e-5 * exact) << what;

@@ -14,6 +14,7 @@
 #include "exitance/bake/prepared_scene.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/runtime/sampling.h"
+#include "support/independent_estimates.h"
 #include "support/test_scenes.h"
 
 namespace exitance {
@@ -21,18 +22,8 @@ namespace {
 
 constexpr int kRepeats = 32;  // the probe estimate is skewed (rare direct hits of the small light): many repeats
 
-struct MeanAndError {
-  double mean = 0, standard_error = 0;
-};
-
-MeanAndError summarise(const std::vector<double>& values) {
-  MeanAndError m;
-  for (double v : values) m.mean += v / double(values.size());
-  double variance = 0;
-  for (double v : values) variance += (v - m.mean) * (v - m.mean) / double(values.size() - 1);
-  m.standard_error = std::sqrt(variance / double(values.size()));
-  return m;
-}
+using testing::MeanAndError;
+using testing::mean_and_standard_error;
 
 TEST(ProbeVsLightmap, ProbeAboveCornellFloorMatchesTheTexelBelow) {
   Diagnostics diagnostics;
@@ -62,10 +53,10 @@ TEST(ProbeVsLightmap, ProbeAboveCornellFloorMatchesTheTexelBelow) {
       }
     }
     for (int c = 0; c < 3; ++c) {
-      const MeanAndError t = summarise(texel_values[c]), p = summarise(probe_values[c]);
+      const MeanAndError t = mean_and_standard_error(texel_values[c]), p = mean_and_standard_error(probe_values[c]);
       const double se = std::sqrt(t.standard_error * t.standard_error + p.standard_error * p.standard_error);
       const double z = (p.mean - t.mean) / se;
-      const MeanAndError d = summarise(sh_minus_probe[c]), bound = summarise(sh_bound[c]);
+      const MeanAndError d = mean_and_standard_error(sh_minus_probe[c]), bound = mean_and_standard_error(sh_bound[c]);
       std::printf("[probe-vs-texel] (%.1f, %.1f) ch%d texel %.5f (SE %.2g) probe rays %.5f (SE %.2g) z %+.2f; "
                   "L2 SH minus rays %+.5f (SE %.2g), bound %.5f\n",
                   floor_point.x, floor_point.z, c, t.mean, t.standard_error, p.mean, p.standard_error, z, d.mean,
