@@ -182,7 +182,6 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   }
 
   ProbeEstimate probe_estimate;
-  std::string probe_backend = backend.name;
   if (options.probes_enabled) {
     std::vector<Vec3> positions;
     std::vector<size_t> traced;  // grid index of each traced probe
@@ -197,12 +196,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
     probe_lighting.time_budget_seconds = 0;
     probe_lighting.target_relative_error = 0;
     probe_lighting.progress = [&](double fraction, uint64_t rays) { report("probes", fraction, rays); };
-    if (backend.bake_probes) {
-      probe_estimate = backend.bake_probes(positions, probe_lighting);
-    } else {
-      probe_backend = "cpu";
-      probe_estimate = CpuReferenceIntegrator(scene).bake_probes(positions, probe_lighting);
-    }
+    probe_estimate = backend.bake_probes(positions, probe_lighting);
     for (size_t k = 0; k < traced.size(); ++k) {
       ShRgb sh = probe_estimate.mean(k);
       if (options.probe_sh_window > 0) sh_apply_hanning_window(sh, options.probe_sh_window);
@@ -320,7 +314,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   if (options.probes_enabled) {
     skipped["probes_far_from_geometry"] = placement.skipped;
     skipped["probes_inside_geometry"] = placement.invalid;
-    stats["probes"] = {{"backend", probe_backend},
+    stats["probes"] = {{"backend", backend.name},
                        {"grid", placement.grid.probes.size()},
                        {"valid", placement.valid},
                        {"moved", placement.moved},

@@ -20,7 +20,7 @@ struct LightingBackend {
   std::string name;    // "cpu" or "vulkan"
   std::string device;  // human-readable device ("Embree 3 on N threads", GPU name)
   std::function<LightmapEstimate(const TexelGBuffer&, const IntegratorSettings&)> bake;
-  // Light probes; empty when the backend cannot bake them (the pipeline then uses the CPU reference).
+  // Light probes, on the same backend and device as the lightmaps.
   std::function<ProbeEstimate(const std::vector<Vec3>&, const IntegratorSettings&)> bake_probes;
   std::shared_ptr<void> keep_alive;  // owns the integrator
 };
