@@ -20,11 +20,10 @@ struct Bounds {
 
 Bounds scene_bounds(const Scene& scene) {
   Bounds b;
-  for (const Vec3& p : scene.positions)
-    for (int a = 0; a < 3; ++a) {
-      b.lo[a] = std::min(b.lo[a], p[a]);
-      b.hi[a] = std::max(b.hi[a], p[a]);
-    }
+  for (const Vec3& p : scene.positions) {
+    b.lo = min(b.lo, p);
+    b.hi = max(b.hi, p);
+  }
   return b;
 }
 
