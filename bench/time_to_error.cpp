@@ -19,6 +19,8 @@
 #include <fstream>
 #include <iostream>
 
+#include "exitance/runtime/embree_scene.h"
+#include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/bake/backend_choice.h"
 #include "exitance/bake/bundle_writer.h"
 #include "exitance/bake/prepared_scene.h"
@@ -88,15 +90,17 @@ int main(int argc, char** argv) {
   const PreparedScene prepared = prepare_scene_for_lighting(scene_path, sky, atlas, diagnostics);
   const Scene& scene = prepared.scene;
   const TexelGBuffer& gbuffer = prepared.gbuffer;
-  CpuReferenceIntegrator integrator(scene);
-  std::vector<LightingBackend> measured;
+  const std::shared_ptr<const LightingScene> lighting = make_lighting_scene(scene);
+  const auto embree = std::make_shared<const EmbreeScene>(*lighting->source);
+  const CpuReferenceIntegrator integrator(lighting, embree);
+  std::vector<std::shared_ptr<const Integrator>> measured;
   for (size_t start = 0; start < backends.size();) {
     const size_t comma = std::min(backends.find(',', start), backends.size());
     BackendRequest request;
     request.name = backends.substr(start, comma - start);
     try {
-      measured.push_back(choose_lighting_backend(scene, request, diagnostics));
-      std::cerr << "backend " << request.name << ": " << measured.back().device << "\n";
+      measured.push_back(choose_lighting_backend(lighting, embree, request, diagnostics));
+      std::cerr << "backend " << request.name << ": " << measured.back()->device_description() << "\n";
     } catch (const std::exception& e) {
       std::cerr << "backend " << request.name << " skipped: " << e.what() << "\n";
     }
@@ -135,24 +139,24 @@ int main(int argc, char** argv) {
   std::ostream& csv = csv_path.empty() ? std::cout : csv_file;
   csv << "backend,integrator,scene,live_texels,spp,seconds,rel_mse,raw_rel_mse,reference_rel_mse,mae,worst_texel_error,"
          "rays_per_second\n";
-  for (const LightingBackend& backend : measured) {
+  for (const std::shared_ptr<const Integrator>& backend : measured) {
     {  // Warm-up, not recorded: lavapipe and GPU drivers compile pipelines at the first dispatch.
       IntegratorSettings warm_up;
       warm_up.spp = 1;
-      backend.bake(gbuffer, warm_up);
+      backend->bake(gbuffer, warm_up);
     }
     double previous_seconds = 0, previous_error = 0, time_to_target = -1;
     for (uint32_t spp = 1; spp <= max_spp; spp *= 2) {
       IntegratorSettings settings;
       settings.spp = spp;
       settings.seed = spp;
-      const LightmapEstimate estimate = backend.bake(gbuffer, settings);
+      const LightmapEstimate estimate = backend->bake(gbuffer, settings);
       std::vector<float> result = flatten(estimate);
       result.resize(values);
       ErrorFigures e = compare(result, reference_mean);
       const double raw = e.rel_mse;
       e.rel_mse = std::max(raw - reference_noise, 1e-12);
-      csv << backend.name << ",path_tracing," << scene_name << "," << gbuffer.texels.size() << "," << spp << ","
+      csv << backend->backend_name() << ",path_tracing," << scene_name << "," << gbuffer.texels.size() << "," << spp << ","
           << estimate.seconds << "," << e.rel_mse << "," << raw << "," << reference_noise << "," << e.mae << ","
           << e.worst << "," << double(estimate.rays) / estimate.seconds << std::endl;
       if (time_to_target < 0 && e.rel_mse <= target) {
@@ -167,7 +171,7 @@ int main(int argc, char** argv) {
       previous_error = e.rel_mse;
       if (estimate.seconds > max_seconds) break;
     }
-    std::cerr << backend.name << ": live texels " << gbuffer.texels.size() << "; time to relMSE " << target << ": "
+    std::cerr << backend->backend_name() << ": live texels " << gbuffer.texels.size() << "; time to relMSE " << target << ": "
               << (time_to_target < 0 ? std::string("not reached") : std::to_string(time_to_target) + " s") << "\n";
   }
   return 0;

@@ -1,10 +1,9 @@
 #include "exitance/bake/backend_choice.h"
 
-#include <tbb/info.h>
-
 #include <mutex>
 #include <stdexcept>
 
+#include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 
 namespace exitance {
@@ -15,20 +14,37 @@ struct ValidationMessages {
   std::vector<std::string> lines;
 };
 
-LightingBackend cpu_backend(const Scene& scene) {
-  auto integrator = std::make_shared<CpuReferenceIntegrator>(scene);
-  LightingBackend backend;
-  backend.name = "cpu";
-  backend.device = "Embree 3 CPU reference on " + std::to_string(tbb::info::default_concurrency()) + " threads";
-  backend.bake = [integrator](const TexelGBuffer& g, const IntegratorSettings& s) { return integrator->bake(g, s); };
-  backend.bake_probes = [integrator](const std::vector<Vec3>& p, const IntegratorSettings& s) {
-    return integrator->bake_probes(p, s);
-  };
-  backend.keep_alive = integrator;
-  return backend;
-}
+// The Vulkan backend with validation layers on: any message fails the bake that produced it.
+class ValidationCheckedIntegrator final : public Integrator {
+ public:
+  ValidationCheckedIntegrator(std::shared_ptr<const Integrator> inner, std::shared_ptr<ValidationMessages> messages)
+      : inner_(std::move(inner)), messages_(std::move(messages)) {}
+  std::string backend_name() const override { return inner_->backend_name(); }
+  std::string device_description() const override { return inner_->device_description(); }
+  LightmapEstimate bake(const TexelGBuffer& g, const IntegratorSettings& s) const override {
+    LightmapEstimate estimate = inner_->bake(g, s);
+    check();
+    return estimate;
+  }
+  ProbeEstimate bake_probes(const std::vector<Vec3>& p, const IntegratorSettings& s) const override {
+    ProbeEstimate estimate = inner_->bake_probes(p, s);
+    check();
+    return estimate;
+  }
 
-LightingBackend vulkan_backend(const Scene& scene, const BackendRequest& request) {
+ private:
+  void check() const {
+    std::lock_guard<std::mutex> lock(messages_->mutex);
+    if (!messages_->lines.empty())
+      throw std::runtime_error("Vulkan validation reported " + std::to_string(messages_->lines.size()) +
+                               " messages, first: " + messages_->lines.front());
+  }
+  std::shared_ptr<const Integrator> inner_;
+  std::shared_ptr<ValidationMessages> messages_;
+};
+
+std::shared_ptr<const Integrator> vulkan_backend(std::shared_ptr<const LightingScene> scene,
+                                                 const BackendRequest& request) {
   VulkanDeviceOptions options;
   options.device_index = request.device_index;
   options.validation = request.validation;
@@ -39,28 +55,9 @@ LightingBackend vulkan_backend(const Scene& scene, const BackendRequest& request
       std::lock_guard<std::mutex> lock(messages->mutex);
       messages->lines.push_back(message);
     };
-  std::shared_ptr<VulkanIntegrator> integrator = VulkanIntegrator::create(scene, options);
-  LightingBackend backend;
-  backend.name = "vulkan";
-  backend.device = integrator->device().name + " (" + to_string(integrator->device().type) + ")";
-  backend.bake = [integrator, messages](const TexelGBuffer& g, const IntegratorSettings& s) {
-    LightmapEstimate estimate = integrator->bake(g, s);
-    std::lock_guard<std::mutex> lock(messages->mutex);
-    if (!messages->lines.empty())
-      throw std::runtime_error("Vulkan validation reported " + std::to_string(messages->lines.size()) +
-                               " messages, first: " + messages->lines.front());
-    return estimate;
-  };
-  backend.bake_probes = [integrator, messages](const std::vector<Vec3>& positions, const IntegratorSettings& s) {
-    ProbeEstimate estimate = integrator->bake_probes(positions, s);
-    std::lock_guard<std::mutex> lock(messages->mutex);
-    if (!messages->lines.empty())
-      throw std::runtime_error("Vulkan validation reported " + std::to_string(messages->lines.size()) +
-                               " messages, first: " + messages->lines.front());
-    return estimate;
-  };
-  backend.keep_alive = integrator;
-  return backend;
+  std::shared_ptr<const Integrator> integrator = VulkanIntegrator::create(std::move(scene), options);
+  if (!request.validation) return integrator;
+  return std::make_shared<ValidationCheckedIntegrator>(std::move(integrator), messages);
 }
 
 bool is_gpu(const VulkanDeviceInfo& device) {
@@ -70,8 +67,11 @@ bool is_gpu(const VulkanDeviceInfo& device) {
 
 }  // namespace
 
-LightingBackend choose_lighting_backend(const Scene& scene, const BackendRequest& request, Diagnostics& diagnostics) {
-  if (request.name == "cpu") return cpu_backend(scene);
+std::shared_ptr<const Integrator> choose_lighting_backend(std::shared_ptr<const LightingScene> scene,
+                                                          std::shared_ptr<const EmbreeScene> embree,
+                                                          const BackendRequest& request, Diagnostics& diagnostics) {
+  auto cpu = [&] { return std::make_shared<const CpuReferenceIntegrator>(scene, embree); };
+  if (request.name == "cpu") return cpu();
   if (request.name == "vulkan") return vulkan_backend(scene, request);
 
   const std::vector<VulkanDeviceInfo> devices = enumerate_vulkan_devices();
@@ -84,14 +84,14 @@ LightingBackend choose_lighting_backend(const Scene& scene, const BackendRequest
                          : "--backend auto: only a CPU Vulkan device (lavapipe measured 0.1-0.2x Embree's rays/s on 2 cores, "
                            "bench/results/vulkan-lavapipe.md); "
                            "using the CPU reference (Embree)");
-    return cpu_backend(scene);
+    return cpu();
   }
   try {
     return vulkan_backend(scene, request);
   } catch (const std::exception& e) {
     diagnostics.warn(std::string("--backend auto: Vulkan backend unavailable for this scene (") + e.what() +
                      "); using the CPU reference (Embree)");
-    return cpu_backend(scene);
+    return cpu();
   }
 }
 

@@ -19,9 +19,10 @@
 #include "exitance/bake/unocclude.h"
 #include "exitance/formats/probes_file.h"
 #include "exitance/formats/svo_file.h"
+#include "exitance/runtime/cpu/bvh4_builder.h"
 #include "exitance/runtime/embree_scene.h"
 #include "exitance/runtime/material_eval.h"
-#include "exitance/runtime/sampling.h"
+#include "exitance/common/sampling.h"
 #include "exitance/runtime/svo_exitance.h"
 
 namespace exitance {
@@ -114,24 +115,34 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   };
 
   report("import", 0, 0);
-  Scene scene = import_gltf(options.input, options.import, diagnostics);
-  scene.sky = parse_sky_option(options.sky);
+  Scene imported = import_gltf(options.input, options.import, diagnostics);
+  imported.sky = parse_sky_option(options.sky);
   seconds["import"] = timer.lap();
 
   report("layout", 0, 0);
-  const AtlasLayout layout = layout_lightmap_atlas(scene, options.atlas, options.input, diagnostics);
+  const AtlasLayout layout = layout_lightmap_atlas(imported, options.atlas, options.input, diagnostics);
   seconds["layout"] = timer.lap();
 
   report("raster", 0, 0);
-  TexelGBuffer gbuffer = rasterize_texel_gbuffer(scene, layout, options.input, diagnostics);
+  TexelGBuffer gbuffer = rasterize_texel_gbuffer(imported, layout, options.input, diagnostics);
   seconds["raster"] = timer.lap();
 
+  // One scene for every later stage: the Embree BVH (unocclude, checks, probe placement, the CPU
+  // reference) and the lighting scene with its BVH4 (every backend).
   report("bvh", 0, 0);
-  const LightingBackend backend = choose_lighting_backend(scene, options.backend, diagnostics);
+  auto shared_scene = std::make_shared<const Scene>(std::move(imported));
+  const Scene& scene = *shared_scene;
+  auto embree_ptr = std::make_shared<const EmbreeScene>(scene);
+  const EmbreeScene& embree = *embree_ptr;
+  auto lighting_scene =
+      std::make_shared<const LightingScene>(build_lighting_scene(shared_scene, build_bvh4(scene)));
   seconds["bvh"] = timer.lap();
+  report("backend", 0, 0);
+  const std::shared_ptr<const Integrator> backend =
+      choose_lighting_backend(lighting_scene, embree_ptr, options.backend, diagnostics);
+  seconds["backend"] = timer.lap();
   size_t moved = 0;
   GeometryCheckReport geometry;
-  const EmbreeScene embree(scene);
   moved = unocclude_texels(embree, gbuffer).moved;
   seconds["unocclude"] = timer.lap();
   geometry = check_scene_geometry(scene, embree, gbuffer);
@@ -169,7 +180,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
 
   IntegratorSettings lighting = options.lighting;
   lighting.progress = [&](double fraction, uint64_t rays) { report("lighting", fraction, rays); };
-  const LightmapEstimate estimate = backend.bake(gbuffer, lighting);
+  const LightmapEstimate estimate = backend->bake(gbuffer, lighting);
   seconds["lighting"] = timer.lap();
   if (estimate.nonfinite_samples > 0)
     diagnostics.warn(options.input + ": " + std::to_string(estimate.nonfinite_samples) +
@@ -196,7 +207,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
     probe_lighting.time_budget_seconds = 0;
     probe_lighting.target_relative_error = 0;
     probe_lighting.progress = [&](double fraction, uint64_t rays) { report("probes", fraction, rays); };
-    probe_estimate = backend.bake_probes(positions, probe_lighting);
+    probe_estimate = backend->bake_probes(positions, probe_lighting);
     for (size_t k = 0; k < traced.size(); ++k) {
       ShRgb sh = probe_estimate.mean(k);
       if (options.probe_sh_window > 0) sh_apply_hanning_window(sh, options.probe_sh_window);
@@ -235,7 +246,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   manifest["generator"] = "exitance 0.1.0";
   manifest["input"] = {{"file", input_path.filename().string()}, {"sha256", sha256_of_file(options.input)}};
   manifest["units"] = {{"lightmap", "irradiance_over_pi"}, {"probes", "incident_radiance_sh_l2"}, {"length", "scene"}};
-  manifest["settings"] = {{"backend", backend.name},
+  manifest["settings"] = {{"backend", backend->backend_name()},
                           {"spp", options.lighting.spp},
                           {"time_budget_seconds", options.lighting.time_budget_seconds},
                           {"target_error", options.lighting.target_relative_error},
@@ -296,7 +307,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   const double lighting_seconds = estimate.seconds;
   json stats;
   stats["seconds"] = seconds;
-  stats["device"] = backend.device;
+  stats["device"] = backend->device_description();
   stats["triangles"] = scene.triangle_count();
   stats["instances"] = scene.instances.size();
   stats["live_texels"] = gbuffer.texels.size();
@@ -314,7 +325,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   if (options.probes_enabled) {
     skipped["probes_far_from_geometry"] = placement.skipped;
     skipped["probes_inside_geometry"] = placement.invalid;
-    stats["probes"] = {{"backend", backend.name},
+    stats["probes"] = {{"backend", backend->backend_name()},
                        {"grid", placement.grid.probes.size()},
                        {"valid", placement.valid},
                        {"moved", placement.moved},

@@ -6,9 +6,9 @@
 #include <cmath>
 
 #include "exitance/runtime/material_eval.h"
-#include "exitance/runtime/ray_offset.h"
-#include "exitance/runtime/rng.h"
-#include "exitance/runtime/sampling.h"
+#include "exitance/common/ray_offset.h"
+#include "exitance/common/rng.h"
+#include "exitance/common/sampling.h"
 
 namespace exitance {
 namespace {
@@ -26,10 +26,11 @@ GeometryCheckReport check_scene_geometry(const Scene& scene, const EmbreeScene& 
   tbb::parallel_for(size_t(0), gbuffer.texels.size(), [&](size_t i) {
     const LiveTexel& t = gbuffer.texels[i];
     const Vec3 origin = offset_ray_origin(t.position, t.geometric_normal, embree.extent());
-    Pcg32 rng(0xC0FFEE, i, 0);
+    Pcg32 rng = pcg_init(0xC0FFEE, i, 0);
     int back = 0;
     for (int k = 0; k < kHemisphereRays; ++k) {
-      const Vec3 d = to_world(sample_cosine_hemisphere(rng.uniform(), rng.uniform()), t.geometric_normal);
+      const float u1 = pcg_uniform(rng), u2 = pcg_uniform(rng);
+      const Vec3 d = to_world(sample_cosine_hemisphere(u1, u2), t.geometric_normal);
       if (hits_back_face(embree.intersect(origin, d, INFINITY), d)) ++back;
     }
     if (back * 2 > kHemisphereRays) ++enclosed.local();
@@ -47,10 +48,11 @@ GeometryCheckReport check_scene_geometry(const Scene& scene, const EmbreeScene& 
   for (size_t l = 0; l < scene.lights.size(); ++l) {
     const PunctualLight& light = scene.lights[l];
     if (light.type == PunctualLight::Type::Directional) continue;
-    Pcg32 rng(0x11647, l, 0);
+    Pcg32 rng = pcg_init(0x11647, l, 0);
     int back = 0, escaped = 0;
     for (int k = 0; k < kLightRays; ++k) {
-      const Vec3 d = uniform_sphere(rng.uniform(), rng.uniform());
+      const float u1 = pcg_uniform(rng), u2 = pcg_uniform(rng);
+      const Vec3 d = uniform_sphere(u1, u2);
       const Hit hit = embree.intersect(light.position, d, INFINITY);
       if (!hit.found) ++escaped;
       else if (hits_back_face(hit, d)) ++back;

@@ -5,8 +5,8 @@
 
 #include <cmath>
 
-#include "exitance/runtime/ray_offset.h"
-#include "exitance/runtime/sampling.h"
+#include "exitance/common/ray_offset.h"
+#include "exitance/common/sampling.h"
 
 namespace exitance {
 

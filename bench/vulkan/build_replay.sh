@@ -10,9 +10,10 @@ build=$1
 out=$2
 ninja -C "$build" exitance_vulkan >/dev/null
 ${CXX:-g++} -std=c++20 -O2 -DNDEBUG -Wno-missing-field-initializers \
-  -I"$root/runtime/include" -I"$root/runtime/src/vulkan" -I"$build/runtime/generated" \
+  -I"$root/runtime/include" -I"$root/runtime/common/include" -I"$root/runtime/src/vulkan" -I"$build/runtime/generated" \
   "$root/runtime/src/vulkan/vulkan_context.cpp" "$root/runtime/src/vulkan/vulkan_integrator.cpp" \
-  "$root/runtime/src/light_sampler.cpp" "$root/runtime/src/material_eval.cpp" \
+  "$root/runtime/src/core/lighting_scene.cpp" "$root/runtime/src/core/pass_scheduler.cpp" \
+  "$root/runtime/src/material_eval.cpp" \
   "$root/runtime/src/environment_sampler.cpp" "$root/runtime/src/lightmap_estimate.cpp" \
-  "$root/bench/vulkan/replay_bvh.cpp" "$root/bench/vulkan/replay_main.cpp" \
+  "$root/bench/vulkan/replay_main.cpp" \
   -static-libstdc++ -static-libgcc -lvulkan -o "$out"

@@ -16,7 +16,7 @@
 
 #include "exitance/runtime/scene.h"
 #include "exitance/runtime/texel_gbuffer.h"
-#include "../../runtime/src/vulkan/gpu_bvh.h"
+#include "exitance/runtime/core/bvh4.h"
 
 namespace exitance::replay {
 
@@ -55,7 +55,7 @@ constexpr char kMagic[8] = {'E', 'X', 'R', 'P', 'L', 'A', 'Y', '2'};
 }  // namespace detail
 
 inline void write_replay(const std::string& path, const ReplayInfo& info, const Scene& scene,
-                         const TexelGBuffer& gbuffer, const vulkan::GpuBvh& bvh) {
+                         const TexelGBuffer& gbuffer, const Bvh4& bvh) {
   std::FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) throw std::runtime_error("replay: cannot write " + path);
   detail::Writer w{f};
@@ -85,15 +85,14 @@ inline void write_replay(const std::string& path, const ReplayInfo& info, const 
   }
   w.vec(texels);
   w.vec(bvh.nodes);
-  std::vector<uint32_t> leaf_ids(bvh.triangles.size());
-  for (size_t i = 0; i < leaf_ids.size(); ++i) std::memcpy(&leaf_ids[i], &bvh.triangles[i][3], 4);
+  const std::vector<uint32_t>& leaf_ids = bvh.leaf_triangles;
   w.vec(leaf_ids);
   w.pod(bvh.stack_entries), w.pod(bvh.depth);
   std::fclose(f);
 }
 
 inline void read_replay(const std::string& path, ReplayInfo& info, Scene& scene, TexelGBuffer& gbuffer,
-                        vulkan::GpuBvh& bvh) {
+                        Bvh4& bvh) {
   std::FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) throw std::runtime_error("replay: cannot read " + path);
   detail::Reader r{f};
@@ -126,20 +125,10 @@ inline void read_replay(const std::string& path, ReplayInfo& info, Scene& scene,
     const float* v = &texels[i * 9];
     t.position = {v[0], v[1], v[2]}, t.geometric_normal = {v[3], v[4], v[5]}, t.shading_normal = {v[6], v[7], v[8]};
   }
-  bvh.nodes = r.vec<vulkan::GpuBvhNode>();
-  const std::vector<uint32_t> leaf_ids = r.vec<uint32_t>();
-  bvh.triangles.resize(leaf_ids.size());
-  for (size_t i = 0; i < leaf_ids.size(); ++i) {
-    const uint32_t t = leaf_ids[i];
+  bvh.nodes = r.vec<Bvh4Node>();
+  bvh.leaf_triangles = r.vec<uint32_t>();
+  for (uint32_t t : bvh.leaf_triangles)
     if (size_t(t) * 3 + 2 >= scene.positions.size()) throw std::runtime_error("replay: leaf triangle out of range");
-    std::array<float, 12>& v = bvh.triangles[i];
-    v.fill(0.0f);
-    for (int k = 0; k < 3; ++k) {
-      const Vec3 p = scene.positions[size_t(t) * 3 + size_t(k)];
-      v[size_t(4 * k)] = p.x, v[size_t(4 * k + 1)] = p.y, v[size_t(4 * k + 2)] = p.z;
-    }
-    std::memcpy(&v[3], &t, 4);
-  }
   bvh.stack_entries = r.pod<uint32_t>();
   bvh.depth = r.pod<uint32_t>();
   std::fclose(f);

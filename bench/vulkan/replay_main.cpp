@@ -21,10 +21,6 @@
 
 using namespace exitance;
 
-namespace exitance::vulkan {
-extern GpuBvh* g_replay_bvh;
-}
-
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr, "usage: %s FILE [--spp N] [--max-paths N] [--traversal-rays N] [--iterations-per-submit N] "
@@ -64,9 +60,10 @@ int main(int argc, char** argv) {
     replay::ReplayInfo info;
     Scene scene;
     TexelGBuffer gbuffer;
-    vulkan::GpuBvh bvh;
+    Bvh4 bvh;
     replay::read_replay(path, info, scene, gbuffer, bvh);
-    vulkan::g_replay_bvh = &bvh;
+    const auto lighting = std::make_shared<const LightingScene>(
+        build_lighting_scene(std::make_shared<const Scene>(scene), std::move(bvh)));
     std::printf("scene %s (replay %s): %zu triangles, %zu live texels at density %g, %u spp\n", info.scene_name.c_str(),
                 path.c_str(), scene.triangle_count(), gbuffer.texels.size(), double(info.texel_density), spp);
     VulkanDeviceOptions options;
@@ -78,7 +75,7 @@ int main(int argc, char** argv) {
     IntegratorSettings settings;
     settings.seed = 1;
     {
-      auto vk = VulkanIntegrator::create(scene, options);
+      auto vk = VulkanIntegrator::create(lighting, options);
       bench::print_device_line(*vk);
       IntegratorSettings warm = settings;
       warm.spp = 1;
@@ -124,7 +121,7 @@ int main(int argc, char** argv) {
       }
     }
     options.collect_stage_statistics = true;
-    auto vk_stats = VulkanIntegrator::create(scene, options);
+    auto vk_stats = VulkanIntegrator::create(lighting, options);
     LightmapEstimate instrumented;
     if (!skip_instrumented) instrumented = vk_stats->bake(gbuffer, settings);
     bench::print_stage_figures(*vk_stats, instrumented, traversal_rays, 5);

@@ -21,7 +21,7 @@
 
 #include "exitance/bake/prepared_scene.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
-#include "../../runtime/src/vulkan/gpu_bvh.h"
+#include "exitance/runtime/cpu/bvh4_builder.h"
 #include "reference_comparison.h"
 #include "replay_format.h"
 #include "report.h"
@@ -75,7 +75,7 @@ int main(int argc, char** argv) {
               gbuffer.texels.size(), spp);
 
   if (!replay_path.empty()) {
-    const vulkan::GpuBvh bvh = vulkan::build_gpu_bvh(scene);
+    const Bvh4 bvh = build_bvh4(scene);
     replay::write_replay(replay_path, {scene_path, density}, scene, gbuffer, bvh);
     std::printf("wrote %s (BVH4 %zu nodes, stack bound %u)\n", replay_path.c_str(), bvh.nodes.size(), bvh.stack_entries);
     if (!reference_path.empty()) {
@@ -95,7 +95,7 @@ int main(int argc, char** argv) {
   options.node_layout = node_layout == "float"       ? VulkanNodeLayout::Float
                         : node_layout == "quantized" ? VulkanNodeLayout::Quantized
                                                      : VulkanNodeLayout::Automatic;
-  auto vk = VulkanIntegrator::create(scene, options);
+  auto vk = VulkanIntegrator::create(make_lighting_scene(scene), options);
   bench::print_device_line(*vk);
   if (grid[0] > 0) {
     Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
@@ -132,7 +132,7 @@ int main(int argc, char** argv) {
       std::printf("ratio vulkan / embree probe rays/s: %.3f\n", gpu_rate / cpu_rate);
     }
     options.collect_stage_statistics = true;  // stage figures: a second, instrumented run
-    auto vk_stats = VulkanIntegrator::create(scene, options);
+    auto vk_stats = VulkanIntegrator::create(make_lighting_scene(scene), options);
     const ProbeEstimate instrumented = vk_stats->bake_probes(probes, settings);
     bench::print_stage_figures(*vk_stats, instrumented.seconds, instrumented.rays, traversal_rays, 3);
     return 0;
@@ -159,7 +159,7 @@ int main(int argc, char** argv) {
 
   // Stage figures (timestamps + lane counters; a second, instrumented run).
   options.collect_stage_statistics = true;
-  auto vk_stats = VulkanIntegrator::create(scene, options);
+  auto vk_stats = VulkanIntegrator::create(make_lighting_scene(scene), options);
   settings.spp = spp;
   const LightmapEstimate instrumented = vk_stats->bake(gbuffer, settings);
   bench::print_stage_figures(*vk_stats, instrumented, traversal_rays, 3);

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "exitance/runtime/sampling.h"
+#include "exitance/common/sampling.h"
 
 namespace exitance {
 

@@ -2,7 +2,9 @@
 // bench_vulkan_replay, which links no Embree), so they live apart from the CPU integrator.
 #include <algorithm>
 
-#include "exitance/runtime/cpu_reference_integrator.h"
+#include <cmath>
+
+#include "exitance/runtime/core/estimates.h"
 
 namespace exitance {
 
@@ -36,6 +38,11 @@ Vec3 LightmapEstimate::variance_of_mean(size_t texel) const {
     v[c] = float(sample_variance / n);
   }
   return v;
+}
+
+bool LightmapEstimate::relative_error_below(size_t texel, double target) const {
+  const float lum = luminance(mean_total(texel));
+  return lum > 0 && std::sqrt(luminance(variance_of_mean(texel))) <= target * lum;
 }
 
 ShRgb ProbeEstimate::mean(size_t probe) const {

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "exitance/common/material.h"
+
 namespace exitance {
 namespace {
 
@@ -61,8 +63,7 @@ Vec2 apply_texture_transform(const TextureTransform& t, Vec2 uv) {
 
 Vec3 diffuse_albedo(const Scene& scene, uint32_t triangle, float b1, float b2) {
   const Material& m = scene.materials[scene.triangle_material[triangle]];
-  const Vec3 albedo = m.base_color * lookup(scene, m.base_color_texture, triangle, b1, b2) * (1.0f - m.metallic);
-  return min(max(albedo, Vec3{0, 0, 0}), Vec3{1, 1, 1});
+  return diffuse_albedo_of(m.base_color * lookup(scene, m.base_color_texture, triangle, b1, b2), m.metallic);
 }
 
 Vec3 emitted_radiance(const Scene& scene, uint32_t triangle, float b1, float b2) {

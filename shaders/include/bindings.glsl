@@ -1,82 +1,43 @@
-// Every buffer of the wavefront, one descriptor set. Host side: runtime/src/vulkan/vulkan_integrator.cpp
-// (enum Binding) must list the same numbers.
+// Every buffer of the wavefront, one descriptor set. Binding numbers, counter slots, the parameter
+// block and the scene records come from runtime/common/.../gpu_layout.h, shared with the host.
+#include "exitance/common/gpu_layout.h"
 
-layout(std430, set = 0, binding = 0) buffer ParamsBuffer {
-  vec4 sky;               // rgb constant sky radiance
-  float scene_extent;     // largest side of the scene bounds (ray offset floor)
-  uint emitter_count;
-  uint punctual_count;
-  uint recorded;          // K: recorded bounce layers; result slot K gathers the deeper ones
-  int max_bounces;
-  int rr_start;
-  int safety_cap;
-  uint path_capacity;     // P: path slots
-  uint seed_lo, seed_hi;
-  uint batch_texel_offset;  // first entry of batch_texels in this batch
-  uint batch_texel_count;   // n
-  uint batch_sample_begin;
-  uint batch_sample_count;
-  uint batch_work_total;    // n * samples
-  uint collect_stats;
-  uint texel_count_total;   // live texels of the whole bake (bounce accumulator stride)
-  uint pad0;
-  uint probe_spp;           // probes: samples per probe of the whole bake (0xFFFFFFFF: until the time budget)
-  uint pad2;
-  vec4 bench_lo;            // traversal bench: scene bounds
-  vec4 bench_hi;
-} params;
+layout(std430, set = 0, binding = kBindingParams) buffer ParamsBuffer { GpuParams params; };
 
 // Specialization constant 2: true in the probe variants of generate and shade (work items are light
 // probes, see regenerate and shade.comp); false compiles the probe code out of the lightmap kernels.
 layout(constant_id = 2) const bool kProbeMode = false;
 
-layout(std430, set = 0, binding = 1) readonly buffer NodeBuffer { uvec4 nodes[]; };       // BVH4 nodes: 4 uvec4 quantized or 7 float (bvh.glsl)
-layout(std430, set = 0, binding = 2) readonly buffer LeafTriBuffer { vec4 leaf_tris[]; }; // 3 vec4 per triangle
-layout(std430, set = 0, binding = 3) readonly buffer TriShadingBuffer { vec4 tri_shading[]; };  // 6 vec4 per scene triangle
-layout(std430, set = 0, binding = 4) readonly buffer MaterialBuffer { vec4 materials[]; };      // 2 vec4 per material
-layout(std430, set = 0, binding = 5) readonly buffer EmitterCdfBuffer { double emitter_cdf[]; };
-layout(std430, set = 0, binding = 6) readonly buffer EmitterTriBuffer { uint emitter_tris[]; };
-layout(std430, set = 0, binding = 7) readonly buffer PunctualBuffer { vec4 punctual[]; };       // 3 vec4 per light
-layout(std430, set = 0, binding = 8) readonly buffer PunctualCdfBuffer { double punctual_cdf[]; };
-layout(std430, set = 0, binding = 9) readonly buffer TexelBuffer { vec4 texels[]; };           // 3 vec4 per texel
-layout(std430, set = 0, binding = 10) readonly buffer BatchTexelBuffer { uint batch_texels[]; };
-layout(std430, set = 0, binding = 11) coherent buffer CounterBuffer { uint counters[]; };
-layout(std430, set = 0, binding = 12) buffer IndirectBuffer { uint indirect_args[]; };
+layout(std430, set = 0, binding = kBindingBvhNodes) readonly buffer NodeBuffer { uvec4 nodes[]; };  // bvh.glsl
+layout(std430, set = 0, binding = kBindingBvhTriangles) readonly buffer LeafTriBuffer { vec4 leaf_tris[]; };  // 3 vec4 per leaf slot
+layout(std430, set = 0, binding = kBindingTriangles) readonly buffer TriangleBuffer { GpuTriangle triangles[]; };
+layout(std430, set = 0, binding = kBindingMaterials) readonly buffer MaterialBuffer { GpuMaterial materials[]; };
+layout(std430, set = 0, binding = kBindingEmitterCdf) readonly buffer EmitterCdfBuffer { double emitter_cdf[]; };
+layout(std430, set = 0, binding = kBindingEmitterTriangles) readonly buffer EmitterTriBuffer { uint emitter_tris[]; };
+layout(std430, set = 0, binding = kBindingPunctualLights) readonly buffer PunctualBuffer { GpuPunctualLight punctual[]; };
+layout(std430, set = 0, binding = kBindingPunctualCdf) readonly buffer PunctualCdfBuffer { double punctual_cdf[]; };
+layout(std430, set = 0, binding = kBindingStartPoints) readonly buffer StartPointBuffer { GpuSurfacePoint start_points[]; };
+layout(std430, set = 0, binding = kBindingBatchItems) readonly buffer BatchItemBuffer { uint batch_items[]; };
+layout(std430, set = 0, binding = kBindingCounters) coherent buffer CounterBuffer { uint counters[]; };
+layout(std430, set = 0, binding = kBindingIndirect) buffer IndirectBuffer { uint indirect_args[]; };
 
 // Path state, structure of arrays, one entry per path slot.
-layout(std430, set = 0, binding = 13) buffer PathWorkBuffer { uint path_work[]; };      // work item or kInvalid
-layout(std430, set = 0, binding = 14) buffer PathDepthBuffer { uint path_depth[]; };
-layout(std430, set = 0, binding = 15) buffer PathRngBuffer { u64vec2 path_rng[]; };     // (state, increment)
-layout(std430, set = 0, binding = 16) buffer PathThroughputBuffer { vec4 path_throughput[]; };  // rgb, pdf of the ray
-layout(std430, set = 0, binding = 17) buffer PathRayOriginBuffer { vec4 path_ray_o[]; };
-layout(std430, set = 0, binding = 18) buffer PathRayDirBuffer { vec4 path_ray_d[]; };
-layout(std430, set = 0, binding = 19) buffer PathHitBuffer { vec4 path_hit[]; };        // t, triangle bits, b1, b2
-layout(std430, set = 0, binding = 20) buffer ShadowBuffer { vec4 shadow_rays[]; };      // 2 rays x (dir|tmax, contrib|valid)
-layout(std430, set = 0, binding = 21) buffer RayQueueBuffer { uint ray_queue[]; };      // 2 x P (ping-pong)
-layout(std430, set = 0, binding = 22) buffer ShadowQueueBuffer { uint shadow_queue[]; };// P
-layout(std430, set = 0, binding = 23) buffer ResultBuffer { float results[]; };         // [work][slot 0..K][rgb]
-layout(std430, set = 0, binding = 24) buffer AccumulatorBuffer { double acc_total[]; }; // [texel][total rgb, squared rgb]
-layout(std430, set = 0, binding = 25) buffer BounceAccumulatorBuffer { double acc_bounce[]; };  // [k][texel][rgb]
-layout(std430, set = 0, binding = 26) buffer SampleCountBuffer { uint acc_samples[]; };
-layout(std430, set = 0, binding = 27) buffer ProbeShBuffer { double acc_probe_sh[]; };       // [probe][coefficient][rgb]
-layout(std430, set = 0, binding = 28) buffer ProbeCountBuffer { uint acc_probe_counts[]; };  // [probe][samples, back faces]
-
-// Counter slots.
-const uint kRayCount0 = 0u;       // ray queue sizes, ping-pong
-const uint kShadowCount = 2u;
-const uint kNextWork = 3u;
-const uint kNonfinite = 4u;
-const uint kRaysPrimary = 5u;
-const uint kRaysBounce = 6u;
-const uint kRaysShadow = 7u;
-const uint kPathsStarted = 8u;
-// Statistics (64-bit as lo/hi pairs): lanes active inside traversal loops / lanes launched there.
-const uint kStatExtendActive = 16u;
-const uint kStatExtendLaunched = 18u;
-const uint kStatConnectActive = 20u;
-const uint kStatConnectLaunched = 22u;
-const uint kStatShadeItems = 24u;
-const uint kStatShadeLanes = 26u;
+layout(std430, set = 0, binding = kBindingPathWork) buffer PathWorkBuffer { uint path_work[]; };  // work item or kInvalid
+layout(std430, set = 0, binding = kBindingPathDepth) buffer PathDepthBuffer { uint path_depth[]; };
+layout(std430, set = 0, binding = kBindingPathRng) buffer PathRngBuffer { u64vec2 path_rng[]; };  // (state, increment)
+layout(std430, set = 0, binding = kBindingPathThroughput) buffer PathThroughputBuffer { vec4 path_throughput[]; };  // rgb, pdf of the ray
+layout(std430, set = 0, binding = kBindingPathRayOrigin) buffer PathRayOriginBuffer { vec4 path_ray_o[]; };
+layout(std430, set = 0, binding = kBindingPathRayDirection) buffer PathRayDirBuffer { vec4 path_ray_d[]; };
+layout(std430, set = 0, binding = kBindingPathHit) buffer PathHitBuffer { vec4 path_hit[]; };  // t, triangle bits, b1, b2
+layout(std430, set = 0, binding = kBindingShadowRays) buffer ShadowBuffer { ShadowRay shadow_rays[]; };  // kShadowRaysPerVertex per path
+layout(std430, set = 0, binding = kBindingRayQueue) buffer RayQueueBuffer { uint ray_queue[]; };  // 2 x P (ping-pong)
+layout(std430, set = 0, binding = kBindingShadowQueue) buffer ShadowQueueBuffer { uint shadow_queue[]; };  // P
+layout(std430, set = 0, binding = kBindingResults) buffer ResultBuffer { float results[]; };  // [work][slot 0..K][rgb]
+layout(std430, set = 0, binding = kBindingTexelSums) buffer AccumulatorBuffer { double acc_total[]; };  // [texel][total rgb, squared rgb]
+layout(std430, set = 0, binding = kBindingBounceSums) buffer BounceAccumulatorBuffer { double acc_bounce[]; };  // [k][texel][rgb]
+layout(std430, set = 0, binding = kBindingTexelSamples) buffer SampleCountBuffer { uint acc_samples[]; };
+layout(std430, set = 0, binding = kBindingProbeShSums) buffer ProbeShBuffer { double acc_probe_sh[]; };  // [probe][coefficient][rgb]
+layout(std430, set = 0, binding = kBindingProbeCounts) buffer ProbeCountBuffer { uint acc_probe_counts[]; };  // [probe][samples, back faces]
 
 layout(push_constant) uniform Push {
   uint cur;    // which ray queue is read this iteration (0/1)

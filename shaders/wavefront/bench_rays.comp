@@ -19,12 +19,12 @@ void main() {
   vec4 hit = trace_closest(o, d, kInfinity, steps);
   bool found = floatBitsToUint(hit.y) != kInvalid;
   uint hits = subgroupBallotBitCount(subgroupBallot(found));
-  if (subgroupElect()) atomicAdd(counters[kRaysPrimary], hits);
+  if (subgroupElect()) atomicAdd(counters[kCounterRaysPrimary], hits);
   if (params.collect_stats != 0u) {
     uint busy = subgroupAdd(steps), longest = subgroupMax(steps);
     if (subgroupElect()) {
-      add_stat64(kStatExtendActive, busy);
-      add_stat64(kStatExtendLaunched, longest * gl_SubgroupSize);
+      add_stat64(kCounterStatExtendActive, busy);
+      add_stat64(kCounterStatExtendLaunched, longest * gl_SubgroupSize);
     }
   }
 }

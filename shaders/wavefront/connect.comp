@@ -7,17 +7,17 @@ layout(local_size_x = 64) in;
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
-  if (i >= counters[kShadowCount]) return;
+  if (i >= counters[kCounterShadowQueue]) return;
   uint p = shadow_queue[i];
   uint steps = 0u;
   uint rays = connect_shadow_rays(p, steps);
   uint total = subgroupAdd(rays);
-  if (subgroupElect()) atomicAdd(counters[kRaysShadow], total);
+  if (subgroupElect()) atomicAdd(counters[kCounterRaysShadow], total);
   if (params.collect_stats != 0u) {
     uint busy = subgroupAdd(steps), longest = subgroupMax(steps);
     if (subgroupElect()) {
-      add_stat64(kStatConnectActive, busy);
-      add_stat64(kStatConnectLaunched, longest * gl_SubgroupSize);
+      add_stat64(kCounterStatConnectActive, busy);
+      add_stat64(kCounterStatConnectLaunched, longest * gl_SubgroupSize);
     }
   }
 }

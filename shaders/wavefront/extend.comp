@@ -7,7 +7,7 @@ layout(local_size_x = 64) in;
 void main() {
   uint i = gl_GlobalInvocationID.x;
   uint q = out_queue();
-  if (i >= counters[kRayCount0 + q]) return;
+  if (i >= counters[kCounterRayQueue0 + q]) return;
   uint p = ray_queue[q * params.path_capacity + i];
   uint steps = 0u;
   path_hit[p] = trace_closest(path_ray_o[p].xyz, path_ray_d[p].xyz, kInfinity, steps);
@@ -15,14 +15,14 @@ void main() {
   uint n_primary = subgroupBallotBitCount(subgroupBallot(primary));
   uint n_all = subgroupBallotBitCount(subgroupBallot(true));
   if (subgroupElect()) {
-    if (n_primary > 0u) atomicAdd(counters[kRaysPrimary], n_primary);
-    if (n_all > n_primary) atomicAdd(counters[kRaysBounce], n_all - n_primary);
+    if (n_primary > 0u) atomicAdd(counters[kCounterRaysPrimary], n_primary);
+    if (n_all > n_primary) atomicAdd(counters[kCounterRaysBounce], n_all - n_primary);
   }
   if (params.collect_stats != 0u) {
     uint busy = subgroupAdd(steps), longest = subgroupMax(steps);
     if (subgroupElect()) {
-      add_stat64(kStatExtendActive, busy);
-      add_stat64(kStatExtendLaunched, longest * gl_SubgroupSize);
+      add_stat64(kCounterStatExtendActive, busy);
+      add_stat64(kCounterStatExtendLaunched, longest * gl_SubgroupSize);
     }
   }
 }

@@ -6,21 +6,21 @@ layout(local_size_x = 1) in;
 
 void main() {
   if (push.mode == 0u) {  // before shade
-    uint items = counters[kRayCount0 + push.cur];
+    uint items = counters[kCounterRayQueue0 + push.cur];
     indirect_args[0] = (items + 63u) / 64u;
     if (params.collect_stats != 0u) {  // shade's lane fill: queue entries / launched lanes
-      add_stat64(kStatShadeItems, items);
-      add_stat64(kStatShadeLanes, indirect_args[0] * 64u);
+      add_stat64(kCounterStatShadeItems, items);
+      add_stat64(kCounterStatShadeLanes, indirect_args[0] * 64u);
     }
     indirect_args[1] = 1u;
     indirect_args[2] = 1u;
-    counters[kRayCount0 + out_queue()] = 0u;
-    counters[kShadowCount] = 0u;
+    counters[kCounterRayQueue0 + out_queue()] = 0u;
+    counters[kCounterShadowQueue] = 0u;
   } else {  // before connect and extend
-    indirect_args[3] = (counters[kShadowCount] + 63u) / 64u;
+    indirect_args[3] = (counters[kCounterShadowQueue] + 63u) / 64u;
     indirect_args[4] = 1u;
     indirect_args[5] = 1u;
-    indirect_args[6] = (counters[kRayCount0 + out_queue()] + 63u) / 64u;
+    indirect_args[6] = (counters[kCounterRayQueue0 + out_queue()] + 63u) / 64u;
     indirect_args[7] = 1u;
     indirect_args[8] = 1u;
   }

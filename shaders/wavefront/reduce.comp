@@ -7,9 +7,9 @@ layout(local_size_x = 64) in;
 
 void main() {
   uint j = gl_GlobalInvocationID.x;
-  uint n = params.batch_texel_count;
+  uint n = params.batch_item_count;
   if (j >= n) return;
-  uint texel = batch_texels[params.batch_texel_offset + j];
+  uint texel = batch_items[params.batch_item_offset + j];
   uint K = params.recorded;
   uint nonfinite = 0u, samples = 0u;
   for (uint s = 0u; s < params.batch_sample_count; ++s) {
@@ -26,10 +26,10 @@ void main() {
     }
     for (uint k = 0u; k < K; ++k) {
       uint r = result_index(w, k);
-      for (uint c = 0u; c < 3u; ++c) acc_bounce[(uint(k) * params.texel_count_total + texel) * 3u + c] += double(results[r + c]);
+      for (uint c = 0u; c < 3u; ++c) acc_bounce[(uint(k) * params.item_count_total + texel) * 3u + c] += double(results[r + c]);
     }
     ++samples;
   }
   acc_samples[texel] += samples;
-  if (nonfinite > 0u) atomicAdd(counters[kNonfinite], nonfinite);
+  if (nonfinite > 0u) atomicAdd(counters[kCounterNonfinite], nonfinite);
 }

@@ -7,25 +7,14 @@
 layout(local_size_x = 64) in;
 #include "../include/kernel_prelude.glsl"
 
-// spherical_harmonics.h sh_basis: Sloan's ordering and constants.
-void sh_basis(vec3 d, out float y[9]) {
-  y[0] = 0.282094792;
-  y[1] = 0.488602512 * d.y;
-  y[2] = 0.488602512 * d.z;
-  y[3] = 0.488602512 * d.x;
-  y[4] = 1.092548431 * d.x * d.y;
-  y[5] = 1.092548431 * d.y * d.z;
-  y[6] = 0.315391565 * (3.0 * d.z * d.z - 1.0);
-  y[7] = 1.092548431 * d.x * d.z;
-  y[8] = 0.546274215 * (d.x * d.x - d.y * d.y);
-}
+#include "exitance/common/spherical_harmonics_basis.h"
 
 void main() {
   uint j = gl_GlobalInvocationID.x;
-  uint n = params.batch_texel_count;
+  uint n = params.batch_item_count;
   if (j >= n) return;
-  uint probe = batch_texels[params.batch_texel_offset + j];
-  const double weight = 4.0lf * double(kPi);
+  uint probe = batch_items[params.batch_item_offset + j];
+  const double weight = double(kShSphereMeasure);
   double sums[27];
   for (uint i = 0u; i < 27u; ++i) sums[i] = acc_probe_sh[probe * 27u + i];
   uint nonfinite = 0u, samples = 0u, back_faces = 0u;
@@ -50,5 +39,5 @@ void main() {
   for (uint i = 0u; i < 27u; ++i) acc_probe_sh[probe * 27u + i] = sums[i];
   acc_probe_counts[probe * 2u] += samples;
   acc_probe_counts[probe * 2u + 1u] += back_faces;
-  if (nonfinite > 0u) atomicAdd(counters[kNonfinite], nonfinite);
+  if (nonfinite > 0u) atomicAdd(counters[kCounterNonfinite], nonfinite);
 }

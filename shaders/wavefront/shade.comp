@@ -1,25 +1,22 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Stage "shade": at each extension ray's hit: sky on a miss, emission with MIS, absorption by back
-// faces, bounce limits, albedo, Russian roulette; then next-event estimation and the cosine-sampled
-// continuation at the new vertex. Finished paths are regenerated from the batch's work.
-// Probe batches (the kProbeMode variant): depth 0 is the ray from the probe: emission at full weight
-// (nothing to MIS with), 0 and a back-face mark on single-sided back faces, and the hit's albedo kept
-// apart (the reference multiplies the hit's whole E/pi estimate by it); the path from the hit is the
-// texel estimator with its depth counted from 1, so bounce limits and roulette use depth - 1.
+// Stage "shade": at each extension ray's hit, path.h's shade_continuation_hit (emission with MIS,
+// absorption by back faces, bounce limits, albedo, Russian roulette) or the sky on a miss; then
+// next-event estimation and the continuation at the new vertex. Finished paths are regenerated.
+// Probe batches (the kProbeMode variant): depth 0 is the ray from the probe, shaded by
+// shade_probe_hit, with the hit's albedo kept apart (the reference multiplies the hit's whole E/pi
+// estimate by it); the path from the hit is the texel estimator with its depth counted from 1.
 layout(local_size_x = 64) in;
 #include "../include/kernel_prelude.glsl"
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
-  if (i >= counters[kRayCount0 + push.cur]) return;
+  if (i >= counters[kCounterRayQueue0 + push.cur]) return;
   uint p = ray_queue[push.cur * params.path_capacity + i];
   vec4 hit = path_hit[p];
   uint tri = floatBitsToUint(hit.y);
   uint work = path_work[p], depth = path_depth[p];
   vec4 tp = path_throughput[p];
-  vec3 throughput = tp.xyz;
-  float pdf_cosine = tp.w;
   vec3 wi = path_ray_d[p].xyz;
   u64vec2 rs = path_rng[p];
   Pcg32 rng;
@@ -27,57 +24,32 @@ void main() {
   rng.increment = rs.y;
 
   bool continues = false;
-  bool probe_ray = kProbeMode && depth == 0u;
+  vec3 throughput = tp.xyz;
   SurfacePoint x;
-  if (tri == kInvalid) {
-    add_result(work, depth, throughput * params.sky.xyz);
-  } else {
-    uint m = tri_material(tri);
-    bool double_sided = material_double_sided(m);
-    vec3 ng = tri_geometric_normal(tri);
-    bool front = dot(wi, ng) < 0.0;
-    if (front || double_sided) {
-      vec3 le = material_emission(m);
-      if (max_component(le) > 0.0) {
-        float cos_l = abs(dot(wi, ng));
-        float pdf_light = tri_area_pdf(tri) * hit.x * hit.x / cos_l;
-        add_result(work, depth, throughput * le * (probe_ray ? 1.0 : power_heuristic(pdf_cosine, pdf_light)));
-      }
-    }
-    continues = front || double_sided;
-    if (probe_ray) {
-      vec3 albedo = continues ? material_albedo(m) : vec3(-1.0);
-      uint e = probe_extra_index(work);
-      results[e] = albedo.x;
-      results[e + 1u] = albedo.y;
-      results[e + 2u] = albedo.z;
-      if (!(max_component(albedo) > 0.0)) continues = false;
+  if (kProbeMode && depth == 0u) {
+    vec3 albedo = vec3(0.0);
+    if (tri == kInvalid) {
+      add_result(work, 0u, scene_sky_radiance(wi));
     } else {
-      int bounce = kProbeMode ? int(depth) - 1 : int(depth);  // depth of the vertex as the texel estimator counts it
-      if (continues && params.max_bounces >= 0 && bounce + 1 > params.max_bounces) continues = false;
-      if (continues && bounce + 1 >= params.safety_cap) continues = false;
-      if (continues) {
-        throughput *= material_albedo(m);
-        if (bounce + 1 >= params.rr_start) {
-          float survive = min(1.0, max_component(throughput));
-          if (!(survive > 0.0) || pcg_uniform(rng) >= survive) continues = false;
-          else throughput = throughput / survive;
-        } else if (max_component(throughput) <= 0.0) {
-          continues = false;
-        }
-      }
+      ProbeHit h = shade_probe_hit(tri, hit.z, hit.w, wi);
+      add_result(work, 0u, h.radiance);
+      albedo = h.back_face ? vec3(-1.0) : h.albedo;
+      continues = h.continues;
+      x = h.next;
     }
-    if (continues) {
-      float b1 = hit.z, b2 = hit.w;
-      x.geometric_normal = front ? ng : -ng;
-      x.position = tri_vertex(tri, 0u) * (1.0 - b1 - b2) + tri_vertex(tri, 1u) * b1 + tri_vertex(tri, 2u) * b2;
-      vec3 nv = tri_shading[tri * 6u + 3u].xyz * (1.0 - b1 - b2) + tri_shading[tri * 6u + 4u].xyz * b1 +
-                tri_shading[tri * 6u + 5u].xyz * b2;
-      float len = length(nv);
-      vec3 n = len > 0.0 ? nv / len : vec3(0.0);
-      if (!front) n = -n;
-      x.shading_normal = dot(n, x.geometric_normal) > 0.05 ? n : x.geometric_normal;
-    }
+    uint e = probe_extra_index(work);
+    results[e] = albedo.x;
+    results[e + 1u] = albedo.y;
+    results[e + 2u] = albedo.z;
+  } else if (tri == kInvalid) {
+    add_result(work, depth, throughput * escaped_radiance(wi, tp.w));
+  } else {
+    int bounce = kProbeMode ? int(depth) - 1 : int(depth);  // the vertex's bounce as the texel estimator counts it
+    HitResult h = shade_continuation_hit(tri, hit.x, hit.z, hit.w, wi, tp.w, throughput, bounce, path_limits(), rng);
+    add_result(work, depth, h.radiance);
+    continues = h.continues;
+    throughput = h.throughput;
+    x = h.next;
   }
   if (continues) {
     path_depth[p] = depth + 1u;

@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "exitance/runtime/sampling.h"
+#include "exitance/common/sampling.h"
 #include "support/analytic_scenes.h"
 
 namespace exitance {

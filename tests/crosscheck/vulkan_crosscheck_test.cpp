@@ -12,7 +12,8 @@
 #include <vector>
 
 #include "exitance/bake/prepared_scene.h"
-#include "exitance/runtime/sampling.h"
+#include "exitance/common/sampling.h"
+#include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "support/analytic_scenes.h"
 #include "support/validated_vulkan_backend.h"
@@ -204,11 +205,11 @@ TEST(VulkanCrosscheck, UnsupportedScenesAreRefused) {
   add_quad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, add_material(scene, {1, 1, 1}));
   scene.sky.environment.width = scene.sky.environment.height = 1;
   scene.sky.environment.rgb = {1, 1, 1};
-  EXPECT_THROW(VulkanIntegrator::create(scene), std::runtime_error);
+  EXPECT_THROW(VulkanIntegrator::create(make_lighting_scene(scene)), std::runtime_error);
   scene.sky.environment = {};
   scene.textures.push_back(scene.sky.environment);
   scene.materials[0].base_color_texture.texture = 0;
-  EXPECT_THROW(VulkanIntegrator::create(scene), std::runtime_error);
+  EXPECT_THROW(VulkanIntegrator::create(make_lighting_scene(scene)), std::runtime_error);
 }
 
 TEST(VulkanCrosscheck, DeviceEnumeration) {

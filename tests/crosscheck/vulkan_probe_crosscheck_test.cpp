@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "exitance/bake/prepared_scene.h"
-#include "exitance/runtime/sampling.h"
+#include "exitance/common/sampling.h"
 #include "exitance/runtime/spherical_harmonics.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "support/analytic_scenes.h"

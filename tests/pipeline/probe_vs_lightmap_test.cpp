@@ -13,7 +13,7 @@
 
 #include "exitance/bake/prepared_scene.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
-#include "exitance/runtime/sampling.h"
+#include "exitance/common/sampling.h"
 #include "support/independent_estimates.h"
 #include "support/test_scenes.h"
 

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "support/test_scenes.h"
 
@@ -74,7 +75,7 @@ class Stress : public ::testing::TestWithParam<std::string> {
     options.on_validation_message = [&messages](const std::string& m) { messages.push_back(m); };
     LightmapEstimate estimate;
     {
-      const auto integrator = VulkanIntegrator::create(scene, options);
+      const auto integrator = VulkanIntegrator::create(make_lighting_scene(scene), options);
       estimate = integrator->bake(texels, settings);
     }
     EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: " << messages.front();

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "exitance/runtime/sampling.h"
+#include "exitance/common/sampling.h"
 #include "support/test_scenes.h"
 
 namespace exitance::testing {

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 
 namespace exitance::testing {
@@ -22,7 +23,7 @@ class VulkanBackend {
     options.validation = true;
     options.on_validation_message = [this](const std::string& m) { messages_->push_back(m); };
     try {
-      integrator_ = VulkanIntegrator::create(scene, options);
+      integrator_ = VulkanIntegrator::create(make_lighting_scene(scene), options);
     } catch (const std::runtime_error& e) {
       const std::string what = e.what();
       if (what.find("no Vulkan device") != std::string::npos || what.find("no usable Vulkan device") != std::string::npos)

@@ -9,9 +9,9 @@
 #include "exitance/bake/texel_raster.h"
 #include "exitance/runtime/distribution_1d.h"
 #include "exitance/runtime/environment_sampler.h"
-#include "exitance/runtime/ray_offset.h"
-#include "exitance/runtime/rng.h"
-#include "exitance/runtime/sampling.h"
+#include "exitance/common/ray_offset.h"
+#include "exitance/common/rng.h"
+#include "exitance/common/sampling.h"
 #include "support/test_scenes.h"
 
 namespace exitance {
@@ -88,11 +88,12 @@ TEST(Dilation, FillsGutterFromNeighbours) {
 }
 
 TEST(Sampling, CosineHemisphereIsNormalisedAndUpward) {
-  Pcg32 rng(1, 2, 3);
+  Pcg32 rng = pcg_init(1, 2, 3);
   double mean_cos = 0;
   const int n = 200000;
   for (int i = 0; i < n; ++i) {
-    const Vec3 d = sample_cosine_hemisphere(rng.uniform(), rng.uniform());
+    const float u1 = pcg_uniform(rng), u2 = pcg_uniform(rng);
+    const Vec3 d = sample_cosine_hemisphere(u1, u2);
     ASSERT_GE(d.z, 0.0f);
     ASSERT_NEAR(length(d), 1.0f, 1e-5f);
     mean_cos += d.z;
@@ -119,10 +120,11 @@ TEST(Sampling, EnvironmentPdfMatchesItsSamples) {
     }
   EXPECT_NEAR(integral, 1.0, 2e-3);
   // Sampled directions report the pdf that pdf() gives them.
-  Pcg32 rng(9, 9, 9);
+  Pcg32 rng = pcg_init(9, 9, 9);
   for (int i = 0; i < 1000; ++i) {
     float pdf = 0;
-    const Vec3 d = sampler.sample(rng.uniform(), rng.uniform(), pdf);
+    const float u1 = pcg_uniform(rng), u2 = pcg_uniform(rng);
+    const Vec3 d = sampler.sample(u1, u2, pdf);
     ASSERT_NEAR(pdf, sampler.pdf(d), 1e-3f * pdf);
   }
 }

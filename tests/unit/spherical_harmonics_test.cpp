@@ -6,7 +6,7 @@
 #include <functional>
 #include <vector>
 
-#include "exitance/runtime/sampling.h"
+#include "exitance/common/sampling.h"
 #include "exitance/runtime/spherical_harmonics.h"
 
 namespace exitance {

@@ -19,9 +19,9 @@
 #include <limits>
 #include <stdexcept>
 
-#include "exitance/runtime/light_sampler.h"
-#include "exitance/runtime/material_eval.h"
-#include "exitance/runtime/sampling.h"
+#include "exitance/common/gpu_layout.h"
+#include "exitance/runtime/core/scene_access.h"
+#include "exitance/runtime/core/pass_scheduler.h"
 #include "exitance_spirv/bench_rays.h"
 #include "exitance_spirv/connect.h"
 #include "exitance_spirv/extend.h"
@@ -30,7 +30,7 @@
 #include "exitance_spirv/reduce.h"
 #include "exitance_spirv/reduce_probes.h"
 #include "exitance_spirv/shade.h"
-#include "gpu_bvh.h"
+#include "bvh_quantization.h"
 #include "vulkan_context.h"
 
 namespace exitance {
@@ -38,33 +38,9 @@ using namespace exitance::vulkan;
 
 namespace {
 
-// Must match shaders/include/bindings.glsl.
-enum Binding : uint32_t {
-  kParams, kNodes, kLeafTris, kTriShading, kMaterials, kEmitterCdf, kEmitterTris, kPunctual, kPunctualCdf, kTexels,
-  kBatchTexels, kCounters, kIndirect, kPathWork, kPathDepth, kPathRng, kPathThroughput, kPathRayO, kPathRayD, kPathHit,
-  kShadowRays, kRayQueue, kShadowQueue, kResults, kAccTotal, kAccBounce, kAccSamples, kProbeSh, kProbeCounts,
-  kBindingCount
-};
-
-struct GpuParams {
-  float sky[4];
-  float scene_extent;
-  uint32_t emitter_count, punctual_count, recorded;
-  int32_t max_bounces, rr_start, safety_cap;
-  uint32_t path_capacity;
-  uint32_t seed_lo, seed_hi, batch_texel_offset, batch_texel_count;
-  uint32_t batch_sample_begin, batch_sample_count, batch_work_total, collect_stats;
-  uint32_t texel_count_total, pad0, probe_spp, pad2;
-  float bench_lo[4];
-  float bench_hi[4];
-};
 static_assert(sizeof(GpuParams) == 128);
-
-enum Counter : uint32_t {
-  kRayCount0 = 0, kShadowCount = 2, kNextWork = 3, kNonfinite = 4, kRaysPrimary = 5, kRaysBounce = 6, kRaysShadow = 7,
-  kStatExtendActive = 16, kStatExtendLaunched = 18, kStatConnectActive = 20, kStatConnectLaunched = 22,
-  kStatShadeItems = 24, kStatShadeLanes = 26, kCounterCount = 32
-};
+static_assert(sizeof(GpuTriangle) == 96 && sizeof(GpuMaterial) == 32 && sizeof(GpuPunctualLight) == 48);
+static_assert(sizeof(GpuSurfacePoint) == 48 && sizeof(ShadowRay) == 32);
 
 // Pipelines. The first kStageCount are the stages of the statistics; the probe variants of generate
 // and shade (specialization constant 2 set) count as those stages.
@@ -91,10 +67,10 @@ uint64_t stat64(const uint32_t* c, uint32_t slot) { return uint64_t(c[slot]) | (
 }  // namespace
 
 struct VulkanIntegrator::Impl {
-  const Scene& scene;
+  std::shared_ptr<const LightingScene> lighting;
+  const LightingScene& scene;
   VulkanDeviceOptions options;
   std::unique_ptr<Context> ctx;
-  GpuBvh bvh;
   uint32_t paths = 0;
   uint32_t iterations_per_submit = 8;
   uint32_t work_per_path = 4;
@@ -102,9 +78,6 @@ struct VulkanIntegrator::Impl {
   // node), float 112-byte nodes on GPUs (the H100 traversal is bound by instructions, not by node
   // bytes: the BVH stays in L2). Measured: bench/results/vulkan-{lavapipe,gpu}.md.
   bool quantized_nodes = false;
-  float scene_extent = 1.0f;
-  Vec3 scene_lo{0, 0, 0}, scene_hi{0, 0, 0};
-  uint32_t emitter_count = 0, punctual_count = 0;
 
   std::array<Buffer, kBindingCount> buffers{};
   Buffer readback;  // counters after each submission
@@ -120,7 +93,7 @@ struct VulkanIntegrator::Impl {
   size_t texel_capacity = 0, result_capacity = 0, bounce_layers = 0;
   mutable std::vector<VulkanStageStatistics> stats;
 
-  explicit Impl(const Scene& s, const VulkanDeviceOptions& o) : scene(s), options(o) {}
+  Impl(std::shared_ptr<const LightingScene> s, const VulkanDeviceOptions& o) : lighting(std::move(s)), scene(*lighting), options(o) {}
 
   ~Impl() {
     if (!ctx) return;
@@ -136,9 +109,9 @@ struct VulkanIntegrator::Impl {
     ctx->destroy(readback);
   }
 
-  Buffer& buf(Binding b) { return buffers[b]; }
+  Buffer& buf(uint32_t b) { return buffers[b]; }
 
-  void make_buffer(Binding b, VkDeviceSize size, VkBufferUsageFlags extra = 0) {
+  void make_buffer(uint32_t b, VkDeviceSize size, VkBufferUsageFlags extra = 0) {
     ctx->destroy(buffers[b]);
     const VkDeviceSize limit = ctx->properties().limits.maxStorageBufferRange;
     if (size > limit)
@@ -148,7 +121,7 @@ struct VulkanIntegrator::Impl {
   }
 
   template <typename T>
-  void make_and_upload(Binding b, const std::vector<T>& data) {
+  void make_and_upload(uint32_t b, const std::vector<T>& data) {
     make_buffer(b, data.size() * sizeof(T));
     ctx->upload(buffers[b], data.data(), data.size() * sizeof(T));
   }
@@ -204,7 +177,7 @@ struct VulkanIntegrator::Impl {
         {spirv_generate, sizeof(spirv_generate)}, {spirv_shade, sizeof(spirv_shade)}}};
     // Specialization: 0 = traversal stack bound, 1 = node layout (quantized or float; bvh.glsl),
     // 2 = probe work items (bindings.glsl kProbeMode).
-    const uint32_t stack_bound = std::max<uint32_t>(bvh.stack_entries + 1, 8);
+    const uint32_t stack_bound = std::max<uint32_t>(scene.bvh.stack_entries + 1, 8);
     const VkSpecializationMapEntry entries[3] = {
         {0, 0, sizeof(uint32_t)}, {1, sizeof(uint32_t), sizeof(uint32_t)}, {2, 2 * sizeof(uint32_t), sizeof(VkBool32)}};
     for (int k = 0; k < kKernelCount; ++k) {
@@ -235,107 +208,59 @@ struct VulkanIntegrator::Impl {
     }
   }
 
-  // Scene upload: BVH, per-triangle shading data, materials, light distributions.
+  // Scene upload: the LightingScene's records as they are (gpu_layout.h), the BVH in the chosen
+  // node layout, and per leaf slot a copy of its triangle's vertices for traversal.
   void upload_scene() {
-    const size_t triangles = scene.triangle_count();
-    Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-    for (const Vec3& p : scene.positions) lo = min(lo, p), hi = max(hi, p);
-    if (triangles > 0) scene_extent = std::max(max_component(hi - lo), 1e-30f);  // as EmbreeScene::extent()
-    scene_lo = lo, scene_hi = hi;
-
     if (quantized_nodes) {
-      make_and_upload(kNodes, quantize_bvh4_nodes(bvh.nodes));
+      make_and_upload(kBindingBvhNodes, quantize_bvh4_nodes(scene.bvh.nodes));
     } else {
-      std::vector<uint32_t> nodes(bvh.nodes.size() * 28);
-      std::memcpy(nodes.data(), bvh.nodes.data(), nodes.size() * 4);
-      make_and_upload(kNodes, nodes);
+      std::vector<uint32_t> nodes(scene.bvh.nodes.size() * 28);
+      std::memcpy(nodes.data(), scene.bvh.nodes.data(), nodes.size() * 4);
+      make_and_upload(kBindingBvhNodes, nodes);
     }
-    std::vector<float> leaf(bvh.triangles.size() * 12);
-    if (!leaf.empty()) std::memcpy(leaf.data(), bvh.triangles.data(), leaf.size() * 4);
-    make_and_upload(kLeafTris, leaf);
-
-    const LightSampler lights(scene);
-    std::vector<float> shading(std::max<size_t>(triangles, 1) * 24, 0.0f);
-    for (size_t t = 0; t < triangles; ++t) {
-      float* s = &shading[t * 24];
-      for (int k = 0; k < 3; ++k) {
-        const Vec3 p = scene.positions[t * 3 + size_t(k)], n = scene.normals[t * 3 + size_t(k)];
-        s[4 * k] = p.x, s[4 * k + 1] = p.y, s[4 * k + 2] = p.z;
-        s[12 + 4 * k] = n.x, s[12 + 4 * k + 1] = n.y, s[12 + 4 * k + 2] = n.z;
-      }
-      const uint32_t material = scene.triangle_material[t];
-      std::memcpy(&s[3], &material, 4);
-      s[7] = lights.area_pdf(uint32_t(t));
+    std::vector<Vec4> leaf(std::max<size_t>(scene.bvh.leaf_triangles.size(), 1) * 3);
+    for (size_t slot = 0; slot < scene.bvh.leaf_triangles.size(); ++slot) {
+      const uint32_t t = scene.bvh.leaf_triangles[slot];
+      const GpuTriangle& g = scene.triangles[t];
+      leaf[slot * 3] = Vec4(triangle_vertex0(g), std::bit_cast<float>(t));
+      leaf[slot * 3 + 1] = Vec4(triangle_vertex1(g), 0.0f);
+      leaf[slot * 3 + 2] = Vec4(triangle_vertex2(g), 0.0f);
     }
-    make_and_upload(kTriShading, shading);
-
-    std::vector<float> materials(std::max<size_t>(scene.materials.size(), 1) * 8, 0.0f);
-    for (size_t m = 0; m < scene.materials.size(); ++m) {
-      const Material& mat = scene.materials[m];
-      // diffuse_albedo() without textures: clamp(base_color * (1 - metallic), 0, 1).
-      const Vec3 albedo = min(max(mat.base_color * (1.0f - mat.metallic), Vec3{0, 0, 0}), Vec3{1, 1, 1});
-      const Vec3 emission = max_component(mat.emission) > 0.0f ? mat.emission : Vec3{0, 0, 0};
-      float* v = &materials[m * 8];
-      v[0] = albedo.x, v[1] = albedo.y, v[2] = albedo.z, v[3] = mat.double_sided ? 1.0f : 0.0f;
-      v[4] = emission.x, v[5] = emission.y, v[6] = emission.z;
-    }
-    make_and_upload(kMaterials, materials);
-
-    // Emitter and punctual-light choice: LightSampler's own distributions, uploaded as CDFs, so both
-    // backends pick lights with identical probabilities.
-    const std::vector<uint32_t>& emitter_tris = lights.emitter_triangles();
-    emitter_count = uint32_t(emitter_tris.size());
-    make_and_upload(kEmitterCdf, padded_cdf(lights.emitter_distribution()));
-    make_and_upload(kEmitterTris, emitter_tris.empty() ? std::vector<uint32_t>{0} : emitter_tris);
-
-    std::vector<float> punctual(std::max<size_t>(scene.lights.size(), 1) * 12, 0.0f);
-    for (size_t i = 0; i < scene.lights.size(); ++i) {
-      const PunctualLight& l = scene.lights[i];
-      uint32_t type = 0;
-      switch (l.type) {
-        case PunctualLight::Type::Point: type = 0; break;
-        case PunctualLight::Type::Spot: type = 1; break;
-        case PunctualLight::Type::Directional: type = 2; break;
-      }
-      float* v = &punctual[i * 12];
-      v[0] = l.position.x, v[1] = l.position.y, v[2] = l.position.z;
-      std::memcpy(&v[3], &type, 4);
-      v[4] = l.direction.x, v[5] = l.direction.y, v[6] = l.direction.z, v[7] = l.cos_inner;
-      v[8] = l.intensity.x, v[9] = l.intensity.y, v[10] = l.intensity.z, v[11] = l.cos_outer;
-    }
-    // An all-zero punctual distribution never samples (Distribution1D::empty -> pmf 0 -> probability 0).
-    punctual_count = uint32_t(scene.lights.size());
-    make_and_upload(kPunctual, punctual);
-    make_and_upload(kPunctualCdf, padded_cdf(lights.punctual_distribution()));
+    make_and_upload(kBindingBvhTriangles, leaf);
+    make_and_upload(kBindingTriangles, at_least_one(scene.triangles));
+    make_and_upload(kBindingMaterials, at_least_one(scene.materials));
+    make_and_upload(kBindingEmitterCdf, scene.emitter_cdf);
+    make_and_upload(kBindingEmitterTriangles, at_least_one(scene.emitter_triangles));
+    make_and_upload(kBindingPunctualLights, at_least_one(scene.punctual_lights));
+    make_and_upload(kBindingPunctualCdf, scene.punctual_cdf);
   }
 
-  // A distribution's CDF for a GPU buffer, which must hold at least two entries.
-  static std::vector<double> padded_cdf(const Distribution1D& distribution) {
-    std::vector<double> cdf = distribution.cdf();
-    if (cdf.size() < 2) cdf.resize(2, 0.0);
-    return cdf;
+  // Vulkan buffers cannot be empty.
+  template <typename T>
+  static std::vector<T> at_least_one(const std::vector<T>& v) {
+    return v.empty() ? std::vector<T>(1) : v;
   }
 
   void allocate_path_state() {
-    make_buffer(kParams, sizeof(GpuParams));
-    make_buffer(kCounters, kCounterCount * 4);
-    make_buffer(kIndirect, 16 * 4, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
-    make_buffer(kPathWork, size_t(paths) * 4);
-    make_buffer(kPathDepth, size_t(paths) * 4);
-    make_buffer(kPathRng, size_t(paths) * 16);
-    make_buffer(kPathThroughput, size_t(paths) * 16);
-    make_buffer(kPathRayO, size_t(paths) * 16);
-    make_buffer(kPathRayD, size_t(paths) * 16);
-    make_buffer(kPathHit, size_t(paths) * 16);
-    make_buffer(kShadowRays, size_t(paths) * 64);
-    make_buffer(kRayQueue, size_t(paths) * 8);
-    make_buffer(kShadowQueue, size_t(paths) * 4);
+    make_buffer(kBindingParams, sizeof(GpuParams));
+    make_buffer(kBindingCounters, kCounterCount * 4);
+    make_buffer(kBindingIndirect, 16 * 4, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+    make_buffer(kBindingPathWork, size_t(paths) * 4);
+    make_buffer(kBindingPathDepth, size_t(paths) * 4);
+    make_buffer(kBindingPathRng, size_t(paths) * 16);
+    make_buffer(kBindingPathThroughput, size_t(paths) * 16);
+    make_buffer(kBindingPathRayOrigin, size_t(paths) * 16);
+    make_buffer(kBindingPathRayDirection, size_t(paths) * 16);
+    make_buffer(kBindingPathHit, size_t(paths) * 16);
+    make_buffer(kBindingShadowRays, size_t(paths) * kShadowRaysPerVertex * sizeof(ShadowRay));
+    make_buffer(kBindingRayQueue, size_t(paths) * 8);
+    make_buffer(kBindingShadowQueue, size_t(paths) * 4);
     readback = ctx->create_buffer(kCounterCount * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
-    for (Binding b : {kTexels, kBatchTexels, kResults, kAccTotal, kAccBounce, kAccSamples, kProbeSh, kProbeCounts})
+    for (uint32_t b : {kBindingStartPoints, kBindingBatchItems, kBindingResults, kBindingTexelSums, kBindingBounceSums, kBindingTexelSamples, kBindingProbeShSums, kBindingProbeCounts})
       make_buffer(b, 16);
   }
 
-  size_t path_bytes() const { return 4 + 4 + 16 + 16 + 16 + 16 + 16 + 64 + 8 + 4; }
+  size_t path_bytes() const { return 4 + 4 + 16 + 16 + 16 + 16 + 16 + kShadowRaysPerVertex * sizeof(ShadowRay) + 8 + 4; }
 
   // ---- command recording ----
   void barrier(VkCommandBuffer cmd) const {
@@ -383,7 +308,7 @@ struct VulkanIntegrator::Impl {
     }
     void dispatch_indirect(Kernel k, uint32_t slot, uint32_t cur) {
       bind(k, cur, 0);
-      vkCmdDispatchIndirect(cmd, impl.buffers[kIndirect].buffer, VkDeviceSize(slot) * 12);
+      vkCmdDispatchIndirect(cmd, impl.buffers[kBindingIndirect].buffer, VkDeviceSize(slot) * 12);
       impl.barrier(cmd);
       stamp(k);
     }
@@ -401,7 +326,7 @@ struct VulkanIntegrator::Impl {
     }
     void copy_counters() {
       VkBufferCopy region{0, 0, kCounterCount * 4};
-      vkCmdCopyBuffer(cmd, impl.buffers[kCounters].buffer, impl.readback.buffer, 1, &region);
+      vkCmdCopyBuffer(cmd, impl.buffers[kBindingCounters].buffer, impl.readback.buffer, 1, &region);
     }
   };
 
@@ -423,23 +348,23 @@ struct VulkanIntegrator::Impl {
   const uint32_t* counters() const { return static_cast<const uint32_t*>(readback.mapped); }
 
   void set_params(VkCommandBuffer cmd, const GpuParams& p) {
-    vkCmdUpdateBuffer(cmd, buffers[kParams].buffer, 0, sizeof(p), &p);
+    vkCmdUpdateBuffer(cmd, buffers[kBindingParams].buffer, 0, sizeof(p), &p);
     barrier(cmd);
   }
 
   void ensure_bake_buffers(size_t texel_count, int recorded, size_t max_work) {
     const size_t result_floats = max_work * size_t(recorded + 1) * 3;
     if (texel_count > texel_capacity || size_t(recorded) != bounce_layers) {
-      make_buffer(kTexels, texel_count * 48);
-      make_buffer(kBatchTexels, texel_count * 4);
-      make_buffer(kAccTotal, texel_count * 6 * 8);
-      make_buffer(kAccBounce, size_t(recorded) * texel_count * 3 * 8);
-      make_buffer(kAccSamples, texel_count * 4);
+      make_buffer(kBindingStartPoints, texel_count * 48);
+      make_buffer(kBindingBatchItems, texel_count * 4);
+      make_buffer(kBindingTexelSums, texel_count * 6 * 8);
+      make_buffer(kBindingBounceSums, size_t(recorded) * texel_count * 3 * 8);
+      make_buffer(kBindingTexelSamples, texel_count * 4);
       texel_capacity = texel_count;
       bounce_layers = size_t(recorded);
     }
     if (result_floats > result_capacity) {
-      make_buffer(kResults, result_floats * 4);
+      make_buffer(kBindingResults, result_floats * 4);
       result_capacity = result_floats;
     }
     write_descriptors();
@@ -483,44 +408,42 @@ LightmapEstimate VulkanIntegrator::Impl::bake(const TexelGBuffer& gbuffer, const
   const size_t max_work = std::max<size_t>(1, std::min<size_t>({size_t(paths) * work_per_path, limit_items, size_t(1) << 30}));
   ensure_bake_buffers(texel_count, K, max_work);
 
-  std::vector<float> texels(texel_count * 12, 0.0f);
+  std::vector<GpuSurfacePoint> texels(texel_count);
   for (size_t i = 0; i < texel_count; ++i) {
     const LiveTexel& t = gbuffer.texels[i];
-    float* v = &texels[i * 12];
-    v[0] = t.position.x, v[1] = t.position.y, v[2] = t.position.z;
-    v[4] = t.geometric_normal.x, v[5] = t.geometric_normal.y, v[6] = t.geometric_normal.z;
-    v[8] = t.shading_normal.x, v[9] = t.shading_normal.y, v[10] = t.shading_normal.z;
+    texels[i] = {Vec4(t.position, 0.0f), Vec4(t.geometric_normal, 0.0f), Vec4(t.shading_normal, 0.0f)};
   }
-  ctx->upload(buffers[kTexels], texels.data(), texels.size() * 4);
+  ctx->upload(buffers[kBindingStartPoints], texels.data(), texels.size() * sizeof(GpuSurfacePoint));
   std::vector<uint32_t> active(texel_count);
   for (size_t i = 0; i < texel_count; ++i) active[i] = uint32_t(i);
-  ctx->upload(buffers[kBatchTexels], active.data(), active.size() * 4);
+  ctx->upload(buffers[kBindingBatchItems], active.data(), active.size() * 4);
   {
     VkCommandBuffer cmd = ctx->begin();
-    for (Binding b : {kAccTotal, kAccBounce, kAccSamples}) vkCmdFillBuffer(cmd, buffers[b].buffer, 0, VK_WHOLE_SIZE, 0);
+    for (uint32_t b : {kBindingTexelSums, kBindingBounceSums, kBindingTexelSamples}) vkCmdFillBuffer(cmd, buffers[b].buffer, 0, VK_WHOLE_SIZE, 0);
     ctx->submit_and_wait(cmd);
   }
 
   GpuParams params{};
-  params.sky[0] = scene.sky.constant.x, params.sky[1] = scene.sky.constant.y, params.sky[2] = scene.sky.constant.z;
-  params.scene_extent = scene_extent;
-  params.emitter_count = emitter_count;
-  params.punctual_count = punctual_count;
+  params.sky = Vec4(scene.sky, 0.0f);
+  params.scene_extent = scene.extent;
+  params.emitter_count = scene.emitter_count();
+  params.punctual_count = scene.punctual_count();
   params.recorded = uint32_t(K);
   params.max_bounces = settings.max_bounces;
   params.rr_start = settings.russian_roulette_start;
   params.safety_cap = settings.safety_bounce_cap;
   params.path_capacity = paths;
   params.seed_lo = uint32_t(settings.seed), params.seed_hi = uint32_t(settings.seed >> 32);
+  params.sampling_strategy = settings.sampling_strategy;
   params.collect_stats = options.collect_stage_statistics ? 1u : 0u;
-  params.texel_count_total = uint32_t(texel_count);
+  params.item_count_total = uint32_t(texel_count);
 
   const bool timing = options.collect_stage_statistics && query_pool != VK_NULL_HANDLE;
   BatchTotals totals;
 
   auto run_batch = [&](uint32_t offset, uint32_t n, uint32_t sample_begin, uint32_t samples) {
-    params.batch_texel_offset = offset;
-    params.batch_texel_count = n;
+    params.batch_item_offset = offset;
+    params.batch_item_count = n;
     params.batch_sample_begin = sample_begin;
     params.batch_sample_count = samples;
     params.batch_work_total = n * samples;
@@ -528,55 +451,49 @@ LightmapEstimate VulkanIntegrator::Impl::bake(const TexelGBuffer& gbuffer, const
   };
 
   const uint32_t spp_limit = settings.spp == 0 ? std::numeric_limits<uint32_t>::max() : settings.spp;
-  const bool timed = settings.time_budget_seconds > 0;
-  uint32_t done = 0;
-  std::vector<uint8_t> converged(texel_count, 0);
-  while (done < spp_limit && !active.empty()) {
+  PassPolicy policy;
+  // Untimed: as many samples per batch as fill the work items; a budget or target error: ramped passes.
+  policy.largest_pass = uint32_t(std::max<size_t>(1, max_work / std::min(texel_count, max_work)));
+  policy.ramp = settings.time_budget_seconds > 0 || settings.target_relative_error > 0;
+  PassScheduler passes(settings, policy);
+  uint32_t first = 0, pass = 0;
+  while (!active.empty() && passes.next_pass(first, pass)) {
     const size_t n_active = active.size();
     const uint32_t chunk = uint32_t(std::min(n_active, max_work));
-    uint32_t pass = uint32_t(std::min<size_t>(spp_limit - done, std::max<size_t>(1, max_work / chunk)));
-    if (timed || settings.target_relative_error > 0) pass = std::min(pass, done < 4 ? 1u : (done < 64 ? 4u : 16u));
+    pass = std::min<uint32_t>(pass, uint32_t(std::max<size_t>(1, max_work / chunk)));
     for (size_t offset = 0; offset < n_active; offset += chunk) {
       const uint32_t n = uint32_t(std::min<size_t>(chunk, n_active - offset));
-      run_batch(uint32_t(offset), n, done, pass);
+      run_batch(uint32_t(offset), n, first, pass);
     }
-    done += pass;
-    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    if (settings.progress) {
-      const double by_spp = settings.spp ? double(done) / double(settings.spp) : 0.0;
-      const double by_time = timed ? elapsed / settings.time_budget_seconds : 0.0;
-      settings.progress(std::min(1.0, std::max(by_spp, by_time)), totals.rays());
-    }
-    if (timed && elapsed >= settings.time_budget_seconds) break;
+    const uint32_t done = first + pass;
     if (settings.target_relative_error > 0 && done >= 16 && done < spp_limit) {
-      // Drop converged texels from the work list (same test as the reference).
+      // Drop converged texels from the work list (the reference's test, estimates.h).
       std::vector<double> sums(texel_count * 6);
       std::vector<uint32_t> samples(texel_count);
-      ctx->download(buffers[kAccTotal], sums.data(), sums.size() * 8);
-      ctx->download(buffers[kAccSamples], samples.data(), samples.size() * 4);
+      ctx->download(buffers[kBindingTexelSums], sums.data(), sums.size() * 8);
+      ctx->download(buffers[kBindingTexelSamples], samples.data(), samples.size() * 4);
       std::vector<uint32_t> still;
       for (uint32_t i : active) {
-        TexelAccumulator a;
-        for (int c = 0; c < 3; ++c) a.total[c] = sums[i * 6 + size_t(c)], a.total_squared[c] = sums[i * 6 + 3 + size_t(c)];
-        a.samples = samples[i];
         LightmapEstimate one;
-        one.texels = {a};
-        const Vec3 mean = one.mean_total(0), var = one.variance_of_mean(0);
-        const float lum = luminance(mean);
-        if (!(lum > 0 && std::sqrt(luminance(var)) <= settings.target_relative_error * lum)) still.push_back(i);
+        one.texels.resize(1);
+        for (int c = 0; c < 3; ++c)
+          one.texels[0].total[c] = sums[i * 6 + size_t(c)], one.texels[0].total_squared[c] = sums[i * 6 + 3 + size_t(c)];
+        one.texels[0].samples = samples[i];
+        if (!one.relative_error_below(0, settings.target_relative_error)) still.push_back(i);
       }
       if (still.size() != active.size()) {
         active = std::move(still);
-        if (!active.empty()) ctx->upload(buffers[kBatchTexels], active.data(), active.size() * 4);
+        if (!active.empty()) ctx->upload(buffers[kBindingBatchItems], active.data(), active.size() * 4);
       }
     }
+    passes.finish_pass(totals.rays(), active.empty());
   }
 
   std::vector<double> sums(texel_count * 6);
   std::vector<uint32_t> samples(texel_count);
-  ctx->download(buffers[kAccTotal], sums.data(), sums.size() * 8);
-  ctx->download(buffers[kAccSamples], samples.data(), samples.size() * 4);
-  ctx->download(buffers[kAccBounce], estimate.bounces.data(), estimate.bounces.size() * 8);
+  ctx->download(buffers[kBindingTexelSums], sums.data(), sums.size() * 8);
+  ctx->download(buffers[kBindingTexelSamples], samples.data(), samples.size() * 4);
+  ctx->download(buffers[kBindingBounceSums], estimate.bounces.data(), estimate.bounces.size() * 8);
   for (size_t i = 0; i < texel_count; ++i) {
     TexelAccumulator& a = estimate.texels[i];
     for (int c = 0; c < 3; ++c) {
@@ -597,20 +514,20 @@ LightmapEstimate VulkanIntegrator::Impl::bake(const TexelGBuffer& gbuffer, const
 // batch's n texels (or probes). `result_bytes`: the part of the result buffer the batch writes.
 void VulkanIntegrator::Impl::run_wavefront_batch(const GpuParams& params, VkDeviceSize result_bytes, bool probes,
                                                  bool timing, BatchTotals& totals) {
-  const uint32_t n = params.batch_texel_count;
+  const uint32_t n = params.batch_item_count;
   Recorder r{*this, ctx->begin(), timing};
   r.probes = probes;
   r.start();
   set_params(r.cmd, params);
-  vkCmdFillBuffer(r.cmd, buffers[kCounters].buffer, 0, VK_WHOLE_SIZE, 0);
-  vkCmdFillBuffer(r.cmd, buffers[kResults].buffer, 0, result_bytes, 0);
+  vkCmdFillBuffer(r.cmd, buffers[kBindingCounters].buffer, 0, VK_WHOLE_SIZE, 0);
+  vkCmdFillBuffer(r.cmd, buffers[kBindingResults].buffer, 0, result_bytes, 0);
   barrier(r.cmd);
   r.dispatch(probes ? kGenerateProbes : kGenerate, (paths + kGroupSize - 1) / kGroupSize, 1);  // fills ray queue 0
   r.connect_and_extend(1);
   uint32_t cur = 0;
   r.copy_counters();
   finish(r);
-  while (counters()[kRayCount0 + cur] > 0) {
+  while (counters()[kCounterRayQueue0 + cur] > 0) {
     Recorder more{*this, ctx->begin(), timing};
     more.probes = probes;
     more.start();
@@ -624,11 +541,11 @@ void VulkanIntegrator::Impl::run_wavefront_batch(const GpuParams& params, VkDevi
   reduce.copy_counters();
   finish(reduce);
   const uint32_t* c = counters();
-  totals.rays_primary += c[kRaysPrimary], totals.rays_bounce += c[kRaysBounce], totals.rays_shadow += c[kRaysShadow];
-  totals.nonfinite += c[kNonfinite];
-  totals.extend_busy += stat64(c, kStatExtendActive), totals.extend_launched += stat64(c, kStatExtendLaunched);
-  totals.connect_busy += stat64(c, kStatConnectActive), totals.connect_launched += stat64(c, kStatConnectLaunched);
-  totals.shade_items += stat64(c, kStatShadeItems), totals.shade_lanes += stat64(c, kStatShadeLanes);
+  totals.rays_primary += c[kCounterRaysPrimary], totals.rays_bounce += c[kCounterRaysBounce], totals.rays_shadow += c[kCounterRaysShadow];
+  totals.nonfinite += c[kCounterNonfinite];
+  totals.extend_busy += stat64(c, kCounterStatExtendActive), totals.extend_launched += stat64(c, kCounterStatExtendLaunched);
+  totals.connect_busy += stat64(c, kCounterStatConnectActive), totals.connect_launched += stat64(c, kCounterStatConnectLaunched);
+  totals.shade_items += stat64(c, kCounterStatShadeItems), totals.shade_lanes += stat64(c, kCounterStatShadeLanes);
 }
 
 void VulkanIntegrator::Impl::record_stats(const BatchTotals& t) const {
@@ -660,79 +577,73 @@ ProbeEstimate VulkanIntegrator::Impl::bake_probes(const std::vector<Vec3>& posit
   constexpr size_t kProbeItemBytes = 48;
   const size_t limit_items = size_t(ctx->properties().limits.maxStorageBufferRange) / kProbeItemBytes;
   const size_t max_work = std::max<size_t>(1, std::min<size_t>({size_t(paths) * work_per_path, limit_items, size_t(1) << 30}));
-  const auto grow = [&](Binding b, size_t bytes) {
+  const auto grow = [&](uint32_t b, size_t bytes) {
     if (buffers[b].size < bytes) make_buffer(b, bytes);
   };
-  grow(kTexels, probe_count * 48);
-  grow(kBatchTexels, probe_count * 4);
-  grow(kProbeSh, probe_count * 27 * 8);
-  grow(kProbeCounts, probe_count * 2 * 4);
-  grow(kResults, max_work * kProbeItemBytes);
-  result_capacity = std::max<size_t>(result_capacity, buffers[kResults].size / 4);
+  grow(kBindingStartPoints, probe_count * 48);
+  grow(kBindingBatchItems, probe_count * 4);
+  grow(kBindingProbeShSums, probe_count * 27 * 8);
+  grow(kBindingProbeCounts, probe_count * 2 * 4);
+  grow(kBindingResults, max_work * kProbeItemBytes);
+  result_capacity = std::max<size_t>(result_capacity, buffers[kBindingResults].size / 4);
   write_descriptors();
 
-  std::vector<float> records(probe_count * 12, 0.0f);  // texel records with the position only
-  for (size_t i = 0; i < probe_count; ++i)
-    records[i * 12] = positions[i].x, records[i * 12 + 1] = positions[i].y, records[i * 12 + 2] = positions[i].z;
-  ctx->upload(buffers[kTexels], records.data(), records.size() * 4);
+  std::vector<GpuSurfacePoint> records(probe_count);  // start points with the position only
+  for (size_t i = 0; i < probe_count; ++i) records[i].position = Vec4(positions[i], 0.0f);
+  ctx->upload(buffers[kBindingStartPoints], records.data(), records.size() * sizeof(GpuSurfacePoint));
   std::vector<uint32_t> order(probe_count);
   for (size_t i = 0; i < probe_count; ++i) order[i] = uint32_t(i);
-  ctx->upload(buffers[kBatchTexels], order.data(), order.size() * 4);
+  ctx->upload(buffers[kBindingBatchItems], order.data(), order.size() * 4);
   {
     VkCommandBuffer cmd = ctx->begin();
-    for (Binding b : {kProbeSh, kProbeCounts}) vkCmdFillBuffer(cmd, buffers[b].buffer, 0, VK_WHOLE_SIZE, 0);
+    for (uint32_t b : {kBindingProbeShSums, kBindingProbeCounts}) vkCmdFillBuffer(cmd, buffers[b].buffer, 0, VK_WHOLE_SIZE, 0);
     ctx->submit_and_wait(cmd);
   }
 
   const uint32_t spp_limit = settings.spp == 0 ? std::numeric_limits<uint32_t>::max() : settings.spp;
   GpuParams params{};
-  params.sky[0] = scene.sky.constant.x, params.sky[1] = scene.sky.constant.y, params.sky[2] = scene.sky.constant.z;
-  params.scene_extent = scene_extent;
-  params.emitter_count = emitter_count;
-  params.punctual_count = punctual_count;
+  params.sky = Vec4(scene.sky, 0.0f);
+  params.scene_extent = scene.extent;
+  params.emitter_count = scene.emitter_count();
+  params.punctual_count = scene.punctual_count();
   params.recorded = 1;  // slot 0: what the probe ray meets; slot 1: E/pi at its hit
   params.max_bounces = settings.max_bounces;
   params.rr_start = settings.russian_roulette_start;
   params.safety_cap = settings.safety_bounce_cap;
   params.path_capacity = paths;
   params.seed_lo = uint32_t(settings.seed), params.seed_hi = uint32_t(settings.seed >> 32);
+  params.sampling_strategy = settings.sampling_strategy;
   params.collect_stats = options.collect_stage_statistics ? 1u : 0u;
-  params.texel_count_total = uint32_t(probe_count);
+  params.item_count_total = uint32_t(probe_count);
   params.probe_spp = spp_limit;
 
   const bool timing = options.collect_stage_statistics && query_pool != VK_NULL_HANDLE;
   BatchTotals totals;
-  const bool timed = settings.time_budget_seconds > 0;
   const uint32_t chunk = uint32_t(std::min(probe_count, max_work));
-  uint32_t done = 0;
-  while (done < spp_limit) {
-    uint32_t pass = uint32_t(std::min<size_t>(spp_limit - done, std::max<size_t>(1, max_work / chunk)));
-    // With a time budget, passes end on stratified-set boundaries and the budget is only checked
-    // there, so a stopped run never leaves a set's strata out (as the reference).
-    if (timed) pass = std::min(pass, kProbeStratifiedSetSize - done % kProbeStratifiedSetSize);
+  PassPolicy policy;
+  policy.largest_pass = uint32_t(std::max<size_t>(1, max_work / chunk));
+  // With a time budget, passes end on stratified-set boundaries and the budget is only checked
+  // there, so a stopped run never leaves a set's strata out (as the reference).
+  policy.stratified_set = kProbeStratifiedSetSize;
+  PassScheduler passes(settings, policy);
+  uint32_t first = 0, pass = 0;
+  while (passes.next_pass(first, pass)) {
     for (size_t offset = 0; offset < probe_count; offset += chunk) {
       const uint32_t n = uint32_t(std::min<size_t>(chunk, probe_count - offset));
-      params.batch_texel_offset = uint32_t(offset);
-      params.batch_texel_count = n;
-      params.batch_sample_begin = done;
+      params.batch_item_offset = uint32_t(offset);
+      params.batch_item_count = n;
+      params.batch_sample_begin = first;
       params.batch_sample_count = pass;
       params.batch_work_total = n * pass;
       run_wavefront_batch(params, VkDeviceSize(n) * pass * kProbeItemBytes, true, timing, totals);
     }
-    done += pass;
-    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    if (settings.progress) {
-      const double by_spp = settings.spp ? double(done) / double(settings.spp) : 0.0;
-      const double by_time = timed ? elapsed / settings.time_budget_seconds : 0.0;
-      settings.progress(std::min(1.0, std::max(by_spp, by_time)), totals.rays());
-    }
-    if (timed && done % kProbeStratifiedSetSize == 0 && elapsed >= settings.time_budget_seconds) break;
+    passes.finish_pass(totals.rays());
   }
 
   std::vector<double> sums(probe_count * 27);
   std::vector<uint32_t> counts(probe_count * 2);
-  ctx->download(buffers[kProbeSh], sums.data(), sums.size() * 8);
-  ctx->download(buffers[kProbeCounts], counts.data(), counts.size() * 4);
+  ctx->download(buffers[kBindingProbeShSums], sums.data(), sums.size() * 8);
+  ctx->download(buffers[kBindingProbeCounts], counts.data(), counts.size() * 4);
   for (size_t i = 0; i < probe_count; ++i) {
     std::copy(sums.begin() + std::ptrdiff_t(i * 27), sums.begin() + std::ptrdiff_t(i * 27 + 27), estimate.sh_sum[i].begin());
     estimate.samples[i] = counts[i * 2];
@@ -753,8 +664,8 @@ double VulkanIntegrator::Impl::traversal_bench(uint32_t ray_count, int repetitio
   params.batch_work_total = ray_count;
   params.collect_stats = 1;
   params.seed_lo = 12345;
-  params.bench_lo[0] = scene_lo.x, params.bench_lo[1] = scene_lo.y, params.bench_lo[2] = scene_lo.z;
-  params.bench_hi[0] = scene_hi.x, params.bench_hi[1] = scene_hi.y, params.bench_hi[2] = scene_hi.z;
+  params.bench_lo = Vec4(scene.bounds_lo, 0.0f);
+  params.bench_hi = Vec4(scene.bounds_hi, 0.0f);
   if (!query_pool) throw std::runtime_error("Vulkan backend: this device has no timestamp queries");
   double best = 0;
   uint64_t busy = 0, launched = 0;
@@ -763,7 +674,7 @@ double VulkanIntegrator::Impl::traversal_bench(uint32_t ray_count, int repetitio
     Recorder r{*this, ctx->begin(), true};
     r.start();
     set_params(r.cmd, params);
-    vkCmdFillBuffer(r.cmd, buffers[kCounters].buffer, 0, VK_WHOLE_SIZE, 0);
+    vkCmdFillBuffer(r.cmd, buffers[kBindingCounters].buffer, 0, VK_WHOLE_SIZE, 0);
     barrier(r.cmd);
     r.stamp(-1);
     r.dispatch(kBenchRays, (ray_count + kGroupSize - 1) / kGroupSize, 0);
@@ -771,23 +682,27 @@ double VulkanIntegrator::Impl::traversal_bench(uint32_t ray_count, int repetitio
     finish(r);
     const double seconds = stats[kBenchRays].seconds;
     if (seconds > 0) best = std::max(best, double(ray_count) / seconds);
-    busy = stat64(counters(), kStatExtendActive), launched = stat64(counters(), kStatExtendLaunched);
+    busy = stat64(counters(), kCounterStatExtendActive), launched = stat64(counters(), kCounterStatExtendLaunched);
   }
   stats[kBenchRays].rays = ray_count;
-  stats[kBenchRays].items = counters()[kRaysPrimary];  // rays that hit something
+  stats[kBenchRays].items = counters()[kCounterRaysPrimary];  // rays that hit something
   stats[kBenchRays].seconds = double(ray_count) / std::max(best, 1e-30);
   stats[kBenchRays].lane_efficiency = launched ? double(busy) / double(launched) : 0.0;
   return best;
 }
 
-std::unique_ptr<VulkanIntegrator> VulkanIntegrator::create(const Scene& scene, const VulkanDeviceOptions& options) {
-  if (scene.sky.has_environment())
+std::unique_ptr<VulkanIntegrator> VulkanIntegrator::create(std::shared_ptr<const LightingScene> scene,
+                                                           const VulkanDeviceOptions& options) {
+  if (!scene) throw std::invalid_argument("Vulkan backend: no scene");
+  if (scene->environment.enabled())
     throw std::runtime_error("Vulkan backend: environment-map skies are not supported yet (use the cpu backend)");
-  for (const Material& m : scene.materials)
-    if (m.base_color_texture.texture >= 0 || m.emissive_texture.texture >= 0)
-      throw std::runtime_error("Vulkan backend: textured materials are not supported yet (material '" + m.name +
-                               "'; use the cpu backend)");
-  auto impl = std::make_unique<Impl>(scene, options);
+  if (scene->textured)
+    for (const Material& m : scene->source->materials)
+      if (m.base_color_texture.texture >= 0 || m.emissive_texture.texture >= 0)
+        throw std::runtime_error("Vulkan backend: textured materials are not supported yet (material '" + m.name +
+                                 "'; use the cpu backend)");
+  if (scene->bvh.nodes.empty()) throw std::invalid_argument("Vulkan backend: the scene has no BVH4 (build_bvh4 or scene.bin)");
+  auto impl = std::make_unique<Impl>(std::move(scene), options);
   impl->ctx = std::make_unique<Context>(options);
   const bool cpu_device = impl->ctx->info().type == VulkanDeviceType::Cpu;
   // Paths in flight: on a GPU, more paths hide more latency and shorten the drains at batch ends
@@ -805,7 +720,6 @@ std::unique_ptr<VulkanIntegrator> VulkanIntegrator::create(const Scene& scene, c
   impl->quantized_nodes = options.node_layout == VulkanNodeLayout::Automatic ? cpu_device
                                                                             : options.node_layout == VulkanNodeLayout::Quantized;
   impl->work_per_path = options.work_items_per_path ? options.work_items_per_path : 4u;
-  impl->bvh = build_gpu_bvh(scene);
   impl->upload_scene();
   impl->allocate_path_state();
   impl->create_pipelines();
@@ -829,13 +743,16 @@ ProbeEstimate VulkanIntegrator::bake_probes(const std::vector<Vec3>& positions, 
 }
 
 const VulkanDeviceInfo& VulkanIntegrator::device() const { return impl_->ctx->info(); }
+std::string VulkanIntegrator::device_description() const {
+  return device().name + " (" + to_string(device().type) + ")";
+}
 uint32_t VulkanIntegrator::max_paths() const { return impl_->paths; }
 size_t VulkanIntegrator::path_state_bytes_per_path() const { return impl_->path_bytes(); }
 size_t VulkanIntegrator::bvh_bytes() const {
-  return impl_->bvh.nodes.size() * (impl_->quantized_nodes ? kQuantizedNodeWords * 4 : sizeof(GpuBvhNode)) +
-         impl_->bvh.triangles.size() * 48;
+  return impl_->scene.bvh.nodes.size() * (impl_->quantized_nodes ? kQuantizedNodeWords * 4 : sizeof(Bvh4Node)) +
+         impl_->scene.bvh.leaf_triangles.size() * 48;
 }
-uint32_t VulkanIntegrator::bvh_node_count() const { return uint32_t(impl_->bvh.nodes.size()); }
+uint32_t VulkanIntegrator::bvh_node_count() const { return uint32_t(impl_->scene.bvh.nodes.size()); }
 const std::vector<VulkanStageStatistics>& VulkanIntegrator::stage_statistics() const { return impl_->stats; }
 double VulkanIntegrator::measure_incoherent_traversal(uint32_t ray_count, int repetitions) const {
   return impl_->traversal_bench(ray_count, repetitions);

@@ -4,6 +4,8 @@
 #include <cstddef>
 #include <vector>
 
+#include "exitance/common/distribution.h"
+
 namespace exitance {
 
 class Distribution1D {
@@ -25,10 +27,8 @@ class Distribution1D {
 
   // Returns the chosen index; `remapped` is u rescaled to [0,1) inside the chosen cell.
   size_t sample(float u, float* remapped = nullptr) const {
-    auto it = std::upper_bound(cdf_.begin(), cdf_.end(), double(u));
-    size_t i = size_t(std::max<std::ptrdiff_t>(0, (it - cdf_.begin()) - 1));
-    i = std::min(i, size() - 1);
-    while (pmf(i) == 0.0f && i > 0) --i;  // never return a zero-weight cell at a CDF plateau
+    float probability = 0;
+    const size_t i = sample_cdf(cdf_.data(), uint32_t(size()), u, probability);  // shared with the shaders
     if (remapped) {
       const double width = cdf_[i + 1] - cdf_[i];
       *remapped = width > 0 ? float(std::clamp((double(u) - cdf_[i]) / width, 0.0, 0.99999994)) : 0.5f;

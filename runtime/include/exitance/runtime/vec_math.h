@@ -1,5 +1,5 @@
-// Small vector types for the lighting stage. Written in the subset of C++ that maps
-// one-to-one onto GLSL's vec2/vec3 so the later shader ports stay literal.
+// Small vector types for the lighting stage, with GLSL's vec2/vec3/vec4 constructors and operators,
+// so headers in runtime/common compile as C++ and as GLSL (runtime/common/.../dialect.h).
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -8,13 +8,27 @@ namespace exitance {
 
 struct Vec2 {
   float x = 0, y = 0;
+  constexpr Vec2() = default;
+  constexpr Vec2(float x_, float y_) : x(x_), y(y_) {}
 };
 
 struct Vec3 {
   float x = 0, y = 0, z = 0;
+  constexpr Vec3() = default;
+  constexpr Vec3(float x_, float y_, float z_) : x(x_), y(y_), z(z_) {}
+  constexpr explicit Vec3(float s) : x(s), y(s), z(s) {}
   float operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
   float& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
 };
+
+// GLSL vec4 in std430 buffers: 16-byte aligned.
+struct alignas(16) Vec4 {
+  float x = 0, y = 0, z = 0, w = 0;
+  constexpr Vec4() = default;
+  constexpr Vec4(float x_, float y_, float z_, float w_) : x(x_), y(y_), z(z_), w(w_) {}
+  constexpr Vec4(Vec3 v, float w_) : x(v.x), y(v.y), z(v.z), w(w_) {}
+};
+static_assert(sizeof(Vec4) == 16);
 
 inline Vec2 operator+(Vec2 a, Vec2 b) { return {a.x + b.x, a.y + b.y}; }
 inline Vec2 operator-(Vec2 a, Vec2 b) { return {a.x - b.x, a.y - b.y}; }
@@ -27,6 +41,7 @@ inline Vec3 operator*(Vec3 a, Vec3 b) { return {a.x * b.x, a.y * b.y, a.z * b.z}
 inline Vec3 operator*(Vec3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
 inline Vec3 operator*(float s, Vec3 a) { return a * s; }
 inline Vec3 operator/(Vec3 a, float s) { return a * (1.0f / s); }
+inline Vec3 operator/(Vec3 a, Vec3 b) { return {a.x / b.x, a.y / b.y, a.z / b.z}; }
 inline Vec3& operator+=(Vec3& a, Vec3 b) { a = a + b; return a; }
 inline Vec3& operator*=(Vec3& a, Vec3 b) { a = a * b; return a; }
 inline Vec3& operator*=(Vec3& a, float s) { a = a * s; return a; }
@@ -37,19 +52,12 @@ inline Vec3 cross(Vec3 a, Vec3 b) {
 }
 inline float length(Vec3 a) { return std::sqrt(dot(a, a)); }
 inline Vec3 normalize(Vec3 a) { return a / length(a); }
-inline float max_component(Vec3 a) { return std::max(a.x, std::max(a.y, a.z)); }
-inline float luminance(Vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 inline bool is_finite(Vec3 a) { return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z); }
 inline Vec3 min(Vec3 a, Vec3 b) { return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)}; }
 inline Vec3 max(Vec3 a, Vec3 b) { return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)}; }
 
-// Orthonormal basis around a unit normal (Duff et al. 2017, "Building an Orthonormal Basis, Revisited").
-inline void orthonormal_basis(Vec3 n, Vec3& t, Vec3& b) {
-  float sign = std::copysign(1.0f, n.z);
-  float a = -1.0f / (sign + n.z);
-  float bb = n.x * n.y * a;
-  t = {1.0f + sign * n.x * n.x * a, sign * bb, -sign * n.x};
-  b = {bb, sign + n.y * n.y * a, -n.y};
-}
 
 }  // namespace exitance
+
+// max_component, luminance, orthonormal_basis: shared with the shaders.
+#include "exitance/common/vector_functions.h"

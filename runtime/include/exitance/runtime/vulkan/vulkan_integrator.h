@@ -1,7 +1,7 @@
-// Vulkan compute backend (DESIGN §5): a wavefront path tracer of lightmap texels that computes
-// the same estimator as the CPU reference (cpu_reference_integrator.h), so both agree within
-// statistical error. Stages: generate -> extend (closest hit) -> shade (emission + MIS, NEE,
-// cosine bounce, Russian roulette) -> connect (shadow rays, any hit); see runtime/src/vulkan/.
+// Vulkan compute backend (DESIGN §5): a wavefront path tracer of lightmap texels over a LightingScene,
+// computing path.h's estimator (runtime/common), the same code the CPU reference runs, so both agree
+// within statistical error. Stages: generate -> extend (closest hit) -> shade (emission + MIS, NEE,
+// continuation, Russian roulette) -> connect (shadow rays, any hit); see runtime/src/vulkan/.
 // Light probes (bake_probes) run through the same kernels.
 #pragma once
 #include <cstdint>
@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "exitance/runtime/cpu_reference_integrator.h"
-#include "exitance/runtime/scene.h"
+#include "exitance/runtime/core/integrator.h"
+#include "exitance/runtime/core/lighting_scene.h"
 #include "exitance/runtime/texel_gbuffer.h"
 
 namespace exitance {
@@ -65,12 +65,14 @@ struct VulkanStageStatistics {
   double lane_efficiency = 0;  // active lanes / launched lanes (traversal stages: inside the traversal loop)
 };
 
-class VulkanIntegrator {
+class VulkanIntegrator final : public Integrator {
  public:
-  // Throws std::runtime_error when no usable Vulkan device exists, and for scenes the backend does
-  // not support yet (textured materials, environment-map skies): never a silently wrong result.
-  static std::unique_ptr<VulkanIntegrator> create(const Scene& scene, const VulkanDeviceOptions& options = {});
-  ~VulkanIntegrator();
+  // Uploads the scene (its BVH4 as built by the offline stage or read from scene.bin). Throws
+  // std::runtime_error when no usable Vulkan device exists, and for scenes the backend does not
+  // support yet (textured materials, environment-map skies): never a silently wrong result.
+  static std::unique_ptr<VulkanIntegrator> create(std::shared_ptr<const LightingScene> scene,
+                                                  const VulkanDeviceOptions& options = {});
+  ~VulkanIntegrator() override;
   VulkanIntegrator(const VulkanIntegrator&) = delete;
   VulkanIntegrator& operator=(const VulkanIntegrator&) = delete;
 
@@ -78,14 +80,16 @@ class VulkanIntegrator {
   // time budget), time_budget_seconds, target_relative_error (checked between batches),
   // max_bounces, seed, recorded_bounces, russian_roulette_start, safety_bounce_cap, progress.
   // Throws std::runtime_error on device loss, out of memory or a fence timeout.
-  LightmapEstimate bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const;
+  LightmapEstimate bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const override;
 
   // Light probes: same contract and fields as CpuReferenceIntegrator::bake_probes (ProbeEstimate:
   // stratified sphere rays, incident radiance projected to L2 SH), same random streams. Supported
   // settings: spp (0 needs a time budget), time_budget_seconds (checked only when every probe has a
   // complete stratified set), max_bounces, seed, russian_roulette_start, safety_bounce_cap, progress.
   // Independent of bake(); throws as bake() does.
-  ProbeEstimate bake_probes(const std::vector<Vec3>& positions, const IntegratorSettings& settings) const;
+  ProbeEstimate bake_probes(const std::vector<Vec3>& positions, const IntegratorSettings& settings) const override;
+  std::string backend_name() const override { return "vulkan"; }
+  std::string device_description() const override;
 
   const VulkanDeviceInfo& device() const;
   uint32_t max_paths() const;

@@ -1,5 +1,4 @@
-// A 4-wide BVH for GPU traversal (shaders/include/bvh.glsl), built by Embree's rtcBuildBVH with
-// our own node callbacks and flattened depth-first.
+// The BVH4's quantized node layout for GPU traversal (shaders/include/bvh.glsl).
 #pragma once
 #include <array>
 #include <cmath>
@@ -8,47 +7,27 @@
 #include <stdexcept>
 #include <vector>
 
-#include "exitance/runtime/scene.h"
+#include "exitance/runtime/core/bvh4.h"
 
 namespace exitance::vulkan {
-
-constexpr uint32_t kEmptyChild = 0xFFFFFFFFu;
-constexpr uint32_t kLeafBit = 0x80000000u;
-constexpr uint32_t kMaxLeafTriangles = 4;
-
-// 7 x vec4: lo.x[4], hi.x[4], lo.y[4], hi.y[4], lo.z[4], hi.z[4], child[4] (bits).
-struct GpuBvhNode {
-  float lo_x[4], hi_x[4], lo_y[4], hi_y[4], lo_z[4], hi_z[4];
-  uint32_t child[4];
-};
-static_assert(sizeof(GpuBvhNode) == 112);
-
-struct GpuBvh {
-  std::vector<GpuBvhNode> nodes;          // nodes[0] is the root (an inner node, possibly with empty children)
-  std::vector<std::array<float, 12>> triangles;  // per leaf slot: v0.xyz|scene triangle bits, v1.xyz|0, v2.xyz|0
-  uint32_t stack_entries = 1;             // traversal stack bound (shaders' kStackSize)
-  uint32_t depth = 0;
-};
-
-GpuBvh build_gpu_bvh(const Scene& scene);
 
 // Quantized node for traversal (shaders/include/bvh.glsl), 64 bytes = 16 words instead of 112:
 //   w0..2  origin (float bits)            w3   biased exponents e+127 of the x, y, z scales (bytes 0..2)
 //   w4..9  lo.x, hi.x, lo.y, hi.y, lo.z, hi.z: four 8-bit child planes each (child i in byte i)
-//   w10..13 child words (as GpuBvhNode)   w14..15 zero
+//   w10..13 child words (as Bvh4Node)   w14..15 zero
 // A plane decodes as origin + q * 2^e: q * 2^e is exact, so the shader's float result (one rounding,
 // fused or not) is the one computed here, and q is chosen so that the decoded box contains the
 // float box (lo rounds down, hi rounds up): traversal stays conservative.
 constexpr size_t kQuantizedNodeWords = 16;
 
-inline std::vector<uint32_t> quantize_bvh4_nodes(const std::vector<GpuBvhNode>& nodes) {
+inline std::vector<uint32_t> quantize_bvh4_nodes(const std::vector<Bvh4Node>& nodes) {
   std::vector<uint32_t> out(nodes.size() * kQuantizedNodeWords, 0u);
   auto decode = [](float origin, uint32_t q, float scale) {
     volatile float product = float(q) * scale;  // exact; volatile keeps the host from fusing differently
     return origin + product;
   };
   for (size_t n = 0; n < nodes.size(); ++n) {
-    const GpuBvhNode& node = nodes[n];
+    const Bvh4Node& node = nodes[n];
     uint32_t* w = &out[n * kQuantizedNodeWords];
     const float* lo[3] = {node.lo_x, node.lo_y, node.lo_z};
     const float* hi[3] = {node.hi_x, node.hi_y, node.hi_z};
@@ -56,7 +35,7 @@ inline std::vector<uint32_t> quantize_bvh4_nodes(const std::vector<GpuBvhNode>& 
     for (int a = 0; a < 3; ++a) {
       float mn = INFINITY, mx = -INFINITY;
       for (int i = 0; i < 4; ++i)
-        if (node.child[i] != kEmptyChild) mn = std::min(mn, lo[a][i]), mx = std::max(mx, hi[a][i]);
+        if (node.child[i] != kBvhEmptyChild) mn = std::min(mn, lo[a][i]), mx = std::max(mx, hi[a][i]);
       if (!(mn <= mx)) mn = mx = 0.0f;  // no children
       const float extent = mx - mn;
       int e = extent > 0 ? int(std::ceil(std::log2(double(extent) / 254.0))) : -126;
@@ -67,7 +46,7 @@ inline std::vector<uint32_t> quantize_bvh4_nodes(const std::vector<GpuBvhNode>& 
         const float scale = std::ldexp(1.0f, e);
         bool ok = true;
         for (int i = 0; i < 4 && ok; ++i) {
-          if (node.child[i] == kEmptyChild) continue;
+          if (node.child[i] == kBvhEmptyChild) continue;
           double fl = std::floor((double(lo[a][i]) - double(mn)) / double(scale));
           double fh = std::ceil((double(hi[a][i]) - double(mn)) / double(scale));
           int64_t l = int64_t(std::clamp(fl, 0.0, 255.0)), h = int64_t(std::clamp(fh, 0.0, 255.0));

@@ -1,4 +1,4 @@
-#include "gpu_bvh.h"
+#include "exitance/runtime/cpu/bvh4_builder.h"
 
 #include <embree3/rtcore.h>
 
@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace exitance::vulkan {
+namespace exitance {
 namespace {
 
 // Temporary tree made by Embree's callbacks (memory from rtcThreadLocalAlloc, freed with the RTCBVH).
@@ -17,7 +17,7 @@ struct BuildNode {
   uint32_t count = 0;      // children (inner) or triangles (leaf)
   BuildNode* children[4] = {};
   RTCBounds bounds[4] = {};
-  uint32_t triangles[kMaxLeafTriangles] = {};
+  uint32_t triangles[kBvhMaxLeafTriangles] = {};
 };
 
 void* create_node(RTCThreadLocalAllocator alloc, unsigned int child_count, void*) {
@@ -48,23 +48,13 @@ void* create_leaf(RTCThreadLocalAllocator alloc, const RTCBuildPrimitive* primit
 }
 
 struct Flattener {
-  const Scene& scene;
-  GpuBvh& out;
+  Bvh4& out;
 
   uint32_t emit_leaf(const BuildNode* leaf) {
-    const uint32_t first = uint32_t(out.triangles.size());
-    if (first >= (1u << 29)) throw std::runtime_error("Vulkan backend: too many triangles for the BVH leaf encoding");
-    for (uint32_t i = 0; i < leaf->count; ++i) {
-      const uint32_t t = leaf->triangles[i];
-      std::array<float, 12> v{};
-      for (int k = 0; k < 3; ++k) {
-        const Vec3 p = scene.positions[size_t(t) * 3 + size_t(k)];
-        v[size_t(4 * k)] = p.x, v[size_t(4 * k + 1)] = p.y, v[size_t(4 * k + 2)] = p.z;
-      }
-      std::memcpy(&v[3], &t, 4);
-      out.triangles.push_back(v);
-    }
-    return kLeafBit | (first << 2) | (leaf->count - 1);
+    const uint32_t first = uint32_t(out.leaf_triangles.size());
+    if (first >= (1u << 29)) throw std::runtime_error("BVH: too many triangles for the leaf encoding");
+    for (uint32_t i = 0; i < leaf->count; ++i) out.leaf_triangles.push_back(leaf->triangles[i]);
+    return kBvhLeafBit | (first << 2) | (leaf->count - 1);
   }
 
   // Returns the stack entries that traversal below `node` can need.
@@ -72,9 +62,9 @@ struct Flattener {
     out.depth = std::max(out.depth, depth);
     uint32_t below = 0;
     for (uint32_t i = 0; i < 4; ++i) {
-      GpuBvhNode& n = out.nodes[index];
+      Bvh4Node& n = out.nodes[index];
       if (i >= node->count) {
-        n.child[i] = kEmptyChild;
+        n.child[i] = kBvhEmptyChild;
         n.lo_x[i] = n.lo_y[i] = n.lo_z[i] = 1.0f;  // empty box; the child word marks it anyway
         n.hi_x[i] = n.hi_y[i] = n.hi_z[i] = -1.0f;
         continue;
@@ -99,8 +89,8 @@ struct Flattener {
 
 }  // namespace
 
-GpuBvh build_gpu_bvh(const Scene& scene) {
-  GpuBvh bvh;
+Bvh4 build_bvh4(const Scene& scene) {
+  Bvh4 bvh;
   const size_t triangle_count = scene.triangle_count();
   std::vector<RTCBuildPrimitive> primitives;
   primitives.reserve(triangle_count);
@@ -116,7 +106,7 @@ GpuBvh build_gpu_bvh(const Scene& scene) {
   bvh.nodes.emplace_back();
   if (primitives.empty()) {
     for (int i = 0; i < 4; ++i) {
-      bvh.nodes[0].child[i] = kEmptyChild;
+      bvh.nodes[0].child[i] = kBvhEmptyChild;
       bvh.nodes[0].lo_x[i] = bvh.nodes[0].lo_y[i] = bvh.nodes[0].lo_z[i] = 1.0f;
       bvh.nodes[0].hi_x[i] = bvh.nodes[0].hi_y[i] = bvh.nodes[0].hi_z[i] = -1.0f;
     }
@@ -124,7 +114,7 @@ GpuBvh build_gpu_bvh(const Scene& scene) {
   }
 
   RTCDevice device = rtcNewDevice(nullptr);
-  if (!device) throw std::runtime_error("Embree: cannot create a device for the GPU BVH build");
+  if (!device) throw std::runtime_error("Embree: cannot create a device for the BVH4 build");
   RTCBVH handle = rtcNewBVH(device);
   RTCBuildArguments args = rtcDefaultBuildArguments();
   args.byteSize = sizeof(args);
@@ -134,7 +124,7 @@ GpuBvh build_gpu_bvh(const Scene& scene) {
   args.maxDepth = 48;
   args.sahBlockSize = 1;
   args.minLeafSize = 1;
-  args.maxLeafSize = kMaxLeafTriangles;
+  args.maxLeafSize = kBvhMaxLeafTriangles;
   args.traversalCost = 1.0f;
   args.intersectionCost = 1.0f;
   args.bvh = handle;
@@ -152,10 +142,10 @@ GpuBvh build_gpu_bvh(const Scene& scene) {
   if (!root || rtcGetDeviceError(device) != RTC_ERROR_NONE) {
     rtcReleaseBVH(handle);
     rtcReleaseDevice(device);
-    throw std::runtime_error("Embree: rtcBuildBVH failed for the GPU BVH");
+    throw std::runtime_error("Embree: rtcBuildBVH failed for the BVH4");
   }
-  bvh.triangles.reserve(primitives.size());
-  Flattener flattener{scene, bvh};
+  bvh.leaf_triangles.reserve(primitives.size());
+  Flattener flattener{bvh};
   if (root->leaf) {
     // Wrap a single leaf into a root with one child.
     BuildNode wrapper;
@@ -179,4 +169,4 @@ GpuBvh build_gpu_bvh(const Scene& scene) {
   return bvh;
 }
 
-}  // namespace exitance::vulkan
+}  // namespace exitance

@@ -1,0 +1,133 @@
+// The lighting scene and the wavefront's parameters as the GPU reads them (std430), shared by the
+// host upload (runtime/src/vulkan) and the kernels (shaders/), and by the CPU reference, which reads
+// the same records, so the layouts cannot drift. Binding numbers and counter slots live here too.
+#ifndef EXITANCE_COMMON_GPU_LAYOUT_H
+#define EXITANCE_COMMON_GPU_LAYOUT_H
+#include "exitance/common/dialect.h"
+EXITANCE_NAMESPACE_BEGIN
+
+// One scene triangle for shading: vertices, shading normals, and what light sampling needs.
+struct GpuTriangle {
+  vec4 p0_material;  // xyz vertex 0; w material index (uint bits)
+  vec4 p1_area_pdf;  // xyz vertex 1; w area density with which NEE picks a point on it (0: not an emitter)
+  vec4 p2_instance;  // xyz vertex 2; w instance index (uint bits)
+  vec4 n0;           // xyz shading normal at vertex 0
+  vec4 n1;
+  vec4 n2;
+};
+
+// Constant-factor material (textured materials are evaluated by the CPU reference only, for now).
+struct GpuMaterial {
+  vec4 albedo_double_sided;  // xyz diffuse albedo (material.h); w 1 when double sided
+  vec4 emission;             // xyz emitted radiance; w 0
+};
+
+struct GpuPunctualLight {
+  vec4 position_type;        // xyz position; w type (uint bits: kPunctualPoint/Spot/Directional)
+  vec4 direction_cos_inner;  // xyz direction the light travels; w spot cos(inner cone)
+  vec4 intensity_cos_outer;  // xyz W/sr (point, spot) or W/m^2 (directional); w spot cos(outer cone)
+};
+
+// A point the estimator starts from: a lightmap texel (or a probe: position only).
+struct GpuSurfacePoint {
+  vec4 position;
+  vec4 geometric_normal;
+  vec4 shading_normal;
+};
+
+// ---- Next-event estimation's shadow rays (path.h), kept per path slot between the shade and connect stages ----
+// A shadow ray from the vertex's offset origin: unit direction and length, and what it adds when
+// unoccluded (path throughput included). state: kShadowNone, kShadowTrace, or kShadowCountOnly
+// (counted as a traced ray, as the reference counts it, but its segment has zero length).
+const uint kShadowRaysPerVertex = 3u;  // area light, punctual light, environment
+const float kShadowNone = 0.0f;
+const float kShadowTrace = 1.0f;
+const float kShadowCountOnly = 2.0f;
+
+struct ShadowRay {
+  vec4 direction_length;    // xyz unit direction, w length (+inf for the environment)
+  vec4 contribution_state;  // xyz contribution when unoccluded, w state
+};
+
+// Everything the kernels read that is not per item. Updated in place between batches.
+struct GpuParams {
+  vec4 sky;             // rgb constant sky radiance
+  vec4 bench_lo;        // traversal bench: scene bounds
+  vec4 bench_hi;
+  float scene_extent;   // largest side of the scene bounds (ray offset floor)
+  uint emitter_count;
+  uint punctual_count;
+  uint recorded;        // K: recorded bounce layers; result slot K gathers the deeper ones
+  int max_bounces;
+  int rr_start;
+  int safety_cap;
+  uint path_capacity;   // P: path slots
+  uint seed_lo;
+  uint seed_hi;
+  uint batch_item_offset;  // first entry of batch_items in this batch
+  uint batch_item_count;   // n
+  uint batch_sample_begin;
+  uint batch_sample_count;
+  uint batch_work_total;   // n * samples
+  uint collect_stats;
+  uint item_count_total;   // items (texels, probes) of the whole bake: the bounce accumulator's stride
+  uint probe_spp;          // probes: samples per probe of the whole bake (0xFFFFFFFF: until the time budget)
+  uint sampling_strategy;  // kStrategy* (path.h)
+  uint pad0;
+};
+
+// Descriptor bindings of the wavefront (one set).
+const uint kBindingParams = 0u;
+const uint kBindingBvhNodes = 1u;
+const uint kBindingBvhTriangles = 2u;
+const uint kBindingTriangles = 3u;
+const uint kBindingMaterials = 4u;
+const uint kBindingEmitterCdf = 5u;
+const uint kBindingEmitterTriangles = 6u;
+const uint kBindingPunctualLights = 7u;
+const uint kBindingPunctualCdf = 8u;
+const uint kBindingStartPoints = 9u;
+const uint kBindingBatchItems = 10u;
+const uint kBindingCounters = 11u;
+const uint kBindingIndirect = 12u;
+const uint kBindingPathWork = 13u;
+const uint kBindingPathDepth = 14u;
+const uint kBindingPathRng = 15u;
+const uint kBindingPathThroughput = 16u;
+const uint kBindingPathRayOrigin = 17u;
+const uint kBindingPathRayDirection = 18u;
+const uint kBindingPathHit = 19u;
+const uint kBindingShadowRays = 20u;
+const uint kBindingRayQueue = 21u;
+const uint kBindingShadowQueue = 22u;
+const uint kBindingResults = 23u;
+const uint kBindingTexelSums = 24u;
+const uint kBindingBounceSums = 25u;
+const uint kBindingTexelSamples = 26u;
+const uint kBindingProbeShSums = 27u;
+const uint kBindingProbeCounts = 28u;
+const uint kBindingCount = 29u;
+
+// Counter slots (uint each; statistics are 64-bit lo/hi pairs).
+const uint kCounterRayQueue0 = 0u;  // ray queue sizes, ping-pong (0 and 1)
+const uint kCounterShadowQueue = 2u;
+const uint kCounterNextWork = 3u;
+const uint kCounterNonfinite = 4u;
+const uint kCounterRaysPrimary = 5u;
+const uint kCounterRaysBounce = 6u;
+const uint kCounterRaysShadow = 7u;
+const uint kCounterStatExtendActive = 16u;  // lanes active inside traversal loops / lanes launched there
+const uint kCounterStatExtendLaunched = 18u;
+const uint kCounterStatConnectActive = 20u;
+const uint kCounterStatConnectLaunched = 22u;
+const uint kCounterStatShadeItems = 24u;
+const uint kCounterStatShadeLanes = 26u;
+const uint kCounterCount = 32u;
+
+// Light probes: random streams Pcg32(seed, kProbeRngStreamBase + probe, sample), and stratified
+// sets of kProbeStratifiedSetSize consecutive samples (sampling.h probe_direction).
+const uint64_t kProbeRngStreamBase = 1099511627776ul;  // 2^40
+const uint kProbeStratifiedSetSize = 256u;
+
+EXITANCE_NAMESPACE_END
+#endif

@@ -1,0 +1,294 @@
+// The path tracer's per-vertex steps, written once for the CPU reference (runtime/src/cpu) and the
+// Vulkan wavefront (shaders/wavefront): next-event estimation, the continuation direction (the
+// sampling-strategy hook), and what a continuation ray's hit adds and where the path goes next.
+// Each backend only traces the rays these functions ask for, so both compute the same estimator,
+// and the same (seed, item, sample) gives the same path on both up to floating-point rounding.
+//
+// The estimator, per lightmap texel (E/pi): cosine-weighted (or guided) continuation rays; next-event
+// estimation to emissive triangles (picked by power, uniform by area), punctual lights (by power) and
+// the environment map; power-heuristic MIS between the continuation and the area/environment samples;
+// back faces of single-sided surfaces absorb; Russian roulette from bounce rr_start.
+//
+// Scene data comes through accessors the including code defines first (C++: scene_access.h over a
+// LightingScene; GLSL: shaders/include/scene_access.glsl over the descriptor set):
+//   GpuTriangle scene_triangle(SCENE_PARAM uint t)        GpuMaterial scene_material(SCENE_PARAM uint m)
+//   GpuPunctualLight scene_punctual_light(SCENE_PARAM uint i)
+//   uint scene_emitter_count(SCENE_ALONE_PARAM)           uint scene_emitter_triangle(SCENE_PARAM uint i)
+//   uint scene_punctual_count(SCENE_ALONE_PARAM)          float scene_extent(SCENE_ALONE_PARAM)
+//   CDF references scene_emitter_cdf(SCENE_ALONE_PARAM), scene_punctual_cdf(SCENE_ALONE_PARAM)
+//   vec3 scene_albedo(SCENE_PARAM uint t, float b1, float b2), vec3 scene_emission(SCENE_PARAM uint t, float b1, float b2)
+//   vec3 scene_sky_radiance(SCENE_PARAM vec3 direction)
+//   bool scene_has_environment(SCENE_ALONE_PARAM), float scene_environment_pdf(SCENE_PARAM vec3 direction),
+//   vec3 scene_sample_environment(SCENE_PARAM float u1, float u2, OUT(float) pdf)
+#ifndef EXITANCE_COMMON_PATH_H
+#define EXITANCE_COMMON_PATH_H
+#include "exitance/common/distribution.h"
+#include "exitance/common/gpu_layout.h"
+#include "exitance/common/punctual_light.h"
+#include "exitance/common/ray_offset.h"
+#include "exitance/common/rng.h"
+#include "exitance/common/sampling.h"
+EXITANCE_NAMESPACE_BEGIN
+
+struct SurfacePoint {
+  vec3 position;
+  vec3 geometric_normal;  // unit, on the side the path arrived from
+  vec3 shading_normal;    // unit, same hemisphere as geometric_normal
+};
+
+struct PathLimits {
+  int max_bounces;  // diffuse bounces after the first hit; -1 = until Russian roulette
+  int rr_start;     // first bounce at which roulette may end a path
+  int safety_cap;   // bounces never exceeded whatever roulette says
+};
+
+// ---- Sampling-strategy hook: the continuation direction at a surface vertex ----
+// kStrategyCosine is the only strategy today; guided distributions add theirs here, and because
+// next-event estimation weighs its samples with continuation_pdf, its MIS stays right for them.
+const uint kStrategyCosine = 0u;
+
+struct DirectionSample {
+  vec3 direction;
+  float pdf;  // solid-angle density; 0: no usable direction, the path ends
+};
+
+EXITANCE_FN float continuation_pdf(uint strategy, SurfacePoint x, vec3 wi) {
+  return max(dot(x.shading_normal, wi), 0.0f) * kInvPi;
+}
+
+// Draws u1 then u2. A direction under the geometric surface would leave through the back: none.
+EXITANCE_FN DirectionSample sample_continuation(uint strategy, SurfacePoint x, INOUT(Pcg32) rng) {
+  float u1 = pcg_uniform(rng);
+  float u2 = pcg_uniform(rng);
+  vec3 local = sample_cosine_hemisphere(u1, u2);
+  DirectionSample s;
+  s.direction = to_world(local, x.shading_normal);
+  s.pdf = local.z * kInvPi;
+  if (!(dot(s.direction, x.geometric_normal) > 0.0f) || local.z <= 0.0f) s.pdf = 0.0f;
+  return s;
+}
+
+// ---- Next-event estimation ----
+EXITANCE_FN ShadowRay no_shadow_ray() {
+  ShadowRay r;
+  r.direction_length = vec4(0.0f, 0.0f, 0.0f, 0.0f);
+  r.contribution_state = vec4(0.0f, 0.0f, 0.0f, kShadowNone);
+  return r;
+}
+
+EXITANCE_FN vec3 triangle_vertex0(GpuTriangle t) { return vec3(t.p0_material.x, t.p0_material.y, t.p0_material.z); }
+EXITANCE_FN vec3 triangle_vertex1(GpuTriangle t) { return vec3(t.p1_area_pdf.x, t.p1_area_pdf.y, t.p1_area_pdf.z); }
+EXITANCE_FN vec3 triangle_vertex2(GpuTriangle t) { return vec3(t.p2_instance.x, t.p2_instance.y, t.p2_instance.z); }
+EXITANCE_FN uint triangle_material(GpuTriangle t) { return floatBitsToUint(t.p0_material.w); }
+EXITANCE_FN vec3 triangle_geometric_normal(GpuTriangle t) {
+  vec3 p0 = triangle_vertex0(t);
+  return normalize(cross(triangle_vertex1(t) - p0, triangle_vertex2(t) - p0));
+}
+EXITANCE_FN bool material_double_sided(GpuMaterial m) { return m.albedo_double_sided.w != 0.0f; }
+
+// One sample of each light strategy at x: (1/pi) * integral of direct radiance * cos, as shadow rays.
+// Random numbers, in order: area light (choice, u1, u2), punctual light (choice), environment (u1, u2);
+// each only when the scene has lights of that kind.
+EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, vec3 throughput, uint strategy,
+                                       INOUT(Pcg32) rng, OUT_ARRAY(ShadowRay, rays, 3)) {
+  rays[0] = no_shadow_ray();
+  rays[1] = no_shadow_ray();
+  rays[2] = no_shadow_ray();
+  uint emitters = scene_emitter_count(SCENE_ALONE_ARG);
+  if (emitters > 0u) {
+    float u_choose = pcg_uniform(rng);
+    float u1 = pcg_uniform(rng);
+    float u2 = pcg_uniform(rng);
+    float pmf;
+    uint tri = scene_emitter_triangle(SCENE_ARG sample_cdf(scene_emitter_cdf(SCENE_ALONE_ARG), emitters, u_choose, pmf));
+    GpuTriangle t = scene_triangle(SCENE_ARG tri);
+    vec2 bary = sample_triangle_barycentrics(u1, u2);
+    vec3 p0 = triangle_vertex0(t);
+    vec3 p1 = triangle_vertex1(t);
+    vec3 p2 = triangle_vertex2(t);
+    vec3 light_position = p0 * (1.0f - bary.x - bary.y) + p1 * bary.x + p2 * bary.y;
+    vec3 light_normal = normalize(cross(p1 - p0, p2 - p0));
+    float pdf_area = t.p1_area_pdf.w;
+    vec3 to_light = light_position - x.position;
+    float distance2 = dot(to_light, to_light);
+    float distance = sqrt(distance2);
+    if (distance > 0.0f) {
+      vec3 wi = to_light / distance;
+      float cos_x = dot(x.shading_normal, wi);
+      float cos_l = -dot(light_normal, wi);
+      if (material_double_sided(scene_material(SCENE_ARG triangle_material(t)))) cos_l = abs(cos_l);
+      if (cos_x > 0.0f && dot(x.geometric_normal, wi) > 0.0f && cos_l > 0.0f) {
+        vec3 toward_x = dot(light_normal, wi) < 0.0f ? light_normal : -light_normal;
+        vec3 target = offset_ray_origin(light_position, toward_x, scene_extent(SCENE_ALONE_ARG));
+        vec3 span = target - origin;
+        float span_length = length(span);
+        if (span_length > 0.0f) {
+          float pdf_light = pdf_area * distance2 / cos_l;
+          float weight = power_heuristic(pdf_light, continuation_pdf(strategy, x, wi));
+          vec3 le = scene_emission(SCENE_ARG tri, bary.x, bary.y);
+          rays[0].direction_length = vec4(span / span_length, span_length);
+          rays[0].contribution_state = vec4(throughput * (le * (cos_x * kInvPi * weight / pdf_light)), kShadowTrace);
+        } else {
+          rays[0].contribution_state = vec4(0.0f, 0.0f, 0.0f, kShadowCountOnly);
+        }
+      }
+    }
+  }
+  uint punctual = scene_punctual_count(SCENE_ALONE_ARG);
+  if (punctual > 0u) {
+    float u_choose = pcg_uniform(rng);
+    float probability;
+    GpuPunctualLight light = scene_punctual_light(SCENE_ARG sample_cdf(scene_punctual_cdf(SCENE_ALONE_ARG), punctual, u_choose, probability));
+    uint type = floatBitsToUint(light.position_type.w);
+    vec3 direction = vec3(light.direction_cos_inner.x, light.direction_cos_inner.y, light.direction_cos_inner.z);
+    vec3 wi;
+    float distance = uintBitsToFloat(0x7F800000u);
+    float falloff = 1.0f;
+    if (type == kPunctualDirectional) {
+      wi = -direction;
+    } else {
+      vec3 to_light = vec3(light.position_type.x, light.position_type.y, light.position_type.z) - x.position;
+      distance = length(to_light);
+      wi = to_light / distance;
+      falloff = 1.0f / (distance * distance);
+      if (type == kPunctualSpot)
+        falloff *= spot_attenuation(direction, light.direction_cos_inner.w, light.intensity_cos_outer.w, -wi);
+    }
+    float cos_x = dot(x.shading_normal, wi);
+    if (distance > 0.0f && falloff > 0.0f && cos_x > 0.0f && dot(x.geometric_normal, wi) > 0.0f && probability > 0.0f) {
+      vec3 intensity = vec3(light.intensity_cos_outer.x, light.intensity_cos_outer.y, light.intensity_cos_outer.z);
+      rays[1].direction_length = vec4(wi, distance);
+      rays[1].contribution_state = vec4(throughput * (intensity * (falloff * cos_x * kInvPi / probability)), kShadowTrace);
+    }
+  }
+  if (scene_has_environment(SCENE_ALONE_ARG)) {
+    float u1 = pcg_uniform(rng);
+    float u2 = pcg_uniform(rng);
+    float pdf_env;
+    vec3 wi = scene_sample_environment(SCENE_ARG u1, u2, pdf_env);
+    float cos_x = dot(x.shading_normal, wi);
+    if (pdf_env > 0.0f && cos_x > 0.0f && dot(x.geometric_normal, wi) > 0.0f) {
+      float weight = power_heuristic(pdf_env, continuation_pdf(strategy, x, wi));
+      rays[2].direction_length = vec4(wi, uintBitsToFloat(0x7F800000u));
+      rays[2].contribution_state =
+          vec4(throughput * (scene_sky_radiance(SCENE_ARG wi) * (cos_x * kInvPi * weight / pdf_env)), kShadowTrace);
+    }
+  }
+}
+
+// ---- Continuation hits ----
+// The sky seen by a continuation ray that escapes, MIS-weighted against environment sampling.
+EXITANCE_FN vec3 escaped_radiance(SCENE_PARAM vec3 wi, float pdf_continuation) {
+  float weight = 1.0f;
+  if (scene_has_environment(SCENE_ALONE_ARG)) weight = power_heuristic(pdf_continuation, scene_environment_pdf(SCENE_ARG wi));
+  return scene_sky_radiance(SCENE_ARG wi) * weight;
+}
+
+// The surface point at barycentrics (b1, b2) of triangle t, seen from the side `front` says.
+// Shading normals that face away from the geometric side would sample into the surface: replaced.
+EXITANCE_FN SurfacePoint surface_point_on_triangle(GpuTriangle t, float b1, float b2, bool front) {
+  SurfacePoint x;
+  vec3 ng = triangle_geometric_normal(t);
+  x.geometric_normal = front ? ng : -ng;
+  float b0 = 1.0f - b1 - b2;
+  x.position = triangle_vertex0(t) * b0 + triangle_vertex1(t) * b1 + triangle_vertex2(t) * b2;
+  vec3 nv = vec3(t.n0.x, t.n0.y, t.n0.z) * b0 + vec3(t.n1.x, t.n1.y, t.n1.z) * b1 + vec3(t.n2.x, t.n2.y, t.n2.z) * b2;
+  float len = length(nv);
+  vec3 n = len > 0.0f ? nv / len : vec3(0.0f);
+  if (!front) n = -n;
+  x.shading_normal = dot(n, x.geometric_normal) > 0.05f ? n : x.geometric_normal;
+  return x;
+}
+
+// What a continuation ray that hit triangle `tri` at distance t adds, and whether the path goes on.
+struct HitResult {
+  vec3 radiance;     // emitted radiance x MIS weight x throughput, to add at this vertex's bounce
+  bool continues;
+  vec3 throughput;   // of the continuing path (albedo and roulette applied)
+  SurfacePoint next; // the new vertex (when continuing)
+};
+
+// `bounce`: the bounce of the vertex the ray left (0 = the texel). Draws one random number when
+// Russian roulette is played.
+EXITANCE_FN HitResult shade_continuation_hit(SCENE_PARAM uint tri, float t_hit, float b1, float b2, vec3 wi,
+                                             float pdf_continuation, vec3 throughput, int bounce, PathLimits limits,
+                                             INOUT(Pcg32) rng) {
+  HitResult h;
+  h.radiance = vec3(0.0f);
+  h.continues = false;
+  h.throughput = throughput;
+  GpuTriangle t = scene_triangle(SCENE_ARG tri);
+  GpuMaterial m = scene_material(SCENE_ARG triangle_material(t));
+  bool double_sided = material_double_sided(m);
+  vec3 ng = triangle_geometric_normal(t);
+  bool front = dot(wi, ng) < 0.0f;
+  if (front || double_sided) {
+    vec3 le = scene_emission(SCENE_ARG tri, b1, b2);
+    if (max_component(le) > 0.0f) {
+      float cos_l = abs(dot(wi, ng));
+      float pdf_light = t.p1_area_pdf.w * t_hit * t_hit / cos_l;
+      h.radiance = throughput * le * power_heuristic(pdf_continuation, pdf_light);
+    }
+  }
+  // Back faces of single-sided surfaces absorb (glTF culls them; light cannot leave through them).
+  if (!front && !double_sided) return h;
+  if (limits.max_bounces >= 0 && bounce + 1 > limits.max_bounces) return h;
+  if (bounce + 1 >= limits.safety_cap) return h;
+  h.throughput = throughput * scene_albedo(SCENE_ARG tri, b1, b2);
+  if (bounce + 1 >= limits.rr_start) {
+    float survive = min(1.0f, max_component(h.throughput));
+    if (!(survive > 0.0f)) return h;
+    float u = pcg_uniform(rng);
+    if (u >= survive) return h;
+    h.throughput = h.throughput / survive;
+  } else if (max_component(h.throughput) <= 0.0f) {
+    return h;
+  }
+  h.continues = true;
+  h.next = surface_point_on_triangle(t, b1, b2, front);
+  return h;
+}
+
+// ---- Light probes ----
+// Probe sample `sample` of `spp` (0xFFFFFFFF: unbounded) at probe `probe`: its stratified sphere
+// direction, drawn from Pcg32(seed, kProbeRngStreamBase + probe, sample), u1 then u2; the generator
+// is left positioned for the path that continues from the ray's hit.
+EXITANCE_FN vec3 probe_ray_direction(uint sample_index, uint spp, INOUT(Pcg32) rng) {
+  float u1 = pcg_uniform(rng);
+  float u2 = pcg_uniform(rng);
+  uint set_begin = sample_index - sample_index % kProbeStratifiedSetSize;
+  uint set_count = min(kProbeStratifiedSetSize, spp - set_begin);
+  return probe_direction(sample_index - set_begin, set_count, u1, u2);
+}
+
+// What a probe ray meets: a probe is no surface, so there is no next-event estimation at it and the
+// emission it sees counts at full weight; the back face of a single-sided surface gives 0 and is
+// reported. The hit's albedo multiplies the texel estimator started at `next` (bounces counted from it).
+struct ProbeHit {
+  vec3 radiance;   // emission seen (0 on a back face)
+  vec3 albedo;     // of the hit; the path continues only when it is > 0
+  bool back_face;
+  bool continues;
+  SurfacePoint next;
+};
+
+EXITANCE_FN ProbeHit shade_probe_hit(SCENE_PARAM uint tri, float b1, float b2, vec3 wi) {
+  ProbeHit h;
+  h.radiance = vec3(0.0f);
+  h.albedo = vec3(0.0f);
+  h.continues = false;
+  GpuTriangle t = scene_triangle(SCENE_ARG tri);
+  GpuMaterial m = scene_material(SCENE_ARG triangle_material(t));
+  vec3 ng = triangle_geometric_normal(t);
+  bool front = dot(wi, ng) < 0.0f;
+  h.back_face = !front && !material_double_sided(m);
+  if (h.back_face) return h;
+  h.radiance = scene_emission(SCENE_ARG tri, b1, b2);
+  h.albedo = scene_albedo(SCENE_ARG tri, b1, b2);
+  h.continues = max_component(h.albedo) > 0.0f;
+  h.next = surface_point_on_triangle(t, b1, b2, front);
+  return h;
+}
+
+EXITANCE_NAMESPACE_END
+#endif

@@ -1,0 +1,66 @@
+// What integrators return: sums of per-sample estimates, from which means and standard errors follow.
+// Every backend fills the same types, so tests compare them directly.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "exitance/common/gpu_layout.h"
+#include "exitance/runtime/spherical_harmonics.h"
+#include "exitance/runtime/vec_math.h"
+
+namespace exitance {
+
+struct TexelAccumulator {
+  double total[3] = {0, 0, 0};
+  double total_squared[3] = {0, 0, 0};
+  double direct[3] = {0, 0, 0};
+  uint32_t samples = 0;
+};
+
+struct LightmapEstimate {
+  std::vector<TexelAccumulator> texels;
+  std::vector<double> bounces;  // [bounce][texel][rgb] flattened: (k * texel_count + i) * 3 + c
+  int recorded_bounces = 0;
+  uint64_t rays = 0;
+  double seconds = 0;
+  uint64_t nonfinite_samples = 0;  // samples discarded because they were NaN/Inf (should stay 0)
+
+  Vec3 mean_total(size_t texel) const;
+  Vec3 mean_direct(size_t texel) const;
+  Vec3 mean_bounce(int bounce, size_t texel) const;
+  // Variance of the mean (standard error squared) of the total, per channel.
+  Vec3 variance_of_mean(size_t texel) const;
+  // The target-error test of --target-error: relative standard error of the luminance below `target`.
+  bool relative_error_below(size_t texel, double target) const;
+};
+
+
+// Light probes: per probe, `spp` rays in uniform sphere directions, stratified in sets of
+// kProbeStratifiedSetSize consecutive samples (path.h probe_ray_direction; random numbers
+// pcg_init(seed, kProbeRngStreamBase + probe, s), u1 then u2 drawn first). Each ray's incident
+// radiance L(w) is: the sky on a miss; on a front face (or a double-sided one) Le at the hit, at full
+// weight (a probe is no surface: there is no next-event estimation at it, so nothing to MIS with),
+// plus albedo times one path sample of E/pi at the hit, exactly the lightmap texel estimator started
+// there (same bounce limits, counted from the hit); 0 on the back face of a single-sided surface.
+// Projected to L2 SH with weight 4*pi/spp.
+
+struct ProbeEstimate {
+  // Per probe: sum over samples of L(w) * Y_i(w) * 4pi at [i * 3 + c] (divide by samples).
+  std::vector<std::array<double, 27>> sh_sum;
+  // Per probe, CPU reference only (empty elsewhere): sum over samples of L(w) * max(0, w . a) * 4
+  // for the six axes a = +x, -x, +y, -y, +z, -z at [axis * 3 + c]; divided by samples it is an
+  // unbiased E/pi for those normals (an ambient cube), free of SH truncation, which tests use to
+  // check the probe radiance itself and to measure the L2 approximation.
+  std::vector<std::array<double, 18>> axis_irradiance_sum;
+  std::vector<uint32_t> samples;         // per probe
+  std::vector<uint32_t> backface_hits;   // per probe: rays that hit the back of a single-sided surface
+  uint64_t rays = 0;
+  double seconds = 0;
+  uint64_t nonfinite_samples = 0;
+
+  ShRgb mean(size_t probe) const;  // SH coefficients of incident radiance
+  Vec3 mean_axis_irradiance_over_pi(size_t probe, int axis) const;  // axis 0..5 as above; 0 when absent
+};
+
+}  // namespace exitance

@@ -1,0 +1,42 @@
+// The scene as every lighting backend reads it, built once by the offline stage (or from scene.bin)
+// and handed to the backends: triangles, materials and lights in the GPU layout
+// (runtime/common/.../gpu_layout.h), the light-selection CDFs, the BVH, and the source Scene for
+// names, instances and what only the CPU reference evaluates today (textures, environment maps).
+#pragma once
+#include <memory>
+#include <vector>
+
+#include "exitance/common/gpu_layout.h"
+#include "exitance/runtime/core/bvh4.h"
+#include "exitance/runtime/environment_sampler.h"
+#include "exitance/runtime/scene.h"
+
+namespace exitance {
+
+struct LightingScene {
+  std::shared_ptr<const Scene> source;
+  std::vector<GpuTriangle> triangles;        // one per scene triangle
+  std::vector<GpuMaterial> materials;        // constant factors (textures: source, CPU only)
+  std::vector<GpuPunctualLight> punctual_lights;
+  std::vector<uint32_t> emitter_triangles;   // emissive triangles NEE picks from, by power
+  std::vector<double> emitter_cdf;           // emitter_triangles.size() + 1 entries (at least 2)
+  std::vector<double> punctual_cdf;          // punctual_lights.size() + 1 entries (at least 2), by power
+  Vec3 sky{0, 0, 0};                         // constant sky radiance (when there is no environment map)
+  EnvironmentSampler environment;            // enabled when the sky is an image (CPU reference only)
+  Vec3 bounds_lo{0, 0, 0}, bounds_hi{0, 0, 0};
+  float extent = 1.0f;                       // largest side of the bounds: the scale of ray-offset floors
+  bool textured = false;                     // some material reads a texture (CPU reference only)
+  Bvh4 bvh;
+
+  uint32_t emitter_count() const { return uint32_t(emitter_triangles.size()); }
+  uint32_t punctual_count() const { return uint32_t(punctual_lights.size()); }
+};
+
+// Derives the GPU-layout records and light distributions from `scene` and takes the BVH built over
+// it. Emitters are chosen by power (area x luminance of the mean emission, x2 when double sided),
+// punctual lights by power (point 4 pi I, spot 2 pi (1 - cos_outer) I, directional pi r^2 E over the
+// scene's bounding sphere). An empty BVH is allowed (the CPU reference traces with Embree's own);
+// throws std::invalid_argument when the BVH references a triangle the scene does not have.
+LightingScene build_lighting_scene(std::shared_ptr<const Scene> scene, Bvh4 bvh);
+
+}  // namespace exitance

@@ -1,0 +1,46 @@
+// How a bake is cut into passes of samples, shared by every integrator and backend: the sample cap
+// (spp), the time budget, a target error, and progress reports all live here once.
+#pragma once
+#include <chrono>
+#include <cstdint>
+
+#include "exitance/runtime/core/integrator_settings.h"
+
+namespace exitance {
+
+struct PassPolicy {
+  // Most samples per item in one pass (a backend's preference: memory, submission length).
+  uint32_t largest_pass = 0xFFFFFFFFu;
+  // Passes of 1 sample, then 4 (from 4 samples), then 16 (from 64): early progress, and a time
+  // budget or target error honoured at fine grain.
+  bool ramp = false;
+  // > 0: when a budget may stop the run, passes end on multiples of this and the budget is checked
+  // only there (probes: a stopped run never leaves a stratified set's strata out).
+  uint32_t stratified_set = 0;
+};
+
+class PassScheduler {
+ public:
+  PassScheduler(const IntegratorSettings& settings, PassPolicy policy);
+
+  // The next pass's samples [begin, begin + count); false when the bake is done.
+  bool next_pass(uint32_t& begin, uint32_t& count);
+  // Reports the pass just run (progress callback) and decides whether the bake stops here: at the
+  // sample cap, at the time budget, or when `all_converged` (the integrator's target-error test).
+  void finish_pass(uint64_t rays_so_far, bool all_converged = false);
+
+  uint32_t samples_done() const { return done_; }
+  double elapsed_seconds() const;
+  bool timed() const { return settings_.time_budget_seconds > 0; }
+
+ private:
+  const IntegratorSettings& settings_;
+  PassPolicy policy_;
+  uint32_t limit_;
+  uint32_t done_ = 0;
+  uint32_t pending_ = 0;  // samples of the pass handed out by next_pass
+  bool stopped_ = false;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace exitance

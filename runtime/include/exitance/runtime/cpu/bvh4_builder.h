@@ -1,0 +1,12 @@
+// The offline stage's BVH4 for every backend (core/bvh4.h): Embree's rtcBuildBVH (SAH, up to 4
+// triangles per leaf) with our node callbacks, flattened depth-first. Triangles with non-finite
+// vertices are left out (Embree's own scene never hits them either).
+#pragma once
+#include "exitance/runtime/core/bvh4.h"
+#include "exitance/runtime/scene.h"
+
+namespace exitance {
+
+Bvh4 build_bvh4(const Scene& scene);
+
+}  // namespace exitance

@@ -1,0 +1,41 @@
+#include "exitance/runtime/core/pass_scheduler.h"
+
+#include <algorithm>
+
+namespace exitance {
+
+PassScheduler::PassScheduler(const IntegratorSettings& settings, PassPolicy policy)
+    : settings_(settings), policy_(policy), limit_(settings.spp == 0 ? 0xFFFFFFFFu : settings.spp) {
+  policy_.largest_pass = std::max(policy_.largest_pass, 1u);
+}
+
+bool PassScheduler::next_pass(uint32_t& begin, uint32_t& count) {
+  if (stopped_ || done_ >= limit_) return false;
+  uint32_t pass = std::min(limit_ - done_, policy_.largest_pass);
+  if (policy_.ramp) pass = std::min(pass, done_ < 4 ? 1u : (done_ < 64 ? 4u : 16u));
+  if (policy_.stratified_set > 0 && timed())
+    pass = std::min(pass, policy_.stratified_set - done_ % policy_.stratified_set);
+  begin = done_;
+  count = pending_ = pass;
+  return true;
+}
+
+double PassScheduler::elapsed_seconds() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+void PassScheduler::finish_pass(uint64_t rays_so_far, bool all_converged) {
+  done_ += pending_;
+  pending_ = 0;
+  const double elapsed = elapsed_seconds();
+  if (settings_.progress) {
+    const double by_spp = settings_.spp ? double(done_) / double(settings_.spp) : 0.0;
+    const double by_time = timed() ? elapsed / settings_.time_budget_seconds : 0.0;
+    settings_.progress(std::min(1.0, std::max(by_spp, by_time)), rays_so_far);
+  }
+  const bool at_set_end = policy_.stratified_set == 0 || done_ % policy_.stratified_set == 0;
+  if (timed() && at_set_end && elapsed >= settings_.time_budget_seconds) stopped_ = true;
+  if (all_converged) stopped_ = true;
+}
+
+}  // namespace exitance

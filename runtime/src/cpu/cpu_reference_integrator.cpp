@@ -1,0 +1,235 @@
+// The CPU reference: path.h's estimator with every ray traced at once by Embree, one sample after
+// another per texel or probe, in parallel over texels with TBB.
+#include "exitance/runtime/cpu_reference_integrator.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "exitance/runtime/core/pass_scheduler.h"
+#include "exitance/runtime/core/scene_access.h"
+#include "exitance/runtime/embree_scene.h"
+
+namespace exitance {
+namespace {
+
+constexpr int kMaxRecordedBounces = 16;
+
+// Per-sample contributions to E/pi, split by the number of diffuse reflections between the
+// light and the texel (0 = direct).
+struct PathContributions {
+  Vec3 by_bounce[kMaxRecordedBounces + 1];  // the last slot gathers every deeper bounce
+  int recorded = 0;
+  void add(int bounce, Vec3 value) { by_bounce[std::min(bounce, recorded)] += value; }
+  Vec3 total() const {
+    Vec3 sum{0, 0, 0};
+    for (int k = 0; k <= recorded; ++k) sum += by_bounce[k];
+    return sum;
+  }
+};
+
+}  // namespace
+
+struct CpuReferenceIntegrator::Impl {
+  std::shared_ptr<const LightingScene> lighting;
+  std::shared_ptr<const EmbreeScene> embree;
+
+  const LightingScene& scene() const { return *lighting; }
+
+  // Traces the shadow rays of one vertex; returns what the unoccluded ones carry.
+  Vec3 connect(const ShadowRay (&rays)[3], Vec3 origin, uint64_t& traced) const {
+    Vec3 sum{0, 0, 0};
+    for (const ShadowRay& r : rays) {
+      const float state = r.contribution_state.w;
+      if (state == kShadowNone) continue;
+      ++traced;
+      if (state != kShadowTrace) continue;
+      const Vec3 d{r.direction_length.x, r.direction_length.y, r.direction_length.z};
+      if (!embree->occluded(origin, d, r.direction_length.w))
+        sum += Vec3{r.contribution_state.x, r.contribution_state.y, r.contribution_state.z};
+    }
+    return sum;
+  }
+
+  // One path sample of E/pi at x; `first_bounce` is the bounce x stands for (0 at a texel).
+  void trace(SurfacePoint x, const IntegratorSettings& settings, Pcg32& rng, PathContributions& out,
+             uint64_t& rays) const {
+    const LightingScene& s = scene();
+    const PathLimits limits{settings.max_bounces, settings.russian_roulette_start, settings.safety_bounce_cap};
+    Vec3 throughput{1, 1, 1};
+    for (int bounce = 0;; ++bounce) {
+      const Vec3 origin = offset_ray_origin(x.position, x.geometric_normal, s.extent);
+      ShadowRay shadow[kShadowRaysPerVertex];
+      next_event_estimation(s, x, origin, throughput, settings.sampling_strategy, rng, shadow);
+      out.add(bounce, connect(shadow, origin, rays));
+      const DirectionSample d = sample_continuation(settings.sampling_strategy, x, rng);
+      if (!(d.pdf > 0)) return;
+      ++rays;
+      const Hit hit = embree->intersect(origin, d.direction, INFINITY);
+      if (!hit.found) {
+        out.add(bounce, throughput * escaped_radiance(s, d.direction, d.pdf));
+        return;
+      }
+      const HitResult h = shade_continuation_hit(s, hit.triangle, hit.distance, hit.b1, hit.b2, d.direction, d.pdf,
+                                                 throughput, bounce, limits, rng);
+      out.add(bounce, h.radiance);
+      if (!h.continues) return;
+      throughput = h.throughput;
+      x = h.next;
+    }
+  }
+
+  // Incident radiance at `origin` from direction -`direction` (see ProbeEstimate).
+  Vec3 radiance_along_ray(Vec3 origin, Vec3 direction, const IntegratorSettings& settings, Pcg32& rng,
+                          uint64_t& rays, bool& backface) const {
+    backface = false;
+    ++rays;
+    const Hit hit = embree->intersect(origin, direction, INFINITY);
+    if (!hit.found) return scene_sky_radiance(scene(), direction);
+    const ProbeHit h = shade_probe_hit(scene(), hit.triangle, hit.b1, hit.b2, direction);
+    backface = h.back_face;
+    if (!h.continues) return h.radiance;
+    PathContributions contributions;
+    contributions.recorded = 0;
+    trace(h.next, settings, rng, contributions, rays);
+    return h.radiance + h.albedo * contributions.total();
+  }
+};
+
+CpuReferenceIntegrator::CpuReferenceIntegrator(std::shared_ptr<const LightingScene> scene,
+                                               std::shared_ptr<const EmbreeScene> embree)
+    : impl_(new Impl{std::move(scene), std::move(embree)}) {}
+
+CpuReferenceIntegrator::CpuReferenceIntegrator(const Scene& scene) : impl_(new Impl) {
+  auto source = std::make_shared<const Scene>(scene);
+  impl_->lighting = std::make_shared<const LightingScene>(build_lighting_scene(source, Bvh4{}));
+  impl_->embree = std::make_shared<const EmbreeScene>(*source);
+}
+
+CpuReferenceIntegrator::~CpuReferenceIntegrator() { delete impl_; }
+
+std::string CpuReferenceIntegrator::device_description() const {
+  return "Embree 3 CPU reference on " + std::to_string(tbb::info::default_concurrency()) + " threads";
+}
+
+LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const {
+  const auto start = std::chrono::steady_clock::now();
+  const size_t texel_count = gbuffer.texels.size();
+  LightmapEstimate estimate;
+  estimate.recorded_bounces = std::clamp(settings.recorded_bounces, 1, kMaxRecordedBounces);
+  estimate.texels.resize(texel_count);
+  estimate.bounces.assign(size_t(estimate.recorded_bounces) * texel_count * 3, 0.0);
+  std::vector<uint8_t> converged(texel_count, 0);
+  tbb::combinable<uint64_t> rays_per_thread([] { return uint64_t(0); });
+  tbb::combinable<uint64_t> nonfinite_per_thread([] { return uint64_t(0); });
+
+  PassPolicy policy;
+  policy.ramp = true;  // small passes early so progress and the time budget are honoured; larger later
+  PassScheduler passes(settings, policy);
+  uint32_t first = 0, count = 0;
+  while (passes.next_pass(first, count)) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, texel_count, 64), [&](const tbb::blocked_range<size_t>& range) {
+      uint64_t& rays = rays_per_thread.local();
+      uint64_t& nonfinite = nonfinite_per_thread.local();
+      PathContributions contributions;
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        if (converged[i]) continue;
+        const LiveTexel& texel = gbuffer.texels[i];
+        const SurfacePoint point{texel.position, texel.geometric_normal, texel.shading_normal};
+        TexelAccumulator& acc = estimate.texels[i];
+        for (uint32_t s = first; s < first + count; ++s) {
+          Pcg32 rng = pcg_init(settings.seed, i, s);
+          contributions = PathContributions{};
+          contributions.recorded = estimate.recorded_bounces;
+          impl_->trace(point, settings, rng, contributions, rays);
+          const Vec3 total = contributions.total();
+          if (!is_finite(total)) {
+            ++nonfinite;
+            continue;  // counted and reported; an unbiased estimator never produces these
+          }
+          for (int c = 0; c < 3; ++c) {
+            acc.total[c] += total[c];
+            acc.total_squared[c] += double(total[c]) * double(total[c]);
+            acc.direct[c] += contributions.by_bounce[0][c];
+          }
+          for (int k = 0; k < estimate.recorded_bounces; ++k)
+            for (int c = 0; c < 3; ++c)
+              estimate.bounces[(size_t(k) * texel_count + i) * 3 + size_t(c)] += contributions.by_bounce[k][c];
+          ++acc.samples;
+        }
+        if (settings.target_relative_error > 0 && acc.samples >= 16 &&
+            estimate.relative_error_below(i, settings.target_relative_error))
+          converged[i] = 1;
+      }
+    });
+    const bool all_converged = settings.target_relative_error > 0 &&
+                               std::all_of(converged.begin(), converged.end(), [](uint8_t c) { return c != 0; });
+    passes.finish_pass(rays_per_thread.combine(std::plus<uint64_t>()), all_converged);
+  }
+  estimate.rays = rays_per_thread.combine(std::plus<uint64_t>());
+  estimate.nonfinite_samples = nonfinite_per_thread.combine(std::plus<uint64_t>());
+  estimate.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return estimate;
+}
+
+ProbeEstimate CpuReferenceIntegrator::bake_probes(const std::vector<Vec3>& positions,
+                                                  const IntegratorSettings& settings) const {
+  const auto start = std::chrono::steady_clock::now();
+  const size_t probe_count = positions.size();
+  ProbeEstimate estimate;
+  estimate.sh_sum.assign(probe_count, std::array<double, 27>{});
+  estimate.axis_irradiance_sum.assign(probe_count, std::array<double, 18>{});
+  estimate.samples.assign(probe_count, 0);
+  estimate.backface_hits.assign(probe_count, 0);
+  tbb::combinable<uint64_t> rays_per_thread([] { return uint64_t(0); });
+  tbb::combinable<uint64_t> nonfinite_per_thread([] { return uint64_t(0); });
+  const uint32_t spp = settings.spp == 0 ? 0xFFFFFFFFu : settings.spp;
+  PassPolicy policy;
+  // One complete stratified set per pass, so stopping on the time budget never leaves strata out.
+  policy.largest_pass = kProbeStratifiedSetSize;
+  policy.stratified_set = kProbeStratifiedSetSize;
+  PassScheduler passes(settings, policy);
+  uint32_t first = 0, count = 0;
+  while (passes.next_pass(first, count)) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, probe_count, 1), [&](const tbb::blocked_range<size_t>& range) {
+      uint64_t& rays = rays_per_thread.local();
+      uint64_t& nonfinite = nonfinite_per_thread.local();
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        for (uint32_t s = first; s < first + count; ++s) {
+          Pcg32 rng = pcg_init(settings.seed, kProbeRngStreamBase + i, s);
+          const Vec3 direction = probe_ray_direction(s, spp, rng);
+          bool backface = false;
+          const Vec3 radiance = impl_->radiance_along_ray(positions[i], direction, settings, rng, rays, backface);
+          if (backface) ++estimate.backface_hits[i];
+          if (!is_finite(radiance)) {
+            ++nonfinite;
+            continue;
+          }
+          const ShBasis y = sh_basis(direction);
+          for (int k = 0; k < kShCoefficients; ++k)
+            for (int c = 0; c < 3; ++c)
+              estimate.sh_sum[i][size_t(k) * 3 + size_t(c)] += double(radiance[c]) * double(y[k]) * double(kShSphereMeasure);
+          for (int axis = 0; axis < 6; ++axis) {
+            const float cosine = (axis % 2 ? -1.0f : 1.0f) * direction[axis / 2];
+            if (cosine <= 0) continue;
+            for (int c = 0; c < 3; ++c)
+              estimate.axis_irradiance_sum[i][size_t(axis) * 3 + size_t(c)] += double(radiance[c]) * cosine * 4.0;
+          }
+          ++estimate.samples[i];
+        }
+      }
+    });
+    passes.finish_pass(rays_per_thread.combine(std::plus<uint64_t>()));
+  }
+  estimate.rays = rays_per_thread.combine(std::plus<uint64_t>());
+  estimate.nonfinite_samples = nonfinite_per_thread.combine(std::plus<uint64_t>());
+  estimate.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return estimate;
+}
+
+}  // namespace exitance
