@@ -29,7 +29,7 @@ layout(std430, set = 0, binding = kBindingPathThroughput) buffer PathThroughputB
 layout(std430, set = 0, binding = kBindingPathRayOrigin) buffer PathRayOriginBuffer { vec4 path_ray_o[]; };
 layout(std430, set = 0, binding = kBindingPathRayDirection) buffer PathRayDirBuffer { vec4 path_ray_d[]; };
 layout(std430, set = 0, binding = kBindingPathHit) buffer PathHitBuffer { vec4 path_hit[]; };  // t, triangle bits, b1, b2
-layout(std430, set = 0, binding = kBindingShadowRays) buffer ShadowBuffer { ShadowRay shadow_rays[]; };  // kShadowRaysPerVertex per path
+layout(std430, set = 0, binding = kBindingShadowRays) buffer ShadowBuffer { ShadowRay shadow_rays[]; };  // kShadowSlotsPerPath per path
 layout(std430, set = 0, binding = kBindingRayQueue) buffer RayQueueBuffer { uint ray_queue[]; };  // 2 x P (ping-pong)
 layout(std430, set = 0, binding = kBindingShadowQueue) buffer ShadowQueueBuffer { uint shadow_queue[]; };  // P
 layout(std430, set = 0, binding = kBindingResults) buffer ResultBuffer { float results[]; };  // [work][slot 0..K][rgb]

@@ -1,7 +1,12 @@
 // The scene accessors of runtime/common/.../path.h over the descriptor set (C++ twin of the
 // interface, over a LightingScene: runtime/include/exitance/runtime/core/scene_access.h). Constant
 // material factors only; the host refuses textured materials and environment-map skies.
-GpuTriangle scene_triangle(uint t) { return triangles[t]; }
+vec3 scene_triangle_vertex(uint t, uint k) {
+  return k == 0u ? triangles[t].p0_material.xyz : (k == 1u ? triangles[t].p1_area_pdf.xyz : triangles[t].p2_instance.xyz);
+}
+vec3 scene_triangle_normal(uint t, uint k) { return k == 0u ? triangles[t].n0.xyz : (k == 1u ? triangles[t].n1.xyz : triangles[t].n2.xyz); }
+uint scene_triangle_material(uint t) { return floatBitsToUint(triangles[t].p0_material.w); }
+float scene_triangle_area_pdf(uint t) { return triangles[t].p1_area_pdf.w; }
 GpuMaterial scene_material(uint m) { return materials[m]; }
 GpuPunctualLight scene_punctual_light(uint i) { return punctual[i]; }
 uint scene_emitter_count() { return params.emitter_count; }
@@ -15,8 +20,8 @@ uint scene_emitter_cdf() { return kCdfEmitters; }
 uint scene_punctual_cdf() { return kCdfPunctual; }
 double cdf_at(uint cdf, uint i) { return cdf == kCdfEmitters ? emitter_cdf[i] : punctual_cdf[i]; }
 
-vec3 scene_albedo(uint t, float b1, float b2) { return materials[floatBitsToUint(triangles[t].p0_material.w)].albedo_double_sided.xyz; }
-vec3 scene_emission(uint t, float b1, float b2) { return materials[floatBitsToUint(triangles[t].p0_material.w)].emission.xyz; }
+vec3 scene_albedo(uint t, float b1, float b2) { return materials[scene_triangle_material(t)].albedo_double_sided.xyz; }
+vec3 scene_emission(uint t, float b1, float b2) { return materials[scene_triangle_material(t)].emission.xyz; }
 vec3 scene_sky_radiance(vec3 direction) { return params.sky.xyz; }
 bool scene_has_environment() { return false; }
 float scene_environment_pdf(vec3 direction) { return 0.0; }

@@ -65,7 +65,7 @@ struct CpuReferenceIntegrator::Impl {
     for (int bounce = 0;; ++bounce) {
       const Vec3 origin = offset_ray_origin(x.position, x.geometric_normal, s.extent);
       ShadowRay shadow[kShadowRaysPerVertex];
-      next_event_estimation(s, x, origin, throughput, settings.sampling_strategy, rng, shadow);
+      next_event_estimation(s, x, origin, throughput, settings.sampling_strategy, rng, shadow[0], shadow[1], shadow[2]);
       out.add(bounce, connect(shadow, origin, rays));
       const DirectionSample d = sample_continuation(settings.sampling_strategy, x, rng);
       if (!(d.pdf > 0)) return;

@@ -221,10 +221,9 @@ struct VulkanIntegrator::Impl {
     std::vector<Vec4> leaf(std::max<size_t>(scene.bvh.leaf_triangles.size(), 1) * 3);
     for (size_t slot = 0; slot < scene.bvh.leaf_triangles.size(); ++slot) {
       const uint32_t t = scene.bvh.leaf_triangles[slot];
-      const GpuTriangle& g = scene.triangles[t];
-      leaf[slot * 3] = Vec4(triangle_vertex0(g), std::bit_cast<float>(t));
-      leaf[slot * 3 + 1] = Vec4(triangle_vertex1(g), 0.0f);
-      leaf[slot * 3 + 2] = Vec4(triangle_vertex2(g), 0.0f);
+      leaf[slot * 3] = Vec4(scene_triangle_vertex(scene, t, 0), std::bit_cast<float>(t));
+      leaf[slot * 3 + 1] = Vec4(scene_triangle_vertex(scene, t, 1), 0.0f);
+      leaf[slot * 3 + 2] = Vec4(scene_triangle_vertex(scene, t, 2), 0.0f);
     }
     make_and_upload(kBindingBvhTriangles, leaf);
     make_and_upload(kBindingTriangles, at_least_one(scene.triangles));
@@ -252,7 +251,7 @@ struct VulkanIntegrator::Impl {
     make_buffer(kBindingPathRayOrigin, size_t(paths) * 16);
     make_buffer(kBindingPathRayDirection, size_t(paths) * 16);
     make_buffer(kBindingPathHit, size_t(paths) * 16);
-    make_buffer(kBindingShadowRays, size_t(paths) * kShadowRaysPerVertex * sizeof(ShadowRay));
+    make_buffer(kBindingShadowRays, size_t(paths) * kShadowSlotsPerPath * sizeof(ShadowRay));
     make_buffer(kBindingRayQueue, size_t(paths) * 8);
     make_buffer(kBindingShadowQueue, size_t(paths) * 4);
     readback = ctx->create_buffer(kCounterCount * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
@@ -260,7 +259,7 @@ struct VulkanIntegrator::Impl {
       make_buffer(b, 16);
   }
 
-  size_t path_bytes() const { return 4 + 4 + 16 + 16 + 16 + 16 + 16 + kShadowRaysPerVertex * sizeof(ShadowRay) + 8 + 4; }
+  size_t path_bytes() const { return 4 + 4 + 16 + 16 + 16 + 16 + 16 + kShadowSlotsPerPath * sizeof(ShadowRay) + 8 + 4; }
 
   // ---- command recording ----
   void barrier(VkCommandBuffer cmd) const {

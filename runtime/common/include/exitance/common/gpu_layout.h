@@ -40,6 +40,10 @@ struct GpuSurfacePoint {
 // unoccluded (path throughput included). state: kShadowNone, kShadowTrace, or kShadowCountOnly
 // (counted as a traced ray, as the reference counts it, but its segment has zero length).
 const uint kShadowRaysPerVertex = 3u;  // area light, punctual light, environment
+// The wavefront keeps the first two per path slot: the Vulkan backend refuses environment-map skies
+// until it samples them (the host checks), and a third slot cost 32 B per path and 7 % of the shade
+// stage's GPU time on the H200 (0.327 -> 0.304 s, bench/results/vulkan-gpu.md).
+const uint kShadowSlotsPerPath = 2u;
 const float kShadowNone = 0.0f;
 const float kShadowTrace = 1.0f;
 const float kShadowCountOnly = 2.0f;

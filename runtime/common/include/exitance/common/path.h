@@ -11,7 +11,9 @@
 //
 // Scene data comes through accessors the including code defines first (C++: scene_access.h over a
 // LightingScene; GLSL: shaders/include/scene_access.glsl over the descriptor set):
-//   GpuTriangle scene_triangle(SCENE_PARAM uint t)        GpuMaterial scene_material(SCENE_PARAM uint m)
+//   vec3 scene_triangle_vertex(SCENE_PARAM uint t, uint k), vec3 scene_triangle_normal(SCENE_PARAM uint t, uint k),
+//   uint scene_triangle_material(SCENE_PARAM uint t), float scene_triangle_area_pdf(SCENE_PARAM uint t)
+//   GpuMaterial scene_material(SCENE_PARAM uint m)
 //   GpuPunctualLight scene_punctual_light(SCENE_PARAM uint i)
 //   uint scene_emitter_count(SCENE_ALONE_PARAM)           uint scene_emitter_triangle(SCENE_PARAM uint i)
 //   uint scene_punctual_count(SCENE_ALONE_PARAM)          float scene_extent(SCENE_ALONE_PARAM)
@@ -76,24 +78,24 @@ EXITANCE_FN ShadowRay no_shadow_ray() {
   return r;
 }
 
-EXITANCE_FN vec3 triangle_vertex0(GpuTriangle t) { return vec3(t.p0_material.x, t.p0_material.y, t.p0_material.z); }
-EXITANCE_FN vec3 triangle_vertex1(GpuTriangle t) { return vec3(t.p1_area_pdf.x, t.p1_area_pdf.y, t.p1_area_pdf.z); }
-EXITANCE_FN vec3 triangle_vertex2(GpuTriangle t) { return vec3(t.p2_instance.x, t.p2_instance.y, t.p2_instance.z); }
-EXITANCE_FN uint triangle_material(GpuTriangle t) { return floatBitsToUint(t.p0_material.w); }
-EXITANCE_FN vec3 triangle_geometric_normal(GpuTriangle t) {
-  vec3 p0 = triangle_vertex0(t);
-  return normalize(cross(triangle_vertex1(t) - p0, triangle_vertex2(t) - p0));
+// Triangle data is read field by field (scene_triangle_vertex and friends), so each step names what
+// it loads (on the H200 this measured the same as whole-record copies).
+EXITANCE_FN vec3 triangle_geometric_normal(SCENE_PARAM uint tri) {
+  vec3 p0 = scene_triangle_vertex(SCENE_ARG tri, 0u);
+  return normalize(cross(scene_triangle_vertex(SCENE_ARG tri, 1u) - p0, scene_triangle_vertex(SCENE_ARG tri, 2u) - p0));
 }
 EXITANCE_FN bool material_double_sided(GpuMaterial m) { return m.albedo_double_sided.w != 0.0f; }
 
 // One sample of each light strategy at x: (1/pi) * integral of direct radiance * cos, as shadow rays.
 // Random numbers, in order: area light (choice, u1, u2), punctual light (choice), environment (u1, u2);
 // each only when the scene has lights of that kind.
+// Three named outputs (area light, punctual light, environment) rather than an array.
 EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, vec3 throughput, uint strategy,
-                                       INOUT(Pcg32) rng, OUT_ARRAY(ShadowRay, rays, 3)) {
-  rays[0] = no_shadow_ray();
-  rays[1] = no_shadow_ray();
-  rays[2] = no_shadow_ray();
+                                       INOUT(Pcg32) rng, OUT(ShadowRay) area_ray, OUT(ShadowRay) punctual_ray,
+                                       OUT(ShadowRay) environment_ray) {
+  area_ray = no_shadow_ray();
+  punctual_ray = no_shadow_ray();
+  environment_ray = no_shadow_ray();
   uint emitters = scene_emitter_count(SCENE_ALONE_ARG);
   if (emitters > 0u) {
     float u_choose = pcg_uniform(rng);
@@ -101,14 +103,13 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
     float u2 = pcg_uniform(rng);
     float pmf;
     uint tri = scene_emitter_triangle(SCENE_ARG sample_cdf(scene_emitter_cdf(SCENE_ALONE_ARG), emitters, u_choose, pmf));
-    GpuTriangle t = scene_triangle(SCENE_ARG tri);
     vec2 bary = sample_triangle_barycentrics(u1, u2);
-    vec3 p0 = triangle_vertex0(t);
-    vec3 p1 = triangle_vertex1(t);
-    vec3 p2 = triangle_vertex2(t);
+    vec3 p0 = scene_triangle_vertex(SCENE_ARG tri, 0u);
+    vec3 p1 = scene_triangle_vertex(SCENE_ARG tri, 1u);
+    vec3 p2 = scene_triangle_vertex(SCENE_ARG tri, 2u);
     vec3 light_position = p0 * (1.0f - bary.x - bary.y) + p1 * bary.x + p2 * bary.y;
     vec3 light_normal = normalize(cross(p1 - p0, p2 - p0));
-    float pdf_area = t.p1_area_pdf.w;
+    float pdf_area = scene_triangle_area_pdf(SCENE_ARG tri);
     vec3 to_light = light_position - x.position;
     float distance2 = dot(to_light, to_light);
     float distance = sqrt(distance2);
@@ -116,7 +117,7 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
       vec3 wi = to_light / distance;
       float cos_x = dot(x.shading_normal, wi);
       float cos_l = -dot(light_normal, wi);
-      if (material_double_sided(scene_material(SCENE_ARG triangle_material(t)))) cos_l = abs(cos_l);
+      if (material_double_sided(scene_material(SCENE_ARG scene_triangle_material(SCENE_ARG tri)))) cos_l = abs(cos_l);
       if (cos_x > 0.0f && dot(x.geometric_normal, wi) > 0.0f && cos_l > 0.0f) {
         vec3 toward_x = dot(light_normal, wi) < 0.0f ? light_normal : -light_normal;
         vec3 target = offset_ray_origin(light_position, toward_x, scene_extent(SCENE_ALONE_ARG));
@@ -126,10 +127,10 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
           float pdf_light = pdf_area * distance2 / cos_l;
           float weight = power_heuristic(pdf_light, continuation_pdf(strategy, x, wi));
           vec3 le = scene_emission(SCENE_ARG tri, bary.x, bary.y);
-          rays[0].direction_length = vec4(span / span_length, span_length);
-          rays[0].contribution_state = vec4(throughput * (le * (cos_x * kInvPi * weight / pdf_light)), kShadowTrace);
+          area_ray.direction_length = vec4(span / span_length, span_length);
+          area_ray.contribution_state = vec4(throughput * (le * (cos_x * kInvPi * weight / pdf_light)), kShadowTrace);
         } else {
-          rays[0].contribution_state = vec4(0.0f, 0.0f, 0.0f, kShadowCountOnly);
+          area_ray.contribution_state = vec4(0.0f, 0.0f, 0.0f, kShadowCountOnly);
         }
       }
     }
@@ -157,8 +158,8 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
     float cos_x = dot(x.shading_normal, wi);
     if (distance > 0.0f && falloff > 0.0f && cos_x > 0.0f && dot(x.geometric_normal, wi) > 0.0f && probability > 0.0f) {
       vec3 intensity = vec3(light.intensity_cos_outer.x, light.intensity_cos_outer.y, light.intensity_cos_outer.z);
-      rays[1].direction_length = vec4(wi, distance);
-      rays[1].contribution_state = vec4(throughput * (intensity * (falloff * cos_x * kInvPi / probability)), kShadowTrace);
+      punctual_ray.direction_length = vec4(wi, distance);
+      punctual_ray.contribution_state = vec4(throughput * (intensity * (falloff * cos_x * kInvPi / probability)), kShadowTrace);
     }
   }
   if (scene_has_environment(SCENE_ALONE_ARG)) {
@@ -169,8 +170,8 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
     float cos_x = dot(x.shading_normal, wi);
     if (pdf_env > 0.0f && cos_x > 0.0f && dot(x.geometric_normal, wi) > 0.0f) {
       float weight = power_heuristic(pdf_env, continuation_pdf(strategy, x, wi));
-      rays[2].direction_length = vec4(wi, uintBitsToFloat(0x7F800000u));
-      rays[2].contribution_state =
+      environment_ray.direction_length = vec4(wi, uintBitsToFloat(0x7F800000u));
+      environment_ray.contribution_state =
           vec4(throughput * (scene_sky_radiance(SCENE_ARG wi) * (cos_x * kInvPi * weight / pdf_env)), kShadowTrace);
     }
   }
@@ -186,13 +187,15 @@ EXITANCE_FN vec3 escaped_radiance(SCENE_PARAM vec3 wi, float pdf_continuation) {
 
 // The surface point at barycentrics (b1, b2) of triangle t, seen from the side `front` says.
 // Shading normals that face away from the geometric side would sample into the surface: replaced.
-EXITANCE_FN SurfacePoint surface_point_on_triangle(GpuTriangle t, float b1, float b2, bool front) {
+// `ng`: the triangle's geometric normal (triangle_geometric_normal), which the caller already has.
+EXITANCE_FN SurfacePoint surface_point_on_triangle(SCENE_PARAM uint tri, vec3 ng, float b1, float b2, bool front) {
   SurfacePoint x;
-  vec3 ng = triangle_geometric_normal(t);
   x.geometric_normal = front ? ng : -ng;
   float b0 = 1.0f - b1 - b2;
-  x.position = triangle_vertex0(t) * b0 + triangle_vertex1(t) * b1 + triangle_vertex2(t) * b2;
-  vec3 nv = vec3(t.n0.x, t.n0.y, t.n0.z) * b0 + vec3(t.n1.x, t.n1.y, t.n1.z) * b1 + vec3(t.n2.x, t.n2.y, t.n2.z) * b2;
+  x.position = scene_triangle_vertex(SCENE_ARG tri, 0u) * b0 + scene_triangle_vertex(SCENE_ARG tri, 1u) * b1 +
+               scene_triangle_vertex(SCENE_ARG tri, 2u) * b2;
+  vec3 nv = scene_triangle_normal(SCENE_ARG tri, 0u) * b0 + scene_triangle_normal(SCENE_ARG tri, 1u) * b1 +
+            scene_triangle_normal(SCENE_ARG tri, 2u) * b2;
   float len = length(nv);
   vec3 n = len > 0.0f ? nv / len : vec3(0.0f);
   if (!front) n = -n;
@@ -217,16 +220,15 @@ EXITANCE_FN HitResult shade_continuation_hit(SCENE_PARAM uint tri, float t_hit, 
   h.radiance = vec3(0.0f);
   h.continues = false;
   h.throughput = throughput;
-  GpuTriangle t = scene_triangle(SCENE_ARG tri);
-  GpuMaterial m = scene_material(SCENE_ARG triangle_material(t));
+  GpuMaterial m = scene_material(SCENE_ARG scene_triangle_material(SCENE_ARG tri));
   bool double_sided = material_double_sided(m);
-  vec3 ng = triangle_geometric_normal(t);
+  vec3 ng = triangle_geometric_normal(SCENE_ARG tri);
   bool front = dot(wi, ng) < 0.0f;
   if (front || double_sided) {
     vec3 le = scene_emission(SCENE_ARG tri, b1, b2);
     if (max_component(le) > 0.0f) {
       float cos_l = abs(dot(wi, ng));
-      float pdf_light = t.p1_area_pdf.w * t_hit * t_hit / cos_l;
+      float pdf_light = scene_triangle_area_pdf(SCENE_ARG tri) * t_hit * t_hit / cos_l;
       h.radiance = throughput * le * power_heuristic(pdf_continuation, pdf_light);
     }
   }
@@ -245,7 +247,7 @@ EXITANCE_FN HitResult shade_continuation_hit(SCENE_PARAM uint tri, float t_hit, 
     return h;
   }
   h.continues = true;
-  h.next = surface_point_on_triangle(t, b1, b2, front);
+  h.next = surface_point_on_triangle(SCENE_ARG tri, ng, b1, b2, front);
   return h;
 }
 
@@ -277,16 +279,15 @@ EXITANCE_FN ProbeHit shade_probe_hit(SCENE_PARAM uint tri, float b1, float b2, v
   h.radiance = vec3(0.0f);
   h.albedo = vec3(0.0f);
   h.continues = false;
-  GpuTriangle t = scene_triangle(SCENE_ARG tri);
-  GpuMaterial m = scene_material(SCENE_ARG triangle_material(t));
-  vec3 ng = triangle_geometric_normal(t);
+  GpuMaterial m = scene_material(SCENE_ARG scene_triangle_material(SCENE_ARG tri));
+  vec3 ng = triangle_geometric_normal(SCENE_ARG tri);
   bool front = dot(wi, ng) < 0.0f;
   h.back_face = !front && !material_double_sided(m);
   if (h.back_face) return h;
   h.radiance = scene_emission(SCENE_ARG tri, b1, b2);
   h.albedo = scene_albedo(SCENE_ARG tri, b1, b2);
   h.continues = max_component(h.albedo) > 0.0f;
-  h.next = surface_point_on_triangle(t, b1, b2, front);
+  h.next = surface_point_on_triangle(SCENE_ARG tri, ng, b1, b2, front);
   return h;
 }
 

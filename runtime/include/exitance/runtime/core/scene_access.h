@@ -9,7 +9,18 @@
 
 namespace exitance {
 
-inline GpuTriangle scene_triangle(const LightingScene& scene, uint t) { return scene.triangles[t]; }
+inline vec3 scene_triangle_vertex(const LightingScene& scene, uint t, uint k) {
+  const GpuTriangle& g = scene.triangles[t];
+  const Vec4& v = k == 0 ? g.p0_material : (k == 1 ? g.p1_area_pdf : g.p2_instance);
+  return {v.x, v.y, v.z};
+}
+inline vec3 scene_triangle_normal(const LightingScene& scene, uint t, uint k) {
+  const GpuTriangle& g = scene.triangles[t];
+  const Vec4& n = k == 0 ? g.n0 : (k == 1 ? g.n1 : g.n2);
+  return {n.x, n.y, n.z};
+}
+inline uint scene_triangle_material(const LightingScene& scene, uint t) { return floatBitsToUint(scene.triangles[t].p0_material.w); }
+inline float scene_triangle_area_pdf(const LightingScene& scene, uint t) { return scene.triangles[t].p1_area_pdf.w; }
 inline GpuMaterial scene_material(const LightingScene& scene, uint m) { return scene.materials[m]; }
 inline GpuPunctualLight scene_punctual_light(const LightingScene& scene, uint i) { return scene.punctual_lights[i]; }
 inline uint scene_emitter_count(const LightingScene& scene) { return scene.emitter_count(); }
