@@ -52,8 +52,7 @@ RTCRayHit make_ray(Vec3 origin, Vec3 direction, float t_max) {
 }  // namespace
 
 EmbreeScene::EmbreeScene(const Scene& scene) : scene_(scene) {
-  device_ = rtcNewDevice(nullptr);
-  if (!device_) throw std::runtime_error("Embree: cannot create a device (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
+  device_ = new_embree_device();
   rtc_scene_ = rtcNewScene(device_);
   rtcSetSceneBuildQuality(rtc_scene_, RTC_BUILD_QUALITY_HIGH);
   rtcSetSceneFlags(rtc_scene_, RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION));

@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "exitance/runtime/embree_device.h"
+
 namespace exitance::vulkan {
 namespace {
 
@@ -123,8 +125,7 @@ GpuBvh build_gpu_bvh(const Scene& scene) {
     return bvh;
   }
 
-  RTCDevice device = rtcNewDevice(nullptr);
-  if (!device) throw std::runtime_error("Embree: cannot create a device for the GPU BVH build");
+  RTCDevice device = new_embree_device();
   RTCBVH handle = rtcNewBVH(device);
   RTCBuildArguments args = rtcDefaultBuildArguments();
   args.byteSize = sizeof(args);

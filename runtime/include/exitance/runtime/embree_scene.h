@@ -2,6 +2,7 @@
 #pragma once
 #include <embree3/rtcore.h>
 
+#include "exitance/runtime/embree_device.h"
 #include "exitance/runtime/scene.h"
 
 namespace exitance {
