@@ -36,11 +36,17 @@ GeometryCheckReport check_scene_geometry(const Scene& scene, const EmbreeScene& 
     if (back * 2 > kHemisphereRays) ++enclosed.local();
     // Look back through the texel: another instance's surface within a few offsets, facing the
     // same way, overlaps it in the same plane (opposite-facing contact, a box on a floor, is fine).
+    // Every hit within reach is tested, not only the closest: the floor under a box meets both the
+    // box's bottom face and a doubled floor at one distance, and which of them Embree reports as
+    // closest differs between its per-CPU kernels.
     const float reach = 4.0f * length(origin - t.position) + 1e-4f * t.world_texel_size;
-    const Hit below = embree.intersect_other_instances(origin, -t.geometric_normal, reach, t.instance);
-    // Hits on the other surface's border are neighbours touching edge to edge, not overlaps.
-    const bool inside = below.found && below.b1 > 1e-3f && below.b2 > 1e-3f && 1.0f - below.b1 - below.b2 > 1e-3f;
-    if (inside && dot(below.geometric_normal, t.geometric_normal) > 0.999f) ++coplanar.local();
+    const bool overlapped = embree.any_hit_where(origin, -t.geometric_normal, reach, [&](const Hit& other) {
+      if (scene.triangle_instance[other.triangle] == t.instance) return false;
+      // Hits on the other surface's border are neighbours touching edge to edge, not overlaps.
+      const bool inside = other.b1 > 1e-3f && other.b2 > 1e-3f && 1.0f - other.b1 - other.b2 > 1e-3f;
+      return inside && dot(other.geometric_normal, t.geometric_normal) > 0.999f;
+    });
+    if (overlapped) ++coplanar.local();
   });
   report.enclosed_texels = enclosed.combine(std::plus<size_t>());
   report.coplanar_texels = coplanar.combine(std::plus<size_t>());

@@ -9,19 +9,25 @@
 namespace exitance {
 namespace {
 
-// Intersection context carrying the instance whose triangles a filter rejects.
-struct InstanceFilterContext {
+// Intersection context carrying the predicate a filter applies to every hit.
+struct PredicateFilterContext {
   RTCIntersectContext context;  // first member: Embree passes a pointer to it
-  const std::vector<uint32_t>* triangle_instance;
-  uint32_t ignored_instance;
+  const Scene* scene;
+  const std::function<bool(const Hit&)>* accept;
 };
 
-void reject_ignored_instance(const RTCFilterFunctionNArguments* args) {
-  const auto* filter = reinterpret_cast<const InstanceFilterContext*>(args->context);
+void reject_unless_accepted(const RTCFilterFunctionNArguments* args) {
+  const auto* filter = reinterpret_cast<const PredicateFilterContext*>(args->context);
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] == 0) continue;
-    const unsigned triangle = RTCHitN_primID(args->hit, args->N, i);
-    if ((*filter->triangle_instance)[triangle] == filter->ignored_instance) args->valid[i] = 0;
+    Hit hit;
+    hit.found = true;
+    hit.distance = RTCRayN_tfar(args->ray, args->N, i);  // Embree passes the hit distance as tfar
+    hit.triangle = RTCHitN_primID(args->hit, args->N, i);
+    hit.b1 = RTCHitN_u(args->hit, args->N, i);
+    hit.b2 = RTCHitN_v(args->hit, args->N, i);
+    hit.geometric_normal = triangle_normal(*filter->scene, hit.triangle);
+    if (!(*filter->accept)(hit)) args->valid[i] = 0;
   }
 }
 
@@ -52,8 +58,7 @@ RTCRayHit make_ray(Vec3 origin, Vec3 direction, float t_max) {
 }  // namespace
 
 EmbreeScene::EmbreeScene(const Scene& scene) : scene_(scene) {
-  device_ = rtcNewDevice(nullptr);
-  if (!device_) throw std::runtime_error("Embree: cannot create a device (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
+  device_ = new_embree_device();
   rtc_scene_ = rtcNewScene(device_);
   rtcSetSceneBuildQuality(rtc_scene_, RTC_BUILD_QUALITY_HIGH);
   rtcSetSceneFlags(rtc_scene_, RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION));
@@ -94,15 +99,16 @@ Hit EmbreeScene::intersect(Vec3 origin, Vec3 direction, float t_max) const {
   return make_hit(scene_, rayhit);
 }
 
-Hit EmbreeScene::intersect_other_instances(Vec3 origin, Vec3 direction, float t_max, uint32_t ignored_instance) const {
-  InstanceFilterContext filter;
+bool EmbreeScene::any_hit_where(Vec3 origin, Vec3 direction, float t_max,
+                                const std::function<bool(const Hit&)>& accept) const {
+  PredicateFilterContext filter;
   rtcInitIntersectContext(&filter.context);
-  filter.context.filter = reject_ignored_instance;
-  filter.triangle_instance = &scene_.triangle_instance;
-  filter.ignored_instance = ignored_instance;
-  RTCRayHit rayhit = make_ray(origin, direction, t_max);
-  rtcIntersect1(rtc_scene_, &filter.context, &rayhit);
-  return make_hit(scene_, rayhit);
+  filter.context.filter = reject_unless_accepted;
+  filter.scene = &scene_;
+  filter.accept = &accept;
+  RTCRay ray = make_ray(origin, direction, t_max).ray;
+  rtcOccluded1(rtc_scene_, &filter.context, &ray);
+  return ray.tfar < 0.0f;  // Embree sets tfar = -inf once a hit passes the filter
 }
 
 bool EmbreeScene::occluded(Vec3 origin, Vec3 direction, float t_max) const {

@@ -2,6 +2,8 @@
 // stays finite on it.
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include "exitance/bake/geometry_checks.h"
 #include "support/test_scenes.h"
 
@@ -80,6 +82,34 @@ TEST(GeometryWarnings, EachProblemIsNamed) {
   const LightmapEstimate estimate = CpuReferenceIntegrator(scene).bake(gbuffer, settings);
   EXPECT_EQ(estimate.nonfinite_samples, 0u);
   for (size_t i = 0; i < gbuffer.texels.size(); ++i) EXPECT_TRUE(is_finite(estimate.mean_total(i)));
+}
+
+// The query under the coplanar check: two coincident quads facing opposite ways are hit at one
+// distance, and a predicate that accepts only one of them must find it whichever Embree's kernels
+// would report as the closest (a closest-hit query fails one of the two cases on any CPU).
+TEST(GeometryWarnings, AnyHitWhereOffersEveryEquidistantHit) {
+  Scene scene;
+  const uint32_t grey = add_material(scene, {0.5f, 0.5f, 0.5f});
+  add_quad(scene, {0, 0, 1}, {1, 0, 0}, {0, 0, -1}, grey);  // normal +y
+  add_quad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, grey);   // normal -y, same square
+  EmbreeScene embree(scene);
+  const Vec3 origin{0.3f, 1.0f, 0.6f}, down{0, -1, 0};
+  for (const float facing : {1.0f, -1.0f}) {
+    int offered = 0;
+    EXPECT_TRUE(embree.any_hit_where(origin, down, 2.0f, [&](const Hit& hit) {
+      ++offered;
+      EXPECT_NEAR(hit.distance, 1.0f, 1e-6f);
+      return hit.geometric_normal.y == facing;
+    })) << "facing " << facing;
+    EXPECT_GE(offered, 1);
+  }
+  // Rejecting everything sees one triangle of each quad (possibly more than once: spatial splits).
+  std::set<uint32_t> seen;
+  EXPECT_FALSE(embree.any_hit_where(origin, down, 2.0f, [&](const Hit& hit) { return seen.insert(hit.triangle), false; }));
+  ASSERT_EQ(seen.size(), 2u);
+  EXPECT_LT(*seen.begin(), 2u);
+  EXPECT_GE(*seen.rbegin(), 2u);
+  EXPECT_FALSE(embree.any_hit_where(origin, down, 0.5f, [](const Hit&) { return true; }));  // out of reach
 }
 
 }  // namespace

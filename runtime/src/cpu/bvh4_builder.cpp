@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "exitance/runtime/embree_device.h"
+
 namespace exitance {
 namespace {
 
@@ -113,8 +115,7 @@ Bvh4 build_bvh4(const Scene& scene) {
     return bvh;
   }
 
-  RTCDevice device = rtcNewDevice(nullptr);
-  if (!device) throw std::runtime_error("Embree: cannot create a device for the BVH4 build");
+  RTCDevice device = new_embree_device();
   RTCBVH handle = rtcNewBVH(device);
   RTCBuildArguments args = rtcDefaultBuildArguments();
   args.byteSize = sizeof(args);

@@ -2,6 +2,9 @@
 #pragma once
 #include <embree3/rtcore.h>
 
+#include <functional>
+
+#include "exitance/runtime/embree_device.h"
 #include "exitance/runtime/scene.h"
 
 namespace exitance {
@@ -23,8 +26,11 @@ class EmbreeScene {
 
   Hit intersect(Vec3 origin, Vec3 direction, float t_max) const;
   bool occluded(Vec3 origin, Vec3 direction, float t_max) const;
-  // Closest hit ignoring the triangles of one mesh instance (for scene checks, not lighting).
-  Hit intersect_other_instances(Vec3 origin, Vec3 direction, float t_max, uint32_t ignored_instance) const;
+  // Whether any triangle hit within t_max along the ray satisfies `accept` (for scene checks, not
+  // lighting). Every hit is offered to `accept` until one passes (an occlusion query whose filter
+  // rejects the rest), so the answer does not depend on which of several equidistant hits the
+  // CPU's Embree kernels would report as the closest.
+  bool any_hit_where(Vec3 origin, Vec3 direction, float t_max, const std::function<bool(const Hit&)>& accept) const;
   // Largest side of the scene's bounding box: the scale of ray-offset error floors.
   float extent() const { return extent_; }
 
