@@ -7,17 +7,20 @@
 #include <sstream>
 
 #include "exitance/bake/backend_choice.h"
-#include "exitance/bake/bundle_writer.h"
+#include "exitance/bake/input_hash.h"
 #include "exitance/bake/geometry_checks.h"
 #include "exitance/bake/image_decode.h"
 #include "exitance/bake/input_error.h"
-#include "exitance/bake/lightmap_assembly.h"
 #include "exitance/bake/probe_placement.h"
 #include "exitance/bake/radiance_vdb.h"
 #include "exitance/bake/svo_build.h"
 #include "exitance/bake/texel_raster.h"
 #include "exitance/bake/unocclude.h"
 #include "exitance/formats/probes_file.h"
+#include "exitance/runtime/bundle/bundle_directory.h"
+#include "exitance/runtime/bundle/lightmap_assembly.h"
+#include "exitance/runtime/bundle/probe_results.h"
+#include "exitance/runtime/bundle/texel_exitance.h"
 #include "exitance/formats/svo_file.h"
 #include "exitance/runtime/cpu/bvh4_builder.h"
 #include "exitance/runtime/embree_scene.h"
@@ -44,36 +47,6 @@ class StageTimer {
  private:
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
-
-// Barycentrics (b1, b2) of p's projection onto triangle t.
-void barycentrics_on_triangle(const Scene& scene, uint32_t t, Vec3 p, float& b1, float& b2) {
-  const Vec3* v = &scene.positions[size_t(t) * 3];
-  const Vec3 e1 = v[1] - v[0], e2 = v[2] - v[0], d = p - v[0];
-  const float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), d1 = dot(d, e1), d2 = dot(d, e2);
-  const float det = d11 * d22 - d12 * d12;
-  b1 = b2 = 1.0f / 3.0f;
-  if (!(std::fabs(det) > 0)) return;
-  b1 = std::clamp((d22 * d1 - d12 * d2) / det, 0.0f, 1.0f);
-  b2 = std::clamp((d11 * d2 - d12 * d1) / det, 0.0f, 1.0f - b1);
-}
-
-// Radiant exitance M = pi * L_o = pi * (Le + albedo * E/pi) of every lit texel, deposited into the
-// octree's leaves with the texel's surface area as weight (texels sample surfaces uniformly by
-// area, so each leaf side gets the area-average exitance of the surface inside it).
-void fill_svo_exitance(formats::SparseVoxelOctree& svo, const Scene& scene, const TexelGBuffer& gbuffer,
-                       const LightmapEstimate& estimate) {
-  SvoExitanceCache cache(svo);
-  for (size_t i = 0; i < gbuffer.texels.size(); ++i) {
-    const LiveTexel& t = gbuffer.texels[i];
-    if (estimate.texels[i].samples == 0) continue;
-    float b1, b2;
-    barycentrics_on_triangle(scene, t.triangle, t.position, b1, b2);
-    const Vec3 outgoing = emitted_radiance(scene, t.triangle, b1, b2) + t.albedo * estimate.mean_total(i);
-    cache.deposit({t.position, t.geometric_normal, outgoing * kPi, t.world_texel_size * t.world_texel_size});
-  }
-  cache.publish(1.0f);
-  cache.store_into(svo);
-}
 
 json vec3_json(const std::array<float, 3>& v) { return json::array({v[0], v[1], v[2]}); }
 
@@ -208,13 +181,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
     probe_lighting.target_relative_error = 0;
     probe_lighting.progress = [&](double fraction, uint64_t rays) { report("probes", fraction, rays); };
     probe_estimate = backend->bake_probes(positions, probe_lighting);
-    for (size_t k = 0; k < traced.size(); ++k) {
-      ShRgb sh = probe_estimate.mean(k);
-      if (options.probe_sh_window > 0) sh_apply_hanning_window(sh, options.probe_sh_window);
-      formats::ProbeRecord& r = placement.grid.probes[traced[k]];
-      for (int i = 0; i < kShCoefficients; ++i)
-        for (int c = 0; c < 3; ++c) r.sh[size_t(i) * 3 + size_t(c)] = is_finite(sh[i]) ? sh[i][c] : 0.0f;
-    }
+    store_probe_radiance(placement.grid, traced, probe_estimate, options.probe_sh_window);
     seconds["probes"] = timer.lap();
     if (probe_estimate.nonfinite_samples > 0)
       diagnostics.warn(options.input + ": " + std::to_string(probe_estimate.nonfinite_samples) +

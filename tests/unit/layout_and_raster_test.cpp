@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "exitance/bake/atlas_layout.h"
-#include "exitance/bake/lightmap_assembly.h"
+#include "exitance/runtime/bundle/lightmap_assembly.h"
 #include "exitance/bake/texel_raster.h"
 #include "exitance/runtime/distribution_1d.h"
 #include "exitance/runtime/environment_sampler.h"

@@ -12,6 +12,4 @@ namespace exitance {
 void write_bundle_atomically(const std::filesystem::path& out_dir,
                              const std::function<void(const std::filesystem::path&)>& write_contents);
 
-std::string sha256_of_file(const std::string& path);
-
 }  // namespace exitance

@@ -1,4 +1,4 @@
-#include "exitance/bake/lightmap_assembly.h"
+#include "exitance/runtime/bundle/lightmap_assembly.h"
 
 #include <string>
 

@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "exitance/formats/lightmap_exr.h"
-#include "exitance/runtime/cpu_reference_integrator.h"
+#include "exitance/runtime/core/estimates.h"
 #include "exitance/runtime/texel_gbuffer.h"
 
 namespace exitance {
