@@ -12,9 +12,9 @@ namespace {
 
 constexpr framing::FileKind kSceneKind{kSceneMagic, kSceneFormatVersion, kSceneHeaderSize};
 
-// Bytes per triangle of the six per-triangle arrays: positions, normals, lightmap UVs, TEXCOORD_0
-// (3 corners each), material and instance.
-constexpr uint64_t kTriangleBytes = 36 + 36 + 24 + 24 + 4 + 4;
+// Bytes per triangle of the seven per-triangle arrays: positions, normals, lightmap UVs, TEXCOORD_0
+// (3 corners each), material, instance and world texel size.
+constexpr uint64_t kTriangleBytes = 36 + 36 + 24 + 24 + 4 + 4 + 4;
 constexpr uint64_t kPageRecordSize = 12;
 constexpr uint64_t kProbeRecordBytes = 16;
 // Smallest size of the variable-length records (an empty name): bounds their counts by the file size.
@@ -307,11 +307,23 @@ void validate_texels(const SceneFile& s, const std::string& name) {
       if (!(t.b1 >= 0 && t.b1 <= 1 && t.b2 >= 0 && t.b2 <= 1 && t.b1 + t.b2 <= 1.000001f))
         throw FormatError(where + "barycentrics " + std::to_string(t.b1) + ", " + std::to_string(t.b2) +
                           " are not on the triangle");
-      if (!(finite(t.world_texel_size) && t.world_texel_size >= 0))
-        throw FormatError(where + "world texel size is not a finite non-negative number");
-      if (!(t.coverage > 0 && t.coverage <= 1))
-        throw FormatError(where + "coverage " + std::to_string(t.coverage) + " is not in (0, 1]");
     }
+  }
+  if (g.triangle_texel_size.size() != triangles)
+    throw FormatError(name + ": " + std::to_string(g.triangle_texel_size.size()) + " world texel sizes for " +
+                      std::to_string(triangles) + " triangles");
+  for (size_t t = 0; t < triangles; ++t)
+    if (!(finite(g.triangle_texel_size[t]) && g.triangle_texel_size[t] >= 0))
+      throw FormatError(at(name, "triangle", t) + "world texel size " + std::to_string(g.triangle_texel_size[t]) +
+                        " is not a finite non-negative number");
+  for (size_t i = 0; i < g.partial_coverage.size(); ++i) {
+    const PartialCoverageRecord& c = g.partial_coverage[i];
+    if (c.texel >= g.texels.size() || (i > 0 && c.texel <= g.partial_coverage[i - 1].texel))
+      throw FormatError(at(name, "partial coverage", i) + "texel " + std::to_string(c.texel) +
+                        " is out of range or not after the previous one");
+    if (!(c.coverage > 0 && c.coverage < 1))
+      throw FormatError(at(name, "partial coverage", i) + "coverage " + std::to_string(c.coverage) +
+                        " is not in (0, 1)");
   }
   for (size_t i = 0; i < g.moved.size(); ++i) {
     const MovedTexelRecord& m = g.moved[i];
@@ -460,9 +472,10 @@ void validate_bvh(const SceneFile& s, const std::string& name) {
 // Payload layout helpers.
 
 uint64_t fixed_payload_bytes(uint64_t triangles, uint64_t bvh_nodes, uint64_t leaf_slots, uint64_t pages,
-                             uint64_t texels, uint64_t moved, uint64_t probes) {
+                             uint64_t texels, uint64_t partial, uint64_t moved, uint64_t probes) {
   return triangles * kTriangleBytes + bvh_nodes * kSceneBvhNodeSize + leaf_slots * 4 + pages * kPageRecordSize +
-         texels * kSceneTexelSize + moved * kSceneMovedTexelSize + probes * kProbeRecordBytes;
+         texels * kSceneTexelSize + partial * kScenePartialCoverageSize + moved * kSceneMovedTexelSize +
+         probes * kProbeRecordBytes;
 }
 
 void put_name(binary_io::LittleEndianWriter& w, const std::string& text) {
@@ -529,6 +542,7 @@ std::vector<uint8_t> encode_scene(const SceneFile& s) {
   h.u32(uint32_t(s.lights.size()));
   h.u32(uint32_t(s.texels.pages.size()));
   h.u32(uint32_t(s.texels.texels.size()));
+  h.u32(uint32_t(s.texels.partial_coverage.size()));
   h.u32(uint32_t(s.texels.moved.size()));
   h.u32(uint32_t(s.probes.probes.size()));
   h.u32(uint32_t(s.bvh.nodes.size()));
@@ -541,10 +555,11 @@ std::vector<uint8_t> encode_scene(const SceneFile& s) {
   put(h, s.probes.origin);
   put(h, s.probes.spacing);
   for (uint32_t c : s.probes.counts) h.u32(c);
+  for (int k = 0; k < 3; ++k) h.u32(0);  // reserved
 
-  const uint64_t fixed =
-      fixed_payload_bytes(t.count(), s.bvh.nodes.size(), s.bvh.leaf_triangles.size(), s.texels.pages.size(),
-                          s.texels.texels.size(), s.texels.moved.size(), s.probes.probes.size());
+  const uint64_t fixed = fixed_payload_bytes(
+      t.count(), s.bvh.nodes.size(), s.bvh.leaf_triangles.size(), s.texels.pages.size(), s.texels.texels.size(),
+      s.texels.partial_coverage.size(), s.texels.moved.size(), s.probes.probes.size());
   std::vector<uint8_t> payload;
   payload.reserve(size_t(fixed) + s.nodes.size() * kMinNodeBytes + s.instances.size() * kMinInstanceBytes);
   binary_io::LittleEndianWriter p(payload);
@@ -554,6 +569,7 @@ std::vector<uint8_t> encode_scene(const SceneFile& s) {
   for (const Float2& v : t.uv0) put(p, v);
   for (uint32_t v : t.material) p.u32(v);
   for (uint32_t v : t.instance) p.u32(v);
+  for (float v : s.texels.triangle_texel_size) p.f32(v);
   for (const BvhNodeRecord& n : s.bvh.nodes) {
     for (const float* plane : {n.lo_x, n.hi_x, n.lo_y, n.hi_y, n.lo_z, n.hi_z})
       for (int c = 0; c < 4; ++c) p.f32(plane[c]);
@@ -569,8 +585,7 @@ std::vector<uint8_t> encode_scene(const SceneFile& s) {
   for (const TexelRecord& r : texels) p.u32(r.triangle);
   for (const TexelRecord& r : texels) p.u32(uint32_t(r.x) | (uint32_t(r.y) << 16));
   for (const TexelRecord& r : texels) p.f32(r.b1), p.f32(r.b2);
-  for (const TexelRecord& r : texels) p.f32(r.world_texel_size);
-  for (const TexelRecord& r : texels) p.f32(r.coverage);
+  for (const PartialCoverageRecord& c : s.texels.partial_coverage) p.u32(c.texel), p.f32(c.coverage);
   for (const MovedTexelRecord& m : s.texels.moved) {
     p.u32(m.texel);
     put(p, m.position);
@@ -640,7 +655,8 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
   h.skip(16);
   const uint32_t triangle_count = h.u32(), material_count = h.u32(), instance_count = h.u32(), node_count = h.u32();
   const uint32_t camera_count = h.u32(), light_count = h.u32(), page_count = h.u32(), texel_count = h.u32();
-  const uint32_t moved_count = h.u32(), probe_count = h.u32(), bvh_node_count = h.u32(), leaf_count = h.u32();
+  const uint32_t partial_count = h.u32(), moved_count = h.u32(), probe_count = h.u32(), bvh_node_count = h.u32();
+  const uint32_t leaf_count = h.u32();
   SceneFile s;
   s.bvh.stack_entries = h.u32();
   s.bvh.depth = h.u32();
@@ -650,6 +666,10 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
   get(h, s.probes.origin);
   get(h, s.probes.spacing);
   for (uint32_t& c : s.probes.counts) c = h.u32();
+  for (int k = 0; k < 3; ++k)
+    if (const uint32_t reserved = h.u32(); reserved != 0)
+      throw FormatError(name + ": header: reserved field at offset " + std::to_string(132 + 4 * k) + " is " +
+                        std::to_string(reserved) + ", not 0");
 
   if (environment != 0)
     throw FormatError(name + ": header: sky environment " + std::to_string(environment) +
@@ -667,7 +687,7 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
                       std::to_string(s.probes.counts[0]) + " x " + std::to_string(s.probes.counts[1]) + " x " +
                       std::to_string(s.probes.counts[2]));
   const uint64_t fixed = fixed_payload_bytes(triangle_count, bvh_node_count, leaf_count, page_count, texel_count,
-                                             moved_count, probe_count);
+                                             partial_count, moved_count, probe_count);
   const uint64_t minimum = fixed + material_count * kMinMaterialBytes + instance_count * kMinInstanceBytes +
                            node_count * kMinNodeBytes + camera_count * kMinCameraBytes + light_count * kMinLightBytes;
   if (frame.payload_size < minimum)
@@ -689,6 +709,8 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
   for (Float2& v : t.uv0) get(p, v);
   for (uint32_t& v : t.material) v = p.u32();
   for (uint32_t& v : t.instance) v = p.u32();
+  s.texels.triangle_texel_size.resize(triangle_count);
+  for (float& v : s.texels.triangle_texel_size) v = p.f32();
   s.bvh.nodes.resize(bvh_node_count);
   for (BvhNodeRecord& n : s.bvh.nodes) {
     for (float* plane : {n.lo_x, n.hi_x, n.lo_y, n.hi_y, n.lo_z, n.hi_z})
@@ -712,8 +734,8 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
     r.y = uint16_t(xy >> 16);
   }
   for (TexelRecord& r : texels) r.b1 = p.f32(), r.b2 = p.f32();
-  for (TexelRecord& r : texels) r.world_texel_size = p.f32();
-  for (TexelRecord& r : texels) r.coverage = p.f32();
+  s.texels.partial_coverage.resize(partial_count);
+  for (PartialCoverageRecord& c : s.texels.partial_coverage) c.texel = p.u32(), c.coverage = p.f32();
   s.texels.moved.resize(moved_count);
   for (MovedTexelRecord& m : s.texels.moved) {
     m.texel = p.u32();

@@ -1,5 +1,6 @@
 #include "exitance/runtime/texel_gbuffer_codec.h"
 
+#include <bit>
 #include <cstring>
 #include <string>
 
@@ -50,6 +51,9 @@ formats::TexelGBufferRecords encode_texel_gbuffer(const TexelGBuffer& gbuffer, c
   for (size_t p = 0; p < gbuffer.pages.size(); ++p) live[p].assign(gbuffer.pages[p].coverage.size(), 0);
 
   records.texels.reserve(gbuffer.texels.size());
+  // World texel size is per triangle (the rasterizer's): the first texel of a triangle sets it.
+  records.triangle_texel_size.assign(scene.triangle_count(), 0.0f);
+  std::vector<uint8_t> size_set(scene.triangle_count(), 0);
   uint32_t previous_page = 0;
   uint64_t previous_code = 0;
   for (size_t i = 0; i < gbuffer.texels.size(); ++i) {
@@ -83,8 +87,15 @@ formats::TexelGBufferRecords encode_texel_gbuffer(const TexelGBuffer& gbuffer, c
     r.triangle = texel.triangle;
     r.x = uint16_t(texel.x);
     r.y = uint16_t(texel.y);
-    r.world_texel_size = texel.world_texel_size;
-    r.coverage = coverage;
+    float& triangle_size = records.triangle_texel_size[texel.triangle];
+    if (!size_set[texel.triangle]) {
+      triangle_size = texel.world_texel_size;
+      size_set[texel.triangle] = 1;
+    } else if (std::bit_cast<uint32_t>(triangle_size) != std::bit_cast<uint32_t>(texel.world_texel_size)) {
+      throw FormatError(texel_where(i) + "world texel size differs from that of other texels of triangle " +
+                        std::to_string(texel.triangle));
+    }
+    if (coverage != 1.0f) records.partial_coverage.push_back({uint32_t(i), coverage});
     raster_barycentrics(scene, atlas.rects[instance], page, texel.triangle, texel.x, texel.y, r.b1, r.b2);
     const TexelSurface surface = texel_surface(scene, texel.triangle, r.b1, r.b2);
     if (!same_bits(surface.geometric_normal, texel.geometric_normal))
@@ -119,7 +130,9 @@ TexelGBuffer decode_texel_gbuffer(const formats::TexelGBufferRecords& records, c
     gbuffer.pages.push_back(std::move(page));
   }
   gbuffer.texels.resize(records.texels.size());
-  size_t index = 0, moved = 0;
+  if (records.triangle_texel_size.size() != scene.triangle_count())
+    throw FormatError("scene.bin: world texel sizes do not match the triangles");
+  size_t index = 0, moved = 0, partial = 0;
   for (size_t p = 0; p < records.pages.size(); ++p) {
     AtlasPage& page = gbuffer.pages[p];
     for (uint32_t k = 0; k < records.pages[p].live_texels; ++k, ++index) {
@@ -138,16 +151,20 @@ TexelGBuffer decode_texel_gbuffer(const formats::TexelGBufferRecords& records, c
       texel.albedo = surface.albedo;
       texel.instance = scene.triangle_instance[r.triangle];
       texel.triangle = r.triangle;
-      texel.world_texel_size = r.world_texel_size;
+      texel.world_texel_size = records.triangle_texel_size[r.triangle];
       if (moved < records.moved.size() && records.moved[moved].texel == index) {
         const formats::Float3& position = records.moved[moved++].position;
         texel.position = {position[0], position[1], position[2]};
       }
-      page.coverage[size_t(r.y) * size_t(page.width) + r.x] = r.coverage;
+      float coverage = 1.0f;
+      if (partial < records.partial_coverage.size() && records.partial_coverage[partial].texel == index)
+        coverage = records.partial_coverage[partial++].coverage;
+      page.coverage[size_t(r.y) * size_t(page.width) + r.x] = coverage;
     }
   }
-  if (index != records.texels.size() || moved != records.moved.size())
-    throw FormatError("scene.bin: live texel counts or the moved-texel table do not match the texels");
+  if (index != records.texels.size() || moved != records.moved.size() || partial != records.partial_coverage.size())
+    throw FormatError(
+        "scene.bin: live texel counts, the partial coverage or the moved-texel table do not match the texels");
   gbuffer.skipped_texels = area - records.texels.size();
   return gbuffer;
 }

@@ -1,7 +1,7 @@
 // A small but complete scene.bin in memory, built by hand so every field has a known, distinct
 // value: 4 triangles in 2 instances on 2 pages, 3 materials, 5 nodes (TRS, matrix, a node outside
-// the scene), 2 cameras, 3 lights, 5 live texels (1 moved), a 2 x 1 x 2 probe grid and a BVH of
-// two inner nodes. Shared by the scene.bin tests and the fuzzer's seed writer.
+// the scene), 2 cameras, 3 lights, 5 live texels (3 partly covered, 1 moved), a 2 x 1 x 2 probe
+// grid and a BVH of two inner nodes. Shared by the scene.bin tests and the fuzzer's seed writer.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -105,11 +105,13 @@ inline formats::SceneFile make_sample_scene_file() {
 
   s.texels.pages = {{8, 4, 3}, {4, 4, 2}};
   // Page 0: Morton codes (1,1)=3, (2,1)=6, (3,2)=13; page 1: (0,0)=0, (3,3)=15.
-  s.texels.texels = {{0, 1, 1, 0.25f, 0.5f, 0.3f, 1.0f},
-                     {1, 2, 1, 0.0f, 1.0f, 0.3f, 0.6f},
-                     {0, 3, 2, 0.125f, 0.125f, 0.3f, 1e-3f},
-                     {2, 0, 0, 1.0f / 3.0f, 1.0f / 3.0f, 0.5f, 1.0f},
-                     {3, 3, 3, 0.5f, 0.25f, std::numeric_limits<float>::denorm_min(), 0.25f}};
+  s.texels.texels = {{0, 1, 1, 0.25f, 0.5f},
+                     {1, 2, 1, 0.0f, 1.0f},
+                     {0, 3, 2, 0.125f, 0.125f},
+                     {2, 0, 0, 1.0f / 3.0f, 1.0f / 3.0f},
+                     {3, 3, 3, 0.5f, 0.25f}};
+  s.texels.triangle_texel_size = {0.3f, 0.3f, 0.5f, std::numeric_limits<float>::denorm_min()};
+  s.texels.partial_coverage = {{1, 0.6f}, {2, 1e-3f}, {4, 0.25f}};
   s.texels.moved = {{3, {-0.9f, 0.1f, -1.999f}}};
 
   s.probes = ProbeGrid{};

@@ -37,17 +37,20 @@ int main(int argc, char** argv) {
   std::printf("%s: density %.3g texels/unit, %zu pages, %llu atlas texels, %zu live, %zu moved\n", argv[1],
               p.layout.texel_density, p.layout.page_sizes.size(), (unsigned long long)atlas_texels, x,
               file.texels.moved.size());
+  const uint64_t file_size = std::filesystem::file_size(argv[2]);
+  const uint64_t triangle_bytes = t * (128 + 4 + 4), bvh_bytes = file.bvh.nodes.size() * 112;
+  const uint64_t texel_bytes = x * formats::kSceneTexelSize;
+  const uint64_t partial_bytes = file.texels.partial_coverage.size() * formats::kScenePartialCoverageSize;
+  const uint64_t moved_bytes = file.texels.moved.size() * formats::kSceneMovedTexelSize;
+  const uint64_t probe_bytes = file.probes.probes.size() * 16;
   std::printf(
-      "scene.bin %.2f MiB: triangles %zu (%.2f MiB), BVH %zu nodes (%.2f MiB), texels %.2f MiB, moved %.3f MiB, "
-      "probes %zu (%.3f MiB), rest %.3f MiB\n",
-      double(std::filesystem::file_size(argv[2])) / mib, t, double(t * 128) / mib, file.bvh.nodes.size(),
-      double(file.bvh.nodes.size() * 112 + t * 4) / mib, double(x * formats::kSceneTexelSize) / mib,
-      double(file.texels.moved.size() * formats::kSceneMovedTexelSize) / mib, file.probes.probes.size(),
-      double(file.probes.probes.size() * 16) / mib,
-      double(std::filesystem::file_size(argv[2]) - formats::kSceneHeaderSize - t * 132 - file.bvh.nodes.size() * 112 -
-             x * formats::kSceneTexelSize - file.texels.moved.size() * formats::kSceneMovedTexelSize -
-             file.probes.probes.size() * 16) /
-          mib);
+      "scene.bin %.2f MiB: %zu triangles %.2f MiB (incl. leaf slots and texel sizes), BVH %zu nodes %.2f MiB, "
+      "texels %.2f MiB, partial coverage %zu %.2f MiB, moved %zu %.3f MiB, probes %zu %.3f MiB, "
+      "header and named records %.3f MiB\n",
+      double(file_size) / mib, t, double(triangle_bytes) / mib, file.bvh.nodes.size(), double(bvh_bytes) / mib,
+      double(texel_bytes) / mib, file.texels.partial_coverage.size(), double(partial_bytes) / mib,
+      file.texels.moved.size(), double(moved_bytes) / mib, file.probes.probes.size(), double(probe_bytes) / mib,
+      double(file_size - triangle_bytes - bvh_bytes - texel_bytes - partial_bytes - moved_bytes - probe_bytes) / mib);
   std::printf("lightmap pages uncompressed (float32 R,G,B,A + direct.RGB + indirect.RGB = 40 B/texel): %.2f MiB\n",
               double(atlas_texels * 40) / mib);
   return 0;

@@ -70,13 +70,16 @@ void expect_records_equal(const formats::TexelGBufferRecords& a, const formats::
   for (size_t i = 0; i < a.texels.size(); ++i) {
     const formats::TexelRecord &x = a.texels[i], &y = b.texels[i];
     const bool same = x.triangle == y.triangle && x.x == y.x && x.y == y.y &&
-                      std::bit_cast<uint32_t>(x.coverage) == std::bit_cast<uint32_t>(y.coverage) &&
                       std::bit_cast<uint32_t>(x.b1) == std::bit_cast<uint32_t>(y.b1) &&
-                      std::bit_cast<uint32_t>(x.b2) == std::bit_cast<uint32_t>(y.b2) &&
-                      std::bit_cast<uint32_t>(x.world_texel_size) == std::bit_cast<uint32_t>(y.world_texel_size);
+                      std::bit_cast<uint32_t>(x.b2) == std::bit_cast<uint32_t>(y.b2);
     if (!same) ++differing;
   }
   EXPECT_EQ(differing, 0u);
+  EXPECT_EQ(a.triangle_texel_size, b.triangle_texel_size);
+  ASSERT_EQ(a.partial_coverage.size(), b.partial_coverage.size());
+  for (size_t i = 0; i < a.partial_coverage.size(); ++i)
+    EXPECT_EQ(std::tie(a.partial_coverage[i].texel, a.partial_coverage[i].coverage),
+              std::tie(b.partial_coverage[i].texel, b.partial_coverage[i].coverage));
   ASSERT_EQ(a.moved.size(), b.moved.size());
   for (size_t i = 0; i < a.moved.size(); ++i)
     EXPECT_EQ(std::tie(a.moved[i].texel, a.moved[i].position), std::tie(b.moved[i].texel, b.moved[i].position));
@@ -102,8 +105,8 @@ TEST(TexelGBufferCodec, DecodeOfEncodeReproducesTheGBufferBitForBit) {
   const formats::TexelGBufferRecords raster_records = encode_texel_gbuffer(raster, p.scene, p.layout);
   EXPECT_TRUE(raster_records.moved.empty());
   expect_gbuffers_equal(raster, decode_texel_gbuffer(raster_records, p.scene));
-  std::printf("cornell_room: %zu live texels on %zu pages, %zu moved by unocclude\n", p.gbuffer.texels.size(),
-              p.gbuffer.pages.size(), unoccluded.size());
+  std::printf("cornell_room: %zu live texels on %zu pages, %zu partly covered, %zu moved by unocclude\n",
+              p.gbuffer.texels.size(), p.gbuffer.pages.size(), records.partial_coverage.size(), unoccluded.size());
 }
 
 TEST(TexelGBufferCodec, EncodeOfDecodeGivesTheSameRecords) {
@@ -147,6 +150,15 @@ TEST(TexelGBufferCodec, RefusesGBuffersItCannotStore) {
       },
       "texel 9: coverage 1.500000 is not in (0, 1]");
   refused([](TexelGBuffer& g, const Scene&) { g.texels.pop_back(); }, "has coverage but is not live");
+  refused(
+      [](TexelGBuffer& g, const Scene&) {
+        for (size_t i = 1; i < g.texels.size(); ++i)
+          if (g.texels[i].triangle == g.texels[0].triangle) {
+            g.texels[i].world_texel_size *= 2;
+            return;
+          }
+      },
+      "world texel size differs from that of other texels of triangle");
 }
 
 struct ConvertedCornell {

@@ -25,8 +25,8 @@ constexpr size_t kHeader = kSceneHeaderSize;
 
 // Payload section offsets (scene_format.md, "Payload") for the sample's counts.
 struct Offsets {
-  size_t positions, normals, lightmap_uv, uv0, material, instance, bvh_nodes, bvh_leaves, pages, texel_triangle,
-      texel_xy, texel_barycentrics, texel_world_size, texel_coverage, moved, probes, materials;
+  size_t positions, normals, lightmap_uv, uv0, material, instance, texel_size, bvh_nodes, bvh_leaves, pages,
+      texel_triangle, texel_xy, texel_barycentrics, partial_coverage, moved, probes, materials;
 };
 Offsets offsets_for(const SceneFile& s) {
   Offsets o{};
@@ -37,15 +37,15 @@ Offsets offsets_for(const SceneFile& s) {
   o.uv0 = o.lightmap_uv + 24 * t;
   o.material = o.uv0 + 24 * t;
   o.instance = o.material + 4 * t;
-  o.bvh_nodes = o.instance + 4 * t;
+  o.texel_size = o.instance + 4 * t;
+  o.bvh_nodes = o.texel_size + 4 * t;
   o.bvh_leaves = o.bvh_nodes + 112 * s.bvh.nodes.size();
   o.pages = o.bvh_leaves + 4 * s.bvh.leaf_triangles.size();
   o.texel_triangle = o.pages + 12 * s.texels.pages.size();
   o.texel_xy = o.texel_triangle + 4 * n;
   o.texel_barycentrics = o.texel_xy + 4 * n;
-  o.texel_world_size = o.texel_barycentrics + 8 * n;
-  o.texel_coverage = o.texel_world_size + 4 * n;
-  o.moved = o.texel_coverage + 4 * n;
+  o.partial_coverage = o.texel_barycentrics + 8 * n;
+  o.moved = o.partial_coverage + 8 * s.texels.partial_coverage.size();
   o.probes = o.moved + 16 * s.texels.moved.size();
   o.materials = o.probes + 16 * s.probes.probes.size();
   return o;
@@ -148,10 +148,14 @@ void expect_bitwise_equal(const SceneFile& a, const SceneFile& b) {
   for (size_t i = 0; i < a.texels.texels.size(); ++i) {
     const TexelRecord &x = a.texels.texels[i], &y = b.texels.texels[i];
     EXPECT_EQ(std::tie(x.triangle, x.x, x.y), std::tie(y.triangle, y.x, y.y)) << "texel " << i;
-    EXPECT_EQ(std::bit_cast<uint32_t>(x.coverage), std::bit_cast<uint32_t>(y.coverage));
     EXPECT_EQ(std::bit_cast<uint32_t>(x.b1), std::bit_cast<uint32_t>(y.b1));
     EXPECT_EQ(std::bit_cast<uint32_t>(x.b2), std::bit_cast<uint32_t>(y.b2));
-    EXPECT_EQ(std::bit_cast<uint32_t>(x.world_texel_size), std::bit_cast<uint32_t>(y.world_texel_size));
+  }
+  expect_same_bytes(a.texels.triangle_texel_size, b.texels.triangle_texel_size, "triangle texel sizes");
+  ASSERT_EQ(a.texels.partial_coverage.size(), b.texels.partial_coverage.size());
+  for (size_t i = 0; i < a.texels.partial_coverage.size(); ++i) {
+    const PartialCoverageRecord &x = a.texels.partial_coverage[i], &y = b.texels.partial_coverage[i];
+    EXPECT_EQ(std::tie(x.texel, x.coverage), std::tie(y.texel, y.coverage));
   }
   ASSERT_EQ(a.texels.moved.size(), b.texels.moved.size());
   for (size_t i = 0; i < a.texels.moved.size(); ++i) {
@@ -207,21 +211,22 @@ TEST(SceneFile, HeaderAndPayloadHaveTheDocumentedLayout) {
   auto u32 = [&](size_t offset) { return test::get_u32(b, offset); };
   EXPECT_EQ(std::memcmp(b.data(), "EXSCENE\0", 8), 0);
   EXPECT_EQ(u32(8), 1u);
-  EXPECT_EQ(u32(12), 144u);
-  const uint32_t counts[14] = {4, 3, 2, 5, 2, 3, 2, 5, 1, 4, 2, 4, 4, 2};
-  for (int i = 0; i < 14; ++i) EXPECT_EQ(u32(16 + 4 * size_t(i)), counts[i]) << "header field at " << 16 + 4 * i;
-  EXPECT_EQ(f32(72), 0.1f);  // sky
-  EXPECT_EQ(f32(80), 0.4f);
-  EXPECT_EQ(u32(84), 0u);     // no environment
-  EXPECT_EQ(f32(88), 3.5f);   // texel density
-  EXPECT_EQ(f32(92), -1.0f);  // probe origin
-  EXPECT_EQ(f32(104), 2.0f);  // probe spacing
-  EXPECT_EQ(u32(116), 2u);    // probe counts
-  EXPECT_EQ(u32(120), 1u);
-  EXPECT_EQ(u32(124), 2u);
-  EXPECT_EQ(test::get_u64(b, 128), b.size() - kHeader);
-  EXPECT_EQ(u32(136), crc32(b.data() + kHeader, b.size() - kHeader));
-  EXPECT_EQ(u32(140), crc32(b.data(), 140));
+  EXPECT_EQ(u32(12), 160u);
+  const uint32_t counts[15] = {4, 3, 2, 5, 2, 3, 2, 5, 3, 1, 4, 2, 4, 4, 2};
+  for (int i = 0; i < 15; ++i) EXPECT_EQ(u32(16 + 4 * size_t(i)), counts[i]) << "header field at " << 16 + 4 * i;
+  EXPECT_EQ(f32(76), 0.1f);  // sky
+  EXPECT_EQ(f32(84), 0.4f);
+  EXPECT_EQ(u32(88), 0u);     // no environment
+  EXPECT_EQ(f32(92), 3.5f);   // texel density
+  EXPECT_EQ(f32(96), -1.0f);  // probe origin
+  EXPECT_EQ(f32(108), 2.0f);  // probe spacing
+  EXPECT_EQ(u32(120), 2u);    // probe counts
+  EXPECT_EQ(u32(124), 1u);
+  EXPECT_EQ(u32(128), 2u);
+  EXPECT_EQ(u32(132) | u32(136) | u32(140), 0u);  // reserved
+  EXPECT_EQ(test::get_u64(b, 144), b.size() - kHeader);
+  EXPECT_EQ(u32(152), crc32(b.data() + kHeader, b.size() - kHeader));
+  EXPECT_EQ(u32(156), crc32(b.data(), 156));
 
   EXPECT_EQ(f32(o.positions + 36 * 2 + 8), -2.0f);    // triangle 2, corner 0, z
   EXPECT_EQ(f32(o.normals + 36 * 3 + 12 + 8), 0.8f);  // triangle 3, corner 1, z
@@ -238,8 +243,9 @@ TEST(SceneFile, HeaderAndPayloadHaveTheDocumentedLayout) {
   EXPECT_EQ(u32(o.texel_triangle + 4 * 4), 3u);
   EXPECT_EQ(u32(o.texel_xy + 4 * 2), 3u | (2u << 16));
   EXPECT_EQ(f32(o.texel_barycentrics + 8 * 4 + 4), 0.25f);
-  EXPECT_EQ(f32(o.texel_world_size), 0.3f);
-  EXPECT_EQ(f32(o.texel_coverage + 4 * 1), 0.6f);
+  EXPECT_EQ(f32(o.texel_size + 4 * 2), 0.5f);
+  EXPECT_EQ(u32(o.partial_coverage + 8 * 1), 2u);
+  EXPECT_EQ(f32(o.partial_coverage + 8 * 1 + 4), 1e-3f);
   EXPECT_EQ(u32(o.moved), 3u);
   EXPECT_EQ(f32(o.moved + 4 + 8), -1.999f);
   EXPECT_EQ(f32(o.probes + 16 * 3), 2.0f);
@@ -329,8 +335,8 @@ const StructuralCase kStructuralCases[] = {
      "bvh node 0: child 0 box does not contain node 1's child"},
     {"bvh nan bound", [](auto& b, auto& o) { put_f32(b, bvh_plane(o, 1, 4, 3), std::nanf("")); },
      "bvh node 1: child 3 bounds are not finite"},
-    {"bvh stack bound", [](auto& b, auto&) { put_u32(b, 64, 3); }, "bvh: stack bound 3 is not the 4 the tree needs"},
-    {"bvh depth", [](auto& b, auto&) { put_u32(b, 68, 9); }, "bvh: depth 9 is not the tree's 2"},
+    {"bvh stack bound", [](auto& b, auto&) { put_u32(b, 68, 3); }, "bvh: stack bound 3 is not the 4 the tree needs"},
+    {"bvh depth", [](auto& b, auto&) { put_u32(b, 72, 9); }, "bvh: depth 9 is not the tree's 2"},
     {"texel triangle out of range", [](auto& b, auto& o) { put_u32(b, o.texel_triangle + 4, 4); },
      "texel 1: triangle 4 does not exist (4 triangles)"},
     {"texel on another page's triangle", [](auto& b, auto& o) { put_u32(b, o.texel_triangle + 4, 2); },
@@ -343,10 +349,16 @@ const StructuralCase kStructuralCases[] = {
      "texel 1: barycentrics 0.500000, 1.000000 are not on the triangle"},
     {"nan barycentric", [](auto& b, auto& o) { put_f32(b, o.texel_barycentrics, std::nanf("")); },
      "texel 0: barycentrics nan"},
-    {"zero coverage", [](auto& b, auto& o) { put_f32(b, o.texel_coverage + 8, 0.0f); },
-     "texel 2: coverage 0.000000 is not in (0, 1]"},
-    {"coverage above one", [](auto& b, auto& o) { put_f32(b, o.texel_coverage + 12, 1.0001f); },
-     "texel 3: coverage 1.000100 is not in (0, 1]"},
+    {"zero coverage", [](auto& b, auto& o) { put_f32(b, o.partial_coverage + 4, 0.0f); },
+     "partial coverage 0: coverage 0.000000 is not in (0, 1)"},
+    {"full coverage listed", [](auto& b, auto& o) { put_f32(b, o.partial_coverage + 8 + 4, 1.0f); },
+     "partial coverage 1: coverage 1.000000 is not in (0, 1)"},
+    {"partial coverage out of order", [](auto& b, auto& o) { put_u32(b, o.partial_coverage + 8, 1); },
+     "partial coverage 1: texel 1 is out of range or not after the previous one"},
+    {"partial coverage out of range", [](auto& b, auto& o) { put_u32(b, o.partial_coverage + 16, 5); },
+     "partial coverage 2: texel 5 is out of range"},
+    {"negative world texel size", [](auto& b, auto& o) { put_f32(b, o.texel_size + 4, -0.3f); },
+     "triangle 1: world texel size -0.300000 is not a finite non-negative number"},
     {"moved position", [](auto& b, auto& o) { put_f32(b, o.moved + 8, INFINITY); },
      "moved texel 0: position is not finite"},
     {"moved texel out of range", [](auto& b, auto& o) { put_u32(b, o.moved, 5); },
@@ -365,11 +377,12 @@ const StructuralCase kStructuralCases[] = {
      "probe 0: state 4 is not a known ProbeState"},
     {"probe position", [](auto& b, auto& o) { put_f32(b, o.probes + 16 + 4, -INFINITY); },
      "probe 1: position is not finite"},
-    {"probe counts", [](auto& b, auto&) { put_u32(b, 116, 3); }, "probe count 4 is not 3 x 1 x 2"},
-    {"probe spacing", [](auto& b, auto&) { put_f32(b, 108, 0.0f); }, "probe spacing on axis 1 is not a positive"},
-    {"sky environment", [](auto& b, auto&) { put_u32(b, 84, 1); }, "environment maps are not stored by version 1"},
-    {"negative sky", [](auto& b, auto&) { put_f32(b, 76, -0.5f); }, "sky radiance must be finite and >= 0"},
-    {"texel density", [](auto& b, auto&) { put_f32(b, 88, std::nanf("")); }, "texel density nan"},
+    {"probe counts", [](auto& b, auto&) { put_u32(b, 120, 3); }, "probe count 4 is not 3 x 1 x 2"},
+    {"probe spacing", [](auto& b, auto&) { put_f32(b, 112, 0.0f); }, "probe spacing on axis 1 is not a positive"},
+    {"sky environment", [](auto& b, auto&) { put_u32(b, 88, 1); }, "environment maps are not stored by version 1"},
+    {"negative sky", [](auto& b, auto&) { put_f32(b, 80, -0.5f); }, "sky radiance must be finite and >= 0"},
+    {"texel density", [](auto& b, auto&) { put_f32(b, 92, std::nanf("")); }, "texel density nan"},
+    {"reserved", [](auto& b, auto&) { put_u32(b, 136, 1); }, "header: reserved field at offset 136 is 1, not 0"},
     {"too many triangles", [](auto& b, auto&) { put_u32(b, 16, 1u << 29); }, "triangles exceed the limit"},
     {"counts beyond the payload", [](auto& b, auto&) { put_u32(b, 44, 0x40000000u); },
      "the header's counts need at least"},

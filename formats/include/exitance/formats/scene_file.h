@@ -22,10 +22,11 @@ namespace exitance::formats {
 
 inline constexpr char kSceneMagic[8] = {'E', 'X', 'S', 'C', 'E', 'N', 'E', '\0'};
 constexpr uint32_t kSceneFormatVersion = 1;
-constexpr uint32_t kSceneHeaderSize = 144;
+constexpr uint32_t kSceneHeaderSize = 160;
 // Fixed record sizes (bytes) of the payload's arrays; scene_format.md has the layouts.
 constexpr uint32_t kSceneBvhNodeSize = 112;
-constexpr uint32_t kSceneTexelSize = 24;  // over the five per-texel arrays
+constexpr uint32_t kSceneTexelSize = 16;  // over the three per-texel arrays
+constexpr uint32_t kScenePartialCoverageSize = 8;
 constexpr uint32_t kSceneMovedTexelSize = 16;
 // Refused above these: a corrupt count must not become a huge allocation, and the BVH's leaf words
 // hold a 29-bit first slot (formats/scene_format.md, "BVH").
@@ -117,9 +118,10 @@ struct LightRecord {
 };
 
 // The compact texel G-buffer (scene_format.md, "Texels"): per live texel its triangle, texel
-// coordinates, barycentrics on the triangle, world texel size and coverage; position, normals,
-// albedo and instance are derived on load (runtime/include/exitance/runtime/texel_surface.h).
-// Texels the unocclude step moved off that point keep their exact position in `moved`.
+// coordinates and barycentrics on the triangle; per triangle the world texel size; coverage 1
+// except for the texels listed in `partial_coverage`. Position, normals, albedo and instance are
+// derived on load (runtime/include/exitance/runtime/texel_surface.h); texels the unocclude step
+// moved off that point keep their exact position in `moved`.
 struct TexelPageRecord {
   uint32_t width = 0, height = 0;
   uint32_t live_texels = 0;  // texels of this page in TexelGBufferRecords::texels, after earlier pages'
@@ -129,8 +131,11 @@ struct TexelRecord {
   uint32_t triangle = 0;
   uint16_t x = 0, y = 0;  // column, row (row 0 = top)
   float b1 = 0, b2 = 0;   // barycentric weights of corners 1 and 2
-  float world_texel_size = 0;
-  float coverage = 1;  // fraction of the texel covered by charts, in (0, 1] (lightmap A channel)
+};
+
+struct PartialCoverageRecord {
+  uint32_t texel = 0;  // index into TexelGBufferRecords::texels
+  float coverage = 0;  // fraction of the texel covered by charts, in (0, 1) (the lightmap's A channel)
 };
 
 struct MovedTexelRecord {
@@ -140,8 +145,10 @@ struct MovedTexelRecord {
 
 struct TexelGBufferRecords {
   std::vector<TexelPageRecord> pages;
-  std::vector<TexelRecord> texels;      // page-major; Morton order (x bits even, y bits odd) inside a page
-  std::vector<MovedTexelRecord> moved;  // ascending texel index
+  std::vector<TexelRecord> texels;         // page-major; Morton order (x bits even, y bits odd) inside a page
+  std::vector<float> triangle_texel_size;  // per scene triangle: world-space edge of one of its texels
+  std::vector<PartialCoverageRecord> partial_coverage;  // ascending texel index; every other texel: 1
+  std::vector<MovedTexelRecord> moved;                  // ascending texel index
 };
 
 // One node of the GPU BVH4 (runtime/src/vulkan/gpu_bvh.h): child i's box and child word.
