@@ -1,5 +1,6 @@
 #include "exitance/bake/gltf_import.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -108,6 +109,52 @@ std::vector<uint32_t> triangle_list(int mode, const std::vector<uint32_t>& indic
   return out;
 }
 
+// The node as written in the file, for Scene::nodes: its local transform exactly as given (the
+// importer validates it when the default scene reaches the node; sanitize_unreached_node resets
+// the others' unusable transforms, as such nodes are never drawn).
+SceneNode scene_node(const tinygltf::Node& node) {
+  SceneNode n;
+  n.name = node.name;
+  n.mesh = node.mesh >= 0 ? node.mesh : -1;
+  if (node.matrix.size() == 16) {
+    n.has_matrix = true;
+    std::copy(node.matrix.begin(), node.matrix.end(), n.matrix.begin());
+  }
+  if (node.translation.size() == 3) std::copy(node.translation.begin(), node.translation.end(), n.translation.begin());
+  if (node.rotation.size() == 4) std::copy(node.rotation.begin(), node.rotation.end(), n.rotation.begin());
+  if (node.scale.size() == 3) std::copy(node.scale.begin(), node.scale.end(), n.scale.begin());
+  return n;
+}
+
+void sanitize_unreached_node(SceneNode& n) {
+  bool usable = true;
+  for (double v : n.matrix) usable = usable && std::isfinite(v);
+  for (double v : n.translation) usable = usable && std::isfinite(v);
+  for (double v : n.rotation) usable = usable && std::isfinite(v);
+  for (double v : n.scale) usable = usable && std::isfinite(v);
+  const auto& q = n.rotation;
+  usable = usable && q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] > 1e-24;
+  if (n.has_matrix)
+    usable = usable && n.translation == std::array<double, 3>{0, 0, 0} && q == std::array<double, 4>{0, 0, 0, 1} &&
+             n.scale == std::array<double, 3>{1, 1, 1};
+  if (usable) return;
+  const SceneNode defaults;
+  n.has_matrix = false;
+  n.matrix = defaults.matrix;
+  n.translation = defaults.translation;
+  n.rotation = defaults.rotation;
+  n.scale = defaults.scale;
+}
+
+// glTF's rules for a camera projection (finite as floats; a perspective zfar of 0 is infinite).
+bool camera_projection_is_valid(const SceneCamera& c) {
+  for (float v : {c.yfov, c.aspect_ratio, c.xmag, c.ymag, c.znear, c.zfar})
+    if (!std::isfinite(v)) return false;
+  if (c.type == SceneCamera::Type::Perspective)
+    return c.yfov > 0 && c.aspect_ratio >= 0 && c.znear > 0 && (c.zfar == 0 || c.zfar > c.znear);
+  return c.xmag != 0 && c.ymag != 0 && c.znear >= 0 && c.zfar > c.znear;
+}
+
 struct RepairCounts {
   size_t degenerate_triangles = 0;
   size_t recomputed_normals = 0;
@@ -120,12 +167,15 @@ class SceneFlattener {
   SceneFlattener(const tinygltf::Model& model, const std::string& file, const ImportOptions& options, Scene& scene,
                  Diagnostics& diagnostics, uint32_t default_material)
       : model_(model), file_(file), options_(options), scene_(scene), diagnostics_(diagnostics),
-        default_material_(default_material), node_state_(model.nodes.size(), 0) {}
+        default_material_(default_material), node_state_(model.nodes.size(), 0) {
+    scene_.nodes.reserve(model.nodes.size());
+    for (const tinygltf::Node& node : model.nodes) scene_.nodes.push_back(scene_node(node));
+  }
 
   void add_scene_roots(const std::vector<int>& roots) {
-    struct Pending { int node; Mat4 parent; size_t depth; bool leaving; };
+    struct Pending { int node; Mat4 parent; size_t depth; bool leaving; int parent_node; };
     std::vector<Pending> stack;
-    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, identity(), 0, false});
+    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, identity(), 0, false, -1});
     while (!stack.empty()) {
       Pending item = stack.back();
       stack.pop_back();
@@ -139,15 +189,20 @@ class SceneFlattener {
       if (item.depth > kMaxNodeDepth)
         throw InputError(file_, element, "hierarchy is deeper than " + std::to_string(kMaxNodeDepth) + " levels");
       node_state_[size_t(item.node)] = 1;
+      scene_.nodes[size_t(item.node)].in_scene = true;
+      scene_.nodes[size_t(item.node)].parent = item.parent_node;
       const tinygltf::Node& node = model_.nodes[size_t(item.node)];
       const Mat4 world = multiply(item.parent, local_transform(node, file_, element));
       if (node.mesh >= 0) add_mesh_instance(item.node, node, world);
       else if (node.mesh < -1) throw InputError(file_, element, "mesh " + std::to_string(node.mesh) + " does not exist");
       add_light_if_any(item.node, node, world);
-      stack.push_back({item.node, world, item.depth, true});
+      add_camera_if_any(item.node, node);
+      stack.push_back({item.node, world, item.depth, true, item.parent_node});
       for (auto child = node.children.rbegin(); child != node.children.rend(); ++child)
-        stack.push_back({*child, world, item.depth + 1, false});
+        stack.push_back({*child, world, item.depth + 1, false, item.node});
     }
+    for (SceneNode& n : scene_.nodes)
+      if (!n.in_scene) sanitize_unreached_node(n);
   }
 
   void report_repairs() const {
@@ -174,6 +229,7 @@ class SceneFlattener {
     instance.name = node.name.empty() ? mesh.name : node.name;
     instance.mesh = node.mesh;
     instance.first_triangle = uint32_t(scene_.triangle_count());
+    instance.world = world;
     const uint32_t instance_index = uint32_t(scene_.instances.size());
     const bool flip_winding = determinant3(world) < 0;
     for (size_t p = 0; p < mesh.primitives.size(); ++p)
@@ -329,7 +385,47 @@ class SceneFlattener {
     if (source.range > 0 && light.type != PunctualLight::Type::Directional)
       diagnostics_.warn(file_ + ": " + light_element +
                         ": range ignored (baked lighting uses the physical inverse-square falloff)");
+    light.node = node_index;
+    scene_.nodes[size_t(node_index)].light = int(scene_.lights.size());
     scene_.lights.push_back(std::move(light));
+  }
+
+  // A camera with an invalid projection is dropped with a warning: it does not affect the bake.
+  void add_camera_if_any(int node_index, const tinygltf::Node& node) {
+    if (node.camera < 0) return;
+    const std::string element = "node " + std::to_string(node_index);
+    if (size_t(node.camera) >= model_.cameras.size())
+      throw InputError(file_, element, "camera " + std::to_string(node.camera) + " does not exist");
+    const tinygltf::Camera& source = model_.cameras[size_t(node.camera)];
+    const std::string camera_element = "camera " + std::to_string(node.camera);
+    SceneCamera camera;
+    camera.name = source.name;
+    camera.node = node_index;
+    if (source.type == "perspective") {
+      camera.type = SceneCamera::Type::Perspective;
+      camera.yfov = float(source.perspective.yfov);
+      camera.aspect_ratio = float(source.perspective.aspectRatio);
+      camera.znear = float(source.perspective.znear);
+      camera.zfar = float(source.perspective.zfar);
+    } else if (source.type == "orthographic") {
+      camera.type = SceneCamera::Type::Orthographic;
+      camera.xmag = float(source.orthographic.xmag);
+      camera.ymag = float(source.orthographic.ymag);
+      camera.znear = float(source.orthographic.znear);
+      camera.zfar = float(source.orthographic.zfar);
+    } else {
+      diagnostics_.warn(file_ + ": " + camera_element + ": type '" + source.type +
+                        "' is not perspective or orthographic; camera ignored");
+      return;
+    }
+    if (!camera_projection_is_valid(camera)) {
+      diagnostics_.warn(file_ + ": " + camera_element +
+                        ": invalid projection (glTF needs yfov > 0, znear > 0, zfar > znear; "
+                        "orthographic xmag, ymag non-zero); camera ignored");
+      return;
+    }
+    scene_.nodes[size_t(node_index)].camera = int(scene_.cameras.size());
+    scene_.cameras.push_back(std::move(camera));
   }
 
   const tinygltf::Model& model_;

@@ -13,8 +13,8 @@ PreparedScene prepare_scene_for_lighting(const std::string& path, const std::str
   PreparedScene prepared;
   prepared.scene = import_gltf(path, {}, diagnostics);
   prepared.scene.sky = parse_sky_option(sky);
-  const AtlasLayout layout = layout_lightmap_atlas(prepared.scene, atlas, path, diagnostics);
-  prepared.gbuffer = rasterize_texel_gbuffer(prepared.scene, layout, path, diagnostics);
+  prepared.layout = layout_lightmap_atlas(prepared.scene, atlas, path, diagnostics);
+  prepared.gbuffer = rasterize_texel_gbuffer(prepared.scene, prepared.layout, path, diagnostics);
   const EmbreeScene embree(prepared.scene);
   unocclude_texels(embree, prepared.gbuffer);
   return prepared;

@@ -1,5 +1,5 @@
-// Little-endian field (de)serialisation and whole-file I/O shared by probes_file.cpp and
-// svo_file.cpp. Fields are assembled byte by byte so the files are the same on any host and no
+// Little-endian field (de)serialisation and whole-file I/O shared by probes_file.cpp,
+// svo_file.cpp and scene_file.cpp. Fields are assembled byte by byte so the files are the same on any host and no
 // struct layout or alignment leaks into the format.
 #pragma once
 #include <bit>
@@ -27,6 +27,7 @@ class LittleEndianWriter {
   void u32(uint32_t v) { for (int i = 0; i < 4; ++i) out_.push_back(uint8_t(v >> (8 * i))); }
   void u64(uint64_t v) { for (int i = 0; i < 8; ++i) out_.push_back(uint8_t(v >> (8 * i))); }
   void f32(float v) { u32(std::bit_cast<uint32_t>(v)); }
+  void f64(double v) { u64(std::bit_cast<uint64_t>(v)); }
 
  private:
   std::vector<uint8_t>& out_;
@@ -52,6 +53,13 @@ class LittleEndianReader {
     return low | (uint64_t(u32()) << 32);
   }
   float f32() { return std::bit_cast<float>(u32()); }
+  double f64() { return std::bit_cast<double>(u64()); }
+  // n bytes as a string (the caller checks n against its limit first).
+  std::string text(size_t n) {
+    const uint8_t* p = take(n);
+    return std::string(reinterpret_cast<const char*>(p), n);
+  }
+  size_t remaining() const { return size_ - position_; }
   void skip(size_t n) { take(n); }
   size_t position() const { return position_; }
 

@@ -1,5 +1,5 @@
-// The framing probes.bin and svo.bin share (probes_format.md, svo_format.md): an 8-byte magic, a
-// u32 format version, a u32 header size, format-specific header fields, then the last 16 header
+// The framing probes.bin, svo.bin and scene.bin share (probes_format.md, svo_format.md,
+// scene_format.md): an 8-byte magic, a u32 format version, a u32 header size, format-specific header fields, then the last 16 header
 // bytes are the u64 payload size, the CRC-32 of the payload and the CRC-32 of the header bytes
 // before it; the payload follows the header and ends the file.
 #pragma once

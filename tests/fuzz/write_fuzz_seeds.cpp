@@ -1,11 +1,13 @@
-// write_fuzz_seeds DIR: valid probes.bin, svo.bin and manifest.json files, written by the real
-// writers, as the fuzzers' starting corpus (DIR/probes, DIR/svo, DIR/manifest).
+// write_fuzz_seeds DIR: valid probes.bin, svo.bin, scene.bin and manifest.json files, written by
+// the real writers, as the fuzzers' starting corpus (DIR/probes, DIR/svo, DIR/scene, DIR/manifest).
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 
 #include "exitance/formats/probes_file.h"
+#include "exitance/formats/scene_file.h"
 #include "exitance/formats/svo_file.h"
+#include "sample_scene_file.h"
 
 using namespace exitance::formats;
 namespace fs = std::filesystem;
@@ -83,7 +85,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path dir = argv[1];
-  for (const char* kind : {"probes", "svo", "manifest"}) fs::create_directories(dir / kind);
+  for (const char* kind : {"probes", "svo", "scene", "manifest"}) fs::create_directories(dir / kind);
   write_probes_file((dir / "probes" / "grid-2x2x2.bin").string(), probe_grid({2, 2, 2}));
   write_probes_file((dir / "probes" / "grid-3x1x1.bin").string(), probe_grid({3, 1, 1}));
   write_probes_file((dir / "probes" / "grid-1x1x1.bin").string(), probe_grid({1, 1, 1}));
@@ -93,6 +95,16 @@ int main(int argc, char** argv) {
   write_svo_file((dir / "svo" / "chain-0.bin").string(), chain_octree(0));
   write_svo_file((dir / "svo" / "chain-3.bin").string(), chain_octree(3));
   write_svo_file((dir / "svo" / "bushy.bin").string(), bushy_octree());
+  // scene.bin: the tests' sample (every section used), without probes, and empty.
+  SceneFile scene = exitance::test::make_sample_scene_file();
+  write_scene_file((dir / "scene" / "sample.bin").string(), scene);
+  scene.probes = SceneFile::no_probe_grid();
+  scene.texels.moved.clear();
+  write_scene_file((dir / "scene" / "no-probes.bin").string(), scene);
+  SceneFile empty_scene;
+  empty_scene.bvh.nodes.resize(1);
+  exitance::test::set_empty_children(empty_scene.bvh.nodes[0]);
+  write_scene_file((dir / "scene" / "empty.bin").string(), empty_scene);
   write_text(dir / "manifest" / "full.json", R"({"format_version": 1, "generator": "exitance 0.1.0",
  "input": {"file": "scene.gltf", "sha256": "00"},
  "units": {"lightmap": "irradiance_over_pi", "probes": "incident_radiance_sh_l2", "length": "scene"},

@@ -221,5 +221,73 @@ TEST(GltfImport, NonFinitePositionIsAnErrorNamingTheAccessor) {
   std::filesystem::remove_all(dir);
 }
 
+// Scene::nodes keeps every glTF node (names, parents, local transforms as written), instances
+// their world transform, lights and cameras the node that places them; an invalid camera is
+// dropped with a warning.
+TEST(GltfImport, KeepsTheNodeHierarchyCamerasAndLightNodes) {
+  json d = triangle_document();
+  d["extensionsUsed"] = {"KHR_lights_punctual"};
+  d["extensions"]["KHR_lights_punctual"]["lights"] =
+      json::parse(R"([{"type": "point", "name": "Lamp", "intensity": 2}])");
+  d["cameras"] = json::parse(R"([
+    {"type": "perspective", "name": "Main", "perspective": {"yfov": 0.7, "znear": 0.1, "zfar": 50, "aspectRatio": 1.5}},
+    {"type": "orthographic", "name": "Broken", "orthographic": {"xmag": 0, "ymag": 1, "znear": 0, "zfar": 10}}])");
+  d["nodes"] = json::parse(R"([
+    {"name": "Root", "translation": [1, 2, 3], "scale": [2, 2, 2], "children": [1, 2, 3], "camera": 0},
+    {"name": "Tri", "mesh": 0, "matrix": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 5, 1]},
+    {"name": "LampNode", "rotation": [0, 0, 0, 2], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+    {"name": "BadCam", "camera": 1},
+    {"name": "Elsewhere", "rotation": [0, 0, 0, 0], "mesh": 0}])");
+  const auto dir = std::filesystem::temp_directory_path() / ("gltf_import_test_nodes_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "nodes.gltf").string();
+  std::ofstream(path) << d.dump();
+  Diagnostics diagnostics;
+  const Scene scene = import_gltf(path, ImportOptions{}, diagnostics);
+  std::filesystem::remove_all(dir);
+
+  ASSERT_EQ(scene.nodes.size(), 5u);
+  EXPECT_EQ(scene.nodes[0].name, "Root");
+  EXPECT_EQ(scene.nodes[0].parent, -1);
+  EXPECT_TRUE(scene.nodes[0].in_scene);
+  EXPECT_FALSE(scene.nodes[0].has_matrix);
+  EXPECT_EQ(scene.nodes[0].translation, (std::array<double, 3>{1, 2, 3}));
+  EXPECT_EQ(scene.nodes[0].scale, (std::array<double, 3>{2, 2, 2}));
+  EXPECT_EQ(scene.nodes[0].camera, 0);
+  EXPECT_EQ(scene.nodes[1].parent, 0);
+  EXPECT_EQ(scene.nodes[1].mesh, 0);
+  EXPECT_TRUE(scene.nodes[1].has_matrix);
+  EXPECT_EQ(scene.nodes[1].matrix[14], 5.0);
+  EXPECT_EQ(scene.nodes[2].rotation, (std::array<double, 4>{0, 0, 0, 2}));  // as written, not normalized
+  EXPECT_EQ(scene.nodes[2].light, 0);
+  EXPECT_EQ(scene.nodes[3].camera, -1);  // its camera was dropped
+  EXPECT_FALSE(scene.nodes[4].in_scene);
+  EXPECT_EQ(scene.nodes[4].parent, -1);
+  EXPECT_EQ(scene.nodes[4].rotation, (std::array<double, 4>{0, 0, 0, 1}));  // unusable, never drawn: reset
+
+  ASSERT_EQ(scene.instances.size(), 1u);
+  EXPECT_EQ(scene.instances[0].node, 1);
+  // World = Root (T (1,2,3), S 2) * Tri (T (0,0,5)): translation (1, 2, 13), scale 2.
+  const Matrix4d expected{2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 2, 0, 1, 2, 13, 1};
+  EXPECT_EQ(scene.instances[0].world, expected);
+  EXPECT_EQ(scene.positions[1].x, 3.0f);  // corner (1, 0, 0) -> (3, 2, 13)
+  EXPECT_EQ(scene.positions[1].z, 13.0f);
+
+  ASSERT_EQ(scene.lights.size(), 1u);
+  EXPECT_EQ(scene.lights[0].name, "Lamp");
+  EXPECT_EQ(scene.lights[0].node, 2);
+  ASSERT_EQ(scene.cameras.size(), 1u);
+  EXPECT_EQ(scene.cameras[0].name, "Main");
+  EXPECT_EQ(scene.cameras[0].node, 0);
+  EXPECT_EQ(scene.cameras[0].type, SceneCamera::Type::Perspective);
+  EXPECT_EQ(scene.cameras[0].yfov, 0.7f);
+  EXPECT_EQ(scene.cameras[0].aspect_ratio, 1.5f);
+  EXPECT_EQ(scene.cameras[0].zfar, 50.0f);
+  bool warned = false;
+  for (const std::string& w : diagnostics.warnings)
+    warned = warned || w.find("camera 1: invalid projection") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
 }  // namespace
 }  // namespace exitance

@@ -14,6 +14,7 @@ namespace exitance {
 struct PreparedScene {
   Scene scene;
   TexelGBuffer gbuffer;
+  AtlasLayout layout;
 };
 
 // `sky` as for --sky ("" = black). Throws InputError for bad input.

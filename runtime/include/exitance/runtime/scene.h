@@ -1,6 +1,7 @@
 // The lighting stage's view of a scene: world-space triangle soup, materials, lights, sky.
 // Produced by the offline stage (bake/gltf_import), consumed by every backend.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -51,6 +52,7 @@ struct PunctualLight {
   Vec3 intensity{1, 1, 1};   // colour * intensity: W/sr for point/spot, W/m^2 for directional
   float cos_inner = 1.0f;    // spot only
   float cos_outer = 0.0f;    // spot only
+  int node = -1;             // the glTF node that places it (Scene::nodes), -1 when built in code
 };
 
 struct Sky {
@@ -60,6 +62,10 @@ struct Sky {
   bool has_environment() const { return environment.width > 0; }
 };
 
+// 4x4 matrix, column-major as glTF stores it; double precision as the importer composes it.
+using Matrix4d = std::array<double, 16>;
+inline constexpr Matrix4d kIdentityMatrix4d{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+
 // One mesh instance (a glTF node with a mesh). Triangles [first_triangle, first_triangle + triangle_count).
 struct Instance {
   int node = -1;
@@ -67,6 +73,34 @@ struct Instance {
   int mesh = -1;
   uint32_t first_triangle = 0;
   uint32_t triangle_count = 0;
+  Matrix4d world = kIdentityMatrix4d;  // node-to-world transform the triangles were flattened with
+};
+
+// A glTF node, kept so edits can address nodes by name and the runtime can recompose world
+// transforms: Scene::nodes[i] is glTF node i.
+struct SceneNode {
+  std::string name;
+  int parent = -1;          // -1: a root of the default scene, or a node outside it
+  int mesh = -1;            // glTF mesh index
+  int light = -1;           // index into Scene::lights (the light this node places)
+  int camera = -1;          // index into Scene::cameras (the camera this node places)
+  bool in_scene = false;    // reached from the default scene's roots
+  bool has_matrix = false;  // local transform is `matrix`; else translation * rotation * scale
+  std::array<double, 3> translation{0, 0, 0};
+  std::array<double, 4> rotation{0, 0, 0, 1};  // quaternion x, y, z, w, as written in the file
+  std::array<double, 3> scale{1, 1, 1};
+  Matrix4d matrix = kIdentityMatrix4d;
+};
+
+// A glTF camera placed by a node (not used for lighting; kept for viewers and edits).
+struct SceneCamera {
+  enum class Type { Perspective, Orthographic };
+  std::string name;  // the glTF camera's name
+  int node = -1;
+  Type type = Type::Perspective;
+  float yfov = 0, aspect_ratio = 0;  // perspective; aspect_ratio 0 = not given
+  float xmag = 0, ymag = 0;          // orthographic
+  float znear = 0, zfar = 0;         // perspective zfar 0 = infinite
 };
 
 // Unindexed triangle soup; every per-vertex array holds 3 entries per triangle.
@@ -82,6 +116,8 @@ struct Scene {
   std::vector<Instance> instances;
   std::vector<PunctualLight> lights;
   Sky sky;
+  std::vector<SceneNode> nodes;      // every glTF node, in glTF order (empty for scenes built in code)
+  std::vector<SceneCamera> cameras;  // one per node that places a camera
 
   size_t triangle_count() const { return triangle_material.size(); }
 };

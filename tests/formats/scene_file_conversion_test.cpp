@@ -1,0 +1,317 @@
+// The runtime side of scene.bin on a real rasterized scene (samples/cornell_room through the
+// offline stage): the texel G-buffer codec (decode(encode(g)) == g bit for bit, encode(decode(r))
+// == r, so decode(encode(.)) is idempotent bit for bit), the Scene <-> SceneFile conversion with
+// the real GPU BVH builder and probe placement, and what version 1 refuses to store.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <cstring>
+
+#include "byte_patching.h"
+#include "exitance/bake/prepared_scene.h"
+#include "exitance/bake/probe_placement.h"
+#include "exitance/bake/texel_raster.h"
+#include "exitance/runtime/embree_scene.h"
+#include "exitance/runtime/scene_file_conversion.h"
+#include "exitance/runtime/texel_gbuffer_codec.h"
+#include "gpu_bvh_records.h"
+
+namespace exitance {
+namespace {
+
+using test::expect_format_error;
+
+const PreparedScene& cornell() {
+  static const PreparedScene prepared = [] {
+    Diagnostics diagnostics;
+    // 24 texels per unit instead of the default 64: ~70k live texels keep each test under a second.
+    AtlasSettings atlas;
+    atlas.texel_density = 24;
+    return prepare_scene_for_lighting(EXITANCE_SAMPLE_DIR "/cornell_room.gltf", "0.1,0.2,0.3", atlas, diagnostics);
+  }();
+  return prepared;
+}
+
+bool same_bits(Vec3 a, Vec3 b) { return std::memcmp(&a, &b, sizeof(Vec3)) == 0; }
+
+// Every LiveTexel field, page size and coverage value bit for bit.
+void expect_gbuffers_equal(const TexelGBuffer& a, const TexelGBuffer& b) {
+  ASSERT_EQ(a.texels.size(), b.texels.size());
+  size_t differing = 0;
+  for (size_t i = 0; i < a.texels.size(); ++i) {
+    const LiveTexel &x = a.texels[i], &y = b.texels[i];
+    const bool same = x.page == y.page && x.x == y.x && x.y == y.y && x.instance == y.instance &&
+                      x.triangle == y.triangle && same_bits(x.position, y.position) &&
+                      same_bits(x.geometric_normal, y.geometric_normal) &&
+                      same_bits(x.shading_normal, y.shading_normal) && same_bits(x.albedo, y.albedo) &&
+                      std::bit_cast<uint32_t>(x.world_texel_size) == std::bit_cast<uint32_t>(y.world_texel_size);
+    if (!same && ++differing <= 5) ADD_FAILURE() << "texel " << i << " differs";
+  }
+  EXPECT_EQ(differing, 0u);
+  ASSERT_EQ(a.pages.size(), b.pages.size());
+  for (size_t p = 0; p < a.pages.size(); ++p) {
+    ASSERT_EQ(a.pages[p].width, b.pages[p].width);
+    ASSERT_EQ(a.pages[p].height, b.pages[p].height);
+    ASSERT_EQ(a.pages[p].coverage.size(), b.pages[p].coverage.size());
+    EXPECT_EQ(std::memcmp(a.pages[p].coverage.data(), b.pages[p].coverage.data(), a.pages[p].coverage.size() * 4), 0)
+        << "page " << p << " coverage";
+  }
+  EXPECT_EQ(a.skipped_texels, b.skipped_texels);
+}
+
+void expect_records_equal(const formats::TexelGBufferRecords& a, const formats::TexelGBufferRecords& b) {
+  ASSERT_EQ(a.pages.size(), b.pages.size());
+  for (size_t p = 0; p < a.pages.size(); ++p)
+    EXPECT_EQ(std::tie(a.pages[p].width, a.pages[p].height, a.pages[p].live_texels),
+              std::tie(b.pages[p].width, b.pages[p].height, b.pages[p].live_texels));
+  ASSERT_EQ(a.texels.size(), b.texels.size());
+  size_t differing = 0;
+  for (size_t i = 0; i < a.texels.size(); ++i) {
+    const formats::TexelRecord &x = a.texels[i], &y = b.texels[i];
+    const bool same = x.triangle == y.triangle && x.x == y.x && x.y == y.y &&
+                      std::bit_cast<uint32_t>(x.b1) == std::bit_cast<uint32_t>(y.b1) &&
+                      std::bit_cast<uint32_t>(x.b2) == std::bit_cast<uint32_t>(y.b2);
+    if (!same) ++differing;
+  }
+  EXPECT_EQ(differing, 0u);
+  EXPECT_EQ(a.triangle_texel_size, b.triangle_texel_size);
+  ASSERT_EQ(a.partial_coverage.size(), b.partial_coverage.size());
+  for (size_t i = 0; i < a.partial_coverage.size(); ++i)
+    EXPECT_EQ(std::tie(a.partial_coverage[i].texel, a.partial_coverage[i].coverage),
+              std::tie(b.partial_coverage[i].texel, b.partial_coverage[i].coverage));
+  ASSERT_EQ(a.moved.size(), b.moved.size());
+  for (size_t i = 0; i < a.moved.size(); ++i)
+    EXPECT_EQ(std::tie(a.moved[i].texel, a.moved[i].position), std::tie(b.moved[i].texel, b.moved[i].position));
+}
+
+TEST(TexelGBufferCodec, DecodeOfEncodeReproducesTheGBufferBitForBit) {
+  const PreparedScene& p = cornell();
+  ASSERT_GT(p.gbuffer.texels.size(), 1000u);
+  const formats::TexelGBufferRecords records = encode_texel_gbuffer(p.gbuffer, p.scene, p.layout);
+  expect_gbuffers_equal(p.gbuffer, decode_texel_gbuffer(records, p.scene));
+
+  // The moved table holds exactly the texels unocclude moved: compare with the raster alone,
+  // which needs no table at all.
+  Diagnostics diagnostics;
+  const TexelGBuffer raster = rasterize_texel_gbuffer(p.scene, p.layout, "cornell_room.gltf", diagnostics);
+  ASSERT_EQ(raster.texels.size(), p.gbuffer.texels.size());
+  std::vector<uint32_t> unoccluded;
+  for (size_t i = 0; i < raster.texels.size(); ++i)
+    if (!same_bits(raster.texels[i].position, p.gbuffer.texels[i].position)) unoccluded.push_back(uint32_t(i));
+  EXPECT_GT(unoccluded.size(), 0u);
+  ASSERT_EQ(records.moved.size(), unoccluded.size());
+  for (size_t k = 0; k < unoccluded.size(); ++k) EXPECT_EQ(records.moved[k].texel, unoccluded[k]);
+  const formats::TexelGBufferRecords raster_records = encode_texel_gbuffer(raster, p.scene, p.layout);
+  EXPECT_TRUE(raster_records.moved.empty());
+  expect_gbuffers_equal(raster, decode_texel_gbuffer(raster_records, p.scene));
+  std::printf("cornell_room: %zu live texels on %zu pages, %zu partly covered, %zu moved by unocclude\n",
+              p.gbuffer.texels.size(), p.gbuffer.pages.size(), records.partial_coverage.size(), unoccluded.size());
+}
+
+TEST(TexelGBufferCodec, EncodeOfDecodeGivesTheSameRecords) {
+  const PreparedScene& p = cornell();
+  const formats::TexelGBufferRecords once = encode_texel_gbuffer(p.gbuffer, p.scene, p.layout);
+  const TexelGBuffer decoded = decode_texel_gbuffer(once, p.scene);
+  const formats::TexelGBufferRecords twice = encode_texel_gbuffer(decoded, p.scene, p.layout);
+  expect_records_equal(once, twice);
+  expect_gbuffers_equal(decoded, decode_texel_gbuffer(twice, p.scene));
+}
+
+TEST(TexelGBufferCodec, RefusesGBuffersItCannotStore) {
+  const PreparedScene& p = cornell();
+  auto refused = [&](void (*edit)(TexelGBuffer&, const Scene&), const char* expected) {
+    TexelGBuffer g = p.gbuffer;
+    edit(g, p.scene);
+    expect_format_error([&] { encode_texel_gbuffer(g, p.scene, p.layout); }, expected);
+  };
+  refused([](TexelGBuffer& g, const Scene&) { g.pages[0].width = 70000; }, "page 0: size 70000");
+  refused([](TexelGBuffer& g, const Scene& s) { g.texels[5].triangle = uint32_t(s.triangle_count()); },
+          "texel 5: triangle");
+  refused([](TexelGBuffer& g, const Scene&) { g.texels[5].instance += 1; }, "texel 5: instance");
+  refused([](TexelGBuffer& g, const Scene&) { g.texels[7].geometric_normal.x += 0.5f; },
+          "texel 7: geometric normal is not its triangle's");
+  refused([](TexelGBuffer& g, const Scene&) { g.texels[8].shading_normal.y += 1e-3f; },
+          "texel 8: shading normal or albedo is not what its triangle gives");
+  refused([](TexelGBuffer& g, const Scene&) { g.texels[8].albedo.z *= 0.5f; },
+          "texel 8: shading normal or albedo is not what its triangle gives");
+  refused([](TexelGBuffer& g, const Scene&) { std::swap(g.texels[3], g.texels[4]); }, "not in Morton order");
+  refused([](TexelGBuffer& g, const Scene&) { g.texels[2].x = uint32_t(g.pages[0].width); }, "lies outside its page");
+  refused(
+      [](TexelGBuffer& g, const Scene&) {
+        const LiveTexel& t = g.texels[9];
+        g.pages[t.page].coverage[size_t(t.y) * size_t(g.pages[t.page].width) + t.x] = 0;
+      },
+      "texel 9: coverage 0.000000 is not in (0, 1]");
+  refused(
+      [](TexelGBuffer& g, const Scene&) {
+        const LiveTexel& t = g.texels[9];
+        g.pages[t.page].coverage[size_t(t.y) * size_t(g.pages[t.page].width) + t.x] = 1.5f;
+      },
+      "texel 9: coverage 1.500000 is not in (0, 1]");
+  refused([](TexelGBuffer& g, const Scene&) { g.texels.pop_back(); }, "has coverage but is not live");
+  refused(
+      [](TexelGBuffer& g, const Scene&) {
+        for (size_t i = 1; i < g.texels.size(); ++i)
+          if (g.texels[i].triangle == g.texels[0].triangle) {
+            g.texels[i].world_texel_size *= 2;
+            return;
+          }
+      },
+      "world texel size differs from that of other texels of triangle");
+}
+
+struct ConvertedCornell {
+  formats::SceneBvh bvh;
+  formats::ProbeGrid probes;
+  formats::SceneFile file;
+  std::vector<uint8_t> bytes;
+};
+
+const ConvertedCornell& converted() {
+  static const ConvertedCornell c = [] {
+    const PreparedScene& p = cornell();
+    ConvertedCornell out;
+    out.bvh = test::scene_bvh_from_gpu(vulkan::build_gpu_bvh(p.scene));
+    const EmbreeScene embree(p.scene);
+    out.probes = place_probes(p.scene, embree, nullptr, ProbePlacementSettings{}).grid;
+    out.file = make_scene_file(p.scene, p.gbuffer, p.layout, &out.probes, out.bvh);
+    out.bytes = formats::encode_scene(out.file);
+    return out;
+  }();
+  return c;
+}
+
+TEST(SceneFileConversion, SceneRoundTripsThroughTheFile) {
+  const PreparedScene& p = cornell();
+  const ConvertedCornell& c = converted();
+  const formats::SceneFile file = formats::read_scene(c.bytes.data(), c.bytes.size(), "scene.bin");
+  const PersistedScene back = restore_scene(file);
+  const Scene &a = p.scene, &b = back.scene;
+
+  auto same_vec3s = [](const std::vector<Vec3>& x, const std::vector<Vec3>& y) {
+    return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(Vec3)) == 0;
+  };
+  auto same_vec2s = [](const std::vector<Vec2>& x, const std::vector<Vec2>& y) {
+    return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(Vec2)) == 0;
+  };
+  EXPECT_TRUE(same_vec3s(a.positions, b.positions));
+  EXPECT_TRUE(same_vec3s(a.normals, b.normals));
+  EXPECT_TRUE(same_vec2s(a.uv0, b.uv0));
+  EXPECT_TRUE(same_vec2s(a.lightmap_uv, b.lightmap_uv));
+  EXPECT_EQ(a.triangle_material, b.triangle_material);
+  EXPECT_EQ(a.triangle_instance, b.triangle_instance);
+  ASSERT_EQ(a.materials.size(), b.materials.size());
+  for (size_t i = 0; i < a.materials.size(); ++i) {
+    EXPECT_EQ(a.materials[i].name, b.materials[i].name);
+    EXPECT_TRUE(same_bits(a.materials[i].base_color, b.materials[i].base_color));
+    EXPECT_EQ(a.materials[i].metallic, b.materials[i].metallic);
+    EXPECT_TRUE(same_bits(a.materials[i].emission, b.materials[i].emission));
+    EXPECT_EQ(a.materials[i].double_sided, b.materials[i].double_sided);
+    EXPECT_EQ(b.materials[i].base_color_texture.texture, -1);
+  }
+  ASSERT_EQ(a.instances.size(), b.instances.size());
+  for (size_t i = 0; i < a.instances.size(); ++i) {
+    const Instance &x = a.instances[i], &y = b.instances[i];
+    EXPECT_EQ(std::tie(x.node, x.name, x.mesh, x.first_triangle, x.triangle_count, x.world),
+              std::tie(y.node, y.name, y.mesh, y.first_triangle, y.triangle_count, y.world));
+    const InstanceRect &r = p.layout.rects[i], &s = back.atlas.rects[i];
+    EXPECT_EQ(std::tie(r.page, r.x, r.y, r.width, r.height), std::tie(s.page, s.x, s.y, s.width, s.height));
+    EXPECT_EQ(std::memcmp(r.scale_offset, s.scale_offset, sizeof(r.scale_offset)), 0);
+  }
+  EXPECT_EQ(back.atlas.page_sizes, p.layout.page_sizes);
+  EXPECT_EQ(back.atlas.texel_density, p.layout.texel_density);
+  ASSERT_EQ(a.nodes.size(), b.nodes.size());
+  ASSERT_FALSE(a.nodes.empty());
+  for (size_t i = 0; i < a.nodes.size(); ++i) {
+    const SceneNode &x = a.nodes[i], &y = b.nodes[i];
+    EXPECT_EQ(std::tie(x.name, x.parent, x.mesh, x.light, x.camera, x.in_scene, x.has_matrix, x.translation, x.rotation,
+                       x.scale, x.matrix),
+              std::tie(y.name, y.parent, y.mesh, y.light, y.camera, y.in_scene, y.has_matrix, y.translation, y.rotation,
+                       y.scale, y.matrix));
+  }
+  ASSERT_EQ(a.lights.size(), b.lights.size());
+  for (size_t i = 0; i < a.lights.size(); ++i) {
+    const PunctualLight &x = a.lights[i], &y = b.lights[i];
+    EXPECT_EQ(std::tie(x.name, x.node, x.type, x.cos_inner, x.cos_outer),
+              std::tie(y.name, y.node, y.type, y.cos_inner, y.cos_outer));
+    EXPECT_TRUE(same_bits(x.position, y.position) && same_bits(x.direction, y.direction) &&
+                same_bits(x.intensity, y.intensity));
+  }
+  EXPECT_EQ(a.cameras.size(), b.cameras.size());
+  EXPECT_TRUE(same_bits(a.sky.constant, b.sky.constant));
+  EXPECT_EQ(b.sky.constant.z, 0.3f);
+
+  expect_gbuffers_equal(p.gbuffer, back.gbuffer);
+
+  ASSERT_TRUE(back.has_probe_grid());
+  EXPECT_EQ(back.probes.counts, c.probes.counts);
+  EXPECT_EQ(back.probes.origin, c.probes.origin);
+  EXPECT_EQ(back.probes.spacing, c.probes.spacing);
+  ASSERT_EQ(back.probes.probes.size(), c.probes.probes.size());
+  for (size_t i = 0; i < c.probes.probes.size(); ++i) {
+    EXPECT_EQ(back.probes.probes[i].position, c.probes.probes[i].position);
+    EXPECT_EQ(back.probes.probes[i].state, c.probes.probes[i].state);
+  }
+  ASSERT_EQ(back.bvh.nodes.size(), c.bvh.nodes.size());
+  EXPECT_EQ(std::memcmp(back.bvh.nodes.data(), c.bvh.nodes.data(), c.bvh.nodes.size() * sizeof(formats::BvhNodeRecord)),
+            0);
+  EXPECT_EQ(back.bvh.leaf_triangles, c.bvh.leaf_triangles);
+  EXPECT_EQ(back.bvh.stack_entries, c.bvh.stack_entries);
+  EXPECT_EQ(back.bvh.depth, c.bvh.depth);
+
+  // Writing what was restored gives the same bytes: a relight that re-saves the bundle is stable.
+  const formats::SceneFile again =
+      make_scene_file(back.scene, back.gbuffer, back.atlas, back.has_probe_grid() ? &back.probes : nullptr, back.bvh);
+  EXPECT_EQ(formats::encode_scene(again), c.bytes);
+}
+
+TEST(SceneFileConversion, TheGpuBvhRoundTripsThroughItsRecords) {
+  const PreparedScene& p = cornell();
+  const vulkan::GpuBvh gpu = vulkan::build_gpu_bvh(p.scene);
+  const formats::SceneBvh& records = converted().bvh;
+  EXPECT_EQ(records.leaf_triangles.size(), p.scene.triangle_count());
+  const vulkan::GpuBvh back = test::gpu_bvh_from_records(records, p.scene);
+  ASSERT_EQ(back.nodes.size(), gpu.nodes.size());
+  EXPECT_EQ(std::memcmp(back.nodes.data(), gpu.nodes.data(), gpu.nodes.size() * sizeof(vulkan::GpuBvhNode)), 0);
+  ASSERT_EQ(back.triangles.size(), gpu.triangles.size());
+  EXPECT_EQ(std::memcmp(back.triangles.data(), gpu.triangles.data(), gpu.triangles.size() * sizeof(gpu.triangles[0])),
+            0);
+  EXPECT_EQ(back.stack_entries, gpu.stack_entries);
+  EXPECT_EQ(back.depth, gpu.depth);
+}
+
+TEST(SceneFileConversion, RefusesWhatVersionOneDoesNotStore) {
+  const PreparedScene& p = cornell();
+  const formats::SceneBvh& bvh = converted().bvh;
+  Scene textured = p.scene;
+  textured.materials[1].base_color_texture.texture = 0;
+  expect_format_error([&] { make_scene_file(textured, p.gbuffer, p.layout, nullptr, bvh); },
+                      "material 1 '" + textured.materials[1].name +
+                          "': base colour texture: textures are not stored by scene.bin version 1");
+  Scene environment = p.scene;
+  environment.sky.environment.width = environment.sky.environment.height = 1;
+  environment.sky.environment.rgb = {1, 1, 1};
+  expect_format_error([&] { make_scene_file(environment, p.gbuffer, p.layout, nullptr, bvh); },
+                      "sky: environment maps are not stored by scene.bin version 1");
+  AtlasLayout short_layout = p.layout;
+  short_layout.rects.pop_back();
+  expect_format_error([&] { make_scene_file(p.scene, p.gbuffer, short_layout, nullptr, bvh); }, "rectangles for");
+  // A corrupt BVH is caught by the writer's validation.
+  formats::SceneFile file = make_scene_file(p.scene, p.gbuffer, p.layout, nullptr, bvh);
+  file.bvh.nodes[0].child[0] = uint32_t(file.bvh.nodes.size());
+  expect_format_error([&] { formats::encode_scene(file); }, "bvh node 0: child 0 index");
+}
+
+TEST(SceneFileConversion, FileWithoutProbesRestoresNoGrid) {
+  const PreparedScene& p = cornell();
+  const formats::SceneFile file = make_scene_file(p.scene, p.gbuffer, p.layout, nullptr, converted().bvh);
+  const std::vector<uint8_t> bytes = formats::encode_scene(file);
+  const PersistedScene back = restore_scene(formats::read_scene(bytes.data(), bytes.size(), "scene.bin"));
+  EXPECT_FALSE(back.has_probe_grid());
+  EXPECT_EQ(back.probes.counts, (std::array<uint32_t, 3>{0, 0, 0}));
+  std::printf("cornell_room scene.bin: %zu bytes (%zu with probe positions)\n", bytes.size(), converted().bytes.size());
+}
+
+}  // namespace
+}  // namespace exitance
