@@ -17,6 +17,8 @@
 #include "exitance/bake/texel_raster.h"
 #include "exitance/bake/unocclude.h"
 #include "exitance/formats/probes_file.h"
+#include "exitance/formats/scene_file.h"
+#include "exitance/runtime/scene_file_conversion.h"
 #include "exitance/runtime/bundle/bundle_directory.h"
 #include "exitance/runtime/bundle/lightmap_assembly.h"
 #include "exitance/runtime/bundle/probe_results.h"
@@ -151,6 +153,23 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
     seconds["probe_placement"] = timer.lap();
   }
 
+  // scene.bin: what the runtime re-lights from (the scene, the texel G-buffer the lighting below
+  // uses, the atlas, the probe layout, the BVH4), so exitance-relight reproduces this bake. Version 1
+  // holds no textures or environment maps: such scenes bake without it, and the manifest says why.
+  report("scene.bin", 0, 0);
+  std::vector<uint8_t> scene_file_bytes;
+  std::string scene_file_skipped;
+  try {
+    scene_file_bytes = formats::encode_scene(
+        make_scene_file(scene, gbuffer, layout, options.probes_enabled ? &placement.grid : nullptr,
+                        to_scene_bvh(lighting_scene->bvh)));
+  } catch (const formats::FormatError& e) {
+    scene_file_skipped = e.what();
+    diagnostics.warn(options.input + ": scene.bin not written (exitance-relight cannot re-light this bundle): " +
+                     scene_file_skipped);
+  }
+  seconds["scene_file"] = timer.lap();
+
   IntegratorSettings lighting = options.lighting;
   lighting.progress = [&](double fraction, uint64_t rays) { report("lighting", fraction, rays); };
   const LightmapEstimate estimate = backend->bake(gbuffer, lighting);
@@ -262,6 +281,10 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                           {"moved", placement.moved},
                           {"invalid", placement.invalid},
                           {"skipped", placement.skipped}};
+  if (!scene_file_bytes.empty())
+    manifest["scene"] = {{"file", "scene.bin"}, {"format_version", formats::kSceneFormatVersion}, {"bytes", scene_file_bytes.size()}};
+  else
+    manifest["scene"] = {{"skipped", scene_file_skipped}};
   if (options.svo_enabled) {
     const std::array<float, 3> hi{svo.origin[0] + svo.size, svo.origin[1] + svo.size, svo.origin[2] + svo.size};
     manifest["svo"] = {{"file", "svo.bin"},
@@ -324,6 +347,11 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
     for (size_t p = 0; p < pages.size(); ++p)
       formats::write_lightmap_exr((dir / ("lightmap-" + std::to_string(p) + ".exr")).string(), pages[p]);
     if (options.probes_enabled) formats::write_probes_file((dir / "probes.bin").string(), placement.grid);
+    if (!scene_file_bytes.empty()) {
+      std::ofstream scene_out(dir / "scene.bin", std::ios::binary);
+      scene_out.write(reinterpret_cast<const char*>(scene_file_bytes.data()), std::streamsize(scene_file_bytes.size()));
+      if (!scene_out) throw std::runtime_error("cannot write " + (dir / "scene.bin").string());
+    }
     if (options.svo_enabled) {
       formats::write_svo_file((dir / "svo.bin").string(), svo);
       write_radiance_vdb((dir / "radiance.vdb").string(), svo);

@@ -1,5 +1,7 @@
 #include "exitance/runtime/scene_file_conversion.h"
 
+#include <cstring>
+
 #include <string>
 
 #include "exitance/runtime/texel_gbuffer_codec.h"
@@ -239,6 +241,29 @@ PersistedScene restore_scene(const formats::SceneFile& file) {
   for (formats::ProbeRecord& r : out.probes.probes) r.sh = {};
   out.bvh = file.bvh;
   return out;
+}
+
+static_assert(sizeof(Bvh4Node) == sizeof(formats::BvhNodeRecord));
+static_assert(kBvhEmptyChild == formats::kSceneBvhEmptyChild && kBvhLeafBit == formats::kSceneBvhLeafBit);
+
+formats::SceneBvh to_scene_bvh(const Bvh4& bvh) {
+  formats::SceneBvh records;
+  records.nodes.resize(bvh.nodes.size());
+  if (!bvh.nodes.empty()) std::memcpy(records.nodes.data(), bvh.nodes.data(), bvh.nodes.size() * sizeof(Bvh4Node));
+  records.leaf_triangles = bvh.leaf_triangles;
+  records.stack_entries = bvh.stack_entries;
+  records.depth = bvh.depth;
+  return records;
+}
+
+Bvh4 to_bvh4(const formats::SceneBvh& records) {
+  Bvh4 bvh;
+  bvh.nodes.resize(records.nodes.size());
+  if (!records.nodes.empty()) std::memcpy(bvh.nodes.data(), records.nodes.data(), records.nodes.size() * sizeof(Bvh4Node));
+  bvh.leaf_triangles = records.leaf_triangles;
+  bvh.stack_entries = records.stack_entries;
+  bvh.depth = records.depth;
+  return bvh;
 }
 
 }  // namespace exitance

@@ -11,7 +11,8 @@
 #include "exitance/formats/scene_file.h"
 #include "exitance/runtime/embree_scene.h"
 #include "exitance/runtime/scene_file_conversion.h"
-#include "gpu_bvh_records.h"
+#include "exitance/runtime/cpu/bvh4_builder.h"
+#include "exitance/runtime/scene_file_conversion.h"
 
 using namespace exitance;
 
@@ -24,7 +25,7 @@ int main(int argc, char** argv) {
   if (argc > 3) atlas.texel_density = std::stof(argv[3]);
   Diagnostics diagnostics;
   const PreparedScene p = prepare_scene_for_lighting(argv[1], "", atlas, diagnostics);
-  const formats::SceneBvh bvh = test::scene_bvh_from_gpu(vulkan::build_gpu_bvh(p.scene));
+  const formats::SceneBvh bvh = to_scene_bvh(build_bvh4(p.scene));
   const EmbreeScene embree(p.scene);
   const formats::ProbeGrid probes = place_probes(p.scene, embree, nullptr, ProbePlacementSettings{}).grid;
   const formats::SceneFile file = make_scene_file(p.scene, p.gbuffer, p.layout, &probes, bvh);

@@ -36,7 +36,7 @@ constexpr uint64_t kMaxSceneAtlasTexels = uint64_t(1) << 30;  // sum of width * 
 constexpr uint32_t kMaxSceneNameBytes = 65535;
 constexpr uint32_t kMaxSceneNodeDepth = 256;  // deepest node depth (root 0), as the glTF importer
 
-// BVH4 child words, as runtime/src/vulkan/gpu_bvh.h and shaders/include/bvh.glsl use them.
+// BVH4 child words, as runtime/.../core/bvh4.h and shaders/include/bvh.glsl use them.
 constexpr uint32_t kSceneBvhEmptyChild = 0xFFFFFFFFu;
 constexpr uint32_t kSceneBvhLeafBit = 0x80000000u;  // leaf: bit 31 | first slot << 2 | (count - 1)
 
@@ -151,7 +151,7 @@ struct TexelGBufferRecords {
   std::vector<MovedTexelRecord> moved;                  // ascending texel index
 };
 
-// One node of the GPU BVH4 (runtime/src/vulkan/gpu_bvh.h): child i's box and child word.
+// One node of the GPU BVH4 (runtime/.../core/bvh4.h): child i's box and child word.
 struct BvhNodeRecord {
   float lo_x[4], hi_x[4], lo_y[4], hi_y[4], lo_z[4], hi_z[4];
   uint32_t child[4];

@@ -9,6 +9,7 @@
 // indices); the Vulkan backend rebuilds its per-slot vertex copies from the scene on load.
 #pragma once
 #include "exitance/formats/scene_file.h"
+#include "exitance/runtime/core/bvh4.h"
 #include "exitance/runtime/lightmap_atlas.h"
 #include "exitance/runtime/scene.h"
 #include "exitance/runtime/texel_gbuffer.h"
@@ -30,6 +31,11 @@ struct PersistedScene {
 // `probes` may be null (no probe grid); its SH coefficients are not stored.
 formats::SceneFile make_scene_file(const Scene& scene, const TexelGBuffer& gbuffer, const AtlasLayout& atlas,
                                    const formats::ProbeGrid* probes, const formats::SceneBvh& bvh);
+
+// The BVH4 as scene.bin's records and back (the same 112-byte node layout, leaf slots as scene
+// triangle indices): exact copies.
+formats::SceneBvh to_scene_bvh(const Bvh4& bvh);
+Bvh4 to_bvh4(const formats::SceneBvh& records);
 
 // `file` as read_scene returns it (validated); throws formats::FormatError if it is not consistent.
 PersistedScene restore_scene(const formats::SceneFile& file);

@@ -1,0 +1,234 @@
+#include "exitance/runtime/relight/relight.h"
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <mutex>
+
+#include "exitance/formats/format_error.h"
+#include "exitance/formats/probes_file.h"
+#include "exitance/formats/scene_file.h"
+#include "exitance/formats/svo_file.h"
+#include "exitance/runtime/bundle/bundle_directory.h"
+#include "exitance/runtime/bundle/lightmap_assembly.h"
+#include "exitance/runtime/bundle/probe_results.h"
+#include "exitance/runtime/bundle/texel_exitance.h"
+#include "exitance/runtime/core/lighting_scene.h"
+#include "exitance/runtime/scene_file_conversion.h"
+#include "exitance/runtime/vulkan/vulkan_integrator.h"
+
+namespace exitance {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace {
+
+json read_manifest(const fs::path& bundle) {
+  const fs::path path = bundle / "manifest.json";
+  std::ifstream in(path);
+  if (!in) throw RelightInputError(path.string() + ": cannot read the manifest (is " + bundle.string() + " a bundle?)");
+  try {
+    json manifest = json::parse(in);
+    if (!manifest.is_object()) throw RelightInputError(path.string() + ": not a JSON object");
+    return manifest;
+  } catch (const json::exception& e) {
+    throw RelightInputError(path.string() + ": " + e.what());
+  }
+}
+
+// A manifest setting of the bake, or `fallback` when absent; a present value of the wrong type is bad input.
+template <typename T>
+T setting(const json& manifest, const char* key, T fallback, const fs::path& bundle) {
+  if (!manifest.contains("settings") || !manifest["settings"].is_object()) return fallback;
+  const json& settings = manifest["settings"];
+  if (!settings.contains(key)) return fallback;
+  try {
+    return settings[key].get<T>();
+  } catch (const json::exception&) {
+    throw RelightInputError((bundle / "manifest.json").string() + ": settings." + key + " has the wrong type");
+  }
+}
+
+bool page_has_bounce_layers(const json& manifest) {
+  if (!manifest.contains("pages") || !manifest["pages"].is_array()) return false;
+  for (const json& page : manifest["pages"])
+    if (page.contains("channels") && page["channels"].is_array())
+      for (const json& channel : page["channels"])
+        if (channel.is_string() && channel.get<std::string>().rfind("bounce", 0) == 0) return true;
+  return false;
+}
+
+struct ValidationLog {
+  std::mutex mutex;
+  std::vector<std::string> lines;
+};
+
+}  // namespace
+
+json relight_bundle(const RelightOptions& options) {
+  using Clock = std::chrono::steady_clock;
+  auto last = Clock::now();
+  json seconds = json::object();
+  auto lap = [&](const char* stage) {
+    const auto now = Clock::now();
+    seconds[stage] = std::chrono::duration<double>(now - last).count();
+    last = now;
+  };
+  auto report = [&](const std::string& stage, double fraction, uint64_t rays) {
+    if (options.progress) options.progress(stage, fraction, rays);
+  };
+
+  const fs::path bundle(options.bundle);
+  const fs::path out = options.output.empty() ? bundle : fs::path(options.output);
+  report("load", 0, 0);
+  json manifest = read_manifest(bundle);
+  PersistedScene persisted;
+  formats::SparseVoxelOctree svo;
+  const bool has_svo = manifest.contains("svo");
+  std::vector<uint8_t> scene_bytes;
+  try {
+    const formats::SceneFile file = formats::read_scene_file((bundle / "scene.bin").string());
+    persisted = restore_scene(file);
+    if (has_svo) svo = formats::read_svo_file((bundle / "svo.bin").string());
+  } catch (const formats::FormatError& e) {
+    throw RelightInputError(e.what());
+  }
+  {
+    std::ifstream in(bundle / "scene.bin", std::ios::binary);
+    scene_bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  lap("load");
+
+  IntegratorSettings lighting;
+  lighting.spp = options.spp ? *options.spp : (options.time_budget_seconds > 0 ? 0u : setting<uint32_t>(manifest, "spp", 128u, bundle));
+  lighting.time_budget_seconds = options.time_budget_seconds;
+  lighting.seed = options.seed ? *options.seed : setting<uint64_t>(manifest, "seed", 0u, bundle);
+  lighting.max_bounces = setting<int>(manifest, "bounces", -1, bundle);
+  lighting.russian_roulette_start = setting<int>(manifest, "russian_roulette_start", 3, bundle);
+  lighting.safety_bounce_cap = setting<int>(manifest, "safety_bounce_cap", 4096, bundle);
+  lighting.target_relative_error = setting<double>(manifest, "target_error", 0.0, bundle);
+  const uint32_t probe_spp = setting<uint32_t>(manifest, "probe_spp", 512u, bundle);
+  const float probe_dering = setting<float>(manifest, "probe_dering_window", 0.0f, bundle);
+  if (lighting.spp == 0 && !(lighting.time_budget_seconds > 0) && !(lighting.target_relative_error > 0))
+    throw RelightInputError("--spp 0 needs --time");
+
+  report("upload", 0, 0);
+  auto scene = std::make_shared<const Scene>(std::move(persisted.scene));
+  std::shared_ptr<const LightingScene> lighting_scene;
+  try {
+    lighting_scene = std::make_shared<const LightingScene>(build_lighting_scene(scene, to_bvh4(persisted.bvh)));
+  } catch (const std::invalid_argument& e) {
+    throw RelightInputError((bundle / "scene.bin").string() + ": " + e.what());
+  }
+  VulkanDeviceOptions device;
+  device.device_index = options.device_index;
+  device.validation = options.validation;
+  auto validation = std::make_shared<ValidationLog>();
+  if (options.validation)
+    device.on_validation_message = [validation](const std::string& m) {
+      std::lock_guard<std::mutex> lock(validation->mutex);
+      validation->lines.push_back(m);
+    };
+  const std::unique_ptr<VulkanIntegrator> integrator = VulkanIntegrator::create(lighting_scene, device);
+  lap("upload");
+
+  lighting.progress = [&](double fraction, uint64_t rays) { report("lighting", fraction, rays); };
+  const LightmapEstimate estimate = integrator->bake(persisted.gbuffer, lighting);
+  lap("lighting");
+
+  ProbeEstimate probe_estimate;
+  const bool has_probes = persisted.has_probe_grid() && manifest.contains("probes");
+  if (has_probes) {
+    std::vector<Vec3> positions;
+    std::vector<size_t> traced;
+    for (size_t i = 0; i < persisted.probes.probes.size(); ++i) {
+      const formats::ProbeRecord& r = persisted.probes.probes[i];
+      if (!formats::probe_is_usable(r)) continue;
+      positions.push_back({r.position[0], r.position[1], r.position[2]});
+      traced.push_back(i);
+    }
+    IntegratorSettings probe_lighting = lighting;
+    probe_lighting.spp = probe_spp;
+    probe_lighting.time_budget_seconds = 0;
+    probe_lighting.target_relative_error = 0;
+    probe_lighting.progress = [&](double fraction, uint64_t rays) { report("probes", fraction, rays); };
+    probe_estimate = integrator->bake_probes(positions, probe_lighting);
+    store_probe_radiance(persisted.probes, traced, probe_estimate, probe_dering);
+    lap("probes");
+  }
+  {
+    std::lock_guard<std::mutex> lock(validation->mutex);
+    if (!validation->lines.empty())
+      throw std::runtime_error("Vulkan validation reported " + std::to_string(validation->lines.size()) +
+                               " messages, first: " + validation->lines.front());
+  }
+
+  if (has_svo) {
+    report("exitance", 0, 0);
+    fill_svo_exitance(svo, *scene, persisted.gbuffer, estimate);
+    lap("exitance");
+  }
+
+  report("write", 0, 0);
+  AssemblyOptions assembly;
+  assembly.bounce_layers = page_has_bounce_layers(manifest);
+  assembly.dilation_texels = std::max(2, setting<int>(manifest, "padding", 2, bundle) * 2);
+  const std::vector<formats::LightmapImage> pages = assemble_lightmap_pages(persisted.gbuffer, estimate, assembly);
+
+  double relative_error_sum = 0;
+  size_t relative_error_count = 0;
+  for (size_t i = 0; i < persisted.gbuffer.texels.size(); ++i) {
+    const float mean = luminance(estimate.mean_total(i));
+    const float se = std::sqrt(luminance(estimate.variance_of_mean(i)));
+    if (mean > 0) relative_error_sum += se / mean, ++relative_error_count;
+  }
+  json run;
+  run["tool"] = "exitance-relight";
+  run["source_bundle"] = fs::absolute(bundle).lexically_normal().string();
+  run["source_generator"] = manifest.value("generator", "");
+  run["what"] = "full relight from scene.bin: lightmaps, probes and voxel exitance recomputed; input lightmaps not read";
+  run["device"] = integrator->device_description();
+  run["spp"] = lighting.spp;
+  run["seed"] = lighting.seed;
+  run["time_budget_seconds"] = lighting.time_budget_seconds;
+  run["rays"] = estimate.rays;
+  run["rays_per_second"] = estimate.seconds > 0 ? double(estimate.rays) / estimate.seconds : 0.0;
+  run["probe_rays"] = probe_estimate.rays;
+  run["estimated_relative_error"] = relative_error_count ? relative_error_sum / double(relative_error_count) : 0.0;
+  run["nonfinite_samples"] = estimate.nonfinite_samples + probe_estimate.nonfinite_samples;
+
+  manifest["generator"] = "exitance-relight 0.1.0";
+  manifest["settings"]["backend"] = "vulkan";
+  manifest["settings"]["spp"] = lighting.spp;
+  manifest["settings"]["seed"] = lighting.seed;
+  manifest["settings"]["time_budget_seconds"] = lighting.time_budget_seconds;
+  if (has_svo) {
+    manifest["svo"].erase("vdb");
+    manifest["svo"]["vdb_note"] = "radiance.vdb is an inspection export of bake; exitance-relight does not write it";
+  }
+  manifest["relight"] = run;
+
+  write_bundle_atomically(out, [&](const fs::path& dir) {
+    for (size_t p = 0; p < pages.size(); ++p)
+      formats::write_lightmap_exr((dir / ("lightmap-" + std::to_string(p) + ".exr")).string(), pages[p]);
+    if (has_probes) formats::write_probes_file((dir / "probes.bin").string(), persisted.probes);
+    if (has_svo) formats::write_svo_file((dir / "svo.bin").string(), svo);
+    {
+      std::ofstream scene_out(dir / "scene.bin", std::ios::binary);
+      scene_out.write(reinterpret_cast<const char*>(scene_bytes.data()), std::streamsize(scene_bytes.size()));
+      if (!scene_out) throw std::runtime_error("cannot write " + (dir / "scene.bin").string());
+    }
+    std::ofstream file(dir / "manifest.json");
+    file << manifest.dump(2) << "\n";
+    if (!file) throw std::runtime_error("cannot write " + (dir / "manifest.json").string());
+  });
+  lap("write");
+  run["seconds"] = seconds;
+  run["output"] = fs::absolute(out).string();
+  return run;
+}
+
+}  // namespace exitance

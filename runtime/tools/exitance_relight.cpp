@@ -1,0 +1,78 @@
+// exitance-relight BUNDLE [-o OUT] [--spp N] [--time S] [--seed N] [--device N] [--json]
+// Re-lights a baked bundle from its scene.bin on the GPU (runtime/src/relight). Links the runtime
+// library and nothing of the offline stage; runs where only a Vulkan driver exists.
+#include <CLI/CLI.hpp>
+
+#include <cstdlib>
+#include <iostream>
+#include <optional>
+
+#include "exitance/runtime/relight/relight.h"
+#include "exitance/runtime/tools/progress_bar.h"
+#include "exitance/runtime/vulkan/vulkan_integrator.h"
+
+namespace {
+
+std::string one_line(std::string text) {
+  for (char& c : text)
+    if (c == '\n' || c == '\r') c = ' ';
+  return text;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"exitance-relight: re-light a baked bundle from its scene.bin on the GPU"};
+  exitance::RelightOptions options;
+  std::optional<uint32_t> spp;
+  std::optional<uint64_t> seed;
+  bool json_report = false, list_devices = false;
+  app.add_option("bundle", options.bundle, "the bundle folder bake wrote (manifest.json, scene.bin, ...)")->required();
+  app.add_option("-o,--out", options.output, "output bundle folder (default: the input bundle, replaced atomically)");
+  app.add_option("--spp", spp, "samples per texel (default: the bake's; 0 = until --time ends the run)");
+  app.add_option("--time", options.time_budget_seconds, "stop the lightmap pass after this many seconds")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--seed", seed, "random seed (default: the bake's); results are deterministic per seed and device");
+  app.add_option("--device", options.device_index, "Vulkan device index (see --list-devices)")->check(CLI::NonNegativeNumber);
+  app.add_flag("--list-devices", list_devices, "print the Vulkan devices and exit");
+  app.add_flag("--json", json_report, "print the run report as JSON on stdout");
+  try {
+    if (argc > 1 && std::string(argv[1]) == "--list-devices") {
+      for (const auto& d : exitance::enumerate_vulkan_devices())
+        std::cout << d.index << ": " << d.name << " (" << exitance::to_string(d.type) << ")"
+                  << (d.usable ? "" : " unusable: " + d.missing_feature) << "\n";
+      return 0;
+    }
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return e.get_exit_code() == 0 ? 0 : (code == 0 ? 0 : 2);
+  }
+  options.spp = spp;
+  options.seed = seed;
+  const char* validation = std::getenv("EXITANCE_VULKAN_VALIDATION");
+  options.validation = validation && std::string(validation) == "1";
+
+  exitance::ProgressBar bar;
+  options.progress = [&](const std::string& stage, double fraction, uint64_t rays) { bar.update(stage, fraction, rays); };
+  try {
+    const nlohmann::json report = exitance::relight_bundle(options);
+    bar.finish();
+    if (json_report) {
+      std::cout << report.dump(2) << "\n";
+    } else {
+      std::cerr << "exitance-relight: wrote " << report["output"].get<std::string>() << " ("
+                << report["rays_per_second"].get<double>() * 1e-6 << " Mrays/s on " << report["device"].get<std::string>()
+                << ")\n";
+    }
+    return 0;
+  } catch (const exitance::RelightInputError& e) {
+    bar.finish();
+    std::cerr << "exitance-relight: error: " << one_line(e.what()) << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    bar.finish();
+    std::cerr << "exitance-relight: error: " << one_line(e.what()) << "\n";
+    return 1;
+  }
+}
