@@ -36,6 +36,8 @@ int main(int argc, char** argv) {
   app.add_option("--device", options.device_index, "Vulkan device index (see --list-devices)")->check(CLI::NonNegativeNumber);
   app.add_flag("--list-devices", list_devices, "print the Vulkan devices and exit");
   app.add_flag("--json", json_report, "print the run report as JSON on stdout");
+  app.add_flag("--stage-statistics", options.stage_statistics,
+               "time each wavefront stage on the GPU (timestamps, lane counters; slower, for benchmarks)");
   try {
     if (argc > 1 && std::string(argv[1]) == "--list-devices") {
       for (const auto& d : exitance::enumerate_vulkan_devices())

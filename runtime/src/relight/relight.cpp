@@ -126,6 +126,7 @@ json relight_bundle(const RelightOptions& options) {
   VulkanDeviceOptions device;
   device.device_index = options.device_index;
   device.validation = options.validation;
+  device.collect_stage_statistics = options.stage_statistics;
   auto validation = std::make_shared<ValidationLog>();
   if (options.validation)
     device.on_validation_message = [validation](const std::string& m) {
@@ -138,6 +139,11 @@ json relight_bundle(const RelightOptions& options) {
   lighting.progress = [&](double fraction, uint64_t rays) { report("lighting", fraction, rays); };
   const LightmapEstimate estimate = integrator->bake(persisted.gbuffer, lighting);
   lap("lighting");
+  json stages = json::array();
+  if (options.stage_statistics)
+    for (const VulkanStageStatistics& s : integrator->stage_statistics())
+      stages.push_back({{"stage", s.stage}, {"gpu_seconds", s.seconds}, {"items", s.items}, {"rays", s.rays},
+                        {"lane_efficiency", s.lane_efficiency}});
 
   ProbeEstimate probe_estimate;
   const bool has_probes = persisted.has_probe_grid() && manifest.contains("probes");
@@ -198,6 +204,9 @@ json relight_bundle(const RelightOptions& options) {
   run["rays_per_second"] = estimate.seconds > 0 ? double(estimate.rays) / estimate.seconds : 0.0;
   run["probe_rays"] = probe_estimate.rays;
   run["estimated_relative_error"] = relative_error_count ? relative_error_sum / double(relative_error_count) : 0.0;
+  run["live_texels"] = persisted.gbuffer.texels.size();
+  run["lighting_seconds"] = estimate.seconds;
+  if (options.stage_statistics) run["stages"] = stages;
   run["nonfinite_samples"] = estimate.nonfinite_samples + probe_estimate.nonfinite_samples;
 
   manifest["generator"] = "exitance-relight 0.1.0";

@@ -21,6 +21,7 @@ struct RelightOptions {
   std::optional<uint64_t> seed;    // default: the bake's
   int device_index = -1;           // Vulkan device; -1 = prefer a discrete GPU
   bool validation = false;         // Vulkan validation layers; any message fails the relight
+  bool stage_statistics = false;   // GPU time, rays and lane efficiency per wavefront stage (slower; benchmarks)
   // Stage reporting: (stage, fraction done, rays so far).
   std::function<void(const std::string&, double, uint64_t)> progress;
 };
