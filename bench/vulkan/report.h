@@ -28,8 +28,8 @@ inline void print_stage_figures(const VulkanIntegrator& vk_stats, double bake_se
               bake_seconds, gpu_total, (unsigned long long)bake_rays, gpu_total > 0 ? double(bake_rays) / gpu_total : 0.0);
   if (traversal_rays == 0) return;
   const double traversal = vk_stats.measure_incoherent_traversal(traversal_rays, traversal_repetitions);
-  for (const VulkanStageStatistics& s : vk_stats.stage_statistics())
-    if (s.stage == "traversal-only")
+  for (const VulkanStageStatistics& s : vk_stats.stage_statistics())  // the traversal kernel's one stage
+    if (s.stage.rfind("traversal", 0) == 0)
       std::printf("traversal-only: %u incoherent rays (%llu hit), %.3g rays/s, lane efficiency %.1f %%\n", traversal_rays,
                   (unsigned long long)s.items, traversal, 100.0 * s.lane_efficiency);
 }

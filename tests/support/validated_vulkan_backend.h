@@ -17,13 +17,14 @@ namespace exitance::testing {
 class VulkanBackend {
  public:
   // `skip_reason` is set (and the integrator left empty) when there is no usable Vulkan device.
-  VulkanBackend(const Scene& scene, std::string& skip_reason, uint32_t max_paths = 0) {
-    VulkanDeviceOptions options;
-    options.max_paths = max_paths;
+  VulkanBackend(const Scene& scene, std::string& skip_reason, uint32_t max_paths = 0)
+      : VulkanBackend(make_lighting_scene(scene), skip_reason, with_max_paths(max_paths)) {}
+  // On a prepared (or edited) lighting scene, with `options` plus validation.
+  VulkanBackend(std::shared_ptr<const LightingScene> scene, std::string& skip_reason, VulkanDeviceOptions options) {
     options.validation = true;
-    options.on_validation_message = [this](const std::string& m) { messages_->push_back(m); };
+    options.on_validation_message = [messages = messages_](const std::string& m) { messages->push_back(m); };
     try {
-      integrator_ = VulkanIntegrator::create(make_lighting_scene(scene), options);
+      integrator_ = VulkanIntegrator::create(std::move(scene), options);
     } catch (const std::runtime_error& e) {
       const std::string what = e.what();
       if (what.find("no Vulkan device") != std::string::npos || what.find("no usable Vulkan device") != std::string::npos)
@@ -39,6 +40,11 @@ class VulkanBackend {
   VulkanIntegrator* operator->() { return integrator_.get(); }
 
  private:
+  static VulkanDeviceOptions with_max_paths(uint32_t max_paths) {
+    VulkanDeviceOptions options;
+    options.max_paths = max_paths;
+    return options;
+  }
   std::shared_ptr<std::vector<std::string>> messages_ = std::make_shared<std::vector<std::string>>();
   std::unique_ptr<VulkanIntegrator> integrator_;
 };

@@ -31,26 +31,50 @@ void check_bvh_references(const Bvh4& bvh, size_t triangle_count) {
                                   std::to_string(triangle_count));
 }
 
-}  // namespace
+bool is_textured(const Material& m) { return m.base_color_texture.texture >= 0 || m.emissive_texture.texture >= 0; }
 
-LightingScene build_lighting_scene(std::shared_ptr<const Scene> source, Bvh4 bvh) {
-  const Scene& scene = *source;
-  const size_t triangle_count = scene.triangle_count();
-  check_bvh_references(bvh, triangle_count);
-  LightingScene lighting;
-  lighting.bvh = std::move(bvh);
+GpuMaterial material_record(const Material& m) {
+  const Vec3 emission = max_component(m.emission) > 0.0f ? m.emission : Vec3{0, 0, 0};
+  GpuMaterial g;
+  g.albedo_double_sided = Vec4(diffuse_albedo_of(m.base_color, m.metallic), m.double_sided ? 1.0f : 0.0f);
+  g.emission = Vec4(emission, 0.0f);
+  return g;
+}
 
-  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-  for (const Vec3& p : scene.positions) lo = min(lo, p), hi = max(hi, p);
-  if (triangle_count > 0) {
-    lighting.bounds_lo = lo, lighting.bounds_hi = hi;
-    lighting.extent = std::max(max_component(hi - lo), 1e-30f);
+GpuPunctualLight punctual_record(const PunctualLight& light) {
+  const uint32_t type = light.type == PunctualLight::Type::Spot          ? kPunctualSpot
+                        : light.type == PunctualLight::Type::Directional ? kPunctualDirectional
+                                                                         : kPunctualPoint;
+  GpuPunctualLight g;
+  g.position_type = Vec4(light.position, bits_as_float(type));
+  g.direction_cos_inner = Vec4(light.direction, light.cos_inner);
+  g.intensity_cos_outer = Vec4(light.intensity, light.cos_outer);
+  return g;
+}
+
+// The bounding sphere's radius: the disc a directional light's power crosses.
+float scene_radius(const LightingScene& lighting) {
+  if (lighting.triangles.empty()) return 1.0f;
+  return std::max(0.5f * length(lighting.bounds_hi - lighting.bounds_lo), 1e-6f);
+}
+
+// Point 4 pi I, spot 2 pi (1 - cos_outer) I, directional pi r^2 E.
+double punctual_power(const PunctualLight& light, float radius) {
+  const double intensity = luminance(light.intensity);
+  switch (light.type) {
+    case PunctualLight::Type::Spot: return 2.0 * kPi * (1.0 - light.cos_outer) * intensity;
+    case PunctualLight::Type::Directional: return kPi * double(radius) * double(radius) * intensity;
+    default: return 4.0 * kPi * intensity;
   }
-  const float scene_radius = triangle_count > 0 ? std::max(0.5f * length(hi - lo), 1e-6f) : 1.0f;
+}
 
-  // Emitters by power; their area density is what NEE's MIS needs at any hit on them.
+// Emitters by power (area x luminance of the mean emission, x2 when double sided), and every
+// triangle's area density under that choice, which NEE's MIS needs at any hit on it.
+void build_emitter_distribution(LightingScene& lighting) {
+  const Scene& scene = *lighting.source;
+  lighting.emitter_triangles.clear();
   std::vector<double> powers;
-  for (uint32_t t = 0; t < triangle_count; ++t) {
+  for (uint32_t t = 0; t < scene.triangle_count(); ++t) {
     if (!is_emissive(scene, t)) continue;
     const Material& m = scene.materials[scene.triangle_material[t]];
     const double area = triangle_area(scene, t);
@@ -63,10 +87,45 @@ LightingScene build_lighting_scene(std::shared_ptr<const Scene> source, Bvh4 bvh
   }
   const Distribution1D emitters(powers);
   lighting.emitter_cdf = padded_cdf(emitters);
-  std::vector<float> area_pdf(triangle_count, 0.0f);
+  for (GpuTriangle& g : lighting.triangles) g.p1_area_pdf.w = 0.0f;
   for (size_t i = 0; i < lighting.emitter_triangles.size(); ++i) {
     const uint32_t t = lighting.emitter_triangles[i];
-    area_pdf[t] = emitters.pmf(i) / triangle_area(scene, t);
+    lighting.triangles[t].p1_area_pdf.w = emitters.pmf(i) / triangle_area(scene, t);
+  }
+}
+
+// Punctual lights by power. An all-zero distribution never samples (pmf 0 -> probability 0).
+void build_punctual_distribution(LightingScene& lighting) {
+  std::vector<double> powers;
+  const float radius = scene_radius(lighting);
+  for (const PunctualLight& light : lighting.source->lights) powers.push_back(punctual_power(light, radius));
+  lighting.punctual_cdf = padded_cdf(Distribution1D(powers));
+}
+
+// Edits copy the source Scene (copy on write): the CPU reference, other LightingScenes and the
+// offline stage may share it, and it is immutable for them.
+Scene& writable_source(LightingScene& lighting) {
+  auto copy = std::make_shared<Scene>(*lighting.source);
+  Scene& scene = *copy;
+  lighting.source = std::move(copy);
+  return scene;
+}
+
+}  // namespace
+
+LightingScene build_lighting_scene(std::shared_ptr<const Scene> source, Bvh4 bvh) {
+  const Scene& scene = *source;
+  const size_t triangle_count = scene.triangle_count();
+  check_bvh_references(bvh, triangle_count);
+  LightingScene lighting;
+  lighting.bvh = std::move(bvh);
+  lighting.source = std::move(source);
+
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  for (const Vec3& p : scene.positions) lo = min(lo, p), hi = max(hi, p);
+  if (triangle_count > 0) {
+    lighting.bounds_lo = lo, lighting.bounds_hi = hi;
+    lighting.extent = std::max(max_component(hi - lo), 1e-30f);
   }
 
   lighting.triangles.resize(triangle_count);
@@ -75,50 +134,42 @@ LightingScene build_lighting_scene(std::shared_ptr<const Scene> source, Bvh4 bvh
     const Vec3* n = &scene.normals[t * 3];
     GpuTriangle& g = lighting.triangles[t];
     g.p0_material = Vec4(p[0], bits_as_float(scene.triangle_material[t]));
-    g.p1_area_pdf = Vec4(p[1], area_pdf[t]);
+    g.p1_area_pdf = Vec4(p[1], 0.0f);  // build_emitter_distribution
     g.p2_instance = Vec4(p[2], bits_as_float(scene.triangle_instance.empty() ? 0u : scene.triangle_instance[t]));
     g.n0 = Vec4(n[0], 0.0f), g.n1 = Vec4(n[1], 0.0f), g.n2 = Vec4(n[2], 0.0f);
   }
-
-  lighting.materials.resize(scene.materials.size());
-  for (size_t m = 0; m < scene.materials.size(); ++m) {
-    const Material& mat = scene.materials[m];
-    if (mat.base_color_texture.texture >= 0 || mat.emissive_texture.texture >= 0) lighting.textured = true;
-    const Vec3 emission = max_component(mat.emission) > 0.0f ? mat.emission : Vec3{0, 0, 0};
-    lighting.materials[m].albedo_double_sided = Vec4(diffuse_albedo_of(mat.base_color, mat.metallic), mat.double_sided ? 1.0f : 0.0f);
-    lighting.materials[m].emission = Vec4(emission, 0.0f);
+  for (const Material& m : scene.materials) {
+    lighting.materials.push_back(material_record(m));
+    lighting.textured = lighting.textured || is_textured(m);
   }
-
-  std::vector<double> light_powers;
-  for (const PunctualLight& light : scene.lights) {
-    const double intensity = luminance(light.intensity);
-    GpuPunctualLight g;
-    uint32_t type = kPunctualPoint;
-    switch (light.type) {
-      case PunctualLight::Type::Point:
-        light_powers.push_back(4.0 * kPi * intensity);
-        break;
-      case PunctualLight::Type::Spot:
-        type = kPunctualSpot;
-        light_powers.push_back(2.0 * kPi * (1.0 - light.cos_outer) * intensity);
-        break;
-      case PunctualLight::Type::Directional:
-        type = kPunctualDirectional;
-        light_powers.push_back(kPi * double(scene_radius) * double(scene_radius) * intensity);
-        break;
-    }
-    g.position_type = Vec4(light.position, bits_as_float(type));
-    g.direction_cos_inner = Vec4(light.direction, light.cos_inner);
-    g.intensity_cos_outer = Vec4(light.intensity, light.cos_outer);
-    lighting.punctual_lights.push_back(g);
-  }
-  // An all-zero punctual distribution never samples (pmf 0 -> probability 0).
-  lighting.punctual_cdf = padded_cdf(Distribution1D(light_powers));
+  for (const PunctualLight& light : scene.lights) lighting.punctual_lights.push_back(punctual_record(light));
+  build_emitter_distribution(lighting);
+  build_punctual_distribution(lighting);
 
   lighting.sky = scene.sky.constant;
-  lighting.source = std::move(source);
-  if (lighting.source->sky.has_environment()) lighting.environment = EnvironmentSampler(lighting.source->sky.environment);
+  if (scene.sky.has_environment()) lighting.environment = EnvironmentSampler(scene.sky.environment);
   return lighting;
+}
+
+void set_material(LightingScene& lighting, uint32_t index, const Material& material) {
+  if (index >= lighting.materials.size())
+    throw std::out_of_range("set_material: material " + std::to_string(index) + " of " +
+                            std::to_string(lighting.materials.size()));
+  Scene& scene = writable_source(lighting);
+  scene.materials[index] = material;
+  lighting.materials[index] = material_record(material);
+  lighting.textured = false;
+  for (const Material& m : scene.materials) lighting.textured = lighting.textured || is_textured(m);
+  build_emitter_distribution(lighting);
+}
+
+void set_punctual_light(LightingScene& lighting, uint32_t index, const PunctualLight& light) {
+  if (index >= lighting.punctual_lights.size())
+    throw std::out_of_range("set_punctual_light: light " + std::to_string(index) + " of " +
+                            std::to_string(lighting.punctual_lights.size()));
+  writable_source(lighting).lights[index] = light;
+  lighting.punctual_lights[index] = punctual_record(light);
+  build_punctual_distribution(lighting);
 }
 
 }  // namespace exitance

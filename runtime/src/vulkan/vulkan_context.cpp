@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cstring>
 #include <mutex>
+#include <utility>
+
+#include "device_requirements.h"
 
 namespace exitance::vulkan {
 
@@ -93,150 +96,123 @@ VkInstance create_instance(bool validation, VkDebugUtilsMessengerCreateInfoEXT* 
   return instance;
 }
 
-VulkanDeviceType device_type(VkPhysicalDeviceType t) {
-  switch (t) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return VulkanDeviceType::Discrete;
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return VulkanDeviceType::Integrated;
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return VulkanDeviceType::Virtual;
-    case VK_PHYSICAL_DEVICE_TYPE_CPU: return VulkanDeviceType::Cpu;
-    default: return VulkanDeviceType::Other;
-  }
-}
-
-int type_rank(VulkanDeviceType t) {
-  switch (t) {
-    case VulkanDeviceType::Discrete: return 0;
-    case VulkanDeviceType::Integrated: return 1;
-    case VulkanDeviceType::Virtual: return 2;
-    case VulkanDeviceType::Cpu: return 3;
-    default: return 4;
-  }
-}
-
-// What the shaders need: int64, fp64, subgroup basic/ballot/arithmetic in compute, a compute queue.
-VulkanDeviceInfo describe(VkPhysicalDevice physical, uint32_t index, uint32_t* queue_family, uint32_t* subgroup_size) {
-  VkPhysicalDeviceSubgroupProperties subgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
-  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
-  props.pNext = &subgroup;
-  vkGetPhysicalDeviceProperties2(physical, &props);
-  VkPhysicalDeviceFeatures features{};
-  vkGetPhysicalDeviceFeatures(physical, &features);
-  VulkanDeviceInfo info;
-  info.index = index;
-  info.name = props.properties.deviceName;
-  info.type = device_type(props.properties.deviceType);
-  info.api_version = props.properties.apiVersion;
-  uint32_t count = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(physical, &count, nullptr);
-  std::vector<VkQueueFamilyProperties> families(count);
-  vkGetPhysicalDeviceQueueFamilyProperties(physical, &count, families.data());
-  int family = -1;
-  for (uint32_t i = 0; i < count; ++i)
-    if (families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) {
-      family = int(i);
-      break;
-    }
-  const VkSubgroupFeatureFlags needed =
-      VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
-  if (VK_API_VERSION_MINOR(info.api_version) < 2 && VK_API_VERSION_MAJOR(info.api_version) == 1)
-    info.missing_feature = "Vulkan 1.2";
-  else if (family < 0) info.missing_feature = "a compute queue";
-  else if (!features.shaderInt64) info.missing_feature = "shaderInt64";
-  else if (!features.shaderFloat64) info.missing_feature = "shaderFloat64";
-  else if ((subgroup.supportedOperations & needed) != needed || !(subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT))
-    info.missing_feature = "subgroup basic/ballot/arithmetic operations in compute shaders";
-  info.usable = info.missing_feature.empty();
-  if (queue_family) *queue_family = uint32_t(std::max(family, 0));
-  if (subgroup_size) *subgroup_size = subgroup.subgroupSize;
-  return info;
-}
-
 }  // namespace
 
 Context::Context(const VulkanDeviceOptions& options) : options_(options), messages_(new Messages) {
-  messages_->sink = options.on_validation_message;
-  VkDebugUtilsMessengerCreateInfoEXT messenger = messenger_info(&messages_->sink);
-  instance_ = create_instance(options.validation, &messenger);
   try {
-    if (options.validation) {
-      auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-          vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
-      if (create) check(create(instance_, &messenger, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
-    }
-    uint32_t count = 0;
-    vkEnumeratePhysicalDevices(instance_, &count, nullptr);
-    std::vector<VkPhysicalDevice> devices(count);
-    vkEnumeratePhysicalDevices(instance_, &count, devices.data());
-    if (count == 0) throw std::runtime_error("no Vulkan device: the Vulkan loader found no physical device");
-    int chosen = -1;
-    std::string reasons;
-    for (uint32_t i = 0; i < count; ++i) {
-      const VulkanDeviceInfo d = describe(devices[i], i, nullptr, nullptr);
-      if (!d.usable) reasons += " " + d.name + " lacks " + d.missing_feature + ";";
-      if (options.device_index >= 0) {
-        if (int(i) == options.device_index) {
-          if (!d.usable) throw std::runtime_error("Vulkan device " + std::to_string(i) + " (" + d.name + ") lacks " + d.missing_feature);
-          chosen = int(i);
-        }
-      } else if (d.usable && (chosen < 0 || type_rank(d.type) < type_rank(describe(devices[size_t(chosen)], 0, nullptr, nullptr).type))) {
-        chosen = int(i);
-      }
-    }
-    if (options.device_index >= 0 && chosen < 0)
-      throw std::runtime_error("no Vulkan device with index " + std::to_string(options.device_index) + " (" +
-                               std::to_string(count) + " present)");
-    if (chosen < 0) throw std::runtime_error("no usable Vulkan device:" + reasons);
-    physical_ = devices[size_t(chosen)];
-    info_ = describe(physical_, uint32_t(chosen), &queue_family_, &subgroup_size_);
-    vkGetPhysicalDeviceProperties(physical_, &properties_);
-    vkGetPhysicalDeviceMemoryProperties(physical_, &memory_properties_);
-    uint32_t family_count = 0;
-    vkGetPhysicalDeviceQueueFamilyProperties(physical_, &family_count, nullptr);
-    std::vector<VkQueueFamilyProperties> families(family_count);
-    vkGetPhysicalDeviceQueueFamilyProperties(physical_, &family_count, families.data());
-    timestamp_valid_bits_ = families[queue_family_].timestampValidBits;
-
-    const float priority = 1.0f;
-    VkDeviceQueueCreateInfo queue_info{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-    queue_info.queueFamilyIndex = queue_family_;
-    queue_info.queueCount = 1;
-    queue_info.pQueuePriorities = &priority;
-    VkPhysicalDeviceFeatures features{};
-    features.shaderInt64 = VK_TRUE;
-    features.shaderFloat64 = VK_TRUE;
-    VkDeviceCreateInfo device_info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
-    device_info.queueCreateInfoCount = 1;
-    device_info.pQueueCreateInfos = &queue_info;
-    device_info.pEnabledFeatures = &features;
-    check(vkCreateDevice(physical_, &device_info, nullptr, &device_), "vkCreateDevice");
-    vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
-    VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-    pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-    pool_info.queueFamilyIndex = queue_family_;
-    check(vkCreateCommandPool(device_, &pool_info, nullptr, &pool_), "vkCreateCommandPool");
-    VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    alloc.commandPool = pool_;
-    alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    alloc.commandBufferCount = 1;
-    check(vkAllocateCommandBuffers(device_, &alloc, &cmd_), "vkAllocateCommandBuffers");
-    VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    check(vkCreateFence(device_, &fence_info, nullptr, &fence_), "vkCreateFence");
+    if (options.external_device) adopt(*options.external_device);
+    else create_own_device(options);
+    create_submission_objects();
   } catch (...) {
     cleanup();
     throw;
   }
 }
 
+void Context::create_own_device(const VulkanDeviceOptions& options) {
+  messages_->sink = options.on_validation_message;
+  VkDebugUtilsMessengerCreateInfoEXT messenger = messenger_info(&messages_->sink);
+  instance_ = create_instance(options.validation, &messenger);
+  if (options.validation) {
+    auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
+    if (create) check(create(instance_, &messenger, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
+  }
+  uint32_t count = 0;
+  vkEnumeratePhysicalDevices(instance_, &count, nullptr);
+  std::vector<VkPhysicalDevice> devices(count);
+  vkEnumeratePhysicalDevices(instance_, &count, devices.data());
+  if (count == 0) throw std::runtime_error("no Vulkan device: the Vulkan loader found no physical device");
+  int chosen = -1;
+  std::string reasons;
+  for (uint32_t i = 0; i < count; ++i) {
+    const VulkanDeviceInfo d = describe_device(devices[i], i);
+    if (!d.usable) reasons += " " + d.name + " lacks " + d.missing_feature + ";";
+    if (options.device_index >= 0) {
+      if (int(i) == options.device_index) {
+        if (!d.usable) throw std::runtime_error("Vulkan device " + std::to_string(i) + " (" + d.name + ") lacks " + d.missing_feature);
+        chosen = int(i);
+      }
+    } else if (d.usable && (chosen < 0 || preference_rank(d.type) < preference_rank(describe_device(devices[size_t(chosen)], 0).type))) {
+      chosen = int(i);
+    }
+  }
+  if (options.device_index >= 0 && chosen < 0)
+    throw std::runtime_error("no Vulkan device with index " + std::to_string(options.device_index) + " (" +
+                             std::to_string(count) + " present)");
+  if (chosen < 0) throw std::runtime_error("no usable Vulkan device:" + reasons);
+  physical_ = devices[size_t(chosen)];
+  info_ = describe_device(physical_, uint32_t(chosen), &queue_family_);
+
+  const float priority = 1.0f;
+  VkDeviceQueueCreateInfo queue_info{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  queue_info.queueFamilyIndex = queue_family_;
+  queue_info.queueCount = 1;
+  queue_info.pQueuePriorities = &priority;
+  const VkPhysicalDeviceFeatures features = vulkan_required_features();
+  VkDeviceCreateInfo device_info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  device_info.queueCreateInfoCount = 1;
+  device_info.pQueueCreateInfos = &queue_info;
+  device_info.pEnabledFeatures = &features;
+  check(vkCreateDevice(physical_, &device_info, nullptr, &device_), "vkCreateDevice");
+  vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+}
+
+void Context::adopt(const VulkanExternalDevice& external) {
+  if (options_.validation || options_.on_validation_message || options_.device_index >= 0)
+    throw std::invalid_argument("Vulkan backend: with an adopted device, validation and the device are the engine's "
+                                "(leave validation, on_validation_message and device_index unset)");
+  check_adopted_device(external);
+  owns_device_ = false;
+  instance_ = external.instance;
+  physical_ = external.physical_device;
+  device_ = external.device;
+  queue_ = external.queue;
+  queue_family_ = external.queue_family;
+  uint32_t count = 0;
+  vkEnumeratePhysicalDevices(instance_, &count, nullptr);
+  std::vector<VkPhysicalDevice> devices(count);
+  vkEnumeratePhysicalDevices(instance_, &count, devices.data());
+  const auto position = std::find(devices.begin(), devices.end(), physical_);
+  info_ = describe_device(physical_, uint32_t(position - devices.begin()));  // its index on the engine's instance
+}
+
+// Properties, and what the context itself creates on either device: one command pool, buffer, fence.
+void Context::create_submission_objects() {
+  vkGetPhysicalDeviceProperties(physical_, &properties_);
+  vkGetPhysicalDeviceMemoryProperties(physical_, &memory_properties_);
+  uint32_t family_count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &family_count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(family_count);
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &family_count, families.data());
+  timestamp_valid_bits_ = families[queue_family_].timestampValidBits;
+  VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pool_info.queueFamilyIndex = queue_family_;
+  check(vkCreateCommandPool(device_, &pool_info, nullptr, &pool_), "vkCreateCommandPool");
+  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  alloc.commandPool = pool_;
+  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  alloc.commandBufferCount = 1;
+  check(vkAllocateCommandBuffers(device_, &alloc, &cmd_), "vkAllocateCommandBuffers");
+  VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  check(vkCreateFence(device_, &fence_info, nullptr, &fence_), "vkCreateFence");
+}
+
 Context::~Context() { cleanup(); }
 
+// Every submission was waited for, so nothing of ours is in flight; an adopted device may run the
+// engine's work, which vkDeviceWaitIdle would wait for (and which needs its queues synchronised).
 void Context::cleanup() {
   if (device_) {
-    if (!lost_) vkDeviceWaitIdle(device_);
+    if (owns_device_ && !lost_) vkDeviceWaitIdle(device_);
     if (fence_) vkDestroyFence(device_, fence_, nullptr);
     if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
-    vkDestroyDevice(device_, nullptr);
+    fence_ = VK_NULL_HANDLE, pool_ = VK_NULL_HANDLE;
+    if (owns_device_) vkDestroyDevice(device_, nullptr);
     device_ = VK_NULL_HANDLE;
   }
+  if (!owns_device_) return;
   if (messenger_) {
     auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
         vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
@@ -257,36 +233,56 @@ uint32_t Context::find_memory_type(uint32_t bits, VkMemoryPropertyFlags required
   throw std::runtime_error("Vulkan: no suitable memory type");
 }
 
+Buffer& Buffer::operator=(Buffer&& other) noexcept {
+  if (this == &other) return *this;
+  release();
+  owner_ = std::exchange(other.owner_, nullptr);
+  buffer_ = std::exchange(other.buffer_, VK_NULL_HANDLE);
+  memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
+  size_ = std::exchange(other.size_, 0);
+  mapped_ = std::exchange(other.mapped_, nullptr);
+  return *this;
+}
+
+void Buffer::release() {
+  if (owner_) owner_->destroy(*this);
+}
+
 Buffer Context::create_buffer(VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible) {
   Buffer b;
-  b.size = std::max<VkDeviceSize>(size, 16);
+  b.size_ = std::max<VkDeviceSize>(size, 16);
   VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-  info.size = b.size;
+  info.size = b.size_;
   info.usage = usage | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-  check(vkCreateBuffer(device_, &info, nullptr, &b.buffer), "vkCreateBuffer");
+  check(vkCreateBuffer(device_, &info, nullptr, &b.buffer_), "vkCreateBuffer");
+  b.owner_ = this;  // from here on, the Buffer frees what it holds, also when a step below throws
   VkMemoryRequirements req;
-  vkGetBufferMemoryRequirements(device_, b.buffer, &req);
+  vkGetBufferMemoryRequirements(device_, b.buffer_, &req);
   VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   alloc.allocationSize = req.size;
   alloc.memoryTypeIndex =
       host_visible ? find_memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
                                       VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
                    : find_memory_type(req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  const VkResult r = vkAllocateMemory(device_, &alloc, nullptr, &b.memory);
-  if (r != VK_SUCCESS) {
-    vkDestroyBuffer(device_, b.buffer, nullptr);
-    check(r, ("allocating a buffer of " + std::to_string(req.size) + " bytes").c_str());
-  }
-  check(vkBindBufferMemory(device_, b.buffer, b.memory, 0), "vkBindBufferMemory");
-  if (host_visible) check(vkMapMemory(device_, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
+  check(vkAllocateMemory(device_, &alloc, nullptr, &b.memory_), ("allocating a buffer of " + std::to_string(req.size) + " bytes").c_str());
+  check(vkBindBufferMemory(device_, b.buffer_, b.memory_, 0), "vkBindBufferMemory");
+  if (host_visible) check(vkMapMemory(device_, b.memory_, 0, VK_WHOLE_SIZE, 0, &b.mapped_), "vkMapMemory");
   return b;
 }
 
+Buffer Context::create_storage_buffer(VkDeviceSize size, VkBufferUsageFlags extra_usage) {
+  const VkDeviceSize limit = properties_.limits.maxStorageBufferRange;
+  if (size > limit)
+    throw std::runtime_error("Vulkan backend: a buffer of " + std::to_string(size) + " bytes exceeds this device's " +
+                             "maxStorageBufferRange (" + std::to_string(limit) + "); use fewer paths or texels per bake");
+  return create_buffer(size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | extra_usage, false);
+}
+
 void Context::destroy(Buffer& b) {
-  if (b.buffer) vkDestroyBuffer(device_, b.buffer, nullptr);
-  if (b.memory) vkFreeMemory(device_, b.memory, nullptr);
-  b = Buffer{};
+  if (b.buffer_) vkDestroyBuffer(device_, b.buffer_, nullptr);
+  if (b.memory_) vkFreeMemory(device_, b.memory_, nullptr);
+  b.owner_ = nullptr, b.buffer_ = VK_NULL_HANDLE, b.memory_ = VK_NULL_HANDLE, b.size_ = 0, b.mapped_ = nullptr;
 }
 
 VkCommandBuffer Context::begin() {
@@ -321,17 +317,29 @@ void Context::submit_and_wait(VkCommandBuffer cmd) {
 void Context::upload(const Buffer& dst, const void* data, VkDeviceSize size, VkDeviceSize offset) {
   if (size == 0) return;
   Buffer staging = create_buffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
-  std::memcpy(staging.mapped, data, size_t(size));
+  std::memcpy(staging.mapped(), data, size_t(size));
   VkCommandBuffer cmd = begin();
   VkBufferCopy region{0, offset, size};
-  vkCmdCopyBuffer(cmd, staging.buffer, dst.buffer, 1, &region);
-  try {
-    submit_and_wait(cmd);
-  } catch (...) {
-    destroy(staging);
-    throw;
+  vkCmdCopyBuffer(cmd, staging.handle(), dst.handle(), 1, &region);
+  submit_and_wait(cmd);
+}
+
+void Context::upload_ranges(const Buffer& dst, const void* data, const std::vector<ByteRange>& ranges) {
+  VkDeviceSize total = 0;
+  for (const ByteRange& r : ranges) total += r.size;
+  if (total == 0) return;
+  Buffer staging = create_buffer(total, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+  std::vector<VkBufferCopy> regions;
+  VkDeviceSize packed = 0;
+  for (const ByteRange& r : ranges) {
+    if (r.size == 0) continue;
+    std::memcpy(static_cast<char*>(staging.mapped()) + packed, static_cast<const char*>(data) + r.offset, size_t(r.size));
+    regions.push_back({packed, r.offset, r.size});
+    packed += r.size;
   }
-  destroy(staging);
+  VkCommandBuffer cmd = begin();
+  vkCmdCopyBuffer(cmd, staging.handle(), dst.handle(), uint32_t(regions.size()), regions.data());
+  submit_and_wait(cmd);
 }
 
 void Context::download(const Buffer& src, void* data, VkDeviceSize size, VkDeviceSize offset) {
@@ -339,15 +347,9 @@ void Context::download(const Buffer& src, void* data, VkDeviceSize size, VkDevic
   Buffer staging = create_buffer(size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
   VkCommandBuffer cmd = begin();
   VkBufferCopy region{offset, 0, size};
-  vkCmdCopyBuffer(cmd, src.buffer, staging.buffer, 1, &region);
-  try {
-    submit_and_wait(cmd);
-  } catch (...) {
-    destroy(staging);
-    throw;
-  }
-  std::memcpy(data, staging.mapped, size_t(size));
-  destroy(staging);
+  vkCmdCopyBuffer(cmd, src.handle(), staging.handle(), 1, &region);
+  submit_and_wait(cmd);
+  std::memcpy(data, staging.mapped(), size_t(size));
 }
 
 }  // namespace exitance::vulkan
@@ -366,7 +368,7 @@ std::vector<VulkanDeviceInfo> enumerate_vulkan_devices() {
   vkEnumeratePhysicalDevices(instance, &count, nullptr);
   std::vector<VkPhysicalDevice> devices(count);
   vkEnumeratePhysicalDevices(instance, &count, devices.data());
-  for (uint32_t i = 0; i < count; ++i) result.push_back(vulkan::describe(devices[i], i, nullptr, nullptr));
+  for (uint32_t i = 0; i < count; ++i) result.push_back(vulkan::describe_device(devices[i], i));
   vkDestroyInstance(instance, nullptr);
   return result;
 }

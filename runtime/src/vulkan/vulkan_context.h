@@ -1,5 +1,6 @@
-// Thin RAII layer over the Vulkan objects the wavefront needs: instance (+ validation messenger),
-// one compute queue, buffers, compute pipelines, one-shot submissions with fence timeouts.
+// Thin RAII layer over the Vulkan objects the wavefront needs: its own instance (+ validation
+// messenger) and device, or an engine's adopted ones; one compute queue, buffers, one-shot
+// submissions with fence timeouts.
 #pragma once
 #include <vulkan/vulkan.h>
 
@@ -18,32 +19,57 @@ std::string result_name(VkResult result);
 // Throws std::runtime_error naming the call; device loss and out-of-memory get their own wording.
 void check(VkResult result, const char* what);
 
-struct Buffer {
-  VkBuffer buffer = VK_NULL_HANDLE;
-  VkDeviceMemory memory = VK_NULL_HANDLE;
-  VkDeviceSize size = 0;
-  void* mapped = nullptr;  // host-visible buffers only
+class Context;
+
+// A buffer and its memory, freed when the Buffer goes (the context outlives every buffer).
+class Buffer {
+ public:
+  Buffer() = default;
+  Buffer(Buffer&& other) noexcept { *this = std::move(other); }
+  Buffer& operator=(Buffer&& other) noexcept;
+  ~Buffer() { release(); }
+
+  VkBuffer handle() const { return buffer_; }
+  VkDeviceSize size() const { return size_; }
+  void* mapped() const { return mapped_; }  // host-visible buffers only
+
+ private:
+  friend class Context;
+  void release();
+  Context* owner_ = nullptr;
+  VkBuffer buffer_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  VkDeviceSize size_ = 0;
+  void* mapped_ = nullptr;
+};
+
+// Bytes [offset, offset + size) of a buffer and of the host array that mirrors it.
+struct ByteRange {
+  VkDeviceSize offset = 0, size = 0;
 };
 
 class Context {
  public:
-  Context(const VulkanDeviceOptions& options);
+  // Creates an instance and a device, or adopts options.external_device (checked, never destroyed).
+  explicit Context(const VulkanDeviceOptions& options);
   ~Context();
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
 
   VkDevice device() const { return device_; }
-  VkQueue queue() const { return queue_; }
   const VulkanDeviceInfo& info() const { return info_; }
   const VkPhysicalDeviceProperties& properties() const { return properties_; }
   const VkPhysicalDeviceMemoryProperties& memory_properties() const { return memory_properties_; }
-  uint32_t subgroup_size() const { return subgroup_size_; }
   bool timestamps() const { return timestamp_valid_bits_ > 0; }
+  bool adopted() const { return !owns_device_; }
 
   Buffer create_buffer(VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible);
-  void destroy(Buffer& buffer);
+  // A device-local storage buffer; throws when `size` exceeds the device's maxStorageBufferRange.
+  Buffer create_storage_buffer(VkDeviceSize size, VkBufferUsageFlags extra_usage = 0);
   // Copies host data into a device buffer (through a staging buffer) and waits.
   void upload(const Buffer& dst, const void* data, VkDeviceSize size, VkDeviceSize offset = 0);
+  // Copies the ranges of `data`, a host mirror of `dst`, to the same ranges of `dst`, and waits.
+  void upload_ranges(const Buffer& dst, const void* data, const std::vector<ByteRange>& ranges);
   void download(const Buffer& src, void* data, VkDeviceSize size, VkDeviceSize offset = 0);
 
   VkCommandBuffer begin();  // the context's single command buffer, reset
@@ -52,12 +78,18 @@ class Context {
   bool lost() const { return lost_; }
 
  private:
+  friend class Buffer;
+  void create_own_device(const VulkanDeviceOptions& options);
+  void adopt(const VulkanExternalDevice& external);
+  void create_submission_objects();
   void cleanup();
+  void destroy(Buffer& buffer);
   uint32_t find_memory_type(uint32_t bits, VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred) const;
 
   VulkanDeviceOptions options_;
   struct Messages;
   std::unique_ptr<Messages> messages_;
+  bool owns_device_ = true;  // false: instance and device are an engine's (never destroyed here)
   VkInstance instance_ = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
   VkPhysicalDevice physical_ = VK_NULL_HANDLE;
@@ -66,7 +98,6 @@ class Context {
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
   uint32_t queue_family_ = 0;
-  uint32_t subgroup_size_ = 0;
   uint32_t timestamp_valid_bits_ = 0;
   VkCommandPool pool_ = VK_NULL_HANDLE;
   VkCommandBuffer cmd_ = VK_NULL_HANDLE;

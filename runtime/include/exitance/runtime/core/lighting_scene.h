@@ -39,4 +39,12 @@ struct LightingScene {
 // throws std::invalid_argument when the BVH references a triangle the scene does not have.
 LightingScene build_lighting_scene(std::shared_ptr<const Scene> scene, Bvh4 bvh);
 
+// Runtime edits in place: the record, the source Scene (copied on write, as others may share it)
+// and what depends on them are recomputed as build_lighting_scene would: a material's record, the
+// `textured` flag, the emitter distribution and every triangle's area pdf; a light's record and the
+// punctual CDF. Geometry, BVH and sizes stay (an instance transform would need a BVH refit: not
+// offered). Throw std::out_of_range for an index the scene does not have.
+void set_material(LightingScene& scene, uint32_t index, const Material& material);
+void set_punctual_light(LightingScene& scene, uint32_t index, const PunctualLight& light);
+
 }  // namespace exitance

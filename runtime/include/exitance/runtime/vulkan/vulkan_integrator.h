@@ -7,12 +7,14 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "exitance/runtime/core/integrator.h"
 #include "exitance/runtime/core/lighting_scene.h"
 #include "exitance/runtime/texel_gbuffer.h"
+#include "exitance/runtime/vulkan/vulkan_external_device.h"
 
 namespace exitance {
 
@@ -36,6 +38,9 @@ std::vector<VulkanDeviceInfo> enumerate_vulkan_devices();
 enum class VulkanNodeLayout { Automatic, Float, Quantized };
 
 struct VulkanDeviceOptions {
+  // Set: the backend adopts this device (vulkan_external_device.h) and creates none; device_index
+  // and validation must be left at their defaults (the engine's instance decides validation).
+  std::optional<VulkanExternalDevice> external_device;
   int device_index = -1;   // -1: prefer a discrete GPU, then integrated, then any (lavapipe)
   bool validation = false; // enable VK_LAYER_KHRONOS_validation + a debug messenger
   // Receives every validation/debug message (warnings and errors), including those at teardown.
@@ -56,7 +61,9 @@ struct VulkanDeviceOptions {
   bool collect_stage_statistics = false;  // timestamps + lane counters per stage (bench only; slower)
 };
 
-// Per-stage figures of the last bake (filled when collect_stage_statistics is on).
+// Per-stage figures of the last bake (filled when collect_stage_statistics is on), one per named
+// kernel launch ("shade: hits, emission, next-event, continuation", ...) in the order of their first
+// launch, then "rays: primary" and "rays: bounce".
 struct VulkanStageStatistics {
   std::string stage;
   double seconds = 0;        // GPU time summed over all dispatches of the stage
@@ -68,8 +75,9 @@ struct VulkanStageStatistics {
 class VulkanIntegrator final : public Integrator {
  public:
   // Uploads the scene (its BVH4 as built by the offline stage or read from scene.bin). Throws
-  // std::runtime_error when no usable Vulkan device exists, and for scenes the backend does not
-  // support yet (textured materials, environment-map skies): never a silently wrong result.
+  // std::runtime_error when no usable Vulkan device exists (or the adopted one lacks a feature), and
+  // for scenes the backend does not support yet (textured materials, environment-map skies): never
+  // a silently wrong result. The integrator keeps no reference to `scene`.
   static std::unique_ptr<VulkanIntegrator> create(std::shared_ptr<const LightingScene> scene,
                                                   const VulkanDeviceOptions& options = {});
   ~VulkanIntegrator() override;
@@ -90,6 +98,16 @@ class VulkanIntegrator final : public Integrator {
   ProbeEstimate bake_probes(const std::vector<Vec3>& positions, const IntegratorSettings& settings) const override;
   std::string backend_name() const override { return "vulkan"; }
   std::string device_description() const override;
+
+  // Runtime edits without a rebuild. `edited` is the scene this integrator was created on (or a
+  // copy) after set_material / set_punctual_light (lighting_scene.h): update_materials uploads the
+  // materials, the emitter distribution and the area pdfs again; update_lights the punctual lights,
+  // their CDF and the constant sky. Geometry and BVH stay: an edit that changes them (instance
+  // transforms need a BVH refit) needs a new integrator. Throws std::invalid_argument when the
+  // counts of triangles, materials or lights differ, std::runtime_error as create() for what the
+  // backend does not support.
+  void update_materials(const LightingScene& edited);
+  void update_lights(const LightingScene& edited);
 
   const VulkanDeviceInfo& device() const;
   uint32_t max_paths() const;

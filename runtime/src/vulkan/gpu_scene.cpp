@@ -1,0 +1,147 @@
+#include "gpu_scene.h"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "bvh_quantization.h"
+#include "exitance/runtime/core/scene_access.h"
+
+namespace exitance::vulkan {
+namespace {
+
+static_assert(sizeof(GpuTriangle) == 96 && sizeof(GpuMaterial) == 32 && sizeof(GpuPunctualLight) == 48);
+
+// Vulkan buffers cannot be empty.
+template <typename T>
+std::vector<T> at_least_one(const std::vector<T>& v) {
+  return v.empty() ? std::vector<T>(1) : v;
+}
+
+template <typename T>
+Buffer upload_new(Context& context, const std::vector<T>& data) {
+  Buffer b = context.create_storage_buffer(data.size() * sizeof(T));
+  context.upload(b, data.data(), data.size() * sizeof(T));
+  return b;
+}
+
+std::vector<uint32_t> node_words(const Bvh4& bvh, bool quantized) {
+  if (quantized) return quantize_bvh4_nodes(bvh.nodes);
+  std::vector<uint32_t> words(bvh.nodes.size() * sizeof(Bvh4Node) / 4);
+  std::memcpy(words.data(), bvh.nodes.data(), words.size() * 4);
+  return words;
+}
+
+// Per leaf slot, its triangle's vertices (and index, in the first w) where traversal reads them together.
+std::vector<Vec4> leaf_triangle_copies(const LightingScene& scene) {
+  std::vector<Vec4> leaf(std::max<size_t>(scene.bvh.leaf_triangles.size(), 1) * 3);
+  for (size_t slot = 0; slot < scene.bvh.leaf_triangles.size(); ++slot) {
+    const uint32_t t = scene.bvh.leaf_triangles[slot];
+    leaf[slot * 3] = Vec4(scene_triangle_vertex(scene, t, 0), std::bit_cast<float>(t));
+    leaf[slot * 3 + 1] = Vec4(scene_triangle_vertex(scene, t, 1), 0.0f);
+    leaf[slot * 3 + 2] = Vec4(scene_triangle_vertex(scene, t, 2), 0.0f);
+  }
+  return leaf;
+}
+
+// The records of `triangles` (sorted, unique) as byte ranges, consecutive ones merged.
+std::vector<ByteRange> triangle_ranges(const std::vector<uint32_t>& triangles) {
+  std::vector<ByteRange> ranges;
+  for (uint32_t t : triangles) {
+    const VkDeviceSize offset = VkDeviceSize(t) * sizeof(GpuTriangle);
+    if (!ranges.empty() && ranges.back().offset + ranges.back().size == offset) ranges.back().size += sizeof(GpuTriangle);
+    else ranges.push_back({offset, sizeof(GpuTriangle)});
+  }
+  return ranges;
+}
+
+}  // namespace
+
+void check_supported_by_vulkan(const LightingScene& scene) {
+  if (scene.environment.enabled())
+    throw std::runtime_error("Vulkan backend: environment-map skies are not supported yet (use the cpu backend)");
+  if (scene.textured)
+    for (const Material& m : scene.source->materials)
+      if (m.base_color_texture.texture >= 0 || m.emissive_texture.texture >= 0)
+        throw std::runtime_error("Vulkan backend: textured materials are not supported yet (material '" + m.name +
+                                 "'; use the cpu backend)");
+  if (scene.bvh.nodes.empty()) throw std::invalid_argument("Vulkan backend: the scene has no BVH4 (build_bvh4 or scene.bin)");
+}
+
+GpuScene::GpuScene(Context& context, const LightingScene& scene, bool quantized_nodes)
+    : context_(context),
+      nodes_(upload_new(context, node_words(scene.bvh, quantized_nodes))),
+      leaf_triangles_(upload_new(context, leaf_triangle_copies(scene))),
+      triangles_(upload_new(context, at_least_one(scene.triangles))),
+      materials_(upload_new(context, at_least_one(scene.materials))),
+      emitter_cdf_(upload_new(context, scene.emitter_cdf)),
+      emitter_triangles_(upload_new(context, at_least_one(scene.emitter_triangles))),
+      punctual_lights_(upload_new(context, at_least_one(scene.punctual_lights))),
+      punctual_cdf_(upload_new(context, scene.punctual_cdf)),
+      emitters_(scene.emitter_triangles),
+      triangle_count_(scene.triangles.size()),
+      material_count_(scene.materials.size()),
+      punctual_count_(scene.punctual_count()),
+      sky_(scene.sky),
+      bounds_lo_(scene.bounds_lo),
+      bounds_hi_(scene.bounds_hi),
+      extent_(scene.extent),
+      stack_bound_(std::max<uint32_t>(scene.bvh.stack_entries + 1, 8)),
+      node_count_(uint32_t(scene.bvh.nodes.size())),
+      leaf_slots_(uint32_t(scene.bvh.leaf_triangles.size())),
+      quantized_(quantized_nodes) {}
+
+size_t GpuScene::bvh_bytes() const {
+  return size_t(node_count_) * (quantized_ ? kQuantizedNodeWords * 4 : sizeof(Bvh4Node)) + size_t(leaf_slots_) * 48;
+}
+
+void GpuScene::bind(DescriptorWrites& writes) const {
+  writes.set(kBindingBvhNodes, nodes_);
+  writes.set(kBindingBvhTriangles, leaf_triangles_);
+  writes.set(kBindingTriangles, triangles_);
+  writes.set(kBindingMaterials, materials_);
+  writes.set(kBindingEmitterCdf, emitter_cdf_);
+  writes.set(kBindingEmitterTriangles, emitter_triangles_);
+  writes.set(kBindingPunctualLights, punctual_lights_);
+  writes.set(kBindingPunctualCdf, punctual_cdf_);
+}
+
+void GpuScene::check_same_shape(const LightingScene& edited) const {
+  if (edited.triangles.size() != triangle_count_ || edited.materials.size() != material_count_ ||
+      edited.punctual_count() != punctual_count_ || edited.bvh.nodes.size() != node_count_)
+    throw std::invalid_argument("Vulkan backend: an update must keep the scene's triangles, materials, lights and BVH "
+                                "(other edits need a new integrator)");
+}
+
+void GpuScene::upload_growing(Buffer& buffer, const void* data, size_t bytes) {
+  if (bytes > buffer.size()) buffer = context_.create_storage_buffer(bytes);
+  context_.upload(buffer, data, bytes);
+}
+
+void GpuScene::update_materials(const LightingScene& edited) {
+  check_same_shape(edited);
+  check_supported_by_vulkan(edited);
+  if (!edited.materials.empty()) context_.upload(materials_, edited.materials.data(), edited.materials.size() * sizeof(GpuMaterial));
+  std::vector<uint32_t> changed = emitters_;
+  changed.insert(changed.end(), edited.emitter_triangles.begin(), edited.emitter_triangles.end());
+  std::sort(changed.begin(), changed.end());
+  changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+  context_.upload_ranges(triangles_, edited.triangles.data(), triangle_ranges(changed));
+  upload_growing(emitter_cdf_, edited.emitter_cdf.data(), edited.emitter_cdf.size() * sizeof(double));
+  const std::vector<uint32_t> emitters = at_least_one(edited.emitter_triangles);
+  upload_growing(emitter_triangles_, emitters.data(), emitters.size() * 4);
+  emitters_ = edited.emitter_triangles;
+}
+
+void GpuScene::update_lights(const LightingScene& edited) {
+  check_same_shape(edited);
+  check_supported_by_vulkan(edited);
+  if (punctual_count_ > 0)
+    context_.upload(punctual_lights_, edited.punctual_lights.data(), edited.punctual_lights.size() * sizeof(GpuPunctualLight));
+  context_.upload(punctual_cdf_, edited.punctual_cdf.data(), edited.punctual_cdf.size() * sizeof(double));
+  sky_ = edited.sky;
+}
+
+}  // namespace exitance::vulkan

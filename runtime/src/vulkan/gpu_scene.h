@@ -1,0 +1,63 @@
+// The scene on the device: a LightingScene's records as the kernels read them (gpu_layout.h), the
+// BVH4 in the chosen node layout, and per leaf slot a copy of its triangle's vertices for traversal.
+// Materials and punctual lights can be updated in place (runtime edits): only those records and
+// what depends on them are uploaded again; geometry and BVH stay.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "exitance/runtime/core/lighting_scene.h"
+#include "vulkan_context.h"
+#include "wavefront_kernels.h"
+
+namespace exitance::vulkan {
+
+// Throws std::runtime_error for what the kernels cannot evaluate yet: environment-map skies,
+// textured materials (naming the first), a scene without a BVH4.
+void check_supported_by_vulkan(const LightingScene& scene);
+
+class GpuScene {
+ public:
+  // `quantized_nodes`: 64-byte nodes with 8-bit child bounds (bvh_quantization.h), else 112-byte float nodes.
+  GpuScene(Context& context, const LightingScene& scene, bool quantized_nodes);
+
+  // `edited`: the scene this one was uploaded from, after set_material (lighting_scene.h): uploads
+  // the materials, the emitter list and CDF, and the triangle records of old and new emitters
+  // (their area pdfs). Throws std::invalid_argument when the scene's shape differs.
+  void update_materials(const LightingScene& edited);
+  // After set_punctual_light: uploads the punctual lights and their CDF, and takes the constant sky.
+  void update_lights(const LightingScene& edited);
+
+  void bind(DescriptorWrites& writes) const;  // kBindingBvhNodes .. kBindingPunctualCdf
+
+  // What the kernels' parameters (GpuParams) take from the scene, current after updates.
+  Vec3 sky() const { return sky_; }
+  float extent() const { return extent_; }
+  Vec3 bounds_lo() const { return bounds_lo_; }
+  Vec3 bounds_hi() const { return bounds_hi_; }
+  uint32_t emitter_count() const { return uint32_t(emitters_.size()); }
+  uint32_t punctual_count() const { return punctual_count_; }
+
+  uint32_t traversal_stack_bound() const { return stack_bound_; }
+  bool quantized_nodes() const { return quantized_; }
+  uint32_t bvh_node_count() const { return node_count_; }
+  size_t bvh_bytes() const;
+
+ private:
+  void check_same_shape(const LightingScene& edited) const;
+  // Uploads `bytes` of `data` into `buffer`, first growing it when they do not fit (a material edit
+  // can add emitters); the integrator writes its descriptors again before each bake.
+  void upload_growing(Buffer& buffer, const void* data, size_t bytes);
+
+  Context& context_;
+  Buffer nodes_, leaf_triangles_, triangles_, materials_, emitter_cdf_, emitter_triangles_, punctual_lights_, punctual_cdf_;
+  std::vector<uint32_t> emitters_;  // uploaded emitter triangles: their records change with the next edit
+  size_t triangle_count_ = 0, material_count_ = 0;
+  uint32_t punctual_count_ = 0;
+  Vec3 sky_{0, 0, 0}, bounds_lo_{0, 0, 0}, bounds_hi_{0, 0, 0};
+  float extent_ = 1.0f;
+  uint32_t stack_bound_ = 8, node_count_ = 0, leaf_slots_ = 0;
+  bool quantized_ = false;
+};
+
+}  // namespace exitance::vulkan

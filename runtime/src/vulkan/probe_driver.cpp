@@ -1,0 +1,89 @@
+#include "probe_driver.h"
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+#include <stdexcept>
+
+#include "exitance/runtime/core/pass_scheduler.h"
+
+namespace exitance::vulkan {
+namespace {
+
+// Per work item: 2 result slots (12 bytes each), then albedo and direction (24 bytes).
+constexpr size_t kProbeResultBytes = 48;
+
+}  // namespace
+
+// Start points with the position only, and the work list of every probe in order.
+void ProbeDriver::upload_probes(const std::vector<Vec3>& positions) {
+  Context& context = runner_.context();
+  WavefrontBuffers& buffers = runner_.buffers();
+  std::vector<GpuSurfacePoint> records(positions.size());
+  for (size_t i = 0; i < positions.size(); ++i) records[i].position = Vec4(positions[i], 0.0f);
+  context.upload(buffers.items.start_points, records.data(), records.size() * sizeof(GpuSurfacePoint));
+  std::vector<uint32_t> order(positions.size());
+  for (size_t i = 0; i < positions.size(); ++i) order[i] = uint32_t(i);
+  context.upload(buffers.items.batch_items, order.data(), order.size() * 4);
+  VkCommandBuffer cmd = context.begin();
+  buffers.probes.clear(cmd);
+  context.submit_and_wait(cmd);
+}
+
+ProbeEstimate ProbeDriver::bake(const std::vector<Vec3>& positions, const IntegratorSettings& settings) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  const size_t probe_count = positions.size();
+  ProbeEstimate estimate;
+  estimate.sh_sum.assign(probe_count, std::array<double, 27>{});
+  estimate.samples.assign(probe_count, 0);
+  estimate.backface_hits.assign(probe_count, 0);
+  runner_.statistics().clear();
+  if (probe_count == 0) return estimate;
+  if (probe_count >= (1ull << 31)) throw std::runtime_error("Vulkan backend: too many probes");
+
+  const size_t max_work = runner_.work_items_per_batch(kProbeResultBytes);
+  Context& context = runner_.context();
+  WavefrontBuffers& buffers = runner_.buffers();
+  buffers.items.reserve(context, probe_count);
+  buffers.probes.reserve(context, probe_count);
+  buffers.results.reserve(context, max_work * kProbeResultBytes);
+  runner_.bind_buffers();
+  upload_probes(positions);
+
+  GpuParams params = runner_.bake_params(settings, 1, uint32_t(probe_count));  // slot 0: what the probe ray meets; 1: E/pi at its hit
+  params.probe_spp = settings.spp == 0 ? std::numeric_limits<uint32_t>::max() : settings.spp;
+  BatchTotals totals;
+  const uint32_t chunk = uint32_t(std::min(probe_count, max_work));
+  PassPolicy policy;
+  policy.largest_pass = uint32_t(std::max<size_t>(1, max_work / chunk));
+  // With a time budget, passes end on stratified-set boundaries and the budget is only checked
+  // there, so a stopped run never leaves a set's strata out (as the reference).
+  policy.stratified_set = kProbeStratifiedSetSize;
+  PassScheduler passes(settings, policy);
+  uint32_t first = 0, pass = 0;
+  while (passes.next_pass(first, pass)) {
+    for (size_t offset = 0; offset < probe_count; offset += chunk) {
+      const uint32_t n = uint32_t(std::min<size_t>(chunk, probe_count - offset));
+      runner_.run(params, {uint32_t(offset), n, first, pass}, kProbeResultBytes, kProbeBatch, totals);
+    }
+    passes.finish_pass(totals.rays());
+  }
+
+  std::vector<double> sums(probe_count * 27);
+  std::vector<uint32_t> counts(probe_count * 2);
+  context.download(buffers.probes.sh_sums, sums.data(), sums.size() * 8);
+  context.download(buffers.probes.counts, counts.data(), counts.size() * 4);
+  for (size_t i = 0; i < probe_count; ++i) {
+    std::copy(sums.begin() + std::ptrdiff_t(i * 27), sums.begin() + std::ptrdiff_t(i * 27 + 27), estimate.sh_sum[i].begin());
+    estimate.samples[i] = counts[i * 2];
+    estimate.backface_hits[i] = counts[i * 2 + 1];
+  }
+  estimate.rays = totals.rays();
+  estimate.nonfinite_samples = totals.nonfinite;
+  estimate.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  runner_.record_statistics(totals, kProbeBatch);
+  return estimate;
+}
+
+}  // namespace exitance::vulkan

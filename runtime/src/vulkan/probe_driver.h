@@ -1,0 +1,25 @@
+// Integrator::bake_probes on the wavefront: the probes are the work items (generate emits each
+// probe's stratified sphere ray, shade weighs what it meets as the reference's radiance_along_ray
+// and continues into the texel estimator at the hit, reduce projects each sample onto L2 SH). The
+// PassScheduler's passes end on stratified sets when a time budget may stop the bake.
+#pragma once
+#include <vector>
+
+#include "exitance/runtime/core/estimates.h"
+#include "exitance/runtime/core/integrator_settings.h"
+#include "wavefront_batch.h"
+
+namespace exitance::vulkan {
+
+class ProbeDriver {
+ public:
+  explicit ProbeDriver(WavefrontBatchRunner& runner) : runner_(runner) {}
+  ProbeEstimate bake(const std::vector<Vec3>& positions, const IntegratorSettings& settings);
+
+ private:
+  void upload_probes(const std::vector<Vec3>& positions);
+
+  WavefrontBatchRunner& runner_;
+};
+
+}  // namespace exitance::vulkan

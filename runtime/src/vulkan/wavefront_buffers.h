@@ -1,0 +1,142 @@
+// The wavefront's state on the device as typed structure-of-arrays buffers and queues
+// (shaders/include/bindings.glsl declares the same, at gpu_layout.h's binding numbers).
+#pragma once
+#include <cstddef>
+#include <cstdint>
+
+#include "exitance/common/gpu_layout.h"
+#include "vulkan_context.h"
+#include "wavefront_kernels.h"
+
+namespace exitance::vulkan {
+
+// What every kernel reads (GpuParams, updated in place per batch) and the counters they count in
+// (queue sizes, work items claimed, rays, statistics), read back after each submission.
+struct WavefrontControl {
+  Buffer params;
+  Buffer counters;  // kCounterCount uints (gpu_layout.h)
+  Buffer readback;  // host-visible copy of the counters
+
+  explicit WavefrontControl(Context& context);
+  const uint32_t* read_back() const { return static_cast<const uint32_t*>(readback.mapped()); }
+  // A 64-bit statistic of the read-back (lo, hi word pair from `slot`).
+  uint64_t read_back64(uint32_t slot) const { return uint64_t(read_back()[slot]) | (uint64_t(read_back()[slot + 1]) << 32); }
+  void bind(DescriptorWrites& writes) const;
+};
+
+// Path state, one entry per path slot.
+struct PathStateBuffers {
+  Buffer work;           // work item of the batch, or kInvalid
+  Buffer depth;          // vertices so far
+  Buffer rng;            // Pcg32 state and increment
+  Buffer throughput;     // rgb, pdf of the ray
+  Buffer ray_origin;
+  Buffer ray_direction;
+  Buffer hit;            // t, triangle bits, b1, b2
+  Buffer shadow_rays;    // kShadowSlotsPerPath next-event shadow rays, waiting for connect
+
+  PathStateBuffers(Context& context, uint32_t paths);
+  void bind(DescriptorWrites& writes) const;
+  static constexpr size_t kBytesPerPath = 4 + 4 + 16 + 16 + 16 + 16 + 16 + kShadowSlotsPerPath * sizeof(ShadowRay);
+};
+
+// Paths whose continuation ray waits for extend, then shade: two queues of a slot per path,
+// ping-pong (shade reads queue q and appends to q ^ 1, which extend reads); sizes in the counters
+// kCounterRayQueue0 + q.
+struct RayQueue {
+  Buffer entries;
+
+  RayQueue(Context& context, uint32_t paths);
+  void bind(DescriptorWrites& writes) const;
+  static constexpr size_t kBytesPerPath = 8;
+};
+
+// Paths whose shadow rays wait for connect; size in the counter kCounterShadowQueue.
+struct ShadowQueue {
+  Buffer entries;
+
+  ShadowQueue(Context& context, uint32_t paths);
+  void bind(DescriptorWrites& writes) const;
+  static constexpr size_t kBytesPerPath = 4;
+};
+
+// A launch over a queue reads its grid size here: vkCmdDispatchIndirect arguments.
+struct IndirectDispatch {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceSize offset = 0;
+};
+
+// The grid sizes prepare.comp writes from the queue sizes (three uints each).
+struct QueueDispatches {
+  Buffer arguments;
+
+  explicit QueueDispatches(Context& context);
+  IndirectDispatch shade() const { return {arguments.handle(), 0}; }     // ray queue q
+  IndirectDispatch connect() const { return {arguments.handle(), 12}; }  // shadow queue
+  IndirectDispatch extend() const { return {arguments.handle(), 24}; }   // ray queue q ^ 1
+  void bind(DescriptorWrites& writes) const;
+};
+
+// A bake's items (texels or probes): their start points, and the list a batch takes its items
+// from (batch_items[batch_item_offset + i]). Grown as bakes need, never shrunk.
+struct WorkItems {
+  Buffer start_points;  // GpuSurfacePoint per item
+  Buffer batch_items;   // item indices
+
+  explicit WorkItems(Context& context);
+  void reserve(Context& context, size_t items);
+  void bind(DescriptorWrites& writes) const;
+};
+
+// Result slots of a batch's work items: texels, E/pi per recorded bounce layer; probes, see
+// bindings.glsl's result_index and probe_extra_index.
+struct SampleResults {
+  Buffer slots;
+
+  explicit SampleResults(Context& context);
+  void reserve(Context& context, VkDeviceSize bytes);
+  void bind(DescriptorWrites& writes) const;
+};
+
+// Per texel, over the bake's samples: total and squared total (doubles), per bounce layer, counts.
+struct TexelAccumulators {
+  Buffer sums;         // [texel][total rgb, squared rgb]
+  Buffer bounce_sums;  // [layer][texel][rgb]
+  Buffer samples;      // [texel]
+
+  explicit TexelAccumulators(Context& context);
+  void reserve(Context& context, size_t texels, int layers);
+  void clear(VkCommandBuffer cmd) const;
+  void bind(DescriptorWrites& writes) const;
+};
+
+// Per probe, over the bake's samples: L2 SH sums (doubles) and counts.
+struct ProbeAccumulators {
+  Buffer sh_sums;  // [probe][coefficient][rgb]
+  Buffer counts;   // [probe][samples, back-face hits]
+
+  explicit ProbeAccumulators(Context& context);
+  void reserve(Context& context, size_t probes);
+  void clear(VkCommandBuffer cmd) const;
+  void bind(DescriptorWrites& writes) const;
+};
+
+// Everything of the wavefront but the scene.
+struct WavefrontBuffers {
+  WavefrontControl control;
+  PathStateBuffers paths;
+  RayQueue rays;
+  ShadowQueue shadows;
+  QueueDispatches dispatches;
+  WorkItems items;
+  SampleResults results;
+  TexelAccumulators texels;
+  ProbeAccumulators probes;
+
+  WavefrontBuffers(Context& context, uint32_t path_count);
+  void bind(DescriptorWrites& writes) const;
+  static constexpr size_t kBytesPerPath =
+      PathStateBuffers::kBytesPerPath + RayQueue::kBytesPerPath + ShadowQueue::kBytesPerPath;
+};
+
+}  // namespace exitance::vulkan

@@ -1,0 +1,32 @@
+#include "wavefront_sizes.h"
+
+#include <algorithm>
+
+#include "wavefront_kernels.h"
+
+namespace exitance::vulkan {
+
+WavefrontSizes choose_wavefront_sizes(const Context& context, const VulkanDeviceOptions& options) {
+  const bool cpu_device = context.info().type == VulkanDeviceType::Cpu;
+  // Paths in flight: on a GPU, more paths hide more latency and shorten the drains at batch ends
+  // (H100, 1 M live texels: 1 Mi paths 1.46 s, 4 Mi paths 1.20 s; bench/results/vulkan-gpu.md);
+  // 4 Mi paths take about 1.7 GB (path state + results), so only where the device has 16 GiB or more.
+  VkDeviceSize device_local = 0;
+  const VkPhysicalDeviceMemoryProperties& memory = context.memory_properties();
+  for (uint32_t h = 0; h < memory.memoryHeapCount; ++h)
+    if (memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
+      device_local = std::max(device_local, memory.memoryHeaps[h].size);
+  const uint32_t gpu_paths = device_local >= (VkDeviceSize(16) << 30) ? (1u << 22) : (1u << 20);
+  WavefrontSizes sizes;
+  sizes.paths = std::max<uint32_t>(options.max_paths ? options.max_paths : (cpu_device ? (1u << 14) : gpu_paths), kGroupSize);
+  sizes.iterations_per_submit = options.iterations_per_submit ? options.iterations_per_submit : (cpu_device ? 8u : 32u);
+  sizes.work_items_per_path = options.work_items_per_path ? options.work_items_per_path : 4u;
+  // Node layout: quantized 64-byte nodes pay on CPU devices (lavapipe: fewer gathered words per
+  // node), float 112-byte nodes on GPUs (the H100 traversal is bound by instructions, not by node
+  // bytes: the BVH stays in L2).
+  sizes.quantized_nodes = options.node_layout == VulkanNodeLayout::Automatic ? cpu_device
+                                                                           : options.node_layout == VulkanNodeLayout::Quantized;
+  return sizes;
+}
+
+}  // namespace exitance::vulkan

@@ -1,0 +1,315 @@
+// The Vulkan host around the kernels (runtime/src/vulkan): an integrator that adopts an engine's
+// device computes what one on its own device computes, bit for bit, and leaves the device to its
+// owner; runtime edits (set_material / set_punctual_light, then update_materials / update_lights)
+// equal a fresh integrator on the edited scene, bit for bit, and the CPU reference or the closed
+// form; launches are named in the statistics. Validation layers on, every message a failure;
+// without a Vulkan device, SKIP.
+#include <gtest/gtest.h>
+
+#include <vulkan/vulkan.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "exitance/runtime/cpu_reference_integrator.h"
+#include "exitance/runtime/vulkan/vulkan_integrator.h"
+#include "support/analytic_scenes.h"
+#include "support/lightmap_comparison.h"
+#include "support/validated_vulkan_backend.h"
+
+namespace exitance {
+namespace {
+
+using testing::AnalyticScene;
+
+// The engine's side: an instance with the validation layer and a messenger collecting messages,
+// a device on the physical device `index` with `features`, its first compute queue.
+class EngineDevice {
+ public:
+  EngineDevice(uint32_t index, VkPhysicalDeviceFeatures features) {
+    VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+    app.pApplicationName = "engine";
+    app.apiVersion = VK_API_VERSION_1_2;
+    const char* layer = "VK_LAYER_KHRONOS_validation";
+    const char* extension = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+    VkDebugUtilsMessengerCreateInfoEXT messenger{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    messenger.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    messenger.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                            VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    messenger.pfnUserCallback = &EngineDevice::on_message;
+    messenger.pUserData = &messages_;
+    VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+    info.pApplicationInfo = &app;
+    info.enabledLayerCount = 1;
+    info.ppEnabledLayerNames = &layer;
+    info.enabledExtensionCount = 1;
+    info.ppEnabledExtensionNames = &extension;
+    info.pNext = &messenger;
+    if (vkCreateInstance(&info, nullptr, &external_.instance) != VK_SUCCESS)
+      throw std::runtime_error("engine: vkCreateInstance with the validation layer failed");
+    auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(external_.instance, "vkCreateDebugUtilsMessengerEXT"));
+    if (create(external_.instance, &messenger, nullptr, &messenger_) != VK_SUCCESS)
+      throw std::runtime_error("engine: vkCreateDebugUtilsMessengerEXT failed");
+    uint32_t count = 0;
+    vkEnumeratePhysicalDevices(external_.instance, &count, nullptr);
+    std::vector<VkPhysicalDevice> devices(count);
+    vkEnumeratePhysicalDevices(external_.instance, &count, devices.data());
+    if (index >= count) throw std::runtime_error("engine: no physical device " + std::to_string(index));
+    external_.physical_device = devices[index];
+    vkGetPhysicalDeviceQueueFamilyProperties(external_.physical_device, &count, nullptr);
+    std::vector<VkQueueFamilyProperties> families(count);
+    vkGetPhysicalDeviceQueueFamilyProperties(external_.physical_device, &count, families.data());
+    external_.queue_family = uint32_t(std::find_if(families.begin(), families.end(), [](const VkQueueFamilyProperties& f) {
+                                        return (f.queueFlags & VK_QUEUE_COMPUTE_BIT) != 0;
+                                      }) - families.begin());
+    const float priority = 1.0f;
+    VkDeviceQueueCreateInfo queue{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+    queue.queueFamilyIndex = external_.queue_family;
+    queue.queueCount = 1;
+    queue.pQueuePriorities = &priority;
+    VkDeviceCreateInfo device{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+    device.queueCreateInfoCount = 1;
+    device.pQueueCreateInfos = &queue;
+    device.pEnabledFeatures = &features;
+    if (vkCreateDevice(external_.physical_device, &device, nullptr, &external_.device) != VK_SUCCESS)
+      throw std::runtime_error("engine: vkCreateDevice failed");
+    vkGetDeviceQueue(external_.device, external_.queue_family, 0, &external_.queue);
+    external_.api_version = app.apiVersion;
+    external_.enabled_features = features;
+  }
+
+  // The engine outlives the integrators it lent its device to, then destroys what it made.
+  ~EngineDevice() {
+    if (external_.device) vkDestroyDevice(external_.device, nullptr);
+    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(external_.instance, "vkDestroyDebugUtilsMessengerEXT"));
+    if (messenger_) destroy(external_.instance, messenger_, nullptr);
+    vkDestroyInstance(external_.instance, nullptr);
+    for (const std::string& m : messages_) ADD_FAILURE() << m;
+  }
+
+  const VulkanExternalDevice& external() const { return external_; }
+  VulkanDeviceOptions options() const {
+    VulkanDeviceOptions options;
+    options.external_device = external_;
+    return options;
+  }
+
+ private:
+  static VKAPI_ATTR VkBool32 VKAPI_CALL on_message(VkDebugUtilsMessageSeverityFlagBitsEXT, VkDebugUtilsMessageTypeFlagsEXT,
+                                                   const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+    static_cast<std::vector<std::string>*>(user)->push_back(std::string("[engine's validation] ") +
+                                                           (data && data->pMessage ? data->pMessage : ""));
+    return VK_FALSE;
+  }
+
+  VulkanExternalDevice external_;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  std::vector<std::string> messages_;
+};
+
+void expect_identical(const LightmapEstimate& a, const LightmapEstimate& b, const char* what) {
+  ASSERT_EQ(a.texels.size(), b.texels.size()) << what;
+  for (size_t i = 0; i < a.texels.size(); ++i) {
+    EXPECT_EQ(a.texels[i].samples, b.texels[i].samples) << what << " texel " << i;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(a.texels[i].total[c], b.texels[i].total[c]) << what << " texel " << i;
+      EXPECT_EQ(a.texels[i].total_squared[c], b.texels[i].total_squared[c]) << what << " texel " << i;
+    }
+  }
+  EXPECT_EQ(a.bounces, b.bounces) << what;
+  EXPECT_EQ(a.rays, b.rays) << what;
+}
+
+void expect_identical(const ProbeEstimate& a, const ProbeEstimate& b, const char* what) {
+  EXPECT_EQ(a.sh_sum, b.sh_sum) << what;
+  EXPECT_EQ(a.samples, b.samples) << what;
+  EXPECT_EQ(a.backface_hits, b.backface_hits) << what;
+  EXPECT_EQ(a.rays, b.rays) << what;
+}
+
+TEST(VulkanExternalDevice, AdoptedDeviceBakesWhatAnOwnDeviceBakes) {
+  const AnalyticScene a = testing::white_furnace(0.5f);
+  const std::shared_ptr<const LightingScene> scene = make_lighting_scene(a.scene);
+  CREATE_VULKAN_OR_SKIP(own, scene, VulkanDeviceOptions{});
+  IntegratorSettings settings;
+  settings.spp = 64;
+  settings.seed = 17;
+  const std::vector<Vec3> probes = {{0.5f, 0.5f, 0.5f}, {0.2f, 0.8f, 0.3f}, {0.5f, 0.5f, -0.001f}};
+  const LightmapEstimate own_lightmap = own->bake(a.gbuffer, settings);
+  const ProbeEstimate own_probes = own->bake_probes(probes, settings);
+
+  EngineDevice engine(own->device().index, vulkan_required_features());
+  {
+    const auto adopted = VulkanIntegrator::create(scene, engine.options());
+    EXPECT_EQ(adopted->device().name, own->device().name);
+    EXPECT_NE(adopted->device_description().find("adopted"), std::string::npos);
+    expect_identical(adopted->bake(a.gbuffer, settings), own_lightmap, "adopted lightmap");
+    expect_identical(adopted->bake_probes(probes, settings), own_probes, "adopted probes");
+  }
+  // The first integrator is gone and took nothing of the engine's with it: a second one works.
+  const auto again = VulkanIntegrator::create(scene, engine.options());
+  expect_identical(again->bake(a.gbuffer, settings), own_lightmap, "second adoption");
+}
+
+TEST(VulkanExternalDevice, WhatTheBackendNeedsIsChecked) {
+  const std::vector<VulkanDeviceInfo> devices = enumerate_vulkan_devices();
+  const auto usable = std::find_if(devices.begin(), devices.end(), [](const VulkanDeviceInfo& d) { return d.usable; });
+  if (usable == devices.end()) GTEST_SKIP() << "no usable Vulkan device";
+  const std::shared_ptr<const LightingScene> scene = make_lighting_scene(testing::white_furnace(0.5f).scene);
+  const auto refused = [&](const VulkanDeviceOptions& options) -> std::string {
+    try {
+      VulkanIntegrator::create(scene, options);
+    } catch (const std::exception& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  {
+    EngineDevice bare(usable->index, VkPhysicalDeviceFeatures{});  // created without the features the kernels use
+    EXPECT_NE(refused(bare.options()).find("shaderInt64"), std::string::npos) << refused(bare.options());
+  }
+  VkPhysicalDeviceFeatures int64_only{};
+  int64_only.shaderInt64 = VK_TRUE;
+  EngineDevice half(usable->index, int64_only);
+  EXPECT_NE(refused(half.options()).find("shaderFloat64"), std::string::npos);
+  EngineDevice engine(usable->index, vulkan_required_features());
+  VulkanDeviceOptions old_instance = engine.options();
+  old_instance.external_device->api_version = VK_API_VERSION_1_1;
+  EXPECT_NE(refused(old_instance).find("Vulkan 1.2"), std::string::npos);
+  VulkanDeviceOptions no_queue = engine.options();
+  no_queue.external_device->queue_family = 1000;
+  EXPECT_NE(refused(no_queue).find("queue family 1000"), std::string::npos);
+  VulkanDeviceOptions validation = engine.options();
+  validation.validation = true;
+  EXPECT_THROW(VulkanIntegrator::create(scene, validation), std::invalid_argument);
+}
+
+// A lit box: grey walls, an emitter under the ceiling, a red panel on the left wall. The edit changes
+// the emitter's colour, the walls' albedo, and turns the panel into an emitter (the emitter list
+// grows, so its buffers do too).
+Scene lit_box() {
+  Scene scene;
+  testing::add_inward_box(scene, {0, 0, 0}, {1, 1, 1}, testing::add_material(scene, {0.5f, 0.5f, 0.5f}));
+  testing::add_quad(scene, {0.3f, 0.99f, 0.3f}, {0.4f, 0, 0}, {0, 0, 0.4f}, testing::add_material(scene, {0, 0, 0}, {4, 4, 4}));
+  testing::add_quad(scene, {0.01f, 0.2f, 0.2f}, {0, 0.6f, 0}, {0, 0, 0.6f}, testing::add_material(scene, {0.8f, 0.2f, 0.2f}));
+  return scene;
+}
+
+TEST(VulkanRuntimeEdits, MaterialEditEqualsAFreshIntegratorAndTheReference) {
+  const Scene scene = lit_box();
+  TexelGBuffer g;
+  for (Vec2 p : testing::grid_points(4, 0.1f)) {
+    g.texels.push_back(testing::texel_at({p.x, 0.0f, p.y}, {0, 1, 0}));   // floor
+    g.texels.push_back(testing::texel_at({p.x, p.y, 0.0f}, {0, 0, 1}));   // back wall
+    g.texels.push_back(testing::texel_at({1.0f, p.x, p.y}, {-1, 0, 0}));  // right wall
+  }
+  const std::shared_ptr<const LightingScene> original = make_lighting_scene(scene);
+  CREATE_VULKAN_OR_SKIP(vk, original, VulkanDeviceOptions{});
+  IntegratorSettings settings;
+  settings.spp = 512;
+  settings.seed = 5;
+  const LightmapEstimate before = vk->bake(g, settings);
+
+  LightingScene edited = *original;
+  Material walls = scene.materials[0], light = scene.materials[1], panel = scene.materials[2];
+  walls.base_color = {0.7f, 0.6f, 0.3f};
+  light.emission = {1, 2, 3};
+  panel.emission = {0.5f, 0.5f, 0.5f};
+  set_material(edited, 0, walls);
+  set_material(edited, 1, light);
+  set_material(edited, 2, panel);
+  ASSERT_GT(edited.emitter_count(), original->emitter_count());
+  vk->update_materials(edited);
+  const LightmapEstimate updated = vk->bake(g, settings);
+
+  CREATE_VULKAN_OR_SKIP(fresh, std::make_shared<const LightingScene>(edited), VulkanDeviceOptions{});
+  expect_identical(updated, fresh->bake(g, settings), "updated vs fresh");
+  settings.seed = 6;
+  const LightmapEstimate reference = CpuReferenceIntegrator(*edited.source).bake(g, settings);
+  testing::compare_estimates(updated, reference, 8, "material edit");
+  // The edit shows: red light, 4 before and 1 after, far beyond the noise.
+  double drop = 0, variance = 0;
+  for (size_t i = 0; i < g.texels.size(); ++i)
+    drop += before.mean_total(i).x - updated.mean_total(i).x,
+        variance += before.variance_of_mean(i).x + updated.variance_of_mean(i).x;
+  EXPECT_GT(drop, 20 * std::sqrt(variance));
+}
+
+TEST(VulkanRuntimeEdits, LightEditEqualsAFreshIntegratorAndTheClosedForm) {
+  const AnalyticScene a = testing::point_light_over_plane();
+  const std::shared_ptr<const LightingScene> original = make_lighting_scene(a.scene);
+  CREATE_VULKAN_OR_SKIP(vk, original, VulkanDeviceOptions{});
+  IntegratorSettings settings;
+  settings.spp = 4;
+  settings.seed = 3;
+  vk->bake(a.gbuffer, settings);
+
+  LightingScene edited = *original;
+  PunctualLight light = a.scene.lights[0];
+  light.position = {-0.5f, 1.5f, 0.4f};
+  light.intensity = {4, 1, 2};
+  set_punctual_light(edited, 0, light);
+  edited.sky = {0.1f, 0.2f, 0.3f};  // the sky is taken by update_lights too
+  vk->update_lights(edited);
+  const LightmapEstimate updated = vk->bake(a.gbuffer, settings);
+
+  CREATE_VULKAN_OR_SKIP(fresh, std::make_shared<const LightingScene>(edited), VulkanDeviceOptions{});
+  expect_identical(updated, fresh->bake(a.gbuffer, settings), "updated vs fresh");
+  // Point light I cos / (pi d^2) plus the unoccluded sky: exact on an upward plane.
+  for (size_t i = 0; i < a.gbuffer.texels.size(); ++i) {
+    const Vec3 d = light.position - a.gbuffer.texels[i].position;
+    const double cos_over_pi_d2 = d.y / std::sqrt(dot(d, d)) / (kPi * dot(d, d));
+    for (int c = 0; c < 3; ++c) {
+      const double exact = light.intensity[c] * cos_over_pi_d2 + edited.sky[c];
+      EXPECT_NEAR(updated.mean_total(i)[c], exact, 1e-5 * exact) << "texel " << i << " channel " << c;
+    }
+  }
+}
+
+TEST(VulkanRuntimeEdits, UpdatesKeepTheSceneShape) {
+  const AnalyticScene a = testing::point_light_over_plane();
+  const std::shared_ptr<const LightingScene> original = make_lighting_scene(a.scene);
+  CREATE_VULKAN_OR_SKIP(vk, original, VulkanDeviceOptions{});
+  LightingScene more_materials = *original;
+  more_materials.materials.push_back({});
+  EXPECT_THROW(vk->update_materials(more_materials), std::invalid_argument);
+  LightingScene more_lights = *original;
+  more_lights.punctual_lights.push_back({});
+  EXPECT_THROW(vk->update_lights(more_lights), std::invalid_argument);
+}
+
+// Every launch is named for what it computes, and the statistics are keyed by those names.
+TEST(VulkanLaunches, StatisticsAreKeyedByLaunchNames) {
+  const AnalyticScene a = testing::white_furnace(0.5f);
+  VulkanDeviceOptions options;
+  options.collect_stage_statistics = true;
+  CREATE_VULKAN_OR_SKIP(vk, make_lighting_scene(a.scene), options);
+  IntegratorSettings settings;
+  settings.spp = 16;
+  const LightmapEstimate e = vk->bake(a.gbuffer, settings);
+  std::vector<std::string> names;
+  for (const VulkanStageStatistics& s : vk->stage_statistics()) names.push_back(s.stage);
+  const auto stage = [&](const std::string& name) -> const VulkanStageStatistics& {
+    const auto& all = vk->stage_statistics();
+    const auto it = std::find_if(all.begin(), all.end(), [&](const VulkanStageStatistics& s) { return s.stage == name; });
+    if (it == all.end()) throw std::runtime_error("no stage '" + name + "'");
+    return *it;
+  };
+  EXPECT_EQ(names.front(), "generate: texel paths into every path slot");
+  EXPECT_GT(stage("shade: hits, emission, next-event, continuation").items, 0u);
+  EXPECT_EQ(stage("extend: continuation rays (closest hit)").rays,
+            stage("rays: primary").rays + stage("rays: bounce").rays);
+  EXPECT_EQ(stage("connect: shadow rays (any hit)").rays + stage("extend: continuation rays (closest hit)").rays, e.rays);
+  EXPECT_NO_THROW(stage("reduce: samples into texel sums"));
+  EXPECT_EQ(stage("rays: primary").rays, uint64_t(a.gbuffer.texels.size()) * settings.spp);
+}
+
+}  // namespace
+}  // namespace exitance

@@ -1,0 +1,89 @@
+// Runtime edits of a LightingScene (set_material, set_punctual_light) must leave it exactly as
+// build_lighting_scene would build it from the edited Scene: records, CDFs, per-triangle area pdfs.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <memory>
+#include <stdexcept>
+
+#include "exitance/runtime/cpu_reference_integrator.h"
+#include "support/analytic_scenes.h"
+
+namespace exitance {
+namespace {
+
+template <typename T>
+bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+}
+
+void expect_same(const LightingScene& edited, const LightingScene& rebuilt) {
+  EXPECT_TRUE(same_bytes(edited.triangles, rebuilt.triangles));
+  EXPECT_TRUE(same_bytes(edited.materials, rebuilt.materials));
+  EXPECT_TRUE(same_bytes(edited.punctual_lights, rebuilt.punctual_lights));
+  EXPECT_EQ(edited.emitter_triangles, rebuilt.emitter_triangles);
+  EXPECT_EQ(edited.emitter_cdf, rebuilt.emitter_cdf);
+  EXPECT_EQ(edited.punctual_cdf, rebuilt.punctual_cdf);
+  EXPECT_EQ(edited.textured, rebuilt.textured);
+}
+
+// Two emitters and a receiver: editing the receiver into a third emitter grows the emitter list and
+// changes every emitter's area pdf; editing an emitter black shrinks it.
+Scene three_quads() {
+  Scene scene;
+  testing::add_quad(scene, {0, 0, 1}, {1, 0, 0}, {0, 0, -1}, testing::add_material(scene, {0.5f, 0.5f, 0.5f}));
+  testing::add_quad(scene, {0, 1, 0}, {1, 0, 0}, {0, 0, 1}, testing::add_material(scene, {0, 0, 0}, {2, 1, 0.5f}));
+  testing::add_quad(scene, {0, 2, 0}, {2, 0, 0}, {0, 0, 2}, testing::add_material(scene, {0.2f, 0.2f, 0.2f}, {1, 1, 1}, true));
+  PunctualLight point;
+  point.position = {0.5f, 3, 0.5f};
+  scene.lights.push_back(point);
+  PunctualLight sun;
+  sun.type = PunctualLight::Type::Directional;
+  sun.intensity = {2, 2, 2};
+  scene.lights.push_back(sun);
+  return scene;
+}
+
+TEST(LightingSceneEdit, SetMaterialMatchesARebuild) {
+  const Scene scene = three_quads();
+  LightingScene edited = *make_lighting_scene(scene);
+  const std::shared_ptr<const Scene> original_source = edited.source;
+  Scene expected = scene;
+  for (auto [index, emission] : {std::pair{0u, Vec3{0.3f, 0.3f, 0.3f}}, std::pair{1u, Vec3{0, 0, 0}}, std::pair{2u, Vec3{5, 4, 3}}}) {
+    Material m = expected.materials[index];
+    m.emission = emission;
+    m.base_color = {0.9f, 0.1f, 0.4f};
+    set_material(edited, index, m);
+    expected.materials[index] = m;
+    expect_same(edited, build_lighting_scene(std::make_shared<const Scene>(expected), edited.bvh));
+    EXPECT_EQ(edited.source->materials[index].base_color.x, 0.9f);
+  }
+  EXPECT_EQ(edited.emitter_count(), 4u);  // the receiver's two triangles and the large quad's
+  EXPECT_EQ(original_source->materials[1].emission.x, 2.0f) << "the shared source Scene must not change";
+  EXPECT_THROW(set_material(edited, 3, Material{}), std::out_of_range);
+}
+
+TEST(LightingSceneEdit, SetPunctualLightMatchesARebuild) {
+  const Scene scene = three_quads();
+  LightingScene edited = *make_lighting_scene(scene);
+  Scene expected = scene;
+  PunctualLight spot;
+  spot.type = PunctualLight::Type::Spot;
+  spot.position = {0.5f, 1.5f, 0.5f};
+  spot.direction = {0, -1, 0};
+  spot.intensity = {30, 10, 10};
+  spot.cos_inner = 0.9f;
+  spot.cos_outer = 0.8f;
+  set_punctual_light(edited, 0, spot);
+  expected.lights[0] = spot;
+  PunctualLight sun = expected.lights[1];
+  sun.intensity = {0, 0, 0};
+  set_punctual_light(edited, 1, sun);
+  expected.lights[1] = sun;
+  expect_same(edited, build_lighting_scene(std::make_shared<const Scene>(expected), edited.bvh));
+  EXPECT_EQ(edited.punctual_cdf[1], 1.0) << "the black sun is never chosen";
+  EXPECT_THROW(set_punctual_light(edited, 2, spot), std::out_of_range);
+}
+
+}  // namespace
+}  // namespace exitance
