@@ -1,8 +1,6 @@
 #include "exitance/bake/command/prepared_scene.h"
 
-#include "exitance/bake/command/bake_pipeline.h"
-#include "exitance/bake/import/gltf_import.h"
-#include "exitance/bake/raster/texel_raster.h"
+#include "exitance/bake/command/bake_stages.h"
 #include "exitance/bake/raster/unocclude.h"
 #include "exitance/runtime/embree_scene.h"
 
@@ -10,11 +8,14 @@ namespace exitance {
 
 PreparedScene prepare_scene_for_lighting(const std::string& path, const std::string& sky, const AtlasSettings& atlas,
                                          Diagnostics& diagnostics) {
+  BakeOptions options;
+  options.input = path;
+  options.sky = sky;
+  options.atlas = atlas;
   PreparedScene prepared;
-  prepared.scene = import_gltf(path, {}, diagnostics);
-  prepared.scene.sky = parse_sky_option(sky);
-  const AtlasLayout layout = layout_lightmap_atlas(prepared.scene, atlas, path, diagnostics);
-  prepared.gbuffer = rasterize_texel_gbuffer(prepared.scene, layout, path, diagnostics);
+  prepared.scene = import_stage(options, diagnostics);
+  const AtlasLayout layout = layout_stage(prepared.scene, options, diagnostics);
+  prepared.gbuffer = raster_stage(prepared.scene, layout, options, diagnostics);
   const EmbreeScene embree(prepared.scene);
   unocclude_texels(embree, prepared.gbuffer);
   return prepared;

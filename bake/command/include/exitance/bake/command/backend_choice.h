@@ -3,6 +3,7 @@
 #include <memory>
 #include <string>
 
+#include "exitance/bake/bake_options.h"
 #include "exitance/bake/diagnostics.h"
 #include "exitance/runtime/core/integrator.h"
 #include "exitance/runtime/core/lighting_scene.h"
@@ -10,12 +11,6 @@
 namespace exitance {
 
 class EmbreeScene;
-
-struct BackendRequest {
-  std::string name = "auto";  // auto | vulkan | cpu
-  int device_index = -1;      // --device N; -1 = prefer a discrete GPU
-  bool validation = false;    // EXITANCE_VULKAN_VALIDATION=1: validation layers, any message is an error
-};
 
 // auto: a GPU Vulkan device when one exists and supports the scene; otherwise the CPU reference,
 // because on this project's 2-core CPU machines lavapipe measured 0.1-0.2x Embree's rays/s

@@ -1,11 +1,11 @@
-// The offline stage in one call, for benchmarks and tests that need a scene's live texels but
-// not a bundle: import -> sky -> atlas layout -> texel raster -> unocclude. (`bake` itself runs
-// the same steps in bake_pipeline.cpp, interleaved with its timings, progress and scene checks.)
+// The offline stage up to the lighting, for benchmarks and tests that need a scene's live texels but
+// not a bundle: the import, layout, raster and unocclude stages of bake_stages.h, as `bake` runs
+// them (without its timings, scene checks, voxelization and probes).
 #pragma once
 #include <string>
 
-#include "exitance/bake/layout/atlas_layout.h"
 #include "exitance/bake/diagnostics.h"
+#include "exitance/bake/layout/atlas_layout.h"
 #include "exitance/runtime/scene.h"
 #include "exitance/runtime/texel_gbuffer.h"
 

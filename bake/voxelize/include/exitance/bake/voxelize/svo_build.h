@@ -40,6 +40,12 @@ struct SvoBuildStatistics {
   uint64_t total_bytes = 0;   // nodes + level_begin, as held in memory / svo.bin's arrays
 };
 
+// What the bake's voxelize stage hands on: the octree (exitance filled later) and its build figures.
+struct VoxelizedScene {
+  formats::SparseVoxelOctree svo;
+  SvoBuildStatistics statistics;
+};
+
 // Depth whose leaves are about 4 lightmap texels wide (leaf edge ≈ 4 / texel_density) over the
 // scene's largest extent: ceil(log2(extent / leaf)), clamped to [1, 12]. 1 for an empty scene.
 // Throws std::invalid_argument when texel_density is not a positive finite number.
