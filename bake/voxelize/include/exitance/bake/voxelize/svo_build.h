@@ -1,6 +1,6 @@
 // Voxelization: the scene's triangles → a sparse voxel octree (formats::SparseVoxelOctree) with
-// occupancy and a two-sided normal per node. Exitance is left zero (and no Lit flags set): the
-// lighting stage fills it (runtime/svo_exitance).
+// occupancy and a two-sided normal per node. Exitance is left zero (and no Lit flags set): bake's
+// exitance stage fills it from the lit texels (fill_svo_exitance, runtime/bundle/texel_exitance.h).
 //
 // Algorithm (seed 000): conservative triangle/voxel overlap (separating axis test) over each
 // triangle's bounding box → one 64-bit key per (leaf voxel, triangle) pair, Morton code in the high
