@@ -28,7 +28,8 @@ WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::jso
   AssemblyOptions assembly;
   assembly.bounce_layers = options.bounce_layers;
   assembly.dilation_texels = std::max(2, options.atlas.padding * 2);
-  const std::vector<formats::LightmapImage> pages = assemble_lightmap_pages(results.gbuffer, results.lightmap, assembly);
+  const std::vector<formats::LightmapImage> pages =
+      assemble_lightmap_pages(results.gbuffer, results.lightmap, assembly);
   const nlohmann::json manifest = build_bundle_manifest(results, pages, sha256_of_file(options.input), seconds,
                                                         diagnostics.warnings.size(), options);
 

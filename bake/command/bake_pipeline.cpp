@@ -53,6 +53,7 @@ json run_report(const WrittenBundle& bundle, const json& seconds) {
 }  // namespace
 
 json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
+  // Offline stage (DESIGN §1): scene, atlas, texel G-buffer, the BVHs, the backend that will light them.
   StageClock clock;
   Scene imported = clock.time("import", [&] { return import_stage(options, diagnostics); });
   const AtlasLayout layout = clock.time("layout", [&] { return layout_stage(imported, options, diagnostics); });
@@ -65,22 +66,26 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   const GeometryCheckReport geometry =
       clock.time("checks", [&] { return scene_checks_stage(scene, gbuffer, options, diagnostics); });
 
-  // Voxelize and place probes before lighting, so a bad --voxel-resolution or --probes fails
-  // before the long stage.
+  // Voxelize and place probes before lighting, so a bad --voxel-resolution or --probes fails before
+  // the long stage.
   std::optional<VoxelizedScene> voxels;
   if (options.svo_enabled)
     voxels = clock.time("voxelize", [&] { return voxelize_stage(*scene.scene, layout, options); });
   std::optional<ProbePlacement> probes;
   if (options.probes_enabled)
-    probes = clock.time("probe_placement", [&] { return place_probes_stage(scene, voxels ? &*voxels : nullptr, options); });
+    probes = clock.time("probe_placement",
+                        [&] { return place_probes_stage(scene, voxels ? &*voxels : nullptr, options); });
 
+  // Lighting stage (runtime/): texels, their exitance into the octree, probes.
   const LightmapEstimate lightmap =
       clock.time("lighting", [&] { return lighting_stage(*backend, gbuffer, options, diagnostics); });
   if (voxels) clock.time("exitance", [&] { exitance_stage(*voxels, scene, gbuffer, lightmap, options); });
   std::optional<ProbeEstimate> probe_lighting;
   if (probes)
-    probe_lighting = clock.time("probes", [&] { return probe_lighting_stage(*backend, *probes, options, diagnostics); });
+    probe_lighting =
+        clock.time("probes", [&] { return probe_lighting_stage(*backend, *probes, options, diagnostics); });
 
+  // Bundle: everything the stages produced, written at once.
   const BakeResults results{.scene = *scene.scene,
                             .layout = layout,
                             .gbuffer = gbuffer,

@@ -6,12 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "exitance/bake/bake_options.h"
-#include "exitance/bake/command/backend_choice.h"
 #include "exitance/bake/diagnostics.h"
-#include "exitance/bake/import/gltf_import.h"
-#include "exitance/bake/import/sky_option.h"
-#include "exitance/bake/layout/atlas_layout.h"
-#include "exitance/runtime/cpu_reference_integrator.h"
 
 namespace exitance {
 
