@@ -11,9 +11,9 @@
 #include <thread>
 #include <vector>
 
-#include "exitance/bake/gltf_import.h"
-#include "exitance/bake/radiance_vdb.h"
-#include "exitance/bake/svo_build.h"
+#include "exitance/bake/import/gltf_import.h"
+#include "exitance/bake/bundle/radiance_vdb.h"
+#include "exitance/bake/voxelize/svo_build.h"
 
 using namespace exitance;
 

@@ -21,9 +21,9 @@
 
 #include "exitance/runtime/embree_scene.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
-#include "exitance/bake/backend_choice.h"
-#include "exitance/bake/input_hash.h"
-#include "exitance/bake/prepared_scene.h"
+#include "exitance/bake/command/backend_choice.h"
+#include "exitance/bake/bundle/input_hash.h"
+#include "exitance/bake/command/prepared_scene.h"
 
 namespace fs = std::filesystem;
 using namespace exitance;

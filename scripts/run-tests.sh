@@ -24,7 +24,8 @@ EXITANCE_EMBREE_CONFIG=isa=sse4.2 ctest --test-dir build --output-on-failure -j"
 cmake -S . -B build-clang -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_C_COMPILER=clang
 cmake --build build-clang -j"$jobs" --target pipeline_tests layout_tests gltf_import_tests spherical_harmonics_tests \
   svo_exitance_tests probe_placement_tests svo_build_tests radiance_vdb_tests bundle_end_to_end_tests formats_tests \
-  make_loader_test_bundle exitance_loader_sample exitance_loader common_math_tests lighting_scene_edit_tests
+  make_loader_test_bundle exitance_loader_sample exitance_loader common_math_tests lighting_scene_edit_tests \
+  scene_file_tests exitance-relight exitance_runtime
 ctest --test-dir build-clang --output-on-failure -j"$jobs" -L unit
 
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEXITANCE_SANITIZE=ON

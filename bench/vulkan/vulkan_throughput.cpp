@@ -19,7 +19,7 @@
 #include <cstdio>
 #include <sstream>
 
-#include "exitance/bake/prepared_scene.h"
+#include "exitance/bake/command/prepared_scene.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "exitance/runtime/cpu/bvh4_builder.h"
 #include "reference_comparison.h"

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "exitance/bake/prepared_scene.h"
+#include "exitance/bake/command/prepared_scene.h"
 #include "exitance/common/sampling.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "exitance/bake/prepared_scene.h"
+#include "exitance/bake/command/prepared_scene.h"
 #include "exitance/common/sampling.h"
 #include "exitance/runtime/spherical_harmonics.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"

@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "exitance/bake/prepared_scene.h"
-#include "exitance/bake/probe_placement.h"
+#include "exitance/bake/command/prepared_scene.h"
+#include "exitance/bake/probes/probe_placement.h"
 #include "exitance/formats/scene_file.h"
 #include "exitance/runtime/embree_scene.h"
 #include "exitance/runtime/scene_file_conversion.h"

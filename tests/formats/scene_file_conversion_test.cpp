@@ -9,9 +9,9 @@
 #include <cstring>
 
 #include "byte_patching.h"
-#include "exitance/bake/prepared_scene.h"
-#include "exitance/bake/probe_placement.h"
-#include "exitance/bake/texel_raster.h"
+#include "exitance/bake/command/prepared_scene.h"
+#include "exitance/bake/probes/probe_placement.h"
+#include "exitance/bake/raster/texel_raster.h"
 #include "exitance/runtime/embree_scene.h"
 #include "exitance/runtime/scene_file_conversion.h"
 #include "exitance/runtime/texel_gbuffer_codec.h"

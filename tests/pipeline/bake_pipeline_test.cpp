@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "exitance/bake/bake_pipeline.h"
+#include "exitance/bake/command/bake_pipeline.h"
 #include "exitance/bake/input_error.h"
 #include "exitance/formats/lightmap_exr.h"
 #include "scene_builder.h"

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "exitance/bake/bake_pipeline.h"
+#include "exitance/bake/command/bake_pipeline.h"
 #include "exitance/loader/bundle.h"
 #include "scene_builder.h"
 #include "support/independent_estimates.h"

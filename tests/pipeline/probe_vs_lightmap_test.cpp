@@ -11,7 +11,7 @@
 
 #include <cmath>
 
-#include "exitance/bake/prepared_scene.h"
+#include "exitance/bake/command/prepared_scene.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/common/sampling.h"
 #include "support/independent_estimates.h"

@@ -14,7 +14,7 @@
 #include <fstream>
 #include <string>
 
-#include "exitance/bake/bake_pipeline.h"
+#include "exitance/bake/command/bake_pipeline.h"
 #include "exitance/formats/lightmap_exr.h"
 #include "exitance/formats/scene_file.h"
 #include "exitance/runtime/cpu_reference_integrator.h"

@@ -4,7 +4,7 @@
 
 #include <set>
 
-#include "exitance/bake/geometry_checks.h"
+#include "exitance/bake/raster/geometry_checks.h"
 #include "support/test_scenes.h"
 
 namespace exitance {

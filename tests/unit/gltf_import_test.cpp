@@ -10,8 +10,8 @@
 
 #include <unistd.h>
 
-#include "exitance/bake/gltf_import.h"
-#include "exitance/bake/gltf_json_validation.h"
+#include "exitance/bake/import/gltf_import.h"
+#include "exitance/bake/import/gltf_json_validation.h"
 #include "exitance/bake/input_error.h"
 
 namespace exitance {

@@ -4,9 +4,9 @@
 
 #include <cmath>
 
-#include "exitance/bake/atlas_layout.h"
+#include "exitance/bake/layout/atlas_layout.h"
 #include "exitance/runtime/bundle/lightmap_assembly.h"
-#include "exitance/bake/texel_raster.h"
+#include "exitance/bake/raster/texel_raster.h"
 #include "exitance/runtime/distribution_1d.h"
 #include "exitance/runtime/environment_sampler.h"
 #include "exitance/common/ray_offset.h"

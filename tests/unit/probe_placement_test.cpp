@@ -2,7 +2,7 @@
 // far from all geometry skipped, and the spacing limit.
 #include <gtest/gtest.h>
 
-#include "exitance/bake/probe_placement.h"
+#include "exitance/bake/probes/probe_placement.h"
 #include "support/test_scenes.h"
 
 namespace exitance {

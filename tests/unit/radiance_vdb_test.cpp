@@ -11,8 +11,8 @@
 #include <string>
 #include <unistd.h>
 
-#include "exitance/bake/radiance_vdb.h"
-#include "exitance/bake/svo_build.h"
+#include "exitance/bake/bundle/radiance_vdb.h"
+#include "exitance/bake/voxelize/svo_build.h"
 #include "exitance/formats/half_float.h"
 
 namespace exitance {

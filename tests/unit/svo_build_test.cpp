@@ -13,7 +13,7 @@
 #include <tuple>
 #include <vector>
 
-#include "exitance/bake/svo_build.h"
+#include "exitance/bake/voxelize/svo_build.h"
 #include "exitance/formats/svo_file.h"
 #include "morton_code.h"
 #include "triangle_box_overlap.h"

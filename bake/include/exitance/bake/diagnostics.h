@@ -1,5 +1,6 @@
-// Warnings collected while importing and laying out a scene. The bake command prints them
-// as "bake: warning: ..." lines; tests inspect them directly.
+// Warnings collected during a bake (import repairs, layout, scene checks, the backend choice,
+// discarded samples). The bake command prints them as "bake: warning: ..." lines after the run;
+// tests inspect them directly.
 #pragma once
 #include <string>
 #include <vector>

@@ -1,0 +1,56 @@
+// manifest.json (DESIGN §4, docs/bundle.md) from the bake's options and its stages' results. Building
+// it reads and writes nothing; write_bundle_stage (write_bundle.h) writes it with the other files.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "exitance/bake/bake_options.h"
+#include "exitance/bake/layout/atlas_layout.h"
+#include "exitance/bake/probes/probe_placement.h"
+#include "exitance/bake/raster/geometry_checks.h"
+#include "exitance/bake/voxelize/svo_build.h"
+#include "exitance/formats/lightmap_exr.h"
+#include "exitance/runtime/core/estimates.h"
+#include "exitance/runtime/core/integrator.h"
+#include "exitance/runtime/scene.h"
+#include "exitance/runtime/texel_gbuffer.h"
+
+namespace exitance {
+
+// What the stages produced, as the bundle records it, in stage order. The optional stages' entries
+// are null when the options turned them off (--voxel-resolution none, --probes none).
+// scene.bin as encoded by the scene-file stage, or why this scene cannot have one (version 1 holds no
+// textures or environment maps).
+struct PersistedSceneFile {
+  std::vector<uint8_t> bytes;
+  std::string skipped;  // non-empty when `bytes` is
+};
+
+struct BakeResults {
+  const Scene& scene;                   // import
+  const AtlasLayout& layout;            // layout
+  const TexelGBuffer& gbuffer;          // raster, after unocclude
+  size_t unoccluded_texels;             // unocclude
+  const GeometryCheckReport& geometry;  // checks
+  const Integrator& backend;            // backend
+  const VoxelizedScene* voxels;         // voxelize; its exitance filled by the exitance stage
+  const ProbePlacement* probes;         // probe placement; coefficients filled by probe lighting
+  const LightmapEstimate& lightmap;     // lighting
+  const ProbeEstimate* probe_lighting;  // probe lighting (set exactly when `probes` is)
+  const PersistedSceneFile& scene_file;  // scene file
+};
+
+// `pages`: the assembled lightmap pages (the manifest lists their channels). `input_sha256`: the
+// input file's hash (input_hash.h). `seconds`: stats.seconds, the stages timed so far. `warnings`:
+// how many warnings the run has given.
+nlohmann::json build_bundle_manifest(const BakeResults& results, const std::vector<formats::LightmapImage>& pages,
+                                     const std::string& input_sha256, const nlohmann::json& seconds, size_t warnings,
+                                     const BakeOptions& options);
+
+}  // namespace exitance

@@ -1,0 +1,58 @@
+#include "exitance/bake/bundle/write_bundle.h"
+
+#include <algorithm>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "exitance/bake/bundle/input_hash.h"
+#include "exitance/bake/bundle/radiance_vdb.h"
+#include "exitance/formats/lightmap_exr.h"
+#include "exitance/formats/probes_file.h"
+#include "exitance/formats/svo_file.h"
+#include "exitance/runtime/bundle/bundle_directory.h"
+#include "exitance/runtime/bundle/lightmap_assembly.h"
+
+namespace exitance {
+
+namespace fs = std::filesystem;
+
+fs::path bundle_folder(const BakeOptions& options) {
+  return options.output.empty() ? fs::path(options.input).replace_extension(".bake") : fs::path(options.output);
+}
+
+WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::json& seconds,
+                                 const Diagnostics& diagnostics, const BakeOptions& options) {
+  options.announce_stage("write");
+  AssemblyOptions assembly;
+  assembly.bounce_layers = options.bounce_layers;
+  assembly.dilation_texels = std::max(2, options.atlas.padding * 2);
+  const std::vector<formats::LightmapImage> pages =
+      assemble_lightmap_pages(results.gbuffer, results.lightmap, assembly);
+  const nlohmann::json manifest = build_bundle_manifest(results, pages, sha256_of_file(options.input), seconds,
+                                                        diagnostics.warnings.size(), options);
+
+  const fs::path out = bundle_folder(options);
+  write_bundle_atomically(out, [&](const fs::path& dir) {
+    for (size_t p = 0; p < pages.size(); ++p)
+      formats::write_lightmap_exr((dir / ("lightmap-" + std::to_string(p) + ".exr")).string(), pages[p]);
+    if (results.probes) formats::write_probes_file((dir / "probes.bin").string(), results.probes->grid);
+    if (!results.scene_file.bytes.empty()) {
+      std::ofstream scene_out(dir / "scene.bin", std::ios::binary);
+      scene_out.write(reinterpret_cast<const char*>(results.scene_file.bytes.data()),
+                      std::streamsize(results.scene_file.bytes.size()));
+      if (!scene_out) throw std::runtime_error("cannot write " + (dir / "scene.bin").string());
+    }
+    if (results.voxels) {
+      formats::write_svo_file((dir / "svo.bin").string(), results.voxels->svo);
+      write_radiance_vdb((dir / "radiance.vdb").string(), results.voxels->svo);
+    }
+    std::ofstream file(dir / "manifest.json");
+    file << manifest.dump(2) << "\n";
+    if (!file) throw std::runtime_error("cannot write " + (dir / "manifest.json").string());
+  });
+  return {out, pages.size(), manifest["stats"]};
+}
+
+}  // namespace exitance

@@ -1,0 +1,158 @@
+#include "exitance/bake/command/bake_stages.h"
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "exitance/bake/command/backend_choice.h"
+#include "exitance/bake/import/gltf_import.h"
+#include "exitance/bake/import/sky_option.h"
+#include "exitance/bake/input_error.h"
+#include "exitance/bake/raster/texel_raster.h"
+#include "exitance/bake/raster/unocclude.h"
+#include "exitance/formats/probe_grid.h"
+#include "exitance/formats/scene_file.h"
+#include "exitance/runtime/scene_file_conversion.h"
+#include "exitance/runtime/bundle/probe_results.h"
+#include "exitance/runtime/bundle/texel_exitance.h"
+#include "exitance/runtime/cpu/bvh4_builder.h"
+
+namespace exitance {
+
+namespace {
+
+void warn_about_nonfinite_samples(uint64_t count, const char* what, const BakeOptions& options,
+                                  Diagnostics& diagnostics) {
+  if (count > 0)
+    diagnostics.warn(options.input + ": " + std::to_string(count) + " " + what +
+                     " samples were NaN/Inf and were discarded (please report this scene)");
+}
+
+}  // namespace
+
+Scene import_stage(const BakeOptions& options, Diagnostics& diagnostics) {
+  options.announce_stage("import");
+  Scene scene = import_gltf(options.input, options.import, diagnostics);
+  scene.sky = parse_sky_option(options.sky);
+  return scene;
+}
+
+AtlasLayout layout_stage(const Scene& scene, const BakeOptions& options, Diagnostics& diagnostics) {
+  options.announce_stage("layout");
+  return layout_lightmap_atlas(scene, options.atlas, options.input, diagnostics);
+}
+
+TexelGBuffer raster_stage(const Scene& scene, const AtlasLayout& layout, const BakeOptions& options,
+                          Diagnostics& diagnostics) {
+  options.announce_stage("raster");
+  return rasterize_texel_gbuffer(scene, layout, options.input, diagnostics);
+}
+
+SceneForLighting build_lighting_scene_stage(Scene scene, const BakeOptions& options) {
+  options.announce_stage("bvh");
+  SceneForLighting built;
+  built.scene = std::make_shared<const Scene>(std::move(scene));
+  built.embree = std::make_shared<const EmbreeScene>(*built.scene);
+  built.lighting = std::make_shared<const LightingScene>(build_lighting_scene(built.scene, build_bvh4(*built.scene)));
+  return built;
+}
+
+std::shared_ptr<const Integrator> backend_stage(const SceneForLighting& scene, const BakeOptions& options,
+                                                Diagnostics& diagnostics) {
+  options.announce_stage("backend");
+  return choose_lighting_backend(scene.lighting, scene.embree, options.backend, diagnostics);
+}
+
+size_t unocclude_stage(const SceneForLighting& scene, TexelGBuffer& gbuffer) {
+  return unocclude_texels(*scene.embree, gbuffer).moved;
+}
+
+GeometryCheckReport scene_checks_stage(const SceneForLighting& scene, const TexelGBuffer& gbuffer,
+                                       const BakeOptions& options, Diagnostics& diagnostics) {
+  GeometryCheckReport report = check_scene_geometry(*scene.scene, *scene.embree, gbuffer);
+  for (std::string& line : describe_geometry_problems(report, *scene.scene, options.input)) diagnostics.warn(line);
+  return report;
+}
+
+VoxelizedScene voxelize_stage(const Scene& scene, const AtlasLayout& layout, const BakeOptions& options) {
+  options.announce_stage("voxelize");
+  SvoBuildSettings settings;
+  try {
+    settings.depth = options.voxel_resolution ? svo_depth_from_resolution(options.voxel_resolution)
+                                              : default_svo_depth(scene, layout.texel_density);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(options.input, "--voxel-resolution", e.what());
+  }
+  VoxelizedScene voxels;
+  voxels.svo = build_sparse_voxel_octree(scene, settings, &voxels.statistics);
+  return voxels;
+}
+
+ProbePlacement place_probes_stage(const SceneForLighting& scene, const VoxelizedScene* voxels,
+                                  const BakeOptions& options) {
+  options.announce_stage("probe placement");
+  ProbePlacementSettings settings;
+  settings.spacing = options.probe_spacing;
+  try {
+    return place_probes(*scene.scene, *scene.embree, voxels ? &voxels->svo : nullptr, settings);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(options.input, "--probes", e.what());
+  }
+}
+
+LightmapEstimate lighting_stage(const Integrator& backend, const TexelGBuffer& gbuffer, const BakeOptions& options,
+                                Diagnostics& diagnostics) {
+  IntegratorSettings settings = options.lighting;
+  settings.progress = [&](double fraction, uint64_t rays) {
+    if (options.progress) options.progress("lighting", fraction, rays);
+  };
+  LightmapEstimate estimate = backend.bake(gbuffer, settings);
+  warn_about_nonfinite_samples(estimate.nonfinite_samples, "path", options, diagnostics);
+  return estimate;
+}
+
+void exitance_stage(VoxelizedScene& voxels, const SceneForLighting& scene, const TexelGBuffer& gbuffer,
+                    const LightmapEstimate& lightmap, const BakeOptions& options) {
+  options.announce_stage("exitance");
+  fill_svo_exitance(voxels.svo, *scene.scene, gbuffer, lightmap);
+}
+
+ProbeEstimate probe_lighting_stage(const Integrator& backend, ProbePlacement& probes, const BakeOptions& options,
+                                   Diagnostics& diagnostics) {
+  std::vector<Vec3> positions;
+  std::vector<size_t> traced;  // grid index of each traced probe
+  for (size_t i = 0; i < probes.grid.probes.size(); ++i) {
+    const formats::ProbeRecord& r = probes.grid.probes[i];
+    if (!formats::probe_is_usable(r)) continue;
+    positions.push_back({r.position[0], r.position[1], r.position[2]});
+    traced.push_back(i);
+  }
+  IntegratorSettings settings = options.lighting;
+  settings.spp = options.probe_spp;
+  settings.time_budget_seconds = 0;
+  settings.target_relative_error = 0;
+  settings.progress = [&](double fraction, uint64_t rays) {
+    if (options.progress) options.progress("probes", fraction, rays);
+  };
+  ProbeEstimate estimate = backend.bake_probes(positions, settings);
+  store_probe_radiance(probes.grid, traced, estimate, options.probe_sh_window);
+  warn_about_nonfinite_samples(estimate.nonfinite_samples, "probe", options, diagnostics);
+  return estimate;
+}
+
+PersistedSceneFile scene_file_stage(const SceneForLighting& scene, const TexelGBuffer& gbuffer, const AtlasLayout& layout,
+                                    const ProbePlacement* probes, const BakeOptions& options, Diagnostics& diagnostics) {
+  if (options.progress) options.progress("scene.bin", 0, 0);
+  PersistedSceneFile file;
+  try {
+    file.bytes = formats::encode_scene(make_scene_file(*scene.scene, gbuffer, layout, probes ? &probes->grid : nullptr,
+                                                       to_scene_bvh(scene.lighting->bvh)));
+  } catch (const formats::FormatError& e) {
+    file.skipped = e.what();
+    diagnostics.warn(options.input + ": scene.bin not written (exitance-relight cannot re-light this bundle): " +
+                     file.skipped);
+  }
+  return file;
+}
+
+}  // namespace exitance

@@ -1,0 +1,156 @@
+// `bake SCENE.{gltf,glb} [-o OUT] [options]`: see docs/cli.md and DESIGN §3.
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+
+#include "exitance/bake/command/bake_pipeline.h"
+#include "exitance/bake/input_error.h"
+#include "exitance/runtime/vulkan/vulkan_integrator.h"
+#include "exitance/runtime/tools/progress_bar.h"
+
+namespace {
+
+std::string one_line(std::string text) {
+  for (char& c : text)
+    if (c == '\n' || c == '\r') c = ' ';
+  return text;
+}
+
+void print_warnings(const exitance::Diagnostics& diagnostics) {
+  for (const std::string& w : diagnostics.warnings) std::cerr << "bake: warning: " << one_line(w) << "\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  exitance::BakeOptions options;
+  CLI::App app{"Exitance lightmap baker: bake SCENE.{gltf,glb} [-o OUT] [options]"};
+  app.add_option("scene", options.input, "input glTF 2.0 scene (.gltf or .glb)")->required();
+  app.add_option("-o,--out", options.output, "output bundle folder (default: SCENE.bake next to the input)");
+  app.add_option("--backend", options.backend.name,
+                 "auto | vulkan | cpu (auto: a GPU if one exists, else the CPU reference)")
+      ->check(CLI::IsMember({"auto", "vulkan", "cpu"}));
+  app.add_option("--device", options.backend.device_index, "Vulkan device index (see --list-devices)")
+      ->check(CLI::NonNegativeNumber);
+  bool list_devices = false;
+  app.add_flag("--list-devices", list_devices, "print the Vulkan devices and exit");
+  app.add_option("--texel-density", options.atlas.texel_density,
+                 "lightmap texels per scene unit (default: 64, lowered for large scenes)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--max-page", options.atlas.max_page, "atlas page size limit in texels")->check(CLI::Range(16, 16384));
+  app.add_option("--padding", options.atlas.padding, "gutter texels around each chart rectangle")->check(CLI::Range(1, 16));
+  app.add_option("--uv", options.import.lightmap_uv_set, "lightmap UV set: 1 = TEXCOORD_1 (default), 0 = TEXCOORD_0")
+      ->check(CLI::IsMember({0, 1}));
+  app.add_option("--spp", options.lighting.spp, "samples per texel (0 = until --time or --target-error ends the run)");
+  app.add_option("--time", options.lighting.time_budget_seconds, "stop the lighting stage after this many seconds")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--target-error", options.lighting.target_relative_error,
+                 "stop a texel once its relative standard error is below this")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--bounces", options.lighting.max_bounces,
+                 "maximum diffuse bounces (default: until Russian roulette ends the path)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--sky", options.sky, "sky radiance: R,G,B or an equirectangular image (EXR/HDR)");
+  app.add_option("--seed", options.lighting.seed, "random seed; results are deterministic per seed and backend");
+  app.add_flag("--bounce-layers", options.bounce_layers, "also write bounce<k>.R/G/B debug layers");
+  std::string probes = "auto", voxels = "auto", directional, guiding = "auto";
+  app.add_option("--probes", probes, "light-probe grid spacing in scene units, auto (largest extent / 12) or none");
+  app.add_option("--probe-spp", options.probe_spp, "rays per light probe")->check(CLI::Range(1u, 1u << 24));
+  app.add_option("--probe-dering", options.probe_sh_window,
+                 "Hanning window width for the probes' SH (e.g. 3; 0 = off, the default)")
+      ->check(CLI::Range(0.0f, 16.0f));
+  app.add_option("--voxel-resolution", voxels,
+                 "SVO leaves per axis: a power of two 2..4096, auto (leaves about 4 texels wide) or none");
+  app.add_option("--directional", directional, "sh1: L1 directional lightmaps (not implemented yet)");
+  app.add_option("--guiding", guiding, "auto | off | svo | grid (only off is implemented yet)")
+      ->check(CLI::IsMember({"auto", "off", "svo", "grid"}));
+  bool json_report = false;
+  app.add_flag("--json", json_report, "print the run report as JSON on stdout");
+  // --list-devices needs no scene: parse it before the required positional is enforced.
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--list-devices") {
+      for (const auto& d : exitance::enumerate_vulkan_devices())
+        std::cout << d.index << ": " << d.name << " (" << exitance::to_string(d.type) << ")"
+                  << (d.usable ? "" : " unusable: " + d.missing_feature) << "\n";
+      return 0;
+    }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return e.get_exit_code() == 0 ? 0 : (code == 0 ? 0 : 2);
+  }
+  if (options.lighting.spp == 0 && options.lighting.time_budget_seconds <= 0 &&
+      options.lighting.target_relative_error <= 0) {
+    std::cerr << "bake: error: --spp 0 needs --time or --target-error to end the run\n";
+    return 2;
+  }
+
+  exitance::Diagnostics diagnostics;
+  const char* validation = std::getenv("EXITANCE_VULKAN_VALIDATION");
+  options.backend.validation = validation && std::string(validation) == "1";
+  if (probes == "none") {
+    options.probes_enabled = false;
+  } else if (probes != "auto") {
+    size_t used = 0;
+    float spacing = -1;
+    try {
+      spacing = std::stof(probes, &used);
+    } catch (...) {
+    }
+    if (used != probes.size() || !(spacing > 0) || !std::isfinite(spacing)) {
+      std::cerr << "bake: error: --probes " << probes << ": expected a positive spacing, auto or none\n";
+      return 2;
+    }
+    options.probe_spacing = spacing;
+  }
+  if (voxels == "none") {
+    options.svo_enabled = false;
+  } else if (voxels != "auto") {
+    size_t used = 0;
+    unsigned long resolution = 0;
+    try {
+      resolution = std::stoul(voxels, &used);
+    } catch (...) {
+    }
+    if (used != voxels.size() || resolution < 2 || resolution > 4096 || (resolution & (resolution - 1))) {
+      std::cerr << "bake: error: --voxel-resolution " << voxels << ": expected a power of two 2..4096, auto or none\n";
+      return 2;
+    }
+    options.voxel_resolution = uint32_t(resolution);
+  }
+  if (!directional.empty()) diagnostics.warn("--directional: directional lightmaps are not implemented yet; ignored");
+  if (guiding == "svo" || guiding == "grid") {
+    std::cerr << "bake: error: --guiding " << guiding << " is not implemented yet (use off)\n";
+    return 1;
+  }
+
+  exitance::ProgressBar bar;
+  options.progress = [&](const std::string& stage, double fraction, uint64_t rays) { bar.update(stage, fraction, rays); };
+  try {
+    const nlohmann::json report = exitance::run_bake(options, diagnostics);
+    bar.finish();
+    print_warnings(diagnostics);
+    if (json_report) {
+      std::cout << report.dump(2) << "\n";
+    } else {
+      std::cerr << "bake: wrote " << report["output"].get<std::string>() << " (" << report["pages"].get<size_t>()
+                << " pages, " << report["live_texels"].get<size_t>() << " texels, "
+                << report["rays_per_second"].get<double>() * 1e-6 << " Mrays/s)\n";
+    }
+    return 0;
+  } catch (const exitance::InputError& e) {
+    bar.finish();
+    print_warnings(diagnostics);
+    std::cerr << "bake: error: " << one_line(e.what()) << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    bar.finish();
+    print_warnings(diagnostics);
+    std::cerr << "bake: error: " << one_line(e.what()) << "\n";
+    return 1;
+  }
+}

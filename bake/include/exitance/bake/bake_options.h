@@ -1,0 +1,46 @@
+// The options of one `bake` run, as the command line gives them (docs/cli.md): every stage's
+// settings in one place. The stages read their part of it; bundle/ records it in the manifest.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "exitance/bake/import/gltf_import.h"
+#include "exitance/bake/layout/atlas_layout.h"
+#include "exitance/runtime/core/integrator_settings.h"
+
+namespace exitance {
+
+struct BackendRequest {
+  std::string name = "auto";  // auto | vulkan | cpu
+  int device_index = -1;      // --device N; -1 = prefer a discrete GPU
+  bool validation = false;    // EXITANCE_VULKAN_VALIDATION=1: validation layers, any message is an error
+};
+
+struct BakeOptions {
+  std::string input;
+  std::string output;          // empty = SCENE.bake next to the input
+  std::string sky;             // "R,G,B" or an equirectangular image path; empty = black
+  BackendRequest backend;
+  ImportOptions import;
+  AtlasSettings atlas;
+  IntegratorSettings lighting;
+  bool bounce_layers = false;
+  // Light probes (--probes): spacing in scene units, 0 = automatic; probes_enabled false = none.
+  bool probes_enabled = true;
+  float probe_spacing = 0;
+  uint32_t probe_spp = 512;       // rays per probe (--probe-spp)
+  float probe_sh_window = 0;      // Hanning deringing window width (--probe-dering), 0 = off
+  // Sparse voxel octree with radiant exitance (svo.bin, radiance.vdb): --voxel-resolution.
+  bool svo_enabled = true;
+  uint32_t voxel_resolution = 0;  // power of two; 0 = automatic (leaves about 4 texels wide)
+  // Stage reporting for the progress bar: (stage name, fraction done, rays so far).
+  std::function<void(const std::string&, double, uint64_t)> progress;
+
+  // Tells the progress bar that `stage` starts.
+  void announce_stage(const std::string& stage) const {
+    if (progress) progress(stage, 0, 0);
+  }
+};
+
+}  // namespace exitance

@@ -1,0 +1,16 @@
+// Conservative rasterization of every triangle in lightmap UV space: each texel touched by a
+// chart becomes live and takes the triangle that covers most of it. The per-texel geometry
+// (clipped_texel_coverage, chart_barycentrics, texel_surface) is in exitance/runtime/texel_surface.h.
+#pragma once
+#include "exitance/bake/layout/atlas_layout.h"
+#include "exitance/bake/diagnostics.h"
+#include "exitance/runtime/scene.h"
+#include "exitance/runtime/texel_gbuffer.h"
+#include "exitance/runtime/texel_surface.h"
+
+namespace exitance {
+
+TexelGBuffer rasterize_texel_gbuffer(const Scene& scene, const AtlasLayout& layout, const std::string& file,
+                                     Diagnostics& diagnostics);
+
+}  // namespace exitance
