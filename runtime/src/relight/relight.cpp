@@ -85,6 +85,9 @@ json relight_bundle(const RelightOptions& options) {
   const fs::path out = options.output.empty() ? bundle : fs::path(options.output);
   report("load", 0, 0);
   json manifest = read_manifest(bundle);
+  if (manifest.contains("scene") && manifest["scene"].is_object() && manifest["scene"].contains("skipped"))
+    throw RelightInputError((bundle / "manifest.json").string() + ": scene: bake wrote no scene.bin (" +
+                            manifest["scene"]["skipped"].dump() + "); re-bake instead");
   PersistedScene persisted;
   formats::SparseVoxelOctree svo;
   const bool has_svo = manifest.contains("svo");
