@@ -17,6 +17,7 @@
 #include "exitance/bake/command/bake_pipeline.h"
 #include "exitance/formats/lightmap_exr.h"
 #include "exitance/formats/scene_file.h"
+#include "exitance/loader/bundle.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/runtime/relight/relight.h"
 #include "exitance/runtime/scene_file_conversion.h"
@@ -98,6 +99,9 @@ TEST(Relight, ReproducesTheVulkanBakeBitForBit) {
   const nlohmann::json manifest = nlohmann::json::parse(file_bytes(output / "manifest.json"));
   EXPECT_EQ(manifest["relight"]["tool"], "exitance-relight");
   EXPECT_FALSE(manifest["svo"].contains("vdb"));
+  // An engine opens the re-lit bundle as it opens a baked one (the loader validates every file).
+  const loader::Bundle bundle = loader::Bundle::open(output.string());
+  EXPECT_EQ(bundle.pages().size(), loader::Bundle::open(f.baked.string()).pages().size());
 }
 
 // The relight's lightmap against the CPU reference on the same restored scene and G-buffer, with
