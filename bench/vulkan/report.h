@@ -1,4 +1,4 @@
-// GPU-side figures shared by bench_vulkan_throughput and bench_vulkan_replay: a timed bake, an
+// GPU-side figures of bench_vulkan_throughput: a timed bake, an
 // instrumented bake (per-stage GPU time, rays, lane efficiency) and the traversal-only kernel.
 #pragma once
 #include <cstdio>

@@ -3,7 +3,7 @@
 // per-stage figures and a traversal-only kernel's incoherent rays/s.
 //
 //   bench_vulkan_throughput SCENE.gltf [--sky R,G,B] [--texel-density T] [--spp N] [--cpu-spp N]
-//                           [--max-paths N] [--traversal-rays N] [--skip-cpu] [--write-replay FILE]
+//                           [--max-paths N] [--traversal-rays N] [--skip-cpu]
 //                           [--node-layout auto|float|quantized] [--probes NX,NY,NZ [--probe-spp N]]
 //
 // --probes NX,NY,NZ: light probes instead of the lightmap: an NX x NY x NZ grid of probes at the
@@ -11,9 +11,8 @@
 // settings, seed 1): probe rays/s (every ray: probe rays, bounces and shadow rays) and the ratio,
 // then the stage table of an instrumented probe bake (stage "rays: primary" = the probe rays).
 //
-// --write-replay FILE: writes the scene, the live texels and the GPU BVH (bench/vulkan/replay_format.h)
-// and exits; bench_vulkan_replay (bench/vulkan/build_replay.sh) then runs the GPU half of this bench
-// on a machine that has nothing but a Vulkan driver.
+// On the GPU machine the same figures come from exitance-relight --stage-statistics on a bundle baked
+// here (bench/results/relight-gpu.md).
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -22,14 +21,12 @@
 #include "exitance/bake/command/prepared_scene.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "exitance/runtime/cpu/bvh4_builder.h"
-#include "reference_comparison.h"
-#include "replay_format.h"
 #include "report.h"
 
 using namespace exitance;
 
 int main(int argc, char** argv) {
-  std::string scene_path, sky, replay_path, node_layout = "auto";
+  std::string scene_path, sky, node_layout = "auto";
   float density = 4;
   uint32_t spp = 16, cpu_spp = 0, max_paths = 0, traversal_rays = 1u << 22;
   bool skip_cpu = false;
@@ -44,11 +41,6 @@ int main(int argc, char** argv) {
   app.add_flag("--skip-cpu", skip_cpu);
   app.add_option("--node-layout", node_layout, "BVH4 node layout: auto, float or quantized")
       ->check(CLI::IsMember({"auto", "float", "quantized"}));
-  app.add_option("--write-replay", replay_path, "write a replay file for bench_vulkan_replay and exit");
-  std::string reference_path;
-  app.add_option("--write-reference", reference_path,
-                 "with --write-replay: also bake the CPU reference at --cpu-spp (seed 7) and write it for "
-                 "bench_vulkan_replay --reference");
   std::string probe_grid;
   uint32_t probe_spp = 256;
   app.add_option("--probes", probe_grid, "NX,NY,NZ: bake a probe grid over the scene bounds instead of the lightmap");
@@ -73,22 +65,6 @@ int main(int argc, char** argv) {
   const TexelGBuffer& gbuffer = prepared.gbuffer;
   std::printf("scene %s: %zu triangles, %zu live texels, %u spp\n", scene_path.c_str(), scene.triangle_count(),
               gbuffer.texels.size(), spp);
-
-  if (!replay_path.empty()) {
-    const Bvh4 bvh = build_bvh4(scene);
-    replay::write_replay(replay_path, {scene_path, density}, scene, gbuffer, bvh);
-    std::printf("wrote %s (BVH4 %zu nodes, stack bound %u)\n", replay_path.c_str(), bvh.nodes.size(), bvh.stack_entries);
-    if (!reference_path.empty()) {
-      IntegratorSettings reference_settings;
-      reference_settings.spp = cpu_spp ? cpu_spp : spp;
-      reference_settings.seed = 7;  // independent of the replay's seed 1
-      const LightmapEstimate reference = CpuReferenceIntegrator(scene).bake(gbuffer, reference_settings);
-      replay::write_reference(reference_path, reference);
-      std::printf("wrote %s (CPU reference, %u spp, %.1f s)\n", reference_path.c_str(), reference_settings.spp,
-                  reference.seconds);
-    }
-    return 0;
-  }
 
   VulkanDeviceOptions options;
   options.max_paths = max_paths;

@@ -38,6 +38,8 @@ int main(int argc, char** argv) {
   app.add_flag("--json", json_report, "print the run report as JSON on stdout");
   app.add_flag("--stage-statistics", options.stage_statistics,
                "time each wavefront stage on the GPU (timestamps, lane counters; slower, for benchmarks)");
+  app.add_option("--traversal-rays", options.traversal_rays,
+                 "also time N incoherent closest-hit rays (origins in the scene bounds, uniform directions) alone");
   try {
     if (argc > 1 && std::string(argv[1]) == "--list-devices") {
       for (const auto& d : exitance::enumerate_vulkan_devices())

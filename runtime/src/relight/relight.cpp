@@ -210,6 +210,8 @@ json relight_bundle(const RelightOptions& options) {
   run["live_texels"] = persisted.gbuffer.texels.size();
   run["lighting_seconds"] = estimate.seconds;
   if (options.stage_statistics) run["stages"] = stages;
+  if (options.traversal_rays > 0)
+    run["traversal_only_rays_per_second"] = integrator->measure_incoherent_traversal(options.traversal_rays);
   run["nonfinite_samples"] = estimate.nonfinite_samples + probe_estimate.nonfinite_samples;
 
   manifest["generator"] = "exitance-relight 0.1.0";

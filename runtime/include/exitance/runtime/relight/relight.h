@@ -22,6 +22,7 @@ struct RelightOptions {
   int device_index = -1;           // Vulkan device; -1 = prefer a discrete GPU
   bool validation = false;         // Vulkan validation layers; any message fails the relight
   bool stage_statistics = false;   // GPU time, rays and lane efficiency per wavefront stage (slower; benchmarks)
+  uint32_t traversal_rays = 0;     // > 0: also time this many incoherent closest-hit rays alone (benchmarks)
   // Stage reporting: (stage, fraction done, rays so far).
   std::function<void(const std::string&, double, uint64_t)> progress;
 };
