@@ -21,6 +21,7 @@
 #include "exitance/bake/command/prepared_scene.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "exitance/runtime/cpu/bvh4_builder.h"
+#include "exitance/runtime/cpu_reference_integrator.h"
 #include "report.h"
 
 using namespace exitance;
