@@ -1,5 +1,5 @@
 // LightmapEstimate's accessors: plain arithmetic on the sums, shared by every backend (and by
-// bench_vulkan_replay, which links no Embree), so they live apart from the CPU integrator.
+// the runtime library, which links no Embree), so they live apart from the CPU integrator.
 #include <algorithm>
 
 #include <cmath>

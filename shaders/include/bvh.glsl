@@ -1,8 +1,8 @@
-// BVH4 traversal (built by Embree's rtcBuildBVH, runtime/src/vulkan/gpu_bvh.cpp).
+// BVH4 traversal (built by Embree's rtcBuildBVH, runtime/src/cpu/bvh4_builder.cpp; core/bvh4.h).
 // Two node layouts, chosen by the host (specialization constant 1, kQuantizedNodes):
 // float: 7 vec4 (112 bytes): lo.x[4], hi.x[4], lo.y[4], hi.y[4], lo.z[4], hi.z[4], child[4] (uint bits);
 // quantized: 4 uvec4 (64 bytes): origin, per-axis power-of-two scales and 8-bit child planes
-// (quantize_bvh4_nodes in runtime/src/vulkan/gpu_bvh.h), then child[4].
+// (quantize_bvh4_nodes in runtime/src/vulkan/bvh_quantization.h), then child[4].
 // Child word: kInvalid = empty, bit 31 set = leaf (first triangle << 2 | count - 1), else inner node index.
 // Triangles: watertight test of Woop, Benthin & Wald (JCGT 2013), double-precision fallback on edges.
 //
@@ -73,7 +73,7 @@ vec3 intersect_triangle(Ray r, vec3 v0, vec3 v1, vec3 v2, out float t_out) {
 
 vec4 decode_planes(float origin, uint bytes, float scale) {
   vec4 q = vec4(uvec4(bytes, bytes >> 8u, bytes >> 16u, bytes >> 24u) & 0xFFu);
-  return origin + q * scale;  // q * scale is exact: the host computed the same floats (gpu_bvh.h)
+  return origin + q * scale;  // q * scale is exact: the host computed the same floats (bvh_quantization.h)
 }
 
 // Slab test of the 4 children of inner node `node` against (0, t_max]; misses get tnear = +inf.

@@ -3,7 +3,7 @@
 // Stage "accumulate" of probe batches: per probe of the batch, in sample order (one writer per
 // probe), the incident radiance of each sample, L = (sky or emission met by the probe ray) +
 // albedo of the hit x (E/pi estimate at the hit), 0 on a back face (counted), projected onto the
-// L2 SH basis with weight 4 pi into double sums (cpu_reference_integrator.cpp, bake_probes).
+// L2 SH basis with weight 4 pi into double sums (runtime/src/cpu/cpu_reference_integrator.cpp, bake_probes).
 layout(local_size_x = 64) in;
 #include "../include/kernel_prelude.glsl"
 

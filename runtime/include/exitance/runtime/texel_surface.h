@@ -1,5 +1,5 @@
 // Where a live texel lies on its triangle and the surface attributes there: the chart geometry
-// and formulas of the texel rasterizer (bake/src/texel_raster.cpp), in one compiled copy that the
+// and formulas of the texel rasterizer (bake/raster/texel_raster.cpp), in one compiled copy that the
 // rasterizer and the scene.bin G-buffer codec (texel_gbuffer_codec.h) both call, so the codec
 // re-derives a texel bit for bit from (triangle, x, y) and the atlas rectangle.
 #pragma once
