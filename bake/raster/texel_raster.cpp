@@ -3,23 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "exitance/formats/scene_file.h"  // texel_morton_code: the order scene.bin stores texels in
 #include "exitance/runtime/texel_surface.h"
 
 namespace exitance {
 namespace {
-
-// Interleaves the bits of x and y (16 bits each) for Morton order.
-uint32_t morton2(uint32_t x, uint32_t y) {
-  auto spread = [](uint32_t v) {
-    v &= 0xFFFF;
-    v = (v | (v << 8)) & 0x00FF00FF;
-    v = (v | (v << 4)) & 0x0F0F0F0F;
-    v = (v | (v << 2)) & 0x33333333;
-    v = (v | (v << 1)) & 0x55555555;
-    return v;
-  };
-  return spread(x) | (spread(y) << 1);
-}
 
 struct TexelCandidate {
   float best_area = 0;
@@ -113,7 +101,7 @@ TexelGBuffer rasterize_texel_gbuffer(const Scene& scene, const AtlasLayout& layo
         gbuffer.texels.push_back(texel);
       }
     std::sort(gbuffer.texels.begin() + long(first_live), gbuffer.texels.end(),
-              [](const LiveTexel& a, const LiveTexel& b) { return morton2(a.x, a.y) < morton2(b.x, b.y); });
+              [](const LiveTexel& a, const LiveTexel& b) { return formats::texel_morton_code(a.x, a.y) < formats::texel_morton_code(b.x, b.y); });
   }
   for (size_t i = 0; i < overlapping_texels.size(); ++i)
     if (overlapping_texels[i] > 0)
