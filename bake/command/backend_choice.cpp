@@ -1,18 +1,13 @@
 #include "exitance/bake/command/backend_choice.h"
 
-#include <mutex>
 #include <stdexcept>
 
 #include "exitance/runtime/cpu_reference_integrator.h"
+#include "exitance/runtime/vulkan/validation_messages.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 
 namespace exitance {
 namespace {
-
-struct ValidationMessages {
-  std::mutex mutex;
-  std::vector<std::string> lines;
-};
 
 // The Vulkan backend with validation layers on: any message fails the bake that produced it.
 class ValidationCheckedIntegrator final : public Integrator {
@@ -33,12 +28,7 @@ class ValidationCheckedIntegrator final : public Integrator {
   }
 
  private:
-  void check() const {
-    std::lock_guard<std::mutex> lock(messages_->mutex);
-    if (!messages_->lines.empty())
-      throw std::runtime_error("Vulkan validation reported " + std::to_string(messages_->lines.size()) +
-                               " messages, first: " + messages_->lines.front());
-  }
+  void check() const { messages_->throw_if_any(); }
   std::shared_ptr<const Integrator> inner_;
   std::shared_ptr<ValidationMessages> messages_;
 };
@@ -48,13 +38,8 @@ std::shared_ptr<const Integrator> vulkan_backend(std::shared_ptr<const LightingS
   VulkanDeviceOptions options;
   options.device_index = request.device_index;
   options.validation = request.validation;
-  // Messages arrive on a driver callback: collect them there, fail the bake afterwards.
   auto messages = std::make_shared<ValidationMessages>();
-  if (request.validation)
-    options.on_validation_message = [messages](const std::string& message) {
-      std::lock_guard<std::mutex> lock(messages->mutex);
-      messages->lines.push_back(message);
-    };
+  if (request.validation) options.on_validation_message = ValidationMessages::collector(messages);
   std::shared_ptr<const Integrator> integrator = VulkanIntegrator::create(std::move(scene), options);
   if (!request.validation) return integrator;
   return std::make_shared<ValidationCheckedIntegrator>(std::move(integrator), messages);

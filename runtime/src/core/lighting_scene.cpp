@@ -13,8 +13,6 @@
 namespace exitance {
 namespace {
 
-float bits_as_float(uint32_t u) { return std::bit_cast<float>(u); }
-
 // A distribution's CDF for a GPU buffer, which must hold at least two entries.
 std::vector<double> padded_cdf(const Distribution1D& distribution) {
   std::vector<double> cdf = distribution.cdf();
@@ -46,7 +44,7 @@ GpuPunctualLight punctual_record(const PunctualLight& light) {
                         : light.type == PunctualLight::Type::Directional ? kPunctualDirectional
                                                                          : kPunctualPoint;
   GpuPunctualLight g;
-  g.position_type = Vec4(light.position, bits_as_float(type));
+  g.position_type = Vec4(light.position, uintBitsToFloat(type));
   g.direction_cos_inner = Vec4(light.direction, light.cos_inner);
   g.intensity_cos_outer = Vec4(light.intensity, light.cos_outer);
   return g;
@@ -133,9 +131,9 @@ LightingScene build_lighting_scene(std::shared_ptr<const Scene> source, Bvh4 bvh
     const Vec3* p = &scene.positions[t * 3];
     const Vec3* n = &scene.normals[t * 3];
     GpuTriangle& g = lighting.triangles[t];
-    g.p0_material = Vec4(p[0], bits_as_float(scene.triangle_material[t]));
+    g.p0_material = Vec4(p[0], uintBitsToFloat(scene.triangle_material[t]));
     g.p1_area_pdf = Vec4(p[1], 0.0f);  // build_emitter_distribution
-    g.p2_instance = Vec4(p[2], bits_as_float(scene.triangle_instance.empty() ? 0u : scene.triangle_instance[t]));
+    g.p2_instance = Vec4(p[2], uintBitsToFloat(scene.triangle_instance.empty() ? 0u : scene.triangle_instance[t]));
     g.n0 = Vec4(n[0], 0.0f), g.n1 = Vec4(n[1], 0.0f), g.n2 = Vec4(n[2], 0.0f);
   }
   for (const Material& m : scene.materials) {

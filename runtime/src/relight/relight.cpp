@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
-#include <mutex>
 
 #include "exitance/formats/format_error.h"
 #include "exitance/formats/probes_file.h"
@@ -17,6 +16,7 @@
 #include "exitance/runtime/bundle/texel_exitance.h"
 #include "exitance/runtime/core/lighting_scene.h"
 #include "exitance/runtime/scene_file_conversion.h"
+#include "exitance/runtime/vulkan/validation_messages.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 
 namespace exitance {
@@ -61,10 +61,6 @@ bool page_has_bounce_layers(const json& manifest) {
   return false;
 }
 
-struct ValidationLog {
-  std::mutex mutex;
-  std::vector<std::string> lines;
-};
 
 }  // namespace
 
@@ -91,17 +87,13 @@ json relight_bundle(const RelightOptions& options) {
   PersistedScene persisted;
   formats::SparseVoxelOctree svo;
   const bool has_svo = manifest.contains("svo");
-  std::vector<uint8_t> scene_bytes;
+  formats::SceneFile scene_file;  // kept to write it back: encoding a file that was read gives its bytes again
   try {
-    const formats::SceneFile file = formats::read_scene_file((bundle / "scene.bin").string());
-    persisted = restore_scene(file);
+    scene_file = formats::read_scene_file((bundle / "scene.bin").string());
+    persisted = restore_scene(scene_file);
     if (has_svo) svo = formats::read_svo_file((bundle / "svo.bin").string());
   } catch (const formats::FormatError& e) {
     throw RelightInputError(e.what());
-  }
-  {
-    std::ifstream in(bundle / "scene.bin", std::ios::binary);
-    scene_bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   lap("load");
 
@@ -130,12 +122,8 @@ json relight_bundle(const RelightOptions& options) {
   device.device_index = options.device_index;
   device.validation = options.validation;
   device.collect_stage_statistics = options.stage_statistics;
-  auto validation = std::make_shared<ValidationLog>();
-  if (options.validation)
-    device.on_validation_message = [validation](const std::string& m) {
-      std::lock_guard<std::mutex> lock(validation->mutex);
-      validation->lines.push_back(m);
-    };
+  auto validation = std::make_shared<ValidationMessages>();
+  if (options.validation) device.on_validation_message = ValidationMessages::collector(validation);
   const std::unique_ptr<VulkanIntegrator> integrator = VulkanIntegrator::create(lighting_scene, device);
   lap("upload");
 
@@ -168,12 +156,7 @@ json relight_bundle(const RelightOptions& options) {
     store_probe_radiance(persisted.probes, traced, probe_estimate, probe_dering);
     lap("probes");
   }
-  {
-    std::lock_guard<std::mutex> lock(validation->mutex);
-    if (!validation->lines.empty())
-      throw std::runtime_error("Vulkan validation reported " + std::to_string(validation->lines.size()) +
-                               " messages, first: " + validation->lines.front());
-  }
+  validation->throw_if_any();
 
   if (has_svo) {
     report("exitance", 0, 0);
@@ -230,11 +213,7 @@ json relight_bundle(const RelightOptions& options) {
       formats::write_lightmap_exr((dir / ("lightmap-" + std::to_string(p) + ".exr")).string(), pages[p]);
     if (has_probes) formats::write_probes_file((dir / "probes.bin").string(), persisted.probes);
     if (has_svo) formats::write_svo_file((dir / "svo.bin").string(), svo);
-    {
-      std::ofstream scene_out(dir / "scene.bin", std::ios::binary);
-      scene_out.write(reinterpret_cast<const char*>(scene_bytes.data()), std::streamsize(scene_bytes.size()));
-      if (!scene_out) throw std::runtime_error("cannot write " + (dir / "scene.bin").string());
-    }
+    formats::write_scene_file((dir / "scene.bin").string(), scene_file);
     std::ofstream file(dir / "manifest.json");
     file << manifest.dump(2) << "\n";
     if (!file) throw std::runtime_error("cannot write " + (dir / "manifest.json").string());

@@ -39,7 +39,7 @@ std::vector<Vec4> leaf_triangle_copies(const LightingScene& scene) {
   std::vector<Vec4> leaf(std::max<size_t>(scene.bvh.leaf_triangles.size(), 1) * 3);
   for (size_t slot = 0; slot < scene.bvh.leaf_triangles.size(); ++slot) {
     const uint32_t t = scene.bvh.leaf_triangles[slot];
-    leaf[slot * 3] = Vec4(scene_triangle_vertex(scene, t, 0), std::bit_cast<float>(t));
+    leaf[slot * 3] = Vec4(scene_triangle_vertex(scene, t, 0), uintBitsToFloat(t));
     leaf[slot * 3 + 1] = Vec4(scene_triangle_vertex(scene, t, 1), 0.0f);
     leaf[slot * 3 + 2] = Vec4(scene_triangle_vertex(scene, t, 2), 0.0f);
   }
