@@ -17,78 +17,78 @@ namespace {
 
 using json = nlohmann::json;
 
-json vec3_json(const std::array<float, 3>& v) { return json::array({v[0], v[1], v[2]}); }
-
 // "settings": the options as the stages used them (the density, probe spacing and voxel resolution
 // they chose when left automatic).
-json settings_json(const BakeResults& results, const BakeOptions& options) {
-  return {{"backend", results.backend.backend_name()},
-          {"spp", options.lighting.spp},
-          {"time_budget_seconds", options.lighting.time_budget_seconds},
-          {"target_error", options.lighting.target_relative_error},
-          {"bounces", options.lighting.max_bounces},
-          {"seed", options.lighting.seed},
-          {"texel_density", results.layout.texel_density},
-          {"max_page", options.atlas.max_page},
-          {"padding", options.atlas.padding},
-          {"lightmap_uv", options.import.lightmap_uv_set},
-          {"russian_roulette_start", options.lighting.russian_roulette_start},
-          {"safety_bounce_cap", options.lighting.safety_bounce_cap},
-          {"sky", options.sky},
-          {"probes", results.probes ? json(results.probes->grid.spacing[0]) : json("none")},
-          {"probe_spp", options.probe_spp},
-          {"probe_dering_window", options.probe_sh_window},
-          {"voxel_resolution", results.voxels ? json(results.voxels->svo.resolution()) : json("none")}};
+formats::BakeSettings settings_of(const BakeResults& results, const BakeOptions& options) {
+  formats::BakeSettings s;
+  s.backend = results.backend.backend_name();
+  s.spp = options.lighting.spp;
+  s.time_budget_seconds = options.lighting.time_budget_seconds;
+  s.target_error = options.lighting.target_relative_error;
+  s.bounces = options.lighting.max_bounces;
+  s.seed = options.lighting.seed;
+  s.texel_density = results.layout.texel_density;
+  s.max_page = uint32_t(options.atlas.max_page);
+  s.padding = uint32_t(options.atlas.padding);
+  s.lightmap_uv = uint32_t(options.import.lightmap_uv_set);
+  s.russian_roulette_start = options.lighting.russian_roulette_start;
+  s.safety_bounce_cap = options.lighting.safety_bounce_cap;
+  s.sky = options.sky;
+  if (results.probes) s.probe_spacing = results.probes->grid.spacing[0];
+  s.probe_spp = options.probe_spp;
+  s.probe_dering_window = options.probe_sh_window;
+  if (results.voxels) s.voxel_resolution = results.voxels->svo.resolution();
+  return s;
 }
 
-json pages_json(const std::vector<formats::LightmapImage>& pages) {
-  json list = json::array();
+std::vector<formats::PageInfo> pages_of(const std::vector<formats::LightmapImage>& pages) {
+  std::vector<formats::PageInfo> list;
   for (size_t p = 0; p < pages.size(); ++p) {
-    json channels = json::array();
-    for (const auto& [name, data] : pages[p].channels) channels.push_back(name);
-    list.push_back({{"file", "lightmap-" + std::to_string(p) + ".exr"},
-                    {"width", pages[p].width},
-                    {"height", pages[p].height},
-                    {"channels", channels}});
+    formats::PageInfo& page = list.emplace_back();
+    page.file = "lightmap-" + std::to_string(p) + ".exr";
+    page.width = uint32_t(pages[p].width);
+    page.height = uint32_t(pages[p].height);
+    for (const auto& [name, data] : pages[p].channels) page.channels.push_back(name);
   }
   return list;
 }
 
-json instances_json(const Scene& scene, const AtlasLayout& layout) {
-  json list = json::array();
+std::vector<formats::InstanceInfo> instances_of(const Scene& scene, const AtlasLayout& layout) {
+  std::vector<formats::InstanceInfo> list;
   for (size_t i = 0; i < scene.instances.size(); ++i) {
     const InstanceRect& r = layout.rects[i];
-    list.push_back({{"node", scene.instances[i].node},
-                    {"name", scene.instances[i].name},
-                    {"mesh", scene.instances[i].mesh},
-                    {"page", r.page},
-                    {"scale_offset", {r.scale_offset[0], r.scale_offset[1], r.scale_offset[2], r.scale_offset[3]}},
-                    {"rect", {r.x, r.y, r.width, r.height}}});
+    formats::InstanceInfo& instance = list.emplace_back();
+    instance.node = uint32_t(scene.instances[i].node);
+    instance.name = scene.instances[i].name;
+    instance.mesh = uint32_t(scene.instances[i].mesh);
+    instance.page = uint32_t(r.page);
+    instance.scale_offset = {r.scale_offset[0], r.scale_offset[1], r.scale_offset[2], r.scale_offset[3]};
+    instance.rect = std::array<uint32_t, 4>{uint32_t(r.x), uint32_t(r.y), uint32_t(r.width), uint32_t(r.height)};
   }
   return list;
 }
 
-json probes_json(const ProbePlacement& probes) {
+formats::ProbeGridInfo probes_of(const ProbePlacement& probes) {
   const formats::ProbeGrid& grid = probes.grid;
-  return {{"file", "probes.bin"},
-          {"origin", vec3_json(grid.origin)},
-          {"spacing", vec3_json(grid.spacing)},
-          {"counts", {grid.counts[0], grid.counts[1], grid.counts[2]}},
-          {"sh_order", 2},
-          {"valid", probes.valid},
-          {"moved", probes.moved},
-          {"invalid", probes.invalid},
-          {"skipped", probes.skipped}};
+  formats::ProbeGridInfo info;
+  info.file = "probes.bin";
+  info.origin = grid.origin;
+  info.spacing = grid.spacing;
+  info.counts = grid.counts;
+  info.sh_order = 2;
+  info.placement = formats::ProbePlacementCounts{probes.valid, probes.moved, probes.invalid, probes.skipped};
+  return info;
 }
 
-json svo_json(const formats::SparseVoxelOctree& svo) {
-  const std::array<float, 3> hi{svo.origin[0] + svo.size, svo.origin[1] + svo.size, svo.origin[2] + svo.size};
-  return {{"file", "svo.bin"},
-          {"vdb", "radiance.vdb"},
-          {"bounds", {vec3_json(svo.origin), vec3_json(hi)}},
-          {"depth", svo.depth},
-          {"nodes", svo.nodes.size()},
-          {"units", "radiant_exitance"}};
+formats::SvoInfo svo_of(const formats::SparseVoxelOctree& svo) {
+  formats::SvoInfo info;
+  info.file = "svo.bin";
+  info.vdb = "radiance.vdb";
+  info.bounds_min = svo.origin;
+  info.bounds_max = {svo.origin[0] + svo.size, svo.origin[1] + svo.size, svo.origin[2] + svo.size};
+  info.depth = svo.depth;
+  info.nodes = svo.nodes.size();
+  return info;
 }
 
 // "stats": what each stage did and how long it took.
@@ -162,26 +162,28 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
 
 }  // namespace
 
-json build_bundle_manifest(const BakeResults& results, const std::vector<formats::LightmapImage>& pages,
-                           const std::string& input_sha256, const json& seconds, size_t warnings,
-                           const BakeOptions& options) {
-  json manifest;
-  manifest["format_version"] = 1;
-  manifest["generator"] = "exitance 0.1.0";
-  manifest["input"] = {{"file", std::filesystem::path(options.input).filename().string()}, {"sha256", input_sha256}};
-  manifest["units"] = {{"lightmap", "irradiance_over_pi"}, {"probes", "incident_radiance_sh_l2"}, {"length", "scene"}};
-  manifest["settings"] = settings_json(results, options);
-  manifest["pages"] = pages_json(pages);
-  manifest["instances"] = instances_json(results.scene, results.layout);
-  if (results.probes) manifest["probes"] = probes_json(*results.probes);
-  if (results.voxels) manifest["svo"] = svo_json(results.voxels->svo);
-  if (!results.scene_file.bytes.empty())
-    manifest["scene"] = {{"file", "scene.bin"},
-                         {"format_version", formats::kSceneFormatVersion},
-                         {"bytes", results.scene_file.bytes.size()}};
-  else
-    manifest["scene"] = {{"skipped", results.scene_file.skipped}};
-  manifest["stats"] = stats_json(results, seconds, warnings, options);
+formats::BundleManifest build_bundle_manifest(const BakeResults& results,
+                                              const std::vector<formats::LightmapImage>& pages,
+                                              const std::string& input_sha256, const json& seconds, size_t warnings,
+                                              const BakeOptions& options) {
+  formats::BundleManifest manifest;
+  manifest.generator = "exitance 0.1.0";
+  manifest.input = formats::InputInfo{std::filesystem::path(options.input).filename().string(), input_sha256};
+  manifest.settings = settings_of(results, options);
+  manifest.pages = pages_of(pages);
+  manifest.instances = instances_of(results.scene, results.layout);
+  if (results.probes) manifest.probes = probes_of(*results.probes);
+  if (results.voxels) manifest.svo = svo_of(results.voxels->svo);
+  formats::SceneFileInfo scene;
+  if (!results.scene_file.bytes.empty()) {
+    scene.file = "scene.bin";
+    scene.format_version = formats::kSceneFormatVersion;
+    scene.bytes = results.scene_file.bytes.size();
+  } else {
+    scene.skipped = results.scene_file.skipped;
+  }
+  manifest.scene = scene;
+  manifest.stats_json = stats_json(results, seconds, warnings, options).dump();
   return manifest;
 }
 

@@ -30,8 +30,9 @@ WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::jso
   assembly.dilation_texels = std::max(2, options.atlas.padding * 2);
   const std::vector<formats::LightmapImage> pages =
       assemble_lightmap_pages(results.gbuffer, results.lightmap, assembly);
-  const nlohmann::json manifest = build_bundle_manifest(results, pages, sha256_of_file(options.input), seconds,
-                                                        diagnostics.warnings.size(), options);
+  const formats::BundleManifest manifest = build_bundle_manifest(
+      results, pages, sha256_of_file(options.input), seconds, diagnostics.warnings.size(), options);
+  const std::string manifest_text = formats::write_bundle_manifest(manifest);
 
   const fs::path out = bundle_folder(options);
   write_bundle_atomically(out, [&](const fs::path& dir) {
@@ -49,10 +50,10 @@ WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::jso
       write_radiance_vdb((dir / "radiance.vdb").string(), results.voxels->svo);
     }
     std::ofstream file(dir / "manifest.json");
-    file << manifest.dump(2) << "\n";
+    file << manifest_text;
     if (!file) throw std::runtime_error("cannot write " + (dir / "manifest.json").string());
   });
-  return {out, pages.size(), manifest["stats"]};
+  return {out, pages.size(), nlohmann::json::parse(manifest.stats_json)};
 }
 
 }  // namespace exitance

@@ -2,6 +2,9 @@
 // field, out-of-range index and other version is one FormatError naming the field.
 #include <gtest/gtest.h>
 
+#include <limits>
+#include <optional>
+
 #include <nlohmann/json.hpp>
 
 #include "byte_patching.h"
@@ -121,6 +124,75 @@ TEST(LoaderManifest, EachWrongFieldIsRefusedByName) {
     c.edit(j);
     expect_format_error([&] { parse(j); }, c.expected);
   }
+}
+
+
+// One schema for reading and writing (formats/bundle_manifest.h): what is read writes back and
+// reads again to the same manifest, including the optional blocks the loader does not use.
+TEST(BundleManifest, WriterAndReaderRoundTrip) {
+  json j = full_manifest();
+  j["input"] = {{"file", "scene.gltf"}, {"sha256", std::string(64, 'a')}};
+  j["settings"] = {{"backend", "vulkan"}, {"spp", 64}, {"seed", 7}, {"bounces", -1}, {"probes", "none"},
+                   {"voxel_resolution", 64}, {"padding", 3}, {"sky", "0.1,0.2,0.3"}};
+  j["scene"] = {{"file", "scene.bin"}, {"format_version", 1}, {"bytes", 1234}};
+  j["stats"] = {{"rays", 99}, {"seconds", {{"lighting", 0.5}}}};
+  const Manifest first = parse(j);
+  ASSERT_TRUE(first.settings.has_value());
+  EXPECT_EQ(first.settings->spp, 64u);
+  EXPECT_EQ(first.settings->seed, 7u);
+  EXPECT_EQ(first.settings->padding, 3u);
+  EXPECT_FALSE(first.settings->probe_spacing.has_value());
+  EXPECT_EQ(first.settings->voxel_resolution, std::optional<uint32_t>(64));
+  EXPECT_EQ(first.settings->probe_spp, 512u);  // absent: bake's default
+  ASSERT_TRUE(first.scene.has_value());
+  EXPECT_EQ(first.scene->bytes, 1234u);
+  EXPECT_EQ(json::parse(first.stats_json)["rays"], 99);
+
+  const std::string written = formats::write_bundle_manifest(first);
+  const Manifest second = parse_manifest(written, "written");
+  EXPECT_EQ(formats::write_bundle_manifest(second), written);
+  EXPECT_EQ(json::parse(written)["units"]["lightmap"], "irradiance_over_pi");
+  EXPECT_EQ(second.instances[0].scale_offset, first.instances[0].scale_offset);
+  EXPECT_EQ(second.probes->counts, first.probes->counts);
+  EXPECT_EQ(second.svo->bounds_max, first.svo->bounds_max);
+  EXPECT_EQ(second.settings->sky, "0.1,0.2,0.3");
+}
+
+TEST(BundleManifest, TheWriterRefusesWhatTheReaderWould) {
+  Manifest m = parse(full_manifest());
+  m.instances[0].scale_offset[2] = std::numeric_limits<float>::quiet_NaN();
+  expect_format_error([&] { formats::write_bundle_manifest(m); }, "instances[0].scale_offset[2]: expected a number, got null");
+  m = parse(full_manifest());
+  m.instances[1].page = 5;
+  expect_format_error([&] { formats::write_bundle_manifest(m); }, "instances[1].page: 5 is not a page (2 pages)");
+  m = parse(full_manifest());
+  m.stats_json = "[1, 2]";
+  expect_format_error([&] { formats::write_bundle_manifest(m); }, "manifest.json: stats: expected an object, got array");
+}
+
+TEST(BundleManifest, SettingsAndSceneFieldsAreCheckedByName) {
+  const auto refused = [](const char* key, const json& value, const std::string& message) {
+    json j = full_manifest();
+    j[key] = value;
+    expect_format_error([&] { parse(j); }, message);
+  };
+  refused("settings", {{"spp", "many"}}, "manifest.json: settings.spp: expected an integer, got string");
+  refused("settings", {{"bounces", -2}}, "settings.bounces: -2 is outside -1..2147483647");
+  refused("settings", {{"probes", "some"}}, "settings.probes: expected a number or \"none\"");
+  refused("settings", {{"backend", "metal"}}, "settings.backend: \"metal\" is not cpu or vulkan");
+  refused("settings", {{"target_error", -0.5}}, "settings.target_error: negative");
+  refused("settings", json::array(), "settings: expected an object, got array");
+  refused("scene", {{"file", "../scene.bin"}, {"format_version", 1}, {"bytes", 10}}, "scene.file: \"../scene.bin\" leaves the bundle folder");
+  refused("scene", {{"file", "scene.bin"}, {"bytes", 10}}, "scene.format_version: missing");
+  refused("scene", {{"skipped", ""}}, "scene.skipped: empty reason");
+  refused("input", {{"file", "a.gltf"}, {"sha256", "xyz"}}, "input.sha256: not 64 lowercase hexadecimal digits");
+  refused("relight", "done", "relight: expected an object, got string");
+  json j = full_manifest();
+  j["scene"] = {{"skipped", "textures are not stored by version 1"}};
+  const Manifest m = parse(j);
+  ASSERT_TRUE(m.scene.has_value());
+  EXPECT_TRUE(m.scene->file.empty());
+  EXPECT_EQ(m.scene->skipped, "textures are not stored by version 1");
 }
 
 }  // namespace

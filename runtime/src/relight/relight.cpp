@@ -6,6 +6,7 @@
 #include <fstream>
 #include <memory>
 
+#include "exitance/formats/bundle_manifest.h"
 #include "exitance/formats/format_error.h"
 #include "exitance/formats/probes_file.h"
 #include "exitance/formats/scene_file.h"
@@ -26,41 +27,17 @@ using json = nlohmann::json;
 
 namespace {
 
-json read_manifest(const fs::path& bundle) {
+formats::BundleManifest read_manifest(const fs::path& bundle) {
   const fs::path path = bundle / "manifest.json";
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw RelightInputError(path.string() + ": cannot read the manifest (is " + bundle.string() + " a bundle?)");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   try {
-    json manifest = json::parse(in);
-    if (!manifest.is_object()) throw RelightInputError(path.string() + ": not a JSON object");
-    return manifest;
-  } catch (const json::exception& e) {
-    throw RelightInputError(path.string() + ": " + e.what());
+    return formats::parse_bundle_manifest(text, path.string());
+  } catch (const formats::FormatError& e) {
+    throw RelightInputError(e.what());
   }
 }
-
-// A manifest setting of the bake, or `fallback` when absent; a present value of the wrong type is bad input.
-template <typename T>
-T setting(const json& manifest, const char* key, T fallback, const fs::path& bundle) {
-  if (!manifest.contains("settings") || !manifest["settings"].is_object()) return fallback;
-  const json& settings = manifest["settings"];
-  if (!settings.contains(key)) return fallback;
-  try {
-    return settings[key].get<T>();
-  } catch (const json::exception&) {
-    throw RelightInputError((bundle / "manifest.json").string() + ": settings." + key + " has the wrong type");
-  }
-}
-
-bool page_has_bounce_layers(const json& manifest) {
-  if (!manifest.contains("pages") || !manifest["pages"].is_array()) return false;
-  for (const json& page : manifest["pages"])
-    if (page.contains("channels") && page["channels"].is_array())
-      for (const json& channel : page["channels"])
-        if (channel.is_string() && channel.get<std::string>().rfind("bounce", 0) == 0) return true;
-  return false;
-}
-
 
 }  // namespace
 
@@ -80,33 +57,37 @@ json relight_bundle(const RelightOptions& options) {
   const fs::path bundle(options.bundle);
   const fs::path out = options.output.empty() ? bundle : fs::path(options.output);
   report("load", 0, 0);
-  json manifest = read_manifest(bundle);
-  if (manifest.contains("scene") && manifest["scene"].is_object() && manifest["scene"].contains("skipped"))
+  formats::BundleManifest manifest = read_manifest(bundle);
+  if (!manifest.scene)
+    throw RelightInputError((bundle / "manifest.json").string() + ": scene: missing (baked before scene.bin existed); re-bake instead");
+  if (manifest.scene->file.empty())
     throw RelightInputError((bundle / "manifest.json").string() + ": scene: bake wrote no scene.bin (" +
-                            manifest["scene"]["skipped"].dump() + "); re-bake instead");
+                            manifest.scene->skipped + "); re-bake instead");
+  // Settings absent from an older manifest take bake's defaults (formats::BakeSettings).
+  const formats::BakeSettings baked = manifest.settings.value_or(formats::BakeSettings{});
   PersistedScene persisted;
   formats::SparseVoxelOctree svo;
-  const bool has_svo = manifest.contains("svo");
+  const bool has_svo = manifest.svo.has_value();
   formats::SceneFile scene_file;  // kept to write it back: encoding a file that was read gives its bytes again
   try {
-    scene_file = formats::read_scene_file((bundle / "scene.bin").string());
+    scene_file = formats::read_scene_file((bundle / manifest.scene->file).string());
     persisted = restore_scene(scene_file);
-    if (has_svo) svo = formats::read_svo_file((bundle / "svo.bin").string());
+    if (has_svo) svo = formats::read_svo_file((bundle / manifest.svo->file).string());
   } catch (const formats::FormatError& e) {
     throw RelightInputError(e.what());
   }
   lap("load");
 
   IntegratorSettings lighting;
-  lighting.spp = options.spp ? *options.spp : (options.time_budget_seconds > 0 ? 0u : setting<uint32_t>(manifest, "spp", 128u, bundle));
+  lighting.spp = options.spp ? *options.spp : (options.time_budget_seconds > 0 ? 0u : baked.spp);
   lighting.time_budget_seconds = options.time_budget_seconds;
-  lighting.seed = options.seed ? *options.seed : setting<uint64_t>(manifest, "seed", 0u, bundle);
-  lighting.max_bounces = setting<int>(manifest, "bounces", -1, bundle);
-  lighting.russian_roulette_start = setting<int>(manifest, "russian_roulette_start", 3, bundle);
-  lighting.safety_bounce_cap = setting<int>(manifest, "safety_bounce_cap", 4096, bundle);
-  lighting.target_relative_error = setting<double>(manifest, "target_error", 0.0, bundle);
-  const uint32_t probe_spp = setting<uint32_t>(manifest, "probe_spp", 512u, bundle);
-  const float probe_dering = setting<float>(manifest, "probe_dering_window", 0.0f, bundle);
+  lighting.seed = options.seed ? *options.seed : baked.seed;
+  lighting.max_bounces = baked.bounces;
+  lighting.russian_roulette_start = baked.russian_roulette_start;
+  lighting.safety_bounce_cap = baked.safety_bounce_cap;
+  lighting.target_relative_error = baked.target_error;
+  const uint32_t probe_spp = baked.probe_spp;
+  const float probe_dering = baked.probe_dering_window;
   if (lighting.spp == 0 && !(lighting.time_budget_seconds > 0) && !(lighting.target_relative_error > 0))
     throw RelightInputError("--spp 0 needs --time");
 
@@ -137,7 +118,7 @@ json relight_bundle(const RelightOptions& options) {
                         {"lane_efficiency", s.lane_efficiency}});
 
   ProbeEstimate probe_estimate;
-  const bool has_probes = persisted.has_probe_grid() && manifest.contains("probes");
+  const bool has_probes = persisted.has_probe_grid() && manifest.probes.has_value();
   if (has_probes) {
     std::vector<Vec3> positions;
     std::vector<size_t> traced;
@@ -166,8 +147,8 @@ json relight_bundle(const RelightOptions& options) {
 
   report("write", 0, 0);
   AssemblyOptions assembly;
-  assembly.bounce_layers = page_has_bounce_layers(manifest);
-  assembly.dilation_texels = std::max(2, setting<int>(manifest, "padding", 2, bundle) * 2);
+  assembly.bounce_layers = manifest.has_bounce_layers();
+  assembly.dilation_texels = std::max(2, int(baked.padding) * 2);
   const std::vector<formats::LightmapImage> pages = assemble_lightmap_pages(persisted.gbuffer, estimate, assembly);
 
   double relative_error_sum = 0;
@@ -180,7 +161,7 @@ json relight_bundle(const RelightOptions& options) {
   json run;
   run["tool"] = "exitance-relight";
   run["source_bundle"] = fs::absolute(bundle).lexically_normal().string();
-  run["source_generator"] = manifest.value("generator", "");
+  run["source_generator"] = manifest.generator;
   run["what"] = "full relight from scene.bin: lightmaps, probes and voxel exitance recomputed; input lightmaps not read";
   run["device"] = integrator->device_description();
   run["spp"] = lighting.spp;
@@ -197,25 +178,37 @@ json relight_bundle(const RelightOptions& options) {
     run["traversal_only_rays_per_second"] = integrator->measure_incoherent_traversal(options.traversal_rays);
   run["nonfinite_samples"] = estimate.nonfinite_samples + probe_estimate.nonfinite_samples;
 
-  manifest["generator"] = "exitance-relight 0.1.0";
-  manifest["settings"]["backend"] = "vulkan";
-  manifest["settings"]["spp"] = lighting.spp;
-  manifest["settings"]["seed"] = lighting.seed;
-  manifest["settings"]["time_budget_seconds"] = lighting.time_budget_seconds;
-  if (has_svo) {
-    manifest["svo"].erase("vdb");
-    manifest["svo"]["vdb_note"] = "radiance.vdb is an inspection export of bake; exitance-relight does not write it";
+  // The pages as assembled now, under the file names the manifest gave them.
+  if (pages.size() != manifest.pages.size())
+    throw RelightInputError((bundle / "manifest.json").string() + ": pages: " + std::to_string(manifest.pages.size()) +
+                            " listed, scene.bin's atlas has " + std::to_string(pages.size()));
+  for (size_t p = 0; p < pages.size(); ++p) {
+    manifest.pages[p].width = uint32_t(pages[p].width);
+    manifest.pages[p].height = uint32_t(pages[p].height);
+    manifest.pages[p].channels.clear();
+    for (const auto& [name, data] : pages[p].channels) manifest.pages[p].channels.push_back(name);
   }
-  manifest["relight"] = run;
+  manifest.generator = "exitance-relight 0.1.0";
+  formats::BakeSettings& settings = manifest.settings.emplace(baked);
+  settings.backend = "vulkan";
+  settings.spp = lighting.spp;
+  settings.seed = lighting.seed;
+  settings.time_budget_seconds = lighting.time_budget_seconds;
+  if (has_svo) {
+    manifest.svo->vdb.clear();
+    manifest.svo->vdb_note = "radiance.vdb is an inspection export of bake; exitance-relight does not write it";
+  }
+  manifest.relight_json = run.dump();
+  const std::string manifest_text = formats::write_bundle_manifest(manifest);
 
   write_bundle_atomically(out, [&](const fs::path& dir) {
     for (size_t p = 0; p < pages.size(); ++p)
-      formats::write_lightmap_exr((dir / ("lightmap-" + std::to_string(p) + ".exr")).string(), pages[p]);
-    if (has_probes) formats::write_probes_file((dir / "probes.bin").string(), persisted.probes);
-    if (has_svo) formats::write_svo_file((dir / "svo.bin").string(), svo);
-    formats::write_scene_file((dir / "scene.bin").string(), scene_file);
+      formats::write_lightmap_exr((dir / manifest.pages[p].file).string(), pages[p]);
+    if (has_probes) formats::write_probes_file((dir / manifest.probes->file).string(), persisted.probes);
+    if (has_svo) formats::write_svo_file((dir / manifest.svo->file).string(), svo);
+    formats::write_scene_file((dir / manifest.scene->file).string(), scene_file);
     std::ofstream file(dir / "manifest.json");
-    file << manifest.dump(2) << "\n";
+    file << manifest_text;
     if (!file) throw std::runtime_error("cannot write " + (dir / "manifest.json").string());
   });
   lap("write");

@@ -1,10 +1,8 @@
 // manifest.json (DESIGN §4, docs/bundle.md) from the bake's options and its stages' results. Building
 // it reads and writes nothing; write_bundle_stage (write_bundle.h) writes it with the other files.
 #pragma once
-#include <cstdint>
-#include <string>
-#include <vector>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -15,6 +13,7 @@
 #include "exitance/bake/probes/probe_placement.h"
 #include "exitance/bake/raster/geometry_checks.h"
 #include "exitance/bake/voxelize/svo_build.h"
+#include "exitance/formats/bundle_manifest.h"
 #include "exitance/formats/lightmap_exr.h"
 #include "exitance/runtime/core/estimates.h"
 #include "exitance/runtime/core/integrator.h"
@@ -46,11 +45,12 @@ struct BakeResults {
   const PersistedSceneFile& scene_file;  // scene file
 };
 
-// `pages`: the assembled lightmap pages (the manifest lists their channels). `input_sha256`: the
+// The manifest (formats/bundle_manifest.h) of the bake: `pages`: the assembled lightmap pages (the manifest lists their channels). `input_sha256`: the
 // input file's hash (input_hash.h). `seconds`: stats.seconds, the stages timed so far. `warnings`:
 // how many warnings the run has given.
-nlohmann::json build_bundle_manifest(const BakeResults& results, const std::vector<formats::LightmapImage>& pages,
-                                     const std::string& input_sha256, const nlohmann::json& seconds, size_t warnings,
-                                     const BakeOptions& options);
+formats::BundleManifest build_bundle_manifest(const BakeResults& results,
+                                              const std::vector<formats::LightmapImage>& pages,
+                                              const std::string& input_sha256, const nlohmann::json& seconds,
+                                              size_t warnings, const BakeOptions& options);
 
 }  // namespace exitance

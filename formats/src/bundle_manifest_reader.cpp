@@ -1,4 +1,4 @@
-#include "exitance/loader/manifest.h"
+#include "exitance/formats/bundle_manifest.h"
 
 #include <cmath>
 #include <filesystem>
@@ -9,11 +9,10 @@
 #include "exitance/formats/probes_file.h"
 #include "exitance/formats/sparse_voxel_octree.h"
 
-namespace exitance::loader {
+namespace exitance::formats {
 namespace {
 
 using nlohmann::json;
-using formats::FormatError;
 
 // Largest page edge accepted; well above --max-page's useful range, small enough that
 // width * height * channels cannot overflow anything.
@@ -56,6 +55,28 @@ class FieldReader {
     }
     if (v < min || v > max)
       fail(where, std::to_string(v) + " is outside " + std::to_string(min) + ".." + std::to_string(max));
+    return v;
+  }
+
+  int64_t signed_integer(const json& value, const std::string& where, int64_t min, int64_t max) const {
+    if (!value.is_number_integer()) fail(where, std::string("expected an integer, got ") + value.type_name());
+    if (value.is_number_unsigned() && value.get<uint64_t>() > uint64_t(max))
+      fail(where, std::to_string(value.get<uint64_t>()) + " is above " + std::to_string(max));
+    const int64_t v = value.get<int64_t>();
+    if (v < min || v > max) fail(where, std::to_string(v) + " is outside " + std::to_string(min) + ".." + std::to_string(max));
+    return v;
+  }
+
+  double finite_double(const json& value, const std::string& where) const {
+    if (!value.is_number()) fail(where, std::string("expected a number, got ") + value.type_name());
+    const double v = value.get<double>();
+    if (!std::isfinite(v)) fail(where, "not finite");
+    return v;
+  }
+
+  double non_negative_double(const json& value, const std::string& where) const {
+    const double v = finite_double(value, where);
+    if (v < 0) fail(where, "negative");
     return v;
   }
 
@@ -143,31 +164,133 @@ ProbeGridInfo parse_probes(const FieldReader& r, const json& j) {
   uint64_t total = 1;
   for (size_t a = 0; a < 3; ++a) {
     probes.counts[a] = uint32_t(
-        r.unsigned_integer(counts[a], where + ".counts[" + std::to_string(a) + "]", 1, formats::kMaxProbeCount));
+        r.unsigned_integer(counts[a], where + ".counts[" + std::to_string(a) + "]", 1, kMaxProbeCount));
     total *= probes.counts[a];  // each factor <= 2^26 and checked below after every step
-    if (total > formats::kMaxProbeCount)
-      r.fail(where + ".counts", "more than " + std::to_string(formats::kMaxProbeCount) + " probes");
+    if (total > kMaxProbeCount)
+      r.fail(where + ".counts", "more than " + std::to_string(kMaxProbeCount) + " probes");
   }
   probes.sh_order = uint32_t(r.unsigned_integer(r.member(j, where, "sh_order"), where + ".sh_order", 2, 2));
+  // Placement counts: all four or none.
+  if (j.contains("valid") || j.contains("moved") || j.contains("invalid") || j.contains("skipped")) {
+    ProbePlacementCounts c;
+    c.valid = r.unsigned_integer(r.member(j, where, "valid"), where + ".valid", 0, total);
+    c.moved = r.unsigned_integer(r.member(j, where, "moved"), where + ".moved", 0, total);
+    c.invalid = r.unsigned_integer(r.member(j, where, "invalid"), where + ".invalid", 0, total);
+    c.skipped = r.unsigned_integer(r.member(j, where, "skipped"), where + ".skipped", 0, total);
+    probes.placement = c;
+  }
   return probes;
 }
 
 SvoInfo parse_svo(const FieldReader& r, const json& j) {
   const std::string where = "svo";
   SvoInfo svo;
+  if (j.contains("nodes")) svo.nodes = r.unsigned_integer(j["nodes"], where + ".nodes", 0, UINT64_MAX);
+  if (j.contains("vdb")) svo.vdb = r.bundle_file(j["vdb"], where + ".vdb");
+  if (j.contains("vdb_note")) svo.vdb_note = r.string(j["vdb_note"], where + ".vdb_note");
   svo.file = r.bundle_file(r.member(j, where, "file"), where + ".file");
   const json& bounds = r.array(r.member(j, where, "bounds"), where + ".bounds", 2);
   svo.bounds_min = r.float_array<3>(bounds[0], where + ".bounds[0]");
   svo.bounds_max = r.float_array<3>(bounds[1], where + ".bounds[1]");
   for (size_t a = 0; a < 3; ++a)
     if (!(svo.bounds_max[a] > svo.bounds_min[a])) r.fail(where + ".bounds", "maximum not above minimum");
-  svo.depth = uint32_t(r.unsigned_integer(r.member(j, where, "depth"), where + ".depth", 0, formats::kSvoMaxDepth));
+  svo.depth = uint32_t(r.unsigned_integer(r.member(j, where, "depth"), where + ".depth", 0, kSvoMaxDepth));
   return svo;
+}
+
+
+SceneFileInfo parse_scene(const FieldReader& r, const json& j) {
+  const std::string where = "scene";
+  SceneFileInfo scene;
+  if (j.is_object() && j.contains("skipped")) {
+    scene.skipped = r.string(j["skipped"], where + ".skipped");
+    if (scene.skipped.empty()) r.fail(where + ".skipped", "empty reason");
+    if (j.contains("file")) r.fail(where, "both a file and a reason it was skipped");
+    return scene;
+  }
+  scene.file = r.bundle_file(r.member(j, where, "file"), where + ".file");
+  scene.format_version =
+      uint32_t(r.unsigned_integer(r.member(j, where, "format_version"), where + ".format_version", 1, UINT32_MAX));
+  scene.bytes = r.unsigned_integer(r.member(j, where, "bytes"), where + ".bytes", 1, UINT64_MAX);
+  return scene;
+}
+
+InputInfo parse_input(const FieldReader& r, const json& j) {
+  InputInfo input;
+  input.file = r.string(r.member(j, "input", "file"), "input.file");
+  input.sha256 = r.string(r.member(j, "input", "sha256"), "input.sha256");
+  if (input.sha256.size() != 64 || input.sha256.find_first_not_of("0123456789abcdef") != std::string::npos)
+    r.fail("input.sha256", "not 64 lowercase hexadecimal digits");
+  return input;
+}
+
+// A setting that may be a number or the string "none" (an optional stage turned off).
+template <typename Read>
+auto number_or_none(const FieldReader& r, const json& j, const std::string& where, Read read)
+    -> std::optional<decltype(read(j))> {
+  if (j.is_string()) {
+    if (j.get<std::string>() != "none") r.fail(where, "expected a number or \"none\"");
+    return std::nullopt;
+  }
+  return read(j);
+}
+
+BakeSettings parse_settings(const FieldReader& r, const json& j) {
+  const std::string where = "settings";
+  if (!j.is_object()) r.fail(where, std::string("expected an object, got ") + j.type_name());
+  BakeSettings s;
+  auto field = [&](const char* key) -> const json* { return j.contains(key) ? &j[key] : nullptr; };
+  auto path = [&](const char* key) { return where + "." + key; };
+  constexpr int64_t kIntMax = std::numeric_limits<int32_t>::max();
+  if (auto v = field("backend")) {
+    s.backend = r.string(*v, path("backend"));
+    if (s.backend != "cpu" && s.backend != "vulkan") r.fail(path("backend"), "\"" + s.backend + "\" is not cpu or vulkan");
+  }
+  if (auto v = field("spp")) s.spp = uint32_t(r.unsigned_integer(*v, path("spp"), 0, UINT32_MAX));
+  if (auto v = field("time_budget_seconds")) s.time_budget_seconds = r.non_negative_double(*v, path("time_budget_seconds"));
+  if (auto v = field("target_error")) s.target_error = r.non_negative_double(*v, path("target_error"));
+  if (auto v = field("bounces")) s.bounces = int32_t(r.signed_integer(*v, path("bounces"), -1, kIntMax));
+  if (auto v = field("seed")) s.seed = r.unsigned_integer(*v, path("seed"), 0, UINT64_MAX);
+  if (auto v = field("texel_density")) s.texel_density = r.non_negative_double(*v, path("texel_density"));
+  if (auto v = field("max_page")) s.max_page = uint32_t(r.unsigned_integer(*v, path("max_page"), 1, kMaxPageEdge));
+  if (auto v = field("padding")) s.padding = uint32_t(r.unsigned_integer(*v, path("padding"), 0, kMaxPageEdge));
+  if (auto v = field("lightmap_uv")) s.lightmap_uv = uint32_t(r.unsigned_integer(*v, path("lightmap_uv"), 0, 1));
+  if (auto v = field("russian_roulette_start"))
+    s.russian_roulette_start = int32_t(r.signed_integer(*v, path("russian_roulette_start"), 0, kIntMax));
+  if (auto v = field("safety_bounce_cap"))
+    s.safety_bounce_cap = int32_t(r.signed_integer(*v, path("safety_bounce_cap"), 1, kIntMax));
+  if (auto v = field("sky")) s.sky = r.string(*v, path("sky"));
+  if (auto v = field("probes"))
+    s.probe_spacing = number_or_none(r, *v, path("probes"), [&](const json& x) {
+      const float spacing = r.finite_float(x, path("probes"));
+      if (!(spacing > 0)) r.fail(path("probes"), "not positive");
+      return spacing;
+    });
+  if (auto v = field("probe_spp")) s.probe_spp = uint32_t(r.unsigned_integer(*v, path("probe_spp"), 1, UINT32_MAX));
+  if (auto v = field("probe_dering_window")) s.probe_dering_window = float(r.non_negative_double(*v, path("probe_dering_window")));
+  if (auto v = field("voxel_resolution"))
+    s.voxel_resolution = number_or_none(r, *v, path("voxel_resolution"), [&](const json& x) {
+      return uint32_t(r.unsigned_integer(x, path("voxel_resolution"), 1, UINT32_MAX));
+    });
+  return s;
+}
+
+// A free-form block, kept as text.
+std::string object_text(const FieldReader& r, const json& j, const std::string& where) {
+  if (!j.is_object()) r.fail(where, std::string("expected an object, got ") + j.type_name());
+  return j.dump();
 }
 
 }  // namespace
 
-Manifest parse_manifest(std::string_view json_text, const std::string& name) {
+bool BundleManifest::has_bounce_layers() const {
+  for (const PageInfo& page : pages)
+    for (const std::string& channel : page.channels)
+      if (channel.rfind("bounce", 0) == 0) return true;
+  return false;
+}
+
+BundleManifest parse_bundle_manifest(std::string_view json_text, const std::string& name) {
   json root;
   try {
     root = json::parse(json_text.begin(), json_text.end());
@@ -177,7 +300,7 @@ Manifest parse_manifest(std::string_view json_text, const std::string& name) {
   const FieldReader r(name);
   if (!root.is_object()) r.fail("top level", std::string("expected an object, got ") + root.type_name());
 
-  Manifest manifest;
+  BundleManifest manifest;
   const uint64_t version =
       r.unsigned_integer(r.member(root, "", "format_version"), "format_version", 0, std::numeric_limits<uint32_t>::max());
   if (version != kManifestFormatVersion)
@@ -196,7 +319,12 @@ Manifest parse_manifest(std::string_view json_text, const std::string& name) {
   // "probes" and "svo" are optional; null counts as absent (a bake with --probes none).
   if (root.contains("probes") && !root["probes"].is_null()) manifest.probes = parse_probes(r, root["probes"]);
   if (root.contains("svo") && !root["svo"].is_null()) manifest.svo = parse_svo(r, root["svo"]);
+  if (root.contains("scene")) manifest.scene = parse_scene(r, root["scene"]);
+  if (root.contains("input")) manifest.input = parse_input(r, root["input"]);
+  if (root.contains("settings")) manifest.settings = parse_settings(r, root["settings"]);
+  if (root.contains("stats")) manifest.stats_json = object_text(r, root["stats"], "stats");
+  if (root.contains("relight")) manifest.relight_json = object_text(r, root["relight"], "relight");
   return manifest;
 }
 
-}  // namespace exitance::loader
+}  // namespace exitance::formats
