@@ -1,4 +1,4 @@
-// exitance-relight BUNDLE [-o OUT] [--spp N] [--time S] [--seed N] [--device N] [--json]
+// exitance-relight BUNDLE [-o OUT] [--spp N] [--time S] [--budget-ms N] [--frames N] [--seed N] [--device N] [--json]
 // Re-lights a baked bundle from its scene.bin on the GPU (runtime/src/relight). Links the runtime
 // library and nothing of the offline stage; runs where only a Vulkan driver exists.
 #include <CLI/CLI.hpp>
@@ -30,8 +30,11 @@ int main(int argc, char** argv) {
   app.add_option("bundle", options.bundle, "the bundle folder bake wrote (manifest.json, scene.bin, ...)")->required();
   app.add_option("-o,--out", options.output, "output bundle folder (default: the input bundle, replaced atomically)");
   app.add_option("--spp", spp, "samples per texel (default: the bake's; 0 = until --time ends the run)");
-  app.add_option("--time", options.time_budget_seconds, "stop the lightmap pass after this many seconds")
+  app.add_option("--time", options.time_budget_seconds, "bound the whole lightmap refresh to this many seconds")
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--budget-ms", options.frame_budget_ms, "bound each frame (refresh call) to this many milliseconds")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--frames", options.frames, "refresh at most this many frames; the report lists each frame's time and error");
   app.add_option("--seed", seed, "random seed (default: the bake's); results are deterministic per seed and device");
   app.add_option("--device", options.device_index, "Vulkan device index (see --list-devices)")->check(CLI::NonNegativeNumber);
   app.add_flag("--list-devices", list_devices, "print the Vulkan devices and exit");

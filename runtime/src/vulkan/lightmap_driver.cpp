@@ -11,22 +11,86 @@ namespace exitance::vulkan {
 namespace {
 
 constexpr int kMaxRecordedBounces = 16;
+using Clock = std::chrono::steady_clock;
 
 }  // namespace
 
-void LightmapDriver::upload_texels(const TexelGBuffer& gbuffer, const std::vector<uint32_t>& work_list) {
+// Buffers sized and bound, texels uploaded, sums cleared: an accumulation at sample 0.
+void LightmapDriver::prepare(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, Accumulation& a) {
+  a.texel_count = gbuffer.texels.size();
+  a.recorded = std::clamp(settings.recorded_bounces, 1, kMaxRecordedBounces);
+  if (a.texel_count >= (1ull << 31)) throw std::runtime_error("Vulkan backend: too many texels");
+  // Per work item, result slots 0..K of RGB floats; enough items per batch to keep every path slot
+  // busy between drains, within the largest storage buffer.
+  a.result_bytes = size_t(a.recorded + 1) * 12;
+  a.max_work = runner_.work_items_per_batch(a.result_bytes);
+  a.start_points.resize(a.texel_count);
+  for (size_t i = 0; i < a.texel_count; ++i) {
+    const LiveTexel& t = gbuffer.texels[i];
+    a.start_points[i] = {Vec4(t.position, 0.0f), Vec4(t.geometric_normal, 0.0f), Vec4(t.shading_normal, 0.0f)};
+  }
+  a.work_list.resize(a.texel_count);
+  for (size_t i = 0; i < a.texel_count; ++i) a.work_list[i] = uint32_t(i);
+  a.params = runner_.bake_params(settings, uint32_t(a.recorded), uint32_t(a.texel_count));
+  if (a.texel_count == 0) return;
+
   Context& context = runner_.context();
   WavefrontBuffers& buffers = runner_.buffers();
-  std::vector<GpuSurfacePoint> texels(gbuffer.texels.size());
-  for (size_t i = 0; i < texels.size(); ++i) {
-    const LiveTexel& t = gbuffer.texels[i];
-    texels[i] = {Vec4(t.position, 0.0f), Vec4(t.geometric_normal, 0.0f), Vec4(t.shading_normal, 0.0f)};
-  }
-  context.upload(buffers.items.start_points, texels.data(), texels.size() * sizeof(GpuSurfacePoint));
-  context.upload(buffers.items.batch_items, work_list.data(), work_list.size() * 4);
+  buffers.items.reserve(context, a.texel_count);
+  buffers.texels.reserve(context, a.texel_count, a.recorded);
+  buffers.results.reserve(context, a.max_work * a.result_bytes);
+  runner_.bind_buffers();
+  upload_items(a);
   VkCommandBuffer cmd = context.begin();
   buffers.texels.clear(cmd);
   context.submit_and_wait(cmd);
+}
+
+void LightmapDriver::upload_items(const Accumulation& a) {
+  Context& context = runner_.context();
+  WavefrontBuffers& buffers = runner_.buffers();
+  context.upload(buffers.items.start_points, a.start_points.data(), a.start_points.size() * sizeof(GpuSurfacePoint));
+  context.upload(buffers.items.batch_items, a.work_list.data(), a.work_list.size() * 4);
+  buffers.items.owner = WorkItems::Owner::Texels;
+}
+
+// Samples [first, first + pass) of every texel on the work list, in batches of at most max_work items.
+void LightmapDriver::run_pass(Accumulation& a, uint32_t first, uint32_t pass) {
+  const uint32_t chunk = uint32_t(std::min(a.work_list.size(), a.max_work));
+  for (size_t offset = 0; offset < a.work_list.size(); offset += chunk) {
+    const uint32_t n = uint32_t(std::min<size_t>(chunk, a.work_list.size() - offset));
+    runner_.run(a.params, {uint32_t(offset), n, first, pass}, a.result_bytes, kTexelBatch, a.totals);
+  }
+}
+
+LightmapEstimate LightmapDriver::download(const Accumulation& a) {
+  LightmapEstimate estimate;
+  const size_t texel_count = a.texel_count;
+  estimate.recorded_bounces = a.recorded;
+  estimate.texels.resize(texel_count);
+  estimate.bounces.assign(size_t(a.recorded) * texel_count * 3, 0.0);
+  if (texel_count > 0) {
+    Context& context = runner_.context();
+    const WavefrontBuffers& buffers = runner_.buffers();
+    std::vector<double> sums(texel_count * 6);
+    std::vector<uint32_t> samples(texel_count);
+    context.download(buffers.texels.sums, sums.data(), sums.size() * 8);
+    context.download(buffers.texels.samples, samples.data(), samples.size() * 4);
+    context.download(buffers.texels.bounce_sums, estimate.bounces.data(), estimate.bounces.size() * 8);
+    for (size_t i = 0; i < texel_count; ++i) {
+      TexelAccumulator& t = estimate.texels[i];
+      for (int c = 0; c < 3; ++c) {
+        t.total[c] = sums[i * 6 + size_t(c)];
+        t.total_squared[c] = sums[i * 6 + 3 + size_t(c)];
+        t.direct[c] = estimate.bounces[i * 3 + size_t(c)];  // layer 0 is the direct light
+      }
+      t.samples = samples[i];
+    }
+  }
+  estimate.rays = a.totals.rays();
+  estimate.nonfinite_samples = a.totals.nonfinite;
+  estimate.seconds = a.seconds;
+  return estimate;
 }
 
 std::vector<uint32_t> LightmapDriver::unconverged(const std::vector<uint32_t>& work_list, size_t texel_count, double target) {
@@ -48,78 +112,76 @@ std::vector<uint32_t> LightmapDriver::unconverged(const std::vector<uint32_t>& w
 }
 
 LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) {
-  using Clock = std::chrono::steady_clock;
-  const auto start = Clock::now();
-  const size_t texel_count = gbuffer.texels.size();
-  LightmapEstimate estimate;
-  estimate.recorded_bounces = std::clamp(settings.recorded_bounces, 1, kMaxRecordedBounces);
-  const int K = estimate.recorded_bounces;
-  estimate.texels.resize(texel_count);
-  estimate.bounces.assign(size_t(K) * texel_count * 3, 0.0);
+  const auto start_time = Clock::now();
+  progressive_.reset();  // the buffers are this bake's now
   runner_.statistics().clear();
-  if (texel_count == 0) return estimate;
-  if (texel_count >= (1ull << 31)) throw std::runtime_error("Vulkan backend: too many texels");
+  Accumulation a;
+  prepare(gbuffer, settings, a);
+  if (a.texel_count == 0) return download(a);
 
-  // Per work item, result slots 0..K of RGB floats; enough items per batch to keep every path slot
-  // busy between drains, within the largest storage buffer.
-  const size_t result_bytes = size_t(K + 1) * 12;
-  const size_t max_work = runner_.work_items_per_batch(result_bytes);
-  Context& context = runner_.context();
-  WavefrontBuffers& buffers = runner_.buffers();
-  buffers.items.reserve(context, texel_count);
-  buffers.texels.reserve(context, texel_count, K);
-  buffers.results.reserve(context, max_work * result_bytes);
-  runner_.bind_buffers();
-  std::vector<uint32_t> work_list(texel_count);
-  for (size_t i = 0; i < texel_count; ++i) work_list[i] = uint32_t(i);
-  upload_texels(gbuffer, work_list);
-
-  GpuParams params = runner_.bake_params(settings, uint32_t(K), uint32_t(texel_count));
-  BatchTotals totals;
   const uint32_t spp_limit = settings.spp == 0 ? std::numeric_limits<uint32_t>::max() : settings.spp;
   PassPolicy policy;
   // Untimed: as many samples per batch as fill the work items; a budget or target error: ramped passes.
-  policy.largest_pass = uint32_t(std::max<size_t>(1, max_work / std::min(texel_count, max_work)));
+  policy.largest_pass = uint32_t(std::max<size_t>(1, a.max_work / std::min(a.texel_count, a.max_work)));
   policy.ramp = settings.time_budget_seconds > 0 || settings.target_relative_error > 0;
   PassScheduler passes(settings, policy);
   uint32_t first = 0, pass = 0;
-  while (!work_list.empty() && passes.next_pass(first, pass)) {
-    const uint32_t chunk = uint32_t(std::min(work_list.size(), max_work));
-    pass = std::min<uint32_t>(pass, uint32_t(std::max<size_t>(1, max_work / chunk)));
-    for (size_t offset = 0; offset < work_list.size(); offset += chunk) {
-      const uint32_t n = uint32_t(std::min<size_t>(chunk, work_list.size() - offset));
-      runner_.run(params, {uint32_t(offset), n, first, pass}, result_bytes, kTexelBatch, totals);
-    }
+  while (!a.work_list.empty() && passes.next_pass(first, pass)) {
+    const size_t chunk = std::min(a.work_list.size(), a.max_work);
+    pass = std::min<uint32_t>(pass, uint32_t(std::max<size_t>(1, a.max_work / chunk)));
+    run_pass(a, first, pass);
     const uint32_t done = first + pass;
     if (settings.target_relative_error > 0 && done >= 16 && done < spp_limit) {
-      std::vector<uint32_t> still = unconverged(work_list, texel_count, settings.target_relative_error);
-      if (still.size() != work_list.size()) {
-        work_list = std::move(still);
-        if (!work_list.empty()) context.upload(buffers.items.batch_items, work_list.data(), work_list.size() * 4);
+      std::vector<uint32_t> still = unconverged(a.work_list, a.texel_count, settings.target_relative_error);
+      if (still.size() != a.work_list.size()) {
+        a.work_list = std::move(still);
+        if (!a.work_list.empty())
+          runner_.context().upload(runner_.buffers().items.batch_items, a.work_list.data(), a.work_list.size() * 4);
       }
     }
-    passes.finish_pass(totals.rays(), work_list.empty());
+    passes.finish_pass(a.totals.rays(), a.work_list.empty());
   }
+  a.seconds = std::chrono::duration<double>(Clock::now() - start_time).count();
+  runner_.record_statistics(a.totals, kTexelBatch);
+  return download(a);
+}
 
-  std::vector<double> sums(texel_count * 6);
-  std::vector<uint32_t> samples(texel_count);
-  context.download(buffers.texels.sums, sums.data(), sums.size() * 8);
-  context.download(buffers.texels.samples, samples.data(), samples.size() * 4);
-  context.download(buffers.texels.bounce_sums, estimate.bounces.data(), estimate.bounces.size() * 8);
-  for (size_t i = 0; i < texel_count; ++i) {
-    TexelAccumulator& a = estimate.texels[i];
-    for (int c = 0; c < 3; ++c) {
-      a.total[c] = sums[i * 6 + size_t(c)];
-      a.total_squared[c] = sums[i * 6 + 3 + size_t(c)];
-      a.direct[c] = estimate.bounces[i * 3 + size_t(c)];  // layer 0 is the direct light
-    }
-    a.samples = samples[i];
+void LightmapDriver::start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) {
+  const auto start_time = Clock::now();
+  progressive_.reset();
+  runner_.statistics().clear();
+  Accumulation a;
+  prepare(gbuffer, settings, a);
+  a.seconds = std::chrono::duration<double>(Clock::now() - start_time).count();
+  progressive_ = std::move(a);
+}
+
+uint64_t LightmapDriver::add_samples(uint32_t samples) {
+  if (!progressive_) throw std::logic_error("Vulkan backend: add_samples before start_progressive");
+  Accumulation& a = *progressive_;
+  if (samples == 0 || a.texel_count == 0) return 0;
+  if (uint64_t(a.next_sample) + samples > std::numeric_limits<uint32_t>::max())
+    throw std::invalid_argument("Vulkan backend: more than 2^32 - 1 samples per texel");
+  const auto start_time = Clock::now();
+  const uint64_t rays_before = a.totals.rays();
+  runner_.bind_buffers();  // a probe bake in between may have grown (reallocated) a buffer
+  if (runner_.buffers().items.owner != WorkItems::Owner::Texels) upload_items(a);
+  // At most as many samples per batch as fill the work items.
+  const uint32_t largest = uint32_t(std::max<size_t>(1, a.max_work / std::min(a.texel_count, a.max_work)));
+  for (uint32_t left = samples; left > 0;) {
+    const uint32_t pass = std::min(left, largest);
+    run_pass(a, a.next_sample, pass);
+    a.next_sample += pass;
+    left -= pass;
   }
-  estimate.rays = totals.rays();
-  estimate.nonfinite_samples = totals.nonfinite;
-  estimate.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  runner_.record_statistics(totals, kTexelBatch);
-  return estimate;
+  a.seconds += std::chrono::duration<double>(Clock::now() - start_time).count();
+  runner_.record_statistics(a.totals, kTexelBatch);
+  return a.totals.rays() - rays_before;
+}
+
+LightmapEstimate LightmapDriver::read() {
+  if (!progressive_) throw std::logic_error("Vulkan backend: progressive_estimate before start_progressive");
+  return download(*progressive_);
 }
 
 }  // namespace exitance::vulkan

@@ -1,7 +1,14 @@
 // Integrator::bake on the wavefront: the live texels are the work items; the PassScheduler's passes
 // of samples are cut into batches of at most work_items_per_batch (texel, sample) items; with a
 // target error, converged texels leave the work list between passes.
+//
+// The same steps, kept on the device between calls, are the runtime's progressive accumulation:
+// start() uploads the texels and clears their sums, add_samples() adds samples to every texel,
+// read() downloads the sums. bake() and the probe driver reuse the buffers, so bake() ends a
+// progressive accumulation, and start points a probe bake overwrote are uploaded again.
 #pragma once
+#include <optional>
+
 #include "exitance/runtime/core/estimates.h"
 #include "exitance/runtime/core/integrator_settings.h"
 #include "exitance/runtime/texel_gbuffer.h"
@@ -14,12 +21,37 @@ class LightmapDriver {
   explicit LightmapDriver(WavefrontBatchRunner& runner) : runner_(runner) {}
   LightmapEstimate bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings);
 
+  void start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings);
+  // `samples` more per texel (sample indices continue where the last call ended); returns the rays traced.
+  uint64_t add_samples(uint32_t samples);
+  LightmapEstimate read();
+  bool started() const { return progressive_.has_value(); }
+  uint32_t samples_done() const { return progressive_ ? progressive_->next_sample : 0; }
+
  private:
-  void upload_texels(const TexelGBuffer& gbuffer, const std::vector<uint32_t>& work_list);
+  // What one accumulation keeps between its passes.
+  struct Accumulation {
+    std::vector<GpuSurfacePoint> start_points;  // to upload again after a probe bake took the buffer
+    std::vector<uint32_t> work_list;
+    size_t texel_count = 0;
+    int recorded = 1;
+    size_t result_bytes = 0;
+    size_t max_work = 0;
+    GpuParams params{};
+    BatchTotals totals;
+    uint32_t next_sample = 0;
+    double seconds = 0;
+  };
+
+  void prepare(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, Accumulation& a);
+  void upload_items(const Accumulation& a);
+  void run_pass(Accumulation& a, uint32_t first, uint32_t pass);
+  LightmapEstimate download(const Accumulation& a);
   // The texels of `work_list` whose relative standard error is still above the target.
   std::vector<uint32_t> unconverged(const std::vector<uint32_t>& work_list, size_t texel_count, double target);
 
   WavefrontBatchRunner& runner_;
+  std::optional<Accumulation> progressive_;
 };
 
 }  // namespace exitance::vulkan

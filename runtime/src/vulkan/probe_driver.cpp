@@ -25,6 +25,7 @@ void ProbeDriver::upload_probes(const std::vector<Vec3>& positions) {
   std::vector<uint32_t> order(positions.size());
   for (size_t i = 0; i < positions.size(); ++i) order[i] = uint32_t(i);
   context.upload(buffers.items.batch_items, order.data(), order.size() * 4);
+  buffers.items.owner = WorkItems::Owner::Probes;
   VkCommandBuffer cmd = context.begin();
   buffers.probes.clear(cmd);
   context.submit_and_wait(cmd);

@@ -66,6 +66,13 @@ ProbeEstimate VulkanIntegrator::bake_probes(const std::vector<Vec3>& positions, 
   return impl_->probes.bake(positions, settings);
 }
 
+void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) {
+  impl_->lightmap.start(gbuffer, settings);
+}
+uint64_t VulkanIntegrator::add_samples(uint32_t samples) { return impl_->lightmap.add_samples(samples); }
+LightmapEstimate VulkanIntegrator::progressive_estimate() const { return impl_->lightmap.read(); }
+uint32_t VulkanIntegrator::progressive_samples() const { return impl_->lightmap.samples_done(); }
+
 void VulkanIntegrator::update_materials(const LightingScene& edited) { impl_->scene.update_materials(edited); }
 void VulkanIntegrator::update_lights(const LightingScene& edited) { impl_->scene.update_lights(edited); }
 

@@ -82,6 +82,9 @@ struct QueueDispatches {
 struct WorkItems {
   Buffer start_points;  // GpuSurfacePoint per item
   Buffer batch_items;   // item indices
+  // Whose items the buffers hold, so a driver that keeps an accumulation between calls (the
+  // lightmap's progressive one) knows when another bake overwrote them.
+  enum class Owner { None, Texels, Probes } owner = Owner::None;
 
   explicit WorkItems(Context& context);
   void reserve(Context& context, size_t items);

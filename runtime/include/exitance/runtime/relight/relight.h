@@ -1,23 +1,30 @@
 // Re-lighting a baked bundle from its scene.bin on the GPU, with no offline stage: what
-// exitance-relight runs and what an engine calls through libexitance_runtime. A full relight never
-// reads the input's lightmaps, probe coefficients or voxel exitance: it recomputes them all.
+// exitance-relight runs, through the runtime's RefreshSession (refresh/refresh_session.h). A
+// relight never reads the input's lightmaps, probe coefficients or voxel exitance: it recomputes
+// them all, in frames when a per-frame budget or a frame count is given.
 #pragma once
 #include <cstdint>
 #include <functional>
 #include <optional>
-#include <stdexcept>
 #include <string>
-#include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "exitance/runtime/refresh/refresh_session.h"
+
 namespace exitance {
+
+// Bad input (exit status 2): the session's BundleInputError.
+using RelightInputError = BundleInputError;
 
 struct RelightOptions {
   std::string bundle;              // the input bundle folder (manifest.json + scene.bin + svo.bin ...)
   std::string output;              // empty: the input bundle, replaced atomically
-  std::optional<uint32_t> spp;     // default: the bake's (manifest settings.spp)
-  double time_budget_seconds = 0;  // > 0: stop the lightmap pass when spent (no sample cap unless spp is given)
+  // Limits; the lightmap refresh ends at whichever comes first.
+  std::optional<uint32_t> spp;     // samples per texel; default: the bake's, or none with --time
+  double time_budget_seconds = 0;  // > 0: the whole lightmap refresh
+  double frame_budget_ms = 0;      // > 0: each frame (refresh call)
+  uint32_t frames = 0;             // > 0: at most this many frames
   std::optional<uint64_t> seed;    // default: the bake's
   int device_index = -1;           // Vulkan device; -1 = prefer a discrete GPU
   bool validation = false;         // Vulkan validation layers; any message fails the relight
@@ -27,16 +34,10 @@ struct RelightOptions {
   std::function<void(const std::string&, double, uint64_t)> progress;
 };
 
-// Bad input: a missing or malformed manifest, scene.bin or svo.bin, an impossible option. The
-// message names the file, the element and the problem, on one line (exit status 2).
-class RelightInputError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
 // Runs the relight and writes the bundle atomically (nothing is written on failure). Returns the
-// run report (what the manifest's "relight" and "stats" entries say). Throws RelightInputError
-// for bad input and std::runtime_error for other failures (no Vulkan device, device loss).
+// run report (the manifest's "relight" entry, plus per-frame figures when frames were asked for).
+// Throws RelightInputError for bad input and std::runtime_error for other failures (no Vulkan
+// device, device loss).
 nlohmann::json relight_bundle(const RelightOptions& options);
 
 }  // namespace exitance

@@ -97,6 +97,18 @@ class VulkanIntegrator final : public Integrator {
   // Independent of bake(); throws as bake() does.
   ProbeEstimate bake_probes(const std::vector<Vec3>& positions, const IntegratorSettings& settings) const override;
   std::string backend_name() const override { return "vulkan"; }
+
+  // Progressive accumulation kept on the device between calls (the runtime's refresh). start
+  // uploads the texels and clears their sums; add_samples adds `samples` to every texel, sample
+  // indices continuing from the last call (so N samples in any number of calls are bake()'s N
+  // samples with the same seed), and returns the rays traced; progressive_estimate downloads the
+  // sums. Settings used: seed, max_bounces, recorded_bounces, russian_roulette_start,
+  // safety_bounce_cap, sampling_strategy. bake() ends an accumulation (start again after it);
+  // bake_probes in between does not. Throws as bake() does; std::logic_error before a start.
+  void start_progressive(const TexelGBuffer& gbuffer, const IntegratorSettings& settings);
+  uint64_t add_samples(uint32_t samples);
+  LightmapEstimate progressive_estimate() const;
+  uint32_t progressive_samples() const;  // per texel so far; 0 before a start
   std::string device_description() const override;
 
   // Runtime edits without a rebuild. `edited` is the scene this integrator was created on (or a

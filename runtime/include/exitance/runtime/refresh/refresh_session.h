@@ -1,0 +1,97 @@
+// The runtime's resident lighting state (DESIGN §3): a baked bundle opened from its manifest and
+// scene.bin onto a Vulkan device (the library's own or one an engine hands over), its lightmap
+// accumulated progressively on the device between calls, refreshed within a budget per call.
+//
+// refresh() adds samples to every live texel, continuing the sample indices of the calls before:
+// after N samples in any number of calls the lightmap equals bake --backend vulkan's N samples
+// with the same seed. restart() (after an edit) drops every accumulated sample, so no texel keeps
+// a value from before it. Probes and voxel exitance are computed on request (probe_estimate,
+// fill_svo_exitance), not per frame yet.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "exitance/formats/bundle_manifest.h"
+#include "exitance/formats/scene_file.h"
+#include "exitance/formats/sparse_voxel_octree.h"
+#include "exitance/runtime/core/estimates.h"
+#include "exitance/runtime/core/integrator_settings.h"
+#include "exitance/runtime/core/lighting_scene.h"
+#include "exitance/runtime/scene_file_conversion.h"
+#include "exitance/runtime/vulkan/vulkan_integrator.h"
+
+namespace exitance {
+
+// Bad input: a missing or malformed manifest, scene.bin or svo.bin, an impossible option or edit.
+// The message names the file (or call), the element and the problem, on one line.
+class BundleInputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct RefreshSessionOptions {
+  VulkanDeviceOptions device;    // device_index, validation, or an adopted engine device
+  std::optional<uint64_t> seed;  // default: the bake's (manifest settings.seed)
+};
+
+// What one refresh() call may spend; it ends at whichever limit comes first. A call with neither
+// limit set adds what the sample cap allows.
+struct RefreshBudget {
+  double milliseconds = 0;             // wall-clock time of the call; 0 = no time limit
+  uint32_t max_samples_per_texel = 0;  // cap on the accumulated samples; 0 = no cap
+};
+
+struct RefreshReport {
+  double milliseconds = 0;         // this call
+  uint64_t rays = 0;               // this call
+  uint32_t samples_added = 0;      // per texel, this call
+  uint32_t samples_per_texel = 0;  // accumulated since the last restart
+  bool capped = false;             // the sample cap is reached: further calls add nothing
+};
+
+class RefreshSession {
+ public:
+  // Reads manifest.json, scene.bin and (when listed) svo.bin from `bundle`, builds the lighting
+  // scene and creates the Vulkan backend on it. Throws BundleInputError for bad input,
+  // std::runtime_error when no usable Vulkan device exists.
+  static std::unique_ptr<RefreshSession> open(const std::string& bundle, const RefreshSessionOptions& options = {});
+  ~RefreshSession();
+  RefreshSession(const RefreshSession&) = delete;
+  RefreshSession& operator=(const RefreshSession&) = delete;
+
+  // Drops every accumulated sample; the next refresh starts at sample 0.
+  void restart();
+  RefreshReport refresh(const RefreshBudget& budget);
+
+  // The lightmap accumulated so far (a read-back: it waits for the device).
+  LightmapEstimate lightmap() const;
+  // Estimated relMSE of `estimate` against its converged value, as bench/time_to_error.cpp defines
+  // relMSE (mean over live texels and channels of err^2 / (r^2 + 1e-3)), from the per-texel
+  // sample variances: v / (max(0, m^2 - v) + 1e-3) with m the mean and v its variance (m^2 - v
+  // estimates r^2 without the noise m^2 carries). Texels with fewer than 2 samples are left out;
+  // infinity when no texel has 2.
+  static double estimated_relative_mse(const LightmapEstimate& estimate);
+  // The probes' incident radiance (usable probes of the grid, in grid order) with `spp` rays each.
+  ProbeEstimate probe_estimate(uint32_t spp);
+
+  const std::string& bundle() const;
+  const formats::BundleManifest& manifest() const;
+  const formats::SceneFile& scene_file() const;
+  const PersistedScene& persisted() const;
+  const LightingScene& lighting_scene() const;
+  const formats::SparseVoxelOctree* svo() const;  // null when the bundle has none
+  const IntegratorSettings& settings() const;     // the bake's path settings, with the session's seed
+  VulkanIntegrator& integrator();
+
+  struct State;
+
+ private:
+  explicit RefreshSession(std::unique_ptr<State> state);
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace exitance

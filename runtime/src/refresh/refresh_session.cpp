@@ -1,0 +1,160 @@
+#include "exitance/runtime/refresh/refresh_session.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+
+#include "exitance/formats/format_error.h"
+#include "exitance/formats/svo_file.h"
+
+namespace exitance {
+
+namespace fs = std::filesystem;
+
+struct RefreshSession::State {
+  std::string bundle;
+  formats::BundleManifest manifest;
+  formats::SceneFile scene_file;  // as read: encoding it again gives its bytes back
+  PersistedScene persisted;
+  std::optional<formats::SparseVoxelOctree> svo;
+  std::shared_ptr<const LightingScene> lighting;
+  IntegratorSettings settings;
+  std::unique_ptr<VulkanIntegrator> integrator;
+  double milliseconds_per_sample = 0;  // of the last pass: sizes the next call's passes
+};
+
+namespace {
+
+formats::BundleManifest read_manifest(const fs::path& bundle) {
+  const fs::path path = bundle / "manifest.json";
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw BundleInputError(path.string() + ": cannot read the manifest (is " + bundle.string() + " a bundle?)");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  try {
+    return formats::parse_bundle_manifest(text, path.string());
+  } catch (const formats::FormatError& e) {
+    throw BundleInputError(e.what());
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_folder, const RefreshSessionOptions& options) {
+  auto state = std::make_unique<State>();
+  const fs::path bundle(bundle_folder);
+  state->bundle = bundle_folder;
+  state->manifest = read_manifest(bundle);
+  const formats::BundleManifest& manifest = state->manifest;
+  const std::string manifest_path = (bundle / "manifest.json").string();
+  if (!manifest.scene)
+    throw BundleInputError(manifest_path + ": scene: missing (baked before scene.bin existed); re-bake instead");
+  if (manifest.scene->file.empty())
+    throw BundleInputError(manifest_path + ": scene: bake wrote no scene.bin (" + manifest.scene->skipped + "); re-bake instead");
+  try {
+    state->scene_file = formats::read_scene_file((bundle / manifest.scene->file).string());
+    state->persisted = restore_scene(state->scene_file);
+    if (manifest.svo) state->svo = formats::read_svo_file((bundle / manifest.svo->file).string());
+  } catch (const formats::FormatError& e) {
+    throw BundleInputError(e.what());
+  }
+
+  // Settings absent from an older manifest take bake's defaults (formats::BakeSettings).
+  const formats::BakeSettings baked = manifest.settings.value_or(formats::BakeSettings{});
+  IntegratorSettings& settings = state->settings;
+  settings.spp = baked.spp;
+  settings.seed = options.seed ? *options.seed : baked.seed;
+  settings.max_bounces = baked.bounces;
+  settings.russian_roulette_start = baked.russian_roulette_start;
+  settings.safety_bounce_cap = baked.safety_bounce_cap;
+
+  auto scene = std::make_shared<const Scene>(state->persisted.scene);
+  try {
+    state->lighting = std::make_shared<const LightingScene>(build_lighting_scene(scene, to_bvh4(state->persisted.bvh)));
+  } catch (const std::invalid_argument& e) {
+    throw BundleInputError((bundle / manifest.scene->file).string() + ": " + e.what());
+  }
+  state->integrator = VulkanIntegrator::create(state->lighting, options.device);
+  state->integrator->start_progressive(state->persisted.gbuffer, settings);
+  return std::unique_ptr<RefreshSession>(new RefreshSession(std::move(state)));
+}
+
+RefreshSession::RefreshSession(std::unique_ptr<State> state) : state_(std::move(state)) {}
+RefreshSession::~RefreshSession() = default;
+
+void RefreshSession::restart() { state_->integrator->start_progressive(state_->persisted.gbuffer, state_->settings); }
+
+RefreshReport RefreshSession::refresh(const RefreshBudget& budget) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  if (!(budget.milliseconds >= 0) || !std::isfinite(budget.milliseconds))
+    throw std::invalid_argument("RefreshSession::refresh: budget milliseconds must be finite and not negative");
+  VulkanIntegrator& integrator = *state_->integrator;
+  const uint32_t cap = budget.max_samples_per_texel ? budget.max_samples_per_texel : std::numeric_limits<uint32_t>::max();
+  RefreshReport report;
+  auto elapsed_ms = [&] { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); };
+  while (integrator.progressive_samples() < cap) {
+    const uint32_t left = cap - integrator.progressive_samples();
+    uint32_t pass = left;
+    if (budget.milliseconds > 0) {
+      // Passes sized from the last measured cost per sample, so the call ends near its budget; the
+      // first pass of a session is one sample, to measure it.
+      const double remaining = budget.milliseconds - elapsed_ms();
+      if (remaining <= 0) break;
+      const double per_sample = state_->milliseconds_per_sample;
+      const double fitting = per_sample > 0 ? std::floor(remaining / per_sample) : 1.0;
+      if (fitting < 1 && report.samples_added > 0) break;  // the next sample would overrun the budget
+      pass = uint32_t(std::clamp(fitting, 1.0, double(left)));
+    } else if (budget.max_samples_per_texel == 0) {
+      throw std::invalid_argument("RefreshSession::refresh: a budget needs milliseconds or a sample cap");
+    }
+    const auto pass_start = Clock::now();
+    report.rays += integrator.add_samples(pass);
+    report.samples_added += pass;
+    state_->milliseconds_per_sample = std::chrono::duration<double, std::milli>(Clock::now() - pass_start).count() / pass;
+    if (budget.milliseconds > 0 && elapsed_ms() >= budget.milliseconds) break;
+  }
+  report.samples_per_texel = integrator.progressive_samples();
+  report.capped = report.samples_per_texel >= cap;
+  report.milliseconds = elapsed_ms();
+  return report;
+}
+
+LightmapEstimate RefreshSession::lightmap() const { return state_->integrator->progressive_estimate(); }
+
+double RefreshSession::estimated_relative_mse(const LightmapEstimate& estimate) {
+  double sum = 0;
+  size_t count = 0;
+  for (size_t i = 0; i < estimate.texels.size(); ++i) {
+    if (estimate.texels[i].samples < 2) continue;  // no variance estimate yet
+    const Vec3 mean = estimate.mean_total(i), variance = estimate.variance_of_mean(i);
+    // mean^2 overestimates the converged value's square by the variance of the mean (E[m^2] = r^2 + v).
+    for (int c = 0; c < 3; ++c)
+      sum += double(variance[c]) / (std::max(0.0, double(mean[c]) * mean[c] - variance[c]) + 1e-3);
+    count += 3;
+  }
+  return count ? sum / double(count) : std::numeric_limits<double>::infinity();
+}
+
+ProbeEstimate RefreshSession::probe_estimate(uint32_t spp) {
+  std::vector<Vec3> positions;
+  for (const formats::ProbeRecord& r : state_->persisted.probes.probes)
+    if (formats::probe_is_usable(r)) positions.push_back({r.position[0], r.position[1], r.position[2]});
+  IntegratorSettings settings = state_->settings;
+  settings.spp = spp;
+  return state_->integrator->bake_probes(positions, settings);
+}
+
+const std::string& RefreshSession::bundle() const { return state_->bundle; }
+const formats::BundleManifest& RefreshSession::manifest() const { return state_->manifest; }
+const formats::SceneFile& RefreshSession::scene_file() const { return state_->scene_file; }
+const PersistedScene& RefreshSession::persisted() const { return state_->persisted; }
+const LightingScene& RefreshSession::lighting_scene() const { return *state_->lighting; }
+const formats::SparseVoxelOctree* RefreshSession::svo() const { return state_->svo ? &*state_->svo : nullptr; }
+const IntegratorSettings& RefreshSession::settings() const { return state_->settings; }
+VulkanIntegrator& RefreshSession::integrator() { return *state_->integrator; }
+
+}  // namespace exitance

@@ -1,0 +1,152 @@
+// The runtime's RefreshSession (runtime/include/exitance/runtime/refresh/refresh_session.h) on a
+// bundle baked here, on lavapipe in CI: samples added over several refresh calls are the bake's
+// samples bit for bit; a restart drops every sample; the estimated relMSE a refresh reports is
+// within 2x of the relMSE measured against a converged lightmap; bad budgets are refused.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+
+#include "exitance/bake/command/bake_pipeline.h"
+#include "exitance/runtime/refresh/refresh_session.h"
+#include "exitance/runtime/vulkan/vulkan_integrator.h"
+
+namespace exitance {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool has_vulkan_device() {
+  for (const VulkanDeviceInfo& d : enumerate_vulkan_devices())
+    if (d.usable) return true;
+  return false;
+}
+
+// The Cornell room baked once (CPU backend: the session must not depend on how it was baked).
+const fs::path& baked_bundle() {
+  static const fs::path bundle = [] {
+    const fs::path dir = fs::temp_directory_path() / ("exitance-refresh-test-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    BakeOptions options;
+    options.input = std::string(EXITANCE_SAMPLE_DIR) + "/cornell_room.gltf";
+    options.output = (dir / "cornell.bake").string();
+    options.backend.name = "cpu";
+    options.atlas.texel_density = 5;
+    options.lighting.spp = 4;
+    options.lighting.seed = 3;
+    options.probes_enabled = false;
+    Diagnostics diagnostics;
+    run_bake(options, diagnostics);
+    return dir / "cornell.bake";
+  }();
+  return bundle;
+}
+
+void expect_same_sums(const LightmapEstimate& a, const LightmapEstimate& b) {
+  ASSERT_EQ(a.texels.size(), b.texels.size());
+  size_t differing = 0;
+  for (size_t i = 0; i < a.texels.size(); ++i) {
+    differing += a.texels[i].samples != b.texels[i].samples;
+    for (int c = 0; c < 3; ++c)
+      differing += a.texels[i].total[c] != b.texels[i].total[c] || a.texels[i].total_squared[c] != b.texels[i].total_squared[c];
+  }
+  EXPECT_EQ(differing, 0u);
+  EXPECT_EQ(a.bounces, b.bounces);
+}
+
+TEST(RefreshSession, FramesAddUpToTheBakesSamplesBitForBit) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  auto session = RefreshSession::open(baked_bundle().string());
+  uint32_t done = 0;
+  for (uint32_t cap : {1u, 3u, 6u}) {
+    const RefreshReport r = session->refresh({0, cap});
+    EXPECT_EQ(r.samples_added, cap - done);
+    EXPECT_EQ(r.samples_per_texel, cap);
+    EXPECT_TRUE(r.capped);
+    EXPECT_GT(r.rays, 0u);
+    done = cap;
+  }
+  EXPECT_EQ(session->refresh({0, 6}).samples_added, 0u);  // capped: nothing more
+  const LightmapEstimate progressive = session->lightmap();
+  IntegratorSettings settings = session->settings();
+  settings.spp = 6;
+  const LightmapEstimate baked = session->integrator().bake(session->persisted().gbuffer, settings);
+  expect_same_sums(progressive, baked);
+}
+
+TEST(RefreshSession, RestartDropsEverySample) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  auto session = RefreshSession::open(baked_bundle().string());
+  session->refresh({0, 3});
+  const LightmapEstimate first_two = [&] {
+    auto other = RefreshSession::open(baked_bundle().string());
+    other->refresh({0, 2});
+    return other->lightmap();
+  }();
+  session->restart();
+  const LightmapEstimate empty = session->lightmap();
+  for (const TexelAccumulator& t : empty.texels) {
+    ASSERT_EQ(t.samples, 0u);
+    ASSERT_EQ(t.total[0] + t.total[1] + t.total[2], 0.0);
+  }
+  session->refresh({0, 2});
+  expect_same_sums(session->lightmap(), first_two);
+}
+
+// relMSE as bench/time_to_error.cpp measures it, against a reference, minus the reference's own
+// expected relMSE (its noise), which the estimate does not include.
+double measured_relative_mse(const LightmapEstimate& x, const LightmapEstimate& reference) {
+  double sum = 0, reference_noise = 0;
+  size_t count = 0;
+  for (size_t i = 0; i < x.texels.size(); ++i) {
+    const Vec3 a = x.mean_total(i), r = reference.mean_total(i), rv = reference.variance_of_mean(i);
+    for (int c = 0; c < 3; ++c) {
+      const double d = double(a[c]) - r[c], denominator = double(r[c]) * r[c] + 1e-3;
+      sum += d * d / denominator;
+      reference_noise += rv[c] / denominator;
+    }
+    count += 3;
+  }
+  return (sum - reference_noise) / double(count);
+}
+
+TEST(RefreshSession, EstimatedErrorIsWithinTwiceTheMeasured) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  RefreshSessionOptions reference_options;
+  reference_options.seed = 1001;  // independent of the estimate's samples
+  auto reference_session = RefreshSession::open(baked_bundle().string(), reference_options);
+  reference_session->refresh({0, 256});
+  const LightmapEstimate reference = reference_session->lightmap();
+
+  auto session = RefreshSession::open(baked_bundle().string());
+  for (uint32_t spp : {8u, 32u}) {
+    session->refresh({0, spp});
+    const LightmapEstimate estimate = session->lightmap();
+    const double estimated = RefreshSession::estimated_relative_mse(estimate);
+    const double measured = measured_relative_mse(estimate, reference);
+    SCOPED_TRACE("spp " + std::to_string(spp) + ": estimated relMSE " + std::to_string(estimated) + ", measured " +
+                 std::to_string(measured));
+    std::printf("spp %u: estimated relMSE %.5f, measured %.5f (ratio %.3f)\n", spp, estimated, measured, estimated / measured);
+    EXPECT_GT(measured, 0);
+    EXPECT_LE(estimated, 2 * measured);
+    EXPECT_GE(estimated, 0.5 * measured);
+  }
+}
+
+TEST(RefreshSession, BadBudgetsAreRefused) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  auto session = RefreshSession::open(baked_bundle().string());
+  EXPECT_THROW(session->refresh({std::numeric_limits<double>::quiet_NaN(), 0}), std::invalid_argument);
+  EXPECT_THROW(session->refresh({-1, 4}), std::invalid_argument);
+  EXPECT_THROW(session->refresh({0, 0}), std::invalid_argument);
+  EXPECT_EQ(session->lightmap().texels.front().samples, 0u);  // nothing was added
+  EXPECT_THROW(RefreshSession::open((baked_bundle().parent_path() / "missing.bake").string()), BundleInputError);
+}
+
+}  // namespace
+}  // namespace exitance
