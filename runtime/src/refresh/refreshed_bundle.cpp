@@ -1,0 +1,143 @@
+#include "exitance/runtime/refresh/refreshed_bundle.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+
+#include "exitance/formats/bundle_manifest.h"
+#include "exitance/formats/probes_file.h"
+#include "exitance/formats/scene_file.h"
+#include "exitance/formats/svo_file.h"
+#include "exitance/runtime/bundle/bundle_directory.h"
+#include "exitance/runtime/bundle/lightmap_assembly.h"
+#include "exitance/runtime/bundle/probe_results.h"
+#include "exitance/runtime/bundle/texel_exitance.h"
+
+namespace exitance {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace {
+
+// Mean over live texels with signal of the relative standard error of the luminance (the
+// manifest's estimated_relative_error, as bake reports it).
+double mean_relative_error(const LightmapEstimate& estimate) {
+  double sum = 0;
+  size_t count = 0;
+  for (size_t i = 0; i < estimate.texels.size(); ++i) {
+    const float mean = luminance(estimate.mean_total(i));
+    const float se = std::sqrt(luminance(estimate.variance_of_mean(i)));
+    if (mean > 0) sum += se / mean, ++count;
+  }
+  return count ? sum / double(count) : 0.0;
+}
+
+}  // namespace
+
+json write_refreshed_bundle(RefreshSession& session, const std::string& output, json report,
+                            const StageProgress& progress, const std::function<void()>& check_before_write) {
+  using Clock = std::chrono::steady_clock;
+  auto last = Clock::now();
+  json seconds = json::object();
+  auto lap = [&](const char* stage) {
+    const auto now = Clock::now();
+    seconds[stage] = std::chrono::duration<double>(now - last).count();
+    last = now;
+  };
+  auto stage = [&](const char* name) {
+    if (progress) progress(name, 0, 0);
+  };
+  const fs::path bundle(session.bundle());
+  formats::BundleManifest manifest = session.manifest();
+  const formats::BakeSettings baked = manifest.settings.value_or(formats::BakeSettings{});
+  const LightmapEstimate estimate = session.lightmap();
+
+  PersistedScene persisted = session.persisted();
+  ProbeEstimate probe_estimate;
+  const bool has_probes = persisted.has_probe_grid() && manifest.probes.has_value();
+  if (has_probes) {
+    stage("probes");
+    std::vector<size_t> traced;
+    for (size_t i = 0; i < persisted.probes.probes.size(); ++i)
+      if (formats::probe_is_usable(persisted.probes.probes[i])) traced.push_back(i);
+    probe_estimate = session.probe_estimate(baked.probe_spp);
+    store_probe_radiance(persisted.probes, traced, probe_estimate, baked.probe_dering_window);
+    lap("probes");
+  }
+
+  std::optional<formats::SparseVoxelOctree> svo;
+  if (session.svo()) {
+    stage("exitance");
+    svo = *session.svo();
+    fill_svo_exitance(*svo, persisted.scene, persisted.gbuffer, estimate);
+    lap("exitance");
+  }
+
+  stage("write");
+  AssemblyOptions assembly;
+  assembly.bounce_layers = manifest.has_bounce_layers();
+  assembly.dilation_texels = std::max(2, int(baked.padding) * 2);
+  const std::vector<formats::LightmapImage> pages = assemble_lightmap_pages(persisted.gbuffer, estimate, assembly);
+  // The pages as assembled now, under the file names the manifest gave them.
+  if (pages.size() != manifest.pages.size())
+    throw BundleInputError((bundle / "manifest.json").string() + ": pages: " + std::to_string(manifest.pages.size()) +
+                           " listed, scene.bin's atlas has " + std::to_string(pages.size()));
+  for (size_t p = 0; p < pages.size(); ++p) {
+    manifest.pages[p].width = uint32_t(pages[p].width);
+    manifest.pages[p].height = uint32_t(pages[p].height);
+    manifest.pages[p].channels.clear();
+    for (const auto& [name, data] : pages[p].channels) manifest.pages[p].channels.push_back(name);
+  }
+
+  VulkanIntegrator& integrator = session.integrator();
+  report["tool"] = "exitance-relight";
+  report["source_bundle"] = fs::absolute(bundle).lexically_normal().string();
+  report["source_generator"] = manifest.generator;
+  report["what"] = "full relight from scene.bin: lightmaps, probes and voxel exitance recomputed; input lightmaps not read";
+  report["device"] = integrator.device_description();
+  report["spp"] = integrator.progressive_samples();
+  report["seed"] = session.settings().seed;
+  report["rays"] = estimate.rays;
+  report["probe_rays"] = probe_estimate.rays;
+  report["estimated_relative_error"] = mean_relative_error(estimate);
+  const double relative_mse = RefreshSession::estimated_relative_mse(estimate);
+  report["estimated_relative_mse"] = std::isfinite(relative_mse) ? json(relative_mse) : json(nullptr);
+  report["live_texels"] = persisted.gbuffer.texels.size();
+  report["nonfinite_samples"] = estimate.nonfinite_samples + probe_estimate.nonfinite_samples;
+
+  manifest.generator = "exitance-relight 0.1.0";
+  formats::BakeSettings& settings = manifest.settings.emplace(baked);
+  settings.backend = "vulkan";
+  settings.spp = integrator.progressive_samples();
+  settings.seed = session.settings().seed;
+  settings.time_budget_seconds = report.value("time_budget_seconds", 0.0);
+  if (svo) {
+    manifest.svo->vdb.clear();
+    manifest.svo->vdb_note = "radiance.vdb is an inspection export of bake; exitance-relight does not write it";
+  }
+  manifest.relight_json = report.dump();
+  const std::string manifest_text = formats::write_bundle_manifest(manifest);
+  if (check_before_write) check_before_write();
+
+  const fs::path out(output);
+  write_bundle_atomically(out, [&](const fs::path& dir) {
+    for (size_t p = 0; p < pages.size(); ++p)
+      formats::write_lightmap_exr((dir / manifest.pages[p].file).string(), pages[p]);
+    if (has_probes) formats::write_probes_file((dir / manifest.probes->file).string(), persisted.probes);
+    if (svo) formats::write_svo_file((dir / manifest.svo->file).string(), *svo);
+    formats::write_scene_file((dir / manifest.scene->file).string(), session.scene_file());
+    std::ofstream file(dir / "manifest.json");
+    file << manifest_text;
+    if (!file) throw std::runtime_error("cannot write " + (dir / "manifest.json").string());
+  });
+  lap("write");
+  report["seconds"] = seconds;
+  report["output"] = fs::absolute(out).string();
+  return report;
+}
+
+}  // namespace exitance
