@@ -583,5 +583,43 @@ TEST(LightingSceneGeometry, SetGeometryEqualsABuildOfTheEditedScene) {
   EXPECT_EQ(lighting.source, kept.source);
 }
 
+template <typename T>
+bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+// update_lighting_scene takes the cheapest in-place path that covers the effects, and ends where a
+// build of the edited scene over the (refit) BVH starts.
+TEST(SceneEditsLighting, UpdateEqualsABuildOfTheEditedScene) {
+  MaterialEdit strength;
+  strength.material.name = "Panel";
+  strength.emissive_strength = 3;
+  const std::vector<std::vector<SceneEdit>> cases = {
+      {light_intensity(EditTarget{"Lamp", {}}, 9), {strength, ""}, {SkyEdit{{0.1f, 0.2f, 0.3f}}, ""}},
+      {node_edit("Root", std::array<double, 3>{1, 2, 3}, std::array<double, 4>{0, 0.6, 0, 0.8}),
+       light_intensity(EditTarget{"Sun", {}}, 0.5f)},
+  };
+  for (size_t c = 0; c < cases.size(); ++c) {
+    const std::vector<SceneEdit>& edits = cases[c];
+    PersistedScene p = baked();
+    LightingScene lighting = build_lighting_scene(std::make_shared<const Scene>(p.scene), to_bvh4(p.bvh));
+    const EditEffects effects = apply_scene_edits(p, edits);
+    EXPECT_EQ(effects.geometry_changed(), c == 1);
+    const auto edited = std::make_shared<const Scene>(p.scene);
+    update_lighting_scene(lighting, edited, effects);
+    const LightingScene fresh = build_lighting_scene(edited, to_bvh4(p.bvh));
+    EXPECT_TRUE(same_bytes(lighting.triangles, fresh.triangles)) << "case " << c;
+    EXPECT_TRUE(same_bytes(lighting.materials, fresh.materials)) << "case " << c;
+    EXPECT_TRUE(same_bytes(lighting.punctual_lights, fresh.punctual_lights)) << "case " << c;
+    EXPECT_TRUE(same_bytes(lighting.bvh.nodes, fresh.bvh.nodes)) << "case " << c;
+    EXPECT_EQ(lighting.emitter_triangles, fresh.emitter_triangles) << "case " << c;
+    EXPECT_EQ(lighting.emitter_cdf, fresh.emitter_cdf) << "case " << c;
+    EXPECT_EQ(lighting.punctual_cdf, fresh.punctual_cdf) << "case " << c;
+    EXPECT_EQ(lighting.sky.z, fresh.sky.z) << "case " << c;
+    EXPECT_EQ(lighting.extent, fresh.extent) << "case " << c;
+    EXPECT_EQ(lighting.source, edited) << "case " << c;
+  }
+}
+
 }  // namespace
 }  // namespace exitance

@@ -5,11 +5,13 @@
 // Use (exitance-relight, the refresh API):
 //   std::vector<SceneEdit> edits = parse_scene_edits(text, "edits.json");   // or build them in code
 //   EditEffects effects = apply_scene_edits(persisted, edits);             // all or nothing
-//   auto edited = std::make_shared<const Scene>(persisted.scene);
-//   if (effects.geometry_changed()) { set_geometry(lighting, edited); integrator.update_geometry(lighting); }
-//   else { set_material / set_punctual_light / lighting.sky for what `effects` lists, then
-//          integrator.update_materials / update_lights }
+//   update_lighting_scene(lighting, std::make_shared<const Scene>(persisted.scene), effects);
+//   if (effects.geometry_changed()) integrator.update_geometry(lighting);
+//   else { if (!effects.materials.empty()) integrator.update_materials(lighting);
+//          if (!effects.lights.empty() || effects.sky) integrator.update_lights(lighting); }
 //   ...and bake persisted.gbuffer again (texels of moved instances moved with them).
+// (A LightingScene built afresh from the edited PersistedScene, build_lighting_scene(scene,
+// to_bvh4(persisted.bvh)), is the same: apply_scene_edits refits persisted.bvh too.)
 //
 // Values are absolute (not increments), in glTF's units. The scene keeps only the products
 // colour x intensity (lights) and emissiveFactor x emissiveStrength (materials), so an edit that
@@ -28,6 +30,7 @@
 #include <variant>
 #include <vector>
 
+#include "exitance/runtime/core/lighting_scene.h"
 #include "exitance/runtime/scene_file_conversion.h"
 
 namespace exitance {
@@ -111,5 +114,12 @@ struct EditEffects {
 // a matrix node that does not decompose (shear), cone angles on a non-spot light, and what
 // parse_scene_edits checks (edits built in code are checked the same way).
 EditEffects apply_scene_edits(PersistedScene& scene, const std::vector<SceneEdit>& edits);
+
+// Brings `lighting`, built on the scene before apply_scene_edits, to `edited` (the scene after):
+// set_geometry (lighting_scene.h: everything re-derived, BVH refit) when geometry moved, else
+// set_material / set_punctual_light for what `effects` lists and the sky. The result equals
+// build_lighting_scene(edited, the refit BVH). Strong guarantee (works on a copy); throws
+// std::invalid_argument when `edited` does not have `lighting`'s triangles, materials and lights.
+void update_lighting_scene(LightingScene& lighting, std::shared_ptr<const Scene> edited, const EditEffects& effects);
 
 }  // namespace exitance
