@@ -256,18 +256,18 @@ TEST(SceneEditsApply, BadEditsLeaveTheSceneUnchanged) {
     collapsing_cone = {e, ""};
   }
   const std::vector<std::pair<std::vector<SceneEdit>, std::string>> cases = {
-      {{good_move, node_edit("Bx", std::array<double, 3>{0, 0, 0})}, R"(edits[1]: no node is named "Bx")"},
+      {{good_move, node_edit("Bx", std::array<double, 3>{0, 0, 0})}, R"(edits[1] (node "Bx"): no node is named "Bx")"},
       {{good_move, node_edit("Twin", std::array<double, 3>{0, 0, 0})},
-       R"(edits[1]: 2 nodes are named "Twin" (nodes 5, 6); give the index of one instead of the name)"},
-      {{light_intensity(EditTarget{"", 7}, 1)}, R"(edits[0]: light 7 does not exist (the scene has 2 lights))"},
-      {{good_move, node_edit("Box", std::array<double, 3>{0, nan, 0})}, R"(edits[1]: translation: nan is not a finite number)"},
-      {{good_move, light_intensity(EditTarget{"Lamp", {}}, -1)}, R"(edits[1]: intensity: -1 is negative)"},
+       R"(edits[1] (node "Twin"): 2 nodes are named "Twin" (nodes 5, 6); give the index of one instead of the name)"},
+      {{light_intensity(EditTarget{"", 7}, 1)}, R"(edits[0] (light 7): light 7 does not exist (the scene has 2 lights))"},
+      {{good_move, node_edit("Box", std::array<double, 3>{0, nan, 0})}, R"(edits[1] (node "Box"): translation: nan is not a finite number)"},
+      {{good_move, light_intensity(EditTarget{"Lamp", {}}, -1)}, R"(edits[1] (light "Lamp"): intensity: -1 is negative)"},
       {{good_move, node_edit("Root", std::nullopt, std::nullopt, std::array<double, 3>{1, 0, 1})},
-       R"(edits[1]: scale: component 1 is 0 (the transform would not be invertible))"},
+       R"(edits[1] (node "Root"): scale: component 1 is 0 (the transform would not be invertible))"},
       {{good_move, node_edit("Root", std::nullopt, std::nullopt, std::array<double, 3>{1e-300, 1e-300, 1e-300})},
-       R"(edits[1]: the world transform of node 0 is singular)"},
-      {{point_cone}, R"(edits[0]: outerConeAngle: light "Sun" is not a spot light)"},
-      {{collapsing_cone}, R"(edits[0]: outerConeAngle: inner 0.1999999 is not below outer 0.1 (the other angle as baked))"},
+       R"(edits[1] (node "Root"): the world transform of node 0 is singular)"},
+      {{point_cone}, R"(edits[0] (light "Sun"): outerConeAngle: light "Sun" is not a spot light)"},
+      {{collapsing_cone}, R"(edits[0] (light "Lamp"): outerConeAngle: inner 0.1999999 is not below outer 0.1 (the other angle as baked))"},
   };
   for (const auto& [edits, expected] : cases) {
     PersistedScene p = baked();

@@ -116,6 +116,14 @@ void edit_node(SceneNode& node, const NodeEdit& e, const std::string& where) {
   if (e.scale) node.scale = *e.scale;
 }
 
+// `node "Box"`, `light 3`, `sky`: as parse_scene_edits labels an edit.
+std::string label_of(const SceneEdit& edit) {
+  if (const auto* e = std::get_if<NodeEdit>(&edit.change)) return refresh::target_label("node", e->node);
+  if (const auto* e = std::get_if<LightEdit>(&edit.change)) return refresh::target_label("light", e->light);
+  if (const auto* e = std::get_if<MaterialEdit>(&edit.change)) return refresh::target_label("material", e->material);
+  return "sky";
+}
+
 std::vector<uint32_t> sorted(const std::set<uint32_t>& s) { return {s.begin(), s.end()}; }
 
 }  // namespace
@@ -127,7 +135,7 @@ EditEffects apply_scene_edits(PersistedScene& persisted, const std::vector<Scene
   std::vector<std::string> edit_of_node(next.nodes.size());
   for (size_t i = 0; i < edits.size(); ++i) {
     const SceneEdit& edit = edits[i];
-    const std::string where = edit.where.empty() ? "edits[" + std::to_string(i) + "]" : edit.where;
+    const std::string where = edit.where.empty() ? "edits[" + std::to_string(i) + "] (" + label_of(edit) + ")" : edit.where;
     refresh::check_edit_values(edit, where);
     if (const auto* e = std::get_if<NodeEdit>(&edit.change)) {
       const uint32_t node = refresh::resolve_node(next, e->node, where);

@@ -81,7 +81,7 @@ struct SkyEdit {
 struct SceneEdit {
   std::variant<NodeEdit, LightEdit, MaterialEdit, SkyEdit> change;
   // Prefix of its error messages, e.g. `edits.json: edits[2] (light "Lamp")`; parse_scene_edits
-  // sets it; when empty, apply_scene_edits says `edits[i]`.
+  // sets it; when empty, apply_scene_edits says `edits[i] (node "Box")`.
   std::string where;
 };
 
