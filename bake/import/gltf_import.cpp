@@ -8,26 +8,16 @@
 #include "exitance/bake/import/gltf_file_load.h"
 #include "exitance/bake/import/gltf_materials.h"
 #include "exitance/bake/input_error.h"
+#include "exitance/runtime/node_transform.h"
 
 namespace exitance {
 namespace {
 
 constexpr size_t kMaxNodeDepth = 256;  // deeper hierarchies are hostile, not authored
 
-using Mat4 = std::array<double, 16>;  // column-major, as glTF stores it
+using Mat4 = Matrix4d;  // column-major, as glTF stores it (node_transform.h: shared with the runtime's edits)
 
-Mat4 identity() { return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; }
-
-Mat4 multiply(const Mat4& a, const Mat4& b) {
-  Mat4 r{};
-  for (int c = 0; c < 4; ++c)
-    for (int row = 0; row < 4; ++row) {
-      double s = 0;
-      for (int k = 0; k < 4; ++k) s += a[size_t(k * 4 + row)] * b[size_t(c * 4 + k)];
-      r[size_t(c * 4 + row)] = s;
-    }
-  return r;
-}
+Mat4 identity() { return kIdentityMatrix4d; }
 
 void require_finite(const std::vector<double>& values, size_t expected, const std::string& file,
                     const std::string& element, const char* what) {
@@ -50,39 +40,17 @@ Mat4 local_transform(const tinygltf::Node& node, const std::string& file, const 
     for (size_t i = 0; i < 16; ++i) m[i] = node.matrix[i];
     return m;
   }
-  double tx = 0, ty = 0, tz = 0, qx = 0, qy = 0, qz = 0, qw = 1, sx = 1, sy = 1, sz = 1;
-  if (!node.translation.empty()) tx = node.translation[0], ty = node.translation[1], tz = node.translation[2];
+  std::array<double, 3> translation{0, 0, 0}, scale{1, 1, 1};
+  std::array<double, 4> rotation{0, 0, 0, 1};
+  if (!node.translation.empty()) std::copy_n(node.translation.begin(), 3, translation.begin());
   if (!node.rotation.empty()) {
-    qx = node.rotation[0], qy = node.rotation[1], qz = node.rotation[2], qw = node.rotation[3];
-    const double len = std::sqrt(qx * qx + qy * qy + qz * qz + qw * qw);
-    if (len < 1e-12) throw InputError(file, element, "rotation quaternion has zero length");
-    qx /= len, qy /= len, qz /= len, qw /= len;
+    std::copy_n(node.rotation.begin(), 4, rotation.begin());
+    const auto& q = rotation;
+    if (std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]) < 1e-12)
+      throw InputError(file, element, "rotation quaternion has zero length");
   }
-  if (!node.scale.empty()) sx = node.scale[0], sy = node.scale[1], sz = node.scale[2];
-  // Column-major R*S then translation.
-  const double r00 = 1 - 2 * (qy * qy + qz * qz), r01 = 2 * (qx * qy - qz * qw), r02 = 2 * (qx * qz + qy * qw);
-  const double r10 = 2 * (qx * qy + qz * qw), r11 = 1 - 2 * (qx * qx + qz * qz), r12 = 2 * (qy * qz - qx * qw);
-  const double r20 = 2 * (qx * qz - qy * qw), r21 = 2 * (qy * qz + qx * qw), r22 = 1 - 2 * (qx * qx + qy * qy);
-  return {r00 * sx, r10 * sx, r20 * sx, 0, r01 * sy, r11 * sy, r21 * sy, 0, r02 * sz, r12 * sz, r22 * sz, 0, tx, ty, tz, 1};
-}
-
-Vec3 transform_point(const Mat4& m, Vec3 p) {
-  return {float(m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12]), float(m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13]),
-          float(m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14])};
-}
-
-// Normals transform with the inverse transpose of the upper 3x3; the cofactor matrix is that times det.
-Vec3 transform_normal(const Mat4& m, Vec3 n) {
-  const double a = m[0], b = m[4], c = m[8], d = m[1], e = m[5], f = m[9], g = m[2], h = m[6], i = m[10];
-  const double c00 = e * i - f * h, c01 = -(d * i - f * g), c02 = d * h - e * g;
-  const double c10 = -(b * i - c * h), c11 = a * i - c * g, c12 = -(a * h - b * g);
-  const double c20 = b * f - c * e, c21 = -(a * f - c * d), c22 = a * e - b * d;
-  return {float(c00 * n.x + c10 * n.y + c20 * n.z), float(c01 * n.x + c11 * n.y + c21 * n.z),
-          float(c02 * n.x + c12 * n.y + c22 * n.z)};
-}
-
-double determinant3(const Mat4& m) {
-  return m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) + m[8] * (m[1] * m[6] - m[5] * m[2]);
+  if (!node.scale.empty()) std::copy_n(node.scale.begin(), 3, scale.begin());
+  return trs_matrix(translation, rotation, scale);
 }
 
 Vec3 to_vec3(const std::vector<float>& v, size_t i) { return {v[3 * i], v[3 * i + 1], v[3 * i + 2]}; }
@@ -364,10 +332,7 @@ class SceneFlattener {
     light.intensity = color * float(source.intensity);
     if (!is_finite(light.intensity) || light.intensity.x < 0 || light.intensity.y < 0 || light.intensity.z < 0)
       throw InputError(file_, light_element, "color * intensity must be finite and >= 0");
-    light.position = transform_point(world, {0, 0, 0});
-    const Vec3 forward = transform_point(world, {0, 0, -1}) - light.position;
-    if (!(length(forward) > 0.0f)) throw InputError(file_, element, "node transform collapses the light direction");
-    light.direction = normalize(forward);
+    if (!place_light(world, light)) throw InputError(file_, element, "node transform collapses the light direction");
     if (source.type == "point") {
       light.type = PunctualLight::Type::Point;
     } else if (source.type == "spot") {

@@ -41,8 +41,8 @@ TexelGBuffer rasterize_texel_gbuffer(const Scene& scene, const AtlasLayout& layo
       chart_triangle_in_texels(scene, t, rect.scale_offset, page.width, page.height, tri);
       const Vec2 e1 = tri[1] - tri[0], e2 = tri[2] - tri[0];
       const float texel_area = 0.5f * std::fabs(e1.x * e2.y - e1.y * e2.x);
-      const float world_area = triangle_area(scene, t);
-      triangle_texel_size[t] = texel_area > 0 ? std::sqrt(world_area / texel_area) : 0.0f;
+      // The runtime's scene edits recompute it with the same function when an instance moves.
+      triangle_texel_size[t] = triangle_world_texel_size(scene, t, rect, page.width, page.height);
       if (!(texel_area > 0)) continue;  // zero-area chart triangle: nothing to raster
       const int x0 = std::max(0, int(std::floor(std::min({tri[0].x, tri[1].x, tri[2].x}))));
       const int y0 = std::max(0, int(std::floor(std::min({tri[0].y, tri[1].y, tri[2].y}))));

@@ -15,16 +15,6 @@ bool same_bits(Vec3 a, Vec3 b) { return std::memcmp(&a, &b, sizeof(Vec3)) == 0; 
 
 std::string texel_where(size_t i) { return "scene.bin (writing): texel " + std::to_string(i) + ": "; }
 
-// The barycentrics the rasterizer gives texel (x, y) of `page` on triangle t.
-void raster_barycentrics(const Scene& scene, const InstanceRect& rect, const AtlasPage& page, uint32_t t, uint32_t x,
-                         uint32_t y, float& b1, float& b2) {
-  Vec2 tri[3];
-  chart_triangle_in_texels(scene, t, rect.scale_offset, page.width, page.height, tri);
-  Vec2 centroid{float(x) + 0.5f, float(y) + 0.5f};  // kept when t does not cover the texel
-  clipped_texel_coverage(tri, int(x), int(y), centroid);
-  chart_barycentrics(tri, centroid, b1, b2);
-}
-
 }  // namespace
 
 formats::TexelGBufferRecords encode_texel_gbuffer(const TexelGBuffer& gbuffer, const Scene& scene,
@@ -96,7 +86,7 @@ formats::TexelGBufferRecords encode_texel_gbuffer(const TexelGBuffer& gbuffer, c
                         std::to_string(texel.triangle));
     }
     if (coverage != 1.0f) records.partial_coverage.push_back({uint32_t(i), coverage});
-    raster_barycentrics(scene, atlas.rects[instance], page, texel.triangle, texel.x, texel.y, r.b1, r.b2);
+    texel_barycentrics(scene, atlas.rects[instance], page.width, page.height, texel.triangle, texel.x, texel.y, r.b1, r.b2);
     const TexelSurface surface = texel_surface(scene, texel.triangle, r.b1, r.b2);
     if (!same_bits(surface.geometric_normal, texel.geometric_normal))
       throw FormatError(texel_where(i) + "geometric normal is not its triangle's");

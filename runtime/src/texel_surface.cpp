@@ -68,6 +68,25 @@ void chart_barycentrics(const Vec2 t[3], Vec2 p, float& b1, float& b2) {
   b2 = std::clamp(b2, 0.0f, 1.0f - b1);
 }
 
+void texel_barycentrics(const Scene& scene, const InstanceRect& rect, int page_width, int page_height, uint32_t t,
+                        uint32_t x, uint32_t y, float& b1, float& b2) {
+  Vec2 tri[3];
+  chart_triangle_in_texels(scene, t, rect.scale_offset, page_width, page_height, tri);
+  Vec2 centroid{float(x) + 0.5f, float(y) + 0.5f};  // kept when t does not cover the texel
+  clipped_texel_coverage(tri, int(x), int(y), centroid);
+  chart_barycentrics(tri, centroid, b1, b2);
+}
+
+float triangle_world_texel_size(const Scene& scene, uint32_t t, const InstanceRect& rect, int page_width,
+                                int page_height) {
+  Vec2 tri[3];
+  chart_triangle_in_texels(scene, t, rect.scale_offset, page_width, page_height, tri);
+  const Vec2 e1 = tri[1] - tri[0], e2 = tri[2] - tri[0];
+  const float texel_area = 0.5f * std::fabs(e1.x * e2.y - e1.y * e2.x);
+  const float world_area = triangle_area(scene, t);
+  return texel_area > 0 ? std::sqrt(world_area / texel_area) : 0.0f;
+}
+
 TexelSurface texel_surface(const Scene& scene, uint32_t t, float b1, float b2) {
   const Vec3* pos = &scene.positions[size_t(t) * 3];
   const Vec3* nrm = &scene.normals[size_t(t) * 3];

@@ -200,6 +200,26 @@ TEST(GltfImport, NonFiniteNormalsAreRepairedWithAWarning) {
   EXPECT_TRUE(warned);
 }
 
+// Vertex normals turn with their node: a flat triangle's +Z normals stay its geometric normal under
+// a rotation (and a non-uniform scale), rather than turning the other way.
+TEST(GltfImport, VertexNormalsTurnWithTheirNode) {
+  const auto dir = std::filesystem::temp_directory_path() / ("gltf_import_test_turn_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "turned.gltf").string();
+  json d = triangle_document();
+  d["nodes"][0]["rotation"] = {0.3, 0.4, -0.2, std::sqrt(1 - 0.09 - 0.16 - 0.04)};
+  d["nodes"][0]["scale"] = {1, 3, 0.5};
+  std::ofstream(path) << d.dump();
+  Diagnostics diagnostics;
+  const Scene scene = import_gltf(path, ImportOptions{}, diagnostics);
+  std::filesystem::remove_all(dir);
+  ASSERT_EQ(scene.triangle_count(), 1u);
+  const Vec3 face = triangle_normal(scene, 0);
+  // Both unit vectors from float products of the same matrix: a few float roundings apart.
+  for (const Vec3& n : scene.normals)
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(n[c], face[c], 1e-6f) << "component " << c;
+}
+
 TEST(GltfImport, NonFinitePositionIsAnErrorNamingTheAccessor) {
   const auto dir = std::filesystem::temp_directory_path() / ("gltf_import_test_pos_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);

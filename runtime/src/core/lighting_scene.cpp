@@ -7,6 +7,7 @@
 #include "exitance/common/material.h"
 #include "exitance/common/punctual_light.h"
 #include "exitance/common/sampling.h"
+#include "exitance/runtime/core/bvh4_refit.h"
 #include "exitance/runtime/distribution_1d.h"
 #include "exitance/runtime/material_eval.h"
 
@@ -147,6 +148,17 @@ LightingScene build_lighting_scene(std::shared_ptr<const Scene> source, Bvh4 bvh
   lighting.sky = scene.sky.constant;
   if (scene.sky.has_environment()) lighting.environment = EnvironmentSampler(scene.sky.environment);
   return lighting;
+}
+
+void set_geometry(LightingScene& lighting, std::shared_ptr<const Scene> edited) {
+  if (!edited || edited->triangle_count() != lighting.triangles.size() ||
+      edited->positions.size() != edited->triangle_count() * 3)
+    throw std::invalid_argument("set_geometry: the edited scene has " +
+                                std::to_string(edited ? edited->triangle_count() : 0) + " triangles, not " +
+                                std::to_string(lighting.triangles.size()));
+  Bvh4 bvh = lighting.bvh;
+  if (!bvh.nodes.empty()) refit_bvh4(bvh, edited->positions);
+  lighting = build_lighting_scene(std::move(edited), std::move(bvh));
 }
 
 void set_material(LightingScene& lighting, uint32_t index, const Material& material) {

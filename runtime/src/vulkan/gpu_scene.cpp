@@ -135,6 +135,24 @@ void GpuScene::update_materials(const LightingScene& edited) {
   emitters_ = edited.emitter_triangles;
 }
 
+void GpuScene::update_geometry(const LightingScene& edited) {
+  check_same_shape(edited);
+  if (edited.bvh.leaf_triangles.size() != leaf_slots_ || std::max<uint32_t>(edited.bvh.stack_entries + 1, 8) > stack_bound_)
+    throw std::invalid_argument("Vulkan backend: a geometry update must keep the BVH's topology (refit_bvh4); "
+                                "a rebuilt BVH needs a new integrator");
+  check_supported_by_vulkan(edited);
+  const std::vector<uint32_t> words = node_words(edited.bvh, quantized_);
+  context_.upload(nodes_, words.data(), words.size() * 4);
+  const std::vector<Vec4> leaf = leaf_triangle_copies(edited);
+  context_.upload(leaf_triangles_, leaf.data(), leaf.size() * sizeof(Vec4));
+  if (!edited.triangles.empty()) context_.upload(triangles_, edited.triangles.data(), edited.triangles.size() * sizeof(GpuTriangle));
+  update_materials(edited);  // emitter areas and CDF follow the triangles
+  update_lights(edited);     // directional powers follow the bounds
+  bounds_lo_ = edited.bounds_lo;
+  bounds_hi_ = edited.bounds_hi;
+  extent_ = edited.extent;
+}
+
 void GpuScene::update_lights(const LightingScene& edited) {
   check_same_shape(edited);
   check_supported_by_vulkan(edited);

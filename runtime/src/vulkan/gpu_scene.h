@@ -1,7 +1,8 @@
 // The scene on the device: a LightingScene's records as the kernels read them (gpu_layout.h), the
 // BVH4 in the chosen node layout, and per leaf slot a copy of its triangle's vertices for traversal.
 // Materials and punctual lights can be updated in place (runtime edits): only those records and
-// what depends on them are uploaded again; geometry and BVH stay.
+// what depends on them are uploaded again. Moved geometry (same triangles, BVH refit) replaces the
+// triangle records, BVH nodes and leaf copies in their buffers, of the same sizes.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -27,6 +28,12 @@ class GpuScene {
   void update_materials(const LightingScene& edited);
   // After set_punctual_light: uploads the punctual lights and their CDF, and takes the constant sky.
   void update_lights(const LightingScene& edited);
+
+  // After set_geometry (lighting_scene.h): uploads the triangles, the BVH nodes (in this scene's
+  // node layout) and per-slot vertex copies, then what update_materials and update_lights upload,
+  // and takes the bounds and extent. Throws std::invalid_argument when the scene's shape (counts,
+  // BVH nodes and leaf slots, traversal stack bound) differs.
+  void update_geometry(const LightingScene& edited);
 
   void bind(DescriptorWrites& writes) const;  // kBindingBvhNodes .. kBindingPunctualCdf
 

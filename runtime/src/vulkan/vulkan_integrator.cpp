@@ -75,6 +75,7 @@ uint32_t VulkanIntegrator::progressive_samples() const { return impl_->lightmap.
 
 void VulkanIntegrator::update_materials(const LightingScene& edited) { impl_->scene.update_materials(edited); }
 void VulkanIntegrator::update_lights(const LightingScene& edited) { impl_->scene.update_lights(edited); }
+void VulkanIntegrator::update_geometry(const LightingScene& edited) { impl_->scene.update_geometry(edited); }
 
 const VulkanDeviceInfo& VulkanIntegrator::device() const { return impl_->context.info(); }
 std::string VulkanIntegrator::device_description() const {

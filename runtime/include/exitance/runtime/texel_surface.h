@@ -5,6 +5,7 @@
 #pragma once
 #include <cstdint>
 
+#include "exitance/runtime/lightmap_atlas.h"
 #include "exitance/runtime/scene.h"
 
 namespace exitance {
@@ -21,6 +22,17 @@ float clipped_texel_coverage(const Vec2 triangle[3], int x, int y, Vec2& centroi
 // Barycentrics (b1, b2) of `point` in the 2D triangle, clamped onto it (b1 in [0, 1], b2 in
 // [0, 1 - b1]); (1/3, 1/3) when the triangle is degenerate.
 void chart_barycentrics(const Vec2 triangle[3], Vec2 point, float& b1, float& b2);
+
+// The rasterizer's barycentrics of texel (x, y) on triangle t of the instance `rect` places on a
+// page_width x page_height page: the centroid of the part of the texel the chart triangle covers
+// (the texel centre when it covers none), by chart_barycentrics.
+void texel_barycentrics(const Scene& scene, const InstanceRect& rect, int page_width, int page_height, uint32_t t,
+                        uint32_t x, uint32_t y, float& b1, float& b2);
+
+// World-space edge length of one texel on triangle t: sqrt(world area / chart area in texels);
+// 0 when the chart triangle has no area (it has no texels).
+float triangle_world_texel_size(const Scene& scene, uint32_t t, const InstanceRect& rect, int page_width,
+                                int page_height);
 
 // What a texel at barycentrics (b1, b2) of `triangle` sees:
 //   position         = p0 (1 - b1 - b2) + p1 b1 + p2 b2

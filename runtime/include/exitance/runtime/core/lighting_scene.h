@@ -39,11 +39,19 @@ struct LightingScene {
 // throws std::invalid_argument when the BVH references a triangle the scene does not have.
 LightingScene build_lighting_scene(std::shared_ptr<const Scene> scene, Bvh4 bvh);
 
+// After geometry moved (an instance transform edit, refresh/scene_edits.h): `edited` is the source
+// scene with the same triangles (count, order, materials, instances) at new positions, and
+// possibly other edits. Everything is derived again as build_lighting_scene does (triangle
+// records, bounds, extent, emitter areas and CDF, light records and CDF, sky), over the current
+// BVH refit to the new positions (bvh4_refit.h: same topology, no rebuild). Throws
+// std::invalid_argument when the triangle count differs; `scene` is unchanged when it throws.
+void set_geometry(LightingScene& scene, std::shared_ptr<const Scene> edited);
+
 // Runtime edits in place: the record, the source Scene (copied on write, as others may share it)
 // and what depends on them are recomputed as build_lighting_scene would: a material's record, the
 // `textured` flag, the emitter distribution and every triangle's area pdf; a light's record and the
-// punctual CDF. Geometry, BVH and sizes stay (an instance transform would need a BVH refit: not
-// offered). Throw std::out_of_range for an index the scene does not have.
+// punctual CDF. Geometry, BVH and sizes stay (an instance transform needs a BVH refit:
+// set_geometry). Throw std::out_of_range for an index the scene does not have.
 void set_material(LightingScene& scene, uint32_t index, const Material& material);
 void set_punctual_light(LightingScene& scene, uint32_t index, const PunctualLight& light);
 

@@ -114,12 +114,18 @@ class VulkanIntegrator final : public Integrator {
   // Runtime edits without a rebuild. `edited` is the scene this integrator was created on (or a
   // copy) after set_material / set_punctual_light (lighting_scene.h): update_materials uploads the
   // materials, the emitter distribution and the area pdfs again; update_lights the punctual lights,
-  // their CDF and the constant sky. Geometry and BVH stay: an edit that changes them (instance
-  // transforms need a BVH refit) needs a new integrator. Throws std::invalid_argument when the
-  // counts of triangles, materials or lights differ, std::runtime_error as create() for what the
-  // backend does not support.
+  // their CDF and the constant sky. Geometry and BVH stay (update_geometry moves them). Throws
+  // std::invalid_argument when the counts of triangles, materials or lights differ,
+  // std::runtime_error as create() for what the backend does not support.
   void update_materials(const LightingScene& edited);
   void update_lights(const LightingScene& edited);
+  // After set_geometry (lighting_scene.h: moved instances, BVH refit, same triangles): uploads the
+  // triangles, BVH nodes (float or quantized, as created) and leaf vertex copies, then what
+  // update_materials and update_lights upload; no device or pipeline is created again (a buffer
+  // only grows when the emitter list does), and a bake afterwards equals one of a fresh integrator
+  // on `edited`. Throws std::invalid_argument when the triangle, material or light count or the
+  // BVH's node count, leaf slots or stack bound differ.
+  void update_geometry(const LightingScene& edited);
 
   const VulkanDeviceInfo& device() const;
   uint32_t max_paths() const;

@@ -1,0 +1,58 @@
+#include "exitance/runtime/core/bvh4_refit.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace exitance {
+namespace {
+
+struct Box {
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  void grow(const Box& b) { lo = min(lo, b.lo), hi = max(hi, b.hi); }
+  void grow(Vec3 p) { lo = min(lo, p), hi = max(hi, p); }
+};
+
+}  // namespace
+
+void refit_bvh4(Bvh4& bvh, const std::vector<Vec3>& positions) {
+  const size_t triangle_count = positions.size() / 3;
+  for (uint32_t t : bvh.leaf_triangles)
+    if (t >= triangle_count)
+      throw std::invalid_argument("refit_bvh4: leaf references triangle " + std::to_string(t) + " of " +
+                                  std::to_string(triangle_count));
+  for (size_t n = 0; n < bvh.nodes.size(); ++n)
+    for (uint32_t child : bvh.nodes[n].child) {
+      if (child == kBvhEmptyChild) continue;
+      if (child & kBvhLeafBit) {
+        const uint32_t first = (child & ~kBvhLeafBit) >> 2, count = (child & 3u) + 1;
+        if (size_t(first) + count > bvh.leaf_triangles.size())
+          throw std::invalid_argument("refit_bvh4: node " + std::to_string(n) + " has a leaf past the last slot");
+      } else if (child <= n || child >= bvh.nodes.size()) {
+        throw std::invalid_argument("refit_bvh4: node " + std::to_string(n) + " has child " + std::to_string(child) +
+                                    " (children come after their parent)");
+      }
+    }
+  // Children come after their parents: one pass from the last node up sees every child's box first.
+  std::vector<Box> node_box(bvh.nodes.size());
+  for (size_t n = bvh.nodes.size(); n-- > 0;) {
+    Bvh4Node& node = bvh.nodes[n];
+    for (int i = 0; i < 4; ++i) {
+      const uint32_t child = node.child[i];
+      if (child == kBvhEmptyChild) continue;  // its box stays the builder's empty one
+      Box box;
+      if (child & kBvhLeafBit) {
+        const uint32_t first = (child & ~kBvhLeafBit) >> 2, count = (child & 3u) + 1;
+        for (uint32_t s = first; s < first + count; ++s)
+          for (int k = 0; k < 3; ++k) box.grow(positions[size_t(bvh.leaf_triangles[s]) * 3 + size_t(k)]);
+      } else {
+        box = node_box[child];
+      }
+      node.lo_x[i] = box.lo.x, node.lo_y[i] = box.lo.y, node.lo_z[i] = box.lo.z;
+      node.hi_x[i] = box.hi.x, node.hi_y[i] = box.hi.y, node.hi_z[i] = box.hi.z;
+      node_box[n].grow(box);
+    }
+  }
+}
+
+}  // namespace exitance

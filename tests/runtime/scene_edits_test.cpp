@@ -1,0 +1,625 @@
+// Runtime scene edits (runtime/include/exitance/runtime/refresh/scene_edits.h) on a small glTF
+// taken through the offline stage and scene.bin: parse errors as one line naming the edit and the
+// field; bad edits leave the scene bit for bit as it was; each edit type's effect; node edits
+// against importing the glTF with the node changed; the BVH refit; set_geometry.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <numbers>
+
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include "exitance/bake/import/gltf_import.h"
+#include "exitance/bake/layout/atlas_layout.h"
+#include "exitance/bake/raster/texel_raster.h"
+#include "exitance/runtime/core/bvh4_refit.h"
+#include "exitance/runtime/core/lighting_scene.h"
+#include "exitance/runtime/cpu/bvh4_builder.h"
+#include "exitance/runtime/node_transform.h"
+#include "exitance/runtime/refresh/scene_edits.h"
+#include "exitance/runtime/scene_file_conversion.h"
+
+namespace exitance {
+namespace {
+
+using json = nlohmann::json;
+constexpr double kHalfUlp = 1.0 / (1 << 24);  // float's unit roundoff 2^-24
+
+std::string base64(const std::vector<unsigned char>& bytes) {
+  static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (size_t i = 0; i < bytes.size(); i += 3) {
+    const uint32_t b = uint32_t(bytes[i]) << 16 | (i + 1 < bytes.size() ? uint32_t(bytes[i + 1]) << 8 : 0) |
+                       (i + 2 < bytes.size() ? uint32_t(bytes[i + 2]) : 0);
+    out += table[(b >> 18) & 63];
+    out += table[(b >> 12) & 63];
+    out += i + 1 < bytes.size() ? table[(b >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? table[b & 63] : '=';
+  }
+  return out;
+}
+
+// A unit quad (two triangles, +Z normals, TEXCOORD_1 = xy) used by every mesh node; a spot lamp
+// and a directional sun; a matrix node ("Group") above an emissive panel; two nodes named "Twin".
+json scene_document() {
+  std::vector<float> values = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 0, 0, 1, 1, 0, 0, 1, 0};  // POSITION
+  for (int i = 0; i < 6; ++i) values.insert(values.end(), {0, 0, 1});                  // NORMAL
+  values.insert(values.end(), {0.05f, 0.05f, 0.95f, 0.05f, 0.95f, 0.95f, 0.05f, 0.05f, 0.95f, 0.95f, 0.05f, 0.95f});
+  std::vector<unsigned char> bytes(values.size() * 4);
+  std::memcpy(bytes.data(), values.data(), bytes.size());
+  json d = json::parse(R"({
+    "asset": {"version": "2.0"},
+    "extensionsUsed": ["KHR_lights_punctual"],
+    "extensions": {"KHR_lights_punctual": {"lights": [
+      {"type": "spot", "name": "Lamp", "color": [1, 0.9, 0.8], "intensity": 5,
+       "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.6}},
+      {"type": "directional", "name": "Sun", "intensity": 2}]}},
+    "scene": 0, "scenes": [{"nodes": [0]}],
+    "nodes": [
+      {"name": "Root", "children": [1, 2, 3, 5, 6, 7]},
+      {"name": "Box", "mesh": 0, "translation": [1, 0, 0.5], "rotation": [0, 0.19866933, 0, 0.98006658]},
+      {"name": "sun", "rotation": [-0.38268343, 0, 0, 0.92387953], "extensions": {"KHR_lights_punctual": {"light": 1}}},
+      {"name": "Group", "matrix": [0, 1, 0, 0, -1, 0, 0, 0, 0, 0, 1, 0, 0, 2, 0, 1], "children": [4]},
+      {"name": "Panel", "mesh": 1, "translation": [0.25, 0, 0]},
+      {"name": "Twin", "mesh": 0, "translation": [3, 0, 0]},
+      {"name": "Twin", "mesh": 0, "translation": [-3, 0, 0]},
+      {"name": "LampNode", "translation": [0, 3, 0], "rotation": [-0.70710678, 0, 0, 0.70710678],
+       "extensions": {"KHR_lights_punctual": {"light": 0}}}],
+    "materials": [{"name": "Grey", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0}},
+                  {"name": "Panel", "emissiveFactor": [1, 0.5, 0.25]}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_1": 2}, "material": 0}]},
+               {"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_1": 2}, "material": 1}]}],
+    "accessors": [
+      {"bufferView": 0, "componentType": 5126, "count": 6, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+      {"bufferView": 0, "byteOffset": 72, "componentType": 5126, "count": 6, "type": "VEC3"},
+      {"bufferView": 1, "componentType": 5126, "count": 6, "type": "VEC2"}],
+    "bufferViews": [{"buffer": 0, "byteLength": 144}, {"buffer": 0, "byteOffset": 144, "byteLength": 48}],
+    "buffers": [{"byteLength": 192}]
+  })");
+  d["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64(bytes);
+  return d;
+}
+
+Scene import_document(const json& d) {
+  static int counter = 0;
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("scene_edits_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + ".gltf");
+  std::ofstream(path) << d.dump();
+  Diagnostics diagnostics;
+  Scene scene = import_gltf(path.string(), ImportOptions{}, diagnostics);
+  std::filesystem::remove(path);
+  return scene;
+}
+
+AtlasLayout layout_of(const Scene& scene) {
+  Diagnostics diagnostics;
+  AtlasSettings settings;
+  settings.texel_density = 8;
+  return layout_lightmap_atlas(scene, settings, "test.gltf", diagnostics);
+}
+
+TexelGBuffer raster(const Scene& scene, const AtlasLayout& atlas) {
+  Diagnostics diagnostics;
+  return rasterize_texel_gbuffer(scene, atlas, "test.gltf", diagnostics);
+}
+
+// What exitance-relight starts from: the scene through scene.bin.
+PersistedScene persisted_from(const json& d) {
+  const Scene scene = import_document(d);
+  const AtlasLayout atlas = layout_of(scene);
+  const formats::SceneFile file = make_scene_file(scene, raster(scene, atlas), atlas, nullptr, to_scene_bvh(build_bvh4(scene)));
+  const std::vector<uint8_t> bytes = formats::encode_scene(file);
+  return restore_scene(formats::read_scene(bytes.data(), bytes.size(), "scene.bin"));
+}
+
+const PersistedScene& baked() {
+  static const PersistedScene p = persisted_from(scene_document());
+  return p;
+}
+
+// Bit for bit: scene.bin's bytes cover the scene, G-buffer, atlas and BVH; the sky's constant and
+// the cone cosines are in them too.
+std::vector<uint8_t> bytes_of(const PersistedScene& p) {
+  return formats::encode_scene(make_scene_file(p.scene, p.gbuffer, p.atlas, nullptr, p.bvh));
+}
+
+std::string edit_error(PersistedScene& p, const std::vector<SceneEdit>& edits) {
+  try {
+    apply_scene_edits(p, edits);
+  } catch (const SceneEditError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+std::string parse_error(const std::string& text) {
+  try {
+    parse_scene_edits(text, "edits.json");
+  } catch (const SceneEditError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+TEST(SceneEditsParse, ReadsEveryEditType) {
+  const std::vector<SceneEdit> edits = parse_scene_edits(R"({"edits": [
+      {"node": "sun", "rotation": [0, 0, 0, 1]}, {"node": 1, "translation": [1, 2, 3], "scale": [2, 2, 2]},
+      {"light": "Lamp", "intensity": 5.0, "color": [1, 0.9, 0.8], "innerConeAngle": 0.2, "outerConeAngle": 0.6},
+      {"material": "Panel", "emissiveStrength": 2.0, "emissiveFactor": [1, 1, 1]}, {"sky": [0.3, 0.4, 0.5]}]})",
+                                                         "edits.json");
+  ASSERT_EQ(edits.size(), 5u);
+  const auto& sun = std::get<NodeEdit>(edits[0].change);
+  EXPECT_EQ(sun.node.name, "sun");
+  EXPECT_EQ(sun.rotation, (std::array<double, 4>{0, 0, 0, 1}));
+  EXPECT_FALSE(sun.translation || sun.scale);
+  const auto& box = std::get<NodeEdit>(edits[1].change);
+  EXPECT_EQ(box.node.index, 1u);
+  EXPECT_EQ(box.translation, (std::array<double, 3>{1, 2, 3}));
+  EXPECT_EQ(edits[1].where, "edits.json: edits[1] (node 1)");
+  const auto& lamp = std::get<LightEdit>(edits[2].change);
+  EXPECT_EQ(lamp.intensity, 5.0f);
+  EXPECT_EQ(lamp.color, (std::array<float, 3>{1, 0.9f, 0.8f}));
+  EXPECT_EQ(lamp.inner_cone_angle, 0.2);
+  EXPECT_EQ(lamp.outer_cone_angle, 0.6);
+  EXPECT_EQ(edits[2].where, "edits.json: edits[2] (light \"Lamp\")");
+  const auto& panel = std::get<MaterialEdit>(edits[3].change);
+  EXPECT_EQ(panel.emissive_strength, 2.0f);
+  EXPECT_EQ(panel.emissive_factor, (std::array<float, 3>{1, 1, 1}));
+  EXPECT_EQ(std::get<SkyEdit>(edits[4].change).color, (std::array<float, 3>{0.3f, 0.4f, 0.5f}));
+  EXPECT_EQ(edits[4].where, "edits.json: edits[4] (sky)");
+}
+
+TEST(SceneEditsParse, ErrorsAreOneLineNamingTheEditAndField) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {R"({"edits": [{"sky": [0, 0, 0]}, {"light": "Lamp", "intensity": -1}]})",
+       R"(edits.json: edits[1] (light "Lamp"): intensity: -1 is negative)"},
+      {R"({"edits": [{"node": "Box", "translaton": [1, 2, 3]}]})",
+       R"(edits.json: edits[0] (node "Box"): unknown key "translaton" (this edit takes node, translation, rotation, scale))"},
+      {R"({"edits": [{"node": "Box", "scale": [1, 0, 1]}]})",
+       R"(edits.json: edits[0] (node "Box"): scale: component 1 is 0 (the transform would not be invertible))"},
+      {R"({"edits": [{"node": "Box", "rotation": [0, 90, 0, 1]}]})",
+       R"(edits.json: edits[0] (node "Box"): rotation: length 90.00555538409837 is not 1 (a unit quaternion [x, y, z, w]))"},
+      {R"({"edits": [{"node": "Box", "translation": [1, 2]}]})",
+       R"(edits.json: edits[0] (node "Box"): translation: must be an array of 3 numbers)"},
+      {R"({"edits": [{"node": 2.5, "translation": [1, 2, 3]}]})",
+       R"(edits.json: edits[0]: "node" must be a name (string) or an index (integer >= 0))"},
+      {R"({"edits": [{"node": -1, "translation": [1, 2, 3]}]})",
+       R"(edits.json: edits[0]: "node" must be a name (string) or an index (integer >= 0))"},
+      {R"({"edits": [{"node": "Box"}]})", R"(edits.json: edits[0] (node "Box"): changes nothing (give translation, rotation or scale))"},
+      {R"({"edits": [{"light": "Lamp", "color": [1, 2, 0]}]})",
+       R"(edits.json: edits[0] (light "Lamp"): color: 2 is outside [0, 1] (glTF colours; scale with intensity))"},
+      {R"({"edits": [{"light": "Lamp", "innerConeAngle": 0.6, "outerConeAngle": 0.2}]})",
+       R"(edits.json: edits[0] (light "Lamp"): innerConeAngle: 0.6 is not below outerConeAngle 0.2)"},
+      {R"({"edits": [{"light": "Lamp", "outerConeAngle": 2}]})",
+       R"(edits.json: edits[0] (light "Lamp"): outerConeAngle: 2 is outside [0, pi/2] (radians))"},
+      {R"({"edits": [{"material": "Panel", "emissiveStrength": "2"}]})",
+       R"(edits.json: edits[0] (material "Panel"): emissiveStrength: must be a number)"},
+      {R"({"edits": [{"material": "Panel", "emissiveStrength": 1e39}]})",
+       R"(edits.json: edits[0] (material "Panel"): emissiveStrength: inf is not a finite number)"},
+      {R"({"edits": [{"sky": [0.1, -0.2, 0]}]})", R"(edits.json: edits[0] (sky): sky: -0.2 is negative)"},
+      {R"({"edits": [{"sky": [0, 0, 0], "light": "Lamp"}]})",
+       R"(edits.json: edits[0]: has both "light" and "sky" (one thing per edit))"},
+      {R"({"edits": [{"colour": [1, 1, 1]}]})",
+       R"(edits.json: edits[0]: names nothing to edit (give "node", "light", "material" or "sky"))"},
+      {R"({"edits": [3]})", R"(edits.json: edits[0]: must be an object)"},
+      {R"({"edits": {}})", R"(edits.json: "edits" must be an array)"},
+      {R"({"edit": []})", R"(edits.json: must be an object {"edits": [...]})"},
+      {R"({"edits": [], "version": 1})", R"(edits.json: unknown key "version" (the document takes only "edits"))"},
+  };
+  for (const auto& [text, expected] : cases) EXPECT_EQ(parse_error(text), expected) << text;
+  const std::string not_json = parse_error(R"({"edits": [)");
+  EXPECT_TRUE(not_json.starts_with("edits.json: not valid JSON: ")) << not_json;
+  EXPECT_EQ(not_json.find('\n'), std::string::npos) << not_json;
+}
+
+SceneEdit node_edit(const std::string& name, std::optional<std::array<double, 3>> translation,
+                    std::optional<std::array<double, 4>> rotation = std::nullopt,
+                    std::optional<std::array<double, 3>> scale = std::nullopt) {
+  NodeEdit e;
+  e.node.name = name;
+  e.translation = translation;
+  e.rotation = rotation;
+  e.scale = scale;
+  return {e, ""};
+}
+
+SceneEdit light_intensity(EditTarget target, float intensity) {
+  LightEdit e;
+  e.light = std::move(target);
+  e.intensity = intensity;
+  return {e, ""};
+}
+
+// Each bad edit throws a one-line SceneEditError and leaves the scene as it was, even after good
+// edits earlier in the same list (all or nothing).
+TEST(SceneEditsApply, BadEditsLeaveTheSceneUnchanged) {
+  const std::vector<uint8_t> before = bytes_of(baked());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const SceneEdit good_move = node_edit("Box", std::array<double, 3>{5, 0, 0});
+  SceneEdit point_cone;
+  {
+    LightEdit e;
+    e.light.name = "Sun";
+    e.outer_cone_angle = 0.5;
+    point_cone = {e, ""};
+  }
+  SceneEdit collapsing_cone;  // inner as baked (0.2) is not below the new outer angle
+  {
+    LightEdit e;
+    e.light.name = "Lamp";
+    e.outer_cone_angle = 0.1;
+    collapsing_cone = {e, ""};
+  }
+  const std::vector<std::pair<std::vector<SceneEdit>, std::string>> cases = {
+      {{good_move, node_edit("Bx", std::array<double, 3>{0, 0, 0})}, R"(edits[1] (node "Bx"): no node is named "Bx")"},
+      {{good_move, node_edit("Twin", std::array<double, 3>{0, 0, 0})},
+       R"(edits[1] (node "Twin"): 2 nodes are named "Twin" (nodes 5, 6); give the index of one instead of the name)"},
+      {{light_intensity(EditTarget{"", 7}, 1)}, R"(edits[0] (light 7): light 7 does not exist (the scene has 2 lights))"},
+      {{good_move, node_edit("Box", std::array<double, 3>{0, nan, 0})}, R"(edits[1] (node "Box"): translation: nan is not a finite number)"},
+      {{good_move, light_intensity(EditTarget{"Lamp", {}}, -1)}, R"(edits[1] (light "Lamp"): intensity: -1 is negative)"},
+      {{good_move, node_edit("Root", std::nullopt, std::nullopt, std::array<double, 3>{1, 0, 1})},
+       R"(edits[1] (node "Root"): scale: component 1 is 0 (the transform would not be invertible))"},
+      {{good_move, node_edit("Root", std::nullopt, std::nullopt, std::array<double, 3>{1e-300, 1e-300, 1e-300})},
+       R"(edits[1] (node "Root"): the world transform of node 0 is singular)"},
+      {{point_cone}, R"(edits[0] (light "Sun"): outerConeAngle: light "Sun" is not a spot light)"},
+      {{collapsing_cone}, R"(edits[0] (light "Lamp"): outerConeAngle: inner 0.1999999 is not below outer 0.1 (the other angle as baked))"},
+  };
+  for (const auto& [edits, expected] : cases) {
+    PersistedScene p = baked();
+    EXPECT_EQ(edit_error(p, edits), expected);
+    EXPECT_EQ(bytes_of(p), before) << expected;
+  }
+}
+
+TEST(SceneEditsApply, AnIndexNamesWhatANameCannot) {
+  PersistedScene p = baked();
+  const std::array<double, 3> moved{0, 7, 0};
+  NodeEdit e;
+  e.node.index = 6;
+  e.translation = moved;
+  const EditEffects effects = apply_scene_edits(p, {{e, ""}});
+  EXPECT_EQ(p.scene.nodes[6].translation, moved);
+  EXPECT_EQ(p.scene.nodes[5].translation, baked().scene.nodes[5].translation);
+  ASSERT_EQ(effects.moved_instances.size(), 1u);
+  EXPECT_EQ(p.scene.instances[effects.moved_instances[0]].node, 6);
+}
+
+TEST(SceneEditsApply, ANoOpEditLeavesTheSceneBitIdentical) {
+  PersistedScene p = baked();
+  const std::array<double, 3> same = baked().scene.nodes[1].translation;
+  const EditEffects effects = apply_scene_edits(p, {node_edit("Box", same), node_edit("Group", std::array<double, 3>{0, 2, 0})});
+  EXPECT_TRUE(effects.moved_instances.empty());
+  EXPECT_TRUE(effects.lights.empty());
+  EXPECT_EQ(bytes_of(p), bytes_of(baked()));
+}
+
+// The scene as importing `d` gives it, rasterized into the baked atlas (the layout stays as baked).
+struct Reimported {
+  Scene scene;
+  TexelGBuffer gbuffer;
+};
+Reimported reimport(const json& d) {
+  Reimported r{import_document(d), {}};
+  r.gbuffer = raster(r.scene, baked().atlas);
+  return r;
+}
+
+float largest_coordinate(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  float m = 0;
+  for (const auto* v : {&a, &b})
+    for (Vec3 p : *v) m = std::max({m, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+  return m;
+}
+
+// Edited positions against the importer's: the stored float positions carry <= 2^-24 |p| of
+// rounding each, which the edit's linear part (norm `delta_norm`) carries over, plus one rounding
+// on each side: |difference| <= (sqrt(3) delta_norm + 2) 2^-24 max|p| per component.
+void expect_geometry_as_imported(const PersistedScene& edited, const Reimported& r, double delta_norm) {
+  const Scene& a = edited.scene;
+  const Scene& b = r.scene;
+  ASSERT_EQ(a.positions.size(), b.positions.size());
+  const double position_tolerance =
+      (std::sqrt(3.0) * delta_norm + 2) * kHalfUlp * largest_coordinate(a.positions, b.positions);
+  // Unit normals: each side rounds a normalization (a few 2^-24); 16 of them is the bound used.
+  const double normal_tolerance = 16 * kHalfUlp * std::max(1.0, delta_norm);
+  for (size_t i = 0; i < a.positions.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_NEAR(a.positions[i][c], b.positions[i][c], position_tolerance) << "vertex " << i;
+      ASSERT_NEAR(a.normals[i][c], b.normals[i][c], normal_tolerance) << "vertex " << i;
+    }
+  EXPECT_EQ(a.lightmap_uv.size(), b.lightmap_uv.size());
+  for (size_t i = 0; i < a.lightmap_uv.size(); ++i) ASSERT_EQ(a.lightmap_uv[i].x, b.lightmap_uv[i].x) << i;
+  for (size_t k = 0; k < a.instances.size(); ++k) EXPECT_EQ(a.instances[k].world, b.instances[k].world) << "instance " << k;
+  for (size_t l = 0; l < a.lights.size(); ++l) {
+    EXPECT_EQ(a.lights[l].position.x, b.lights[l].position.x) << "light " << l;
+    EXPECT_EQ(a.lights[l].position.y, b.lights[l].position.y) << "light " << l;
+    EXPECT_EQ(a.lights[l].position.z, b.lights[l].position.z) << "light " << l;
+    EXPECT_EQ(a.lights[l].direction.x, b.lights[l].direction.x) << "light " << l;
+    EXPECT_EQ(a.lights[l].direction.y, b.lights[l].direction.y) << "light " << l;
+    EXPECT_EQ(a.lights[l].direction.z, b.lights[l].direction.z) << "light " << l;
+  }
+  // Texels: the same texels (the atlas stays), at the importer's surface points within the
+  // positions' tolerance (an interpolation adds 3 roundings), with its normals and texel sizes.
+  ASSERT_EQ(edited.gbuffer.texels.size(), r.gbuffer.texels.size());
+  const double texel_tolerance = position_tolerance + 3 * kHalfUlp * largest_coordinate(a.positions, b.positions);
+  for (size_t i = 0; i < r.gbuffer.texels.size(); ++i) {
+    const LiveTexel& t = edited.gbuffer.texels[i];
+    const LiveTexel& u = r.gbuffer.texels[i];
+    ASSERT_EQ(t.triangle, u.triangle);
+    ASSERT_EQ(t.x, u.x);
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_NEAR(t.position[c], u.position[c], texel_tolerance) << "texel " << i;
+      ASSERT_NEAR(t.shading_normal[c], u.shading_normal[c], normal_tolerance) << "texel " << i;
+      ASSERT_NEAR(t.geometric_normal[c], u.geometric_normal[c], normal_tolerance * 4) << "texel " << i;
+    }
+    ASSERT_NEAR(t.world_texel_size, u.world_texel_size, 8 * kHalfUlp * u.world_texel_size) << "texel " << i;
+  }
+}
+
+// Moving "Box" equals importing the glTF with Box's translation changed; moving "Root" moves the
+// lights and every instance below it; the edited scene is still one scene.bin accepts.
+TEST(SceneEditsApply, TranslationEqualsImportingTheMovedNode) {
+  for (const auto& [node, index] : {std::pair<std::string, int>{"Box", 1}, {"Root", 0}}) {
+    PersistedScene p = baked();
+    const std::array<double, 3> moved{-2.5, 1.25, 0.75};
+    const EditEffects effects = apply_scene_edits(p, {node_edit(node, moved)});
+    json d = scene_document();
+    d["nodes"][index]["translation"] = moved;
+    expect_geometry_as_imported(p, reimport(d), 1.0);
+    EXPECT_TRUE(effects.geometry_changed());
+    EXPECT_EQ(effects.moved_instances.size(), node == "Box" ? 1u : p.scene.instances.size());
+    EXPECT_EQ(effects.lights.size(), node == "Box" ? 0u : 2u);
+    EXPECT_GT(effects.moved_texels, 0u);
+    EXPECT_NO_THROW(bytes_of(p));  // texels re-derived as the codec derives them
+  }
+}
+
+// Rotating the sun's node turns the light as the importer would (bit for bit: the same matrices).
+TEST(SceneEditsApply, RotatingALightsNodeTurnsTheLight) {
+  PersistedScene p = baked();
+  const std::array<double, 4> q{-0.5, 0.5, 0.0, std::sqrt(0.5)};  // unit
+  const EditEffects effects = apply_scene_edits(p, {node_edit("sun", std::nullopt, q)});
+  json d = scene_document();
+  d["nodes"][2]["rotation"] = q;
+  const Scene r = import_document(d);
+  // Scene::lights in the order nodes place them: the sun's node (2) before the lamp's (7).
+  EXPECT_EQ(effects.lights, std::vector<uint32_t>{0});
+  EXPECT_TRUE(effects.moved_instances.empty());
+  const PunctualLight& sun = p.scene.lights[0];
+  EXPECT_EQ(sun.name, "Sun");
+  EXPECT_EQ(sun.direction.x, r.lights[0].direction.x);
+  EXPECT_EQ(sun.direction.y, r.lights[0].direction.y);
+  EXPECT_EQ(sun.direction.z, r.lights[0].direction.z);
+  EXPECT_GT(length(sun.direction - baked().scene.lights[0].direction), 0.1f);
+  // Rotating a node by q turns -Z into q (-Z) q*: ((x z + y w) * -2, (y z - x w) * -2, -(1 - 2 (x^2 + y^2))).
+  const double x = q[0], y = q[1], z = q[2], w = q[3];
+  EXPECT_NEAR(sun.direction.x, -2 * (x * z + y * w), 4 * kHalfUlp);
+  EXPECT_NEAR(sun.direction.y, -2 * (y * z - x * w), 4 * kHalfUlp);
+  EXPECT_NEAR(sun.direction.z, -(1 - 2 * (x * x + y * y)), 4 * kHalfUlp);
+}
+
+// A matrix node is decomposed (a 90 degree turn about Z, translation (0, 2, 0)) before its rotation
+// is replaced: as importing the node written as translation/rotation/scale.
+TEST(SceneEditsApply, RotatingAMatrixNodeDecomposesIt) {
+  PersistedScene p = baked();
+  const std::array<double, 4> q{0, 0, 0.38268343236508978, 0.92387953251128674};  // 45 degrees about Z
+  apply_scene_edits(p, {node_edit("Group", std::nullopt, q)});
+  EXPECT_FALSE(p.scene.nodes[3].has_matrix);
+  EXPECT_EQ(p.scene.nodes[3].translation, (std::array<double, 3>{0, 2, 0}));
+  EXPECT_EQ(p.scene.nodes[3].scale, (std::array<double, 3>{1, 1, 1}));
+  json d = scene_document();
+  d["nodes"][3].erase("matrix");
+  d["nodes"][3]["translation"] = {0, 2, 0};
+  d["nodes"][3]["rotation"] = q;
+  expect_geometry_as_imported(p, reimport(d), 1.0);
+}
+
+// Scale keeps the texel count (the atlas stays) and scales the world texel size; a mirroring scale
+// flips the winding as the importer does, so the front side stays the front side.
+TEST(SceneEditsApply, ScaleKeepsTexelsAndMirrorsLikeTheImporter) {
+  for (const std::array<double, 3> scale : {std::array<double, 3>{2, 2, 2}, std::array<double, 3>{-1, 1, 1}}) {
+    SCOPED_TRACE("scale x " + std::to_string(scale[0]));
+    PersistedScene p = baked();
+    apply_scene_edits(p, {node_edit("Box", std::nullopt, std::nullopt, scale)});
+    json d = scene_document();
+    d["nodes"][1]["scale"] = scale;
+    expect_geometry_as_imported(p, reimport(d), std::fabs(scale[0]));
+    EXPECT_EQ(p.gbuffer.texels.size(), baked().gbuffer.texels.size());
+    for (size_t i = 0; i < p.gbuffer.texels.size(); ++i) {
+      if (p.scene.instances[p.gbuffer.texels[i].instance].node != 1) continue;
+      ASSERT_NEAR(p.gbuffer.texels[i].world_texel_size, std::fabs(scale[0]) * baked().gbuffer.texels[i].world_texel_size,
+                  8 * kHalfUlp * p.gbuffer.texels[i].world_texel_size);
+    }
+    EXPECT_NO_THROW(bytes_of(p));
+  }
+}
+
+// A texel the unocclude step pushed off its surface point keeps the push, moved rigidly.
+TEST(SceneEditsApply, PushedTexelsMoveRigidly) {
+  PersistedScene p = baked();
+  size_t pushed = 0;
+  while (p.scene.instances[p.gbuffer.texels[pushed].instance].node != 1) ++pushed;
+  const Vec3 offset{0.01f, -0.02f, 0.03f};
+  p.gbuffer.texels[pushed].position = p.gbuffer.texels[pushed].position + offset;
+  const Vec3 old_position = p.gbuffer.texels[pushed].position;
+  const Matrix4d old_world = p.scene.instances[p.gbuffer.texels[pushed].instance].world;
+  apply_scene_edits(p, {node_edit("Box", std::array<double, 3>{0, 4, 0})});
+  const Matrix4d& new_world = p.scene.instances[p.gbuffer.texels[pushed].instance].world;
+  const Vec3 expected = transform_point(multiply(new_world, *affine_inverse(old_world)), old_position);
+  EXPECT_EQ(p.gbuffer.texels[pushed].position.x, expected.x);
+  EXPECT_EQ(p.gbuffer.texels[pushed].position.y, expected.y);
+  EXPECT_EQ(p.gbuffer.texels[pushed].position.z, expected.z);
+  EXPECT_NO_THROW(bytes_of(p));  // kept in scene.bin's moved-texel table
+}
+
+TEST(SceneEditsApply, LightIntensityAndColourKeepTheOtherPart) {
+  PersistedScene p = baked();
+  ASSERT_EQ(baked().scene.lights[1].name, "Lamp");
+  const Vec3 baked_intensity = baked().scene.lights[1].intensity;  // (1, 0.9, 0.8) x 5
+  const EditEffects effects = apply_scene_edits(p, {light_intensity(EditTarget{"Lamp", {}}, 2)});
+  EXPECT_EQ(effects.lights, std::vector<uint32_t>{1});
+  // colour = product / 5 and x 2: three float roundings of a value <= 2.
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(p.scene.lights[1].intensity[c], baked_intensity[c] * 2 / 5, 3 * 2 * kHalfUlp * 2);
+  LightEdit colour;
+  colour.light.name = "Lamp";
+  colour.color = {0.5f, 1.0f, 0.25f};
+  colour.inner_cone_angle = 0.1;
+  colour.outer_cone_angle = 0.9;
+  apply_scene_edits(p, {{colour, ""}});
+  EXPECT_NEAR(p.scene.lights[1].intensity.x, 1.0f, 3 * 2 * kHalfUlp * 2);  // intensity 2 kept
+  EXPECT_NEAR(p.scene.lights[1].intensity.y, 2.0f, 3 * 2 * kHalfUlp * 2);
+  EXPECT_NEAR(p.scene.lights[1].intensity.z, 0.5f, 3 * 2 * kHalfUlp * 2);
+  EXPECT_EQ(p.scene.lights[1].cos_inner, float(std::cos(0.1)));
+  EXPECT_EQ(p.scene.lights[1].cos_outer, float(std::cos(0.9)));
+}
+
+TEST(SceneEditsApply, EmissionStrengthAndFactorKeepTheOtherPart) {
+  PersistedScene p = baked();
+  MaterialEdit strength;
+  strength.material.name = "Panel";
+  strength.emissive_strength = 4;
+  const EditEffects effects = apply_scene_edits(p, {{strength, ""}});
+  EXPECT_EQ(effects.materials, std::vector<uint32_t>{1});
+  EXPECT_EQ(p.scene.materials[1].emission.x, 4.0f);  // factor (1, 0.5, 0.25) as baked, strength 1
+  EXPECT_EQ(p.scene.materials[1].emission.y, 2.0f);
+  EXPECT_EQ(p.scene.materials[1].emission.z, 1.0f);
+  MaterialEdit factor;
+  factor.material.name = "Panel";
+  factor.emissive_factor = {0.5f, 0.5f, 1.0f};
+  apply_scene_edits(p, {{factor, ""}});
+  EXPECT_EQ(p.scene.materials[1].emission.x, 2.0f);  // strength 4 kept
+  EXPECT_EQ(p.scene.materials[1].emission.z, 4.0f);
+}
+
+TEST(SceneEditsApply, SkySetsTheConstantRadiance) {
+  PersistedScene p = baked();
+  const EditEffects effects = apply_scene_edits(p, {{SkyEdit{{0.3f, 0.4f, 0.5f}}, ""}});
+  EXPECT_TRUE(effects.sky);
+  EXPECT_FALSE(effects.geometry_changed());
+  EXPECT_EQ(p.scene.sky.constant.y, 0.4f);
+}
+
+// Every triangle a leaf holds lies inside every box on the path to it.
+void expect_boxes_contain_their_triangles(const Bvh4& bvh, const std::vector<Vec3>& positions) {
+  size_t checked = 0;
+  const auto visit = [&](auto&& self, uint32_t node, std::vector<std::pair<uint32_t, int>>& path) -> void {
+    for (int i = 0; i < 4; ++i) {
+      const uint32_t child = bvh.nodes[node].child[i];
+      if (child == kBvhEmptyChild) continue;
+      path.push_back({node, i});
+      if (child & kBvhLeafBit) {
+        const uint32_t first = (child & ~kBvhLeafBit) >> 2, count = (child & 3u) + 1;
+        for (uint32_t s = first; s < first + count; ++s)
+          for (int k = 0; k < 3; ++k) {
+            const Vec3 p = positions[size_t(bvh.leaf_triangles[s]) * 3 + size_t(k)];
+            for (const auto& [n, c] : path) {
+              const Bvh4Node& b = bvh.nodes[n];
+              ASSERT_TRUE(b.lo_x[c] <= p.x && p.x <= b.hi_x[c] && b.lo_y[c] <= p.y && p.y <= b.hi_y[c] &&
+                          b.lo_z[c] <= p.z && p.z <= b.hi_z[c])
+                  << "triangle " << bvh.leaf_triangles[s] << " outside node " << n << " child " << c;
+            }
+            ++checked;
+          }
+      } else {
+        self(self, child, path);
+      }
+      path.pop_back();
+    }
+  };
+  std::vector<std::pair<uint32_t, int>> path;
+  visit(visit, 0, path);
+  EXPECT_EQ(checked, positions.size());
+}
+
+TEST(Bvh4Refit, MovedTrianglesStayInsideEveryBoxAbove) {
+  PersistedScene p = baked();
+  const Bvh4 built = to_bvh4(p.bvh);
+  // The builder's boxes are the triangles' exact bounds: a refit of unmoved geometry keeps them.
+  Bvh4 same = built;
+  refit_bvh4(same, p.scene.positions);
+  ASSERT_EQ(same.nodes.size(), built.nodes.size());
+  EXPECT_EQ(std::memcmp(same.nodes.data(), built.nodes.data(), built.nodes.size() * sizeof(Bvh4Node)), 0);
+
+  apply_scene_edits(p, {node_edit("Box", std::array<double, 3>{-8, 3, 2}, std::array<double, 4>{0.6, 0, 0, 0.8})});
+  const Bvh4 refit = to_bvh4(p.bvh);
+  EXPECT_EQ(refit.leaf_triangles, built.leaf_triangles);
+  EXPECT_NE(std::memcmp(refit.nodes.data(), built.nodes.data(), built.nodes.size() * sizeof(Bvh4Node)), 0);
+  expect_boxes_contain_their_triangles(refit, p.scene.positions);
+
+  Bvh4 broken = built;
+  broken.leaf_triangles[0] = uint32_t(p.scene.triangle_count());
+  EXPECT_THROW(refit_bvh4(broken, p.scene.positions), std::invalid_argument);
+}
+
+// set_geometry derives what build_lighting_scene derives from the edited scene, over the refit BVH.
+TEST(LightingSceneGeometry, SetGeometryEqualsABuildOfTheEditedScene) {
+  PersistedScene p = baked();
+  LightingScene lighting = build_lighting_scene(std::make_shared<const Scene>(p.scene), to_bvh4(p.bvh));
+  apply_scene_edits(p, {node_edit("Group", std::array<double, 3>{0, 5, 1}), node_edit("Root", std::nullopt, std::nullopt,
+                                                                                      std::array<double, 3>{3, 3, 3})});
+  const auto edited = std::make_shared<const Scene>(p.scene);
+  set_geometry(lighting, edited);
+  const LightingScene fresh = build_lighting_scene(edited, to_bvh4(p.bvh));
+  ASSERT_EQ(lighting.triangles.size(), fresh.triangles.size());
+  EXPECT_EQ(std::memcmp(lighting.triangles.data(), fresh.triangles.data(), fresh.triangles.size() * sizeof(GpuTriangle)), 0);
+  EXPECT_EQ(std::memcmp(lighting.bvh.nodes.data(), fresh.bvh.nodes.data(), fresh.bvh.nodes.size() * sizeof(Bvh4Node)), 0);
+  EXPECT_EQ(lighting.emitter_cdf, fresh.emitter_cdf);
+  EXPECT_EQ(lighting.punctual_cdf, fresh.punctual_cdf);
+  EXPECT_EQ(std::memcmp(lighting.punctual_lights.data(), fresh.punctual_lights.data(),
+                        fresh.punctual_lights.size() * sizeof(GpuPunctualLight)), 0);
+  EXPECT_EQ(lighting.extent, fresh.extent);
+  EXPECT_GT(lighting.extent, 2.5f * build_lighting_scene(std::make_shared<const Scene>(baked().scene), {}).extent);
+
+  Scene fewer = p.scene;
+  fewer.triangle_material.pop_back();
+  const LightingScene kept = lighting;
+  EXPECT_THROW(set_geometry(lighting, std::make_shared<const Scene>(fewer)), std::invalid_argument);
+  EXPECT_EQ(lighting.source, kept.source);
+}
+
+template <typename T>
+bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+// update_lighting_scene takes the cheapest in-place path that covers the effects, and ends where a
+// build of the edited scene over the (refit) BVH starts.
+TEST(SceneEditsLighting, UpdateEqualsABuildOfTheEditedScene) {
+  MaterialEdit strength;
+  strength.material.name = "Panel";
+  strength.emissive_strength = 3;
+  const std::vector<std::vector<SceneEdit>> cases = {
+      {light_intensity(EditTarget{"Lamp", {}}, 9), {strength, ""}, {SkyEdit{{0.1f, 0.2f, 0.3f}}, ""}},
+      {node_edit("Root", std::array<double, 3>{1, 2, 3}, std::array<double, 4>{0, 0.6, 0, 0.8}),
+       light_intensity(EditTarget{"Sun", {}}, 0.5f)},
+  };
+  for (size_t c = 0; c < cases.size(); ++c) {
+    const std::vector<SceneEdit>& edits = cases[c];
+    PersistedScene p = baked();
+    LightingScene lighting = build_lighting_scene(std::make_shared<const Scene>(p.scene), to_bvh4(p.bvh));
+    const EditEffects effects = apply_scene_edits(p, edits);
+    EXPECT_EQ(effects.geometry_changed(), c == 1);
+    const auto edited = std::make_shared<const Scene>(p.scene);
+    update_lighting_scene(lighting, edited, effects);
+    const LightingScene fresh = build_lighting_scene(edited, to_bvh4(p.bvh));
+    EXPECT_TRUE(same_bytes(lighting.triangles, fresh.triangles)) << "case " << c;
+    EXPECT_TRUE(same_bytes(lighting.materials, fresh.materials)) << "case " << c;
+    EXPECT_TRUE(same_bytes(lighting.punctual_lights, fresh.punctual_lights)) << "case " << c;
+    EXPECT_TRUE(same_bytes(lighting.bvh.nodes, fresh.bvh.nodes)) << "case " << c;
+    EXPECT_EQ(lighting.emitter_triangles, fresh.emitter_triangles) << "case " << c;
+    EXPECT_EQ(lighting.emitter_cdf, fresh.emitter_cdf) << "case " << c;
+    EXPECT_EQ(lighting.punctual_cdf, fresh.punctual_cdf) << "case " << c;
+    EXPECT_EQ(lighting.sky.z, fresh.sky.z) << "case " << c;
+    EXPECT_EQ(lighting.extent, fresh.extent) << "case " << c;
+    EXPECT_EQ(lighting.source, edited) << "case " << c;
+  }
+}
+
+}  // namespace
+}  // namespace exitance
