@@ -1,4 +1,4 @@
-// exitance-relight BUNDLE [-o OUT] [--spp N] [--time S] [--budget-ms N] [--frames N] [--seed N] [--device N] [--json]
+// exitance-relight BUNDLE [-o OUT] [--edits EDITS.json] [--spp N] [--time S] [--budget-ms N] [--frames N] [--seed N] [--device N] [--json]
 // Re-lights a baked bundle from its scene.bin on the GPU (runtime/src/relight). Links the runtime
 // library and nothing of the offline stage; runs where only a Vulkan driver exists.
 #include <CLI/CLI.hpp>
@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   bool json_report = false, list_devices = false;
   app.add_option("bundle", options.bundle, "the bundle folder bake wrote (manifest.json, scene.bin, ...)")->required();
   app.add_option("-o,--out", options.output, "output bundle folder (default: the input bundle, replaced atomically)");
+  app.add_option("--edits", options.edits_file, "apply these edits (docs/edits.md) to the scene before the refresh");
   app.add_option("--spp", spp, "samples per texel (default: the bake's; 0 = until --time ends the run)");
   app.add_option("--time", options.time_budget_seconds, "bound the whole lightmap refresh to this many seconds")
       ->check(CLI::NonNegativeNumber);

@@ -9,7 +9,9 @@
 #include <limits>
 
 #include "exitance/formats/format_error.h"
+#include "exitance/formats/scene_file.h"
 #include "exitance/formats/svo_file.h"
+#include "exitance/runtime/refresh/unocclude_near_moved.h"
 
 namespace exitance {
 
@@ -18,7 +20,8 @@ namespace fs = std::filesystem;
 struct RefreshSession::State {
   std::string bundle;
   formats::BundleManifest manifest;
-  formats::SceneFile scene_file;  // as read: encoding it again gives its bytes back
+  // As read (encoding it again gives its bytes back); empty after an edit until asked for.
+  mutable std::optional<formats::SceneFile> scene_file;
   PersistedScene persisted;
   std::optional<formats::SparseVoxelOctree> svo;
   std::shared_ptr<const LightingScene> lighting;
@@ -56,7 +59,7 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
     throw BundleInputError(manifest_path + ": scene: bake wrote no scene.bin (" + manifest.scene->skipped + "); re-bake instead");
   try {
     state->scene_file = formats::read_scene_file((bundle / manifest.scene->file).string());
-    state->persisted = restore_scene(state->scene_file);
+    state->persisted = restore_scene(*state->scene_file);
     if (manifest.svo) state->svo = formats::read_svo_file((bundle / manifest.svo->file).string());
   } catch (const formats::FormatError& e) {
     throw BundleInputError(e.what());
@@ -84,6 +87,28 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
 
 RefreshSession::RefreshSession(std::unique_ptr<State> state) : state_(std::move(state)) {}
 RefreshSession::~RefreshSession() = default;
+
+EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
+  State& s = *state_;
+  // Everything on copies first; the session changes only when every step succeeded.
+  PersistedScene edited = s.persisted;
+  const EditEffects effects = apply_scene_edits(edited, edits);
+  LightingScene lighting = *s.lighting;
+  update_lighting_scene(lighting, std::make_shared<const Scene>(edited.scene), effects);
+  unocclude_near_moved(edited, s.persisted.scene, lighting, effects);
+
+  if (effects.geometry_changed()) {
+    s.integrator->update_geometry(lighting);
+  } else {
+    if (!effects.materials.empty()) s.integrator->update_materials(lighting);
+    if (!effects.lights.empty() || effects.sky) s.integrator->update_lights(lighting);
+  }
+  s.persisted = std::move(edited);
+  s.lighting = std::make_shared<const LightingScene>(std::move(lighting));
+  s.scene_file.reset();  // encoded again from the edited scene when a bundle is written
+  restart();  // moved texels are uploaded again with the rest
+  return effects;
+}
 
 void RefreshSession::restart() { state_->integrator->start_progressive(state_->persisted.gbuffer, state_->settings); }
 
@@ -150,7 +175,13 @@ ProbeEstimate RefreshSession::probe_estimate(uint32_t spp) {
 
 const std::string& RefreshSession::bundle() const { return state_->bundle; }
 const formats::BundleManifest& RefreshSession::manifest() const { return state_->manifest; }
-const formats::SceneFile& RefreshSession::scene_file() const { return state_->scene_file; }
+const formats::SceneFile& RefreshSession::scene_file() const {
+  const State& s = *state_;
+  if (!s.scene_file)
+    s.scene_file = make_scene_file(s.persisted.scene, s.persisted.gbuffer, s.persisted.atlas,
+                                   s.persisted.has_probe_grid() ? &s.persisted.probes : nullptr, s.persisted.bvh);
+  return *s.scene_file;
+}
 const PersistedScene& RefreshSession::persisted() const { return state_->persisted; }
 const LightingScene& RefreshSession::lighting_scene() const { return *state_->lighting; }
 const formats::SparseVoxelOctree* RefreshSession::svo() const { return state_->svo ? &*state_->svo : nullptr; }

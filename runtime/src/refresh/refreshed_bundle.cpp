@@ -97,7 +97,8 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   report["tool"] = "exitance-relight";
   report["source_bundle"] = fs::absolute(bundle).lexically_normal().string();
   report["source_generator"] = manifest.generator;
-  report["what"] = "full relight from scene.bin: lightmaps, probes and voxel exitance recomputed; input lightmaps not read";
+  report["what"] = std::string(report.contains("edits") ? "scene.bin edited, then " : "") +
+                   "full relight from scene.bin: lightmaps, probes and voxel exitance recomputed; input lightmaps not read";
   report["device"] = integrator.device_description();
   report["spp"] = integrator.progressive_samples();
   report["seed"] = session.settings().seed;
@@ -119,6 +120,8 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
     manifest.svo->vdb.clear();
     manifest.svo->vdb_note = "radiance.vdb is an inspection export of bake; exitance-relight does not write it";
   }
+  const std::vector<uint8_t> scene_bytes = formats::encode_scene(session.scene_file());
+  manifest.scene->bytes = scene_bytes.size();
   manifest.relight_json = report.dump();
   const std::string manifest_text = formats::write_bundle_manifest(manifest);
   if (check_before_write) check_before_write();
@@ -129,7 +132,9 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
       formats::write_lightmap_exr((dir / manifest.pages[p].file).string(), pages[p]);
     if (has_probes) formats::write_probes_file((dir / manifest.probes->file).string(), persisted.probes);
     if (svo) formats::write_svo_file((dir / manifest.svo->file).string(), *svo);
-    formats::write_scene_file((dir / manifest.scene->file).string(), session.scene_file());
+    std::ofstream scene_out(dir / manifest.scene->file, std::ios::binary);
+    scene_out.write(reinterpret_cast<const char*>(scene_bytes.data()), std::streamsize(scene_bytes.size()));
+    if (!scene_out) throw std::runtime_error("cannot write " + (dir / manifest.scene->file).string());
     std::ofstream file(dir / "manifest.json");
     file << manifest_text;
     if (!file) throw std::runtime_error("cannot write " + (dir / "manifest.json").string());

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <memory>
 
@@ -44,6 +46,28 @@ json relight_bundle(const RelightOptions& options) {
   const std::unique_ptr<RefreshSession> session = RefreshSession::open(options.bundle, session_options);
   const formats::BakeSettings baked = session->manifest().settings.value_or(formats::BakeSettings{});
   lap("load");
+
+  json edits_report;
+  if (!options.edits_file.empty()) {
+    report("edits", 0, 0);
+    std::ifstream in(options.edits_file, std::ios::binary);
+    if (!in) throw RelightInputError(options.edits_file + ": cannot read the edits file");
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    try {
+      const std::vector<SceneEdit> edits = parse_scene_edits(text, options.edits_file);
+      const EditEffects effects = session->apply_edits(edits);
+      edits_report = {{"file", fs::absolute(options.edits_file).lexically_normal().string()},
+                      {"edits", edits.size()},
+                      {"moved_instances", effects.moved_instances},
+                      {"moved_texels", effects.moved_texels},
+                      {"lights", effects.lights},
+                      {"materials", effects.materials},
+                      {"sky", effects.sky}};
+    } catch (const SceneEditError& e) {
+      throw RelightInputError(e.what());
+    }
+    lap("edits");
+  }
 
   // The sample cap: --spp, else the bake's unless a time budget bounds the run.
   const uint32_t spp = options.spp ? *options.spp : (options.time_budget_seconds > 0 ? 0u : baked.spp);
@@ -95,6 +119,7 @@ json relight_bundle(const RelightOptions& options) {
   run["lighting_seconds"] = lighting_seconds;
   run["rays_per_second"] = lighting_seconds > 0 ? double(rays) / lighting_seconds : 0.0;
   if (options.stage_statistics) run["stages"] = stages;
+  if (!edits_report.is_null()) run["edits"] = edits_report;
   if (options.traversal_rays > 0)
     run["traversal_only_rays_per_second"] = session->integrator().measure_incoherent_traversal(options.traversal_rays);
   json written = write_refreshed_bundle(*session, out.string(), run, options.progress,

@@ -5,8 +5,8 @@
 // refresh() adds samples to every live texel, continuing the sample indices of the calls before:
 // after N samples in any number of calls the lightmap equals bake --backend vulkan's N samples
 // with the same seed. restart() (after an edit) drops every accumulated sample, so no texel keeps
-// a value from before it. Probes and voxel exitance are computed on request (probe_estimate,
-// fill_svo_exitance), not per frame yet.
+// a value from before it; apply_edits restarts. Probes and voxel exitance are computed on request
+// (probe_estimate, fill_svo_exitance), not per frame yet.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -21,6 +21,7 @@
 #include "exitance/runtime/core/estimates.h"
 #include "exitance/runtime/core/integrator_settings.h"
 #include "exitance/runtime/core/lighting_scene.h"
+#include "exitance/runtime/refresh/scene_edits.h"
 #include "exitance/runtime/scene_file_conversion.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 
@@ -63,6 +64,12 @@ class RefreshSession {
   RefreshSession(const RefreshSession&) = delete;
   RefreshSession& operator=(const RefreshSession&) = delete;
 
+  // Applies `edits` (scene_edits.h, docs/edits.md) to the session's scene, the device's copy of it
+  // and scene.bin as write_refreshed_bundle will write it, then restarts the accumulation, so no
+  // texel keeps a value from before the edit. All or nothing: throws SceneEditError (one line
+  // naming the edit and the problem) with the session unchanged. std::runtime_error on device
+  // failure.
+  EditEffects apply_edits(const std::vector<SceneEdit>& edits);
   // Drops every accumulated sample; the next refresh starts at sample 0.
   void restart();
   RefreshReport refresh(const RefreshBudget& budget);
@@ -80,6 +87,8 @@ class RefreshSession {
 
   const std::string& bundle() const;
   const formats::BundleManifest& manifest() const;
+  // scene.bin's records of the session's scene: as read, or encoded from the edited scene (throws
+  // formats::FormatError if that cannot be stored: not expected, edits add nothing scene.bin lacks).
   const formats::SceneFile& scene_file() const;
   const PersistedScene& persisted() const;
   const LightingScene& lighting_scene() const;

@@ -20,6 +20,7 @@ using RelightInputError = BundleInputError;
 struct RelightOptions {
   std::string bundle;              // the input bundle folder (manifest.json + scene.bin + svo.bin ...)
   std::string output;              // empty: the input bundle, replaced atomically
+  std::string edits_file;          // EDITS.json (docs/edits.md) applied before the refresh; empty: none
   // Limits; the lightmap refresh ends at whichever comes first.
   std::optional<uint32_t> spp;     // samples per texel; default: the bake's, or none with --time
   double time_budget_seconds = 0;  // > 0: the whole lightmap refresh

@@ -1,0 +1,20 @@
+// After an edit moved instances (apply_scene_edits), the unocclude step again near them: a texel
+// the moved object used to bury (a floor texel where a box stood) must come back to its surface
+// point, and one it now buries must be pushed out, as a fresh bake would do.
+#pragma once
+#include <cstddef>
+
+#include "exitance/runtime/core/lighting_scene.h"
+#include "exitance/runtime/refresh/scene_edits.h"
+#include "exitance/runtime/scene_file_conversion.h"
+
+namespace exitance {
+
+// Every live texel within unocclude's reach (0.75 texel) of a moved instance's bounds before or
+// after the edit goes back to its surface point (texel_surface.h, as the rasterizer places it) and
+// through unocclude_texel on `edited_lighting` (the edited scene, its BVH refit), on the CPU.
+// `before`: the scene before the edit. Returns the number of texels reconsidered.
+size_t unocclude_near_moved(PersistedScene& edited, const Scene& before, const LightingScene& edited_lighting,
+                            const EditEffects& effects);
+
+}  // namespace exitance
