@@ -7,6 +7,10 @@ time to reach the target relMSE and of relMSE at equal time, as ratios to the CP
 measured in the same run. References are cached by content hash in ~/.cache/exitance.
 
   /usr/bin/python3 bench/run_time_vs_error.py --build build --out bench/results [--quick]
+      [--integrators path,bounces] [--report NAME]
+
+--report names the CSV, plot and table (default time_vs_error); the per-bounce mode's figures
+(bench/results/per-bounce.md) come from --backends cpu --integrators path,bounces --report per-bounce.
 
 (Debian's python3 has python3-matplotlib; a pyenv python3 on PATH may not.)
 """
@@ -28,10 +32,10 @@ SCENES = [
 ]
 
 
-def run_scene(build, backends, name, sky, density, reference_spp, max_spp, max_seconds, target):
+def run_scene(build, backends, integrators, name, sky, density, reference_spp, max_spp, max_seconds, target):
     tool = os.path.join(build, "bench", "bench_time_to_error")
     scene = os.path.join(build, "samples", name + ".gltf")
-    command = [tool, scene, "--backends", backends, "--name", name, "--texel-density", str(density), "--reference-spp", str(reference_spp),
+    command = [tool, scene, "--backends", backends, "--integrators", integrators, "--name", name, "--texel-density", str(density), "--reference-spp", str(reference_spp),
                "--max-spp", str(max_spp), "--max-seconds", str(max_seconds), "--target", str(target)]
     if sky:
         command += ["--sky", sky]
@@ -64,6 +68,8 @@ def main():
     parser.add_argument("--max-seconds", type=float, default=60)
     parser.add_argument("--only", default="")
     parser.add_argument("--backends", default="cpu,vulkan")
+    parser.add_argument("--integrators", default="path")
+    parser.add_argument("--report", default="time_vs_error")
     parser.add_argument("--quick", action="store_true", help="4x fewer reference and ladder samples")
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
@@ -74,12 +80,12 @@ def main():
             continue
         if args.quick:
             reference_spp, max_spp = max(64, reference_spp // 4), max(16, max_spp // 4)
-        rows, command = run_scene(args.build, args.backends, name, sky, density, reference_spp, max_spp, args.max_seconds, args.target)
+        rows, command = run_scene(args.build, args.backends, args.integrators, name, sky, density, reference_spp, max_spp, args.max_seconds, args.target)
         all_rows += rows
         commands.append(" ".join(command))
 
     stamp = time.strftime("%Y-%m-%d")
-    csv_path = os.path.join(args.out, "time_vs_error.csv")
+    csv_path = os.path.join(args.out, args.report + ".csv")
     with open(csv_path, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=list(all_rows[0].keys()))
         writer.writeheader()
@@ -107,7 +113,7 @@ def main():
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
     fig.tight_layout()
-    png_path = os.path.join(args.out, "time_vs_error.png")
+    png_path = os.path.join(args.out, args.report + ".png")
     fig.savefig(png_path, dpi=110)
 
     lines = [f"# Time against error ({stamp})", "",
@@ -117,7 +123,8 @@ def main():
              f"relMSE (column reference_rel_mse of {os.path.basename(csv_path)}). Machine: 2 shared cores; absolute "
              "seconds are noisy, ratios inside one run are what count.", "",
              f"| scene | backend | integrator | live texels | time to relMSE {args.target:g} (s) | relMSE at the largest run | "
-             "rays/s | ratio of time to the CPU reference |", "|---|---|---|---|---|---|---|---|"]
+             "rays/s | ratio of time to the CPU reference | bounces, bias relMSE (per-bounce) |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for (scene, backend, integrator), rows in sorted(groups.items()):
         t = time_to_target(rows, args.target)
         base = time_to_target(groups.get((scene, "cpu", "path_tracing"), []), args.target)
@@ -127,8 +134,12 @@ def main():
                      f"{t:.3g}" if t else f"| {scene} | {backend} | {integrator} | {last['live_texels']} | not reached")
         lines[-1] += (f" | {float(last['rel_mse']):.3g} at {float(last['seconds']):.3g} s ({last['spp']} spp) | "
                       f"{float(last['rays_per_second']) / 1e6:.2f} M | {ratio} |")
+        if integrator == "per_bounce":
+            lines[-1] += f" {last['bounces']}, {float(last['bias_rel_mse']):.2g} |"
+        else:
+            lines[-1] += " - |"
     lines += ["", f"![time against error]({os.path.basename(png_path)})", ""]
-    with open(os.path.join(args.out, "time_vs_error.md"), "w") as f:
+    with open(os.path.join(args.out, args.report + ".md"), "w") as f:
         f.write("\n".join(lines))
     print("\n".join(lines))
 

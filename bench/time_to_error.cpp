@@ -2,9 +2,15 @@
 // content hash outside the repository) is the reference; runs at doubling spp record seconds,
 // relMSE, MAE, worst-texel error and rays/s as CSV, and the time to reach a target relMSE.
 //
-//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--name NAME] [--sky R,G,B] [--texel-density T]
-//                       [--reference-spp N] [--max-spp N] [--max-seconds S] [--target 0.01]
-//                       [--cache DIR] [--csv FILE]
+//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,bounces] [--name NAME]
+//                       [--sky R,G,B] [--texel-density T] [--reference-spp N] [--max-spp N]
+//                       [--max-seconds S] [--target 0.01] [--cache DIR] [--csv FILE]
+//
+// The reference is always the CPU path tracer. For the per-bounce mode (integrator per_bounce) the
+// CSV also has the bounces run, the fraction of gather hits without texels, and bias_rel_mse: at
+// every rung a second run with another seed, and the mean over texels of w (x1 - r)(x2 - r) minus
+// the reference's noise - the two runs' noises are independent, so this estimates the squared
+// bias alone (relMSE units), whatever the noise (it can come out slightly negative).
 //
 // relMSE = mean over live texels and channels of (x - r)^2 / (r^2 + 1e-3): the 1e-3 keeps
 // black texels from dominating (the usual regulariser of relMSE in rendering papers).
@@ -63,7 +69,7 @@ std::vector<float> flatten(const LightmapEstimate& estimate) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string scene_path, scene_name, sky, csv_path, cache_dir, backends = "cpu";
+  std::string scene_path, scene_name, sky, csv_path, cache_dir, backends = "cpu", integrators = "path";
   double max_seconds = 120;
   float density = 8;
   uint32_t reference_spp = 8192, max_spp = 1024;
@@ -71,6 +77,7 @@ int main(int argc, char** argv) {
   CLI::App app{"time against error of the CPU reference"};
   app.add_option("scene", scene_path)->required();
   app.add_option("--backends", backends, "comma-separated: cpu, vulkan (the reference is always cpu)");
+  app.add_option("--integrators", integrators, "comma-separated: path, bounces");
   app.add_option("--name", scene_name, "scene name in the CSV (default: file stem)");
   app.add_option("--max-seconds", max_seconds, "stop the ladder after a run longer than this");
   app.add_option("--sky", sky);
@@ -138,41 +145,66 @@ int main(int argc, char** argv) {
   if (!csv_path.empty()) csv_file.open(csv_path);
   std::ostream& csv = csv_path.empty() ? std::cout : csv_file;
   csv << "backend,integrator,scene,live_texels,spp,seconds,rel_mse,raw_rel_mse,reference_rel_mse,mae,worst_texel_error,"
-         "rays_per_second\n";
-  for (const std::shared_ptr<const Integrator>& backend : measured) {
-    {  // Warm-up, not recorded: lavapipe and GPU drivers compile pipelines at the first dispatch.
-      IntegratorSettings warm_up;
-      warm_up.spp = 1;
-      backend->bake(gbuffer, warm_up);
-    }
-    double previous_seconds = 0, previous_error = 0, time_to_target = -1;
-    for (uint32_t spp = 1; spp <= max_spp; spp *= 2) {
-      IntegratorSettings settings;
-      settings.spp = spp;
-      settings.seed = spp;
-      const LightmapEstimate estimate = backend->bake(gbuffer, settings);
-      std::vector<float> result = flatten(estimate);
-      result.resize(values);
-      ErrorFigures e = compare(result, reference_mean);
-      const double raw = e.rel_mse;
-      e.rel_mse = std::max(raw - reference_noise, 1e-12);
-      csv << backend->backend_name() << ",path_tracing," << scene_name << "," << gbuffer.texels.size() << "," << spp << ","
-          << estimate.seconds << "," << e.rel_mse << "," << raw << "," << reference_noise << "," << e.mae << ","
-          << e.worst << "," << double(estimate.rays) / estimate.seconds << std::endl;
-      if (time_to_target < 0 && e.rel_mse <= target) {
-        // Log-log interpolation between the two runs that bracket the target.
-        time_to_target = previous_seconds > 0
-                             ? std::exp(std::log(previous_seconds) + (std::log(target) - std::log(previous_error)) /
-                                                                         (std::log(e.rel_mse) - std::log(previous_error)) *
-                                                                         (std::log(estimate.seconds) - std::log(previous_seconds)))
-                             : estimate.seconds;
+         "rays_per_second,bounces,texelless_fraction,bias_rel_mse\n";
+  std::vector<IntegratorMode> modes;
+  if (integrators.find("path") != std::string::npos) modes.push_back(IntegratorMode::Path);
+  if (integrators.find("bounces") != std::string::npos) modes.push_back(IntegratorMode::Bounces);
+  for (const std::shared_ptr<const Integrator>& backend : measured)
+    for (IntegratorMode mode : modes) {
+      const char* mode_name = mode == IntegratorMode::Path ? "path_tracing" : "per_bounce";
+      {  // Warm-up, not recorded: lavapipe and GPU drivers compile pipelines at the first dispatch.
+        IntegratorSettings warm_up;
+        warm_up.spp = 1;
+        warm_up.integrator = mode;
+        try {
+          backend->bake(gbuffer, warm_up);
+        } catch (const std::exception& e) {
+          std::cerr << backend->backend_name() << " " << mode_name << " skipped: " << e.what() << "\n";
+          continue;
+        }
       }
-      previous_seconds = estimate.seconds;
-      previous_error = e.rel_mse;
-      if (estimate.seconds > max_seconds) break;
+      double previous_seconds = 0, previous_error = 0, time_to_target = -1;
+      for (uint32_t spp = 1; spp <= max_spp; spp *= 2) {
+        IntegratorSettings settings;
+        settings.spp = spp;
+        settings.seed = spp;
+        settings.integrator = mode;
+        const LightmapEstimate estimate = backend->bake(gbuffer, settings);
+        std::vector<float> result = flatten(estimate);
+        result.resize(values);
+        ErrorFigures e = compare(result, reference_mean);
+        const double raw = e.rel_mse;
+        e.rel_mse = std::max(raw - reference_noise, 1e-12);
+        double bias = 0, texelless = 0;
+        if (mode == IntegratorMode::Bounces) {
+          settings.seed = spp + 0x10000;
+          std::vector<float> second = flatten(backend->bake(gbuffer, settings));
+          for (size_t i = 0; i < values; ++i)
+            bias += (double(result[i]) - reference_mean[i]) * (double(second[i]) - reference_mean[i]) *
+                    rel_mse_weight(reference_mean[i]);
+          bias = bias / double(values) - reference_noise;
+          const BounceGatherStatistics& b = estimate.bounce_statistics;
+          texelless = b.gathers ? double(b.texelless_hits) / double(b.gathers) : 0.0;
+        }
+        csv << backend->backend_name() << "," << mode_name << "," << scene_name << "," << gbuffer.texels.size() << ","
+            << spp << "," << estimate.seconds << "," << e.rel_mse << "," << raw << "," << reference_noise << "," << e.mae
+            << "," << e.worst << "," << double(estimate.rays) / estimate.seconds << ","
+            << estimate.bounce_statistics.bounces << "," << texelless << "," << bias << std::endl;
+        if (time_to_target < 0 && e.rel_mse <= target) {
+          // Log-log interpolation between the two runs that bracket the target.
+          time_to_target = previous_seconds > 0
+                               ? std::exp(std::log(previous_seconds) + (std::log(target) - std::log(previous_error)) /
+                                                                           (std::log(e.rel_mse) - std::log(previous_error)) *
+                                                                           (std::log(estimate.seconds) - std::log(previous_seconds)))
+                               : estimate.seconds;
+        }
+        previous_seconds = estimate.seconds;
+        previous_error = e.rel_mse;
+        if (estimate.seconds > max_seconds) break;
+      }
+      std::cerr << backend->backend_name() << " " << mode_name << ": live texels " << gbuffer.texels.size()
+                << "; time to relMSE " << target << ": "
+                << (time_to_target < 0 ? std::string("not reached") : std::to_string(time_to_target) + " s") << "\n";
     }
-    std::cerr << backend->backend_name() << ": live texels " << gbuffer.texels.size() << "; time to relMSE " << target << ": "
-              << (time_to_target < 0 ? std::string("not reached") : std::to_string(time_to_target) + " s") << "\n";
-  }
   return 0;
 }

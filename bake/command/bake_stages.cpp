@@ -60,7 +60,13 @@ SceneForLighting build_lighting_scene_stage(Scene scene, const BakeOptions& opti
 std::shared_ptr<const Integrator> backend_stage(const SceneForLighting& scene, const BakeOptions& options,
                                                 Diagnostics& diagnostics) {
   options.announce_stage("backend");
-  return choose_lighting_backend(scene.lighting, scene.embree, options.backend, diagnostics);
+  BackendRequest request = options.backend;
+  if (options.lighting.integrator == IntegratorMode::Bounces && request.name == "auto") {
+    // The per-bounce mode exists on the CPU backend only for now (the Vulkan backend refuses it).
+    request.name = "cpu";
+    diagnostics.warn("--integrator bounces: using the CPU reference (Embree), the only backend with per-bounce passes yet");
+  }
+  return choose_lighting_backend(scene.lighting, scene.embree, request, diagnostics);
 }
 
 size_t unocclude_stage(const SceneForLighting& scene, TexelGBuffer& gbuffer) {

@@ -51,8 +51,14 @@ int main(int argc, char** argv) {
                  "stop a texel once its relative standard error is below this")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--bounces", options.lighting.max_bounces,
-                 "maximum diffuse bounces (default: until Russian roulette ends the path)")
+                 "maximum diffuse bounces (default: path: until Russian roulette ends the path; bounces: until the "
+                 "extrapolated tail is below the noise)")
       ->check(CLI::NonNegativeNumber);
+  std::string integrator = "path";
+  app.add_option("--integrator", integrator,
+                 "path (unbiased path tracing) | bounces (per-bounce gather passes; CPU backend only, biased by the "
+                 "lightmap resolution: bench/results/per-bounce.md)")
+      ->check(CLI::IsMember({"path", "bounces"}));
   app.add_option("--sky", options.sky, "sky radiance: R,G,B or an equirectangular image (EXR/HDR)");
   app.add_option("--seed", options.lighting.seed, "random seed; results are deterministic per seed and backend");
   app.add_flag("--bounce-layers", options.bounce_layers, "also write bounce<k>.R/G/B debug layers");
@@ -122,6 +128,7 @@ int main(int argc, char** argv) {
     }
     options.voxel_resolution = uint32_t(resolution);
   }
+  if (integrator == "bounces") options.lighting.integrator = exitance::IntegratorMode::Bounces;
   if (!directional.empty()) diagnostics.warn("--directional: directional lightmaps are not implemented yet; ignored");
   if (guiding == "svo" || guiding == "grid") {
     std::cerr << "bake: error: --guiding " << guiding << " is not implemented yet (use off)\n";

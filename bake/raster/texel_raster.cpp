@@ -21,6 +21,7 @@ struct TexelCandidate {
 TexelGBuffer rasterize_texel_gbuffer(const Scene& scene, const AtlasLayout& layout, const std::string& file,
                                      Diagnostics& diagnostics) {
   TexelGBuffer gbuffer;
+  gbuffer.instance_rects = layout.rects;
   std::vector<std::vector<TexelCandidate>> candidates;
   for (const auto& [w, h] : layout.page_sizes) {
     AtlasPage page;

@@ -237,6 +237,7 @@ PersistedScene restore_scene(const formats::SceneFile& file) {
   scene.sky.constant = from_record(file.sky);
 
   out.gbuffer = decode_texel_gbuffer(file.texels, scene);
+  out.gbuffer.instance_rects = out.atlas.rects;  // as the raster stage's G-buffer has them
   out.probes = file.probes;
   for (formats::ProbeRecord& r : out.probes.probes) r.sh = {};
   out.bvh = file.bvh;

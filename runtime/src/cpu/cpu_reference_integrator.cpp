@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 
+#include "cpu_bounce_integrator.h"
 #include "exitance/runtime/core/pass_scheduler.h"
 #include "exitance/runtime/core/scene_access.h"
 #include "exitance/runtime/embree_scene.h"
@@ -118,6 +119,7 @@ std::string CpuReferenceIntegrator::device_description() const {
 }
 
 LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const {
+  if (settings.integrator == IntegratorMode::Bounces) return bake_per_bounce(*impl_->lighting, *impl_->embree, gbuffer, settings);
   const auto start = std::chrono::steady_clock::now();
   const size_t texel_count = gbuffer.texels.size();
   LightmapEstimate estimate;

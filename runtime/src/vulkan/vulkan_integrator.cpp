@@ -55,6 +55,7 @@ VulkanIntegrator::VulkanIntegrator(std::unique_ptr<Impl> impl) : impl_(std::move
 VulkanIntegrator::~VulkanIntegrator() = default;
 
 LightmapEstimate VulkanIntegrator::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const {
+  if (settings.integrator == IntegratorMode::Bounces) throw std::runtime_error("Vulkan backend: --integrator bounces is implemented on the CPU backend only (use --backend cpu)");
   if (settings.spp == 0 && !(settings.time_budget_seconds > 0) && !(settings.target_relative_error > 0))
     throw std::invalid_argument("Vulkan backend: spp 0 needs a time budget or a target error");
   return impl_->lightmap.bake(gbuffer, settings);

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "exitance/runtime/lightmap_atlas.h"
 #include "exitance/runtime/vec_math.h"
 
 namespace exitance {
@@ -29,6 +30,9 @@ struct TexelGBuffer {
   std::vector<AtlasPage> pages;
   std::vector<LiveTexel> texels;  // live texels only, page-major, Morton order inside a page
   size_t skipped_texels = 0;      // texels of the pages not covered by any chart
+  // Per scene instance, its atlas rectangle (page, scale_offset): how a ray hit finds its texels (the
+  // per-bounce gather). Empty for hand-made G-buffers: then no hit has texels.
+  std::vector<InstanceRect> instance_rects;
 };
 
 }  // namespace exitance

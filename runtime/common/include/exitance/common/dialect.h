@@ -52,6 +52,7 @@ inline uint max(uint a, uint b) { return a < b ? b : a; }
 inline int max(int a, int b) { return a < b ? b : a; }
 inline float clamp(float x, float lo, float hi) { return min(max(x, lo), hi); }
 inline float sqrt(float a) { return std::sqrt(a); }
+inline float floor(float a) { return std::floor(a); }
 inline float cos(float a) { return std::cos(a); }
 inline float sin(float a) { return std::sin(a); }
 inline bool isinf(float a) { return std::isinf(a); }

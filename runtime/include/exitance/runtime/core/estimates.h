@@ -18,6 +18,19 @@ struct TexelAccumulator {
   uint32_t samples = 0;
 };
 
+// What the per-bounce mode (IntegratorMode::Bounces) did; all zero in path mode.
+struct BounceGatherStatistics {
+  int bounces = 0;                 // indirect passes run: layers B_0 .. B_bounces
+  std::vector<uint32_t> samples;   // per layer, samples per texel (a time budget can leave later layers behind)
+  uint64_t gathers = 0;            // gather rays that hit a surface
+  uint64_t texelless_hits = 0;     // of those, hits with no lit texel to read (estimated on the fly instead)
+  uint64_t back_face_hits = 0;     // of those, back faces of single-sided surfaces (0, as in path mode)
+  double ratio = 0;                // B_k / B_{k-1} of the last two layers (area-weighted)
+  double tail_rms = 0;             // the extrapolated tail at the stop, relative RMS (bounce_tail.h)
+  double noise_rms = 0;            // the total's noise at the stop, relative RMS
+  bool tail_below_noise = false;   // false: stopped by --bounces, the time budget or the layer cap
+};
+
 struct LightmapEstimate {
   std::vector<TexelAccumulator> texels;
   std::vector<double> bounces;  // [bounce][texel][rgb] flattened: (k * texel_count + i) * 3 + c
@@ -25,6 +38,7 @@ struct LightmapEstimate {
   uint64_t rays = 0;
   double seconds = 0;
   uint64_t nonfinite_samples = 0;  // samples discarded because they were NaN/Inf (should stay 0)
+  BounceGatherStatistics bounce_statistics;
 
   Vec3 mean_total(size_t texel) const;
   Vec3 mean_direct(size_t texel) const;

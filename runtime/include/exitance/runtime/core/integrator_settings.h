@@ -5,7 +5,19 @@
 
 namespace exitance {
 
+// How texels are lit (bake --integrator). Path: the unbiased path tracer of path.h, one path per
+// sample. Bounces: per-bounce passes (seed 003, issue 10): B_0 = direct light; pass k+1 gathers, at
+// the hits of cosine rays from every texel, the stored outgoing radiance albedo * B_k of the hit's
+// lightmap texels (bilinear) - a cache lookup with a resolution bias, measured in
+// bench/results/per-bounce.md. See docs/lighting-core.md, "Per-bounce mode".
+enum class IntegratorMode { Path, Bounces };
+
 struct IntegratorSettings {
+  IntegratorMode integrator = IntegratorMode::Path;
+  // spp, time_budget_seconds and target_relative_error mean the same in both modes. Bounces: spp is
+  // the samples per texel of every bounce pass (B_0: direct-light samples; k >= 1: gather rays);
+  // max_bounces = N forces the passes B_0..B_N, -1 = until the extrapolated tail is below the noise;
+  // every pass is recorded (recorded_bounces is ignored); the roulette settings do not apply.
   uint32_t spp = 128;              // samples per texel; 0 = until the time budget ends
   double time_budget_seconds = 0;  // 0 = no budget
   double target_relative_error = 0;  // stop a texel when its relative standard error is below this; 0 = off
@@ -18,5 +30,4 @@ struct IntegratorSettings {
   std::function<void(double fraction_done, uint64_t rays)> progress;  // called between passes
 };
 
-// Sums of per-sample estimates of E/pi (RGB, doubles so long runs keep precision).
 }  // namespace exitance

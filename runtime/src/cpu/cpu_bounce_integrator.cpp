@@ -1,0 +1,344 @@
+// The per-bounce mode on the CPU backend (issue 10; seed 003 ch. 3-4).
+//
+// Layers: B_0(x) is one sample of path.h's estimator cut at direct light (next-event estimation to
+// emitters, punctual lights and the sky, plus the MIS-weighted emission or sky the continuation ray
+// sees); B_{k+1}(x) is one cosine ray whose hit y contributes albedo(y) * B_k(y), B_k(y) read from
+// the layer's dilated atlas pages at y's lightmap UV (bilinear, BounceLayerCache). A miss adds 0
+// (the sky is in B_0), a single-sided back face 0 (it absorbs, as in path mode). Rays are not
+// capped at a tracing range, so no far-field value is needed.
+//
+// A hit with no lit texel to read - the back of a double-sided surface (texels hold the front's
+// irradiance), a triangle the raster left without texels, or a G-buffer without atlas rectangles -
+// gets B_k(y) estimated on the fly instead: one direct-light sample at y for k = 0, else one more
+// gather ray from y reading B_{k-1}. That keeps such hits unbiased (with a G-buffer without
+// rectangles the mode degenerates into a path tracer split by bounce). The SVO's exitance is not
+// available here (it is filled from the lightmap after the lighting stage). Such hits are counted
+// (BounceGatherStatistics::texelless_hits).
+//
+// Schedule: passes from the PassScheduler; a pass adds `count` samples to every layer in order,
+// B_0 first, each layer's pages rebuilt before the next layer gathers from them (the gather is
+// linear in the cache, so samples gathered from an earlier, noisier cache stay unbiased). After the
+// last layer of a pass, a further layer is started within the same pass when --bounces asks for
+// more, or (automatic) while the tail extrapolated from the last two layers is above the noise of
+// the total (bounce_tail.h). spp N gives every layer N samples, in one pass; a time budget or a
+// target error ramps passes of 1, 4 then 16 samples (PassPolicy::ramp) and the layers started late
+// have fewer samples. The target error is tested on the whole lightmap (every texel's relative
+// standard error below it, and the tail below the noise), not per texel.
+//
+// Noise: per layer, the variance of each texel's gather samples given the layer below; the total's
+// variance is taken as their sum. That leaves out the noise of a cache propagated upward (spread
+// over many texels, it acts at the scale of the scene, and shows as a correlated error), so the
+// tracked variance underestimates the total's error and the tail criterion errs towards more bounces.
+#include "cpu_bounce_integrator.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "bounce_layer_cache.h"
+#include "exitance/common/bounce_gather.h"
+#include "exitance/runtime/core/bounce_tail.h"
+#include "exitance/runtime/core/pass_scheduler.h"
+#include "exitance/runtime/core/scene_access.h"
+#include "exitance/runtime/embree_scene.h"
+
+namespace exitance {
+namespace {
+
+// B_0 .. B_256 at most; fewer when the layers' sums would pass ~2 GiB.
+constexpr int kMaxLayers = 257;
+constexpr size_t kLayerMemoryLimit = size_t(2) << 30;
+// Rings of gutter texels filled around charts: a bilinear footprint reaches one texel past a chart.
+constexpr int kCacheDilation = 2;
+
+struct Counters {
+  uint64_t rays = 0, gathers = 0, texelless = 0, back_faces = 0, nonfinite = 0;
+};
+
+// Per texel sums of one layer's samples (RGB, doubles: long runs keep precision).
+struct Layer {
+  std::vector<double> sum, sum_squared;
+  uint32_t samples = 0;
+  explicit Layer(size_t texels) : sum(texels * 3, 0.0), sum_squared(texels * 3, 0.0) {}
+  Vec3 mean(size_t i) const {
+    if (samples == 0) return {0, 0, 0};
+    return {float(sum[i * 3] / samples), float(sum[i * 3 + 1] / samples), float(sum[i * 3 + 2] / samples)};
+  }
+  double variance_of_mean(size_t i, int c) const {
+    if (samples < 2) return 0;
+    const double n = samples, m = sum[i * 3 + size_t(c)] / n;
+    return std::max(0.0, (sum_squared[i * 3 + size_t(c)] - n * m * m) / (n - 1)) / n;
+  }
+};
+
+class BounceGather {
+ public:
+  BounceGather(const LightingScene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer,
+               const std::vector<BounceLayerCache>& caches, const IntegratorSettings& settings)
+      : scene_(scene), embree_(embree), gbuffer_(gbuffer), caches_(caches), settings_(settings) {}
+
+  // One sample of B_0 at x: path.h's estimator stopped after the direct light.
+  Vec3 direct(SurfacePoint x, Pcg32& rng, Counters& c) const {
+    const LightingScene& scene = scene_;
+    const Vec3 origin = offset_ray_origin(x.position, x.geometric_normal, scene.extent);
+    ShadowRay shadow[kShadowRaysPerVertex];
+    next_event_estimation(scene, x, origin, Vec3(1.0f), settings_.sampling_strategy, rng, shadow[0], shadow[1],
+                          shadow[2]);
+    Vec3 sum = connect(shadow, origin, c);
+    const DirectionSample d = sample_continuation(settings_.sampling_strategy, x, rng);
+    if (!(d.pdf > 0)) return sum;
+    ++c.rays;
+    const Hit hit = embree_.intersect(origin, d.direction, INFINITY);
+    if (!hit.found) return sum + escaped_radiance(scene, d.direction, d.pdf);
+    const PathLimits direct_only{0, settings_.russian_roulette_start, settings_.safety_bounce_cap};
+    const HitResult h = shade_continuation_hit(scene, hit.triangle, hit.distance, hit.b1, hit.b2, d.direction, d.pdf,
+                                               Vec3(1.0f), 0, direct_only, rng);
+    return sum + h.radiance;
+  }
+
+  // One sample of B_{layer+1} at x: a continuation ray, the hit's albedo times B_layer there.
+  Vec3 gather(SurfacePoint x, int layer, Pcg32& rng, Counters& c) const {
+    const LightingScene& scene = scene_;
+    const DirectionSample d = sample_continuation(settings_.sampling_strategy, x, rng);
+    if (!(d.pdf > 0)) return {0, 0, 0};
+    // cos / (pi pdf): 1 for cosine sampling; kept so another strategy stays unbiased.
+    const float weight = max(dot(x.shading_normal, d.direction), 0.0f) * kInvPi / d.pdf;
+    const Vec3 origin = offset_ray_origin(x.position, x.geometric_normal, scene.extent);
+    ++c.rays;
+    const Hit hit = embree_.intersect(origin, d.direction, INFINITY);
+    if (!hit.found) return {0, 0, 0};
+    ++c.gathers;
+    const uint tri = hit.triangle;
+    const Vec3 ng = triangle_geometric_normal(scene, tri);
+    const bool front = dot(d.direction, ng) < 0.0f;
+    if (!front && !material_double_sided(scene_material(scene, scene_triangle_material(scene, tri)))) {
+      ++c.back_faces;
+      return {0, 0, 0};
+    }
+    const Vec3 albedo = scene_albedo(scene, tri, hit.b1, hit.b2);
+    if (!(max_component(albedo) > 0)) return {0, 0, 0};
+    Vec3 b;
+    if (!front || !caches_[size_t(layer)].lookup(gbuffer_, instance_of(tri), lightmap_uv(tri, hit.b1, hit.b2), b)) {
+      ++c.texelless;
+      b = on_the_fly(surface_point_on_triangle(scene, tri, ng, hit.b1, hit.b2, front), layer, rng, c);
+    }
+    return albedo * b * weight;
+  }
+
+ private:
+  // B_layer at a surface point that has no texels: one sample, from the layer below.
+  Vec3 on_the_fly(SurfacePoint y, int layer, Pcg32& rng, Counters& c) const {
+    return layer == 0 ? direct(y, rng, c) : gather(y, layer - 1, rng, c);
+  }
+
+  Vec3 connect(const ShadowRay (&rays)[kShadowRaysPerVertex], Vec3 origin, Counters& c) const {
+    Vec3 sum{0, 0, 0};
+    for (const ShadowRay& r : rays) {
+      const float state = r.contribution_state.w;
+      if (state == kShadowNone) continue;
+      ++c.rays;
+      if (state != kShadowTrace) continue;
+      const Vec3 d{r.direction_length.x, r.direction_length.y, r.direction_length.z};
+      if (!embree_.occluded(origin, d, r.direction_length.w))
+        sum += Vec3{r.contribution_state.x, r.contribution_state.y, r.contribution_state.z};
+    }
+    return sum;
+  }
+
+  uint32_t instance_of(uint tri) const {
+    const Scene* source = scene_.source.get();
+    return source && tri < source->triangle_instance.size() ? source->triangle_instance[tri]
+                                                             : std::numeric_limits<uint32_t>::max();
+  }
+  Vec2 lightmap_uv(uint tri, float b1, float b2) const {
+    const Scene* source = scene_.source.get();
+    if (!source || size_t(tri) * 3 + 2 >= source->lightmap_uv.size()) return {0, 0};
+    const Vec2* uv = &source->lightmap_uv[size_t(tri) * 3];
+    return uv[0] * (1 - b1 - b2) + uv[1] * b1 + uv[2] * b2;
+  }
+
+  const LightingScene& scene_;
+  const EmbreeScene& embree_;
+  const TexelGBuffer& gbuffer_;
+  const std::vector<BounceLayerCache>& caches_;
+  const IntegratorSettings& settings_;
+};
+
+double area_of(const LiveTexel& t) {
+  const double s = t.world_texel_size;
+  return s > 0 && std::isfinite(s) ? s * s : 1.0;
+}
+
+BounceTail tail_after(const std::vector<Layer>& layers, const TexelGBuffer& gbuffer) {
+  const size_t n = gbuffer.texels.size(), last = layers.size() - 1;
+  BounceTailInputs in;
+  in.area.resize(n);
+  in.previous_bounce.resize(n);
+  in.last_bounce.resize(n);
+  in.total.resize(n);
+  in.total_variance.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    in.area[i] = area_of(gbuffer.texels[i]);
+    in.previous_bounce[i] = luminance(layers[last - 1].mean(i));
+    in.last_bounce[i] = luminance(layers[last].mean(i));
+    Vec3 total{0, 0, 0}, variance{0, 0, 0};
+    for (const Layer& layer : layers) {
+      total += layer.mean(i);
+      for (int c = 0; c < 3; ++c) variance[c] += float(layer.variance_of_mean(i, c));
+    }
+    in.total[i] = luminance(total);
+    in.total_variance[i] = luminance(variance);
+  }
+  return estimate_bounce_tail(in);
+}
+
+}  // namespace
+
+LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer,
+                                 const IntegratorSettings& settings) {
+  const auto start = std::chrono::steady_clock::now();
+  const size_t n = gbuffer.texels.size();
+  const bool forced = settings.max_bounces >= 0;
+  int layer_cap = forced ? settings.max_bounces + 1 : std::min(kMaxLayers, std::max(settings.safety_bounce_cap, 1) + 1);
+  layer_cap = int(std::min<size_t>(size_t(layer_cap), std::max<size_t>(2, kLayerMemoryLimit / (48 * std::max<size_t>(n, 1)))));
+
+  std::vector<Layer> layers;
+  std::vector<BounceLayerCache> caches;
+  layers.emplace_back(n);
+  caches.emplace_back();
+  tbb::combinable<Counters> counters_per_thread;
+  auto counters = [&] {
+    Counters sum;
+    counters_per_thread.combine_each([&](const Counters& c) {
+      sum.rays += c.rays, sum.gathers += c.gathers, sum.texelless += c.texelless;
+      sum.back_faces += c.back_faces, sum.nonfinite += c.nonfinite;
+    });
+    return sum;
+  };
+  BounceTail tail;
+  bool tail_known = false;
+
+  PassPolicy policy;
+  policy.ramp = settings.time_budget_seconds > 0 || settings.target_relative_error > 0;
+  PassScheduler passes(settings, policy);
+  uint32_t first = 0, count = 0;
+  while (passes.next_pass(first, count)) {
+    bool wants_more = false;
+    for (size_t k = 0; k < layers.size(); ++k) {
+      Layer& layer = layers[k];
+      const uint32_t add = settings.spp > 0 ? std::min(count, settings.spp - std::min(settings.spp, layer.samples)) : count;
+      const BounceGather gather(scene, embree, gbuffer, caches, settings);
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& range) {
+        Counters& c = counters_per_thread.local();
+        for (size_t i = range.begin(); i != range.end(); ++i) {
+          const LiveTexel& texel = gbuffer.texels[i];
+          const SurfacePoint x{texel.position, texel.geometric_normal, texel.shading_normal};
+          for (uint32_t s = layer.samples; s < layer.samples + add; ++s) {
+            Pcg32 rng = k == 0 ? pcg_init(settings.seed, i, s) : pcg_init(settings.seed, kBounceRngStreamBase * k + i, s);
+            const Vec3 value = k == 0 ? gather.direct(x, rng, c) : gather.gather(x, int(k) - 1, rng, c);
+            if (!is_finite(value)) {
+              ++c.nonfinite;  // counted and reported; counts as 0 (an unbiased estimator never produces these)
+              continue;
+            }
+            for (int ch = 0; ch < 3; ++ch) {
+              layer.sum[i * 3 + size_t(ch)] += value[ch];
+              layer.sum_squared[i * 3 + size_t(ch)] += double(value[ch]) * double(value[ch]);
+            }
+          }
+        }
+      });
+      layer.samples += add;
+      std::vector<Vec3> means(n);
+      for (size_t i = 0; i < n; ++i) means[i] = layer.mean(i);
+      caches[k].build(gbuffer, means, kCacheDilation);
+
+      if (k + 1 == layers.size()) {  // the top layer: does the light bounce on?
+        // The noise needs two samples in every layer; until then no layer beyond B_1 is started.
+        const bool noise_known =
+            std::all_of(layers.begin(), layers.end(), [](const Layer& l) { return l.samples >= 2; });
+        if (k >= 1) {
+          tail = tail_after(layers, gbuffer);
+          tail_known = true;
+        }
+        const bool tail_above_noise = k >= 1 && (!noise_known || !tail.below_noise);
+        const bool more = forced ? int(layers.size()) < layer_cap
+                                 : (k == 0 || (noise_known && !tail.below_noise)) && int(layers.size()) < layer_cap;
+        wants_more = wants_more || (!forced && tail_above_noise);
+        if (more) {
+          layers.emplace_back(n);
+          caches.emplace_back();
+        }
+      }
+      if (settings.progress && !passes.timed())
+        settings.progress(forced ? double(k + 1) / double(layer_cap) : double(k + 1) / double(k + 2), counters().rays);
+      if (passes.timed() && passes.elapsed_seconds() >= settings.time_budget_seconds) break;
+    }
+    bool all_converged = false;
+    if (settings.target_relative_error > 0 && !wants_more) {
+      all_converged = true;
+      for (size_t i = 0; i < n && all_converged; ++i) {
+        Vec3 total{0, 0, 0}, variance{0, 0, 0};
+        for (const Layer& layer : layers) {
+          total += layer.mean(i);
+          for (int c = 0; c < 3; ++c) variance[c] += float(layer.variance_of_mean(i, c));
+        }
+        const float lum = luminance(total);
+        all_converged = lum > 0 && std::sqrt(luminance(variance)) <= settings.target_relative_error * lum;
+      }
+    }
+    passes.finish_pass(counters().rays, all_converged);
+  }
+
+  // A layer started but never sampled (the budget ended first) is dropped.
+  while (layers.size() > 1 && layers.back().samples == 0) layers.pop_back();
+  if (!tail_known && layers.size() >= 2) tail = tail_after(layers, gbuffer);
+
+  LightmapEstimate estimate;
+  const int layer_count = int(layers.size());
+  estimate.recorded_bounces = layer_count;
+  estimate.texels.resize(n);
+  estimate.bounces.assign(size_t(layer_count) * n * 3, 0.0);
+  const double n0 = layers[0].samples;
+  for (size_t i = 0; i < n; ++i) {
+    TexelAccumulator& acc = estimate.texels[i];
+    acc.samples = layers[0].samples;
+    double total[3] = {0, 0, 0}, variance[3] = {0, 0, 0};
+    for (int k = 0; k < layer_count; ++k) {
+      const Vec3 mean = layers[size_t(k)].mean(i);
+      for (int c = 0; c < 3; ++c) {
+        // The layer's mean as a sum over the texel's B_0 samples, so mean_bounce() reads it back.
+        estimate.bounces[(size_t(k) * n + i) * 3 + size_t(c)] = n0 * mean[c];
+        total[c] += mean[c];
+        variance[c] += layers[size_t(k)].variance_of_mean(i, c);
+      }
+    }
+    for (int c = 0; c < 3; ++c) {
+      acc.total[c] = n0 * total[c];
+      acc.direct[c] = n0 * layers[0].mean(i)[c];
+      // Chosen so variance_of_mean() returns the summed layer variances.
+      acc.total_squared[c] = n0 * total[c] * total[c] + (n0 >= 2 ? (n0 - 1) * n0 * variance[c] : 0.0);
+    }
+  }
+  const Counters c = counters();
+  BounceGatherStatistics& stats = estimate.bounce_statistics;
+  stats.bounces = layer_count - 1;
+  for (const Layer& layer : layers) stats.samples.push_back(layer.samples);
+  stats.gathers = c.gathers;
+  stats.texelless_hits = c.texelless;
+  stats.back_face_hits = c.back_faces;
+  stats.ratio = tail.ratio;
+  stats.tail_rms = tail.tail_rms;
+  stats.noise_rms = tail.noise_rms;
+  stats.tail_below_noise = layer_count >= 2 && tail.below_noise;
+  estimate.rays = c.rays;
+  estimate.nonfinite_samples = c.nonfinite;
+  estimate.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return estimate;
+}
+
+}  // namespace exitance
