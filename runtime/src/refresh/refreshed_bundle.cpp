@@ -127,18 +127,24 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   if (check_before_write) check_before_write();
 
   const fs::path out(output);
-  write_bundle_atomically(out, [&](const fs::path& dir) {
-    for (size_t p = 0; p < pages.size(); ++p)
-      formats::write_lightmap_exr((dir / manifest.pages[p].file).string(), pages[p]);
-    if (has_probes) formats::write_probes_file((dir / manifest.probes->file).string(), persisted.probes);
-    if (svo) formats::write_svo_file((dir / manifest.svo->file).string(), *svo);
-    std::ofstream scene_out(dir / manifest.scene->file, std::ios::binary);
-    scene_out.write(reinterpret_cast<const char*>(scene_bytes.data()), std::streamsize(scene_bytes.size()));
-    if (!scene_out) throw std::runtime_error("cannot write " + (dir / manifest.scene->file).string());
-    std::ofstream file(dir / "manifest.json");
-    file << manifest_text;
-    if (!file) throw std::runtime_error("cannot write " + (dir / "manifest.json").string());
-  });
+  try {
+    write_bundle_atomically(out, [&](const fs::path& dir) {
+      for (size_t p = 0; p < pages.size(); ++p)
+        formats::write_lightmap_exr((dir / manifest.pages[p].file).string(), pages[p]);
+      if (has_probes) formats::write_probes_file((dir / manifest.probes->file).string(), persisted.probes);
+      if (svo) formats::write_svo_file((dir / manifest.svo->file).string(), *svo);
+      std::ofstream scene_out(dir / manifest.scene->file, std::ios::binary);
+      scene_out.write(reinterpret_cast<const char*>(scene_bytes.data()), std::streamsize(scene_bytes.size()));
+      if (!scene_out) throw std::runtime_error("cannot write " + (dir / manifest.scene->file).string());
+      std::ofstream file(dir / "manifest.json");
+      file << manifest_text;
+      if (!file) throw std::runtime_error("cannot write " + (dir / "manifest.json").string());
+    });
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw BundleWriteError(e.what());
+  }
   lap("write");
   report["seconds"] = seconds;
   report["output"] = fs::absolute(out).string();

@@ -5,6 +5,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <stdexcept>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -13,13 +14,20 @@
 
 namespace exitance {
 
+// A file of the bundle could not be written (nothing of it was left behind).
+class BundleWriteError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 // (stage, fraction done, rays so far)
 using StageProgress = std::function<void(const std::string&, double, uint64_t)>;
 
 // `report`: figures of the caller's run, merged into the manifest's "relight" entry (the function
 // adds source, device, samples, rays, estimated errors, probe rays). Returns that entry, plus
 // "seconds" (probes, exitance, write) and "output". Throws BundleInputError when the manifest and
-// scene.bin disagree, std::runtime_error when a file cannot be written or the device fails.
+// scene.bin disagree, BundleWriteError when a file cannot be written, std::runtime_error when the
+// device fails.
 // `check_before_write` runs after all computing and before the first file is written (a caller's
 // last chance to refuse, e.g. on validation-layer messages).
 nlohmann::json write_refreshed_bundle(RefreshSession& session, const std::string& output, nlohmann::json report,

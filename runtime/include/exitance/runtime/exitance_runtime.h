@@ -1,0 +1,102 @@
+/* Exitance runtime, C API (C99): a baked bundle's lighting kept resident on a Vulkan device and
+ * refreshed within a per-call budget after edits (docs/runtime.md). The C++ API is
+ * exitance/runtime/refresh/refresh_session.h, in the same library (libexitance_runtime).
+ *
+ *   ExitanceRuntime* rt = NULL;
+ *   if (exitance_runtime_open("scene.bake", NULL, &rt) != EXITANCE_RUNTIME_OK) {
+ *     fprintf(stderr, "%s\n", exitance_runtime_last_error_message());
+ *     return 1;
+ *   }
+ *   exitance_runtime_apply_edits(rt, "{\"edits\": [{\"light\": \"Lamp\", \"intensity\": 5}]}");
+ *   ExitanceRefreshReport report;
+ *   exitance_runtime_refresh(rt, 16.0, 0, &report);     // one frame of at most 16 ms
+ *   exitance_runtime_read_page(rt, 0, rgb, width, height); // E/pi of page 0, RGB floats
+ *   exitance_runtime_release(rt);
+ *
+ * Every function sets this thread's last error (EXITANCE_RUNTIME_OK on success); the message
+ * stays valid until the next call of this API on the same thread. A handle is used by one thread
+ * at a time. A call that fails changes nothing (an edit is all or nothing).
+ */
+#ifndef EXITANCE_RUNTIME_H
+#define EXITANCE_RUNTIME_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct ExitanceRuntime ExitanceRuntime;
+
+typedef enum ExitanceRuntimeError {
+  EXITANCE_RUNTIME_OK = 0,
+  EXITANCE_RUNTIME_INVALID_ARGUMENT = 1, /* NULL pointer, index or size out of range, non-finite or negative budget */
+  EXITANCE_RUNTIME_BAD_BUNDLE = 2,       /* a bundle file is missing, malformed or has no scene.bin */
+  EXITANCE_RUNTIME_BAD_EDIT = 3,         /* an edit is malformed or names nothing; the state is unchanged */
+  EXITANCE_RUNTIME_NO_DEVICE = 4,        /* no usable Vulkan device, or the scene needs what the GPU backend lacks */
+  EXITANCE_RUNTIME_DEVICE_FAILED = 5,    /* device lost, out of device memory, a submission timed out */
+  EXITANCE_RUNTIME_IO = 6,               /* a bundle could not be written */
+  EXITANCE_RUNTIME_UNKNOWN = 7
+} ExitanceRuntimeError;
+
+typedef struct ExitanceRuntimeOptions {
+  int32_t device_index; /* Vulkan physical device; -1 = prefer a discrete GPU */
+  int32_t has_seed;     /* 0: the bake's seed; 1: `seed` */
+  uint64_t seed;
+} ExitanceRuntimeOptions;
+
+typedef struct ExitanceRefreshReport {
+  double milliseconds;        /* this call */
+  uint64_t rays;              /* this call */
+  uint32_t samples_added;     /* per texel, this call */
+  uint32_t samples_per_texel; /* accumulated since the last edit */
+  int32_t capped;             /* 1 when the sample cap is reached */
+} ExitanceRefreshReport;
+
+typedef struct ExitanceRuntimePageInfo {
+  uint32_t width;
+  uint32_t height;
+} ExitanceRuntimePageInfo;
+
+/* Opens a bundle bake wrote (manifest.json, scene.bin, ...) on a Vulkan device. options may be
+ * NULL (defaults). On failure *out_runtime is NULL. */
+ExitanceRuntimeError exitance_runtime_open(const char* bundle, const ExitanceRuntimeOptions* options,
+                                           ExitanceRuntime** out_runtime);
+/* Frees the runtime and its device resources. NULL is ignored. */
+void exitance_runtime_release(ExitanceRuntime* runtime);
+
+/* The error of this thread's most recent call, and its one-line message ("" when none). */
+ExitanceRuntimeError exitance_runtime_last_error(void);
+const char* exitance_runtime_last_error_message(void);
+
+/* Applies edits given as EDITS.json text (docs/edits.md) and restarts the accumulation. */
+ExitanceRuntimeError exitance_runtime_apply_edits(ExitanceRuntime* runtime, const char* edits_json);
+
+/* Adds samples to every texel within `budget_ms` milliseconds (0 = no time limit) and up to
+ * `max_samples_per_texel` accumulated (0 = no cap); at least one of the two must be set.
+ * out_report may be NULL. */
+ExitanceRuntimeError exitance_runtime_refresh(ExitanceRuntime* runtime, double budget_ms, uint32_t max_samples_per_texel,
+                                              ExitanceRefreshReport* out_report);
+
+/* Estimated relMSE of the lightmap against its converged value (per-texel sample variances);
+ * infinity before 2 samples. Reads the lightmap back from the device. */
+ExitanceRuntimeError exitance_runtime_estimated_relative_mse(ExitanceRuntime* runtime, double* out_relative_mse);
+
+uint32_t exitance_runtime_page_count(const ExitanceRuntime* runtime);
+ExitanceRuntimeError exitance_runtime_page_info(const ExitanceRuntime* runtime, uint32_t page,
+                                                ExitanceRuntimePageInfo* out_info);
+/* Lightmap page `page` as it would be written (E/pi, gutters dilated): width x height RGB floats,
+ * row 0 at the top, into out_rgb (3 * width * height floats; width and height must match). */
+ExitanceRuntimeError exitance_runtime_read_page(ExitanceRuntime* runtime, uint32_t page, float* out_rgb, uint32_t width,
+                                                uint32_t height);
+
+/* Writes the refreshed bundle (lightmaps, probes, voxel exitance, the edited scene.bin) to
+ * `output_folder` atomically; the loader (exitance_loader.h) opens it. */
+ExitanceRuntimeError exitance_runtime_write_bundle(ExitanceRuntime* runtime, const char* output_folder);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* EXITANCE_RUNTIME_H */

@@ -1,0 +1,180 @@
+// The C API over RefreshSession: every entry point catches every exception and turns it into an
+// ExitanceRuntimeError plus a thread-local message, so no C++ exception crosses into C.
+#include "exitance/runtime/exitance_runtime.h"
+
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <new>
+#include <stdexcept>
+#include <string>
+
+#include "exitance/formats/format_error.h"
+#include "exitance/runtime/bundle/lightmap_assembly.h"
+#include "exitance/runtime/refresh/refresh_session.h"
+#include "exitance/runtime/refresh/refreshed_bundle.h"
+
+struct ExitanceRuntime {
+  std::unique_ptr<exitance::RefreshSession> session;
+  std::vector<exitance::AtlasPage> pages;  // sizes, for the checks of read_page
+};
+
+namespace {
+
+using namespace exitance;
+
+struct LastError {
+  ExitanceRuntimeError code = EXITANCE_RUNTIME_OK;
+  std::string message;
+};
+thread_local LastError last_error;
+
+ExitanceRuntimeError set_error(ExitanceRuntimeError code, const std::string& message) {
+  last_error.code = code;
+  last_error.message = message;
+  return code;
+}
+
+class NoDevice : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+template <typename Body>
+ExitanceRuntimeError guarded(const char* function, Body&& body) {
+  try {
+    body();
+    return set_error(EXITANCE_RUNTIME_OK, "");
+  } catch (const SceneEditError& e) {
+    return set_error(EXITANCE_RUNTIME_BAD_EDIT, e.what());
+  } catch (const BundleInputError& e) {
+    return set_error(EXITANCE_RUNTIME_BAD_BUNDLE, e.what());
+  } catch (const formats::FormatError& e) {
+    return set_error(EXITANCE_RUNTIME_BAD_BUNDLE, e.what());
+  } catch (const NoDevice& e) {
+    return set_error(EXITANCE_RUNTIME_NO_DEVICE, std::string(function) + ": " + e.what());
+  } catch (const BundleWriteError& e) {
+    return set_error(EXITANCE_RUNTIME_IO, std::string(function) + ": " + e.what());
+  } catch (const std::logic_error& e) {  // invalid_argument, out_of_range
+    return set_error(EXITANCE_RUNTIME_INVALID_ARGUMENT, std::string(function) + ": " + e.what());
+  } catch (const std::bad_alloc&) {
+    return set_error(EXITANCE_RUNTIME_UNKNOWN, std::string(function) + ": out of host memory");
+  } catch (const std::exception& e) {  // device loss, fence timeout, out of device memory
+    return set_error(EXITANCE_RUNTIME_DEVICE_FAILED, std::string(function) + ": " + e.what());
+  } catch (...) {
+    return set_error(EXITANCE_RUNTIME_UNKNOWN, std::string(function) + ": unknown error");
+  }
+}
+
+void require(bool condition, const char* what) {
+  if (!condition) throw std::invalid_argument(what);
+}
+
+}  // namespace
+
+extern "C" {
+
+ExitanceRuntimeError exitance_runtime_open(const char* bundle, const ExitanceRuntimeOptions* options,
+                                           ExitanceRuntime** out_runtime) {
+  if (out_runtime) *out_runtime = nullptr;
+  return guarded("exitance_runtime_open", [&] {
+    require(bundle != nullptr, "bundle is NULL");
+    require(out_runtime != nullptr, "out_runtime is NULL");
+    RefreshSessionOptions session_options;
+    if (options) {
+      session_options.device.device_index = options->device_index;
+      if (options->has_seed) session_options.seed = options->seed;
+    }
+    auto runtime = std::make_unique<ExitanceRuntime>();
+    if (enumerate_vulkan_devices().empty()) throw NoDevice("no Vulkan device (no loader, driver or device)");
+    try {
+      runtime->session = RefreshSession::open(bundle, session_options);
+    } catch (const BundleInputError&) {
+      throw;
+    } catch (const std::runtime_error& e) {
+      throw NoDevice(e.what());  // creating the backend: no usable device, or the scene needs what it lacks
+    }
+    runtime->pages = runtime->session->persisted().gbuffer.pages;
+    *out_runtime = runtime.release();
+  });
+}
+
+void exitance_runtime_release(ExitanceRuntime* runtime) { delete runtime; }
+
+ExitanceRuntimeError exitance_runtime_last_error(void) { return last_error.code; }
+const char* exitance_runtime_last_error_message(void) { return last_error.message.c_str(); }
+
+ExitanceRuntimeError exitance_runtime_apply_edits(ExitanceRuntime* runtime, const char* edits_json) {
+  return guarded("exitance_runtime_apply_edits", [&] {
+    require(runtime != nullptr, "runtime is NULL");
+    require(edits_json != nullptr, "edits_json is NULL");
+    runtime->session->apply_edits(parse_scene_edits(edits_json, "exitance_runtime_apply_edits"));
+  });
+}
+
+ExitanceRuntimeError exitance_runtime_refresh(ExitanceRuntime* runtime, double budget_ms, uint32_t max_samples_per_texel,
+                                              ExitanceRefreshReport* out_report) {
+  return guarded("exitance_runtime_refresh", [&] {
+    require(runtime != nullptr, "runtime is NULL");
+    const RefreshReport r = runtime->session->refresh({budget_ms, max_samples_per_texel});
+    if (out_report)
+      *out_report = {r.milliseconds, r.rays, r.samples_added, r.samples_per_texel, r.capped ? 1 : 0};
+  });
+}
+
+ExitanceRuntimeError exitance_runtime_estimated_relative_mse(ExitanceRuntime* runtime, double* out_relative_mse) {
+  return guarded("exitance_runtime_estimated_relative_mse", [&] {
+    require(runtime != nullptr, "runtime is NULL");
+    require(out_relative_mse != nullptr, "out_relative_mse is NULL");
+    *out_relative_mse = RefreshSession::estimated_relative_mse(runtime->session->lightmap());
+  });
+}
+
+uint32_t exitance_runtime_page_count(const ExitanceRuntime* runtime) {
+  return runtime ? uint32_t(runtime->pages.size()) : 0;
+}
+
+ExitanceRuntimeError exitance_runtime_page_info(const ExitanceRuntime* runtime, uint32_t page,
+                                                ExitanceRuntimePageInfo* out_info) {
+  return guarded("exitance_runtime_page_info", [&] {
+    require(runtime != nullptr && out_info != nullptr, "runtime or out_info is NULL");
+    if (page >= runtime->pages.size())
+      throw std::out_of_range("page " + std::to_string(page) + " of " + std::to_string(runtime->pages.size()));
+    *out_info = {uint32_t(runtime->pages[page].width), uint32_t(runtime->pages[page].height)};
+  });
+}
+
+ExitanceRuntimeError exitance_runtime_read_page(ExitanceRuntime* runtime, uint32_t page, float* out_rgb, uint32_t width,
+                                                uint32_t height) {
+  return guarded("exitance_runtime_read_page", [&] {
+    require(runtime != nullptr && out_rgb != nullptr, "runtime or out_rgb is NULL");
+    if (page >= runtime->pages.size())
+      throw std::out_of_range("page " + std::to_string(page) + " of " + std::to_string(runtime->pages.size()));
+    const AtlasPage& info = runtime->pages[page];
+    if (width != uint32_t(info.width) || height != uint32_t(info.height))
+      throw std::invalid_argument("page " + std::to_string(page) + " is " + std::to_string(info.width) + " x " +
+                                  std::to_string(info.height) + ", not " + std::to_string(width) + " x " +
+                                  std::to_string(height));
+    const formats::BakeSettings baked = runtime->session->manifest().settings.value_or(formats::BakeSettings{});
+    AssemblyOptions assembly;
+    assembly.dilation_texels = std::max(2, int(baked.padding) * 2);
+    const std::vector<formats::LightmapImage> pages =
+        assemble_lightmap_pages(runtime->session->persisted().gbuffer, runtime->session->lightmap(), assembly);
+    const formats::LightmapImage& image = pages.at(page);
+    const float* channel[3] = {image.channels.at("R").data(), image.channels.at("G").data(), image.channels.at("B").data()};
+    const size_t texels = size_t(width) * height;
+    for (size_t i = 0; i < texels; ++i)
+      for (int c = 0; c < 3; ++c) out_rgb[i * 3 + size_t(c)] = channel[c][i];
+  });
+}
+
+ExitanceRuntimeError exitance_runtime_write_bundle(ExitanceRuntime* runtime, const char* output_folder) {
+  return guarded("exitance_runtime_write_bundle", [&] {
+    require(runtime != nullptr && output_folder != nullptr, "runtime or output_folder is NULL");
+    nlohmann::json report;
+    report["api"] = "exitance_runtime_write_bundle";
+    write_refreshed_bundle(*runtime->session, output_folder, report);
+  });
+}
+
+}  // extern "C"

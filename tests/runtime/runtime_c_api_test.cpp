@@ -1,0 +1,114 @@
+// libexitance_runtime's C API (exitance/runtime/exitance_runtime.h), linked as the shared library
+// an engine links: a C99 walkthrough, errors as codes with one-line messages, failed calls that
+// change nothing, and a written bundle the loader opens. The bundle is baked by the `bake` program,
+// so this test links nothing of the offline stage.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "exitance/loader/exitance_loader.h"
+#include "exitance/runtime/exitance_runtime.h"
+
+extern "C" int runtime_c_walkthrough(const char* bundle, const char* output, char* message, size_t message_size);
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path& bundle() {
+  static const fs::path path = [] {
+    const fs::path dir = fs::temp_directory_path() / ("exitance-runtime-c-api-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string command = std::string(EXITANCE_BAKE) + " " + EXITANCE_SAMPLE_DIR +
+                                "/cornell_room.gltf -o " + (dir / "cornell.bake").string() +
+                                " --backend cpu --spp 1 --texel-density 4 --probe-spp 16 2>/dev/null";
+    if (std::system(command.c_str()) != 0) throw std::runtime_error("bake failed: " + command);
+    return dir / "cornell.bake";
+  }();
+  return path;
+}
+
+bool has_device() {
+  ExitanceRuntime* rt = nullptr;
+  const ExitanceRuntimeError code = exitance_runtime_open(bundle().c_str(), nullptr, &rt);
+  exitance_runtime_release(rt);
+  return code != EXITANCE_RUNTIME_NO_DEVICE;
+}
+
+TEST(RuntimeCApi, WalkthroughFromCWritesABundleTheLoaderOpens) {
+  if (!has_device()) GTEST_SKIP() << "no Vulkan device";
+  const fs::path output = bundle().parent_path() / "refreshed.bake";
+  char message[512] = "";
+  ASSERT_EQ(runtime_c_walkthrough(bundle().c_str(), output.c_str(), message, sizeof message), 0) << message;
+  ExitanceBundle* loaded = nullptr;
+  ASSERT_EQ(exitance_bundle_open(output.c_str(), &loaded), EXITANCE_ERROR_NONE) << exitance_last_error_message();
+  float rgb[3];
+  EXPECT_EQ(exitance_bundle_lightmap(loaded, 0, 0.5f, 0.5f, rgb), EXITANCE_ERROR_NONE);
+  EXPECT_TRUE(std::isfinite(rgb[0]) && std::isfinite(rgb[1]) && std::isfinite(rgb[2]));
+  EXPECT_EQ(exitance_bundle_has_probes(loaded), 1);
+  exitance_bundle_release(loaded);
+}
+
+TEST(RuntimeCApi, ErrorsAreCodesWithOneLineMessages) {
+  ExitanceRuntime* rt = reinterpret_cast<ExitanceRuntime*>(0x1);
+  EXPECT_EQ(exitance_runtime_open(nullptr, nullptr, &rt), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+  EXPECT_EQ(rt, nullptr);
+  EXPECT_EQ(exitance_runtime_last_error(), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+  EXPECT_EQ(std::string(exitance_runtime_last_error_message()), "exitance_runtime_open: bundle is NULL");
+  const std::string missing = (bundle().parent_path() / "missing.bake").string();
+  const ExitanceRuntimeError code = exitance_runtime_open(missing.c_str(), nullptr, &rt);
+  if (code == EXITANCE_RUNTIME_NO_DEVICE) GTEST_SKIP() << "no Vulkan device";
+  EXPECT_EQ(code, EXITANCE_RUNTIME_BAD_BUNDLE);
+  const std::string message = exitance_runtime_last_error_message();
+  EXPECT_NE(message.find("missing.bake/manifest.json: cannot read the manifest"), std::string::npos) << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos);
+  EXPECT_EQ(exitance_runtime_refresh(nullptr, 16, 0, nullptr), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+  exitance_runtime_release(nullptr);  // ignored
+}
+
+TEST(RuntimeCApi, FailedCallsChangeNothing) {
+  if (!has_device()) GTEST_SKIP() << "no Vulkan device";
+  ExitanceRuntime* rt = nullptr;
+  ASSERT_EQ(exitance_runtime_open(bundle().c_str(), nullptr, &rt), EXITANCE_RUNTIME_OK);
+  ExitanceRefreshReport report{};
+  ASSERT_EQ(exitance_runtime_refresh(rt, 0, 2, &report), EXITANCE_RUNTIME_OK);
+  EXPECT_EQ(report.samples_per_texel, 2u);
+
+  EXPECT_EQ(exitance_runtime_refresh(rt, std::numeric_limits<double>::quiet_NaN(), 0, &report),
+            EXITANCE_RUNTIME_INVALID_ARGUMENT);
+  EXPECT_EQ(exitance_runtime_refresh(rt, 0, 0, &report), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+  EXPECT_EQ(exitance_runtime_apply_edits(rt, "{\"edits\": [{\"light\": \"NoSuchLamp\", \"intensity\": 1}]}"),
+            EXITANCE_RUNTIME_BAD_EDIT);
+  EXPECT_NE(std::string(exitance_runtime_last_error_message()).find("exitance_runtime_apply_edits: edits[0]"),
+            std::string::npos)
+      << exitance_runtime_last_error_message();
+  EXPECT_EQ(exitance_runtime_apply_edits(rt, "{\"edits\": [{\"sky\": [0.1, 0.2]}]}"), EXITANCE_RUNTIME_BAD_EDIT);
+  EXPECT_EQ(exitance_runtime_apply_edits(rt, "not json"), EXITANCE_RUNTIME_BAD_EDIT);
+  ExitanceRuntimePageInfo page{};
+  ASSERT_EQ(exitance_runtime_page_info(rt, 0, &page), EXITANCE_RUNTIME_OK);
+  EXPECT_EQ(exitance_runtime_page_info(rt, exitance_runtime_page_count(rt), &page), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+  std::vector<float> rgb(size_t(page.width) * page.height * 3);
+  EXPECT_EQ(exitance_runtime_read_page(rt, 0, rgb.data(), page.width + 1, page.height), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+
+  // Still 2 samples: the next refresh adds the third.
+  ASSERT_EQ(exitance_runtime_refresh(rt, 0, 3, &report), EXITANCE_RUNTIME_OK);
+  EXPECT_EQ(report.samples_added, 1u);
+  ASSERT_EQ(exitance_runtime_read_page(rt, 0, rgb.data(), page.width, page.height), EXITANCE_RUNTIME_OK);
+  size_t lit = 0;
+  for (float v : rgb) {
+    ASSERT_TRUE(std::isfinite(v) && v >= 0);
+    lit += v > 0;
+  }
+  EXPECT_GT(lit, rgb.size() / 4);
+  exitance_runtime_release(rt);
+}
+
+}  // namespace
