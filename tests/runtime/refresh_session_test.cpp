@@ -1,7 +1,8 @@
 // The runtime's RefreshSession (runtime/include/exitance/runtime/refresh/refresh_session.h) on a
 // bundle baked here, on lavapipe in CI: samples added over several refresh calls are the bake's
 // samples bit for bit; a restart drops every sample; the estimated relMSE a refresh reports is
-// within 2x of the relMSE measured against a converged lightmap; bad budgets are refused.
+// within 2x of the relMSE measured against a converged lightmap; an engine's adopted device gives
+// the same results; bad budgets are refused.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -14,6 +15,7 @@
 #include "exitance/bake/command/bake_pipeline.h"
 #include "exitance/runtime/refresh/refresh_session.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
+#include "support/engine_vulkan_device.h"
 
 namespace exitance {
 namespace {
@@ -135,6 +137,31 @@ TEST(RefreshSession, EstimatedErrorIsWithinTwiceTheMeasured) {
     EXPECT_GT(measured, 0);
     EXPECT_LE(estimated, 2 * measured);
     EXPECT_GE(estimated, 0.5 * measured);
+  }
+}
+
+// An engine hands over its own device and queue (validation on, every message a failure): the
+// session's frames and an edit give what a session on its own device gives, bit for bit, and the
+// engine's device outlives the session.
+TEST(RefreshSession, OnAnEnginesDeviceGivesTheSameResults) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const char* edit = R"({"edits": [{"material": "CeilingLight", "emissiveStrength": 3.0}]})";
+  auto own = RefreshSession::open(baked_bundle().string());
+  own->refresh({0, 2});
+  own->apply_edits(parse_scene_edits(edit, "edit.json"));
+  own->refresh({0, 3});
+  const LightmapEstimate expected = own->lightmap();
+
+  testing::EngineDevice engine(own->integrator().device().index, vulkan_required_features());
+  for (int round = 0; round < 2; ++round) {  // the second: the first session took nothing with it
+    RefreshSessionOptions options;
+    options.device = engine.options();
+    auto adopted = RefreshSession::open(baked_bundle().string(), options);
+    EXPECT_NE(adopted->integrator().device_description().find("adopted"), std::string::npos);
+    adopted->refresh({0, 2});
+    adopted->apply_edits(parse_scene_edits(edit, "edit.json"));
+    adopted->refresh({0, 3});
+    expect_same_sums(adopted->lightmap(), expected);
   }
 }
 
