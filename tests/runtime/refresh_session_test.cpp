@@ -7,6 +7,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -163,6 +164,92 @@ TEST(RefreshSession, OnAnEnginesDeviceGivesTheSameResults) {
     adopted->refresh({0, 3});
     expect_same_sums(adopted->lightmap(), expected);
   }
+}
+
+// Estimated relMSE over a subset of texels; infinity while one of them has fewer than 2 samples
+// (the estimate leaves those out).
+double subset_relative_mse(const LightmapEstimate& all, const std::vector<uint32_t>& texels) {
+  LightmapEstimate subset;
+  for (uint32_t i : texels) {
+    if (all.texels[i].samples < 2) return std::numeric_limits<double>::infinity();
+    subset.texels.push_back(all.texels[i]);
+  }
+  return RefreshSession::estimated_relative_mse(subset);
+}
+
+// The courtyard baked once (its pavilion is a small part of it).
+const fs::path& courtyard_bundle() {
+  static const fs::path bundle = [] {
+    const fs::path dir = baked_bundle().parent_path();
+    BakeOptions options;
+    options.input = std::string(EXITANCE_SAMPLE_DIR) + "/courtyard.gltf";
+    options.output = (dir / "courtyard.bake").string();
+    options.backend.name = "cpu";
+    options.sky = "0.3,0.4,0.5";
+    options.atlas.texel_density = 2;
+    options.lighting.spp = 1;
+    options.probes_enabled = false;
+    Diagnostics diagnostics;
+    run_bake(options, diagnostics);
+    return dir / "courtyard.bake";
+  }();
+  return bundle;
+}
+
+// Refresh calls of one sample of every texel each (a deterministic budget) after moving the
+// pavilion 3 m: how many calls until the texels within 3 m of it (before or after), and the
+// others, reach the error the whole lightmap had at 8 samples before the edit (fewer than the 16
+// prioritized samples).
+struct CallsToError {
+  int near = 0, far = 0;
+};
+CallsToError calls_to_error(uint32_t priority_samples) {
+  RefreshSessionOptions options;
+  options.priority_samples = priority_samples;
+  auto session = RefreshSession::open(courtyard_bundle().string(), options);
+  session->refresh({0, 8});
+  const double target = RefreshSession::estimated_relative_mse(session->lightmap());
+  const Scene& before = session->persisted().scene;
+  Vec3 lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
+  for (const Instance& instance : before.instances)
+    if (instance.name == "Pavilion")
+      for (size_t v = size_t(instance.first_triangle) * 3; v < size_t(instance.first_triangle + instance.triangle_count) * 3; ++v) {
+        const Vec3& p = before.positions[v];
+        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+      }
+  session->apply_edits(parse_scene_edits(R"({"edits": [{"node": "Pavilion", "translation": [3.5, 0, 7]}]})", "e.json"));
+  const TexelGBuffer& gbuffer = session->persisted().gbuffer;
+  lo.x -= 3.0f;  // the move: 3 m towards -x
+  std::vector<uint32_t> near, far;
+  for (uint32_t i = 0; i < gbuffer.texels.size(); ++i) {
+    const Vec3& p = gbuffer.texels[i].position;
+    const float dx = std::max({lo.x - p.x, 0.0f, p.x - hi.x}), dy = std::max({lo.y - p.y, 0.0f, p.y - hi.y}),
+                dz = std::max({lo.z - p.z, 0.0f, p.z - hi.z});
+    (dx * dx + dy * dy + dz * dz < 9.0f ? near : far).push_back(i);
+  }
+  EXPECT_GT(near.size(), 50u);
+  EXPECT_GT(far.size(), near.size());
+  CallsToError calls;
+  const uint64_t budget = gbuffer.texels.size();
+  for (int call = 1; call <= 200 && (calls.near == 0 || calls.far == 0); ++call) {
+    session->refresh({0, 0, budget});
+    const LightmapEstimate estimate = session->lightmap();
+    if (!calls.near && subset_relative_mse(estimate, near) <= target) calls.near = call;
+    if (!calls.far && subset_relative_mse(estimate, far) <= target) calls.far = call;
+  }
+  return calls;
+}
+
+TEST(RefreshSession, TexelsNearAnEditReachAnErrorInFewerCalls) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const CallsToError prioritized = calls_to_error(16), uniform = calls_to_error(0);
+  std::printf("calls to the pre-edit 8-sample error: near %d, far %d (prioritized); near %d, far %d (uniform)\n",
+              prioritized.near, prioritized.far, uniform.near, uniform.far);
+  ASSERT_GT(prioritized.near, 0);
+  ASSERT_GT(prioritized.far, 0);
+  EXPECT_LT(prioritized.near, prioritized.far);
+  EXPECT_LT(prioritized.near, uniform.near);  // the priorities, not the texels' own noise, make the difference
 }
 
 TEST(RefreshSession, BadBudgetsAreRefused) {

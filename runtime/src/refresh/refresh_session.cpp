@@ -11,6 +11,7 @@
 #include "exitance/formats/format_error.h"
 #include "exitance/formats/scene_file.h"
 #include "exitance/formats/svo_file.h"
+#include "exitance/runtime/refresh/texels_near_change.h"
 #include "exitance/runtime/refresh/unocclude_near_moved.h"
 
 namespace exitance {
@@ -27,7 +28,17 @@ struct RefreshSession::State {
   std::shared_ptr<const LightingScene> lighting;
   IntegratorSettings settings;
   std::unique_ptr<VulkanIntegrator> integrator;
-  double milliseconds_per_sample = 0;  // of the last pass: sizes the next call's passes
+  // Milliseconds per texel-sample of the last pass: sizes the next passes to the budget.
+  double milliseconds_per_texel_sample = 0;
+  uint32_t priority_samples = 16;
+  // The accumulation since the last edit, as lists of texels with their sample counts: after a
+  // local edit, the texels near it first (until priority_samples), then the others until they
+  // catch up, then all together. Each list's texels share one count, so sample indices stay those
+  // of a bake.
+  std::vector<uint32_t> near_texels, far_texels, all_texels;
+  uint32_t near_samples = 0, far_samples = 0, all_samples = 0;
+  // What texels show until they have samples again after an edit (published_lightmap).
+  std::optional<LightmapEstimate> previous;
 };
 
 namespace {
@@ -81,6 +92,9 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
     throw BundleInputError((bundle / manifest.scene->file).string() + ": " + e.what());
   }
   state->integrator = VulkanIntegrator::create(state->lighting, options.device);
+  state->priority_samples = options.priority_samples;
+  state->all_texels.resize(state->persisted.gbuffer.texels.size());
+  for (size_t i = 0; i < state->all_texels.size(); ++i) state->all_texels[i] = uint32_t(i);
   state->integrator->start_progressive(state->persisted.gbuffer, settings);
   return std::unique_ptr<RefreshSession>(new RefreshSession(std::move(state)));
 }
@@ -103,52 +117,117 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
     if (!effects.materials.empty()) s.integrator->update_materials(lighting);
     if (!effects.lights.empty() || effects.sky) s.integrator->update_lights(lighting);
   }
+  std::vector<uint32_t> near = texels_near_change(edited, s.persisted.scene, lighting, effects);
+  s.previous = published_lightmap();  // what texels show until refreshed again
   s.persisted = std::move(edited);
   s.lighting = std::make_shared<const LightingScene>(std::move(lighting));
   s.scene_file.reset();  // encoded again from the edited scene when a bundle is written
   restart();  // moved texels are uploaded again with the rest
+  if (s.priority_samples > 0 && !near.empty() && near.size() < s.all_texels.size()) {
+    std::vector<uint8_t> is_near(s.all_texels.size(), 0);
+    for (uint32_t i : near) is_near[i] = 1;
+    s.near_texels = std::move(near);
+    for (uint32_t i = 0; i < is_near.size(); ++i)
+      if (!is_near[i]) s.far_texels.push_back(i);
+  }
   return effects;
 }
 
-void RefreshSession::restart() { state_->integrator->start_progressive(state_->persisted.gbuffer, state_->settings); }
+void RefreshSession::restart() {
+  State& s = *state_;
+  s.integrator->start_progressive(s.persisted.gbuffer, s.settings);
+  s.near_texels.clear();
+  s.far_texels.clear();
+  s.near_samples = s.far_samples = s.all_samples = 0;
+}
+
+uint32_t RefreshSession::samples_per_texel() const {
+  const State& s = *state_;
+  if (!s.near_texels.empty()) return s.far_samples;  // the far texels lag
+  return s.all_samples;
+}
 
 RefreshReport RefreshSession::refresh(const RefreshBudget& budget) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   if (!(budget.milliseconds >= 0) || !std::isfinite(budget.milliseconds))
     throw std::invalid_argument("RefreshSession::refresh: budget milliseconds must be finite and not negative");
-  VulkanIntegrator& integrator = *state_->integrator;
+  if (budget.milliseconds == 0 && budget.max_samples_per_texel == 0 && budget.texel_samples == 0)
+    throw std::invalid_argument("RefreshSession::refresh: a budget needs milliseconds, a sample cap or texel-samples");
+  State& s = *state_;
+  VulkanIntegrator& integrator = *s.integrator;
   const uint32_t cap = budget.max_samples_per_texel ? budget.max_samples_per_texel : std::numeric_limits<uint32_t>::max();
   RefreshReport report;
   auto elapsed_ms = [&] { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); };
-  while (integrator.progressive_samples() < cap) {
-    const uint32_t left = cap - integrator.progressive_samples();
-    uint32_t pass = left;
+  const uint32_t samples_before = samples_per_texel();
+  uint64_t used = 0;  // texel-samples
+  for (;;) {
+    // Which texels the next pass takes, from which sample index, and how many samples at most.
+    const std::vector<uint32_t>* list = &s.all_texels;
+    uint32_t* count = &s.all_samples;
+    uint32_t limit = cap;
+    if (!s.near_texels.empty()) {
+      if (s.near_samples < std::min(cap, s.priority_samples)) {
+        list = &s.near_texels, count = &s.near_samples, limit = std::min(cap, s.priority_samples);
+      } else if (s.far_samples < s.near_samples) {
+        list = &s.far_texels, count = &s.far_samples, limit = s.near_samples;
+      } else {  // caught up: one list again, at their common count
+        s.all_samples = s.near_samples;
+        s.near_texels.clear();
+        s.far_texels.clear();
+        continue;
+      }
+    }
+    if (*count >= limit) break;
+    uint32_t pass = limit - *count;
+    if (budget.texel_samples > 0) {
+      const uint64_t fitting = (budget.texel_samples - std::min(budget.texel_samples, used)) / list->size();
+      if (fitting == 0) break;
+      pass = uint32_t(std::min<uint64_t>(pass, fitting));
+    }
     if (budget.milliseconds > 0) {
-      // Passes sized from the last measured cost per sample, so the call ends near its budget; the
-      // first pass of a session is one sample, to measure it.
+      // Passes sized from the last measured cost per texel-sample, so the call ends near its
+      // budget; the first pass of a session is one sample, to measure it.
       const double remaining = budget.milliseconds - elapsed_ms();
       if (remaining <= 0) break;
-      const double per_sample = state_->milliseconds_per_sample;
+      const double per_sample = s.milliseconds_per_texel_sample * double(list->size());
       const double fitting = per_sample > 0 ? std::floor(remaining / per_sample) : 1.0;
-      if (fitting < 1 && report.samples_added > 0) break;  // the next sample would overrun the budget
-      pass = uint32_t(std::clamp(fitting, 1.0, double(left)));
-    } else if (budget.max_samples_per_texel == 0) {
-      throw std::invalid_argument("RefreshSession::refresh: a budget needs milliseconds or a sample cap");
+      if (fitting < 1 && report.rays > 0) break;  // the next sample would overrun the budget
+      pass = uint32_t(std::clamp(fitting, 1.0, double(pass)));
     }
     const auto pass_start = Clock::now();
-    report.rays += integrator.add_samples(pass);
-    report.samples_added += pass;
-    state_->milliseconds_per_sample = std::chrono::duration<double, std::milli>(Clock::now() - pass_start).count() / pass;
+    report.rays += integrator.add_samples_to(*list, *count, pass);
+    used += uint64_t(pass) * list->size();
+    *count += pass;
+    if (list == &s.near_texels) report.prioritized_texels = uint32_t(list->size());
+    s.milliseconds_per_texel_sample = std::chrono::duration<double, std::milli>(Clock::now() - pass_start).count() /
+                                      (double(pass) * double(list->size()));
     if (budget.milliseconds > 0 && elapsed_ms() >= budget.milliseconds) break;
   }
-  report.samples_per_texel = integrator.progressive_samples();
-  report.capped = report.samples_per_texel >= cap;
+  report.samples_per_texel = samples_per_texel();
+  report.samples_added = report.samples_per_texel - samples_before;
+  report.capped = s.near_texels.empty() && s.all_samples >= cap;
   report.milliseconds = elapsed_ms();
   return report;
 }
 
 LightmapEstimate RefreshSession::lightmap() const { return state_->integrator->progressive_estimate(); }
+
+LightmapEstimate RefreshSession::published_lightmap() const {
+  LightmapEstimate estimate = lightmap();
+  const State& s = *state_;
+  if (!s.previous || s.previous->texels.size() != estimate.texels.size() ||
+      s.previous->recorded_bounces != estimate.recorded_bounces)
+    return estimate;
+  const size_t n = estimate.texels.size();
+  for (size_t i = 0; i < n; ++i) {
+    if (estimate.texels[i].samples > 0) continue;
+    estimate.texels[i] = s.previous->texels[i];
+    for (int k = 0; k < estimate.recorded_bounces; ++k)
+      for (int c = 0; c < 3; ++c) estimate.bounces[(size_t(k) * n + i) * 3 + size_t(c)] = s.previous->bounces[(size_t(k) * n + i) * 3 + size_t(c)];
+  }
+  return estimate;
+}
 
 double RefreshSession::estimated_relative_mse(const LightmapEstimate& estimate) {
   double sum = 0;

@@ -54,7 +54,7 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   const fs::path bundle(session.bundle());
   formats::BundleManifest manifest = session.manifest();
   const formats::BakeSettings baked = manifest.settings.value_or(formats::BakeSettings{});
-  const LightmapEstimate estimate = session.lightmap();
+  const LightmapEstimate estimate = session.published_lightmap();
 
   PersistedScene persisted = session.persisted();
   ProbeEstimate probe_estimate;
@@ -100,7 +100,7 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   report["what"] = std::string(report.contains("edits") ? "scene.bin edited, then " : "") +
                    "full relight from scene.bin: lightmaps, probes and voxel exitance recomputed; input lightmaps not read";
   report["device"] = integrator.device_description();
-  report["spp"] = integrator.progressive_samples();
+  report["spp"] = session.samples_per_texel();
   report["seed"] = session.settings().seed;
   report["rays"] = estimate.rays;
   report["probe_rays"] = probe_estimate.rays;
@@ -113,7 +113,7 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   manifest.generator = "exitance-relight 0.1.0";
   formats::BakeSettings& settings = manifest.settings.emplace(baked);
   settings.backend = "vulkan";
-  settings.spp = integrator.progressive_samples();
+  settings.spp = session.samples_per_texel();
   settings.seed = session.settings().seed;
   settings.time_budget_seconds = report.value("time_budget_seconds", 0.0);
   if (svo) {

@@ -159,7 +159,7 @@ ExitanceRuntimeError exitance_runtime_read_page(ExitanceRuntime* runtime, uint32
     AssemblyOptions assembly;
     assembly.dilation_texels = std::max(2, int(baked.padding) * 2);
     const std::vector<formats::LightmapImage> pages =
-        assemble_lightmap_pages(runtime->session->persisted().gbuffer, runtime->session->lightmap(), assembly);
+        assemble_lightmap_pages(runtime->session->persisted().gbuffer, runtime->session->published_lightmap(), assembly);
     const formats::LightmapImage& image = pages.at(page);
     const float* channel[3] = {image.channels.at("R").data(), image.channels.at("G").data(), image.channels.at("B").data()};
     const size_t texels = size_t(width) * height;

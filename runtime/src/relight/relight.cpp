@@ -113,7 +113,7 @@ json relight_bundle(const RelightOptions& options) {
                         {"lane_efficiency", s.lane_efficiency}});
 
   json run;
-  run["spp"] = session->integrator().progressive_samples();
+  run["spp"] = session->samples_per_texel();
   run["time_budget_seconds"] = options.time_budget_seconds;
   if (options.frame_budget_ms > 0) run["frame_budget_ms"] = options.frame_budget_ms;
   run["lighting_seconds"] = lighting_seconds;

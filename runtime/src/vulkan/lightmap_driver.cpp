@@ -159,19 +159,38 @@ void LightmapDriver::start(const TexelGBuffer& gbuffer, const IntegratorSettings
 uint64_t LightmapDriver::add_samples(uint32_t samples) {
   if (!progressive_) throw std::logic_error("Vulkan backend: add_samples before start_progressive");
   Accumulation& a = *progressive_;
-  if (samples == 0 || a.texel_count == 0) return 0;
-  if (uint64_t(a.next_sample) + samples > std::numeric_limits<uint32_t>::max())
+  std::vector<uint32_t> all(a.texel_count);
+  for (size_t i = 0; i < all.size(); ++i) all[i] = uint32_t(i);
+  const uint64_t rays = add_samples_to(all, a.next_sample, samples);
+  a.next_sample += samples;
+  return rays;
+}
+
+uint64_t LightmapDriver::add_samples_to(const std::vector<uint32_t>& texels, uint32_t first_sample, uint32_t samples) {
+  if (!progressive_) throw std::logic_error("Vulkan backend: add_samples before start_progressive");
+  Accumulation& a = *progressive_;
+  if (samples == 0 || texels.empty()) return 0;
+  if (uint64_t(first_sample) + samples > std::numeric_limits<uint32_t>::max())
     throw std::invalid_argument("Vulkan backend: more than 2^32 - 1 samples per texel");
+  for (uint32_t i : texels)
+    if (i >= a.texel_count) throw std::out_of_range("Vulkan backend: texel " + std::to_string(i) + " of " + std::to_string(a.texel_count));
   const auto start_time = Clock::now();
   const uint64_t rays_before = a.totals.rays();
   runner_.bind_buffers();  // a probe bake in between may have grown (reallocated) a buffer
-  if (runner_.buffers().items.owner != WorkItems::Owner::Texels) upload_items(a);
+  if (runner_.buffers().items.owner != WorkItems::Owner::Texels) {
+    upload_items(a);
+  }
+  if (a.work_list != texels) {
+    a.work_list = texels;
+    runner_.context().upload(runner_.buffers().items.batch_items, a.work_list.data(), a.work_list.size() * 4);
+  }
   // At most as many samples per batch as fill the work items.
-  const uint32_t largest = uint32_t(std::max<size_t>(1, a.max_work / std::min(a.texel_count, a.max_work)));
+  const uint32_t largest = uint32_t(std::max<size_t>(1, a.max_work / std::min(a.work_list.size(), a.max_work)));
+  uint32_t next = first_sample;
   for (uint32_t left = samples; left > 0;) {
     const uint32_t pass = std::min(left, largest);
-    run_pass(a, a.next_sample, pass);
-    a.next_sample += pass;
+    run_pass(a, next, pass);
+    next += pass;
     left -= pass;
   }
   a.seconds += std::chrono::duration<double>(Clock::now() - start_time).count();

@@ -24,6 +24,9 @@ class LightmapDriver {
   void start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings);
   // `samples` more per texel (sample indices continue where the last call ended); returns the rays traced.
   uint64_t add_samples(uint32_t samples);
+  // Samples [first_sample, first_sample + samples) of the listed texels only (indices into the
+  // G-buffer, each at most once); the caller keeps each texel's count. Returns the rays traced.
+  uint64_t add_samples_to(const std::vector<uint32_t>& texels, uint32_t first_sample, uint32_t samples);
   LightmapEstimate read();
   bool started() const { return progressive_.has_value(); }
   uint32_t samples_done() const { return progressive_ ? progressive_->next_sample : 0; }

@@ -71,6 +71,9 @@ void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const Inte
   impl_->lightmap.start(gbuffer, settings);
 }
 uint64_t VulkanIntegrator::add_samples(uint32_t samples) { return impl_->lightmap.add_samples(samples); }
+uint64_t VulkanIntegrator::add_samples_to(const std::vector<uint32_t>& texels, uint32_t first_sample, uint32_t samples) {
+  return impl_->lightmap.add_samples_to(texels, first_sample, samples);
+}
 LightmapEstimate VulkanIntegrator::progressive_estimate() const { return impl_->lightmap.read(); }
 uint32_t VulkanIntegrator::progressive_samples() const { return impl_->lightmap.samples_done(); }
 

@@ -4,8 +4,12 @@
 //
 // refresh() adds samples to every live texel, continuing the sample indices of the calls before:
 // after N samples in any number of calls the lightmap equals bake --backend vulkan's N samples
-// with the same seed. restart() (after an edit) drops every accumulated sample, so no texel keeps
-// a value from before it; apply_edits restarts. Probes and voxel exitance are computed on request
+// with the same seed. restart() drops every accumulated sample, so no texel keeps a value from
+// before it; apply_edits restarts, and after a local edit (a moved instance, a point or spot light,
+// an emissive material) refreshes the texels near it first (priority_samples), then the others
+// until they catch up; each texel's samples are still a bake's samples 0..N-1. Until a texel has
+// samples again, published_lightmap() shows its value from before the edit (never averaged with
+// new samples). Probes and voxel exitance are computed on request
 // (probe_estimate, fill_svo_exitance), not per frame yet.
 #pragma once
 #include <cstdint>
@@ -37,6 +41,9 @@ class BundleInputError : public std::runtime_error {
 struct RefreshSessionOptions {
   VulkanDeviceOptions device;    // device_index, validation, or an adopted engine device
   std::optional<uint64_t> seed;  // default: the bake's (manifest settings.seed)
+  // After a local edit, the texels near it get this many samples before the others get any
+  // (texels_near_change.h); 0: every pass takes every texel.
+  uint32_t priority_samples = 16;
 };
 
 // What one refresh() call may spend; it ends at whichever limit comes first. A call with neither
@@ -44,14 +51,18 @@ struct RefreshSessionOptions {
 struct RefreshBudget {
   double milliseconds = 0;             // wall-clock time of the call; 0 = no time limit
   uint32_t max_samples_per_texel = 0;  // cap on the accumulated samples; 0 = no cap
+  // Work of the call in texel-samples (a pass of n samples over m texels is n * m); 0 = no limit.
+  // Unlike milliseconds, deterministic: the same calls give the same results on any machine.
+  uint64_t texel_samples = 0;
 };
 
 struct RefreshReport {
-  double milliseconds = 0;         // this call
-  uint64_t rays = 0;               // this call
-  uint32_t samples_added = 0;      // per texel, this call
-  uint32_t samples_per_texel = 0;  // accumulated since the last restart
-  bool capped = false;             // the sample cap is reached: further calls add nothing
+  double milliseconds = 0;          // this call
+  uint64_t rays = 0;                // this call
+  uint32_t samples_added = 0;       // to samples_per_texel, this call
+  uint32_t samples_per_texel = 0;   // every texel has at least this many since the last edit or restart
+  uint32_t prioritized_texels = 0;  // texels near the last edit that this call refreshed first (0: none)
+  bool capped = false;              // the sample cap is reached: further calls add nothing
 };
 
 class RefreshSession {
@@ -74,8 +85,13 @@ class RefreshSession {
   void restart();
   RefreshReport refresh(const RefreshBudget& budget);
 
-  // The lightmap accumulated so far (a read-back: it waits for the device).
+  // The lightmap accumulated since the last edit or restart (a read-back: it waits for the device).
   LightmapEstimate lightmap() const;
+  // lightmap(), where texels without samples since the last edit keep their value from before it:
+  // what an engine shows, and what write_refreshed_bundle and the C API's read_page publish.
+  LightmapEstimate published_lightmap() const;
+  // Samples every texel has since the last edit or restart.
+  uint32_t samples_per_texel() const;
   // Estimated relMSE of `estimate` against its converged value, as bench/time_to_error.cpp defines
   // relMSE (mean over live texels and channels of err^2 / (r^2 + 1e-3)), from the per-texel
   // sample variances: v / (max(0, m^2 - v) + 1e-3) with m the mean and v its variance (m^2 - v

@@ -107,6 +107,10 @@ class VulkanIntegrator final : public Integrator {
   // bake_probes in between does not. Throws as bake() does; std::logic_error before a start.
   void start_progressive(const TexelGBuffer& gbuffer, const IntegratorSettings& settings);
   uint64_t add_samples(uint32_t samples);
+  // Samples [first_sample, first_sample + samples) of the listed texels only (G-buffer indices, each
+  // at most once): the runtime's priorities. The caller keeps each texel's count (add_samples'
+  // count is not advanced). std::out_of_range for an index beyond the G-buffer.
+  uint64_t add_samples_to(const std::vector<uint32_t>& texels, uint32_t first_sample, uint32_t samples);
   LightmapEstimate progressive_estimate() const;
   uint32_t progressive_samples() const;  // per texel so far; 0 before a start
   std::string device_description() const override;

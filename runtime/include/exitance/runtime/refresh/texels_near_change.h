@@ -1,0 +1,20 @@
+// Which texels an edit changes most (seed 003 §4.7.3's refresh priorities): those near what it
+// changed. A RefreshSession refreshes them first after a local edit.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "exitance/runtime/core/lighting_scene.h"
+#include "exitance/runtime/refresh/scene_edits.h"
+#include "exitance/runtime/scene_file_conversion.h"
+
+namespace exitance {
+
+// Live texels (G-buffer indices of `edited`, ascending) within twice its half-diagonal (at least a
+// tenth of the scene's extent) of a box of what the edit changed: a moved instance's bounds before and after, a point or spot light's
+// position (before and after), the triangles of a material whose emission changed. Empty when the
+// change is not local (a directional light, the sky), or nothing changed.
+std::vector<uint32_t> texels_near_change(const PersistedScene& edited, const Scene& before,
+                                         const LightingScene& edited_lighting, const EditEffects& effects);
+
+}  // namespace exitance
