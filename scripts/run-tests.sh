@@ -25,14 +25,15 @@ cmake -S . -B build-clang -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPIL
 cmake --build build-clang -j"$jobs" --target pipeline_tests layout_tests gltf_import_tests spherical_harmonics_tests \
   svo_exitance_tests probe_placement_tests svo_build_tests radiance_vdb_tests bundle_end_to_end_tests formats_tests \
   make_loader_test_bundle exitance_loader_sample exitance_loader common_math_tests lighting_scene_edit_tests \
-  scene_file_tests exitance-relight exitance_runtime
+  scene_file_tests scene_edits_tests exitance-relight exitance_runtime
 ctest --test-dir build-clang --output-on-failure -j"$jobs" -L unit
 
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEXITANCE_SANITIZE=ON
 # Only what the sanitizer run executes: the bake command and the unit/stress test programs.
 cmake --build build-asan -j"$jobs" --target bake stress_tests geometry_warning_tests layout_tests gltf_import_tests \
   pipeline_tests formats_tests exitance_loader_sample make_loader_test_bundle spherical_harmonics_tests \
-  svo_exitance_tests svo_build_tests probe_placement_tests bundle_end_to_end_tests common_math_tests lighting_scene_edit_tests
+  svo_exitance_tests svo_build_tests probe_placement_tests bundle_end_to_end_tests common_math_tests lighting_scene_edit_tests \
+  scene_edits_tests
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1

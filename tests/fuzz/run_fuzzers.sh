@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # run_fuzzers.sh [SECONDS]: builds the libFuzzer targets with clang++ in build-fuzz/, seeds a corpus
 # with valid files from the writers, and runs each fuzzer (probes.bin, svo.bin, scene.bin,
-# manifest.json) for SECONDS (default 30); EXITANCE_FUZZERS="scene" runs only the ones named. Exits non-zero if any fuzzer finds a crash, a sanitizer error, an escaped
+# manifest.json, EDITS.json) for SECONDS (default 30); EXITANCE_FUZZERS="scene" runs only the ones named. Exits non-zero if any fuzzer finds a crash, a sanitizer error, an escaped
 # exception or a timeout; the failing input is left in build-fuzz/artifacts/.
 # Needs clang and libclang-rt-14-dev (scripts/install-deps.sh).
 set -euo pipefail
@@ -20,7 +20,7 @@ mkdir -p "$build/artifacts"
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 failed=()
-for reader in ${EXITANCE_FUZZERS:-probes svo scene manifest}; do
+for reader in ${EXITANCE_FUZZERS:-probes svo scene manifest edits}; do
   corpus="$build/corpus/$reader"  # kept between runs so each run starts where the last one stopped
   mkdir -p "$corpus"
   options=(-max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1

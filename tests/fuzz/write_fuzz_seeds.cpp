@@ -1,4 +1,4 @@
-// write_fuzz_seeds DIR: valid probes.bin, svo.bin, scene.bin and manifest.json files, written by
+// write_fuzz_seeds DIR: valid probes.bin, svo.bin, scene.bin, manifest.json and EDITS.json files, written by
 // the real writers, as the fuzzers' starting corpus (DIR/probes, DIR/svo, DIR/scene, DIR/manifest).
 #include <cstdio>
 #include <filesystem>
@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path dir = argv[1];
-  for (const char* kind : {"probes", "svo", "scene", "manifest"}) fs::create_directories(dir / kind);
+  for (const char* kind : {"probes", "svo", "scene", "manifest", "edits"}) fs::create_directories(dir / kind);
   write_probes_file((dir / "probes" / "grid-2x2x2.bin").string(), probe_grid({2, 2, 2}));
   write_probes_file((dir / "probes" / "grid-3x1x1.bin").string(), probe_grid({3, 1, 1}));
   write_probes_file((dir / "probes" / "grid-1x1x1.bin").string(), probe_grid({1, 1, 1}));
@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
   exitance::test::set_empty_children(empty_scene.bvh.nodes[0]);
   write_scene_file((dir / "scene" / "empty.bin").string(), empty_scene);
   write_text(dir / "manifest" / "full.json", R"({"format_version": 1, "generator": "exitance 0.1.0",
- "input": {"file": "scene.gltf", "sha256": "00"},
+ "input": {"file": "scene.gltf", "sha256": "0000000000000000000000000000000000000000000000000000000000000000"},
  "units": {"lightmap": "irradiance_over_pi", "probes": "incident_radiance_sh_l2", "length": "scene"},
  "pages": [{"file": "lightmap-0.exr", "width": 1024, "height": 1024, "channels": ["R", "G", "B", "A"]}],
  "instances": [{"node": 0, "name": "Floor", "mesh": 0, "page": 0, "scale_offset": [0.25, 0.25, 0.0, 0.5], "rect": [0, 0, 4, 4]}],
@@ -114,5 +114,11 @@ int main(int argc, char** argv) {
  "svo": {"file": "svo.bin", "bounds": [[0, 0, 0], [8, 8, 8]], "depth": 8},
  "stats": {"seconds": {"import": 0.1}, "rays": 0}})");
   write_text(dir / "manifest" / "minimal.json", R"({"format_version": 1, "pages": [], "instances": []})");
+  // EDITS.json on the sample scene's names (docs/edits.md): every kind of edit.
+  write_text(dir / "edits" / "all.json", R"({"edits": [{"node": "root", "translation": [1, 2, 3], "rotation": [0, 0, 0, 1]},
+ {"node": "Wall", "scale": [1, 2, 1]}, {"node": 1, "translation": [0, 0.5, 0]},
+ {"light": "Sun", "intensity": 2.5, "color": [1, 0.5, 0.25]}, {"material": 1, "emissiveStrength": 3, "emissiveFactor": [1, 1, 0]},
+ {"sky": [0.1, 0.2, 0.3]}]})");
+  write_text(dir / "edits" / "none.json", R"({"edits": []})");
   return 0;
 }
