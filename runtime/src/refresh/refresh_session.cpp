@@ -36,6 +36,7 @@ struct RefreshSession::State {
   // catch up, then all together. Each list's texels share one count, so sample indices stay those
   // of a bake.
   std::vector<uint32_t> near_texels, far_texels, all_texels;
+  std::vector<uint32_t> last_edit_near;  // near_texels of the last edit, kept after the others caught up
   uint32_t near_samples = 0, far_samples = 0, all_samples = 0;
   // What texels show until they have samples again after an edit (published_lightmap).
   std::optional<LightmapEstimate> previous;
@@ -118,6 +119,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
     if (!effects.lights.empty() || effects.sky) s.integrator->update_lights(lighting);
   }
   std::vector<uint32_t> near = texels_near_change(edited, s.persisted.scene, lighting, effects);
+  s.last_edit_near.clear();
   s.previous = published_lightmap();  // what texels show until refreshed again
   s.persisted = std::move(edited);
   s.lighting = std::make_shared<const LightingScene>(std::move(lighting));
@@ -127,6 +129,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
     std::vector<uint8_t> is_near(s.all_texels.size(), 0);
     for (uint32_t i : near) is_near[i] = 1;
     s.near_texels = std::move(near);
+    s.last_edit_near = s.near_texels;
     for (uint32_t i = 0; i < is_near.size(); ++i)
       if (!is_near[i]) s.far_texels.push_back(i);
   }
@@ -140,6 +143,8 @@ void RefreshSession::restart() {
   s.far_texels.clear();
   s.near_samples = s.far_samples = s.all_samples = 0;
 }
+
+const std::vector<uint32_t>& RefreshSession::texels_near_last_edit() const { return state_->last_edit_near; }
 
 uint32_t RefreshSession::samples_per_texel() const {
   const State& s = *state_;

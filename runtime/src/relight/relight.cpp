@@ -94,10 +94,22 @@ json relight_bundle(const RelightOptions& options) {
     rays += r.rays;
     if (options.frames > 0) {
       // Per-frame figures cost a read-back of the sums, outside the frame's time.
-      const double error = RefreshSession::estimated_relative_mse(session->lightmap());
-      frames.push_back({{"frame", frame}, {"milliseconds", r.milliseconds}, {"rays", r.rays},
-                        {"samples_added", r.samples_added}, {"samples_per_texel", r.samples_per_texel},
-                        {"estimated_relative_mse", std::isfinite(error) ? json(error) : json(nullptr)}});
+      const LightmapEstimate now = session->lightmap();
+      const double error = RefreshSession::estimated_relative_mse(now);
+      json entry = {{"frame", frame}, {"milliseconds", r.milliseconds}, {"rays", r.rays},
+                    {"samples_added", r.samples_added}, {"samples_per_texel", r.samples_per_texel},
+                    {"estimated_relative_mse", std::isfinite(error) ? json(error) : json(nullptr)}};
+      const std::vector<uint32_t>& near = session->texels_near_last_edit();
+      if (!near.empty()) {
+        // The texels the edit prioritized: their own error (null while one has fewer than 2 samples).
+        LightmapEstimate subset;
+        bool complete = true;
+        for (uint32_t i : near) complete = complete && now.texels[i].samples >= 2, subset.texels.push_back(now.texels[i]);
+        const double near_error = complete ? RefreshSession::estimated_relative_mse(subset) : INFINITY;
+        entry["prioritized_texels"] = near.size();
+        entry["prioritized_estimated_relative_mse"] = std::isfinite(near_error) ? json(near_error) : json(nullptr);
+      }
+      frames.push_back(entry);
     }
     const double fraction = spp ? double(r.samples_per_texel) / spp
                                 : options.frames ? double(frame + 1) / options.frames : 0.0;

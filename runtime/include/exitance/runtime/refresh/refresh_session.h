@@ -92,6 +92,8 @@ class RefreshSession {
   LightmapEstimate published_lightmap() const;
   // Samples every texel has since the last edit or restart.
   uint32_t samples_per_texel() const;
+  // The texels the last edit prioritized (G-buffer indices); empty when it was not local.
+  const std::vector<uint32_t>& texels_near_last_edit() const;
   // Estimated relMSE of `estimate` against its converged value, as bench/time_to_error.cpp defines
   // relMSE (mean over live texels and channels of err^2 / (r^2 + 1e-3)), from the per-texel
   // sample variances: v / (max(0, m^2 - v) + 1e-3) with m the mean and v its variance (m^2 - v
