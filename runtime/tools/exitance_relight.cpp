@@ -36,6 +36,9 @@ int main(int argc, char** argv) {
   app.add_option("--budget-ms", options.frame_budget_ms, "bound each frame (refresh call) to this many milliseconds")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--frames", options.frames, "refresh at most this many frames; the report lists each frame's time and error");
+  bool no_frame_errors = false;
+  app.add_flag("--no-frame-errors", no_frame_errors,
+               "with --frames: no per-frame error (it reads the lightmap back between frames, which idles the GPU)");
   app.add_option("--seed", seed, "random seed (default: the bake's); results are deterministic per seed and device");
   app.add_option("--device", options.device_index, "Vulkan device index (see --list-devices)")->check(CLI::NonNegativeNumber);
   app.add_flag("--list-devices", list_devices, "print the Vulkan devices and exit");
@@ -57,6 +60,7 @@ int main(int argc, char** argv) {
     return e.get_exit_code() == 0 ? 0 : (code == 0 ? 0 : 2);
   }
   options.spp = spp;
+  options.frame_errors = !no_frame_errors;
   options.seed = seed;
   const char* validation = std::getenv("EXITANCE_VULKAN_VALIDATION");
   options.validation = validation && std::string(validation) == "1";

@@ -94,13 +94,15 @@ json relight_bundle(const RelightOptions& options) {
     rays += r.rays;
     if (options.frames > 0) {
       // Per-frame figures cost a read-back of the sums, outside the frame's time.
-      const LightmapEstimate now = session->lightmap();
-      const double error = RefreshSession::estimated_relative_mse(now);
       json entry = {{"frame", frame}, {"milliseconds", r.milliseconds}, {"rays", r.rays},
-                    {"samples_added", r.samples_added}, {"samples_per_texel", r.samples_per_texel},
-                    {"estimated_relative_mse", std::isfinite(error) ? json(error) : json(nullptr)}};
+                    {"samples_added", r.samples_added}, {"samples_per_texel", r.samples_per_texel}};
+      const LightmapEstimate now = options.frame_errors ? session->lightmap() : LightmapEstimate{};
+      if (options.frame_errors) {
+        const double error = RefreshSession::estimated_relative_mse(now);
+        entry["estimated_relative_mse"] = std::isfinite(error) ? json(error) : json(nullptr);
+      }
       const std::vector<uint32_t>& near = session->texels_near_last_edit();
-      if (!near.empty()) {
+      if (options.frame_errors && !near.empty()) {
         // The texels the edit prioritized: their own error (null while one has fewer than 2 samples).
         LightmapEstimate subset;
         bool complete = true;
