@@ -28,8 +28,29 @@ struct RefreshSession::State {
   std::shared_ptr<const LightingScene> lighting;
   IntegratorSettings settings;
   std::unique_ptr<VulkanIntegrator> integrator;
-  // Milliseconds per texel-sample of the last pass: sizes the next passes to the budget.
-  double milliseconds_per_texel_sample = 0;
+  // What a pass over a work list costs, to size passes to a millisecond budget: a fixed part (its
+  // drain and submissions) plus a part per sample, fitted from the last two passes of different
+  // sizes; until then the last pass's cost per sample, fixed part included (conservative). Kept
+  // per list (a small list's passes are not a large one's).
+  struct PassCost {
+    size_t texels = 0;  // the list it was measured on
+    double last_work = 0, last_ms = 0;  // texel-samples and milliseconds of the last pass
+    double fixed_ms = 0, ms_per_work = 0;
+    bool fitted = false, explored = false;
+    void add(double work, double ms) {
+      if (last_work > 0 && work != last_work) {
+        const double slope = (ms - last_ms) / (work - last_work), intercept = ms - slope * work;
+        if (slope > 0 && intercept >= 0) fixed_ms = intercept, ms_per_work = slope, fitted = true;
+      }
+      if (!fitted) fixed_ms = 0, ms_per_work = ms / work;
+      last_work = work, last_ms = ms;
+    }
+    // Samples of `texels` that fit in `remaining` ms; 0 when none.
+    double fitting(double remaining, size_t texels) const {
+      const double per_sample = ms_per_work * double(texels);
+      return per_sample > 0 ? std::floor((remaining - fixed_ms) / per_sample) : 1.0;
+    }
+  } pass_cost;
   uint32_t priority_samples = 16;
   // The accumulation since the last edit, as lists of texels with their sample counts: after a
   // local edit, the texels near it first (until priority_samples), then the others until they
@@ -191,12 +212,23 @@ RefreshReport RefreshSession::refresh(const RefreshBudget& budget) {
       pass = uint32_t(std::min<uint64_t>(pass, fitting));
     }
     if (budget.milliseconds > 0) {
-      // Passes sized from the last measured cost per texel-sample, so the call ends near its
-      // budget; the first pass of a session is one sample, to measure it.
+      // Passes sized from the measured pass cost, so the call ends near its budget; the first
+      // pass of a session is one sample, to measure it. Before the fit exists, one pass is one
+      // sample larger than the conservative estimate allows, once, to measure a second size.
       const double remaining = budget.milliseconds - elapsed_ms();
       if (remaining <= 0) break;
-      const double per_sample = s.milliseconds_per_texel_sample * double(list->size());
-      const double fitting = per_sample > 0 ? std::floor(remaining / per_sample) : 1.0;
+      if (s.pass_cost.texels != list->size()) {
+        // A list not measured yet: its first pass (one sample) only at the start of a call, where
+        // the whole budget is left for it.
+        if (report.rays > 0) break;
+        s.pass_cost = State::PassCost{list->size()};
+      }
+      double fitting = s.pass_cost.fitting(remaining, list->size());
+      if (!s.pass_cost.fitted && !s.pass_cost.explored && s.pass_cost.last_work > 0 && fitting >= 1 &&
+          remaining >= 1.25 * s.pass_cost.last_ms) {
+        fitting += 1;
+        s.pass_cost.explored = true;
+      }
       if (fitting < 1 && report.rays > 0) break;  // the next sample would overrun the budget
       pass = uint32_t(std::clamp(fitting, 1.0, double(pass)));
     }
@@ -205,8 +237,8 @@ RefreshReport RefreshSession::refresh(const RefreshBudget& budget) {
     used += uint64_t(pass) * list->size();
     *count += pass;
     if (list == &s.near_texels) report.prioritized_texels = uint32_t(list->size());
-    s.milliseconds_per_texel_sample = std::chrono::duration<double, std::milli>(Clock::now() - pass_start).count() /
-                                      (double(pass) * double(list->size()));
+    s.pass_cost.add(double(pass) * double(list->size()),
+                    std::chrono::duration<double, std::milli>(Clock::now() - pass_start).count());
     if (budget.milliseconds > 0 && elapsed_ms() >= budget.milliseconds) break;
   }
   report.samples_per_texel = samples_per_texel();
