@@ -15,6 +15,7 @@
 #include "exitance/bake/command/prepared_scene.h"
 #include "exitance/bake/layout/atlas_layout.h"
 #include "exitance/bake/raster/texel_raster.h"
+#include "exitance/common/bounce_gather.h"
 #include "exitance/runtime/core/bounce_tail.h"
 #include "support/analytic_scenes.h"
 
@@ -118,7 +119,7 @@ TEST(PerBounce, FurnaceWithAutomaticBouncesMatchesTheSumOfTheBouncesRun) { expec
 
 // At rho = 0.9 the last bounce is 1/10 of the tail: the criterion must run ~22 bounces more than
 // "stop when the last bounce is below the noise" would, and leave a truncated tail (exactly
-// rho^(K+1) of the total here) no larger than the noise of the total.
+// rho^(K+1) of the total here) below the noise of the total (half of it: kTailToNoise).
 TEST(PerBounce, TailCriterionRunsUntilTheTailIsBelowTheNoise) {
   const float rho = 0.9f;
   const AtlasScene box = furnace_box(rho, {1, 1, 1}, 8);
@@ -138,9 +139,10 @@ TEST(PerBounce, TailCriterionRunsUntilTheTailIsBelowTheNoise) {
     EXPECT_TRUE(b.tail_below_noise);
     EXPECT_GT(noise, 0.0);
     EXPECT_NEAR(b.ratio, rho, 0.02);
-    // Factor 2: the ratio and the per-texel B_K it extrapolates are estimates themselves.
-    EXPECT_LE(truncated, 2 * noise) << "stopped with the tail above the noise";
-    EXPECT_GE(std::pow(double(rho), k), noise / 2) << "ran bounces the noise could not see";
+    // The stop is at tail <= kTailToNoise x noise; factor 2 either way: the ratio and the per-texel
+    // B_K it extrapolates are estimates themselves.
+    EXPECT_LE(truncated, 2 * kTailToNoise * noise) << "stopped with the tail above the noise";
+    EXPECT_GE(std::pow(double(rho), k), kTailToNoise * noise / 2) << "ran bounces the noise could not see";
     EXPECT_GE(k, last_bounce_rule + 15);
     ratios.push_back(mean_over_texels(e, 0) * (1 - rho) / (1 - truncated));
   }
@@ -268,6 +270,35 @@ TEST(PerBounce, CornellRoomAgainstThePathTracer) {
   ::testing::Test::RecordProperty("rel_mse_vs_path", std::to_string(rel_mse / values));
 }
 
+// bounce_gather.h as C++ (the same text compiles as GLSL: shaders/checks/bounce_gather_check.comp).
+TEST(BounceGatherMath, FootprintAndTail) {
+  // The centre of texel (5, 2) of a 16 x 8 page reads that texel alone.
+  BilinearFootprint f = bilinear_footprint(vec2(5.5f / 16, 2.5f / 8), 16, 8);
+  EXPECT_EQ(f.x0, 5);
+  EXPECT_EQ(f.y0, 2);
+  EXPECT_NEAR(bilinear_weight(f, 0, 0), 1.0f, 1e-5f);
+  // Halfway between the centres of (5, 2) and (6, 3): four equal weights summing to 1.
+  f = bilinear_footprint(vec2(6.0f / 16, 3.0f / 8), 16, 8);
+  EXPECT_EQ(f.x0, 5);
+  EXPECT_EQ(f.y0, 2);
+  float sum = 0;
+  for (int dy = 0; dy <= 1; ++dy)
+    for (int dx = 0; dx <= 1; ++dx) {
+      EXPECT_NEAR(bilinear_weight(f, dx, dy), 0.25f, 1e-5f);
+      sum += bilinear_weight(f, dx, dy);
+    }
+  EXPECT_NEAR(sum, 1.0f, 1e-6f);
+  // The left edge of the page: the footprint starts at column -1 (left out by the lookup).
+  EXPECT_EQ(bilinear_footprint(vec2(0.0f, 0.5f), 16, 8).x0, -1);
+  const Vec2 uv = lightmap_page_uv(vec2(0.5f, 0.25f), Vec4(0.5f, 0.25f, 0.125f, 0.5f));
+  EXPECT_FLOAT_EQ(uv.x, 0.375f);
+  EXPECT_FLOAT_EQ(uv.y, 0.5625f);
+  EXPECT_FLOAT_EQ(geometric_tail_factor(0.5f), 1.0f);
+  EXPECT_NEAR(geometric_tail_factor(0.99f), 99.0f, 1e-3f);  // the tail is ~100x the last bounce
+  EXPECT_FLOAT_EQ(geometric_tail_factor(0.0f), 0.0f);
+  EXPECT_TRUE(std::isinf(geometric_tail_factor(1.0f)));
+}
+
 TEST(BounceTail, GeometricSeriesAgainstItsNoise) {
   BounceTailInputs in;
   const size_t n = 10;
@@ -280,10 +311,13 @@ TEST(BounceTail, GeometricSeriesAgainstItsNoise) {
   EXPECT_NEAR(t.ratio, 0.5, 1e-12);
   EXPECT_NEAR(t.tail_rms, 0.1 / std::sqrt(1.001), 1e-6);
   EXPECT_FALSE(t.below_noise);
-  in.total_variance.assign(n, 0.011 * 0.011);  // noise of 1.1 %: still above... no, the tail (10 %) is larger
+  in.total_variance.assign(n, 0.11 * 0.11);  // noise 11 % > tail 10 %, but not twice the tail
   EXPECT_FALSE(estimate_bounce_tail(in).below_noise);
-  in.total_variance.assign(n, 0.11 * 0.11);    // noise 11 % > tail 10 %
+  in.total_variance.assign(n, 0.21 * 0.21);  // noise 21 %: the tail is below half of it
   EXPECT_TRUE(estimate_bounce_tail(in).below_noise);
+  in.last_bounce_variance.assign(n, 0.1 * 0.1);  // B_k no larger than its own noise: nothing left
+  EXPECT_TRUE(estimate_bounce_tail(in).below_noise);
+  in.last_bounce_variance.clear();
   in.last_bounce.assign(n, 0.2);               // no decay: r = 1, the tail is unbounded
   t = estimate_bounce_tail(in);
   EXPECT_TRUE(std::isinf(t.tail_rms));

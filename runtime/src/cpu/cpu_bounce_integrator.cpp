@@ -180,12 +180,23 @@ BounceTail tail_after(const std::vector<Layer>& layers, const TexelGBuffer& gbuf
   in.area.resize(n);
   in.previous_bounce.resize(n);
   in.last_bounce.resize(n);
+  in.previous_bounce_variance.resize(n);
+  in.last_bounce_variance.resize(n);
   in.total.resize(n);
   in.total_variance.resize(n);
+  // Variance of the luminance of a layer's mean, its channels taken as fully correlated (they are
+  // nearly so: one ray lights all three).
+  auto luminance_variance = [&](const Layer& layer, size_t i) {
+    const double sd = luminance(Vec3(float(std::sqrt(layer.variance_of_mean(i, 0))), float(std::sqrt(layer.variance_of_mean(i, 1))),
+                                     float(std::sqrt(layer.variance_of_mean(i, 2)))));
+    return sd * sd;
+  };
   for (size_t i = 0; i < n; ++i) {
     in.area[i] = area_of(gbuffer.texels[i]);
     in.previous_bounce[i] = luminance(layers[last - 1].mean(i));
     in.last_bounce[i] = luminance(layers[last].mean(i));
+    in.previous_bounce_variance[i] = luminance_variance(layers[last - 1], i);
+    in.last_bounce_variance[i] = luminance_variance(layers[last], i);
     Vec3 total{0, 0, 0}, variance{0, 0, 0};
     for (const Layer& layer : layers) {
       total += layer.mean(i);
