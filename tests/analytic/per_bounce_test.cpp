@@ -171,6 +171,36 @@ TEST(PerBounce, LayersSumToTheTotal) {
   }
 }
 
+// A time budget ramps passes over all layers: later layers have fewer samples, the budget holds,
+// the layers still sum to the total. A target error stops the whole lightmap when every texel meets
+// it and the tail is below the noise.
+TEST(PerBounce, TimeBudgetAndTargetError) {
+  const AtlasScene box = furnace_box(0.7f, {1, 1, 1}, 8);
+  const CpuReferenceIntegrator integrator(box.scene);
+  IntegratorSettings timed = bounce_settings(0, 5);
+  timed.time_budget_seconds = 0.3;
+  const LightmapEstimate e = integrator.bake(box.gbuffer, timed);
+  const BounceGatherStatistics& b = e.bounce_statistics;
+  std::printf("[per-bounce] 0.3 s budget: %.3f s, %d bounces, samples of B_0 %u, of B_%d %u\n", e.seconds, b.bounces,
+              b.samples.front(), b.bounces, b.samples.back());
+  EXPECT_LT(e.seconds, 0.3 + 0.5);  // a pass over one layer is milliseconds here; 0.5 s for a loaded machine
+  ASSERT_GE(b.bounces, 2);
+  EXPECT_GT(b.samples.front(), 16u);
+  for (size_t k = 1; k < b.samples.size(); ++k) EXPECT_LE(b.samples[k], b.samples[k - 1]);
+  EXPECT_GT(b.samples.back(), 0u);
+  for (size_t i = 0; i < e.texels.size(); ++i) {
+    float sum = 0;
+    for (int k = 0; k <= b.bounces; ++k) sum += e.mean_bounce(k, i)[1];
+    ASSERT_NEAR(sum, e.mean_total(i)[1], 1e-5f * sum);
+  }
+
+  IntegratorSettings target = bounce_settings(0, 6);
+  target.target_relative_error = 0.03;
+  const LightmapEstimate t = integrator.bake(box.gbuffer, target);
+  EXPECT_TRUE(t.bounce_statistics.tail_below_noise);
+  for (size_t i = 0; i < t.texels.size(); ++i) ASSERT_TRUE(t.relative_error_below(i, 0.03)) << "texel " << i;
+}
+
 // A hand-made G-buffer has no atlas rectangles: every gather hit is estimated on the fly, which
 // makes the mode an unbiased path tracer split by bounce. Its layers are independent samples, so
 // here the tracked variance is the variance of the texel means.
