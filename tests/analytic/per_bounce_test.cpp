@@ -10,13 +10,20 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
+#include "exitance/bake/command/bake_pipeline.h"
 #include "exitance/bake/command/prepared_scene.h"
 #include "exitance/bake/layout/atlas_layout.h"
 #include "exitance/bake/raster/texel_raster.h"
 #include "exitance/common/bounce_gather.h"
+#include "exitance/formats/lightmap_exr.h"
 #include "exitance/runtime/core/bounce_tail.h"
+#include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "support/analytic_scenes.h"
 
 namespace exitance {
@@ -298,6 +305,54 @@ TEST(PerBounce, CornellRoomAgainstThePathTracer) {
               "per-bounce tracked noise %.3g), mean E/pi ratio %.4f\n",
               b.bounces, rel_mse / values, path_noise / values, bounce_noise / values, sum_bounces / sum_path);
   ::testing::Test::RecordProperty("rel_mse_vs_path", std::to_string(rel_mse / values));
+}
+
+// bake --integrator bounces --bounce-layers: with --backend auto the CPU reference is chosen (the
+// only backend with the mode), and the page holds every bounce layer, which sum to R,G,B.
+TEST(PerBounce, BakeWritesEveryBounceLayer) {
+  namespace fs = std::filesystem;
+  const fs::path out = fs::temp_directory_path() / ("exitance-test-per-bounce-" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  BakeOptions options;
+  options.input = EXITANCE_SAMPLE_DIR "/cornell_room.gltf";
+  options.output = out.string();
+  options.atlas.texel_density = 4;
+  options.lighting.spp = 16;
+  options.lighting.integrator = IntegratorMode::Bounces;
+  options.bounce_layers = true;
+  options.probes_enabled = false;
+  options.svo_enabled = false;
+  Diagnostics diagnostics;
+  run_bake(options, diagnostics);
+  bool told = false;
+  for (const std::string& w : diagnostics.warnings) told = told || w.find("--integrator bounces") != std::string::npos;
+  EXPECT_TRUE(told) << "--backend auto with bounces names the CPU reference it uses";
+  std::ifstream manifest_file(out / "manifest.json");
+  const nlohmann::json manifest = nlohmann::json::parse(manifest_file);
+  const formats::LightmapImage page =
+      formats::read_lightmap_exr((out / manifest["pages"][0]["file"].get<std::string>()).string());
+  int layers = 0;
+  while (page.channels.count("bounce" + std::to_string(layers) + ".R")) ++layers;
+  EXPECT_GE(layers, 4);
+  const std::vector<float>& r = page.channels.at("R");
+  const std::vector<float>& a = page.channels.at("A");
+  for (size_t i = 0; i < r.size(); ++i) {
+    if (!(a[i] > 0)) continue;
+    float sum = 0;
+    for (int k = 0; k < layers; ++k) sum += page.channels.at("bounce" + std::to_string(k) + ".R")[i];
+    ASSERT_NEAR(sum, r[i], 1e-5f * r[i] + 1e-6f) << "texel " << i;
+  }
+  fs::remove_all(out);
+}
+
+// The Vulkan backend has no per-bounce mode yet: it says so instead of path tracing silently.
+TEST(PerBounce, VulkanBackendRefusesTheMode) {
+  const std::vector<VulkanDeviceInfo> devices = enumerate_vulkan_devices();
+  if (std::none_of(devices.begin(), devices.end(), [](const VulkanDeviceInfo& d) { return d.usable; }))
+    GTEST_SKIP() << "no usable Vulkan device";
+  const AtlasScene box = furnace_box(0.5f, {1, 1, 1}, 4);
+  const std::unique_ptr<VulkanIntegrator> vulkan = VulkanIntegrator::create(make_lighting_scene(box.scene));
+  EXPECT_THROW(vulkan->bake(box.gbuffer, bounce_settings(4, 1)), std::runtime_error);
 }
 
 // bounce_gather.h as C++ (the same text compiles as GLSL: shaders/checks/bounce_gather_check.comp).
