@@ -206,6 +206,21 @@ TEST(PerBounce, TimeBudgetAndTargetError) {
   const LightmapEstimate t = integrator.bake(box.gbuffer, target);
   EXPECT_TRUE(t.bounce_statistics.tail_below_noise);
   for (size_t i = 0; i < t.texels.size(); ++i) ASSERT_TRUE(t.relative_error_below(i, 0.03)) << "texel " << i;
+
+  // A texel that never sees light (under a tile lying on the floor of a lit box) has no relative
+  // error to meet: the run must still end. A budget stops it if it does not.
+  AtlasScene covered = furnace_box(0.5f, {1, 1, 1}, 4);
+  const uint32_t tile = testing::add_material(covered.scene, {0.5f, 0.5f, 0.5f});
+  testing::add_quad(covered.scene, {0.2f, 1e-4f, 0.2f}, {0, 0, 0.6f}, {0.6f, 0, 0}, tile);  // faces up
+  LiveTexel under = covered.gbuffer.texels.front();
+  under.position = {0.5f, 0.0f, 0.5f};
+  under.geometric_normal = under.shading_normal = {0, 1, 0};
+  covered.gbuffer.texels.push_back(under);
+  IntegratorSettings bounded = target;
+  bounded.time_budget_seconds = 20;
+  const LightmapEstimate c = CpuReferenceIntegrator(covered.scene).bake(covered.gbuffer, bounded);
+  EXPECT_LT(c.seconds, 10.0) << "the black texel kept the target-error run going";
+  EXPECT_EQ(c.mean_total(covered.gbuffer.texels.size() - 1)[0], 0.0f);
 }
 
 // A hand-made G-buffer has no atlas rectangles: every gather hit is estimated on the fly, which

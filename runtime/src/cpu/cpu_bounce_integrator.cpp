@@ -306,7 +306,9 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
       if (passes.timed() && passes.elapsed_seconds() >= settings.time_budget_seconds) break;
     }
     bool all_converged = false;
-    if (settings.target_relative_error > 0 && !wants_more) {
+    // At least 16 samples, as in path mode; a texel that stayed black with no variance (inside
+    // geometry) has met any target (a relative error of 0/0 would never end the run).
+    if (settings.target_relative_error > 0 && !wants_more && layers[0].samples >= 16) {
       all_converged = true;
       for (size_t i = 0; i < n && all_converged; ++i) {
         Vec3 total{0, 0, 0}, variance{0, 0, 0};
@@ -315,7 +317,7 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
           for (int c = 0; c < 3; ++c) variance[c] += float(layer.variance_of_mean(i, c));
         }
         const float lum = luminance(total);
-        all_converged = lum > 0 && std::sqrt(luminance(variance)) <= settings.target_relative_error * lum;
+        all_converged = std::sqrt(luminance(variance)) <= settings.target_relative_error * lum;
       }
     }
     passes.finish_pass(counters().rays, all_converged);
