@@ -4,13 +4,18 @@
 //
 //   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,bounces] [--name NAME]
 //                       [--sky R,G,B] [--texel-density T] [--reference-spp N] [--max-spp N]
-//                       [--max-seconds S] [--target 0.01] [--cache DIR] [--csv FILE]
+//                       [--max-seconds S] [--target 0.01] [--bounces N] [--min-spp N] [--cache DIR] [--csv FILE]
+//                       [--texel-csv FILE]
 //
 // The reference is always the CPU path tracer. For the per-bounce mode (integrator per_bounce) the
 // CSV also has the bounces run, the fraction of gather hits without texels, and bias_rel_mse: at
 // every rung a second run with another seed, and the mean over texels of w (x1 - r)(x2 - r) minus
 // the reference's noise - the two runs' noises are independent, so this estimates the squared
-// bias alone (relMSE units), whatever the noise (it can come out slightly negative).
+// bias alone (relMSE units), whatever the noise (it can come out slightly negative). --bounces N
+// forces N bounces in both modes (default: automatic), so the per-bounce mode's resolution bias can
+// be told from its truncation; --min-spp starts the ladder higher. --texel-csv writes, for the last
+// run of each integrator, every texel's instance, page position, world position, reference and
+// estimate (luminance), to see where an error lives.
 //
 // relMSE = mean over live texels and channels of (x - r)^2 / (r^2 + 1e-3): the 1e-3 keeps
 // black texels from dominating (the usual regulariser of relMSE in rendering papers).
@@ -69,10 +74,11 @@ std::vector<float> flatten(const LightmapEstimate& estimate) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string scene_path, scene_name, sky, csv_path, cache_dir, backends = "cpu", integrators = "path";
+  std::string scene_path, scene_name, sky, csv_path, cache_dir, texel_csv_path, backends = "cpu", integrators = "path";
   double max_seconds = 120;
   float density = 8;
-  uint32_t reference_spp = 8192, max_spp = 1024;
+  uint32_t reference_spp = 8192, max_spp = 1024, min_spp = 1;
+  int bounces = -1;
   double target = 0.01;
   CLI::App app{"time against error of the CPU reference"};
   app.add_option("scene", scene_path)->required();
@@ -85,6 +91,9 @@ int main(int argc, char** argv) {
   app.add_option("--reference-spp", reference_spp);
   app.add_option("--max-spp", max_spp);
   app.add_option("--target", target, "relMSE target (0.01 = 1 %)");
+  app.add_option("--bounces", bounces, "forced bounces of the measured runs (default: automatic)");
+  app.add_option("--min-spp", min_spp, "first spp of the ladder");
+  app.add_option("--texel-csv", texel_csv_path, "per-texel reference and estimate of each integrator's last run");
   app.add_option("--cache", cache_dir, "reference cache folder (default ~/.cache/exitance)");
   app.add_option("--csv", csv_path);
   CLI11_PARSE(app, argc, argv);
@@ -144,6 +153,11 @@ int main(int argc, char** argv) {
   std::ofstream csv_file;
   if (!csv_path.empty()) csv_file.open(csv_path);
   std::ostream& csv = csv_path.empty() ? std::cout : csv_file;
+  std::ofstream texel_csv;
+  if (!texel_csv_path.empty()) {
+    texel_csv.open(texel_csv_path);
+    texel_csv << "integrator,texel,instance,page,x,y,px,py,pz,reference,estimate\n";
+  }
   csv << "backend,integrator,scene,live_texels,spp,seconds,rel_mse,raw_rel_mse,reference_rel_mse,mae,worst_texel_error,"
          "rays_per_second,bounces,texelless_fraction,bias_rel_mse\n";
   std::vector<IntegratorMode> modes;
@@ -164,11 +178,13 @@ int main(int argc, char** argv) {
         }
       }
       double previous_seconds = 0, previous_error = 0, time_to_target = -1;
-      for (uint32_t spp = 1; spp <= max_spp; spp *= 2) {
+      std::vector<float> last_result;
+      for (uint32_t spp = std::max(min_spp, 1u); spp <= max_spp; spp *= 2) {
         IntegratorSettings settings;
         settings.spp = spp;
         settings.seed = spp;
         settings.integrator = mode;
+        settings.max_bounces = bounces;
         const LightmapEstimate estimate = backend->bake(gbuffer, settings);
         std::vector<float> result = flatten(estimate);
         result.resize(values);
@@ -200,8 +216,17 @@ int main(int argc, char** argv) {
         }
         previous_seconds = estimate.seconds;
         previous_error = e.rel_mse;
+        last_result = result;
         if (estimate.seconds > max_seconds) break;
       }
+      if (texel_csv.is_open())
+        for (size_t i = 0; i < gbuffer.texels.size(); ++i) {
+          const LiveTexel& t = gbuffer.texels[i];
+          auto lum = [&](const std::vector<float>& v) { return luminance({v[i * 3], v[i * 3 + 1], v[i * 3 + 2]}); };
+          texel_csv << mode_name << "," << i << "," << t.instance << "," << t.page << "," << t.x << "," << t.y << ","
+                    << t.position.x << "," << t.position.y << "," << t.position.z << "," << lum(reference_mean) << ","
+                    << lum(last_result) << "\n";
+        }
       std::cerr << backend->backend_name() << " " << mode_name << ": live texels " << gbuffer.texels.size()
                 << "; time to relMSE " << target << ": "
                 << (time_to_target < 0 ? std::string("not reached") : std::to_string(time_to_target) + " s") << "\n";

@@ -10,12 +10,20 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
+#include "exitance/bake/command/bake_pipeline.h"
 #include "exitance/bake/command/prepared_scene.h"
 #include "exitance/bake/layout/atlas_layout.h"
 #include "exitance/bake/raster/texel_raster.h"
+#include "exitance/common/bounce_gather.h"
+#include "exitance/formats/lightmap_exr.h"
 #include "exitance/runtime/core/bounce_tail.h"
+#include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "support/analytic_scenes.h"
 
 namespace exitance {
@@ -118,7 +126,7 @@ TEST(PerBounce, FurnaceWithAutomaticBouncesMatchesTheSumOfTheBouncesRun) { expec
 
 // At rho = 0.9 the last bounce is 1/10 of the tail: the criterion must run ~22 bounces more than
 // "stop when the last bounce is below the noise" would, and leave a truncated tail (exactly
-// rho^(K+1) of the total here) no larger than the noise of the total.
+// rho^(K+1) of the total here) below the noise of the total (half of it: kTailToNoise).
 TEST(PerBounce, TailCriterionRunsUntilTheTailIsBelowTheNoise) {
   const float rho = 0.9f;
   const AtlasScene box = furnace_box(rho, {1, 1, 1}, 8);
@@ -138,9 +146,10 @@ TEST(PerBounce, TailCriterionRunsUntilTheTailIsBelowTheNoise) {
     EXPECT_TRUE(b.tail_below_noise);
     EXPECT_GT(noise, 0.0);
     EXPECT_NEAR(b.ratio, rho, 0.02);
-    // Factor 2: the ratio and the per-texel B_K it extrapolates are estimates themselves.
-    EXPECT_LE(truncated, 2 * noise) << "stopped with the tail above the noise";
-    EXPECT_GE(std::pow(double(rho), k), noise / 2) << "ran bounces the noise could not see";
+    // The stop is at tail <= kTailToNoise x noise; factor 2 either way: the ratio and the per-texel
+    // B_K it extrapolates are estimates themselves.
+    EXPECT_LE(truncated, 2 * kTailToNoise * noise) << "stopped with the tail above the noise";
+    EXPECT_GE(std::pow(double(rho), k), kTailToNoise * noise / 2) << "ran bounces the noise could not see";
     EXPECT_GE(k, last_bounce_rule + 15);
     ratios.push_back(mean_over_texels(e, 0) * (1 - rho) / (1 - truncated));
   }
@@ -167,6 +176,51 @@ TEST(PerBounce, LayersSumToTheTotal) {
     }
     EXPECT_GT(e.variance_of_mean(i)[0], 0.0f);
   }
+}
+
+// A time budget ramps passes over all layers: later layers have fewer samples, the budget holds,
+// the layers still sum to the total. A target error stops the whole lightmap when every texel meets
+// it and the tail is below the noise.
+TEST(PerBounce, TimeBudgetAndTargetError) {
+  const AtlasScene box = furnace_box(0.7f, {1, 1, 1}, 8);
+  const CpuReferenceIntegrator integrator(box.scene);
+  IntegratorSettings timed = bounce_settings(0, 5);
+  timed.time_budget_seconds = 0.3;
+  const LightmapEstimate e = integrator.bake(box.gbuffer, timed);
+  const BounceGatherStatistics& b = e.bounce_statistics;
+  std::printf("[per-bounce] 0.3 s budget: %.3f s, %d bounces, samples of B_0 %u, of B_%d %u\n", e.seconds, b.bounces,
+              b.samples.front(), b.bounces, b.samples.back());
+  EXPECT_LT(e.seconds, 0.3 + 0.5);  // a pass over one layer is milliseconds here; 0.5 s for a loaded machine
+  ASSERT_GE(b.bounces, 2);
+  EXPECT_GT(b.samples.front(), 16u);
+  for (size_t k = 1; k < b.samples.size(); ++k) EXPECT_LE(b.samples[k], b.samples[k - 1]);
+  EXPECT_GT(b.samples.back(), 0u);
+  for (size_t i = 0; i < e.texels.size(); ++i) {
+    float sum = 0;
+    for (int k = 0; k <= b.bounces; ++k) sum += e.mean_bounce(k, i)[1];
+    ASSERT_NEAR(sum, e.mean_total(i)[1], 1e-5f * sum);
+  }
+
+  IntegratorSettings target = bounce_settings(0, 6);
+  target.target_relative_error = 0.03;
+  const LightmapEstimate t = integrator.bake(box.gbuffer, target);
+  EXPECT_TRUE(t.bounce_statistics.tail_below_noise);
+  for (size_t i = 0; i < t.texels.size(); ++i) ASSERT_TRUE(t.relative_error_below(i, 0.03)) << "texel " << i;
+
+  // A texel that never sees light (under a tile lying on the floor of a lit box) has no relative
+  // error to meet: the run must still end. A budget stops it if it does not.
+  AtlasScene covered = furnace_box(0.5f, {1, 1, 1}, 4);
+  const uint32_t tile = testing::add_material(covered.scene, {0.5f, 0.5f, 0.5f});
+  testing::add_quad(covered.scene, {0.2f, 1e-4f, 0.2f}, {0, 0, 0.6f}, {0.6f, 0, 0}, tile);  // faces up
+  LiveTexel under = covered.gbuffer.texels.front();
+  under.position = {0.5f, 0.0f, 0.5f};
+  under.geometric_normal = under.shading_normal = {0, 1, 0};
+  covered.gbuffer.texels.push_back(under);
+  IntegratorSettings bounded = target;
+  bounded.time_budget_seconds = 20;
+  const LightmapEstimate c = CpuReferenceIntegrator(covered.scene).bake(covered.gbuffer, bounded);
+  EXPECT_LT(c.seconds, 10.0) << "the black texel kept the target-error run going";
+  EXPECT_EQ(c.mean_total(covered.gbuffer.texels.size() - 1)[0], 0.0f);
 }
 
 // A hand-made G-buffer has no atlas rectangles: every gather hit is estimated on the fly, which
@@ -268,6 +322,83 @@ TEST(PerBounce, CornellRoomAgainstThePathTracer) {
   ::testing::Test::RecordProperty("rel_mse_vs_path", std::to_string(rel_mse / values));
 }
 
+// bake --integrator bounces --bounce-layers: with --backend auto the CPU reference is chosen (the
+// only backend with the mode), and the page holds every bounce layer, which sum to R,G,B.
+TEST(PerBounce, BakeWritesEveryBounceLayer) {
+  namespace fs = std::filesystem;
+  const fs::path out = fs::temp_directory_path() / ("exitance-test-per-bounce-" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  BakeOptions options;
+  options.input = EXITANCE_SAMPLE_DIR "/cornell_room.gltf";
+  options.output = out.string();
+  options.atlas.texel_density = 4;
+  options.lighting.spp = 16;
+  options.lighting.integrator = IntegratorMode::Bounces;
+  options.bounce_layers = true;
+  options.probes_enabled = false;
+  options.svo_enabled = false;
+  Diagnostics diagnostics;
+  run_bake(options, diagnostics);
+  bool told = false;
+  for (const std::string& w : diagnostics.warnings) told = told || w.find("--integrator bounces") != std::string::npos;
+  EXPECT_TRUE(told) << "--backend auto with bounces names the CPU reference it uses";
+  std::ifstream manifest_file(out / "manifest.json");
+  const nlohmann::json manifest = nlohmann::json::parse(manifest_file);
+  const formats::LightmapImage page =
+      formats::read_lightmap_exr((out / manifest["pages"][0]["file"].get<std::string>()).string());
+  int layers = 0;
+  while (page.channels.count("bounce" + std::to_string(layers) + ".R")) ++layers;
+  EXPECT_GE(layers, 4);
+  const std::vector<float>& r = page.channels.at("R");
+  const std::vector<float>& a = page.channels.at("A");
+  for (size_t i = 0; i < r.size(); ++i) {
+    if (!(a[i] > 0)) continue;
+    float sum = 0;
+    for (int k = 0; k < layers; ++k) sum += page.channels.at("bounce" + std::to_string(k) + ".R")[i];
+    ASSERT_NEAR(sum, r[i], 1e-5f * r[i] + 1e-6f) << "texel " << i;
+  }
+  fs::remove_all(out);
+}
+
+// The Vulkan backend has no per-bounce mode yet: it says so instead of path tracing silently.
+TEST(PerBounce, VulkanBackendRefusesTheMode) {
+  const std::vector<VulkanDeviceInfo> devices = enumerate_vulkan_devices();
+  if (std::none_of(devices.begin(), devices.end(), [](const VulkanDeviceInfo& d) { return d.usable; }))
+    GTEST_SKIP() << "no usable Vulkan device";
+  const AtlasScene box = furnace_box(0.5f, {1, 1, 1}, 4);
+  const std::unique_ptr<VulkanIntegrator> vulkan = VulkanIntegrator::create(make_lighting_scene(box.scene));
+  EXPECT_THROW(vulkan->bake(box.gbuffer, bounce_settings(4, 1)), std::runtime_error);
+}
+
+// bounce_gather.h as C++ (the same text compiles as GLSL: shaders/checks/bounce_gather_check.comp).
+TEST(BounceGatherMath, FootprintAndTail) {
+  // The centre of texel (5, 2) of a 16 x 8 page reads that texel alone.
+  BilinearFootprint f = bilinear_footprint(vec2(5.5f / 16, 2.5f / 8), 16, 8);
+  EXPECT_EQ(f.x0, 5);
+  EXPECT_EQ(f.y0, 2);
+  EXPECT_NEAR(bilinear_weight(f, 0, 0), 1.0f, 1e-5f);
+  // Halfway between the centres of (5, 2) and (6, 3): four equal weights summing to 1.
+  f = bilinear_footprint(vec2(6.0f / 16, 3.0f / 8), 16, 8);
+  EXPECT_EQ(f.x0, 5);
+  EXPECT_EQ(f.y0, 2);
+  float sum = 0;
+  for (int dy = 0; dy <= 1; ++dy)
+    for (int dx = 0; dx <= 1; ++dx) {
+      EXPECT_NEAR(bilinear_weight(f, dx, dy), 0.25f, 1e-5f);
+      sum += bilinear_weight(f, dx, dy);
+    }
+  EXPECT_NEAR(sum, 1.0f, 1e-6f);
+  // The left edge of the page: the footprint starts at column -1 (left out by the lookup).
+  EXPECT_EQ(bilinear_footprint(vec2(0.0f, 0.5f), 16, 8).x0, -1);
+  const Vec2 uv = lightmap_page_uv(vec2(0.5f, 0.25f), Vec4(0.5f, 0.25f, 0.125f, 0.5f));
+  EXPECT_FLOAT_EQ(uv.x, 0.375f);
+  EXPECT_FLOAT_EQ(uv.y, 0.5625f);
+  EXPECT_FLOAT_EQ(geometric_tail_factor(0.5f), 1.0f);
+  EXPECT_NEAR(geometric_tail_factor(0.99f), 99.0f, 1e-3f);  // the tail is ~100x the last bounce
+  EXPECT_FLOAT_EQ(geometric_tail_factor(0.0f), 0.0f);
+  EXPECT_TRUE(std::isinf(geometric_tail_factor(1.0f)));
+}
+
 TEST(BounceTail, GeometricSeriesAgainstItsNoise) {
   BounceTailInputs in;
   const size_t n = 10;
@@ -280,10 +411,13 @@ TEST(BounceTail, GeometricSeriesAgainstItsNoise) {
   EXPECT_NEAR(t.ratio, 0.5, 1e-12);
   EXPECT_NEAR(t.tail_rms, 0.1 / std::sqrt(1.001), 1e-6);
   EXPECT_FALSE(t.below_noise);
-  in.total_variance.assign(n, 0.011 * 0.011);  // noise of 1.1 %: still above... no, the tail (10 %) is larger
+  in.total_variance.assign(n, 0.11 * 0.11);  // noise 11 % > tail 10 %, but not twice the tail
   EXPECT_FALSE(estimate_bounce_tail(in).below_noise);
-  in.total_variance.assign(n, 0.11 * 0.11);    // noise 11 % > tail 10 %
+  in.total_variance.assign(n, 0.21 * 0.21);  // noise 21 %: the tail is below half of it
   EXPECT_TRUE(estimate_bounce_tail(in).below_noise);
+  in.last_bounce_variance.assign(n, 0.1 * 0.1);  // B_k no larger than its own noise: nothing left
+  EXPECT_TRUE(estimate_bounce_tail(in).below_noise);
+  in.last_bounce_variance.clear();
   in.last_bounce.assign(n, 0.2);               // no decay: r = 1, the tail is unbounded
   t = estimate_bounce_tail(in);
   EXPECT_TRUE(std::isinf(t.tail_rms));

@@ -1,40 +1,55 @@
 #include "bounce_layer_cache.h"
 
+#include <cmath>
+
 #include "exitance/common/bounce_gather.h"
 #include "exitance/runtime/bundle/lightmap_assembly.h"
 
 namespace exitance {
+namespace {
 
-void BounceLayerCache::build(const TexelGBuffer& gbuffer, const std::vector<Vec3>& texel_values, int dilation) {
+enum Channel { kR, kG, kB, kLit, kPx, kPy, kPz, kNx, kNy, kNz, kChannels };
+
+// A footprint texel is on the hit's surface when its normal is within ~37 degrees of the hit's and
+// it lies near the hit's tangent plane (within ~14 degrees seen from the hit): thresholds loose
+// enough for curved surfaces at coarse texels, tight enough to drop the next face of a box.
+constexpr float kSameSurfaceCosine = 0.8f;
+constexpr float kPlaneSlope = 0.25f;
+
+}  // namespace
+
+void BounceLayerCache::build(const TexelGBuffer& gbuffer, const std::vector<Vec3>& texel_values,
+                             const std::vector<uint8_t>& valid, int dilation) {
   pages_.resize(gbuffer.pages.size());
   for (size_t p = 0; p < pages_.size(); ++p) {
     Page& page = pages_[p];
     page.width = gbuffer.pages[p].width;
     page.height = gbuffer.pages[p].height;
-    const size_t n = size_t(page.width) * size_t(page.height);
-    for (std::vector<float>* channel : {&page.r, &page.g, &page.b, &page.lit}) channel->assign(n, 0.0f);
+    for (std::vector<float>& c : page.channel) c.assign(size_t(page.width) * size_t(page.height), 0.0f);
   }
   for (size_t i = 0; i < gbuffer.texels.size(); ++i) {
     const LiveTexel& t = gbuffer.texels[i];
     if (t.page >= pages_.size()) continue;  // a hand-made G-buffer without pages: nothing to look up
+    if (!valid.empty() && !valid[i]) continue;
     Page& page = pages_[t.page];
     if (t.x >= uint32_t(page.width) || t.y >= uint32_t(page.height)) continue;
     const size_t at = size_t(t.y) * size_t(page.width) + size_t(t.x);
-    page.r[at] = texel_values[i].x;
-    page.g[at] = texel_values[i].y;
-    page.b[at] = texel_values[i].z;
-    page.lit[at] = 1.0f;
+    const float values[kChannels] = {texel_values[i].x, texel_values[i].y, texel_values[i].z, 1.0f,
+                                     t.position.x,      t.position.y,      t.position.z,      t.geometric_normal.x,
+                                     t.geometric_normal.y, t.geometric_normal.z};
+    for (int c = 0; c < kChannels; ++c) page.channel[c][at] = values[c];
   }
-  // The "lit" channel dilates with the colour: a filled gutter texel averages lit neighbours (1).
-  for (size_t p = 0; p < pages_.size(); ++p) {
-    Page& page = pages_[p];
-    const std::vector<float> live = page.lit;
-    dilate_into_gutter(page.width, page.height, live, {page.r.data(), page.g.data(), page.b.data(), page.lit.data()},
-                       dilation);
+  // Every channel dilates: a filled gutter texel averages its lit neighbours (lit = 1).
+  for (Page& page : pages_) {
+    const std::vector<float> lit = page.channel[kLit];
+    std::vector<float*> channels;
+    for (std::vector<float>& c : page.channel) channels.push_back(c.data());
+    dilate_into_gutter(page.width, page.height, lit, channels, dilation);
   }
 }
 
-bool BounceLayerCache::lookup(const TexelGBuffer& gbuffer, uint32_t instance, Vec2 uv, Vec3& out) const {
+bool BounceLayerCache::lookup(const TexelGBuffer& gbuffer, uint32_t instance, Vec2 uv, Vec3 position, Vec3 normal,
+                              Vec3& out) const {
   if (instance >= gbuffer.instance_rects.size()) return false;
   const InstanceRect& rect = gbuffer.instance_rects[instance];
   if (rect.page < 0 || size_t(rect.page) >= pages_.size()) return false;
@@ -47,14 +62,16 @@ bool BounceLayerCache::lookup(const TexelGBuffer& gbuffer, uint32_t instance, Ve
       const int x = f.x0 + dx, y = f.y0 + dy;
       if (x < 0 || y < 0 || x >= page.width || y >= page.height) continue;
       const size_t at = size_t(y) * size_t(page.width) + size_t(x);
-      if (!(page.lit[at] > 0)) continue;
+      if (!(page.channel[kLit][at] > 0)) continue;
+      const Vec3 n{page.channel[kNx][at], page.channel[kNy][at], page.channel[kNz][at]};
+      const Vec3 d = Vec3{page.channel[kPx][at], page.channel[kPy][at], page.channel[kPz][at]} - position;
+      if (dot(n, normal) < kSameSurfaceCosine * length(n)) continue;
+      if (std::fabs(dot(d, normal)) > kPlaneSlope * length(d)) continue;
       const double w = bilinear_weight(f, dx, dy);
       weight += w;
-      sum[0] += w * page.r[at];
-      sum[1] += w * page.g[at];
-      sum[2] += w * page.b[at];
+      for (int c = 0; c < 3; ++c) sum[c] += w * page.channel[c][at];
     }
-  // A footprint whose lit texels carry almost no weight would amplify one texel's noise: treat as none.
+  // A footprint whose usable texels carry almost no weight would amplify one texel's noise: none.
   if (!(weight > 1e-3)) return false;
   out = {float(sum[0] / weight), float(sum[1] / weight), float(sum[2] / weight)};
   return true;

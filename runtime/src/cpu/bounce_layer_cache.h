@@ -1,7 +1,15 @@
 // One bounce layer B_k laid out on the atlas pages, for the per-bounce gather: the texels' means,
 // dilated into the gutter (lightmap_assembly.h's dilate_into_gutter, as the bundle's pages are) so
-// a bilinear lookup near a chart edge does not read unlit texels, and a "lit" channel saying which
-// texels hold a value.
+// a bilinear lookup near a chart edge does not read unlit texels.
+//
+// Two resolution biases are kept out of the lookup, because both only ever darken:
+// - texels inside or under geometry (most of their rays meet back faces, e.g. a wall behind a lamp
+//   panel 1 cm in front of it) hold no light of a visible surface: they are left out like gutter
+//   texels, and dilation refills them from valid neighbours;
+// - a bilinear footprint can straddle a chart seam (the faces of a box packed side by side in UV):
+//   a texel whose normal or plane differs from the hit's is not on the hit's surface and is left
+//   out. Positions and normals are dilated with the colour, so gutter texels between two charts
+//   carry a mixed normal and are left out too.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -12,17 +20,22 @@ namespace exitance {
 
 class BounceLayerCache {
  public:
-  // `texel_values`: B_k per live texel, in gbuffer.texels order. `dilation`: rings filled around charts.
-  void build(const TexelGBuffer& gbuffer, const std::vector<Vec3>& texel_values, int dilation);
-  // B_k at lightmap UV `uv` of scene instance `instance`: the bilinear mean of the lit texels of its
-  // footprint (bounce_gather.h), renormalised over them; false when none is lit or the G-buffer has
-  // no rectangle for the instance.
-  bool lookup(const TexelGBuffer& gbuffer, uint32_t instance, Vec2 uv, Vec3& out) const;
+  // `texel_values`: B_k per live texel, in gbuffer.texels order; `valid`: per live texel, 0 for one
+  // inside geometry (empty: all valid). `dilation`: rings filled around charts.
+  void build(const TexelGBuffer& gbuffer, const std::vector<Vec3>& texel_values, const std::vector<uint8_t>& valid,
+             int dilation);
+  // B_k at lightmap UV `uv` of scene instance `instance`, hit at `position` on the side `normal`
+  // (unit geometric normal): the bilinear mean of the footprint's lit texels on the same surface
+  // (bounce_gather.h), renormalised over them; false when there is none, or the G-buffer has no
+  // rectangle for the instance.
+  bool lookup(const TexelGBuffer& gbuffer, uint32_t instance, Vec2 uv, Vec3 position, Vec3 normal, Vec3& out) const;
 
  private:
   struct Page {
     int width = 0, height = 0;
-    std::vector<float> r, g, b, lit;  // planar, row 0 = top
+    // Planar channels, row 0 = top: colour, lit (1 where a valid texel or its dilation holds a
+    // value), then the texel's world position and geometric normal.
+    std::vector<float> channel[10];
   };
   std::vector<Page> pages_;
 };

@@ -63,6 +63,7 @@ struct Counters {
 // Per texel sums of one layer's samples (RGB, doubles: long runs keep precision).
 struct Layer {
   std::vector<double> sum, sum_squared;
+  std::vector<uint32_t> back_faces;  // B_0 only: samples whose continuation ray met a back face
   uint32_t samples = 0;
   explicit Layer(size_t texels) : sum(texels * 3, 0.0), sum_squared(texels * 3, 0.0) {}
   Vec3 mean(size_t i) const {
@@ -82,8 +83,10 @@ class BounceGather {
                const std::vector<BounceLayerCache>& caches, const IntegratorSettings& settings)
       : scene_(scene), embree_(embree), gbuffer_(gbuffer), caches_(caches), settings_(settings) {}
 
-  // One sample of B_0 at x: path.h's estimator stopped after the direct light.
-  Vec3 direct(SurfacePoint x, Pcg32& rng, Counters& c) const {
+  // One sample of B_0 at x: path.h's estimator stopped after the direct light. `back_face`: its
+  // continuation ray met the back of a single-sided surface (x is inside or under geometry).
+  Vec3 direct(SurfacePoint x, Pcg32& rng, Counters& c, bool& back_face) const {
+    back_face = false;
     const LightingScene& scene = scene_;
     const Vec3 origin = offset_ray_origin(x.position, x.geometric_normal, scene.extent);
     ShadowRay shadow[kShadowRaysPerVertex];
@@ -95,6 +98,8 @@ class BounceGather {
     ++c.rays;
     const Hit hit = embree_.intersect(origin, d.direction, INFINITY);
     if (!hit.found) return sum + escaped_radiance(scene, d.direction, d.pdf);
+    back_face = !(dot(d.direction, triangle_geometric_normal(scene, hit.triangle)) < 0.0f) &&
+                !material_double_sided(scene_material(scene, scene_triangle_material(scene, hit.triangle)));
     const PathLimits direct_only{0, settings_.russian_roulette_start, settings_.safety_bounce_cap};
     const HitResult h = shade_continuation_hit(scene, hit.triangle, hit.distance, hit.b1, hit.b2, d.direction, d.pdf,
                                                Vec3(1.0f), 0, direct_only, rng);
@@ -123,9 +128,11 @@ class BounceGather {
     const Vec3 albedo = scene_albedo(scene, tri, hit.b1, hit.b2);
     if (!(max_component(albedo) > 0)) return {0, 0, 0};
     Vec3 b;
-    if (!front || !caches_[size_t(layer)].lookup(gbuffer_, instance_of(tri), lightmap_uv(tri, hit.b1, hit.b2), b)) {
+    const SurfacePoint y = surface_point_on_triangle(scene, tri, ng, hit.b1, hit.b2, front);
+    if (!front ||
+        !caches_[size_t(layer)].lookup(gbuffer_, instance_of(tri), lightmap_uv(tri, hit.b1, hit.b2), y.position, ng, b)) {
       ++c.texelless;
-      b = on_the_fly(surface_point_on_triangle(scene, tri, ng, hit.b1, hit.b2, front), layer, rng, c);
+      b = on_the_fly(y, layer, rng, c);
     }
     return albedo * b * weight;
   }
@@ -133,7 +140,8 @@ class BounceGather {
  private:
   // B_layer at a surface point that has no texels: one sample, from the layer below.
   Vec3 on_the_fly(SurfacePoint y, int layer, Pcg32& rng, Counters& c) const {
-    return layer == 0 ? direct(y, rng, c) : gather(y, layer - 1, rng, c);
+    bool back_face = false;
+    return layer == 0 ? direct(y, rng, c, back_face) : gather(y, layer - 1, rng, c);
   }
 
   Vec3 connect(const ShadowRay (&rays)[kShadowRaysPerVertex], Vec3 origin, Counters& c) const {
@@ -180,12 +188,23 @@ BounceTail tail_after(const std::vector<Layer>& layers, const TexelGBuffer& gbuf
   in.area.resize(n);
   in.previous_bounce.resize(n);
   in.last_bounce.resize(n);
+  in.previous_bounce_variance.resize(n);
+  in.last_bounce_variance.resize(n);
   in.total.resize(n);
   in.total_variance.resize(n);
+  // Variance of the luminance of a layer's mean, its channels taken as fully correlated (they are
+  // nearly so: one ray lights all three).
+  auto luminance_variance = [&](const Layer& layer, size_t i) {
+    const double sd = luminance(Vec3(float(std::sqrt(layer.variance_of_mean(i, 0))), float(std::sqrt(layer.variance_of_mean(i, 1))),
+                                     float(std::sqrt(layer.variance_of_mean(i, 2)))));
+    return sd * sd;
+  };
   for (size_t i = 0; i < n; ++i) {
     in.area[i] = area_of(gbuffer.texels[i]);
     in.previous_bounce[i] = luminance(layers[last - 1].mean(i));
     in.last_bounce[i] = luminance(layers[last].mean(i));
+    in.previous_bounce_variance[i] = luminance_variance(layers[last - 1], i);
+    in.last_bounce_variance[i] = luminance_variance(layers[last], i);
     Vec3 total{0, 0, 0}, variance{0, 0, 0};
     for (const Layer& layer : layers) {
       total += layer.mean(i);
@@ -210,7 +229,11 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
   std::vector<Layer> layers;
   std::vector<BounceLayerCache> caches;
   layers.emplace_back(n);
+  layers[0].back_faces.assign(n, 0);
   caches.emplace_back();
+  // Texels whose B_0 rays mostly meet back faces are inside or under geometry (as the bake's scene
+  // checks say): left out of every lookup (BounceLayerCache).
+  std::vector<uint8_t> valid(n, 1);
   tbb::combinable<Counters> counters_per_thread;
   auto counters = [&] {
     Counters sum;
@@ -240,7 +263,9 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
           const SurfacePoint x{texel.position, texel.geometric_normal, texel.shading_normal};
           for (uint32_t s = layer.samples; s < layer.samples + add; ++s) {
             Pcg32 rng = k == 0 ? pcg_init(settings.seed, i, s) : pcg_init(settings.seed, kBounceRngStreamBase * k + i, s);
-            const Vec3 value = k == 0 ? gather.direct(x, rng, c) : gather.gather(x, int(k) - 1, rng, c);
+            bool back_face = false;
+            const Vec3 value = k == 0 ? gather.direct(x, rng, c, back_face) : gather.gather(x, int(k) - 1, rng, c);
+            if (back_face) ++layer.back_faces[i];
             if (!is_finite(value)) {
               ++c.nonfinite;  // counted and reported; counts as 0 (an unbiased estimator never produces these)
               continue;
@@ -253,9 +278,11 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
         }
       });
       layer.samples += add;
+      if (k == 0)
+        for (size_t i = 0; i < n; ++i) valid[i] = 2 * layers[0].back_faces[i] <= layers[0].samples ? 1 : 0;
       std::vector<Vec3> means(n);
       for (size_t i = 0; i < n; ++i) means[i] = layer.mean(i);
-      caches[k].build(gbuffer, means, kCacheDilation);
+      caches[k].build(gbuffer, means, valid, kCacheDilation);
 
       if (k + 1 == layers.size()) {  // the top layer: does the light bounce on?
         // The noise needs two samples in every layer; until then no layer beyond B_1 is started.
@@ -279,7 +306,9 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
       if (passes.timed() && passes.elapsed_seconds() >= settings.time_budget_seconds) break;
     }
     bool all_converged = false;
-    if (settings.target_relative_error > 0 && !wants_more) {
+    // At least 16 samples, as in path mode; a texel that stayed black with no variance (inside
+    // geometry) has met any target (a relative error of 0/0 would never end the run).
+    if (settings.target_relative_error > 0 && !wants_more && layers[0].samples >= 16) {
       all_converged = true;
       for (size_t i = 0; i < n && all_converged; ++i) {
         Vec3 total{0, 0, 0}, variance{0, 0, 0};
@@ -288,7 +317,7 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
           for (int c = 0; c < 3; ++c) variance[c] += float(layer.variance_of_mean(i, c));
         }
         const float lum = luminance(total);
-        all_converged = lum > 0 && std::sqrt(luminance(variance)) <= settings.target_relative_error * lum;
+        all_converged = std::sqrt(luminance(variance)) <= settings.target_relative_error * lum;
       }
     }
     passes.finish_pass(counters().rays, all_converged);

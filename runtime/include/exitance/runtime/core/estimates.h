@@ -25,7 +25,7 @@ struct BounceGatherStatistics {
   uint64_t gathers = 0;            // gather rays that hit a surface
   uint64_t texelless_hits = 0;     // of those, hits with no lit texel to read (estimated on the fly instead)
   uint64_t back_face_hits = 0;     // of those, back faces of single-sided surfaces (0, as in path mode)
-  double ratio = 0;                // B_k / B_{k-1} of the last two layers (area-weighted)
+  double ratio = 0;                // B_k / B_{k-1} of the last two layers (relative RMS, bounce_tail.h)
   double tail_rms = 0;             // the extrapolated tail at the stop, relative RMS (bounce_tail.h)
   double noise_rms = 0;            // the total's noise at the stop, relative RMS
   bool tail_below_noise = false;   // false: stopped by --bounces, the time budget or the layer cap
