@@ -22,6 +22,7 @@ using json = nlohmann::json;
 formats::BakeSettings settings_of(const BakeResults& results, const BakeOptions& options) {
   formats::BakeSettings s;
   s.backend = results.backend.backend_name();
+  s.integrator = options.lighting.integrator == IntegratorMode::Bounces ? "bounces" : "path";
   s.spp = options.lighting.spp;
   s.time_budget_seconds = options.lighting.time_budget_seconds;
   s.target_error = options.lighting.target_relative_error;

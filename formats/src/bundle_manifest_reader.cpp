@@ -246,6 +246,11 @@ BakeSettings parse_settings(const FieldReader& r, const json& j) {
     s.backend = r.string(*v, path("backend"));
     if (s.backend != "cpu" && s.backend != "vulkan") r.fail(path("backend"), "\"" + s.backend + "\" is not cpu or vulkan");
   }
+  if (auto v = field("integrator")) {
+    s.integrator = r.string(*v, path("integrator"));
+    if (s.integrator != "path" && s.integrator != "bounces")
+      r.fail(path("integrator"), "\"" + s.integrator + "\" is not path or bounces");
+  }
   if (auto v = field("spp")) s.spp = uint32_t(r.unsigned_integer(*v, path("spp"), 0, UINT32_MAX));
   if (auto v = field("time_budget_seconds")) s.time_budget_seconds = r.non_negative_double(*v, path("time_budget_seconds"));
   if (auto v = field("target_error")) s.target_error = r.non_negative_double(*v, path("target_error"));

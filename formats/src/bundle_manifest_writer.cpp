@@ -16,7 +16,8 @@ json array_json(const std::array<T, N>& values) {
 }
 
 json settings_json(const BakeSettings& s) {
-  json j = {{"spp", s.spp},
+  json j = {{"integrator", s.integrator},
+            {"spp", s.spp},
             {"time_budget_seconds", s.time_budget_seconds},
             {"target_error", s.target_error},
             {"bounces", s.bounces},

@@ -42,7 +42,11 @@ Vec3 LightmapEstimate::variance_of_mean(size_t texel) const {
 
 bool LightmapEstimate::relative_error_below(size_t texel, double target) const {
   const float lum = luminance(mean_total(texel));
-  return lum > 0 && std::sqrt(luminance(variance_of_mean(texel))) <= target * lum;
+  const float standard_error = std::sqrt(luminance(variance_of_mean(texel)));
+  // A texel that stayed black with no variance over 16 samples or more (inside geometry) has no
+  // relative error left to reduce: met (0/0 would keep a target-error run going forever).
+  if (!(lum > 0)) return standard_error == 0 && texels[texel].samples >= 16;
+  return standard_error <= target * lum;
 }
 
 ShRgb ProbeEstimate::mean(size_t probe) const {

@@ -180,6 +180,7 @@ TEST(BundleManifest, SettingsAndSceneFieldsAreCheckedByName) {
   refused("settings", {{"bounces", -2}}, "settings.bounces: -2 is outside -1..2147483647");
   refused("settings", {{"probes", "some"}}, "settings.probes: expected a number or \"none\"");
   refused("settings", {{"backend", "metal"}}, "settings.backend: \"metal\" is not cpu or vulkan");
+  refused("settings", {{"integrator", "photons"}}, "settings.integrator: \"photons\" is not path or bounces");
   refused("settings", {{"target_error", -0.5}}, "settings.target_error: negative");
   refused("settings", json::array(), "settings: expected an object, got array");
   refused("scene", {{"file", "../scene.bin"}, {"format_version", 1}, {"bytes", 10}}, "scene.file: \"../scene.bin\" leaves the bundle folder");

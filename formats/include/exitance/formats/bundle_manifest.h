@@ -80,6 +80,7 @@ struct InputInfo {
 // present must have the right type and range.
 struct BakeSettings {
   std::string backend;  // "cpu" | "vulkan"; "" when absent
+  std::string integrator = "path";  // "path" | "bounces" (bake --integrator)
   uint32_t spp = 128;
   double time_budget_seconds = 0;
   double target_error = 0;

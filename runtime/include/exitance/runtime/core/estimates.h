@@ -45,7 +45,8 @@ struct LightmapEstimate {
   Vec3 mean_bounce(int bounce, size_t texel) const;
   // Variance of the mean (standard error squared) of the total, per channel.
   Vec3 variance_of_mean(size_t texel) const;
-  // The target-error test of --target-error: relative standard error of the luminance below `target`.
+  // The target-error test of --target-error: relative standard error of the luminance below `target`;
+  // a texel black with no variance after 16 samples or more counts as met.
   bool relative_error_below(size_t texel, double target) const;
 };
 
