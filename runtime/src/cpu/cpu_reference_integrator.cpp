@@ -21,6 +21,10 @@ namespace exitance {
 namespace {
 
 constexpr int kMaxRecordedBounces = 16;
+// Grid guiding learns during the first samples per texel and then samples its frozen table: on
+// small scenes the learning (a target per ray, atomic adds) costs as much as the ray itself, and by
+// then the table has stopped improving (bench/results/guiding.md).
+constexpr uint32_t kGuidingLearningSamples = 64;
 
 // Per-sample contributions to E/pi, split by the number of diffuse reflections between the
 // light and the texel (0 = direct).
@@ -75,7 +79,8 @@ struct CpuReferenceIntegrator::Impl {
   // One path sample of E/pi at x; `first_bounce` is the bounce x stands for (0 at a texel). With a
   // guiding cache, vertices sample its frozen table's mixture and every ray teaches its back table.
   void trace(SurfacePoint x, const IntegratorSettings& settings, Pcg32& rng, PathContributions& out,
-             uint64_t& rays, GridGuidingCache* guide = nullptr) const {
+             uint64_t& rays, GridGuidingCache* guide = nullptr, bool learn = false,
+             uint64_t* guided_vertices = nullptr) const {
     const LightingScene& s = scene();
     const PathLimits limits{settings.max_bounces, settings.russian_roulette_start, settings.safety_bounce_cap};
     Vec3 throughput{1, 1, 1};
@@ -83,6 +88,7 @@ struct CpuReferenceIntegrator::Impl {
       const Vec3 origin = offset_ray_origin(x.position, x.geometric_normal, s.extent);
       const uint32_t record = guide ? guide->record_of(x.position, x.shading_normal) : GridGuidingCache::kNoRecord;
       const GuideVertex g = guide ? guide->vertex(record) : guide_vertex_cosine();
+      if (guided_vertices && g.guided_probability > 0) ++*guided_vertices;
       ShadowRay shadow[kShadowRaysPerVertex];
       next_event_estimation(s, x, origin, throughput, g, rng, shadow[0], shadow[1], shadow[2]);
       out.add(bounce, connect(shadow, origin, rays));
@@ -91,7 +97,7 @@ struct CpuReferenceIntegrator::Impl {
       const Vec3 ray_throughput = throughput * continuation_weight(g, x, d);
       ++rays;
       const Hit hit = embree->intersect(origin, d.direction, INFINITY);
-      if (record != GridGuidingCache::kNoRecord) {
+      if (learn && record != GridGuidingCache::kNoRecord) {
         const Vec3 local = guide_to_class_local(g.normal_class, d.direction);
         if (local.z > 0) guide->learn(record, guide_bin_of_local(local), learning_target(*guide, hit, d.direction));
       }
@@ -152,6 +158,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   std::vector<uint8_t> converged(texel_count, 0);
   tbb::combinable<uint64_t> rays_per_thread([] { return uint64_t(0); });
   tbb::combinable<uint64_t> nonfinite_per_thread([] { return uint64_t(0); });
+  tbb::combinable<uint64_t> guided_per_thread([] { return uint64_t(0); });
 
   PassPolicy policy;
   policy.ramp = true;  // small passes early so progress and the time budget are honoured; larger later
@@ -166,9 +173,11 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   }
   uint32_t first = 0, count = 0;
   while (passes.next_pass(first, count)) {
+    const bool learning = guide && first < kGuidingLearningSamples;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, texel_count, 64), [&](const tbb::blocked_range<size_t>& range) {
       uint64_t& rays = rays_per_thread.local();
       uint64_t& nonfinite = nonfinite_per_thread.local();
+      uint64_t& guided = guided_per_thread.local();
       PathContributions contributions;
       for (size_t i = range.begin(); i != range.end(); ++i) {
         if (converged[i]) continue;
@@ -179,7 +188,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
           Pcg32 rng = pcg_init(settings.seed, i, s);
           contributions = PathContributions{};
           contributions.recorded = estimate.recorded_bounces;
-          impl_->trace(point, settings, rng, contributions, rays, guide.get());
+          impl_->trace(point, settings, rng, contributions, rays, guide.get(), learning, &guided);
           const Vec3 total = contributions.total();
           if (!is_finite(total)) {
             ++nonfinite;
@@ -200,13 +209,14 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
           converged[i] = 1;
       }
     });
-    if (guide) guide->swap();  // this pass's learning becomes the next pass's frozen table
+    if (learning) guide->swap();  // this pass's learning becomes the next pass's frozen table
     const bool all_converged = settings.target_relative_error > 0 &&
                                std::all_of(converged.begin(), converged.end(), [](uint8_t c) { return c != 0; });
     passes.finish_pass(rays_per_thread.combine(std::plus<uint64_t>()), all_converged);
   }
   estimate.rays = rays_per_thread.combine(std::plus<uint64_t>());
   estimate.nonfinite_samples = nonfinite_per_thread.combine(std::plus<uint64_t>());
+  estimate.guided_vertices = guided_per_thread.combine(std::plus<uint64_t>());
   estimate.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return estimate;
 }

@@ -6,7 +6,7 @@
 // Choices (documented in docs/lighting-core.md, "Grid guiding"):
 //  - Grid: cubic cells, n along the longest side of the scene bounds and as many along the others
 //    as fit; n is the largest value up to `cells_on_longest_axis` (default 16) for which the
-//    occupied (cell, class) records hold at least kMinTexelsPerRecord texels on average, so every
+//    occupied (cell, class) records hold at least kMinTexelsPerRecord (16) texels on average, so every
 //    table is learned from enough paths per pass (the thesis's 8^3 was for camera paths; lightmaps
 //    at usual densities get 16, coarse test atlases fewer).
 //  - Per cell, one hemisphere table per normal class (guided_direction.h), allocated only for the
@@ -45,7 +45,7 @@ class GridGuidingCache {
  public:
   static constexpr uint32_t kNoRecord = 0xFFFFFFFFu;
   static constexpr float kUniformFloor = 0.02f;
-  static constexpr double kMinTexelsPerRecord = 64;
+  static constexpr double kMinTexelsPerRecord = 16;
 
   // Records for the (cell, class) pairs of `gbuffer`'s texels. `scene` gives the bounds and the
   // radiance scale of the fixed-point sums (the brightest emitter or sky).
