@@ -1,5 +1,5 @@
-// The guiding math shared by C++ and GLSL (runtime/common: equal_area_hemisphere.h,
-// guided_direction.h, path.h's mixture): the map is equal-area and invertible, the guided and
+// The guiding math shared by C++ and GLSL (runtime/common: concentric_hemisphere.h,
+// guided_direction.h, path.h's mixture): the map preserves projected solid angle and is invertible, the guided and
 // mixture pdfs integrate to 1, sampled directions follow the pdf (chi-square), CDF inversion is exact
 // at bin edges, and degenerate inputs give no NaN.
 //
@@ -53,14 +53,14 @@ GuideVertex guided(const std::vector<float>& cdf, uint normal_class, float m) {
   return g;
 }
 
-TEST(EqualAreaHemisphere, RoundTripsAndGivesUnitDirections) {
+TEST(ConcentricHemisphere, RoundTripsAndGivesUnitDirections) {
   for (int i = 0; i <= 64; ++i)
     for (int j = 0; j <= 64; ++j) {
       const float s = std::min(i / 64.0f, 0.99999994f), t = std::min(j / 64.0f, 0.99999994f);
-      const Vec3 d = equal_area_square_to_hemisphere(s, t);
+      const Vec3 d = concentric_square_to_hemisphere(s, t);
       EXPECT_NEAR(length(d), 1.0f, 2e-6f);
       EXPECT_GE(d.z, 0.0f);
-      const Vec2 back = equal_area_hemisphere_to_square(d);
+      const Vec2 back = hemisphere_to_concentric_square(d);
       // At the pole (s, t) = (0.5, 0.5) every square point maps to z = 1: no inverse to compare.
       if (std::fabs(s - 0.5f) + std::fabs(t - 0.5f) < 1e-6f) continue;
       EXPECT_NEAR(back.x, s, 2e-5f) << s << "," << t;
@@ -70,14 +70,15 @@ TEST(EqualAreaHemisphere, RoundTripsAndGivesUnitDirections) {
 
 // A point drawn inside a bin, even a thousandth of a bin from its edge, maps back to that bin: the
 // sampler (forward map) and the pdf (inverse map) agree on every bin's extent.
-TEST(EqualAreaHemisphere, PointsInsideABinMapBackToIt) {
+TEST(ConcentricHemisphere, PointsInsideABinMapBackToIt) {
   for (uint b = 0; b < kGuideBins; ++b)
     for (float fx : {0.001f, 0.5f, 0.999f})
       for (float fy : {0.001f, 0.5f, 0.999f}) ASSERT_EQ(guide_bin_of_local(guide_bin_point(b, fx, fy)), b) << fx << "," << fy;
 }
 
-// Uniform directions on the hemisphere must fall into the 256 bins equally often.
-TEST(EqualAreaHemisphere, BinsHaveEqualSolidAngle) {
+// Cosine-distributed directions, drawn independently of the map (uniform directions accepted with
+// probability cos), must fall into the 256 bins equally often: every bin has the same cosine mass.
+TEST(ConcentricHemisphere, BinsHaveEqualCosineMass) {
   const int n = kGuideBins * 400;
   std::vector<double> count(kGuideBins, 0);
   Pcg32 rng = pcg_init(3, 1, 0);
@@ -85,6 +86,10 @@ TEST(EqualAreaHemisphere, BinsHaveEqualSolidAngle) {
     const float u1 = pcg_uniform(rng), u2 = pcg_uniform(rng);
     Vec3 d = uniform_sphere(u1, u2);
     d.z = std::fabs(d.z);
+    if (pcg_uniform(rng) >= d.z) {
+      --k;
+      continue;
+    }
     count[guide_bin_of_local(d)] += 1;
   }
   const double expected = double(n) / kGuideBins;
@@ -151,7 +156,7 @@ TEST(GuidedDirection, SampledDirectionsFollowTheGuidedPdf) {
     const float u1 = pcg_uniform(rng), u2 = pcg_uniform(rng), u3 = pcg_uniform(rng);
     const Vec3 w = guided_component_sample(g, u1, u2, u3);
     ASSERT_GT(guided_component_pdf(g, w), 0.0f);
-    const Vec2 st = equal_area_hemisphere_to_square(guide_to_class_local(g.normal_class, w));
+    const Vec2 st = hemisphere_to_concentric_square(guide_to_class_local(g.normal_class, w));
     count[std::min(int(st.y * kFine), kFine - 1) * kFine + std::min(int(st.x * kFine), kFine - 1)] += 1;
   }
   double chi2 = 0;
@@ -250,13 +255,13 @@ TEST(GuidedDirection, DegenerateInputsGiveNoNaN) {
     const float p = guided_component_pdf(g, w);
     EXPECT_TRUE(std::isfinite(p));
     EXPECT_GE(p, 0.0f);
-    const Vec2 st = equal_area_hemisphere_to_square(w);
+    const Vec2 st = hemisphere_to_concentric_square(w);
     EXPECT_TRUE(st.x >= 0 && st.x <= 1 && st.y >= 0 && st.y <= 1);
     EXPECT_LT(guide_normal_class(w), kGuideNormalClasses);
   }
   // The pole and the square's corners.
   for (Vec2 st : {Vec2(0.5f, 0.5f), Vec2(0, 0), Vec2(0.99999994f, 0.99999994f), Vec2(0, 0.99999994f)}) {
-    const Vec3 d = equal_area_square_to_hemisphere(st.x, st.y);
+    const Vec3 d = concentric_square_to_hemisphere(st.x, st.y);
     EXPECT_NEAR(length(d), 1.0f, 1e-5f);
     EXPECT_LT(guide_bin_of_local(d), kGuideBins);
   }

@@ -63,14 +63,6 @@ GridGuidingCache::GridGuidingCache(const LightingScene& scene, const TexelGBuffe
   fixed_scale_ = kFixedUnitsPerReference / double(reference);
   target_cap_ = reference * kCapInReferences;
 
-  // Mean cosine of each bin over its class hemisphere (8 x 8 points per bin).
-  for (uint b = 0; b < kGuideBins; ++b) {
-    double sum = 0;
-    for (int i = 0; i < 8; ++i)
-      for (int j = 0; j < 8; ++j) sum += guide_bin_point(b, (i + 0.5f) / 8, (j + 0.5f) / 8).z;
-    bin_mean_cosine_[b] = float(sum / 64);
-  }
-
   const size_t records = front_.size();
   cdf_.assign(records * (kGuideBins + 1), 0.0f);
   radiance_.assign(records * kGuideBins, 0.0f);
@@ -148,15 +140,15 @@ void GridGuidingCache::rebuild(uint32_t record) {
   const float* radiance = &radiance_[size_t(record) * kGuideBins];
   float* cdf = &cdf_[size_t(record) * (kGuideBins + 1)];
   double total = 0;
-  for (uint b = 0; b < kGuideBins; ++b) total += double(radiance[b]) * bin_mean_cosine_[b];
+  for (uint b = 0; b < kGuideBins; ++b) total += double(radiance[b]);
   const bool learned = total > 0 && std::isfinite(total);
-  // (1/pi) * sum of L_b * mean cos_b * (2 pi / bins)
-  front_[record].expected_cosine = learned ? float(total * 2.0 / kGuideBins) : 0.0f;
+  // (1/pi) * integral of L cos = (1/pi) * sum of L_b * (pi / bins): every bin has cosine mass pi / bins.
+  front_[record].expected_cosine = learned ? float(total / kGuideBins) : 0.0f;
   front_[record].guided_probability = learned ? config_.mix : 0.0f;
   double run = 0;
   cdf[0] = 0;
   for (uint b = 0; b < kGuideBins; ++b) {
-    const double share = learned ? double(radiance[b]) * bin_mean_cosine_[b] / total : 0.0;
+    const double share = learned ? double(radiance[b]) / total : 0.0;
     run += (1.0 - kUniformFloor) * share + kUniformFloor / kGuideBins;
     cdf[b + 1] = float(std::min(run, 1.0));
   }

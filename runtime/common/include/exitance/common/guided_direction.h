@@ -1,7 +1,9 @@
 // The directional part of the grid guiding cache (seed 002, issue 11): per (spatial cell, normal
-// class) a hemisphere of kGuideBinsPerSide^2 equal-solid-angle bins (equal_area_hemisphere.h) with a
-// piecewise-constant density, sampled by inverting its CDF (O(log N), exact, no rejection loop) and
-// uniformly inside the chosen bin (the thesis's Alg. 2 never jitters inside a bin).
+// class) a hemisphere of kGuideBinsPerSide^2 bins of equal cosine mass (concentric_hemisphere.h)
+// holding piecewise-constant incident radiance, sampled in product with the cosine: a bin by
+// inverting its CDF (O(log N), exact, no rejection loop), then a point uniform in the bin's square
+// cell, which has density proportional to cos inside the bin (the thesis's Alg. 2 never jitters
+// inside a bin). pdf(w) = P(bin) * kGuideBins * cos / pi; a constant table is cosine sampling.
 //
 // Normal classes: the six axis directions. A vertex takes the class of its normal's largest
 // component, and the class's hemisphere is laid out in a fixed axis frame, so a cell's walls of
@@ -13,7 +15,7 @@
 // includer over its buffer), as distribution.h reads its CDFs.
 #ifndef EXITANCE_COMMON_GUIDED_DIRECTION_H
 #define EXITANCE_COMMON_GUIDED_DIRECTION_H
-#include "exitance/common/equal_area_hemisphere.h"
+#include "exitance/common/concentric_hemisphere.h"
 
 #ifdef __cplusplus
 #define GUIDE_CDF_REF const float*
@@ -69,7 +71,7 @@ EXITANCE_FN vec3 guide_from_class_local(uint normal_class, vec3 l) {
 
 // The bin of a class-local direction with z > 0: row-major over the equal-area square.
 EXITANCE_FN uint guide_bin_of_local(vec3 local) {
-  vec2 st = equal_area_hemisphere_to_square(local);
+  vec2 st = hemisphere_to_concentric_square(local);
   uint i = min(uint(st.x * float(kGuideBinsPerSide)), kGuideBinsPerSide - 1u);
   uint j = min(uint(st.y * float(kGuideBinsPerSide)), kGuideBinsPerSide - 1u);
   return j * kGuideBinsPerSide + i;
@@ -80,7 +82,7 @@ EXITANCE_FN vec3 guide_bin_point(uint bin, float fx, float fy) {
   float inv = 1.0f / float(kGuideBinsPerSide);
   float s = min((float(bin % kGuideBinsPerSide) + fx) * inv, 0.99999994f);
   float t = min((float(bin / kGuideBinsPerSide) + fy) * inv, 0.99999994f);
-  return equal_area_square_to_hemisphere(s, t);
+  return concentric_square_to_hemisphere(s, t);
 }
 
 EXITANCE_FN float guide_bin_probability(GUIDE_CDF_REF cdf, uint bin) {
@@ -102,7 +104,7 @@ EXITANCE_FN uint guide_sample_bin(GUIDE_CDF_REF cdf, float u) {
 EXITANCE_FN float guided_component_pdf(GuideVertex g, vec3 wi) {
   vec3 local = guide_to_class_local(g.normal_class, wi);
   if (!(local.z > 0.0f)) return 0.0f;
-  return guide_bin_probability(g.cdf, guide_bin_of_local(local)) * (float(kGuideBins) / kHemisphereSolidAngle);
+  return guide_bin_probability(g.cdf, guide_bin_of_local(local)) * float(kGuideBins) * local.z * kInvPi;
 }
 
 // A world direction from the guided component: u_bin picks the bin, (u_x, u_y) place it in the bin.

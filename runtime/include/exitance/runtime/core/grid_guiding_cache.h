@@ -20,8 +20,9 @@
 //    with integer (fixed-point) atomic adds, so the sums do not depend on thread count or order;
 //    swap() folds the back sums into the table (an exponential moving average weighted by sample
 //    counts, old counts halved per swap so early bootstrapped values fade) and rebuilds the CDFs.
-//  - Sampling pdf per bin proportional to L_i x (mean cosine of the bin), plus a uniform floor
-//    (kUniformFloor of the mass) so no bin has probability 0. A record with nothing learned, or
+//  - Bins have equal cosine mass (concentric_hemisphere.h), so the bin probabilities are the
+//    learned L_i normalised, plus a uniform floor (kUniformFloor of the mass) so no bin has
+//    probability 0, and the pdf is L_i x cos exactly up to the bins' resolution. A record with nothing learned, or
 //    learned all zero, samples cosine only.
 #pragma once
 #include <atomic>
@@ -93,7 +94,6 @@ class GridGuidingCache {
   int dims_[3] = {1, 1, 1};
   double fixed_scale_ = 1;  // fixed-point units per unit of radiance
   float target_cap_ = 0;    // targets are clamped here (guiding only: no estimator bias)
-  float bin_mean_cosine_[kGuideBins];
   std::vector<uint32_t> record_index_;  // per (cell, class)
   std::vector<Front> front_;
   std::vector<float> cdf_;       // kGuideBins + 1 per record

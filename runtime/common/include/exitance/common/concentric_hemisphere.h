@@ -1,14 +1,15 @@
-// An equal-area map between the unit square and the hemisphere z >= 0: Shirley & Chiu's
-// concentric square -> disk map (area-preserving up to a constant), then Lambert's azimuthal
-// equal-area projection of the disk onto the hemisphere (z = 1 - r^2, xy scaled by sqrt(2 - r^2)).
-// Every region of the square of area A maps to a solid angle 2 pi A, so a regular grid on the square
-// is a set of equal-solid-angle bins and a point uniform in a square cell is uniform in its bin.
-#ifndef EXITANCE_COMMON_EQUAL_AREA_HEMISPHERE_H
-#define EXITANCE_COMMON_EQUAL_AREA_HEMISPHERE_H
+// A map between the unit square and the hemisphere z >= 0 that preserves projected solid angle:
+// Shirley & Chiu's concentric square -> disk map (area-preserving up to a constant), then Malley's
+// projection of the disk up onto the hemisphere (xy kept, z = sqrt(1 - r^2)), as the cosine sampler
+// of sampling.h does. Every region of the square of area A maps to directions of projected solid
+// angle (integral of cos) pi A: a regular grid on the square is a set of bins of equal cosine
+// mass, and a point uniform in a square cell has density cos / (pi * cell area) in its bin. So a
+// piecewise-constant table of incident radiance sampled through this map is sampled in product with
+// the diffuse cosine exactly, and a constant table is exactly cosine sampling.
+#ifndef EXITANCE_COMMON_CONCENTRIC_HEMISPHERE_H
+#define EXITANCE_COMMON_CONCENTRIC_HEMISPHERE_H
 #include "exitance/common/sampling.h"
 EXITANCE_NAMESPACE_BEGIN
-
-const float kHemisphereSolidAngle = 6.28318530717958647692f;
 
 // sin, cos and atan on the concentric map's wedges (|angle| <= pi/4, |x| <= 1) as Cephes' float
 // polynomials (about 1e-7 relative): the same arithmetic in C++ and GLSL (whose built-ins differ
@@ -34,7 +35,7 @@ EXITANCE_FN float unit_atan(float x) {
   return x < 0.0f ? -r : r;
 }
 
-EXITANCE_FN vec3 equal_area_square_to_hemisphere(float s, float t) {
+EXITANCE_FN vec3 concentric_square_to_hemisphere(float s, float t) {
   float a = 2.0f * s - 1.0f;
   float b = 2.0f * t - 1.0f;
   float x = 0.0f;
@@ -48,17 +49,13 @@ EXITANCE_FN vec3 equal_area_square_to_hemisphere(float s, float t) {
     x = b * wedge_sin(angle);
     y = b * wedge_cos(angle);
   }
-  float r2 = min(x * x + y * y, 1.0f);
-  float scale = sqrt(2.0f - r2);
-  return vec3(x * scale, y * scale, 1.0f - r2);
+  return vec3(x, y, sqrt(max(0.0f, 1.0f - x * x - y * y)));
 }
 
-// The inverse, for unit d with d.z >= 0 (d.z < 0 is treated as the equator); the result lies in
-// [0, 1]^2. Unit length is not checked: a slightly long d gives a point just inside the square.
-EXITANCE_FN vec2 equal_area_hemisphere_to_square(vec3 d) {
-  float z = clamp(d.z, 0.0f, 1.0f);
-  // Disk radius sqrt(1 - z), from |d.xy| = sqrt(1 - z) sqrt(1 + z): 1 - z would cancel near the pole.
-  float r = min(sqrt(d.x * d.x + d.y * d.y) / sqrt(1.0f + z), 1.0f);
+// The inverse, for unit d (only d.xy is read: the disk point); the result lies in [0, 1]^2. Unit
+// length is not checked: a slightly long d gives a point just inside the square.
+EXITANCE_FN vec2 hemisphere_to_concentric_square(vec3 d) {
+  float r = min(sqrt(d.x * d.x + d.y * d.y), 1.0f);
   float a = 0.0f;
   float b = 0.0f;
   float ax = abs(d.x);
