@@ -26,6 +26,7 @@
 #include <iostream>
 
 #include "exitance/runtime/embree_scene.h"
+#include "exitance/runtime/core/grid_guiding_cache.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/bake/command/backend_choice.h"
 #include "exitance/bake/bundle/input_hash.h"
@@ -80,6 +81,9 @@ int main(int argc, char** argv) {
   app.add_option("--integrators", integrators, "comma-separated: path, bounces, guided (path with --guiding grid)");
   float guiding_mix = 0.5f;
   app.add_option("--guiding-mix", guiding_mix, "guided component's probability (guided runs)");
+  std::string guiding_fields;
+  app.add_option("--guiding-fields", guiding_fields,
+                 "CSV of the learned grid guiding tables of the last guided run (record, cell, class, bins)");
   app.add_option("--name", scene_name, "scene name in the CSV (default: file stem)");
   app.add_option("--max-seconds", max_seconds, "stop the ladder after a run longer than this");
   app.add_option("--sky", sky);
@@ -184,6 +188,24 @@ int main(int argc, char** argv) {
         settings.integrator = mode;
         settings.guiding = m.guiding;
         settings.guiding_mix = guiding_mix;
+        if (!guiding_fields.empty())
+          settings.inspect_guiding = [&](const GridGuidingCache& cache) {
+            std::ofstream out(guiding_fields);
+            out << "cell_x,cell_y,cell_z,normal_class,cell_size,memory_bytes_per_record";
+            for (uint b = 0; b < kGuideBins; ++b) out << ",bin" << b;
+            out << "\n";
+            for (int z = 0; z < cache.cells(2); ++z)
+              for (int y = 0; y < cache.cells(1); ++y)
+                for (int x = 0; x < cache.cells(0); ++x)
+                  for (uint k = 0; k < kGuideNormalClasses; ++k) {
+                    const uint32_t r = cache.record_of_cell(x, y, z, k);
+                    if (r == GridGuidingCache::kNoRecord) continue;
+                    out << x << "," << y << "," << z << "," << k << "," << cache.cell_size() << ","
+                        << GridGuidingCache::bytes_per_record();
+                    for (uint b = 0; b < kGuideBins; ++b) out << "," << cache.radiance(r)[b];
+                    out << "\n";
+                  }
+          };
         const LightmapEstimate estimate = backend->bake(gbuffer, settings);
         std::vector<float> result = flatten(estimate);
         result.resize(values);

@@ -11,8 +11,13 @@ namespace {
 // bin overflows its 64 bits only after 2^24 capped targets in one pass.
 constexpr double kFixedUnitsPerReference = 16777216.0;
 constexpr float kCapInReferences = 65536.0f;
-// Old sample counts are halved at every swap: the bootstrapped values of early passes fade.
-constexpr float kCountDecay = 0.5f;
+// Old sample counts are kept at every swap (a cumulative mean, as the thesis accumulates): passes
+// are small (a few spp), and halving per swap left ~4 samples behind a bin (plots in
+// bench/results/guiding.md), whose noise the sampler then followed.
+constexpr float kCountDecay = 1.0f;
+// Each bin's value is shrunk toward its record's mean by this many pseudo-samples, so a bin seen a
+// few times (one lucky emitter hit) does not draw the sampler.
+constexpr double kPriorSamples = 8;
 
 struct Grid {
   float cell = 1;
@@ -137,10 +142,21 @@ void GridGuidingCache::swap() {
 }
 
 void GridGuidingCache::rebuild(uint32_t record) {
-  const float* radiance = &radiance_[size_t(record) * kGuideBins];
+  const float* learned_radiance = &radiance_[size_t(record) * kGuideBins];
+  const float* weight = &weight_[size_t(record) * kGuideBins];
   float* cdf = &cdf_[size_t(record) * (kGuideBins + 1)];
+  double weighted = 0, weights = 0;
+  for (uint b = 0; b < kGuideBins; ++b) {
+    weighted += double(weight[b]) * learned_radiance[b];
+    weights += weight[b];
+  }
+  const double prior = weights > 0 ? weighted / weights : 0.0;
+  double radiance[kGuideBins];
   double total = 0;
-  for (uint b = 0; b < kGuideBins; ++b) total += double(radiance[b]);
+  for (uint b = 0; b < kGuideBins; ++b) {
+    radiance[b] = (double(weight[b]) * learned_radiance[b] + kPriorSamples * prior) / (double(weight[b]) + kPriorSamples);
+    total += radiance[b];
+  }
   const bool learned = total > 0 && std::isfinite(total);
   // (1/pi) * integral of L cos = (1/pi) * sum of L_b * (pi / bins): every bin has cosine mass pi / bins.
   front_[record].expected_cosine = learned ? float(total / kGuideBins) : 0.0f;
@@ -148,7 +164,7 @@ void GridGuidingCache::rebuild(uint32_t record) {
   double run = 0;
   cdf[0] = 0;
   for (uint b = 0; b < kGuideBins; ++b) {
-    const double share = learned ? double(radiance[b]) / total : 0.0;
+    const double share = learned ? radiance[b] / total : 0.0;
     run += (1.0 - kUniformFloor) * share + kUniformFloor / kGuideBins;
     cdf[b + 1] = float(std::min(run, 1.0));
   }

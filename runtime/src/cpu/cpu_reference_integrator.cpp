@@ -217,6 +217,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   estimate.rays = rays_per_thread.combine(std::plus<uint64_t>());
   estimate.nonfinite_samples = nonfinite_per_thread.combine(std::plus<uint64_t>());
   estimate.guided_vertices = guided_per_thread.combine(std::plus<uint64_t>());
+  if (guide && settings.inspect_guiding) settings.inspect_guiding(*guide);
   estimate.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return estimate;
 }

@@ -18,8 +18,8 @@
 //    the path. Escaping rays learn the sky's radiance; back faces of single-sided surfaces learn 0.
 //  - Double buffering: a pass's samples read the front table (frozen) and learn into the back one
 //    with integer (fixed-point) atomic adds, so the sums do not depend on thread count or order;
-//    swap() folds the back sums into the table (an exponential moving average weighted by sample
-//    counts, old counts halved per swap so early bootstrapped values fade) and rebuilds the CDFs.
+//    swap() folds the back sums into the table (the cumulative mean of each bin's targets) and
+//    rebuilds the CDFs from the bins shrunk toward their record's mean by 8 pseudo-samples.
 //  - Bins have equal cosine mass (concentric_hemisphere.h), so the bin probabilities are the
 //    learned L_i normalised, plus a uniform floor (kUniformFloor of the mass) so no bin has
 //    probability 0, and the pdf is L_i x cos exactly up to the bins' resolution. A record with nothing learned, or

@@ -5,6 +5,8 @@
 
 namespace exitance {
 
+class GridGuidingCache;
+
 // How texels are lit (bake --integrator). Path: the unbiased path tracer of path.h, one path per
 // sample. Bounces: per-bounce passes (seed 003, issue 10): B_0 = direct light; pass k+1 gathers, at
 // the hits of cosine rays from every texel, the stored outgoing radiance albedo * B_k of the hit's
@@ -36,6 +38,8 @@ struct IntegratorSettings {
   float guiding_mix = 0.5f;         // probability of the guided component at a guided vertex (0..1)
   int guiding_grid_cells = 16;      // grid cells along the scene's longest axis (cubic cells)
   std::function<void(double fraction_done, uint64_t rays)> progress;  // called between passes
+  // Called once at the end of a guided bake with its cache (plots of the learned fields, tests).
+  std::function<void(const GridGuidingCache&)> inspect_guiding;
 };
 
 }  // namespace exitance
