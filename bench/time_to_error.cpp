@@ -4,7 +4,7 @@
 //
 //   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,bounces,guided] [--guiding-mix M] [--name NAME]
 //                       [--sky R,G,B] [--texel-density T] [--reference-spp N] [--max-spp N]
-//                       [--max-seconds S] [--target 0.01] [--cache DIR] [--csv FILE]
+//                       [--max-seconds S] [--target 0.01] [--cache DIR] [--csv FILE] [--guiding-fields FILE]
 //
 // The reference is always the CPU path tracer. For the per-bounce mode (integrator per_bounce) the
 // CSV also has the bounces run, the fraction of gather hits without texels, and bias_rel_mse: at
