@@ -22,6 +22,7 @@
 #include "exitance/bake/layout/atlas_layout.h"
 #include "exitance/bake/raster/texel_raster.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
+#include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "support/analytic_scenes.h"
 
 namespace exitance {
@@ -209,6 +210,22 @@ TEST(GridGuiding, BitIdenticalPerSeedAndThreadCount) {
   }
   const LightmapEstimate other = integrator.bake(p.gbuffer, settings(24, 8, GuidingMode::Grid));
   EXPECT_FALSE(identical(a, other)) << "the seed must matter";
+}
+
+// Modes that do not implement guiding refuse it rather than ignore it.
+TEST(GridGuiding, RefusedWhereNotImplemented) {
+  const Vec3 le{1, 1, 1};
+  const Vec3 emission[6] = {le, le, le, le, le, le};
+  const AtlasScene box = atlas_box(0.5f, emission, 4);
+  IntegratorSettings bounces = settings(4, 1, GuidingMode::Grid);
+  bounces.integrator = IntegratorMode::Bounces;
+  EXPECT_THROW(CpuReferenceIntegrator(box.scene).bake(box.gbuffer, bounces), std::invalid_argument);
+  bool usable = false;
+  for (const VulkanDeviceInfo& d : enumerate_vulkan_devices()) usable = usable || d.usable;
+  if (!usable) GTEST_SKIP() << "no usable Vulkan device";
+  const auto vulkan = VulkanIntegrator::create(make_lighting_scene(box.scene), VulkanDeviceOptions{});
+  EXPECT_THROW(vulkan->bake(box.gbuffer, settings(4, 1, GuidingMode::Grid)), std::runtime_error);
+  EXPECT_EQ(vulkan->bake(box.gbuffer, settings(4, 1, GuidingMode::Off)).nonfinite_samples, 0u);
 }
 
 }  // namespace

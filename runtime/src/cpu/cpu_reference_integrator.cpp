@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "cpu_bounce_integrator.h"
 #include "exitance/runtime/core/grid_guiding_cache.h"
@@ -148,7 +149,11 @@ std::string CpuReferenceIntegrator::device_description() const {
 }
 
 LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const {
-  if (settings.integrator == IntegratorMode::Bounces) return bake_per_bounce(*impl_->lighting, *impl_->embree, gbuffer, settings);
+  if (settings.integrator == IntegratorMode::Bounces) {
+    if (settings.guiding != GuidingMode::Off)
+      throw std::invalid_argument("CPU backend: guiding applies to path tracing, not to --integrator bounces");
+    return bake_per_bounce(*impl_->lighting, *impl_->embree, gbuffer, settings);
+  }
   const auto start = std::chrono::steady_clock::now();
   const size_t texel_count = gbuffer.texels.size();
   LightmapEstimate estimate;
