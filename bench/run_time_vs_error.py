@@ -7,10 +7,14 @@ time to reach the target relMSE and of relMSE at equal time, as ratios to the CP
 measured in the same run. References are cached by content hash in ~/.cache/exitance.
 
   /usr/bin/python3 bench/run_time_vs_error.py --build build --out bench/results [--quick]
-      [--integrators path,bounces] [--report NAME]
+      [--integrators path,bounces] [--report NAME] [--only SCENE,SCENE] [--ladder-scale K]
 
 --report names the CSV, plot and table (default time_vs_error); the per-bounce mode's figures
-(bench/results/per-bounce.md) come from --backends cpu --integrators path,bounces --report per-bounce.
+(bench/results/per-bounce.md) come from --backends cpu --integrators path,bounces --report per-bounce;
+grid guiding's (bench/results/guiding.md) from --backends cpu --integrators path,guided --report guiding_time_vs_error.
+--ladder-scale multiplies every scene's largest spp (longer ladders, e.g. to reach 20 s).
+The table's last column: relMSE of the CPU path tracer divided by this row's, both interpolated
+(log-log) at the same time, the longest both reached: > 1 = better than the CPU path tracer.
 
 (Debian's python3 has python3-matplotlib; a pyenv python3 on PATH may not.)
 """
@@ -45,6 +49,18 @@ def run_scene(build, backends, integrators, name, sky, density, reference_spp, m
     return list(csv.DictReader(result.stdout.splitlines())), command
 
 
+def rel_mse_at(rows, seconds):
+    """relMSE at `seconds`, log-log interpolated between the ladder's runs; None outside them."""
+    points = [(float(r["seconds"]), float(r["rel_mse"])) for r in rows]
+    for (t0, e0), (t1, e1) in zip(points, points[1:]):
+        if t0 <= seconds <= t1 and t0 > 0 and t1 > t0:
+            f = (math.log(seconds) - math.log(t0)) / (math.log(t1) - math.log(t0))
+            return math.exp(math.log(e0) + f * (math.log(e1) - math.log(e0)))
+    if points and abs(points[-1][0] - seconds) < 1e-9:
+        return points[-1][1]
+    return None
+
+
 def time_to_target(rows, target):
     """Seconds at which relMSE crosses the target, log-log interpolated; None if never."""
     previous = None
@@ -71,13 +87,15 @@ def main():
     parser.add_argument("--integrators", default="path")
     parser.add_argument("--report", default="time_vs_error")
     parser.add_argument("--quick", action="store_true", help="4x fewer reference and ladder samples")
+    parser.add_argument("--ladder-scale", type=int, default=1, help="multiply every scene's largest spp")
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
 
     all_rows, commands = [], []
     for name, sky, density, reference_spp, max_spp in SCENES:
-        if args.only and args.only != name:
+        if args.only and name not in args.only.split(","):
             continue
+        max_spp *= args.ladder_scale
         if args.quick:
             reference_spp, max_spp = max(64, reference_spp // 4), max(16, max_spp // 4)
         rows, command = run_scene(args.build, args.backends, args.integrators, name, sky, density, reference_spp, max_spp, args.max_seconds, args.target)
@@ -123,8 +141,9 @@ def main():
              f"relMSE (column reference_rel_mse of {os.path.basename(csv_path)}). Machine: 2 shared cores; absolute "
              "seconds are noisy, ratios inside one run are what count.", "",
              f"| scene | backend | integrator | live texels | time to relMSE {args.target:g} (s) | relMSE at the largest run | "
-             "rays/s | ratio of time to the CPU reference | bounces, bias relMSE (per-bounce) |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "rays/s | ratio of time to the CPU reference | bounces, bias relMSE (per-bounce) | "
+             "relMSE gain over the CPU path tracer at equal time |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for (scene, backend, integrator), rows in sorted(groups.items()):
         t = time_to_target(rows, args.target)
         base = time_to_target(groups.get((scene, "cpu", "path_tracing"), []), args.target)
@@ -138,6 +157,14 @@ def main():
             lines[-1] += f" {last['bounces']}, {float(last['bias_rel_mse']):.2g} |"
         else:
             lines[-1] += " - |"
+        base_rows = groups.get((scene, "cpu", "path_tracing"), [])
+        gain = "-"
+        if base_rows and base_rows is not rows:
+            t_equal = min(float(rows[-1]["seconds"]), float(base_rows[-1]["seconds"]))
+            mine, theirs = rel_mse_at(rows, t_equal), rel_mse_at(base_rows, t_equal)
+            if mine and theirs:
+                gain = f"{theirs / mine:.2f} at {t_equal:.3g} s"
+        lines[-1] += f" {gain} |"
     lines += ["", f"![time against error]({os.path.basename(png_path)})", ""]
     with open(os.path.join(args.out, args.report + ".md"), "w") as f:
         f.write("\n".join(lines))

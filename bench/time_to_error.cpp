@@ -2,10 +2,10 @@
 // content hash outside the repository) is the reference; runs at doubling spp record seconds,
 // relMSE, MAE, worst-texel error and rays/s as CSV, and the time to reach a target relMSE.
 //
-//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,bounces] [--name NAME]
+//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,bounces,guided] [--guiding-mix M] [--name NAME]
 //                       [--sky R,G,B] [--texel-density T] [--reference-spp N] [--max-spp N]
 //                       [--max-seconds S] [--target 0.01] [--bounces N] [--min-spp N] [--cache DIR] [--csv FILE]
-//                       [--texel-csv FILE]
+//                       [--texel-csv FILE] [--guiding-fields FILE]
 //
 // The reference is always the CPU path tracer. For the per-bounce mode (integrator per_bounce) the
 // CSV also has the bounces run, the fraction of gather hits without texels, and bias_rel_mse: at
@@ -31,6 +31,7 @@
 #include <iostream>
 
 #include "exitance/runtime/embree_scene.h"
+#include "exitance/runtime/core/grid_guiding_cache.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/bake/command/backend_choice.h"
 #include "exitance/bake/bundle/input_hash.h"
@@ -83,7 +84,12 @@ int main(int argc, char** argv) {
   CLI::App app{"time against error of the CPU reference"};
   app.add_option("scene", scene_path)->required();
   app.add_option("--backends", backends, "comma-separated: cpu, vulkan (the reference is always cpu)");
-  app.add_option("--integrators", integrators, "comma-separated: path, bounces");
+  app.add_option("--integrators", integrators, "comma-separated: path, bounces, guided (path with --guiding grid)");
+  float guiding_mix = 0.5f;
+  app.add_option("--guiding-mix", guiding_mix, "guided component's probability (guided runs)");
+  std::string guiding_fields;
+  app.add_option("--guiding-fields", guiding_fields,
+                 "CSV of the learned grid guiding tables of the last guided run (record, cell, class, bins)");
   app.add_option("--name", scene_name, "scene name in the CSV (default: file stem)");
   app.add_option("--max-seconds", max_seconds, "stop the ladder after a run longer than this");
   app.add_option("--sky", sky);
@@ -160,16 +166,27 @@ int main(int argc, char** argv) {
   }
   csv << "backend,integrator,scene,live_texels,spp,seconds,rel_mse,raw_rel_mse,reference_rel_mse,mae,worst_texel_error,"
          "rays_per_second,bounces,texelless_fraction,bias_rel_mse\n";
-  std::vector<IntegratorMode> modes;
-  if (integrators.find("path") != std::string::npos) modes.push_back(IntegratorMode::Path);
-  if (integrators.find("bounces") != std::string::npos) modes.push_back(IntegratorMode::Bounces);
+  struct Mode {
+    IntegratorMode integrator;
+    GuidingMode guiding;
+    const char* name;
+  };
+  std::vector<Mode> modes;
+  auto listed = [&](const std::string& name) {
+    return ("," + integrators + ",").find("," + name + ",") != std::string::npos;
+  };
+  if (listed("path")) modes.push_back({IntegratorMode::Path, GuidingMode::Off, "path_tracing"});
+  if (listed("guided")) modes.push_back({IntegratorMode::Path, GuidingMode::Grid, "path_guided_grid"});
+  if (listed("bounces")) modes.push_back({IntegratorMode::Bounces, GuidingMode::Off, "per_bounce"});
   for (const std::shared_ptr<const Integrator>& backend : measured)
-    for (IntegratorMode mode : modes) {
-      const char* mode_name = mode == IntegratorMode::Path ? "path_tracing" : "per_bounce";
+    for (const Mode& m : modes) {
+      const IntegratorMode mode = m.integrator;
+      const char* mode_name = m.name;
       {  // Warm-up, not recorded: lavapipe and GPU drivers compile pipelines at the first dispatch.
         IntegratorSettings warm_up;
         warm_up.spp = 1;
         warm_up.integrator = mode;
+        warm_up.guiding = m.guiding;
         try {
           backend->bake(gbuffer, warm_up);
         } catch (const std::exception& e) {
@@ -185,6 +202,26 @@ int main(int argc, char** argv) {
         settings.seed = spp;
         settings.integrator = mode;
         settings.max_bounces = bounces;
+        settings.guiding = m.guiding;
+        settings.guiding_mix = guiding_mix;
+        if (!guiding_fields.empty())
+          settings.inspect_guiding = [&](const GridGuidingCache& cache) {
+            std::ofstream out(guiding_fields);
+            out << "cell_x,cell_y,cell_z,normal_class,cell_size,memory_bytes_per_record";
+            for (uint b = 0; b < kGuideBins; ++b) out << ",bin" << b;
+            out << "\n";
+            for (int z = 0; z < cache.cells(2); ++z)
+              for (int y = 0; y < cache.cells(1); ++y)
+                for (int x = 0; x < cache.cells(0); ++x)
+                  for (uint k = 0; k < kGuideNormalClasses; ++k) {
+                    const uint32_t r = cache.record_of_cell(x, y, z, k);
+                    if (r == GridGuidingCache::kNoRecord) continue;
+                    out << x << "," << y << "," << z << "," << k << "," << cache.cell_size() << ","
+                        << GridGuidingCache::bytes_per_record();
+                    for (uint b = 0; b < kGuideBins; ++b) out << "," << cache.radiance(r)[b];
+                    out << "\n";
+                  }
+          };
         const LightmapEstimate estimate = backend->bake(gbuffer, settings);
         std::vector<float> result = flatten(estimate);
         result.resize(values);

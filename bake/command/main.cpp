@@ -71,8 +71,13 @@ int main(int argc, char** argv) {
   app.add_option("--voxel-resolution", voxels,
                  "SVO leaves per axis: a power of two 2..4096, auto (leaves about 4 texels wide) or none");
   app.add_option("--directional", directional, "sh1: L1 directional lightmaps (not implemented yet)");
-  app.add_option("--guiding", guiding, "auto | off | svo | grid (only off is implemented yet)")
+  app.add_option("--guiding", guiding,
+                 "auto (= off for now) | off | svo (not implemented yet) | grid (regular-grid SARSA cache, seed 002; "
+                 "CPU backend only)")
       ->check(CLI::IsMember({"auto", "off", "svo", "grid"}));
+  app.add_option("--guiding-mix", options.lighting.guiding_mix,
+                 "probability of the guided direction in the one-sample mixture with cosine sampling (default 0.5)")
+      ->check(CLI::Range(0.0f, 1.0f));
   bool json_report = false;
   app.add_flag("--json", json_report, "print the run report as JSON on stdout");
   // --list-devices needs no scene: parse it before the required positional is enforced.
@@ -130,9 +135,16 @@ int main(int argc, char** argv) {
   }
   if (integrator == "bounces") options.lighting.integrator = exitance::IntegratorMode::Bounces;
   if (!directional.empty()) diagnostics.warn("--directional: directional lightmaps are not implemented yet; ignored");
-  if (guiding == "svo" || guiding == "grid") {
-    std::cerr << "bake: error: --guiding " << guiding << " is not implemented yet (use off)\n";
+  if (guiding == "svo") {
+    std::cerr << "bake: error: --guiding svo is not implemented yet (use grid or off)\n";
     return 1;
+  }
+  if (guiding == "grid") {
+    if (integrator != "path") {
+      std::cerr << "bake: error: --guiding grid guides path tracing: it needs --integrator path\n";
+      return 2;
+    }
+    options.lighting.guiding = exitance::GuidingMode::Grid;
   }
 
   exitance::ProgressBar bar;

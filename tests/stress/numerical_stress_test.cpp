@@ -56,8 +56,9 @@ Room make_room(float scale, Vec3 offset) {
   return room;
 }
 
-// Every stress test runs on each backend: the CPU reference and the Vulkan compute backend
-// (lavapipe in CI, validation layers on; any validation message fails the test).
+// Every stress test runs on each backend: the CPU reference, the CPU reference with grid guiding
+// forced on, and the Vulkan compute backend (lavapipe in CI, validation layers on; any validation
+// message fails the test).
 class Stress : public ::testing::TestWithParam<std::string> {
  protected:
   void SetUp() override {
@@ -69,6 +70,11 @@ class Stress : public ::testing::TestWithParam<std::string> {
 
   LightmapEstimate bake_scene(const Scene& scene, const TexelGBuffer& texels, const IntegratorSettings& settings) {
     if (GetParam() == "cpu") return CpuReferenceIntegrator(scene).bake(texels, settings);
+    if (GetParam() == "cpu_guided") {  // grid guiding forced on (issue 11): same checks, same tolerances
+      IntegratorSettings guided = settings;
+      guided.guiding = GuidingMode::Grid;
+      return CpuReferenceIntegrator(scene).bake(texels, guided);
+    }
     std::vector<std::string> messages;
     VulkanDeviceOptions options;
     options.validation = true;
@@ -245,7 +251,7 @@ TEST_P(Stress, ThinWallDoesNotLeak) {
   EXPECT_EQ(leak, 0.0);
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, Stress, ::testing::Values("cpu", "vulkan"),
+INSTANTIATE_TEST_SUITE_P(Backends, Stress, ::testing::Values("cpu", "cpu_guided", "vulkan"),
                          [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
 
 }  // namespace

@@ -10,8 +10,10 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "cpu_bounce_integrator.h"
+#include "exitance/runtime/core/grid_guiding_cache.h"
 #include "exitance/runtime/core/pass_scheduler.h"
 #include "exitance/runtime/core/scene_access.h"
 #include "exitance/runtime/embree_scene.h"
@@ -20,6 +22,10 @@ namespace exitance {
 namespace {
 
 constexpr int kMaxRecordedBounces = 16;
+// Grid guiding learns during the first samples per texel and then samples its frozen table: on
+// small scenes the learning (a target per ray, atomic adds) costs as much as the ray itself, and by
+// then the table has stopped improving (bench/results/guiding.md).
+constexpr uint32_t kGuidingLearningSamples = 64;
 
 // Per-sample contributions to E/pi, split by the number of diffuse reflections between the
 // light and the texel (0 = direct).
@@ -57,27 +63,51 @@ struct CpuReferenceIntegrator::Impl {
     return sum;
   }
 
-  // One path sample of E/pi at x; `first_bounce` is the bounce x stands for (0 at a texel).
+  // What a guided vertex's continuation ray saw, as the learning target of its bin (luminance of
+  // incident radiance): the emission and albedo x the frozen table's cosine-weighted mean at the hit.
+  float learning_target(const GridGuidingCache& guide, const Hit& hit, Vec3 wi) const {
+    const LightingScene& s = scene();
+    if (!hit.found) return luminance(scene_sky_radiance(s, wi));
+    const Vec3 ng = triangle_geometric_normal(s, hit.triangle);
+    const bool front = dot(wi, ng) < 0;
+    if (!front && !material_double_sided(scene_material(s, scene_triangle_material(s, hit.triangle)))) return 0.0f;
+    const SurfacePoint y = surface_point_on_triangle(s, hit.triangle, ng, hit.b1, hit.b2, front);
+    return luminance(scene_emission(s, hit.triangle, hit.b1, hit.b2)) +
+           luminance(scene_albedo(s, hit.triangle, hit.b1, hit.b2)) *
+               guide.expected_cosine_radiance(guide.record_of(y.position, y.shading_normal));
+  }
+
+  // One path sample of E/pi at x; `first_bounce` is the bounce x stands for (0 at a texel). With a
+  // guiding cache, vertices sample its frozen table's mixture and every ray teaches its back table.
   void trace(SurfacePoint x, const IntegratorSettings& settings, Pcg32& rng, PathContributions& out,
-             uint64_t& rays) const {
+             uint64_t& rays, GridGuidingCache* guide = nullptr, bool learn = false,
+             uint64_t* guided_vertices = nullptr) const {
     const LightingScene& s = scene();
     const PathLimits limits{settings.max_bounces, settings.russian_roulette_start, settings.safety_bounce_cap};
     Vec3 throughput{1, 1, 1};
     for (int bounce = 0;; ++bounce) {
       const Vec3 origin = offset_ray_origin(x.position, x.geometric_normal, s.extent);
+      const uint32_t record = guide ? guide->record_of(x.position, x.shading_normal) : GridGuidingCache::kNoRecord;
+      const GuideVertex g = guide ? guide->vertex(record) : guide_vertex_cosine();
+      if (guided_vertices && g.guided_probability > 0) ++*guided_vertices;
       ShadowRay shadow[kShadowRaysPerVertex];
-      next_event_estimation(s, x, origin, throughput, settings.sampling_strategy, rng, shadow[0], shadow[1], shadow[2]);
+      next_event_estimation(s, x, origin, throughput, g, rng, shadow[0], shadow[1], shadow[2]);
       out.add(bounce, connect(shadow, origin, rays));
-      const DirectionSample d = sample_continuation(settings.sampling_strategy, x, rng);
+      const DirectionSample d = sample_continuation(g, x, rng);
       if (!(d.pdf > 0)) return;
+      const Vec3 ray_throughput = throughput * continuation_weight(g, x, d);
       ++rays;
       const Hit hit = embree->intersect(origin, d.direction, INFINITY);
+      if (learn && record != GridGuidingCache::kNoRecord) {
+        const Vec3 local = guide_to_class_local(g.normal_class, d.direction);
+        if (local.z > 0) guide->learn(record, guide_bin_of_local(local), learning_target(*guide, hit, d.direction));
+      }
       if (!hit.found) {
-        out.add(bounce, throughput * escaped_radiance(s, d.direction, d.pdf));
+        out.add(bounce, ray_throughput * escaped_radiance(s, d.direction, d.pdf));
         return;
       }
       const HitResult h = shade_continuation_hit(s, hit.triangle, hit.distance, hit.b1, hit.b2, d.direction, d.pdf,
-                                                 throughput, bounce, limits, rng);
+                                                 ray_throughput, bounce, limits, rng);
       out.add(bounce, h.radiance);
       if (!h.continues) return;
       throughput = h.throughput;
@@ -119,7 +149,11 @@ std::string CpuReferenceIntegrator::device_description() const {
 }
 
 LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const {
-  if (settings.integrator == IntegratorMode::Bounces) return bake_per_bounce(*impl_->lighting, *impl_->embree, gbuffer, settings);
+  if (settings.integrator == IntegratorMode::Bounces) {
+    if (settings.guiding != GuidingMode::Off)
+      throw std::invalid_argument("CPU backend: guiding applies to path tracing, not to --integrator bounces");
+    return bake_per_bounce(*impl_->lighting, *impl_->embree, gbuffer, settings);
+  }
   const auto start = std::chrono::steady_clock::now();
   const size_t texel_count = gbuffer.texels.size();
   LightmapEstimate estimate;
@@ -129,15 +163,26 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   std::vector<uint8_t> converged(texel_count, 0);
   tbb::combinable<uint64_t> rays_per_thread([] { return uint64_t(0); });
   tbb::combinable<uint64_t> nonfinite_per_thread([] { return uint64_t(0); });
+  tbb::combinable<uint64_t> guided_per_thread([] { return uint64_t(0); });
 
   PassPolicy policy;
   policy.ramp = true;  // small passes early so progress and the time budget are honoured; larger later
   PassScheduler passes(settings, policy);
+  // Built inside the timed bake: guided results are measured with the cost of their guiding data.
+  std::unique_ptr<GridGuidingCache> guide;
+  if (settings.guiding == GuidingMode::Grid) {
+    GridGuidingConfig config;
+    config.mix = settings.guiding_mix;
+    config.cells_on_longest_axis = settings.guiding_grid_cells;
+    guide = std::make_unique<GridGuidingCache>(*impl_->lighting, gbuffer, config);
+  }
   uint32_t first = 0, count = 0;
   while (passes.next_pass(first, count)) {
+    const bool learning = guide && first < kGuidingLearningSamples;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, texel_count, 64), [&](const tbb::blocked_range<size_t>& range) {
       uint64_t& rays = rays_per_thread.local();
       uint64_t& nonfinite = nonfinite_per_thread.local();
+      uint64_t& guided = guided_per_thread.local();
       PathContributions contributions;
       for (size_t i = range.begin(); i != range.end(); ++i) {
         if (converged[i]) continue;
@@ -148,7 +193,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
           Pcg32 rng = pcg_init(settings.seed, i, s);
           contributions = PathContributions{};
           contributions.recorded = estimate.recorded_bounces;
-          impl_->trace(point, settings, rng, contributions, rays);
+          impl_->trace(point, settings, rng, contributions, rays, guide.get(), learning, &guided);
           const Vec3 total = contributions.total();
           if (!is_finite(total)) {
             ++nonfinite;
@@ -169,12 +214,15 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
           converged[i] = 1;
       }
     });
+    if (learning) guide->swap();  // this pass's learning becomes the next pass's frozen table
     const bool all_converged = settings.target_relative_error > 0 &&
                                std::all_of(converged.begin(), converged.end(), [](uint8_t c) { return c != 0; });
     passes.finish_pass(rays_per_thread.combine(std::plus<uint64_t>()), all_converged);
   }
   estimate.rays = rays_per_thread.combine(std::plus<uint64_t>());
   estimate.nonfinite_samples = nonfinite_per_thread.combine(std::plus<uint64_t>());
+  estimate.guided_vertices = guided_per_thread.combine(std::plus<uint64_t>());
+  if (guide && settings.inspect_guiding) settings.inspect_guiding(*guide);
   estimate.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return estimate;
 }

@@ -55,6 +55,8 @@ inline float sqrt(float a) { return std::sqrt(a); }
 inline float floor(float a) { return std::floor(a); }
 inline float cos(float a) { return std::cos(a); }
 inline float sin(float a) { return std::sin(a); }
+// GLSL's two-argument atan is C's atan2.
+inline float atan(float y, float x) { return std::atan2(y, x); }
 inline bool isinf(float a) { return std::isinf(a); }
 inline bool isnan(float a) { return std::isnan(a); }
 inline uint floatBitsToUint(float f) { return std::bit_cast<uint>(f); }

@@ -26,6 +26,7 @@
 #define EXITANCE_COMMON_PATH_H
 #include "exitance/common/distribution.h"
 #include "exitance/common/gpu_layout.h"
+#include "exitance/common/guided_direction.h"
 #include "exitance/common/punctual_light.h"
 #include "exitance/common/ray_offset.h"
 #include "exitance/common/rng.h"
@@ -45,8 +46,9 @@ struct PathLimits {
 };
 
 // ---- Sampling-strategy hook: the continuation direction at a surface vertex ----
-// kStrategyCosine is the only strategy today; guided distributions add theirs here, and because
-// next-event estimation weighs its samples with continuation_pdf, its MIS stays right for them.
+// kStrategyCosine: cosine-weighted. A guided vertex (GuideVertex, guided_direction.h) samples the
+// one-sample mixture m * guided + (1 - m) * cosine, and its pdf is the mixture's: next-event
+// estimation weighs its samples with continuation_pdf, so its MIS stays right for any strategy.
 const uint kStrategyCosine = 0u;
 
 struct DirectionSample {
@@ -54,8 +56,23 @@ struct DirectionSample {
   float pdf;  // solid-angle density; 0: no usable direction, the path ends
 };
 
+EXITANCE_FN GuideVertex guide_vertex_cosine() {
+  GuideVertex g;
+  g.guided_probability = 0.0f;
+  g.normal_class = 0u;
+  g.cdf = GUIDE_CDF_NONE;
+  return g;
+}
+
+// A vertex with guided_probability 0 computes exactly what the cosine strategy computes.
+EXITANCE_FN float continuation_pdf(GuideVertex g, SurfacePoint x, vec3 wi) {
+  float cosine = max(dot(x.shading_normal, wi), 0.0f) * kInvPi;
+  if (!(g.guided_probability > 0.0f)) return cosine;
+  return g.guided_probability * guided_component_pdf(g, wi) + (1.0f - g.guided_probability) * cosine;
+}
+
 EXITANCE_FN float continuation_pdf(uint strategy, SurfacePoint x, vec3 wi) {
-  return max(dot(x.shading_normal, wi), 0.0f) * kInvPi;
+  return continuation_pdf(guide_vertex_cosine(), x, wi);
 }
 
 // Draws u1 then u2. A direction under the geometric surface would leave through the back: none.
@@ -68,6 +85,33 @@ EXITANCE_FN DirectionSample sample_continuation(uint strategy, SurfacePoint x, I
   s.pdf = local.z * kInvPi;
   if (!(dot(s.direction, x.geometric_normal) > 0.0f) || local.z <= 0.0f) s.pdf = 0.0f;
   return s;
+}
+
+// Cosine vertices: as above. Guided vertices draw the component choice, u1, u2, and for the guided
+// component a third number (bin, then the point in it). A guided direction under the surface
+// (shading or geometric) ends the path: the integrand is 0 there.
+EXITANCE_FN DirectionSample sample_continuation(GuideVertex g, SurfacePoint x, INOUT(Pcg32) rng) {
+  if (!(g.guided_probability > 0.0f)) return sample_continuation(kStrategyCosine, x, rng);
+  float u_choose = pcg_uniform(rng);
+  float u1 = pcg_uniform(rng);
+  float u2 = pcg_uniform(rng);
+  DirectionSample s;
+  if (u_choose < g.guided_probability) {
+    float u3 = pcg_uniform(rng);
+    s.direction = guided_component_sample(g, u1, u2, u3);
+  } else {
+    s.direction = to_world(sample_cosine_hemisphere(u1, u2), x.shading_normal);
+  }
+  s.pdf = continuation_pdf(g, x, s.direction);
+  if (!(dot(s.direction, x.geometric_normal) > 0.0f) || !(dot(s.direction, x.shading_normal) > 0.0f)) s.pdf = 0.0f;
+  return s;
+}
+
+// The factor (cos / pi) / pdf the continuation carries into the path's throughput (the albedo is
+// applied at the hit): exactly 1 for cosine vertices, so unguided results do not change.
+EXITANCE_FN float continuation_weight(GuideVertex g, SurfacePoint x, DirectionSample d) {
+  if (!(g.guided_probability > 0.0f)) return 1.0f;
+  return max(dot(x.shading_normal, d.direction), 0.0f) * kInvPi / d.pdf;
 }
 
 // ---- Next-event estimation ----
@@ -90,7 +134,8 @@ EXITANCE_FN bool material_double_sided(GpuMaterial m) { return m.albedo_double_s
 // Random numbers, in order: area light (choice, u1, u2), punctual light (choice), environment (u1, u2);
 // each only when the scene has lights of that kind.
 // Three named outputs (area light, punctual light, environment) rather than an array.
-EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, vec3 throughput, uint strategy,
+// `guide`: the vertex's continuation strategy, whose pdf weighs the area and environment samples.
+EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, vec3 throughput, GuideVertex guide,
                                        INOUT(Pcg32) rng, OUT(ShadowRay) area_ray, OUT(ShadowRay) punctual_ray,
                                        OUT(ShadowRay) environment_ray) {
   area_ray = no_shadow_ray();
@@ -125,7 +170,7 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
         float span_length = length(span);
         if (span_length > 0.0f) {
           float pdf_light = pdf_area * distance2 / cos_l;
-          float weight = power_heuristic(pdf_light, continuation_pdf(strategy, x, wi));
+          float weight = power_heuristic(pdf_light, continuation_pdf(guide, x, wi));
           vec3 le = scene_emission(SCENE_ARG tri, bary.x, bary.y);
           area_ray.direction_length = vec4(span / span_length, span_length);
           area_ray.contribution_state = vec4(throughput * (le * (cos_x * kInvPi * weight / pdf_light)), kShadowTrace);
@@ -169,12 +214,19 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
     vec3 wi = scene_sample_environment(SCENE_ARG u1, u2, pdf_env);
     float cos_x = dot(x.shading_normal, wi);
     if (pdf_env > 0.0f && cos_x > 0.0f && dot(x.geometric_normal, wi) > 0.0f) {
-      float weight = power_heuristic(pdf_env, continuation_pdf(strategy, x, wi));
+      float weight = power_heuristic(pdf_env, continuation_pdf(guide, x, wi));
       environment_ray.direction_length = vec4(wi, uintBitsToFloat(0x7F800000u));
       environment_ray.contribution_state =
           vec4(throughput * (scene_sky_radiance(SCENE_ARG wi) * (cos_x * kInvPi * weight / pdf_env)), kShadowTrace);
     }
   }
+}
+
+EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, vec3 throughput, uint strategy,
+                                       INOUT(Pcg32) rng, OUT(ShadowRay) area_ray, OUT(ShadowRay) punctual_ray,
+                                       OUT(ShadowRay) environment_ray) {
+  next_event_estimation(SCENE_ARG x, origin, throughput, guide_vertex_cosine(), rng, area_ray, punctual_ray,
+                        environment_ray);
 }
 
 // ---- Continuation hits ----

@@ -39,6 +39,7 @@ struct LightmapEstimate {
   double seconds = 0;
   uint64_t nonfinite_samples = 0;  // samples discarded because they were NaN/Inf (should stay 0)
   BounceGatherStatistics bounce_statistics;
+  uint64_t guided_vertices = 0;  // path vertices that sampled a guided mixture (--guiding); 0 unguided
 
   Vec3 mean_total(size_t texel) const;
   Vec3 mean_direct(size_t texel) const;

@@ -5,12 +5,19 @@
 
 namespace exitance {
 
+class GridGuidingCache;
+
 // How texels are lit (bake --integrator). Path: the unbiased path tracer of path.h, one path per
 // sample. Bounces: per-bounce passes (seed 003, issue 10): B_0 = direct light; pass k+1 gathers, at
 // the hits of cosine rays from every texel, the stored outgoing radiance albedo * B_k of the hit's
 // lightmap texels (bilinear) - a cache lookup with a resolution bias, measured in
 // bench/results/per-bounce.md. See docs/lighting-core.md, "Per-bounce mode".
 enum class IntegratorMode { Path, Bounces };
+
+// Path guiding of the continuation directions (bake --guiding, issue 11). Grid: the regular-grid
+// SARSA cache of seed 002 (core/grid_guiding_cache.h), one-sample MIS with cosine sampling. The
+// choice of `auto` is made by the caller (bake), which hands Off or a mode here.
+enum class GuidingMode { Off, Grid };
 
 struct IntegratorSettings {
   IntegratorMode integrator = IntegratorMode::Path;
@@ -26,8 +33,13 @@ struct IntegratorSettings {
   int recorded_bounces = 4;        // layers bounce0 (= direct) .. bounce<K-1> kept separately
   int russian_roulette_start = 3;  // first bounce at which roulette may end a path
   int safety_bounce_cap = 4096;    // never reached by paths of albedo < 0.998 in practice; documented
-  uint32_t sampling_strategy = 0;  // continuation directions: kStrategyCosine (path.h); guided strategies later
+  uint32_t sampling_strategy = 0;  // continuation directions: kStrategyCosine (path.h)
+  GuidingMode guiding = GuidingMode::Off;  // Path mode only; backends refuse modes they lack
+  float guiding_mix = 0.5f;         // probability of the guided component at a guided vertex (0..1)
+  int guiding_grid_cells = 16;      // grid cells along the scene's longest axis (cubic cells)
   std::function<void(double fraction_done, uint64_t rays)> progress;  // called between passes
+  // Called once at the end of a guided bake with its cache (plots of the learned fields, tests).
+  std::function<void(const GridGuidingCache&)> inspect_guiding;
 };
 
 }  // namespace exitance

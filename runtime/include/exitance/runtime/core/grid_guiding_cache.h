@@ -1,0 +1,105 @@
+// The regular-grid guiding cache (seed 002, chapter 4; issue 11): incident radiance L_i(x, w)
+// tabulated per (grid cell, normal class) over guided_direction.h's 16 x 16 equal-area hemisphere
+// bins, learned online from path samples with a SARSA-style temporal-difference target, and sampled
+// by the path tracer as one component of a one-sample mixture with cosine sampling.
+//
+// Choices (documented in docs/lighting-core.md, "Grid guiding"):
+//  - Grid: cubic cells, n along the longest side of the scene bounds and as many along the others
+//    as fit; n is the largest value up to `cells_on_longest_axis` (default 16) for which the
+//    occupied (cell, class) records hold at least kMinTexelsPerRecord (16) texels on average, so every
+//    table is learned from enough paths per pass (the thesis's 8^3 was for camera paths; lightmaps
+//    at usual densities get 16, coarse test atlases fewer).
+//  - Per cell, one hemisphere table per normal class (guided_direction.h), allocated only for the
+//    (cell, class) pairs that lightmap texels occupy; other vertices sample cosine only.
+//  - Learning target for the bin of w at x, whose ray hits y: L_e(y, -w) + albedo(y) * Lbar(y), with
+//    Lbar(y) = (1/pi) * integral of the frozen table's L_i(y, .) cos over y's class hemisphere: the
+//    SARSA bootstrap (thesis eq. 4.8) with its expectation over the next action memoized per record
+//    at each swap (O(1) per update, like the thesis's memoized normaliser), so no state travels with
+//    the path. Escaping rays learn the sky's radiance; back faces of single-sided surfaces learn 0.
+//  - Double buffering: a pass's samples read the front table (frozen) and learn into the back one
+//    with integer (fixed-point) atomic adds, so the sums do not depend on thread count or order;
+//    swap() folds the back sums into the table (the cumulative mean of each bin's targets) and
+//    rebuilds the CDFs from the bins shrunk toward their record's mean by 8 pseudo-samples.
+//  - Bins have equal cosine mass (concentric_hemisphere.h), so the bin probabilities are the
+//    learned L_i normalised, plus a uniform floor (kUniformFloor of the mass) so no bin has
+//    probability 0, and the pdf is L_i x cos exactly up to the bins' resolution. A record with nothing learned, or
+//    learned all zero, samples cosine only.
+#pragma once
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "exitance/common/guided_direction.h"
+#include "exitance/runtime/core/lighting_scene.h"
+#include "exitance/runtime/texel_gbuffer.h"
+
+namespace exitance {
+
+struct GridGuidingConfig {
+  float mix = 0.5f;               // guided component's probability at a guided vertex
+  int cells_on_longest_axis = 16;
+};
+
+class GridGuidingCache {
+ public:
+  static constexpr uint32_t kNoRecord = 0xFFFFFFFFu;
+  static constexpr float kUniformFloor = 0.02f;
+  static constexpr double kMinTexelsPerRecord = 16;
+
+  // Records for the (cell, class) pairs of `gbuffer`'s texels. `scene` gives the bounds and the
+  // radiance scale of the fixed-point sums (the brightest emitter or sky).
+  GridGuidingCache(const LightingScene& scene, const TexelGBuffer& gbuffer, const GridGuidingConfig& config);
+
+  // The record of a surface point, kNoRecord when its (cell, class) has no texels.
+  uint32_t record_of(Vec3 position, Vec3 shading_normal) const;
+  // The strategy at a vertex of record `record` from the front table (cosine only for kNoRecord).
+  GuideVertex vertex(uint32_t record) const;
+  // (1/pi) * integral of the front L_i * cos over the record's class hemisphere (0 for kNoRecord).
+  float expected_cosine_radiance(uint32_t record) const;
+  // Adds one learning target (luminance of radiance) for `bin` of `record` to the back table.
+  // Thread-safe; the sums are integers, so their result does not depend on the order of calls.
+  void learn(uint32_t record, uint32_t bin, float target);
+  // Between passes: folds the back table into the front one, rebuilds the CDFs, clears the back.
+  void swap();
+
+  uint32_t record_count() const { return uint32_t(front_.size()); }
+  int cells(int axis) const { return dims_[axis]; }
+  float cell_size() const { return cell_size_; }
+  static size_t bytes_per_record();
+  size_t memory_bytes() const;
+  // The front table's learned radiance of a record (kGuideBins values), for plots and tests.
+  const float* radiance(uint32_t record) const { return &radiance_[size_t(record) * kGuideBins]; }
+  uint32_t record_of_cell(int x, int y, int z, uint normal_class) const;
+
+ private:
+  // What a vertex reads (small and together: the hot data of every path vertex).
+  struct Front {
+    float guided_probability = 0;  // config mix, or 0 while nothing is learned
+    float expected_cosine = 0;     // Lbar
+    uint32_t normal_class = 0;
+  };
+  // A bin of the back table: sum and count on one cache line.
+  struct BinAccumulator {
+    std::atomic<uint64_t> sum{0};   // fixed-point
+    std::atomic<uint32_t> count{0};
+  };
+  uint32_t cell_index(Vec3 position) const;
+  void rebuild(uint32_t record);
+
+  GridGuidingConfig config_;
+  Vec3 lo_;
+  float cell_size_ = 1;
+  int dims_[3] = {1, 1, 1};
+  double fixed_scale_ = 1;  // fixed-point units per unit of radiance
+  float target_cap_ = 0;    // targets are clamped here (guiding only: no estimator bias)
+  std::vector<uint32_t> record_index_;  // per (cell, class)
+  std::vector<Front> front_;
+  std::vector<float> cdf_;       // kGuideBins + 1 per record
+  std::vector<float> radiance_;  // kGuideBins per record: learned L_i
+  std::vector<float> weight_;    // kGuideBins per record: effective sample count behind each value
+  std::unique_ptr<BinAccumulator[]> back_;  // kGuideBins per record
+};
+
+}  // namespace exitance

@@ -1,0 +1,183 @@
+// The regular-grid guiding cache: see grid_guiding_cache.h for the choices.
+#include "exitance/runtime/core/grid_guiding_cache.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace exitance {
+namespace {
+
+// Fixed-point sums: 2^24 units per reference radiance, targets capped at 2^16 references, so one
+// bin overflows its 64 bits only after 2^24 capped targets in one pass.
+constexpr double kFixedUnitsPerReference = 16777216.0;
+constexpr float kCapInReferences = 65536.0f;
+// Old sample counts are kept at every swap (a cumulative mean, as the thesis accumulates): passes
+// are small (a few spp), and halving per swap left ~4 samples behind a bin (plots in
+// bench/results/guiding.md), whose noise the sampler then followed.
+constexpr float kCountDecay = 1.0f;
+// Each bin's value is shrunk toward its record's mean by this many pseudo-samples, so a bin seen a
+// few times (one lucky emitter hit) does not draw the sampler.
+constexpr double kPriorSamples = 8;
+
+struct Grid {
+  float cell = 1;
+  int dims[3] = {1, 1, 1};
+};
+
+Grid make_grid(Vec3 extent, int n) {
+  Grid g;
+  const float longest = std::max({extent.x, extent.y, extent.z});
+  g.cell = longest > 0 && std::isfinite(longest) ? longest / float(n) : 1.0f;
+  for (int a = 0; a < 3; ++a) g.dims[a] = std::clamp(int(std::ceil(extent[a] / g.cell)), 1, n);
+  return g;
+}
+
+}  // namespace
+
+GridGuidingCache::GridGuidingCache(const LightingScene& scene, const TexelGBuffer& gbuffer,
+                                   const GridGuidingConfig& config)
+    : config_(config) {
+  config_.mix = std::clamp(config_.mix, 0.0f, 1.0f);
+  lo_ = scene.bounds_lo;
+  const Vec3 extent = scene.bounds_hi - scene.bounds_lo;
+  // The finest grid whose records average kMinTexelsPerRecord texels.
+  for (int n = std::max(1, config_.cells_on_longest_axis);; --n) {
+    const Grid g = make_grid(extent, n);
+    cell_size_ = g.cell;
+    for (int a = 0; a < 3; ++a) dims_[a] = g.dims[a];
+    const size_t cells = size_t(dims_[0]) * size_t(dims_[1]) * size_t(dims_[2]);
+    record_index_.assign(cells * kGuideNormalClasses, kNoRecord);
+    front_.clear();
+    for (const LiveTexel& t : gbuffer.texels) {
+      const uint normal_class = guide_normal_class(t.shading_normal);
+      const size_t key = size_t(cell_index(t.position)) * kGuideNormalClasses + normal_class;
+      if (record_index_[key] != kNoRecord) continue;
+      record_index_[key] = uint32_t(front_.size());
+      Front f;
+      f.normal_class = normal_class;
+      front_.push_back(f);
+    }
+    if (n == 1 || double(gbuffer.texels.size()) >= kMinTexelsPerRecord * double(front_.size())) break;
+  }
+
+  // The radiance scale: the brightest emission or sky (luminance); a scene without either learns 0.
+  float reference = luminance(scene.sky);
+  for (const GpuMaterial& m : scene.materials)
+    reference = std::max(reference, luminance(Vec3(m.emission.x, m.emission.y, m.emission.z)));
+  if (!(reference > 0) || !std::isfinite(reference)) reference = 1.0f;
+  fixed_scale_ = kFixedUnitsPerReference / double(reference);
+  target_cap_ = reference * kCapInReferences;
+
+  const size_t records = front_.size();
+  cdf_.assign(records * (kGuideBins + 1), 0.0f);
+  radiance_.assign(records * kGuideBins, 0.0f);
+  weight_.assign(records * kGuideBins, 0.0f);
+  back_.reset(new BinAccumulator[records * kGuideBins]);
+  for (uint32_t r = 0; r < records; ++r) rebuild(r);
+}
+
+uint32_t GridGuidingCache::cell_index(Vec3 p) const {
+  int c[3];
+  for (int a = 0; a < 3; ++a) {
+    const float f = (p[a] - lo_[a]) / cell_size_;
+    c[a] = f >= 0 ? std::min(int(std::min(f, 1e9f)), dims_[a] - 1) : 0;  // NaN and below: cell 0
+  }
+  return uint32_t((c[2] * dims_[1] + c[1]) * dims_[0] + c[0]);
+}
+
+uint32_t GridGuidingCache::record_of(Vec3 position, Vec3 shading_normal) const {
+  return record_index_[size_t(cell_index(position)) * kGuideNormalClasses + guide_normal_class(shading_normal)];
+}
+
+uint32_t GridGuidingCache::record_of_cell(int x, int y, int z, uint normal_class) const {
+  if (x < 0 || y < 0 || z < 0 || x >= dims_[0] || y >= dims_[1] || z >= dims_[2]) return kNoRecord;
+  return record_index_[size_t((z * dims_[1] + y) * dims_[0] + x) * kGuideNormalClasses + normal_class];
+}
+
+GuideVertex GridGuidingCache::vertex(uint32_t record) const {
+  GuideVertex g;
+  g.guided_probability = 0;
+  g.normal_class = 0;
+  g.cdf = nullptr;
+  if (record == kNoRecord) return g;
+  const Front& f = front_[record];
+  g.guided_probability = f.guided_probability;
+  g.normal_class = f.normal_class;
+  g.cdf = &cdf_[size_t(record) * (kGuideBins + 1)];
+  return g;
+}
+
+float GridGuidingCache::expected_cosine_radiance(uint32_t record) const {
+  return record == kNoRecord ? 0.0f : front_[record].expected_cosine;
+}
+
+void GridGuidingCache::learn(uint32_t record, uint32_t bin, float target) {
+  if (record == kNoRecord || bin >= kGuideBins || !(target >= 0)) return;  // NaN never enters
+  const double fixed = double(std::min(target, target_cap_)) * fixed_scale_ + 0.5;
+  BinAccumulator& a = back_[size_t(record) * kGuideBins + bin];
+  a.sum.fetch_add(uint64_t(fixed), std::memory_order_relaxed);
+  a.count.fetch_add(1, std::memory_order_relaxed);
+}
+
+void GridGuidingCache::swap() {
+  for (uint32_t r = 0; r < front_.size(); ++r) {
+    bool changed = false;
+    for (uint b = 0; b < kGuideBins; ++b) {
+      const size_t i = size_t(r) * kGuideBins + b;
+      BinAccumulator& a = back_[i];
+      const uint32_t count = a.count.load(std::memory_order_relaxed);
+      weight_[i] *= kCountDecay;
+      if (count == 0) continue;
+      const uint64_t sum = a.sum.load(std::memory_order_relaxed);
+      a.count.store(0, std::memory_order_relaxed);
+      a.sum.store(0, std::memory_order_relaxed);
+      const float mean = float(double(sum) / fixed_scale_ / double(count));
+      const float w = weight_[i] + float(count);
+      radiance_[i] += (mean - radiance_[i]) * (float(count) / w);
+      weight_[i] = w;
+      changed = true;
+    }
+    if (changed) rebuild(r);
+  }
+}
+
+void GridGuidingCache::rebuild(uint32_t record) {
+  const float* learned_radiance = &radiance_[size_t(record) * kGuideBins];
+  const float* weight = &weight_[size_t(record) * kGuideBins];
+  float* cdf = &cdf_[size_t(record) * (kGuideBins + 1)];
+  double weighted = 0, weights = 0;
+  for (uint b = 0; b < kGuideBins; ++b) {
+    weighted += double(weight[b]) * learned_radiance[b];
+    weights += weight[b];
+  }
+  const double prior = weights > 0 ? weighted / weights : 0.0;
+  double radiance[kGuideBins];
+  double total = 0;
+  for (uint b = 0; b < kGuideBins; ++b) {
+    radiance[b] = (double(weight[b]) * learned_radiance[b] + kPriorSamples * prior) / (double(weight[b]) + kPriorSamples);
+    total += radiance[b];
+  }
+  const bool learned = total > 0 && std::isfinite(total);
+  // (1/pi) * integral of L cos = (1/pi) * sum of L_b * (pi / bins): every bin has cosine mass pi / bins.
+  front_[record].expected_cosine = learned ? float(total / kGuideBins) : 0.0f;
+  front_[record].guided_probability = learned ? config_.mix : 0.0f;
+  double run = 0;
+  cdf[0] = 0;
+  for (uint b = 0; b < kGuideBins; ++b) {
+    const double share = learned ? radiance[b] / total : 0.0;
+    run += (1.0 - kUniformFloor) * share + kUniformFloor / kGuideBins;
+    cdf[b + 1] = float(std::min(run, 1.0));
+  }
+  cdf[kGuideBins] = 1.0f;
+}
+
+size_t GridGuidingCache::bytes_per_record() {
+  return sizeof(Front) + sizeof(float) * (kGuideBins + 1) + 2 * sizeof(float) * kGuideBins +
+         sizeof(BinAccumulator) * kGuideBins;
+}
+
+size_t GridGuidingCache::memory_bytes() const {
+  return bytes_per_record() * front_.size() + record_index_.size() * sizeof(uint32_t);
+}
+
+}  // namespace exitance
