@@ -2,7 +2,8 @@
 # Builds Release and runs the whole CTest suite, reruns the CPU-reference tests on Embree's SSE4.2
 # kernels, builds the unit tests with clang and runs them, then builds with ASan+UBSan and reruns the
 # bad-input, stress and unit tests (formats and loader included) under the sanitizers, then fuzzes
-# the probes.bin / svo.bin / manifest.json readers for 20 s each. Assumes scripts/install-deps.sh has run.
+# the probes.bin / svo.bin / scene.bin / manifest.json / EDITS.json readers for 20 s each. Assumes
+# scripts/install-deps.sh has run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs="$(nproc)"
