@@ -2,7 +2,7 @@
 # Builds Release and runs the whole CTest suite, reruns the CPU-reference tests on Embree's SSE4.2
 # kernels, builds the unit tests with clang and runs them, then builds with ASan+UBSan and reruns the
 # bad-input, stress and unit tests (formats and loader included) under the sanitizers, then fuzzes
-# the probes.bin / svo.bin / scene.bin / manifest.json / EDITS.json readers for 20 s each. Assumes
+# the probes.bin / svo.bin / scene.bin / manifest.json / EDITS.json readers for 10 s each. Assumes
 # scripts/install-deps.sh has run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -41,4 +41,4 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 ctest --test-dir build-asan --output-on-failure -j"$jobs" -L "badinput|stress|unit"
 
 # libFuzzer (clang) on the on-disk readers; non-zero on any crash or sanitizer report.
-bash tests/fuzz/run_fuzzers.sh 20
+bash tests/fuzz/run_fuzzers.sh 10

@@ -38,4 +38,4 @@ if [ "${#failed[@]}" -ne 0 ]; then
   echo "fuzzers failed: ${failed[*]} (inputs in $build/artifacts/)"
   exit 1
 fi
-echo "fuzzers ran clean: ${EXITANCE_FUZZERS:-probes svo scene manifest}, ${seconds}s each"
+echo "fuzzers ran clean: ${EXITANCE_FUZZERS:-probes svo scene manifest edits}, ${seconds}s each"
