@@ -44,7 +44,9 @@ int main(int argc, char** argv) {
   app.add_option("--padding", options.atlas.padding, "gutter texels around each chart rectangle")->check(CLI::Range(1, 16));
   app.add_option("--uv", options.import.lightmap_uv_set, "lightmap UV set: 1 = TEXCOORD_1 (default), 0 = TEXCOORD_0")
       ->check(CLI::IsMember({0, 1}));
-  app.add_option("--spp", options.lighting.spp, "samples per texel (0 = until --time or --target-error ends the run)");
+  CLI::Option* spp_option = app.add_option(
+      "--spp", options.lighting.spp,
+      "samples per texel (default 128; 0 = until --time or --target-error ends the run, the default when either is given)");
   app.add_option("--time", options.lighting.time_budget_seconds, "stop the lighting stage after this many seconds")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--target-error", options.lighting.target_relative_error,
@@ -94,6 +96,9 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return e.get_exit_code() == 0 ? 0 : (code == 0 ? 0 : 2);
   }
+  // A time budget or a target error ends the run itself: no sample cap unless --spp asks for one.
+  if (spp_option->count() == 0 && (options.lighting.time_budget_seconds > 0 || options.lighting.target_relative_error > 0))
+    options.lighting.spp = 0;
   if (options.lighting.spp == 0 && options.lighting.time_budget_seconds <= 0 &&
       options.lighting.target_relative_error <= 0) {
     std::cerr << "bake: error: --spp 0 needs --time or --target-error to end the run\n";
