@@ -4,8 +4,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 
+#include "exitance/bake/bundle/write_bundle.h"
 #include "exitance/bake/command/bake_pipeline.h"
 #include "exitance/bake/input_error.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
@@ -80,6 +82,12 @@ int main(int argc, char** argv) {
   app.add_option("--guiding-mix", options.lighting.guiding_mix,
                  "probability of the guided direction in the one-sample mixture with cosine sampling (default 0.5)")
       ->check(CLI::Range(0.0f, 1.0f));
+  std::string cache_directory;
+  bool no_cache = false;
+  app.add_option("--cache", cache_directory,
+                 "bundle cache folder: a bake of the same input with the same options reuses the stored bundle "
+                 "(default: .exitance-cache beside the output)");
+  app.add_flag("--no-cache", no_cache, "neither read nor fill the bundle cache");
   bool json_report = false;
   app.add_flag("--json", json_report, "print the run report as JSON on stdout");
   // --list-devices needs no scene: parse it before the required positional is enforced.
@@ -152,6 +160,22 @@ int main(int argc, char** argv) {
     options.lighting.guiding = exitance::GuidingMode::Grid;
   }
 
+  if (no_cache && !cache_directory.empty()) {
+    std::cerr << "bake: error: --cache " << cache_directory << ": contradicts --no-cache\n";
+    return 2;
+  }
+  if (!no_cache) {
+    options.cache_directory = cache_directory.empty()
+                                  ? (exitance::bundle_folder(options).parent_path() / ".exitance-cache").string()
+                                  : cache_directory;
+    std::error_code error;
+    if (std::filesystem::exists(options.cache_directory, error) &&
+        !std::filesystem::is_directory(options.cache_directory, error)) {
+      std::cerr << "bake: error: --cache " << options.cache_directory << ": exists and is not a folder\n";
+      return 2;
+    }
+  }
+
   exitance::ProgressBar bar;
   options.progress = [&](const std::string& stage, double fraction, uint64_t rays) { bar.update(stage, fraction, rays); };
   try {
@@ -163,7 +187,9 @@ int main(int argc, char** argv) {
     } else {
       std::cerr << "bake: wrote " << report["output"].get<std::string>() << " (" << report["pages"].get<size_t>()
                 << " pages, " << report["live_texels"].get<size_t>() << " texels, "
-                << report["rays_per_second"].get<double>() * 1e-6 << " Mrays/s)\n";
+                << report["rays_per_second"].get<double>() * 1e-6 << " Mrays/s"
+                << (report.contains("cache") && report["cache"].value("reused", false) ? "; reused from the cache" : "")
+                << ")\n";
     }
     return 0;
   } catch (const exitance::InputError& e) {
