@@ -29,6 +29,7 @@ void hash_texture(Sha256Stream& h, const Texture& t) {
 
 void hash_scene(Sha256Stream& h, const Scene& scene) {
   h.array(scene.positions), h.array(scene.normals), h.array(scene.uv0), h.array(scene.lightmap_uv);
+  h.array(scene.vertex_color), h.array(scene.vertex_alpha);
   h.array(scene.triangle_material), h.array(scene.triangle_instance);
   h.value(uint64_t(scene.materials.size()));
   for (const Material& m : scene.materials) {

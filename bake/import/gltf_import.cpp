@@ -240,6 +240,27 @@ class SceneFlattener {
     const std::vector<float> normals = read_optional("NORMAL", 3, NonFinite::Keep);
     const std::vector<float> uv0 = read_optional("TEXCOORD_0", 2, NonFinite::Reject);
     const std::vector<float> lightmap_uv = read_optional(uv_name, 2, NonFinite::Reject);
+    // COLOR_0: VEC3 or VEC4, float or normalized unsigned byte/short (glTF: linear, multiplies the
+    // base colour and its alpha).
+    std::vector<float> colors;
+    int color_components = 0;
+    if (const int color_accessor = attribute(primitive, "COLOR_0"); color_accessor >= 0) {
+      const bool vec4 = size_t(color_accessor) < model_.accessors.size() &&
+                        model_.accessors[size_t(color_accessor)].type == TINYGLTF_TYPE_VEC4;
+      color_components = vec4 ? 4 : 3;
+      colors = read_optional("COLOR_0", color_components, NonFinite::Reject);
+      size_t clamped = 0;
+      for (float& c : colors)
+        if (c < 0.0f || c > 1.0f) c = std::clamp(c, 0.0f, 1.0f), ++clamped;
+      if (clamped)  // as baseColorFactor above 1: an albedo above 1 would not conserve energy
+        diagnostics_.warn(file_ + ": accessor " + std::to_string(color_accessor) + ": " + std::to_string(clamped) +
+                          " COLOR_0 values outside [0, 1] clamped");
+      if (!vertex_colors_) {  // corners before this primitive were white
+        vertex_colors_ = true;
+        scene_.vertex_color.assign(scene_.positions.size(), Vec3{1, 1, 1});
+        scene_.vertex_alpha.assign(scene_.positions.size(), 1.0f);
+      }
+    }
 
     std::vector<uint32_t> indices;
     if (primitive.indices >= 0) {
@@ -278,6 +299,11 @@ class SceneFlattener {
         scene_.normals.push_back(shading_normal(normals, vi, world, face_normal, flip_winding));
         scene_.uv0.push_back(uv0.empty() ? Vec2{} : to_vec2(uv0, vi));
         scene_.lightmap_uv.push_back(to_vec2(lightmap_uv, vi));
+        if (vertex_colors_) {
+          const size_t c = size_t(vi) * size_t(color_components);
+          scene_.vertex_color.push_back(colors.empty() ? Vec3{1, 1, 1} : Vec3{colors[c], colors[c + 1], colors[c + 2]});
+          scene_.vertex_alpha.push_back(color_components == 4 ? colors[c + 3] : 1.0f);
+        }
       }
       scene_.triangle_material.push_back(material);
       scene_.triangle_instance.push_back(instance_index);
@@ -397,6 +423,7 @@ class SceneFlattener {
   const std::string& file_;
   const ImportOptions& options_;
   Scene& scene_;
+  bool vertex_colors_ = false;  // some primitive so far has COLOR_0: every corner gets a colour
   Diagnostics& diagnostics_;
   uint32_t default_material_;
   std::vector<uint8_t> node_state_;  // 0 unvisited, 1 on the current path, 2 done

@@ -15,6 +15,10 @@ float surface_coverage(const Scene& scene, uint32_t triangle, float b1, float b2
     const Texture& texture = scene.textures[size_t(m.base_color_texture.texture)];
     coverage *= sample_texture_alpha(texture, binding_uv(scene, m.base_color_texture, triangle, b1, b2));
   }
+  if (!scene.vertex_alpha.empty()) {
+    const float* a = &scene.vertex_alpha[size_t(triangle) * 3];
+    coverage *= a[0] * (1 - b1 - b2) + a[1] * b1 + a[2] * b2;
+  }
   return std::isfinite(coverage) ? std::clamp(coverage, 0.0f, 1.0f) : 1.0f;
 }
 

@@ -25,7 +25,8 @@ Vec3 texel(const Texture& t, int x, int y) {
   return {t.rgb[i], t.rgb[i + 1], t.rgb[i + 2]};
 }
 
-Vec2 interpolate(const std::vector<Vec2>& values, uint32_t triangle, float b1, float b2) {
+template <class T>
+T interpolate(const std::vector<T>& values, uint32_t triangle, float b1, float b2) {
   const size_t base = size_t(triangle) * 3;
   return values[base] * (1.0f - b1 - b2) + values[base + 1] * b1 + values[base + 2] * b2;
 }
@@ -77,7 +78,9 @@ Vec2 apply_texture_transform(const TextureTransform& t, Vec2 uv) {
 
 Vec3 diffuse_albedo(const Scene& scene, uint32_t triangle, float b1, float b2) {
   const Material& m = scene.materials[scene.triangle_material[triangle]];
-  return diffuse_albedo_of(m.base_color * lookup(scene, m.base_color_texture, triangle, b1, b2), m.metallic);
+  Vec3 base = m.base_color * lookup(scene, m.base_color_texture, triangle, b1, b2);
+  if (!scene.vertex_color.empty()) base = base * interpolate(scene.vertex_color, triangle, b1, b2);
+  return diffuse_albedo_of(base, m.metallic);
 }
 
 Vec3 emitted_radiance(const Scene& scene, uint32_t triangle, float b1, float b2) {

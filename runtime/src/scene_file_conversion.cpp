@@ -48,6 +48,8 @@ formats::SceneFile make_scene_file(const Scene& scene, const TexelGBuffer& gbuff
   t.material = scene.triangle_material;
   t.instance = scene.triangle_instance;
 
+  if (!scene.vertex_color.empty())
+    throw FormatError("scene.bin (writing): COLOR_0: vertex colours are not stored by scene.bin version 1");
   for (size_t i = 0; i < scene.materials.size(); ++i) {
     const Material& m = scene.materials[i];
     if (m.base_color_texture.texture >= 0)

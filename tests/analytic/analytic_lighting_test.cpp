@@ -44,8 +44,16 @@ std::vector<size_t> all_texels(const TexelGBuffer& g) {
   return v;
 }
 
-void run_furnace(float albedo, uint32_t spp, double max_relative_se) {
-  const AnalyticScene a = testing::white_furnace(albedo);
+// `vertex_colour` >= 0: the material is white and COLOR_0 = vertex_colour on every corner carries
+// the albedo instead (glTF: base colour x COLOR_0), so the closed form is Le / (1 - vertex_colour).
+void run_furnace(float albedo, uint32_t spp, double max_relative_se, float vertex_colour = -1) {
+  AnalyticScene a = testing::white_furnace(vertex_colour >= 0 ? 1.0f : albedo);
+  if (vertex_colour >= 0) {
+    a.scene.vertex_color.assign(a.scene.positions.size(), Vec3{vertex_colour, vertex_colour, vertex_colour});
+    a.scene.vertex_alpha.assign(a.scene.positions.size(), 1.0f);
+    a.exact.assign(a.gbuffer.texels.size(), 1.0 / (1.0 - vertex_colour));
+    albedo = vertex_colour;
+  }
   IntegratorSettings settings;
   settings.spp = spp;
   settings.seed = 7;
@@ -67,6 +75,7 @@ void run_furnace(float albedo, uint32_t spp, double max_relative_se) {
 
 TEST(AnalyticLighting, WhiteFurnaceAlbedoHalf) { run_furnace(0.5f, 256, 0.005); }
 TEST(AnalyticLighting, WhiteFurnaceAlbedoPointNine) { run_furnace(0.9f, 512, 0.01); }
+TEST(AnalyticLighting, WhiteFurnaceAlbedoFromVertexColours) { run_furnace(0.0f, 256, 0.005, 0.5f); }
 
 TEST(AnalyticLighting, PlaneUnderConstantSky) {
   const AnalyticScene a = testing::plane_under_constant_sky();

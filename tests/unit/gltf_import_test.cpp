@@ -15,6 +15,7 @@
 #include "exitance/bake/import/gltf_json_validation.h"
 #include "exitance/bake/input_error.h"
 #include "exitance/runtime/alpha_coverage.h"
+#include "exitance/runtime/material_eval.h"
 
 namespace exitance {
 namespace {
@@ -375,6 +376,48 @@ TEST(GltfImport, BadAlphaValuesAreErrorsNamingTheMaterial) {
     }
   }
   std::filesystem::remove_all(dir);
+}
+
+// COLOR_0 (normalized unsigned bytes, VEC4) reaches the scene per corner, linear; it multiplies the
+// albedo; a COLOR_0 outside [0, 1] is an error naming its accessor.
+TEST(GltfImport, VertexColoursMultiplyTheBaseColour) {
+  const auto dir = std::filesystem::temp_directory_path() / ("gltf_color_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  auto document_with_colours = [](const std::vector<unsigned char>& rgba) {
+    json document = triangle_document();
+    std::string uri = document["buffers"][0]["uri"];
+    std::vector<unsigned char> data;
+    append_floats(data, {0, 0, 0, 1, 0, 0, 0, 1, 0});
+    append_floats(data, {0, 0, 1, 0, 0, 1, 0, 0, 1});
+    append_floats(data, {0, 0, 1, 0, 0, 1});
+    data.insert(data.end(), rgba.begin(), rgba.end());
+    document["buffers"][0] = {{"byteLength", data.size()}, {"uri", "data:application/octet-stream;base64," + base64(data)}};
+    document["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 96}, {"byteLength", rgba.size()}});
+    document["accessors"].push_back(
+        {{"bufferView", 2}, {"componentType", 5121}, {"normalized", true}, {"count", 3}, {"type", "VEC4"}});
+    document["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = 3;
+    document["materials"] = json::parse(R"([{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 1, 1, 1], "metallicFactor": 0}}])");
+    document["meshes"][0]["primitives"][0]["material"] = 0;
+    return document;
+  };
+  const std::string path = (dir / "colours.gltf").string();
+  std::ofstream(path) << document_with_colours({255, 0, 0, 255, 0, 255, 0, 128, 0, 0, 255, 0}).dump();
+  Diagnostics diagnostics;
+  const Scene scene = import_gltf(path, ImportOptions{}, diagnostics);
+  std::filesystem::remove_all(dir);
+  ASSERT_EQ(scene.vertex_color.size(), 3u);
+  ASSERT_EQ(scene.vertex_alpha.size(), 3u);
+  EXPECT_EQ(scene.vertex_color[0].x, 1.0f);
+  EXPECT_EQ(scene.vertex_color[0].y, 0.0f);
+  EXPECT_NEAR(scene.vertex_alpha[1], 128.0f / 255.0f, 1e-6f);
+  EXPECT_EQ(scene.vertex_alpha[2], 0.0f);
+  // At corner 1 (b1 = 1): base colour (0.5, 1, 1) x COLOR_0 (0, 1, 0).
+  const Vec3 albedo = diffuse_albedo(scene, 0, 1, 0);
+  EXPECT_EQ(albedo.x, 0.0f);
+  EXPECT_EQ(albedo.y, 1.0f);
+  EXPECT_EQ(albedo.z, 0.0f);
+  const Vec3 red = diffuse_albedo(scene, 0, 0, 0);
+  EXPECT_EQ(red.x, 0.5f);
 }
 
 }  // namespace

@@ -30,7 +30,12 @@ void check_bvh_references(const Bvh4& bvh, size_t triangle_count) {
                                   std::to_string(triangle_count));
 }
 
-bool is_textured(const Material& m) { return m.base_color_texture.texture >= 0 || m.emissive_texture.texture >= 0; }
+// The material varies over a surface (textures) or over its hits (MASK, BLEND): the CPU reference
+// evaluates it per point from the source Scene.
+bool is_textured(const Material& m) {
+  return m.base_color_texture.texture >= 0 || m.emissive_texture.texture >= 0 ||
+         m.alpha_mode != Material::AlphaMode::Opaque;
+}
 
 GpuMaterial material_record(const Material& m) {
   const Vec3 emission = max_component(m.emission) > 0.0f ? m.emission : Vec3{0, 0, 0};
@@ -137,6 +142,7 @@ LightingScene build_lighting_scene(std::shared_ptr<const Scene> source, Bvh4 bvh
     g.p2_instance = Vec4(p[2], uintBitsToFloat(scene.triangle_instance.empty() ? 0u : scene.triangle_instance[t]));
     g.n0 = Vec4(n[0], 0.0f), g.n1 = Vec4(n[1], 0.0f), g.n2 = Vec4(n[2], 0.0f);
   }
+  lighting.textured = !scene.vertex_color.empty();
   for (const Material& m : scene.materials) {
     lighting.materials.push_back(material_record(m));
     lighting.textured = lighting.textured || is_textured(m);
@@ -168,7 +174,7 @@ void set_material(LightingScene& lighting, uint32_t index, const Material& mater
   Scene& scene = writable_source(lighting);
   scene.materials[index] = material;
   lighting.materials[index] = material_record(material);
-  lighting.textured = false;
+  lighting.textured = !scene.vertex_color.empty();
   for (const Material& m : scene.materials) lighting.textured = lighting.textured || is_textured(m);
   build_emitter_distribution(lighting);
 }

@@ -47,6 +47,10 @@ void move_triangles(Scene& next, const Instance& instance, const Matrix4d& delta
       std::swap(n[1], n[2]);
       for (std::vector<Vec2>* uv : {&next.uv0, &next.lightmap_uv})
         if (uv->size() == next.positions.size()) std::swap((*uv)[size_t(t) * 3 + 1], (*uv)[size_t(t) * 3 + 2]);
+      if (next.vertex_color.size() == next.positions.size()) {
+        std::swap(next.vertex_color[size_t(t) * 3 + 1], next.vertex_color[size_t(t) * 3 + 2]);
+        std::swap(next.vertex_alpha[size_t(t) * 3 + 1], next.vertex_alpha[size_t(t) * 3 + 2]);
+      }
     }
     const Vec3 face = cross(p[1] - p[0], p[2] - p[0]);
     const float face_length = length(face);

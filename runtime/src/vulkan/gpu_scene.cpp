@@ -67,6 +67,8 @@ void check_supported_by_vulkan(const LightingScene& scene) {
       if (m.base_color_texture.texture >= 0 || m.emissive_texture.texture >= 0)
         throw std::runtime_error("Vulkan backend: textured materials are not supported yet (material '" + m.name +
                                  "'; use the cpu backend)");
+  if (scene.source && !scene.source->vertex_color.empty())
+    throw std::runtime_error("Vulkan backend: vertex colours (COLOR_0) are not supported yet (use the cpu backend)");
   if (scene.source)
     for (const Material& m : scene.source->materials)
       if (m.alpha_mode != Material::AlphaMode::Opaque)

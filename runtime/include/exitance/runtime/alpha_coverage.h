@@ -9,7 +9,7 @@
 namespace exitance {
 
 // Coverage at barycentrics (b1, b2) of `triangle`: base_alpha times the base colour texture's
-// alpha (bilinear, with the texture's wrap modes and transform), in [0, 1].
+// alpha (bilinear, with the texture's wrap modes and transform) times COLOR_0's alpha, in [0, 1].
 float surface_coverage(const Scene& scene, uint32_t triangle, float b1, float b2);
 
 // Whether the hit stops the ray. `u` is uniform in [0, 1), drawn per ray and surface (BLEND only).

@@ -16,7 +16,8 @@ Vec2 binding_uv(const Scene& scene, const TextureBinding& binding, uint32_t tria
 // Applies KHR_texture_transform to a texture coordinate.
 Vec2 apply_texture_transform(const TextureTransform& transform, Vec2 uv);
 
-// Barycentrics (b1, b2) weight vertices 1 and 2 of the triangle.
+// Barycentrics (b1, b2) weight vertices 1 and 2 of the triangle. The albedo is base colour x
+// texture x COLOR_0 (when the scene has vertex colours), as glTF defines it.
 Vec3 diffuse_albedo(const Scene& scene, uint32_t triangle, float b1, float b2);
 // Zero where a MASK material's coverage is below its cutoff: rays pass there, so light sampling
 // must not find emission there either.

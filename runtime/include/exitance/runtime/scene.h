@@ -119,6 +119,10 @@ struct Scene {
   std::vector<Vec3> normals;          // world space shading normals, unit length
   std::vector<Vec2> uv0;              // TEXCOORD_0 (zeros when absent)
   std::vector<Vec2> lightmap_uv;      // TEXCOORD_1 (or TEXCOORD_0 with --uv 0)
+  // COLOR_0 (linear), which multiplies the base colour and its alpha: per corner, or both empty
+  // when no primitive has COLOR_0 (corners of primitives without it are white, alpha 1).
+  std::vector<Vec3> vertex_color;
+  std::vector<float> vertex_alpha;
   std::vector<uint32_t> triangle_material;
   std::vector<uint32_t> triangle_instance;
   std::vector<Material> materials;

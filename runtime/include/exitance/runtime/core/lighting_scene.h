@@ -25,7 +25,7 @@ struct LightingScene {
   EnvironmentSampler environment;            // enabled when the sky is an image (CPU reference only)
   Vec3 bounds_lo{0, 0, 0}, bounds_hi{0, 0, 0};
   float extent = 1.0f;                       // largest side of the bounds: the scale of ray-offset floors
-  bool textured = false;                     // some material reads a texture (CPU reference only)
+  bool textured = false;  // materials vary per point (textures, MASK/BLEND, COLOR_0): CPU reference only
   Bvh4 bvh;
 
   uint32_t emitter_count() const { return uint32_t(emitter_triangles.size()); }
