@@ -7,7 +7,7 @@ density="${2:-2}"
 spp="${3:-16}"
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
-"$build/bake/bake" "$build/samples/building.gltf" -o "$out/building.bake" --backend cpu \
+"$build/bake/bake" "$build/samples/building.gltf" -o "$out/building.bake" --backend cpu --no-cache \
   --texel-density "$density" --spp "$spp" --json 2>/dev/null >"$out/report.json"
 python3 - "$out/report.json" <<'PY'
 import json, sys
