@@ -55,7 +55,13 @@ json run_report(const WrittenBundle& bundle, const json& seconds) {
 json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   // Offline stage (DESIGN §1): scene, atlas, texel G-buffer, the BVHs, the backend that will light them.
   StageClock clock;
-  Scene imported = clock.time("import", [&] { return import_stage(options, diagnostics); });
+  std::vector<MeshWithoutLightmapUvs> without_lightmap_uvs;
+  Scene imported = clock.time("import", [&] { return import_stage(options, diagnostics, without_lightmap_uvs); });
+  std::vector<MeshUvReport> generated_uvs;
+  if (!without_lightmap_uvs.empty())
+    generated_uvs = clock.time("uv_generation", [&] {
+      return uv_generation_stage(imported, without_lightmap_uvs, options, diagnostics);
+    });
   const AtlasLayout layout = clock.time("layout", [&] { return layout_stage(imported, options, diagnostics); });
   TexelGBuffer gbuffer = clock.time("raster", [&] { return raster_stage(imported, layout, options, diagnostics); });
   const SceneForLighting scene =
@@ -100,7 +106,8 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                             .probes = probes ? &*probes : nullptr,
                             .lightmap = lightmap,
                             .probe_lighting = probe_lighting ? &*probe_lighting : nullptr,
-                            .scene_file = scene_file};
+                            .scene_file = scene_file,
+                            .generated_uvs = &generated_uvs};
   const WrittenBundle bundle =
       clock.time("write", [&] { return write_bundle_stage(results, clock.seconds(), diagnostics, options); });
   return run_report(bundle, clock.seconds());

@@ -42,8 +42,11 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--max-page", options.atlas.max_page, "atlas page size limit in texels")->check(CLI::Range(16, 16384));
   app.add_option("--padding", options.atlas.padding, "gutter texels around each chart rectangle")->check(CLI::Range(1, 16));
-  app.add_option("--uv", options.import.lightmap_uv_set, "lightmap UV set: 1 = TEXCOORD_1 (default), 0 = TEXCOORD_0")
-      ->check(CLI::IsMember({0, 1}));
+  std::string uv = "1";
+  app.add_option("--uv", uv,
+                 "lightmap UV set: 1 = TEXCOORD_1 (default), 0 = TEXCOORD_0; generated (CGAL charts) for a mesh "
+                 "without it; generate = generated for every mesh")
+      ->check(CLI::IsMember({"0", "1", "generate"}));
   app.add_option("--spp", options.lighting.spp, "samples per texel (0 = until --time or --target-error ends the run)");
   app.add_option("--time", options.lighting.time_budget_seconds, "stop the lighting stage after this many seconds")
       ->check(CLI::NonNegativeNumber);
@@ -133,6 +136,8 @@ int main(int argc, char** argv) {
     }
     options.voxel_resolution = uint32_t(resolution);
   }
+  if (uv == "generate") options.import.generate_lightmap_uvs = true;
+  else options.import.lightmap_uv_set = uv == "0" ? 0 : 1;
   if (integrator == "bounces") options.lighting.integrator = exitance::IntegratorMode::Bounces;
   if (!directional.empty()) diagnostics.warn("--directional: directional lightmaps are not implemented yet; ignored");
   if (guiding == "svo") {
