@@ -65,77 +65,150 @@ Orientation minimal_area_orientation(const ChartOutline& chart) {
   return o;
 }
 
-struct Box {
-  int width, height;
-  size_t chart;
+// A chart's texels at one density: row-major mask, true where a triangle (grown by `grow` texels)
+// touches the texel.
+struct ChartMask {
+  int width = 0, height = 0;
+  std::vector<uint8_t> texels;
+  bool at(int x, int y) const { return texels[size_t(y) * size_t(width) + size_t(x)] != 0; }
 };
 
-struct Segment {
-  int x, y, width;
+// Separating-axis test of a triangle against the texel [x, x+1] x [y, y+1] grown by `grow`.
+bool touches(const std::array<Point2, 3>& p, int x, int y, double grow) {
+  auto separated = [&](double ax, double ay) {
+    double lo = 1e300, hi = -1e300;
+    for (const Point2& q : p) lo = std::min(lo, ax * q[0] + ay * q[1]), hi = std::max(hi, ax * q[0] + ay * q[1]);
+    const double centre = ax * (x + 0.5) + ay * (y + 0.5);
+    const double radius = (0.5 + grow) * (std::fabs(ax) + std::fabs(ay));
+    return hi < centre - radius || lo > centre + radius;
+  };
+  if (separated(1, 0) || separated(0, 1)) return false;
+  for (int k = 0; k < 3; ++k) {
+    const Point2 &a = p[size_t(k)], &b = p[size_t(k + 1) % 3];
+    const double ex = b[0] - a[0], ey = b[1] - a[1];
+    const double length = std::sqrt(ex * ex + ey * ey);
+    if (length > 0 && separated(-ey / length, ex / length)) return false;
+  }
+  return true;
+}
+
+// Chart points in texels after the placement's rotation and minimum, before the quarter turns.
+Point2 to_texels(const ChartPlacement& c, Point2 point, double density) {
+  return {(point[0] * c.cos_angle - point[1] * c.sin_angle - c.min_after_rotation[0]) * density,
+          (point[0] * c.sin_angle + point[1] * c.cos_angle - c.min_after_rotation[1]) * density};
+}
+
+ChartMask rasterize_chart(const ChartOutline& chart, const ChartPlacement& placement, double density, double grow) {
+  ChartMask mask;
+  mask.width = std::max(1, int(std::floor(placement.extent[0] * density + grow)) + 1);
+  mask.height = std::max(1, int(std::floor(placement.extent[1] * density + grow)) + 1);
+  mask.texels.assign(size_t(mask.width) * size_t(mask.height), 0);
+  for (size_t i = 0; i + 2 < chart.points.size(); i += 3) {
+    std::array<Point2, 3> p;
+    for (size_t k = 0; k < 3; ++k) p[k] = to_texels(placement, chart.points[i + k], density);
+    const int x0 = std::max(0, int(std::floor(std::min({p[0][0], p[1][0], p[2][0]}) - grow)));
+    const int x1 = std::min(mask.width - 1, int(std::floor(std::max({p[0][0], p[1][0], p[2][0]}) + grow)));
+    const int y0 = std::max(0, int(std::floor(std::min({p[0][1], p[1][1], p[2][1]}) - grow)));
+    const int y1 = std::min(mask.height - 1, int(std::floor(std::max({p[0][1], p[1][1], p[2][1]}) + grow)));
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x)
+        if (!mask.at(x, y) && touches(p, x, y, grow)) mask.texels[size_t(y) * size_t(mask.width) + size_t(x)] = 1;
+  }
+  return mask;
+}
+
+// The mask turned by `turns` quarter turns counter-clockwise: texel (x, y) goes to
+// (h-1-y, x), (w-1-x, h-1-y) or (y, w-1-x), matching PackedCharts::uv's continuous turns.
+ChartMask turned(const ChartMask& m, int turns) {
+  if (turns == 0) return m;
+  ChartMask t;
+  t.width = turns % 2 ? m.height : m.width;
+  t.height = turns % 2 ? m.width : m.height;
+  t.texels.assign(m.texels.size(), 0);
+  for (int y = 0; y < m.height; ++y)
+    for (int x = 0; x < m.width; ++x) {
+      if (!m.at(x, y)) continue;
+      int tx = 0, ty = 0;
+      if (turns == 1) tx = m.height - 1 - y, ty = x;
+      else if (turns == 2) tx = m.width - 1 - x, ty = m.height - 1 - y;
+      else tx = y, ty = m.width - 1 - x;
+      t.texels[size_t(ty) * size_t(t.width) + size_t(tx)] = 1;
+    }
+  return t;
+}
+
+// What the skyline needs of a turned mask: per column its lowest texel (or none), and per column of
+// the mask widened by the dilation its dilated top (one past the highest texel, plus the dilation).
+struct Profile {
+  int width = 0, height = 0;
+  std::vector<int> bottom;     // per column; INT32_MAX when the column is empty
+  std::vector<int> dilated_top;  // per column x - dilation .. width - 1 + dilation; INT32_MIN when empty
 };
+
+Profile profile_of(const ChartMask& m, int dilation) {
+  Profile p;
+  p.width = m.width;
+  p.height = m.height;
+  p.bottom.assign(size_t(m.width), INT32_MAX);
+  std::vector<int> top(size_t(m.width), INT32_MIN);
+  for (int x = 0; x < m.width; ++x)
+    for (int y = 0; y < m.height; ++y)
+      if (m.at(x, y)) {
+        p.bottom[size_t(x)] = std::min(p.bottom[size_t(x)], y);
+        top[size_t(x)] = y + 1;
+      }
+  p.dilated_top.assign(size_t(m.width + 2 * dilation), INT32_MIN);
+  for (int x = 0; x < m.width; ++x)
+    if (top[size_t(x)] != INT32_MIN)
+      for (int d = 0; d <= 2 * dilation; ++d)
+        p.dilated_top[size_t(x + d)] = std::max(p.dilated_top[size_t(x + d)], top[size_t(x)] + dilation);
+  return p;
+}
 
 struct StripResult {
-  std::vector<std::array<int, 2>> position;  // per box, in sorted-box order
-  std::vector<uint8_t> turned;
+  std::vector<std::array<int, 2>> position;  // per chart
+  std::vector<int> turns;
   int width = 0, height = 0;
 };
 
-// Bottom-left skyline packing into a strip `strip_width` wide; each box goes where its top is lowest
-// (then leftmost), turned by 90 degrees when that is lower.
-StripResult pack_strip(const std::vector<Box>& boxes, int strip_width) {
+// Charts in `order` dropped one by one onto a skyline `strip_width` texels wide, each at the column
+// and turn where its top ends lowest (then leftmost, then fewest turns).
+StripResult pack_strip(const std::vector<std::array<Profile, 4>>& profiles, const std::vector<size_t>& order,
+                       int strip_width, int dilation, int turn_choices) {
   StripResult result;
-  result.position.resize(boxes.size());
-  result.turned.resize(boxes.size());
-  std::vector<Segment> skyline{{0, 0, strip_width}};
-  for (size_t b = 0; b < boxes.size(); ++b) {
-    int best_top = INT32_MAX, best_x = 0, best_y = 0, best_w = 0;
-    bool best_turned = false;
-    for (int turned = 0; turned < 2; ++turned) {
-      const int w = turned ? boxes[b].height : boxes[b].width, h = turned ? boxes[b].width : boxes[b].height;
-      if (w > strip_width || (turned && w == h)) continue;
-      for (size_t i = 0; i < skyline.size(); ++i) {
-        const int x = skyline[i].x;
-        if (x + w > strip_width) break;
+  result.position.resize(profiles.size());
+  result.turns.resize(profiles.size());
+  std::vector<int> skyline(size_t(strip_width), 0);
+  for (size_t chart : order) {
+    int best_top = INT32_MAX, best_x = 0, best_y = 0, best_turns = 0;
+    int64_t best_waste = INT64_MAX;
+    for (int turns = 0; turns < turn_choices; ++turns) {
+      const Profile& p = profiles[chart][size_t(turns)];
+      for (int x = 0; x + p.width <= strip_width; ++x) {
         int y = 0;
-        for (size_t j = i; j < skyline.size() && skyline[j].x < x + w; ++j) y = std::max(y, skyline[j].y);
-        if (y + h < best_top || (y + h == best_top && x < best_x)) {
-          best_top = y + h, best_x = x, best_y = y, best_w = w, best_turned = turned;
-        }
+        for (int c = 0; c < p.width; ++c)
+          if (p.bottom[size_t(c)] != INT32_MAX) y = std::max(y, skyline[size_t(x + c)] - p.bottom[size_t(c)]);
+        if (y + p.height > best_top) continue;
+        // Equal tops: the least area left unreachable under the chart (an arch opening up, not down,
+        // so later charts can fill it).
+        int64_t waste = 0;
+        for (int c = 0; c < p.width; ++c)
+          if (p.bottom[size_t(c)] != INT32_MAX) waste += y + p.bottom[size_t(c)] - skyline[size_t(x + c)];
+        if (y + p.height < best_top || waste < best_waste)
+          best_top = y + p.height, best_waste = waste, best_x = x, best_y = y, best_turns = turns;
       }
     }
-    result.position[b] = {best_x, best_y};
-    result.turned[b] = best_turned;
-    result.width = std::max(result.width, best_x + best_w);
+    if (best_top == INT32_MAX) return {};  // wider than the strip in every turn
+    const Profile& p = profiles[chart][size_t(best_turns)];
+    for (int c = 0; c < int(p.dilated_top.size()); ++c) {
+      const int column = best_x + c - dilation;
+      if (column < 0 || column >= strip_width || p.dilated_top[size_t(c)] == INT32_MIN) continue;
+      skyline[size_t(column)] = std::max(skyline[size_t(column)], best_y + p.dilated_top[size_t(c)]);
+    }
+    result.position[chart] = {best_x, best_y};
+    result.turns[chart] = best_turns;
+    result.width = std::max(result.width, best_x + p.width);
     result.height = std::max(result.height, best_top);
-    // The skyline under the box rises to its top.
-    std::vector<Segment> next;
-    next.reserve(skyline.size() + 2);
-    const Segment placed{best_x, best_top, best_w};
-    const int end = best_x + best_w;
-    bool inserted = false;
-    for (const Segment& s : skyline) {
-      const int s_end = s.x + s.width;
-      if (s_end <= best_x) {
-        next.push_back(s);
-        continue;
-      }
-      if (s.x >= end) {
-        if (!inserted) next.push_back(placed), inserted = true;
-        next.push_back(s);
-        continue;
-      }
-      if (s.x < best_x) next.push_back({s.x, s.y, best_x - s.x});
-      if (!inserted) next.push_back(placed), inserted = true;
-      if (s_end > end) next.push_back({end, s.y, s_end - end});
-    }
-    if (!inserted) next.push_back(placed);
-    skyline.clear();
-    for (const Segment& s : next) {
-      if (!skyline.empty() && skyline.back().y == s.y && skyline.back().x + skyline.back().width == s.x)
-        skyline.back().width += s.width;
-      else
-        skyline.push_back(s);
-    }
   }
   return result;
 }
@@ -144,20 +217,21 @@ StripResult pack_strip(const std::vector<Box>& boxes, int strip_width) {
 
 Point2 PackedCharts::uv(size_t chart, Point2 point) const {
   const ChartPlacement& c = placements[chart];
-  double x = (point[0] * c.cos_angle - point[1] * c.sin_angle - c.min_after_rotation[0]) * texels_per_unit;
-  double y = (point[0] * c.sin_angle + point[1] * c.cos_angle - c.min_after_rotation[1]) * texels_per_unit;
-  if (c.quarter_turn) {
-    const double turned_x = c.extent[1] * texels_per_unit - y;
-    y = x;
-    x = turned_x;
-  }
+  const Point2 t = to_texels(c, point, texels_per_unit);
+  const double w = c.mask_width, h = c.mask_height;
+  Point2 turned_point = t;
+  if (c.quarter_turns == 1) turned_point = {h - t[1], t[0]};
+  else if (c.quarter_turns == 2) turned_point = {w - t[0], h - t[1]};
+  else if (c.quarter_turns == 3) turned_point = {t[1], w - t[0]};
   const double side = double(std::max(width, height));
-  return {std::clamp((c.origin[0] + x) / side, 0.0, 1.0), std::clamp((c.origin[1] + y) / side, 0.0, 1.0)};
+  return {std::clamp((c.origin[0] + turned_point[0]) / side, 0.0, 1.0),
+          std::clamp((c.origin[1] + turned_point[1]) / side, 0.0, 1.0)};
 }
 
 PackedCharts pack_charts(const std::vector<ChartOutline>& charts, const PackingSettings& settings) {
   PackedCharts packed;
   packed.placements.resize(charts.size());
+  double largest_extent = 0;
   for (size_t c = 0; c < charts.size(); ++c) {
     const Orientation o = minimal_area_orientation(charts[c]);
     ChartPlacement& p = packed.placements[c];
@@ -165,32 +239,43 @@ PackedCharts pack_charts(const std::vector<ChartOutline>& charts, const PackingS
     p.sin_angle = o.sin_angle;
     p.min_after_rotation = o.min;
     p.extent = o.extent;
+    largest_extent = std::max({largest_extent, o.extent[0], o.extent[1]});
   }
-  const double gutter = settings.gutter_texels;
+  const int dilation = std::max(0, int(std::ceil(settings.gutter_texels)) - 1);
+  const double grow = std::max(0.0, 0.5 * (settings.gutter_texels - dilation));
+  // Four turns let charts nest; with many charts two keep the cost of the column scan down.
+  const int turn_choices = charts.size() <= 256 ? 4 : 2;
   const int max_side = std::max(settings.max_side_texels, 1);
   double density = settings.texels_per_unit;
   for (int attempt = 0;; ++attempt) {
-    // Each chart's box: the chart plus half the gutter on every side, whole texels.
-    std::vector<Box> boxes(charts.size());
-    double box_area = 0;
-    int narrowest_fit = 1;
+    std::vector<std::array<Profile, 4>> profiles(charts.size());
+    std::vector<size_t> mask_area(charts.size());
+    double total_area = 0;
+    int widest_needed = 1;
     for (size_t c = 0; c < charts.size(); ++c) {
-      const Point2& e = packed.placements[c].extent;
-      boxes[c] = {std::max(1, int(std::ceil(e[0] * density + gutter))), std::max(1, int(std::ceil(e[1] * density + gutter))), c};
-      box_area += double(boxes[c].width) * boxes[c].height;
-      narrowest_fit = std::max(narrowest_fit, std::min(boxes[c].width, boxes[c].height));
+      ChartPlacement& p = packed.placements[c];
+      const ChartMask mask = rasterize_chart(charts[c], p, density, grow);
+      p.mask_width = mask.width;
+      p.mask_height = mask.height;
+      for (int turns = 0; turns < turn_choices; ++turns) profiles[c][size_t(turns)] = profile_of(turned(mask, turns), dilation);
+      mask_area[c] = size_t(std::count(mask.texels.begin(), mask.texels.end(), uint8_t(1)));
+      total_area += double(mask.width + dilation) * double(mask.height + dilation);
+      widest_needed = std::max(widest_needed, std::min(mask.width, mask.height));
     }
-    std::sort(boxes.begin(), boxes.end(), [](const Box& a, const Box& b) {
-      if (a.height != b.height) return a.height > b.height;
-      if (a.width != b.width) return a.width > b.width;
-      return a.chart < b.chart;
+    std::vector<size_t> order(charts.size());
+    std::iota(order.begin(), order.end(), size_t(0));
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+      const int ha = std::min(packed.placements[a].mask_width, packed.placements[a].mask_height);
+      const int hb = std::min(packed.placements[b].mask_width, packed.placements[b].mask_height);
+      return mask_area[a] != mask_area[b] ? mask_area[a] > mask_area[b] : ha > hb;
     });
     // A few strip widths around the square; keep the smallest rectangle that fits the page.
     StripResult best;
     bool have_best = false, best_fits = false;
-    for (double factor : {1.0, 1.1, 1.25, 1.5, 2.0}) {
-      const int strip = std::max(narrowest_fit, int(std::ceil(std::sqrt(box_area) * factor)));
-      StripResult r = pack_strip(boxes, strip);
+    for (double factor : {0.8, 0.9, 1.0, 1.15, 1.3, 1.6}) {
+      const int strip = std::max(widest_needed, int(std::ceil(std::sqrt(total_area) * factor)));
+      StripResult r = pack_strip(profiles, order, strip, dilation, turn_choices);
+      if (r.position.empty()) continue;
       const bool fits = std::max(r.width, r.height) <= max_side;
       const double area = double(r.width) * r.height, best_area = double(best.width) * best.height;
       const bool better = !have_best || (fits && !best_fits) ||
@@ -198,25 +283,22 @@ PackedCharts pack_charts(const std::vector<ChartOutline>& charts, const PackingS
                                                  std::max(r.width, r.height) < std::max(best.width, best.height))));
       if (better) best = std::move(r), have_best = true, best_fits = fits;
     }
-    const bool smallest = density * std::max(1e-300, [&] {
-      double largest = 0;
-      for (const ChartPlacement& p : packed.placements) largest = std::max({largest, p.extent[0], p.extent[1]});
-      return largest;
-    }()) < 0.5;
-    if (best_fits || attempt >= 60 || smallest) {
+    const bool smallest = density * largest_extent < 0.5;
+    if (have_best && (best_fits || attempt >= 60 || smallest)) {
       packed.fits = best_fits;
       packed.width = std::max(best.width, 1);
       packed.height = std::max(best.height, 1);
       packed.texels_per_unit = density;
-      for (size_t b = 0; b < boxes.size(); ++b) {
-        ChartPlacement& p = packed.placements[boxes[b].chart];
-        p.quarter_turn = best.turned[b];
-        p.origin = {best.position[b][0] + 0.5 * gutter, best.position[b][1] + 0.5 * gutter};
+      for (size_t c = 0; c < charts.size(); ++c) {
+        ChartPlacement& p = packed.placements[c];
+        p.quarter_turns = best.turns[c];
+        p.origin = {double(best.position[c][0]), double(best.position[c][1])};
       }
       return packed;
     }
     // Too big for the page: lower the density (the gutters do not shrink, so shrink a bit more).
-    density *= std::min(0.95, 0.97 * double(max_side) / double(std::max(best.width, best.height)));
+    const int side = have_best ? std::max(best.width, best.height) : 2 * max_side;
+    density *= std::min(0.95, 0.97 * double(max_side) / double(side));
   }
 }
 

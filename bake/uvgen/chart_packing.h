@@ -1,5 +1,8 @@
-// Charts into one rectangle: each turned to its minimal-area bounding box, then skyline-packed in
-// texel units with a gutter, at the largest density (up to the one asked) whose rectangle fits.
+// Charts into one rectangle: each turned to its minimal-area bounding box and rasterized into a texel
+// mask, then dropped onto a per-column skyline (Tetris-like: a chart's bottom profile rests on the
+// tops of the charts below, dilated by the gutter), at the largest density, up to the one asked,
+// whose rectangle fits the page. Masks make round and C-shaped charts nest, which their bounding
+// boxes cannot.
 #pragma once
 #include <vector>
 
@@ -7,7 +10,8 @@
 
 namespace exitance::uvgen {
 
-// A chart's points in 3-D-area units (UV area = 3-D area), before packing.
+// A chart's triangles (consecutive corner triples) in 3-D-area units (UV area = 3-D area). A point
+// chart is one triangle with three equal corners.
 struct ChartOutline {
   std::vector<Point2> points;
 };
@@ -15,16 +19,20 @@ struct ChartOutline {
 struct PackingSettings {
   double texels_per_unit = 32;
   int max_side_texels = 2044;
-  double gutter_texels = 3;
+  // Least distance between two charts, in texels: masks are dilated by ceil(gutter) - 1 texels and
+  // triangles rasterized grown by the rest over 2, so charts end at least `gutter_texels` apart.
+  double gutter_texels = 3.1;
 };
 
-// Where every chart went: uv = (origin + rotate(point) * texels_per_unit) / side.
+// Where every chart went: rotate to the minimal-area box, subtract its minimum, scale to texels,
+// turn by quarter turns within its mask, then offset to the mask's texel position.
 struct ChartPlacement {
   double cos_angle = 1, sin_angle = 0;  // rotation to the minimal-area bounding box, applied first
   Point2 min_after_rotation{};          // subtracted after the rotation (3-D-area units)
   Point2 extent{};                      // the rotated chart's width and height (3-D-area units)
-  bool quarter_turn = false;            // then turned by 90 degrees to fit the skyline
-  Point2 origin{};                      // texel position of the chart's box corner, gutter included
+  int quarter_turns = 0;                // 0..3, counter-clockwise, inside the mask
+  int mask_width = 0, mask_height = 0;  // texels, before the turns
+  Point2 origin{};                      // texel position of the turned mask's corner
 };
 
 struct PackedCharts {

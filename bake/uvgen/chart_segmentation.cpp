@@ -10,11 +10,15 @@ namespace {
 
 constexpr int32_t kNoNeighbour = -1;
 
-double dot(const Point3& a, const Point3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double cos_degrees(double degrees) { return std::cos(degrees * std::numbers::pi / 180.0); }
+double dot(const Point3& a, const Point3& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+double cos_degrees(double degrees) {
+  return std::cos(degrees * std::numbers::pi / 180.0);
+}
 
-// neighbour[3 t + k]: the face across corner k's edge (k → k+1), or kNoNeighbour when that edge is a
-// seam: a boundary, used by more than two faces, shared by faces of opposite orientation, or sharp.
+}  // namespace
+
 std::vector<int32_t> face_neighbours(const WeldedMesh& mesh, double sharp_edge_degrees) {
   struct DirectedEdge {
     uint32_t lo, hi, face;
@@ -40,7 +44,8 @@ std::vector<int32_t> face_neighbours(const WeldedMesh& mesh, double sharp_edge_d
   std::vector<int32_t> neighbour(mesh.triangle_count() * 3, kNoNeighbour);
   for (size_t i = 0; i < edges.size();) {
     size_t j = i;
-    while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi) ++j;
+    while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi)
+      ++j;
     if (j - i == 2) {
       const DirectedEdge &x = edges[i], &y = edges[i + 1];
       const bool manifold = x.face != y.face && x.forward != y.forward;
@@ -54,105 +59,95 @@ std::vector<int32_t> face_neighbours(const WeldedMesh& mesh, double sharp_edge_d
   return neighbour;
 }
 
-// Splits charts that are not disks or are too large, keeping the order deterministic.
-class ChartSplitter {
- public:
-  ChartSplitter(const WeldedMesh& mesh, const std::vector<int32_t>& neighbour, size_t max_triangles)
-      : mesh_(mesh), neighbour_(neighbour), max_triangles_(std::max<size_t>(max_triangles, 1)),
-        member_(mesh.triangle_count(), 0), distance_(mesh.triangle_count(), 0) {}
+ChartSplitter::ChartSplitter(const WeldedMesh& mesh, const std::vector<int32_t>& neighbour, size_t max_triangles)
+    : mesh_(mesh),
+      neighbour_(neighbour),
+      max_triangles_(std::max<size_t>(max_triangles, 1)),
+      member_(mesh.triangle_count(), 0),
+      distance_(mesh.triangle_count(), 0) {}
 
-  void add(Chart chart, std::vector<Chart>& out) {
-    std::vector<Chart> pending{std::move(chart)};
-    while (!pending.empty()) {
-      Chart c = std::move(pending.back());
-      pending.pop_back();
-      if (c.triangles.size() <= 1 || (c.triangles.size() <= max_triangles_ && chart_is_disk(mesh_, c.triangles))) {
-        out.push_back(std::move(c));
-        continue;
-      }
-      std::vector<Chart> parts = split(c);
-      for (auto it = parts.rbegin(); it != parts.rend(); ++it) pending.push_back(std::move(*it));
+void ChartSplitter::add(Chart chart, std::vector<Chart>& out) {
+  std::vector<Chart> pending{std::move(chart)};
+  while (!pending.empty()) {
+    Chart c = std::move(pending.back());
+    pending.pop_back();
+    if (c.triangles.size() <= 1 || (c.triangles.size() <= max_triangles_ && chart_is_disk(mesh_, c.triangles))) {
+      out.push_back(std::move(c));
+      continue;
+    }
+    std::vector<Chart> parts = split(c);
+    for (auto it = parts.rbegin(); it != parts.rend(); ++it)
+      pending.push_back(std::move(*it));
+  }
+}
+
+std::vector<Chart> ChartSplitter::split(const Chart& chart) {
+  ++stamp_;
+  for (uint32_t t : chart.triangles)
+    member_[t] = stamp_;
+  const uint32_t a = farthest_from(chart.triangles.front());
+  const uint32_t b = farthest_from(a);
+  std::vector<uint8_t> label;  // per chart face, by position in chart.triangles: 0 none, 1 a, 2 b
+  label.assign(chart.triangles.size(), 0);
+  auto position = [&](uint32_t t) {
+    return size_t(std::lower_bound(chart.triangles.begin(), chart.triangles.end(), t) - chart.triangles.begin());
+  };
+  std::deque<uint32_t> queue{a};
+  label[position(a)] = 1;
+  if (b != a) {
+    queue.push_back(b);
+    label[position(b)] = 2;
+  }
+  while (!queue.empty()) {
+    const uint32_t t = queue.front();
+    queue.pop_front();
+    const uint8_t l = label[position(t)];
+    for (int k = 0; k < 3; ++k) {
+      const int32_t u = neighbour_[3 * size_t(t) + size_t(k)];
+      if (u == kNoNeighbour || member_[size_t(u)] != stamp_) continue;
+      uint8_t& lu = label[position(uint32_t(u))];
+      if (lu) continue;
+      lu = l;
+      queue.push_back(uint32_t(u));
     }
   }
-
- private:
-  // Two parts grown at once from two far-apart faces (in face hops), plus any faces neither reaches.
-  std::vector<Chart> split(const Chart& chart) {
-    ++stamp_;
-    for (uint32_t t : chart.triangles) member_[t] = stamp_;
-    const uint32_t a = farthest_from(chart.triangles.front());
-    const uint32_t b = farthest_from(a);
-    std::vector<uint8_t> label;  // per chart face, by position in chart.triangles: 0 none, 1 a, 2 b
-    label.assign(chart.triangles.size(), 0);
-    auto position = [&](uint32_t t) {
-      return size_t(std::lower_bound(chart.triangles.begin(), chart.triangles.end(), t) - chart.triangles.begin());
-    };
-    std::deque<uint32_t> queue{a};
-    label[position(a)] = 1;
-    if (b != a) {
-      queue.push_back(b);
-      label[position(b)] = 2;
-    }
-    while (!queue.empty()) {
-      const uint32_t t = queue.front();
-      queue.pop_front();
-      const uint8_t l = label[position(t)];
-      for (int k = 0; k < 3; ++k) {
-        const int32_t u = neighbour_[3 * size_t(t) + size_t(k)];
-        if (u == kNoNeighbour || member_[size_t(u)] != stamp_) continue;
-        uint8_t& lu = label[position(uint32_t(u))];
-        if (lu) continue;
-        lu = l;
-        queue.push_back(uint32_t(u));
-      }
-    }
-    std::vector<Chart> parts(3);
-    for (size_t i = 0; i < chart.triangles.size(); ++i) parts[label[i]].triangles.push_back(chart.triangles[i]);
-    parts[1].normal = mesh_.normals[a];
-    parts[2].normal = mesh_.normals[b];
-    parts[0].normal = chart.normal;
-    std::vector<Chart> result;
-    for (size_t i : {size_t(1), size_t(2), size_t(0)})
-      if (!parts[i].triangles.empty()) result.push_back(std::move(parts[i]));
-    if (result.size() == 1) {  // no second seed: split by position in the list instead
-      Chart& whole = result.front();
-      Chart half;
-      half.normal = whole.normal;
-      half.triangles.assign(whole.triangles.begin() + long(whole.triangles.size() / 2), whole.triangles.end());
-      whole.triangles.resize(whole.triangles.size() / 2);
-      result.push_back(std::move(half));
-    }
-    return result;
+  std::vector<Chart> parts(3);
+  for (size_t i = 0; i < chart.triangles.size(); ++i)
+    parts[label[i]].triangles.push_back(chart.triangles[i]);
+  parts[1].normal = mesh_.normals[a];
+  parts[2].normal = mesh_.normals[b];
+  parts[0].normal = chart.normal;
+  std::vector<Chart> result;
+  for (size_t i : {size_t(1), size_t(2), size_t(0)})
+    if (!parts[i].triangles.empty()) result.push_back(std::move(parts[i]));
+  if (result.size() == 1) {  // no second seed: split by position in the list instead
+    Chart& whole = result.front();
+    Chart half;
+    half.normal = whole.normal;
+    half.triangles.assign(whole.triangles.begin() + long(whole.triangles.size() / 2), whole.triangles.end());
+    whole.triangles.resize(whole.triangles.size() / 2);
+    result.push_back(std::move(half));
   }
+  return result;
+}
 
-  // The last face a breadth-first walk from `start` over the chart's faces reaches.
-  uint32_t farthest_from(uint32_t start) {
-    ++walk_;
-    std::deque<uint32_t> queue{start};
-    distance_[start] = walk_;
-    uint32_t last = start;
-    while (!queue.empty()) {
-      last = queue.front();
-      queue.pop_front();
-      for (int k = 0; k < 3; ++k) {
-        const int32_t u = neighbour_[3 * size_t(last) + size_t(k)];
-        if (u == kNoNeighbour || member_[size_t(u)] != stamp_ || distance_[size_t(u)] == walk_) continue;
-        distance_[size_t(u)] = walk_;
-        queue.push_back(uint32_t(u));
-      }
+uint32_t ChartSplitter::farthest_from(uint32_t start) {
+  ++walk_;
+  std::deque<uint32_t> queue{start};
+  distance_[start] = walk_;
+  uint32_t last = start;
+  while (!queue.empty()) {
+    last = queue.front();
+    queue.pop_front();
+    for (int k = 0; k < 3; ++k) {
+      const int32_t u = neighbour_[3 * size_t(last) + size_t(k)];
+      if (u == kNoNeighbour || member_[size_t(u)] != stamp_ || distance_[size_t(u)] == walk_) continue;
+      distance_[size_t(u)] = walk_;
+      queue.push_back(uint32_t(u));
     }
-    return last;
   }
-
-  const WeldedMesh& mesh_;
-  const std::vector<int32_t>& neighbour_;
-  size_t max_triangles_;
-  std::vector<uint32_t> member_;    // == stamp_: in the chart being split
-  std::vector<uint32_t> distance_;  // == walk_: visited by the current walk
-  uint32_t stamp_ = 0, walk_ = 0;
-};
-
-}  // namespace
+  return last;
+}
 
 bool chart_is_disk(const WeldedMesh& mesh, const std::vector<uint32_t>& triangles) {
   struct Edge {
@@ -178,7 +173,8 @@ bool chart_is_disk(const WeldedMesh& mesh, const std::vector<uint32_t>& triangle
   size_t edge_count = 0;
   for (size_t i = 0; i < edges.size();) {
     size_t j = i;
-    while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi) ++j;
+    while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi)
+      ++j;
     if (j - i > 2) return false;
     if (j - i == 2 && edges[i].forward == edges[i + 1].forward) return false;
     if (j - i == 1)
@@ -191,7 +187,8 @@ bool chart_is_disk(const WeldedMesh& mesh, const std::vector<uint32_t>& triangle
   std::sort(boundary.begin(), boundary.end());
   for (size_t i = 1; i < boundary.size(); ++i)
     if (boundary[i].first == boundary[i - 1].first) return false;  // two boundary edges leave one vertex
-  // Walk the loop from the first boundary edge; a disk's single loop visits every boundary edge.
+  // Walk the loop from the first boundary edge; a disk's single loop visits
+  // every boundary edge.
   size_t steps = 0;
   uint32_t at = boundary.front().first;
   do {
@@ -203,16 +200,16 @@ bool chart_is_disk(const WeldedMesh& mesh, const std::vector<uint32_t>& triangle
   return steps == boundary.size();
 }
 
-std::vector<Chart> segment_into_charts(const WeldedMesh& mesh, const SegmentationSettings& settings) {
-  const std::vector<int32_t> neighbour = face_neighbours(mesh, settings.sharp_edge_degrees);
+std::vector<Chart> segment_into_charts(const WeldedMesh& mesh, const std::vector<int32_t>& neighbour,
+                                       const SegmentationSettings& settings, ChartSplitter& splitter) {
   const double cos_cone = cos_degrees(settings.cone_degrees);
   std::vector<uint8_t> assigned(mesh.triangle_count(), 0);
-  ChartSplitter splitter(mesh, neighbour, settings.max_chart_triangles);
   std::vector<Chart> charts;
   std::deque<uint32_t> queue;
-  // Seeds: the free face whose normal is farthest from every seed so far (a sphere then gives two
-  // caps, not a cap and crescents), for the first charts; after that, the first free face in order,
-  // which bounds the cost on meshes with many charts.
+  // Seeds: the free face whose normal is farthest from every seed so far (a
+  // sphere then gives two caps, not a cap and crescents), for the first charts;
+  // after that, the first free face in order, which bounds the cost on meshes
+  // with many charts.
   constexpr size_t kFarthestSeedCharts = 128;
   std::vector<double> closest_seed(mesh.triangle_count(), -2);  // max over seeds of dot(normal, seed normal)
   uint32_t next_in_order = 0;

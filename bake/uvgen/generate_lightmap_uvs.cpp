@@ -49,7 +49,9 @@ GeneratedUvs generate_lightmap_uvs(std::span<const Vec3> positions, std::span<co
   segmentation.cone_degrees = settings.chart_cone_degrees;
   segmentation.sharp_edge_degrees = settings.sharp_edge_degrees;
   segmentation.max_chart_triangles = settings.max_chart_triangles;
-  std::vector<uvgen::Chart> charts = uvgen::segment_into_charts(mesh, segmentation);
+  const std::vector<int32_t> neighbour = uvgen::face_neighbours(mesh, segmentation.sharp_edge_degrees);
+  uvgen::ChartSplitter splitter(mesh, neighbour, segmentation.max_chart_triangles);
+  std::vector<uvgen::Chart> grown = uvgen::segment_into_charts(mesh, neighbour, segmentation, splitter);
   progress.at(0.05);
 
   GeneratedUvs out;
@@ -57,6 +59,9 @@ GeneratedUvs generate_lightmap_uvs(std::span<const Vec3> positions, std::span<co
   stats.triangles = triangle_count;
 
   // Flatten every chart, then scale it so its UV area equals its 3-D area (uniform texel density).
+  // (Splitting charts that fill their bounding box badly, arches like a torus's, was measured: 10
+  // charts instead of 5 on the test torus for 0.522 utilization instead of 0.515; not kept.)
+  const std::vector<uvgen::Chart> charts = std::move(grown);
   std::vector<uvgen::FlatChart> flat(charts.size());
   size_t flattened = 0;
   for (size_t c = 0; c < charts.size(); ++c) {
@@ -98,7 +103,7 @@ GeneratedUvs generate_lightmap_uvs(std::span<const Vec3> positions, std::span<co
       }
     if (collapsed[t].first < 0) {
       collapsed[t] = {int32_t(outlines.size()), Point2{0, 0}};
-      outlines.push_back({{Point2{0, 0}}});
+      outlines.push_back({{Point2{0, 0}, Point2{0, 0}, Point2{0, 0}}});
     }
   }
   for (size_t c = 0; c < real_charts; ++c) {

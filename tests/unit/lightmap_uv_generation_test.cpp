@@ -249,12 +249,13 @@ struct Shape {
 };
 
 TEST(LightmapUvGeneration, ClosedPrimitivesGiveFewChartsAndNoOverlap) {
-  // Utilization is bounded by packing bounding boxes: a torus's charts are C-shaped (see
-  // bench/results/uvgen.md); the bounds below are what the packer achieves, not the 60 % aimed for.
-  const Shape shapes[] = {{"cube", cube(), 6, 0.75, 1.01},
-                          {"uv sphere", uv_sphere(), 4, 0.55, 1.3},
-                          {"cylinder", cylinder(), 6, 0.6, 1.01},
-                          {"torus", torus(), 6, 0.35, 1.35}};
+  // At 32 texels per unit the 3.1-texel gaps cost much of a small chart; a torus's charts are arches
+  // whose inside the skyline cannot reach (bench/results/uvgen.md): the bounds are what the packer
+  // achieves here (cube 0.85, sphere 0.65, cylinder 0.73, torus 0.515), not 60 % everywhere.
+  const Shape shapes[] = {{"cube", cube(), 6, 0.8, 1.01},
+                          {"uv sphere", uv_sphere(), 4, 0.6, 1.3},
+                          {"cylinder", cylinder(), 6, 0.7, 1.01},
+                          {"torus", torus(), 6, 0.5, 1.35}};
   for (const Shape& shape : shapes) {
     SCOPED_TRACE(shape.name);
     const GeneratedUvs uvs = generate(shape.mesh);
