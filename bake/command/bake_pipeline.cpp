@@ -110,6 +110,8 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                             .generated_uvs = &generated_uvs};
   const WrittenBundle bundle =
       clock.time("write", [&] { return write_bundle_stage(results, clock.seconds(), diagnostics, options); });
+  // After the bundle, so a failed bake writes neither.
+  if (!options.write_gltf.empty()) write_gltf_stage(generated_uvs, options, diagnostics);
   return run_report(bundle, clock.seconds());
 }
 

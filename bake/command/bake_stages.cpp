@@ -6,6 +6,7 @@
 
 #include "exitance/bake/command/backend_choice.h"
 #include "exitance/bake/import/gltf_import.h"
+#include "exitance/bake/import/gltf_lightmap_uv_writer.h"
 #include "exitance/bake/import/sky_option.h"
 #include "exitance/bake/input_error.h"
 #include "exitance/bake/raster/texel_raster.h"
@@ -67,6 +68,18 @@ std::vector<MeshUvReport> uv_generation_stage(Scene& scene, const std::vector<Me
                        std::to_string(options.atlas.max_page) + " with a 2-texel gap; they may bleed into each other");
   }
   return reports;
+}
+
+void write_gltf_stage(const std::vector<MeshUvReport>& generated_uvs, const BakeOptions& options,
+                      Diagnostics& diagnostics) {
+  options.announce_stage("write gltf");
+  std::vector<MeshLightmapUvs> meshes;
+  for (const MeshUvReport& r : generated_uvs) meshes.push_back({r.mesh, r.corner_uv});
+  Diagnostics reload;  // the input's repairs were reported by the import already
+  write_gltf_with_lightmap_uvs(options.input, options.write_gltf, options.import.lightmap_uv_set, meshes, reload);
+  if (generated_uvs.empty())
+    diagnostics.warn(options.input + ": --write-gltf: no mesh needed generated lightmap UVs; " + options.write_gltf +
+                     " has the input's own");
 }
 
 AtlasLayout layout_stage(const Scene& scene, const BakeOptions& options, Diagnostics& diagnostics) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 
 #include "exitance/bake/command/bake_pipeline.h"
@@ -47,6 +48,8 @@ int main(int argc, char** argv) {
                  "lightmap UV set: 1 = TEXCOORD_1 (default), 0 = TEXCOORD_0; generated (CGAL charts) for a mesh "
                  "without it; generate = generated for every mesh")
       ->check(CLI::IsMember({"0", "1", "generate"}));
+  app.add_option("--write-gltf", options.write_gltf,
+                 "also write the scene with its generated lightmap UVs (as the --uv set) to this .gltf");
   app.add_option("--spp", options.lighting.spp, "samples per texel (0 = until --time or --target-error ends the run)");
   app.add_option("--time", options.lighting.time_budget_seconds, "stop the lighting stage after this many seconds")
       ->check(CLI::NonNegativeNumber);
@@ -135,6 +138,10 @@ int main(int argc, char** argv) {
       return 2;
     }
     options.voxel_resolution = uint32_t(resolution);
+  }
+  if (!options.write_gltf.empty() && std::filesystem::path(options.write_gltf).extension() != ".gltf") {
+    std::cerr << "bake: error: --write-gltf " << options.write_gltf << ": the file name must end in .gltf\n";
+    return 2;
   }
   if (uv == "generate") options.import.generate_lightmap_uvs = true;
   else options.import.lightmap_uv_set = uv == "0" ? 0 : 1;

@@ -7,6 +7,7 @@
 #include "exitance/bake/import/gltf_accessor_reader.h"
 #include "exitance/bake/import/gltf_file_load.h"
 #include "exitance/bake/import/gltf_materials.h"
+#include "exitance/bake/import/gltf_triangle_corners.h"
 #include "exitance/bake/input_error.h"
 #include "exitance/runtime/node_transform.h"
 
@@ -59,22 +60,6 @@ Vec2 to_vec2(const std::vector<float>& v, size_t i) { return {v[2 * i], v[2 * i 
 int attribute(const tinygltf::Primitive& primitive, const std::string& name) {
   auto it = primitive.attributes.find(name);
   return it == primitive.attributes.end() ? -1 : it->second;
-}
-
-// Triangle corner indices for TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN.
-std::vector<uint32_t> triangle_list(int mode, const std::vector<uint32_t>& indices) {
-  std::vector<uint32_t> out;
-  if (mode == TINYGLTF_MODE_TRIANGLES) {
-    out.assign(indices.begin(), indices.begin() + long(indices.size() / 3 * 3));
-  } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
-    for (size_t i = 2; i < indices.size(); ++i) {
-      if (i % 2 == 0) out.insert(out.end(), {indices[i - 2], indices[i - 1], indices[i]});
-      else out.insert(out.end(), {indices[i - 1], indices[i - 2], indices[i]});
-    }
-  } else {  // fan
-    for (size_t i = 2; i < indices.size(); ++i) out.insert(out.end(), {indices[0], indices[i - 1], indices[i]});
-  }
-  return out;
 }
 
 // The node as written in the file, for Scene::nodes: its local transform exactly as given (the
@@ -297,7 +282,7 @@ class SceneFlattener {
         throw InputError(file_, element, "material " + std::to_string(primitive.material) + " does not exist");
       material = uint32_t(primitive.material);
     }
-    const std::vector<uint32_t> corners = triangle_list(mode, indices);
+    const std::vector<uint32_t> corners = triangle_corners(mode, indices);
     const uint32_t first_local_triangle = generated.local_triangles;
     generated.local_triangles += uint32_t(corners.size() / 3);
     if (generated.request && generated.first_instance) {

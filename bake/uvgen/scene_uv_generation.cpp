@@ -96,6 +96,7 @@ std::vector<MeshUvReport> generate_missing_lightmap_uvs(Scene& scene, const std:
     report.name = mesh.name;
     report.missing_set = mesh.missing_set;
     report.stats = uvs.stats;
+    report.corner_uv = std::move(uvs.corner_uv);
     report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
   return reports;

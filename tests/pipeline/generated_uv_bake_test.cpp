@@ -9,6 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "exitance/bake/command/bake_pipeline.h"
+#include "exitance/bake/import/gltf_import.h"
+#include "exitance/bake/uvgen/scene_uv_generation.h"
 #include "exitance/formats/bundle_manifest.h"
 #include "exitance/formats/lightmap_exr.h"
 
@@ -59,6 +61,40 @@ TEST(GeneratedUvBake, CubeWithoutTexcoord1BakesWithAWarning) {
   EXPECT_GT(covered, 6u * 16 * 16 / 2);  // six unit faces at 16 texels per unit
   EXPECT_GT(lit, covered / 2);
   fs::remove_all(out);
+}
+
+// --write-gltf: the written file has the generated UVs as TEXCOORD_1 (it imports without generating),
+// the same triangles in the same order, and exactly the UVs the bake generated.
+TEST(GeneratedUvBake, WriteGltfHasTheGeneratedTexcoord1) {
+  const fs::path dir = fs::temp_directory_path() / ("exitance-test-write-gltf-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  BakeOptions options;
+  options.input = std::string(EXITANCE_HOSTILE_DIR) + "/mesh_without_texcoord1.gltf";
+  options.output = (dir / "out.bake").string();
+  options.write_gltf = (dir / "with_uvs.gltf").string();
+  options.atlas.texel_density = 16;
+  options.lighting.spp = 1;
+  options.backend.name = "cpu";
+  options.probes_enabled = false;
+  options.svo_enabled = false;
+  Diagnostics diagnostics;
+  run_bake(options, diagnostics);
+
+  Diagnostics d;
+  std::vector<MeshWithoutLightmapUvs> missing;
+  Scene generated = import_gltf(options.input, {}, d, &missing);
+  generate_missing_lightmap_uvs(generated, missing, 16, options.atlas.max_page - 2 * options.atlas.padding, {});
+  const Scene written = import_gltf(options.write_gltf, {}, d);  // no generation: TEXCOORD_1 is there
+  ASSERT_EQ(written.triangle_count(), generated.triangle_count());
+  for (size_t c = 0; c < written.positions.size(); ++c) {
+    EXPECT_EQ(written.positions[c].x, generated.positions[c].x);
+    EXPECT_EQ(written.positions[c].y, generated.positions[c].y);
+    EXPECT_EQ(written.positions[c].z, generated.positions[c].z);
+    EXPECT_EQ(written.lightmap_uv[c].x, generated.lightmap_uv[c].x);
+    EXPECT_EQ(written.lightmap_uv[c].y, generated.lightmap_uv[c].y);
+  }
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -47,6 +47,10 @@ Scene import_stage(const BakeOptions& options, Diagnostics& diagnostics,
 std::vector<MeshUvReport> uv_generation_stage(Scene& scene, const std::vector<MeshWithoutLightmapUvs>& without_lightmap_uvs,
                                               const BakeOptions& options, Diagnostics& diagnostics);
 
+// write gltf (--write-gltf): the input scene again with the generated lightmap UVs as the chosen set.
+void write_gltf_stage(const std::vector<MeshUvReport>& generated_uvs, const BakeOptions& options,
+                      Diagnostics& diagnostics);
+
 // layout: one atlas rectangle per instance, at --texel-density (or the automatic density).
 AtlasLayout layout_stage(const Scene& scene, const BakeOptions& options, Diagnostics& diagnostics);
 

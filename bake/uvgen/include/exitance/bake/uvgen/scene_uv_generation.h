@@ -19,6 +19,7 @@ struct MeshUvReport {
   std::string missing_set;  // "" with --uv generate
   UvGenerationStats stats;
   double seconds = 0;
+  std::vector<Vec2> corner_uv;  // per mesh corner (MeshWithoutLightmapUvs::indices), for --write-gltf
 };
 
 // `texel_density`: the layout's texels per scene unit; `max_side_texels`: the layout's usable page
