@@ -129,9 +129,12 @@ ChartMask turned(const ChartMask& m, int turns) {
     for (int x = 0; x < m.width; ++x) {
       if (!m.at(x, y)) continue;
       int tx = 0, ty = 0;
-      if (turns == 1) tx = m.height - 1 - y, ty = x;
-      else if (turns == 2) tx = m.width - 1 - x, ty = m.height - 1 - y;
-      else tx = y, ty = m.width - 1 - x;
+      if (turns == 1)
+        tx = m.height - 1 - y, ty = x;
+      else if (turns == 2)
+        tx = m.width - 1 - x, ty = m.height - 1 - y;
+      else
+        tx = y, ty = m.width - 1 - x;
       t.texels[size_t(ty) * size_t(t.width) + size_t(tx)] = 1;
     }
   return t;
@@ -141,7 +144,7 @@ ChartMask turned(const ChartMask& m, int turns) {
 // the mask widened by the dilation its dilated top (one past the highest texel, plus the dilation).
 struct Profile {
   int width = 0, height = 0;
-  std::vector<int> bottom;     // per column; INT32_MAX when the column is empty
+  std::vector<int> bottom;       // per column; INT32_MAX when the column is empty
   std::vector<int> dilated_top;  // per column x - dilation .. width - 1 + dilation; INT32_MIN when empty
 };
 
@@ -220,9 +223,12 @@ Point2 PackedCharts::uv(size_t chart, Point2 point) const {
   const Point2 t = to_texels(c, point, texels_per_unit);
   const double w = c.mask_width, h = c.mask_height;
   Point2 turned_point = t;
-  if (c.quarter_turns == 1) turned_point = {h - t[1], t[0]};
-  else if (c.quarter_turns == 2) turned_point = {w - t[0], h - t[1]};
-  else if (c.quarter_turns == 3) turned_point = {t[1], w - t[0]};
+  if (c.quarter_turns == 1)
+    turned_point = {h - t[1], t[0]};
+  else if (c.quarter_turns == 2)
+    turned_point = {w - t[0], h - t[1]};
+  else if (c.quarter_turns == 3)
+    turned_point = {t[1], w - t[0]};
   const double side = double(std::max(width, height));
   return {std::clamp((c.origin[0] + turned_point[0]) / side, 0.0, 1.0),
           std::clamp((c.origin[1] + turned_point[1]) / side, 0.0, 1.0)};
@@ -246,8 +252,21 @@ PackedCharts pack_charts(const std::vector<ChartOutline>& charts, const PackingS
   // Four turns let charts nest; with many charts two keep the cost of the column scan down.
   const int turn_choices = charts.size() <= 256 ? 4 : 2;
   const int max_side = std::max(settings.max_side_texels, 1);
-  double density = settings.texels_per_unit;
-  for (int attempt = 0;; ++attempt) {
+  // One packing at `density`: the best strip, and the charts' mask sizes at that density.
+  struct Attempt {
+    StripResult best;
+    bool packed = false, fits = false;
+  };
+  double chart_area = 0;  // 3-D-area units
+  for (const ChartOutline& chart : charts)
+    for (size_t i = 0; i + 2 < chart.points.size(); i += 3) {
+      const Point2 &a = chart.points[i], &b = chart.points[i + 1], &c = chart.points[i + 2];
+      chart_area += 0.5 * std::fabs((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
+    }
+  auto pack_at = [&](double density) {
+    // The charts' own texels alone exceed the page: not worth rasterizing (it is slow at a density
+    // far too high).
+    if (chart_area * density * density > double(max_side) * max_side) return Attempt{};
     std::vector<std::array<Profile, 4>> profiles(charts.size());
     std::vector<size_t> mask_area(charts.size());
     double total_area = 0;
@@ -257,7 +276,8 @@ PackedCharts pack_charts(const std::vector<ChartOutline>& charts, const PackingS
       const ChartMask mask = rasterize_chart(charts[c], p, density, grow);
       p.mask_width = mask.width;
       p.mask_height = mask.height;
-      for (int turns = 0; turns < turn_choices; ++turns) profiles[c][size_t(turns)] = profile_of(turned(mask, turns), dilation);
+      for (int turns = 0; turns < turn_choices; ++turns)
+        profiles[c][size_t(turns)] = profile_of(turned(mask, turns), dilation);
       mask_area[c] = size_t(std::count(mask.texels.begin(), mask.texels.end(), uint8_t(1)));
       total_area += double(mask.width + dilation) * double(mask.height + dilation);
       widest_needed = std::max(widest_needed, std::min(mask.width, mask.height));
@@ -279,27 +299,67 @@ PackedCharts pack_charts(const std::vector<ChartOutline>& charts, const PackingS
       const bool fits = std::max(r.width, r.height) <= max_side;
       const double area = double(r.width) * r.height, best_area = double(best.width) * best.height;
       const bool better = !have_best || (fits && !best_fits) ||
-                          (fits == best_fits && (area < best_area || (area == best_area &&
-                                                 std::max(r.width, r.height) < std::max(best.width, best.height))));
+                          (fits == best_fits &&
+                           (area < best_area ||
+                            (area == best_area && std::max(r.width, r.height) < std::max(best.width, best.height))));
       if (better) best = std::move(r), have_best = true, best_fits = fits;
     }
-    const bool smallest = density * largest_extent < 0.5;
-    if (have_best && (best_fits || attempt >= 60 || smallest)) {
-      packed.fits = best_fits;
-      packed.width = std::max(best.width, 1);
-      packed.height = std::max(best.height, 1);
-      packed.texels_per_unit = density;
-      for (size_t c = 0; c < charts.size(); ++c) {
-        ChartPlacement& p = packed.placements[c];
-        p.quarter_turns = best.turns[c];
-        p.origin = {double(best.position[c][0]), double(best.position[c][1])};
-      }
-      return packed;
+    return Attempt{std::move(best), have_best, best_fits};
+  };
+  auto commit = [&](double density) {
+    Attempt a = pack_at(density);
+    packed.fits = a.fits;
+    packed.width = std::max(a.best.width, 1);
+    packed.height = std::max(a.best.height, 1);
+    packed.texels_per_unit = density;
+    for (size_t c = 0; c < charts.size(); ++c) {
+      ChartPlacement& p = packed.placements[c];
+      p.quarter_turns = a.packed ? a.best.turns[c] : 0;
+      p.origin = a.packed ? Point2{double(a.best.position[c][0]), double(a.best.position[c][1])} : Point2{0, 0};
     }
-    // Too big for the page: lower the density (the gutters do not shrink, so shrink a bit more).
-    const int side = have_best ? std::max(best.width, best.height) : 2 * max_side;
-    density *= std::min(0.95, 0.97 * double(max_side) / double(side));
+    return packed;
+  };
+  auto side_of = [&](const Attempt& a, double density) {
+    return a.packed ? double(std::max(a.best.width, a.best.height))
+                    : std::max(2.0 * max_side, std::sqrt(chart_area) * density);
+  };
+
+  // Every chart takes at least (1 + dilation)^2 texels whatever the density: when that is more than
+  // the page, no density keeps the gutter; pack once, the charts' own area about half the page.
+  const double first = settings.texels_per_unit;
+  if (double(charts.size()) * (1.0 + dilation) * (1.0 + dilation) > double(max_side) * max_side) {
+    const double fitting = chart_area > 0 ? std::sqrt(0.5 * double(max_side) * max_side / chart_area) : first;
+    PackedCharts result = commit(std::min(first, fitting));
+    result.fits = false;
+    return result;
   }
+  Attempt attempt = pack_at(first);
+  if (attempt.fits) return commit(first);
+  // Too big for the page: shrink (at least halving) until it fits, then bisect between the two.
+  double too_big = first, fitting = 0;
+  for (int step = 0; step < 40; ++step) {
+    const double next = too_big * std::min(0.5, 0.97 * double(max_side) / side_of(attempt, too_big));
+    if (next * largest_extent < 0.05) break;
+    attempt = pack_at(next);
+    if (attempt.fits) {
+      fitting = next;
+      break;
+    }
+    too_big = next;
+  }
+  if (fitting == 0) {  // nothing fitted: the smallest tried, marked as not fitting
+    PackedCharts result = commit(too_big);
+    result.fits = false;
+    return result;
+  }
+  for (int step = 0; step < 6; ++step) {  // the largest fitting density within about 3 %
+    const double middle = std::sqrt(fitting * too_big);
+    if (pack_at(middle).fits)
+      fitting = middle;
+    else
+      too_big = middle;
+  }
+  return commit(fitting);
 }
 
 }  // namespace exitance::uvgen
