@@ -10,7 +10,7 @@ packages=(
   libopenvdb-dev libopenvdb-tools
   libopenexr-dev libopenimageio-dev openimageio-tools
   libtinygltf-dev libstb-dev nlohmann-json3-dev libcli11-dev
-  libcgal-dev
+  libcgal-dev libeigen3-dev
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools glslang-tools
   libgtest-dev libgmock-dev libbenchmark-dev
   libssl-dev

@@ -32,6 +32,9 @@ formats::BakeSettings settings_of(const BakeResults& results, const BakeOptions&
   s.max_page = uint32_t(options.atlas.max_page);
   s.padding = uint32_t(options.atlas.padding);
   s.lightmap_uv = uint32_t(options.import.lightmap_uv_set);
+  s.lightmap_uv_generate = options.import.generate_lightmap_uvs;
+  if (results.generated_uvs)
+    for (const MeshUvReport& r : *results.generated_uvs) s.generated_uv_meshes.push_back(uint32_t(r.mesh));
   s.russian_roulette_start = options.lighting.russian_roulette_start;
   s.safety_bounce_cap = options.lighting.safety_bounce_cap;
   s.sky = options.sky;
@@ -149,6 +152,29 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
                     {"build_seconds", svo_stats.total_seconds}};
   } else {
     skipped["svo"] = "--voxel-resolution none";
+  }
+  if (results.generated_uvs && !results.generated_uvs->empty()) {
+    json meshes = json::array();
+    for (const MeshUvReport& r : *results.generated_uvs) {
+      const UvGenerationStats& u = r.stats;
+      meshes.push_back({{"mesh", r.mesh},
+                        {"name", r.name},
+                        {"reason", r.missing_set.empty() ? std::string("--uv generate") : "no " + r.missing_set},
+                        {"triangles", u.triangles},
+                        {"charts", u.charts},
+                        {"lscm_charts", u.lscm_charts},
+                        {"planar_charts", u.planar_charts},
+                        {"degenerate_triangles", u.degenerate_triangles},
+                        {"stretched_charts", u.stretched_charts},
+                        {"utilization", u.utilization},
+                        {"area_distortion", {{"max", u.max_area_distortion}, {"mean", u.mean_area_distortion}}},
+                        {"angle_distortion", {{"max", u.max_angle_distortion}, {"mean", u.mean_angle_distortion}}},
+                        {"packed_texels", {u.packed_width, u.packed_height}},
+                        {"texels_per_unit", u.texels_per_unit},
+                        {"gutter_holds", u.gutter_holds},
+                        {"seconds", r.seconds}});
+    }
+    stats["generated_lightmap_uvs"] = meshes;
   }
   stats["skipped"] = skipped;
   stats["warnings"] = warnings;

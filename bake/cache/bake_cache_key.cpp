@@ -10,8 +10,10 @@ namespace {
 // A new field in one of these must be added to the key below; the sizes catch most additions.
 static_assert(sizeof(IntegratorSettings) == 136, "IntegratorSettings changed: hash the new field in bake_cache_key");
 static_assert(sizeof(AtlasSettings) == 24, "AtlasSettings changed: hash the new field in bake_cache_key");
-static_assert(sizeof(BakeOptions) == 392, "BakeOptions changed: hash the new field in bake_cache_key (or say why not)");
-static_assert(sizeof(ImportOptions) == 4, "ImportOptions changed: hash the new field in bake_cache_key");
+// Not hashed: input and output paths (the input's name and bytes are), cache_directory and
+// write_gltf (where results go does not change them), progress.
+static_assert(sizeof(BakeOptions) == 424, "BakeOptions changed: hash the new field in bake_cache_key (or say why not)");
+static_assert(sizeof(ImportOptions) == 8, "ImportOptions changed: hash the new field in bake_cache_key");
 static_assert(sizeof(Material) == 136, "Material changed: hash the new field in bake_cache_key");
 static_assert(sizeof(PunctualLight) == 88, "PunctualLight changed: hash the new field in bake_cache_key");
 
@@ -67,7 +69,7 @@ void hash_scene(Sha256Stream& h, const Scene& scene) {
 
 void hash_options(Sha256Stream& h, const BakeOptions& o) {
   h.text(o.sky), h.text(o.backend.name), h.value(o.backend.device_index), h.value(o.backend.validation);
-  h.value(o.import.lightmap_uv_set);
+  h.value(o.import.lightmap_uv_set), h.value(o.import.generate_lightmap_uvs);
   h.value(o.atlas.texel_density), h.value(o.atlas.max_page), h.value(o.atlas.padding);
   h.value(uint64_t(o.atlas.max_total_texels));
   const IntegratorSettings& l = o.lighting;

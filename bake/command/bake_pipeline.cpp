@@ -81,17 +81,32 @@ void repeat_stored_warnings(const std::vector<std::string>& stored, Diagnostics&
 json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   // Offline stage (DESIGN §1): scene, atlas, texel G-buffer, the BVHs, the backend that will light them.
   StageTimer clock;
-  Scene imported = clock.time("import", [&] { return import_stage(options, diagnostics); });
-
-  // A bake of the same input with the same options and program is in the cache: reuse it.
+  std::vector<MeshWithoutLightmapUvs> without_lightmap_uvs;
+  Scene imported = clock.time("import", [&] { return import_stage(options, diagnostics, without_lightmap_uvs); });
+  std::vector<MeshUvReport> generated_uvs;
+  auto generate_uvs = [&] {
+    if (!without_lightmap_uvs.empty())
+      generated_uvs = clock.time("uv_generation", [&] {
+        return uv_generation_stage(imported, without_lightmap_uvs, options, diagnostics);
+      });
+  };
+  // The cache key is taken from the imported scene before UV generation (which is deterministic in
+  // the scene and the options), so it does not depend on --write-gltf.
   std::optional<BundleCache> cache;
   std::string cache_key;
   if (!options.cache_directory.empty()) {
     cache.emplace(options.cache_directory);
-    std::optional<json> reused = clock.time("cache", [&]() -> std::optional<json> {
+    cache_key = clock.time("cache_key", [&] {
       options.announce_stage("cache");
-      cache_key =
-          bake_cache_key(imported, options, sha256_of_file(options.input), backend_candidates(options.backend));
+      return bake_cache_key(imported, options, sha256_of_file(options.input), backend_candidates(options.backend));
+    });
+  }
+  // --write-gltf needs the generated UVs even when the bundle comes from the cache.
+  if (!options.write_gltf.empty()) generate_uvs();
+
+  // A bake of the same input with the same options and program is in the cache: reuse it.
+  if (cache) {
+    std::optional<json> reused = clock.time("cache", [&]() -> std::optional<json> {
       std::vector<std::string> stored_warnings;
       const std::filesystem::path out = bundle_folder(options);
       auto edit = [&](const std::string& text) { return mark_reused(text, cache_key); };
@@ -102,10 +117,13 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
           std::string(std::istreambuf_iterator<char>(in), {}), (out / "manifest.json").string());
       return json{{"stats", json::parse(manifest.stats_json)}, {"pages", manifest.pages.size()}};
     });
-    if (reused)
+    if (reused) {
+      if (!options.write_gltf.empty()) write_gltf_stage(generated_uvs, options, diagnostics);
       return run_report(WrittenBundle{bundle_folder(options), (*reused)["pages"].get<size_t>(), (*reused)["stats"]},
                         clock.seconds());
+    }
   }
+  if (options.write_gltf.empty()) generate_uvs();
   const AtlasLayout layout = clock.time("layout", [&] { return layout_stage(imported, options, diagnostics); });
   TexelGBuffer gbuffer = clock.time("raster", [&] { return raster_stage(imported, layout, options, diagnostics); });
   const SceneForLighting scene =
@@ -150,9 +168,12 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                             .probes = probes ? &*probes : nullptr,
                             .lightmap = lightmap,
                             .probe_lighting = probe_lighting ? &*probe_lighting : nullptr,
-                            .scene_file = scene_file};
+                            .scene_file = scene_file,
+                            .generated_uvs = &generated_uvs};
   WrittenBundle bundle =
       clock.time("write", [&] { return write_bundle_stage(results, clock.seconds(), diagnostics, options); });
+  // After the bundle, so a failed bake writes neither.
+  if (!options.write_gltf.empty()) write_gltf_stage(generated_uvs, options, diagnostics);
   if (cache) {
     clock.time("cache_store", [&] { cache->store(cache_key, bundle.folder, diagnostics.warnings, diagnostics); });
     bundle.stats["cache"] = {{"reused", false}, {"key", cache_key}};

@@ -6,6 +6,7 @@
 
 #include "exitance/bake/command/backend_choice.h"
 #include "exitance/bake/import/gltf_import.h"
+#include "exitance/bake/import/gltf_lightmap_uv_writer.h"
 #include "exitance/bake/import/sky_option.h"
 #include "exitance/bake/input_error.h"
 #include "exitance/bake/raster/texel_raster.h"
@@ -30,11 +31,55 @@ void warn_about_nonfinite_samples(uint64_t count, const char* what, const BakeOp
 
 }  // namespace
 
-Scene import_stage(const BakeOptions& options, Diagnostics& diagnostics) {
+Scene import_stage(const BakeOptions& options, Diagnostics& diagnostics,
+                   std::vector<MeshWithoutLightmapUvs>& without_lightmap_uvs) {
   options.announce_stage("import");
-  Scene scene = import_gltf(options.input, options.import, diagnostics);
+  Scene scene = import_gltf(options.input, options.import, diagnostics, &without_lightmap_uvs);
   scene.sky = parse_sky_option(options.sky);
   return scene;
+}
+
+std::vector<MeshUvReport> uv_generation_stage(Scene& scene, const std::vector<MeshWithoutLightmapUvs>& without_lightmap_uvs,
+                                              const BakeOptions& options, Diagnostics& diagnostics) {
+  if (without_lightmap_uvs.empty()) return {};
+  options.announce_stage("uv generation");
+  // The density and usable page side the layout stage will use (the density depends on world areas
+  // only, not on UVs), so the packed gutter holds at the rectangles it lays out.
+  const double density = options.atlas.texel_density > 0
+                             ? options.atlas.texel_density
+                             : automatic_texel_density(scene, options.atlas.max_total_texels);
+  const int usable_side = options.atlas.max_page - 2 * options.atlas.padding;
+  if (usable_side < 4) throw InputError(options.input, "--max-page", "is too small for the padding");
+  std::vector<MeshUvReport> reports = generate_missing_lightmap_uvs(
+      scene, without_lightmap_uvs, density, usable_side,
+      [&](double fraction) {
+        if (options.progress) options.progress("uv generation", fraction, 0);
+      });
+  for (const MeshUvReport& r : reports) {
+    const std::string mesh = "mesh " + std::to_string(r.mesh) + (r.name.empty() ? "" : " '" + r.name + "'");
+    const std::string charts = std::to_string(r.stats.charts) + (r.stats.charts == 1 ? " chart" : " charts");
+    if (!r.missing_set.empty())
+      diagnostics.warn(options.input + ": " + mesh + ": no " + r.missing_set + "; generated lightmap UVs: " + charts);
+    if (r.stats.stretched_charts)
+      diagnostics.warn(options.input + ": " + mesh + ": " + std::to_string(r.stats.stretched_charts) + " of " + charts +
+                       " of the generated lightmap UVs are stretched (mean area or angle distortion above 2)");
+    if (!r.stats.gutter_holds)
+      diagnostics.warn(options.input + ": " + mesh + ": generated lightmap UV charts do not fit --max-page " +
+                       std::to_string(options.atlas.max_page) + " with a 2-texel gap; they may bleed into each other");
+  }
+  return reports;
+}
+
+void write_gltf_stage(const std::vector<MeshUvReport>& generated_uvs, const BakeOptions& options,
+                      Diagnostics& diagnostics) {
+  options.announce_stage("write gltf");
+  std::vector<MeshLightmapUvs> meshes;
+  for (const MeshUvReport& r : generated_uvs) meshes.push_back({r.mesh, r.corner_uv});
+  Diagnostics reload;  // the input's repairs were reported by the import already
+  write_gltf_with_lightmap_uvs(options.input, options.write_gltf, options.import.lightmap_uv_set, meshes, reload);
+  if (generated_uvs.empty())
+    diagnostics.warn(options.input + ": --write-gltf: no mesh needed generated lightmap UVs; " + options.write_gltf +
+                     " has the input's own");
 }
 
 AtlasLayout layout_stage(const Scene& scene, const BakeOptions& options, Diagnostics& diagnostics) {

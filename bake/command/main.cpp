@@ -44,8 +44,13 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--max-page", options.atlas.max_page, "atlas page size limit in texels")->check(CLI::Range(16, 16384));
   app.add_option("--padding", options.atlas.padding, "gutter texels around each chart rectangle")->check(CLI::Range(1, 16));
-  app.add_option("--uv", options.import.lightmap_uv_set, "lightmap UV set: 1 = TEXCOORD_1 (default), 0 = TEXCOORD_0")
-      ->check(CLI::IsMember({0, 1}));
+  std::string uv = "1";
+  app.add_option("--uv", uv,
+                 "lightmap UV set: 1 = TEXCOORD_1 (default), 0 = TEXCOORD_0; generated (CGAL charts) for a mesh "
+                 "without it; generate = generated for every mesh")
+      ->check(CLI::IsMember({"0", "1", "generate"}));
+  app.add_option("--write-gltf", options.write_gltf,
+                 "also write the scene with its generated lightmap UVs (as the --uv set) to this .gltf");
   CLI::Option* spp_option = app.add_option(
       "--spp", options.lighting.spp,
       "samples per texel (default 128; 0 = until --time or --target-error ends the run, the default when either is given)");
@@ -146,6 +151,12 @@ int main(int argc, char** argv) {
     }
     options.voxel_resolution = uint32_t(resolution);
   }
+  if (!options.write_gltf.empty() && std::filesystem::path(options.write_gltf).extension() != ".gltf") {
+    std::cerr << "bake: error: --write-gltf " << options.write_gltf << ": the file name must end in .gltf\n";
+    return 2;
+  }
+  if (uv == "generate") options.import.generate_lightmap_uvs = true;
+  else options.import.lightmap_uv_set = uv == "0" ? 0 : 1;
   if (integrator == "bounces") options.lighting.integrator = exitance::IntegratorMode::Bounces;
   if (!directional.empty()) diagnostics.warn("--directional: directional lightmaps are not implemented yet; ignored");
   if (guiding == "svo") {

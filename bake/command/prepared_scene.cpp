@@ -13,7 +13,9 @@ PreparedScene prepare_scene_for_lighting(const std::string& path, const std::str
   options.sky = sky;
   options.atlas = atlas;
   PreparedScene prepared;
-  prepared.scene = import_stage(options, diagnostics);
+  std::vector<MeshWithoutLightmapUvs> without_lightmap_uvs;
+  prepared.scene = import_stage(options, diagnostics, without_lightmap_uvs);
+  uv_generation_stage(prepared.scene, without_lightmap_uvs, options, diagnostics);
   prepared.layout = layout_stage(prepared.scene, options, diagnostics);
   prepared.gbuffer = raster_stage(prepared.scene, prepared.layout, options, diagnostics);
   const EmbreeScene embree(prepared.scene);

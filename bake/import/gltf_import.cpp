@@ -7,6 +7,7 @@
 #include "exitance/bake/import/gltf_accessor_reader.h"
 #include "exitance/bake/import/gltf_file_load.h"
 #include "exitance/bake/import/gltf_materials.h"
+#include "exitance/bake/import/gltf_triangle_corners.h"
 #include "exitance/bake/input_error.h"
 #include "exitance/runtime/node_transform.h"
 
@@ -59,22 +60,6 @@ Vec2 to_vec2(const std::vector<float>& v, size_t i) { return {v[2 * i], v[2 * i 
 int attribute(const tinygltf::Primitive& primitive, const std::string& name) {
   auto it = primitive.attributes.find(name);
   return it == primitive.attributes.end() ? -1 : it->second;
-}
-
-// Triangle corner indices for TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN.
-std::vector<uint32_t> triangle_list(int mode, const std::vector<uint32_t>& indices) {
-  std::vector<uint32_t> out;
-  if (mode == TINYGLTF_MODE_TRIANGLES) {
-    out.assign(indices.begin(), indices.begin() + long(indices.size() / 3 * 3));
-  } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
-    for (size_t i = 2; i < indices.size(); ++i) {
-      if (i % 2 == 0) out.insert(out.end(), {indices[i - 2], indices[i - 1], indices[i]});
-      else out.insert(out.end(), {indices[i - 1], indices[i - 2], indices[i]});
-    }
-  } else {  // fan
-    for (size_t i = 2; i < indices.size(); ++i) out.insert(out.end(), {indices[0], indices[i - 1], indices[i]});
-  }
-  return out;
 }
 
 // The node as written in the file, for Scene::nodes: its local transform exactly as given (the
@@ -133,9 +118,11 @@ struct RepairCounts {
 class SceneFlattener {
  public:
   SceneFlattener(const tinygltf::Model& model, const std::string& file, const ImportOptions& options, Scene& scene,
-                 Diagnostics& diagnostics, uint32_t default_material)
+                 Diagnostics& diagnostics, uint32_t default_material,
+                 std::vector<MeshWithoutLightmapUvs>* without_lightmap_uvs)
       : model_(model), file_(file), options_(options), scene_(scene), diagnostics_(diagnostics),
-        default_material_(default_material), node_state_(model.nodes.size(), 0) {
+        default_material_(default_material), node_state_(model.nodes.size(), 0),
+        without_lightmap_uvs_(without_lightmap_uvs), generated_mesh_(model.meshes.size(), -1) {
     scene_.nodes.reserve(model.nodes.size());
     for (const tinygltf::Node& node : model.nodes) scene_.nodes.push_back(scene_node(node));
   }
@@ -200,15 +187,54 @@ class SceneFlattener {
     instance.world = world;
     const uint32_t instance_index = uint32_t(scene_.instances.size());
     const bool flip_winding = determinant3(world) < 0;
+    GeneratedUvTarget target = generated_uv_target(node.mesh, mesh, instance_index);
     for (size_t p = 0; p < mesh.primitives.size(); ++p)
       add_primitive(mesh.primitives[p], "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p), world,
-                    flip_winding, instance_index);
+                    flip_winding, instance_index, target);
     instance.triangle_count = uint32_t(scene_.triangle_count()) - instance.first_triangle;
     if (instance.triangle_count > 0) scene_.instances.push_back(std::move(instance));
+    else if (target.request) target.request->instances.pop_back();
+  }
+
+  // Where a mesh whose lightmap UVs will be generated records its local triangles (first instance
+  // only) and each instance's corner mapping; request is null for a mesh with its own UVs.
+  struct GeneratedUvTarget {
+    MeshWithoutLightmapUvs* request = nullptr;
+    bool first_instance = false;
+    uint32_t local_triangles = 0;  // mesh triangles so far in this instance (all primitives)
+  };
+
+  GeneratedUvTarget generated_uv_target(int mesh_index, const tinygltf::Mesh& mesh, uint32_t instance_index) {
+    const std::string uv_name = "TEXCOORD_" + std::to_string(options_.lightmap_uv_set);
+    std::string missing;  // the element that lacks the set
+    for (size_t p = 0; p < mesh.primitives.size() && missing.empty(); ++p) {
+      const int mode = mesh.primitives[p].mode < 0 ? TINYGLTF_MODE_TRIANGLES : mesh.primitives[p].mode;
+      if (mode > TINYGLTF_MODE_LINE_STRIP && mode <= TINYGLTF_MODE_TRIANGLE_FAN &&
+          attribute(mesh.primitives[p], uv_name) < 0)
+        missing = "mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(p);
+    }
+    if (missing.empty() && !options_.generate_lightmap_uvs) return {};
+    if (!without_lightmap_uvs_)
+      throw InputError(file_, missing,
+                       "has no " + uv_name + " lightmap UVs" +
+                           (options_.lightmap_uv_set == 1 ? " (use --uv 0 to bake with TEXCOORD_0)" : ""));
+    GeneratedUvTarget target;
+    int& slot = generated_mesh_[size_t(mesh_index)];
+    if (slot < 0) {
+      slot = int(without_lightmap_uvs_->size());
+      MeshWithoutLightmapUvs& request = without_lightmap_uvs_->emplace_back();
+      request.mesh = mesh_index;
+      request.name = mesh.name;
+      request.missing_set = missing.empty() ? "" : uv_name;
+      target.first_instance = true;
+    }
+    target.request = &(*without_lightmap_uvs_)[size_t(slot)];
+    target.request->instances.push_back({instance_index, {}});
+    return target;
   }
 
   void add_primitive(const tinygltf::Primitive& primitive, const std::string& element, const Mat4& world,
-                     bool flip_winding, uint32_t instance_index) {
+                     bool flip_winding, uint32_t instance_index, GeneratedUvTarget& generated) {
     const int mode = primitive.mode < 0 ? TINYGLTF_MODE_TRIANGLES : primitive.mode;
     if (mode <= TINYGLTF_MODE_LINE_STRIP) {
       diagnostics_.warn(file_ + ": " + element + ": points/lines primitive skipped (nothing to light)");
@@ -220,11 +246,6 @@ class SceneFlattener {
     const std::vector<float> positions = read_accessor_floats(model_, position_accessor, 3, file_, "POSITION");
     const size_t vertex_count = positions.size() / 3;
     const std::string uv_name = "TEXCOORD_" + std::to_string(options_.lightmap_uv_set);
-    const int lightmap_accessor = attribute(primitive, uv_name);
-    if (lightmap_accessor < 0)
-      throw InputError(file_, element,
-                       "has no " + uv_name + " lightmap UVs" +
-                           (options_.lightmap_uv_set == 1 ? " (use --uv 0 to bake with TEXCOORD_0)" : ""));
     auto read_optional = [&](const std::string& name, int components, NonFinite non_finite) {
       const int index = attribute(primitive, name);
       std::vector<float> values;
@@ -239,7 +260,9 @@ class SceneFlattener {
     // NaN/Inf normals are repaired per vertex (shading_normal); NaN/Inf UVs cannot be.
     const std::vector<float> normals = read_optional("NORMAL", 3, NonFinite::Keep);
     const std::vector<float> uv0 = read_optional("TEXCOORD_0", 2, NonFinite::Reject);
-    const std::vector<float> lightmap_uv = read_optional(uv_name, 2, NonFinite::Reject);
+    // A mesh whose UVs are generated reads no set (a partial or broken one is ignored).
+    const std::vector<float> lightmap_uv =
+        generated.request ? std::vector<float>{} : read_optional(uv_name, 2, NonFinite::Reject);
     // COLOR_0: VEC3 or VEC4, float or normalized unsigned byte/short (glTF: linear, multiplies the
     // base colour and its alpha).
     std::vector<float> colors;
@@ -280,10 +303,19 @@ class SceneFlattener {
         throw InputError(file_, element, "material " + std::to_string(primitive.material) + " does not exist");
       material = uint32_t(primitive.material);
     }
-    const std::vector<uint32_t> corners = triangle_list(mode, indices);
+    const std::vector<uint32_t> corners = triangle_corners(mode, indices);
+    const uint32_t first_local_triangle = generated.local_triangles;
+    generated.local_triangles += uint32_t(corners.size() / 3);
+    if (generated.request && generated.first_instance) {
+      const uint32_t base = uint32_t(generated.request->positions.size());
+      for (size_t i = 0; i < vertex_count; ++i) generated.request->positions.push_back(to_vec3(positions, i));
+      for (size_t t = 0; t + 2 < corners.size(); t += 3)
+        for (size_t k = 0; k < 3; ++k) generated.request->indices.push_back(base + corners[t + k]);
+    }
     for (size_t t = 0; t + 2 < corners.size(); t += 3) {
       std::array<uint32_t, 3> v{corners[t], corners[t + 1], corners[t + 2]};
-      if (flip_winding) std::swap(v[1], v[2]);
+      std::array<uint32_t, 3> local_corner{0, 1, 2};
+      if (flip_winding) std::swap(v[1], v[2]), std::swap(local_corner[1], local_corner[2]);
       std::array<Vec3, 3> p;
       for (int k = 0; k < 3; ++k) p[size_t(k)] = transform_point(world, to_vec3(positions, v[size_t(k)]));
       const Vec3 face = cross(p[1] - p[0], p[2] - p[0]);
@@ -298,7 +330,10 @@ class SceneFlattener {
         scene_.positions.push_back(p[size_t(k)]);
         scene_.normals.push_back(shading_normal(normals, vi, world, face_normal, flip_winding));
         scene_.uv0.push_back(uv0.empty() ? Vec2{} : to_vec2(uv0, vi));
-        scene_.lightmap_uv.push_back(to_vec2(lightmap_uv, vi));
+        scene_.lightmap_uv.push_back(generated.request ? Vec2{} : to_vec2(lightmap_uv, vi));
+        if (generated.request)
+          generated.request->instances.back().corners.push_back(3 * (first_local_triangle + uint32_t(t / 3)) +
+                                                                local_corner[size_t(k)]);
         if (vertex_colors_) {
           const size_t c = size_t(vi) * size_t(color_components);
           scene_.vertex_color.push_back(colors.empty() ? Vec3{1, 1, 1} : Vec3{colors[c], colors[c + 1], colors[c + 2]});
@@ -428,11 +463,15 @@ class SceneFlattener {
   uint32_t default_material_;
   std::vector<uint8_t> node_state_;  // 0 unvisited, 1 on the current path, 2 done
   RepairCounts repairs_;
+  std::vector<MeshWithoutLightmapUvs>* without_lightmap_uvs_;
+  std::vector<int> generated_mesh_;  // per glTF mesh: its index in *without_lightmap_uvs_, or -1
 };
 
 }  // namespace
 
-Scene import_gltf(const std::string& path, const ImportOptions& options, Diagnostics& diagnostics) {
+Scene import_gltf(const std::string& path, const ImportOptions& options, Diagnostics& diagnostics,
+                  std::vector<MeshWithoutLightmapUvs>* without_lightmap_uvs) {
+  if (without_lightmap_uvs) without_lightmap_uvs->clear();
   const tinygltf::Model model = load_gltf_model(path, diagnostics);
   Scene scene;
   const uint32_t default_material = import_gltf_materials(model, path, scene, diagnostics);
@@ -445,7 +484,7 @@ Scene import_gltf(const std::string& path, const ImportOptions& options, Diagnos
   } else {
     throw InputError(path, "scenes", "the file defines no scene to bake");
   }
-  SceneFlattener flattener(model, path, options, scene, diagnostics, default_material);
+  SceneFlattener flattener(model, path, options, scene, diagnostics, default_material, without_lightmap_uvs);
   flattener.add_scene_roots(roots);
   flattener.report_repairs();
   if (scene.triangle_count() == 0) throw InputError(path, "scene", "contains no triangles to bake");

@@ -259,7 +259,20 @@ BakeSettings parse_settings(const FieldReader& r, const json& j) {
   if (auto v = field("texel_density")) s.texel_density = r.non_negative_double(*v, path("texel_density"));
   if (auto v = field("max_page")) s.max_page = uint32_t(r.unsigned_integer(*v, path("max_page"), 1, kMaxPageEdge));
   if (auto v = field("padding")) s.padding = uint32_t(r.unsigned_integer(*v, path("padding"), 0, kMaxPageEdge));
-  if (auto v = field("lightmap_uv")) s.lightmap_uv = uint32_t(r.unsigned_integer(*v, path("lightmap_uv"), 0, 1));
+  if (auto v = field("lightmap_uv")) {
+    if (v->is_string()) {
+      if (v->get<std::string>() != "generate") r.fail(path("lightmap_uv"), "expected 0, 1 or \"generate\"");
+      s.lightmap_uv_generate = true;
+    } else {
+      s.lightmap_uv = uint32_t(r.unsigned_integer(*v, path("lightmap_uv"), 0, 1));
+    }
+  }
+  if (auto v = field("generated_uv_meshes")) {
+    if (!v->is_array()) r.fail(path("generated_uv_meshes"), std::string("expected an array, got ") + v->type_name());
+    for (size_t i = 0; i < v->size(); ++i)
+      s.generated_uv_meshes.push_back(uint32_t(r.unsigned_integer(
+          (*v)[i], path("generated_uv_meshes") + "[" + std::to_string(i) + "]", 0, UINT32_MAX)));
+  }
   if (auto v = field("russian_roulette_start"))
     s.russian_roulette_start = int32_t(r.signed_integer(*v, path("russian_roulette_start"), 0, kIntMax));
   if (auto v = field("safety_bounce_cap"))

@@ -158,6 +158,25 @@ TEST(BundleManifest, WriterAndReaderRoundTrip) {
   EXPECT_EQ(second.settings->sky, "0.1,0.2,0.3");
 }
 
+// Generated lightmap UVs (issue 13): "lightmap_uv": "generate" and the meshes that got them.
+TEST(BundleManifest, GeneratedLightmapUvsRoundTrip) {
+  json j = full_manifest();
+  j["settings"] = {{"lightmap_uv", "generate"}, {"generated_uv_meshes", {0, 3}}};
+  const Manifest first = parse(j);
+  ASSERT_TRUE(first.settings.has_value());
+  EXPECT_TRUE(first.settings->lightmap_uv_generate);
+  EXPECT_EQ(first.settings->generated_uv_meshes, (std::vector<uint32_t>{0, 3}));
+  const std::string written = formats::write_bundle_manifest(first);
+  EXPECT_EQ(json::parse(written)["settings"]["lightmap_uv"], "generate");
+  const Manifest second = parse_manifest(written, "written");
+  EXPECT_EQ(second.settings->generated_uv_meshes, first.settings->generated_uv_meshes);
+  j["settings"] = {{"lightmap_uv", 1}};
+  const Manifest numbered = parse(j);
+  EXPECT_FALSE(numbered.settings->lightmap_uv_generate);
+  EXPECT_EQ(numbered.settings->lightmap_uv, 1u);
+  EXPECT_TRUE(numbered.settings->generated_uv_meshes.empty());
+}
+
 TEST(BundleManifest, TheWriterRefusesWhatTheReaderWould) {
   Manifest m = parse(full_manifest());
   m.instances[0].scale_offset[2] = std::numeric_limits<float>::quiet_NaN();
@@ -183,6 +202,10 @@ TEST(BundleManifest, SettingsAndSceneFieldsAreCheckedByName) {
   refused("settings", {{"integrator", "photons"}}, "settings.integrator: \"photons\" is not path or bounces");
   refused("settings", {{"target_error", -0.5}}, "settings.target_error: negative");
   refused("settings", json::array(), "settings: expected an object, got array");
+  refused("settings", {{"lightmap_uv", "auto"}}, "settings.lightmap_uv: expected 0, 1 or \"generate\"");
+  refused("settings", {{"lightmap_uv", 2}}, "settings.lightmap_uv: 2 is outside 0..1");
+  refused("settings", {{"generated_uv_meshes", 3}}, "settings.generated_uv_meshes: expected an array, got number");
+  refused("settings", {{"generated_uv_meshes", {1, -1}}}, "settings.generated_uv_meshes[1]:");
   refused("scene", {{"file", "../scene.bin"}, {"format_version", 1}, {"bytes", 10}}, "scene.file: \"../scene.bin\" leaves the bundle folder");
   refused("scene", {{"file", "scene.bin"}, {"bytes", 10}}, "scene.format_version: missing");
   refused("scene", {{"skipped", ""}}, "scene.skipped: empty reason");

@@ -21,6 +21,7 @@ struct BakeOptions {
   std::string input;
   std::string output;          // empty = SCENE.bake next to the input
   std::string sky;             // "R,G,B" or an equirectangular image path; empty = black
+  std::string write_gltf;      // --write-gltf: the scene with its generated lightmap UVs; empty = none
   BackendRequest backend;
   ImportOptions import;
   AtlasSettings atlas;

@@ -89,7 +89,9 @@ struct BakeSettings {
   double texel_density = 0;
   uint32_t max_page = 2048;
   uint32_t padding = 2;
-  uint32_t lightmap_uv = 1;
+  uint32_t lightmap_uv = 1;                   // the TEXCOORD set read where a mesh has it
+  bool lightmap_uv_generate = false;          // --uv generate: written as "lightmap_uv": "generate"
+  std::vector<uint32_t> generated_uv_meshes;  // glTF meshes whose lightmap UVs bake generated
   int32_t russian_roulette_start = 3;
   int32_t safety_bounce_cap = 4096;
   std::string sky;                       // as --sky gave it; "" = black

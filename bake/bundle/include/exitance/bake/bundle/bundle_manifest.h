@@ -12,6 +12,7 @@
 #include "exitance/bake/layout/atlas_layout.h"
 #include "exitance/bake/probes/probe_placement.h"
 #include "exitance/bake/raster/geometry_checks.h"
+#include "exitance/bake/uvgen/scene_uv_generation.h"
 #include "exitance/bake/voxelize/svo_build.h"
 #include "exitance/formats/bundle_manifest.h"
 #include "exitance/formats/lightmap_exr.h"
@@ -43,6 +44,7 @@ struct BakeResults {
   const LightmapEstimate& lightmap;     // lighting
   const ProbeEstimate* probe_lighting;  // probe lighting (set exactly when `probes` is)
   const PersistedSceneFile& scene_file;  // scene file
+  const std::vector<MeshUvReport>* generated_uvs = nullptr;  // uv generation: the meshes whose UVs it made
 };
 
 // The manifest (formats/bundle_manifest.h) of the bake: `pages`: the assembled lightmap pages (the manifest lists their channels). `input_sha256`: the

@@ -11,9 +11,11 @@
 #include "exitance/bake/bake_options.h"
 #include "exitance/bake/bundle/bundle_manifest.h"
 #include "exitance/bake/diagnostics.h"
+#include "exitance/bake/import/gltf_import.h"
 #include "exitance/bake/layout/atlas_layout.h"
 #include "exitance/bake/probes/probe_placement.h"
 #include "exitance/bake/raster/geometry_checks.h"
+#include "exitance/bake/uvgen/scene_uv_generation.h"
 #include "exitance/bake/voxelize/svo_build.h"
 #include "exitance/runtime/core/estimates.h"
 #include "exitance/runtime/core/integrator.h"
@@ -33,8 +35,21 @@ struct SceneForLighting {
   std::shared_ptr<const LightingScene> lighting;
 };
 
-// import: the glTF file as a Scene (validated, repairs warned about), lit by the --sky radiance.
-Scene import_stage(const BakeOptions& options, Diagnostics& diagnostics);
+// import: the glTF file as a Scene (validated, repairs warned about), lit by the --sky radiance; the
+// meshes whose lightmap UVs must be generated (the chosen set missing, or --uv generate) are listed
+// in `without_lightmap_uvs`.
+Scene import_stage(const BakeOptions& options, Diagnostics& diagnostics,
+                   std::vector<MeshWithoutLightmapUvs>& without_lightmap_uvs);
+
+// uv generation: lightmap UVs for those meshes (bake/uvgen), written into the scene, packed for the
+// density and page the layout stage will use. Warns per mesh whose set was missing, and about
+// stretched charts.
+std::vector<MeshUvReport> uv_generation_stage(Scene& scene, const std::vector<MeshWithoutLightmapUvs>& without_lightmap_uvs,
+                                              const BakeOptions& options, Diagnostics& diagnostics);
+
+// write gltf (--write-gltf): the input scene again with the generated lightmap UVs as the chosen set.
+void write_gltf_stage(const std::vector<MeshUvReport>& generated_uvs, const BakeOptions& options,
+                      Diagnostics& diagnostics);
 
 // layout: one atlas rectangle per instance, at --texel-density (or the automatic density).
 AtlasLayout layout_stage(const Scene& scene, const BakeOptions& options, Diagnostics& diagnostics);
