@@ -34,7 +34,7 @@
 #include "exitance/runtime/core/grid_guiding_cache.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/bake/command/backend_choice.h"
-#include "exitance/bake/bundle/input_hash.h"
+#include "exitance/bake/cache/sha256_stream.h"
 #include "exitance/bake/command/prepared_scene.h"
 
 namespace fs = std::filesystem;

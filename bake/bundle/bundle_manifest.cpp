@@ -99,14 +99,8 @@ formats::SvoInfo svo_of(const formats::SparseVoxelOctree& svo) {
 json stats_json(const BakeResults& results, const json& seconds, size_t warnings, const BakeOptions& options) {
   const TexelGBuffer& gbuffer = results.gbuffer;
   const LightmapEstimate& estimate = results.lightmap;
-  // Mean relative standard error over live texels with signal; samples per texel.
-  double relative_error_sum = 0;
-  size_t relative_error_count = 0;
   uint64_t min_samples = gbuffer.texels.empty() ? 0 : UINT64_MAX, sample_sum = 0;
   for (size_t i = 0; i < gbuffer.texels.size(); ++i) {
-    const float mean = luminance(estimate.mean_total(i));
-    const float se = std::sqrt(luminance(estimate.variance_of_mean(i)));
-    if (mean > 0) relative_error_sum += se / mean, ++relative_error_count;
     min_samples = std::min<uint64_t>(min_samples, estimate.texels[i].samples);
     sample_sum += estimate.texels[i].samples;
   }
@@ -122,7 +116,7 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
   stats["rays_per_second"] = lighting_seconds > 0 ? double(estimate.rays) / lighting_seconds : 0.0;
   stats["samples_per_texel"] = {{"min", min_samples},
                                 {"mean", gbuffer.texels.empty() ? 0.0 : double(sample_sum) / double(gbuffer.texels.size())}};
-  stats["estimated_relative_error"] = relative_error_count ? relative_error_sum / double(relative_error_count) : 0.0;
+  stats["estimated_relative_error"] = estimate.mean_relative_standard_error();
   stats["unoccluded_texels"] = results.unoccluded_texels;
   stats["enclosed_texels"] = results.geometry.enclosed_texels;
   stats["coplanar_texels"] = results.geometry.coplanar_texels;

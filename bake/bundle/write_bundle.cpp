@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "exitance/bake/bundle/input_hash.h"
+#include "exitance/bake/cache/sha256_stream.h"
 #include "exitance/bake/bundle/radiance_vdb.h"
 #include "exitance/formats/lightmap_exr.h"
 #include "exitance/formats/probes_file.h"

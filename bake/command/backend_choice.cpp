@@ -80,4 +80,13 @@ std::shared_ptr<const Integrator> choose_lighting_backend(std::shared_ptr<const 
   }
 }
 
+std::string backend_candidates(const BackendRequest& request) {
+  if (request.name == "cpu") return "cpu";
+  std::string devices = request.name;
+  for (const VulkanDeviceInfo& d : enumerate_vulkan_devices())
+    devices += ";" + std::to_string(d.index) + ":" + d.name + ":" + to_string(d.type) + ":" +
+               std::to_string(d.api_version) + ":" + (d.usable ? "usable" : "unusable");
+  return devices;
+}
+
 }  // namespace exitance

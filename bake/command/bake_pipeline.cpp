@@ -1,12 +1,21 @@
 #include "exitance/bake/command/bake_pipeline.h"
 
+#include <algorithm>
 #include <chrono>
+#include <fstream>
+#include <iterator>
 #include <filesystem>
 #include <optional>
 #include <type_traits>
 
 #include "exitance/bake/bundle/write_bundle.h"
+#include "exitance/bake/cache/bake_cache_key.h"
+#include "exitance/bake/cache/bundle_cache.h"
+#include "exitance/bake/cache/sha256_stream.h"
+#include "exitance/bake/command/backend_choice.h"
 #include "exitance/bake/command/bake_stages.h"
+#include "exitance/formats/bundle_manifest.h"
+#include "exitance/runtime/stage_clock.h"
 
 namespace exitance {
 
@@ -16,29 +25,23 @@ using json = nlohmann::json;
 
 // stats.seconds: one lap per stage, each from the end of the stage before, so the laps add up to
 // the whole run.
-class StageClock {
+class StageTimer {
  public:
   template <class Stage>
   auto time(const char* stage_name, Stage&& stage) -> decltype(stage()) {
     if constexpr (std::is_void_v<decltype(stage())>) {
       stage();
-      seconds_[stage_name] = lap();
+      seconds_[stage_name] = clock_.lap();
     } else {
       auto result = stage();
-      seconds_[stage_name] = lap();
+      seconds_[stage_name] = clock_.lap();
       return result;
     }
   }
   const json& seconds() const { return seconds_; }
 
  private:
-  double lap() {
-    const auto now = std::chrono::steady_clock::now();
-    const double seconds = std::chrono::duration<double>(now - last_).count();
-    last_ = now;
-    return seconds;
-  }
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+  StageClock clock_;
   json seconds_ = json::object();
 };
 
@@ -50,13 +53,66 @@ json run_report(const WrittenBundle& bundle, const json& seconds) {
   return report;
 }
 
+// The stored manifest with stats.cache saying it was reused (the rest of its stats describe the
+// bake that computed it).
+std::string mark_reused(const std::string& manifest_text, const std::string& key) {
+  formats::BundleManifest manifest = formats::parse_bundle_manifest(manifest_text, "manifest.json");
+  json stats = manifest.stats_json.empty() ? json::object() : json::parse(manifest.stats_json);
+  stats["cache"] = {{"reused", true}, {"key", key}};
+  manifest.stats_json = stats.dump();
+  return formats::write_bundle_manifest(manifest);
+}
+
+// Warnings of the stored bake not given again by this run's import (which ran), in order.
+void repeat_stored_warnings(const std::vector<std::string>& stored, Diagnostics& diagnostics) {
+  std::vector<std::string> given = diagnostics.warnings;
+  for (const std::string& w : stored) {
+    auto found = std::find(given.begin(), given.end(), w);
+    if (found != given.end()) {
+      given.erase(found);
+      continue;
+    }
+    diagnostics.warn(w);
+  }
+}
+
 }  // namespace
 
 json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   // Offline stage (DESIGN §1): scene, atlas, texel G-buffer, the BVHs, the backend that will light them.
-  StageClock clock;
+  StageTimer clock;
   std::vector<MeshWithoutLightmapUvs> without_lightmap_uvs;
   Scene imported = clock.time("import", [&] { return import_stage(options, diagnostics, without_lightmap_uvs); });
+
+  // A bake of the same input with the same options and program is in the cache: reuse it. The key is
+  // taken before UV generation, which it determines (the scene, the options and the program).
+  std::optional<BundleCache> cache;
+  std::string cache_key;
+  if (!options.cache_directory.empty()) {
+    cache.emplace(options.cache_directory);
+    std::optional<json> reused = clock.time("cache", [&]() -> std::optional<json> {
+      options.announce_stage("cache");
+      cache_key =
+          bake_cache_key(imported, options, sha256_of_file(options.input), backend_candidates(options.backend));
+      std::vector<std::string> stored_warnings;
+      const std::filesystem::path out = bundle_folder(options);
+      auto edit = [&](const std::string& text) { return mark_reused(text, cache_key); };
+      if (!cache->restore(cache_key, out, edit, stored_warnings, diagnostics)) return std::nullopt;
+      repeat_stored_warnings(stored_warnings, diagnostics);
+      std::ifstream in(out / "manifest.json");
+      const formats::BundleManifest manifest = formats::parse_bundle_manifest(
+          std::string(std::istreambuf_iterator<char>(in), {}), (out / "manifest.json").string());
+      return json{{"stats", json::parse(manifest.stats_json)}, {"pages", manifest.pages.size()}};
+    });
+    if (reused) {
+      if (!options.write_gltf.empty()) {  // the UVs again (their warnings were repeated from the cache)
+        Diagnostics repeated;
+        write_gltf_stage(uv_generation_stage(imported, without_lightmap_uvs, options, repeated), options, diagnostics);
+      }
+      return run_report(WrittenBundle{bundle_folder(options), (*reused)["pages"].get<size_t>(), (*reused)["stats"]},
+                        clock.seconds());
+    }
+  }
   std::vector<MeshUvReport> generated_uvs;
   if (!without_lightmap_uvs.empty())
     generated_uvs = clock.time("uv_generation", [&] {
@@ -108,8 +164,12 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                             .probe_lighting = probe_lighting ? &*probe_lighting : nullptr,
                             .scene_file = scene_file,
                             .generated_uvs = &generated_uvs};
-  const WrittenBundle bundle =
+  WrittenBundle bundle =
       clock.time("write", [&] { return write_bundle_stage(results, clock.seconds(), diagnostics, options); });
+  if (cache) {
+    clock.time("cache_store", [&] { cache->store(cache_key, bundle.folder, diagnostics.warnings, diagnostics); });
+    bundle.stats["cache"] = {{"reused", false}, {"key", cache_key}};
+  }
   // After the bundle, so a failed bake writes neither.
   if (!options.write_gltf.empty()) write_gltf_stage(generated_uvs, options, diagnostics);
   return run_report(bundle, clock.seconds());

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "exitance/bake/bundle/write_bundle.h"
 #include "exitance/bake/command/bake_pipeline.h"
 #include "exitance/bake/input_error.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
@@ -50,7 +51,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"0", "1", "generate"}));
   app.add_option("--write-gltf", options.write_gltf,
                  "also write the scene with its generated lightmap UVs (as the --uv set) to this .gltf");
-  app.add_option("--spp", options.lighting.spp, "samples per texel (0 = until --time or --target-error ends the run)");
+  CLI::Option* spp_option = app.add_option(
+      "--spp", options.lighting.spp,
+      "samples per texel (default 128; 0 = until --time or --target-error ends the run, the default when either is given)");
   app.add_option("--time", options.lighting.time_budget_seconds, "stop the lighting stage after this many seconds")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--target-error", options.lighting.target_relative_error,
@@ -84,6 +87,12 @@ int main(int argc, char** argv) {
   app.add_option("--guiding-mix", options.lighting.guiding_mix,
                  "probability of the guided direction in the one-sample mixture with cosine sampling (default 0.5)")
       ->check(CLI::Range(0.0f, 1.0f));
+  std::string cache_directory;
+  bool no_cache = false;
+  app.add_option("--cache", cache_directory,
+                 "bundle cache folder: a bake of the same input with the same options reuses the stored bundle "
+                 "(default: .exitance-cache beside the output)");
+  app.add_flag("--no-cache", no_cache, "neither read nor fill the bundle cache");
   bool json_report = false;
   app.add_flag("--json", json_report, "print the run report as JSON on stdout");
   // --list-devices needs no scene: parse it before the required positional is enforced.
@@ -100,6 +109,9 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return e.get_exit_code() == 0 ? 0 : (code == 0 ? 0 : 2);
   }
+  // A time budget or a target error ends the run itself: no sample cap unless --spp asks for one.
+  if (spp_option->count() == 0 && (options.lighting.time_budget_seconds > 0 || options.lighting.target_relative_error > 0))
+    options.lighting.spp = 0;
   if (options.lighting.spp == 0 && options.lighting.time_budget_seconds <= 0 &&
       options.lighting.target_relative_error <= 0) {
     std::cerr << "bake: error: --spp 0 needs --time or --target-error to end the run\n";
@@ -159,6 +171,22 @@ int main(int argc, char** argv) {
     options.lighting.guiding = exitance::GuidingMode::Grid;
   }
 
+  if (no_cache && !cache_directory.empty()) {
+    std::cerr << "bake: error: --cache " << cache_directory << ": contradicts --no-cache\n";
+    return 2;
+  }
+  if (!no_cache) {
+    options.cache_directory = cache_directory.empty()
+                                  ? (exitance::bundle_folder(options).parent_path() / ".exitance-cache").string()
+                                  : cache_directory;
+    std::error_code error;
+    if (std::filesystem::exists(options.cache_directory, error) &&
+        !std::filesystem::is_directory(options.cache_directory, error)) {
+      std::cerr << "bake: error: --cache " << options.cache_directory << ": exists and is not a folder\n";
+      return 2;
+    }
+  }
+
   exitance::ProgressBar bar;
   options.progress = [&](const std::string& stage, double fraction, uint64_t rays) { bar.update(stage, fraction, rays); };
   try {
@@ -170,7 +198,9 @@ int main(int argc, char** argv) {
     } else {
       std::cerr << "bake: wrote " << report["output"].get<std::string>() << " (" << report["pages"].get<size_t>()
                 << " pages, " << report["live_texels"].get<size_t>() << " texels, "
-                << report["rays_per_second"].get<double>() * 1e-6 << " Mrays/s)\n";
+                << report["rays_per_second"].get<double>() * 1e-6 << " Mrays/s"
+                << (report.contains("cache") && report["cache"].value("reused", false) ? "; reused from the cache" : "")
+                << ")\n";
     }
     return 0;
   } catch (const exitance::InputError& e) {

@@ -134,6 +134,24 @@ uint32_t import_gltf_materials(const tinygltf::Model& model, const std::string& 
     material.emission = rgb_factor(source.emissiveFactor, {0, 0, 0}, file, element + " emissiveFactor") * strength;
     material.emissive_texture = textures.bind(source.emissiveTexture, element + " emissiveTexture");
     material.double_sided = source.doubleSided;
+    if (pbr.baseColorFactor.size() == 4) {
+      material.base_alpha = float(pbr.baseColorFactor[3]);
+      if (!std::isfinite(material.base_alpha) || material.base_alpha < 0 || material.base_alpha > 1)
+        throw InputError(file, element + " baseColorFactor", "alpha must be in [0, 1]");
+    }
+    if (source.alphaMode == "MASK" || source.alphaMode == "BLEND") {
+      material.alpha_mode = source.alphaMode == "MASK" ? Material::AlphaMode::Mask : Material::AlphaMode::Blend;
+      material.alpha_cutoff = float(source.alphaCutoff);
+      if (!std::isfinite(material.alpha_cutoff) || material.alpha_cutoff < 0)
+        throw InputError(file, element + " alphaCutoff", "must be a finite number >= 0");
+      if (material.alpha_mode == Material::AlphaMode::Blend && max_component(material.emission) > 0) {
+        // Stochastic transparency of an emitter would need its light sampling weighted by coverage.
+        diagnostics.warn(file + ": " + element + ": alphaMode BLEND on an emissive material: treated as OPAQUE");
+        material.alpha_mode = Material::AlphaMode::Opaque;
+      }
+    } else if (source.alphaMode != "OPAQUE" && !source.alphaMode.empty()) {
+      throw InputError(file, element + " alphaMode", "'" + source.alphaMode + "' is not OPAQUE, MASK or BLEND");
+    }
     if (max_component(material.base_color) > 1.0f) {
       diagnostics.warn(file + ": " + element + ": baseColorFactor above 1 clamped (energy would not be conserved)");
       material.base_color = min(material.base_color, Vec3{1, 1, 1});
@@ -142,6 +160,13 @@ uint32_t import_gltf_materials(const tinygltf::Model& model, const std::string& 
       diagnostics.warn(file + ": " + element + ": metallicFactor is 1 (the glTF default), so its diffuse albedo is 0");
     scene.materials.push_back(std::move(material));
   }
+  // Keep alpha only where a MASK or BLEND material's base colour reads it.
+  std::vector<uint8_t> alpha_read(scene.textures.size(), 0);
+  for (const Material& m : scene.materials)
+    if (m.alpha_mode != Material::AlphaMode::Opaque && m.base_color_texture.texture >= 0)
+      alpha_read[size_t(m.base_color_texture.texture)] = 1;
+  for (size_t t = 0; t < scene.textures.size(); ++t)
+    if (!alpha_read[t]) std::vector<float>().swap(scene.textures[t].alpha);
   Material fallback;
   fallback.name = "(default)";
   fallback.metallic = 0.0f;  // glTF's default material is metallic 1; a baker treats unmaterialed meshes as white diffuse

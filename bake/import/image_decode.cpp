@@ -97,6 +97,14 @@ Texture read_all(OIIO::ImageInput& input, const std::string& file, const std::st
       float v = pixels[i * n + (n >= 3 ? c : 0)];
       texture.rgb[i * 3 + c] = std::isfinite(v) ? v : 0.0f;
     }
+  // Alpha is the 4th channel (RGBA) or the 2nd (grey + alpha); linear, not sRGB-encoded.
+  if (n == 4 || n == 2) {
+    texture.alpha.resize(size_t(spec.width) * size_t(spec.height));
+    for (size_t i = 0; i < texture.alpha.size(); ++i) {
+      const float a = pixels[i * n + n - 1];
+      texture.alpha[i] = std::isfinite(a) ? std::clamp(a, 0.0f, 1.0f) : 1.0f;
+    }
+  }
   return texture;
 }
 
@@ -124,6 +132,7 @@ Texture read_linear_image_file(const std::string& path, const std::string& eleme
   if (!input) throw InputError(path, element, "cannot read image (" + one_line(OIIO::geterror()) + ")");
   Texture texture = read_all(*input, path, element);
   for (float& v : texture.rgb) v = std::max(v, 0.0f);
+  texture.alpha.clear();  // a sky has no coverage
   return texture;
 }
 

@@ -9,23 +9,10 @@
 #include <stdexcept>
 #include <vector>
 
+#include "exitance/runtime/world_box.h"
+
 namespace exitance {
 namespace {
-
-struct Bounds {
-  Vec3 lo{std::numeric_limits<float>::max(), std::numeric_limits<float>::max(), std::numeric_limits<float>::max()};
-  Vec3 hi{-std::numeric_limits<float>::max(), -std::numeric_limits<float>::max(), -std::numeric_limits<float>::max()};
-  bool empty() const { return !(lo.x <= hi.x); }
-};
-
-Bounds scene_bounds(const Scene& scene) {
-  Bounds b;
-  for (const Vec3& p : scene.positions) {
-    b.lo = min(b.lo, p);
-    b.hi = max(b.hi, p);
-  }
-  return b;
-}
 
 // Evenly spread unit directions (golden-angle spiral): deterministic, no clustering.
 std::vector<Vec3> fibonacci_sphere(uint32_t count) {
@@ -117,7 +104,7 @@ struct SiteTester {
 }  // namespace
 
 float automatic_probe_spacing(const Scene& scene) {
-  const Bounds b = scene_bounds(scene);
+  const WorldBox b = scene_world_box(scene);
   if (b.empty()) return 1.0f;
   const float extent = std::max({b.hi.x - b.lo.x, b.hi.y - b.lo.y, b.hi.z - b.lo.z});
   return extent > 0 && std::isfinite(extent) ? extent / 12.0f : 1.0f;
@@ -130,7 +117,7 @@ ProbePlacement place_probes(const Scene& scene, const EmbreeScene& embree, const
   if (settings.spacing < 0 || !std::isfinite(settings.spacing))
     throw std::invalid_argument("probe spacing must be a positive number");
   const float spacing = placement.automatic_spacing ? automatic_probe_spacing(scene) : settings.spacing;
-  const Bounds b = scene_bounds(scene);
+  const WorldBox b = scene_world_box(scene);
   formats::ProbeGrid& grid = placement.grid;
   grid.spacing = {spacing, spacing, spacing};
   if (b.empty()) return placement;

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "exitance/runtime/alpha_coverage.h"
+
 namespace exitance {
 namespace {
 
@@ -28,6 +30,24 @@ void reject_unless_accepted(const RTCFilterFunctionNArguments* args) {
     hit.b2 = RTCHitN_v(args->hit, args->N, i);
     hit.geometric_normal = triangle_normal(*filter->scene, hit.triangle);
     if (!(*filter->accept)(hit)) args->valid[i] = 0;
+  }
+}
+
+// Geometry filter for MASK and BLEND materials (alpha_coverage.h): a hit where the surface is
+// transparent for this ray is rejected, and Embree goes on to the next one.
+void reject_transparent_hits(const RTCFilterFunctionNArguments* args) {
+  const auto* scene = static_cast<const Scene*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    const uint32_t triangle = RTCHitN_primID(args->hit, args->N, i);
+    if (scene->materials[scene->triangle_material[triangle]].alpha_mode == Material::AlphaMode::Opaque) continue;
+    const Vec3 origin{RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
+                      RTCRayN_org_z(args->ray, args->N, i)};
+    const Vec3 direction{RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                         RTCRayN_dir_z(args->ray, args->N, i)};
+    const float u = blend_decision_number(origin, direction, triangle);
+    if (!hit_is_opaque(*scene, triangle, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i), u))
+      args->valid[i] = 0;
   }
 }
 
@@ -79,6 +99,11 @@ EmbreeScene::EmbreeScene(const Scene& scene) : scene_(scene) {
     indices[i] = uint32_t(i);
   }
   if (triangles > 0) extent_ = std::max(max_component(hi - lo), 1e-30f);
+  if (has_alpha_tested_materials(scene)) {
+    rtcSetGeometryUserData(geometry, const_cast<Scene*>(&scene_));
+    rtcSetGeometryIntersectFilterFunction(geometry, reject_transparent_hits);
+    rtcSetGeometryOccludedFilterFunction(geometry, reject_transparent_hits);
+  }
   rtcCommitGeometry(geometry);
   rtcAttachGeometry(rtc_scene_, geometry);
   rtcReleaseGeometry(geometry);

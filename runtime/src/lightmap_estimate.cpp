@@ -49,6 +49,17 @@ bool LightmapEstimate::relative_error_below(size_t texel, double target) const {
   return standard_error <= target * lum;
 }
 
+double LightmapEstimate::mean_relative_standard_error() const {
+  double sum = 0;
+  size_t count = 0;
+  for (size_t i = 0; i < texels.size(); ++i) {
+    const float mean = luminance(mean_total(i));
+    const float standard_error = std::sqrt(luminance(variance_of_mean(i)));
+    if (mean > 0) sum += standard_error / mean, ++count;
+  }
+  return count ? sum / double(count) : 0.0;
+}
+
 ShRgb ProbeEstimate::mean(size_t probe) const {
   ShRgb sh{};
   const uint32_t n = samples[probe];

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "exitance/common/material.h"
+#include "exitance/runtime/alpha_coverage.h"
 
 namespace exitance {
 namespace {
@@ -31,15 +32,13 @@ Vec2 interpolate(const std::vector<Vec2>& values, uint32_t triangle, float b1, f
 
 Vec3 lookup(const Scene& scene, const TextureBinding& binding, uint32_t triangle, float b1, float b2) {
   if (binding.texture < 0) return {1, 1, 1};
-  const std::vector<Vec2>& set = binding.transform.tex_coord == 1 ? scene.lightmap_uv : scene.uv0;
-  const Vec2 uv = apply_texture_transform(binding.transform, interpolate(set, triangle, b1, b2));
-  return sample_texture(scene.textures[size_t(binding.texture)], uv);
+  return sample_texture(scene.textures[size_t(binding.texture)], binding_uv(scene, binding, triangle, b1, b2));
 }
 
-}  // namespace
-
-Vec3 sample_texture(const Texture& texture, Vec2 uv) {
-  if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return texel(texture, 0, 0);
+// Bilinear filtering of fetch(x, y) over the texture's texels with its wrap modes.
+template <typename Fetch>
+auto bilinear(const Texture& texture, Vec2 uv, const Fetch& fetch) {
+  if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return fetch(0, 0);
   // Keep the coordinate small before flooring so huge UVs cannot overflow int.
   const float x = float(std::fmod(double(uv.x), 2.0 * 65536.0)) * float(texture.width) - 0.5f;
   const float y = float(std::fmod(double(uv.y), 2.0 * 65536.0)) * float(texture.height) - 0.5f;
@@ -48,8 +47,23 @@ Vec3 sample_texture(const Texture& texture, Vec2 uv) {
   const int x0 = int(fx), y0 = int(fy);
   const int xa = wrap_index(x0, texture.width, texture.wrap_s), xb = wrap_index(x0 + 1, texture.width, texture.wrap_s);
   const int ya = wrap_index(y0, texture.height, texture.wrap_t), yb = wrap_index(y0 + 1, texture.height, texture.wrap_t);
-  return (texel(texture, xa, ya) * (1 - tx) + texel(texture, xb, ya) * tx) * (1 - ty) +
-         (texel(texture, xa, yb) * (1 - tx) + texel(texture, xb, yb) * tx) * ty;
+  return (fetch(xa, ya) * (1 - tx) + fetch(xb, ya) * tx) * (1 - ty) + (fetch(xa, yb) * (1 - tx) + fetch(xb, yb) * tx) * ty;
+}
+
+}  // namespace
+
+Vec2 binding_uv(const Scene& scene, const TextureBinding& binding, uint32_t triangle, float b1, float b2) {
+  const std::vector<Vec2>& set = binding.transform.tex_coord == 1 ? scene.lightmap_uv : scene.uv0;
+  return apply_texture_transform(binding.transform, interpolate(set, triangle, b1, b2));
+}
+
+Vec3 sample_texture(const Texture& texture, Vec2 uv) {
+  return bilinear(texture, uv, [&](int x, int y) { return texel(texture, x, y); });
+}
+
+float sample_texture_alpha(const Texture& texture, Vec2 uv) {
+  if (texture.alpha.empty()) return 1.0f;
+  return bilinear(texture, uv, [&](int x, int y) { return texture.alpha[size_t(y) * size_t(texture.width) + size_t(x)]; });
 }
 
 Vec2 apply_texture_transform(const TextureTransform& t, Vec2 uv) {
@@ -69,6 +83,8 @@ Vec3 diffuse_albedo(const Scene& scene, uint32_t triangle, float b1, float b2) {
 Vec3 emitted_radiance(const Scene& scene, uint32_t triangle, float b1, float b2) {
   const Material& m = scene.materials[scene.triangle_material[triangle]];
   if (max_component(m.emission) <= 0.0f) return {0, 0, 0};
+  if (m.alpha_mode == Material::AlphaMode::Mask && surface_coverage(scene, triangle, b1, b2) < m.alpha_cutoff)
+    return {0, 0, 0};
   return m.emission * lookup(scene, m.emissive_texture, triangle, b1, b2);
 }
 

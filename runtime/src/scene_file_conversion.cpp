@@ -54,6 +54,8 @@ formats::SceneFile make_scene_file(const Scene& scene, const TexelGBuffer& gbuff
       throw FormatError(material_where(i, m) + "base colour texture: textures are not stored by scene.bin version 1");
     if (m.emissive_texture.texture >= 0)
       throw FormatError(material_where(i, m) + "emissive texture: textures are not stored by scene.bin version 1");
+    if (m.alpha_mode != Material::AlphaMode::Opaque)
+      throw FormatError(material_where(i, m) + "alphaMode: MASK and BLEND are not stored by scene.bin version 1");
     formats::MaterialRecord r;
     r.name = m.name;
     r.base_color = to_record(m.base_color);

@@ -19,11 +19,10 @@
 #include <string>
 
 #include "exitance/bake/command/prepared_scene.h"
-#include "exitance/bake/layout/atlas_layout.h"
-#include "exitance/bake/raster/texel_raster.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
-#include "support/analytic_scenes.h"
+#include "support/atlas_box.h"
+#include "support/independent_estimates.h"
 
 namespace exitance {
 namespace {
@@ -39,50 +38,6 @@ IntegratorSettings settings(uint32_t spp, uint64_t seed, GuidingMode guiding, fl
   s.guiding = guiding;
   s.guiding_mix = mix;
   return s;
-}
-
-struct SeedStatistics {
-  double mean = 0, standard_error = 0;
-};
-SeedStatistics over_seeds(const std::vector<double>& values) {
-  SeedStatistics s;
-  for (double v : values) s.mean += v;
-  s.mean /= double(values.size());
-  double sq = 0;
-  for (double v : values) sq += (v - s.mean) * (v - s.mean);
-  s.standard_error = std::sqrt(sq / double(values.size() - 1) / double(values.size()));
-  return s;
-}
-
-struct AtlasScene {
-  Scene scene;
-  TexelGBuffer gbuffer;
-};
-
-// The unit box with inward faces on a real atlas; emission[f] for face f (floor, ceiling, back,
-// front, left, right); optionally a small emitter of side `light_side` under the ceiling's centre.
-AtlasScene atlas_box(float albedo, const Vec3 (&emission)[6], float density, float light_side = 0, Vec3 light_le = {}) {
-  AtlasScene a;
-  const Vec3 ex{1, 0, 0}, ey{0, 1, 0}, ez{0, 0, 1}, o{0, 0, 0};
-  const Vec3 corner[6] = {o, ey, o, ez, o, ex};
-  const Vec3 u[6] = {ez, ex, ex, ey, ey, ez};
-  const Vec3 v[6] = {ex, ez, ey, ex, ez, ey};
-  for (int f = 0; f < 6; ++f) {
-    testing::add_quad(a.scene, corner[f], u[f], v[f], testing::add_material(a.scene, {albedo, albedo, albedo}, emission[f]));
-    a.scene.instances.back().name = "face" + std::to_string(f);
-  }
-  if (light_side > 0) {
-    const float lo = 0.5f - light_side / 2;
-    testing::add_quad(a.scene, {lo, 0.999f, lo}, ex * light_side, ez * light_side,
-                      testing::add_material(a.scene, {0, 0, 0}, light_le));
-    a.scene.instances.back().name = "light";
-  }
-  AtlasSettings atlas;
-  atlas.texel_density = density;
-  Diagnostics diagnostics;
-  const AtlasLayout layout = layout_lightmap_atlas(a.scene, atlas, "box", diagnostics);
-  a.gbuffer = rasterize_texel_gbuffer(a.scene, layout, "box", diagnostics);
-  return a;
 }
 
 // Luminance of E/pi averaged per instance (region), for one run.
@@ -118,7 +73,7 @@ double expect_regions_agree(const std::string& label, const Scene& scene, const 
   EXPECT_GT(double(guided_vertices), 0.5 * double(vertices_possible)) << label;
   std::vector<double> relative_se;
   for (auto& [region, values] : unguided) {
-    const SeedStatistics su = over_seeds(values), sg = over_seeds(guided[region]);
+    const testing::MeanAndError su = testing::mean_and_standard_error(values), sg = testing::mean_and_standard_error(guided[region]);
     const double se = std::hypot(su.standard_error, sg.standard_error);
     const double z = se > 0 ? (sg.mean - su.mean) / se : (sg.mean == su.mean ? 0.0 : INFINITY);
     std::printf("[guided] %s region %u: unguided %.5g guided %.5g (SE %.2g) z %+.2f\n", label.c_str(), region, su.mean,
@@ -134,7 +89,7 @@ TEST(GridGuiding, FurnaceReachesLeOverOneMinusAlbedo) {
   const Vec3 le{1.0f, 0.5f, 0.25f};
   const float rho = 0.5f;
   const Vec3 emission[6] = {le, le, le, le, le, le};
-  const AtlasScene box = atlas_box(rho, emission, 8);
+  const testing::AtlasScene box = testing::atlas_box(rho, emission, 8);
   const CpuReferenceIntegrator integrator(box.scene);
   for (int c = 0; c < 3; ++c) {
     std::vector<double> means;
@@ -146,7 +101,7 @@ TEST(GridGuiding, FurnaceReachesLeOverOneMinusAlbedo) {
       for (size_t i = 0; i < e.texels.size(); ++i) sum += e.mean_total(i)[c];
       means.push_back(sum / double(e.texels.size()));
     }
-    const SeedStatistics s = over_seeds(means);
+    const testing::MeanAndError s = testing::mean_and_standard_error(means);
     const double exact = le[c] / (1 - rho);
     std::printf("[guided] furnace ch%d: exact %.5g estimate %.6g SE %.2g\n", c, exact, s.mean, s.standard_error);
     EXPECT_LE(std::fabs(s.mean - exact), kZLimit * s.standard_error + 1e-6 * exact);
@@ -163,7 +118,7 @@ TEST(GridGuiding, FurnaceReachesLeOverOneMinusAlbedo) {
 TEST(GridGuiding, SmallBrightEmitterAgreesWithUnguided) {
   const Vec3 black{0, 0, 0};
   const Vec3 emission[6] = {black, black, black, black, black, black};
-  const AtlasScene box = atlas_box(0.6f, emission, 8, 0.2f, {200, 200, 200});
+  const testing::AtlasScene box = testing::atlas_box(0.6f, emission, 8, 0.2f, {200, 200, 200});
   const double se = expect_regions_agree("small emitter", box.scene, box.gbuffer, 256, 0.75f);
   EXPECT_LT(kZLimit * se, kDetectableBias) << "the test could not see a 10 % bias";
 }
@@ -216,7 +171,7 @@ TEST(GridGuiding, BitIdenticalPerSeedAndThreadCount) {
 TEST(GridGuiding, RefusedWhereNotImplemented) {
   const Vec3 le{1, 1, 1};
   const Vec3 emission[6] = {le, le, le, le, le, le};
-  const AtlasScene box = atlas_box(0.5f, emission, 4);
+  const testing::AtlasScene box = testing::atlas_box(0.5f, emission, 4);
   IntegratorSettings bounces = settings(4, 1, GuidingMode::Grid);
   bounces.integrator = IntegratorMode::Bounces;
   EXPECT_THROW(CpuReferenceIntegrator(box.scene).bake(box.gbuffer, bounces), std::invalid_argument);

@@ -18,13 +18,12 @@
 
 #include "exitance/bake/command/bake_pipeline.h"
 #include "exitance/bake/command/prepared_scene.h"
-#include "exitance/bake/layout/atlas_layout.h"
-#include "exitance/bake/raster/texel_raster.h"
 #include "exitance/common/bounce_gather.h"
 #include "exitance/formats/lightmap_exr.h"
 #include "exitance/runtime/core/bounce_tail.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
-#include "support/analytic_scenes.h"
+#include "support/atlas_box.h"
+#include "support/independent_estimates.h"
 
 namespace exitance {
 namespace {
@@ -32,54 +31,15 @@ namespace {
 constexpr double kZLimit = 4.0;  // two-sided, 16 seeds: p ~ 1e-3 under Student's t with 15 dof
 constexpr int kSeeds = 16;
 
-struct AtlasScene {
-  Scene scene;
-  TexelGBuffer gbuffer;
-};
-
-// The unit box with inward faces, each face its own instance (its own chart), on a real atlas at
-// `density` texels per unit. `emission[f]` for face f (floor, ceiling, back, front, left, right).
-AtlasScene atlas_box(float albedo, const Vec3 (&emission)[6], float density) {
-  AtlasScene a;
-  const Vec3 ex{1, 0, 0}, ey{0, 1, 0}, ez{0, 0, 1}, o{0, 0, 0};
-  const Vec3 corner[6] = {o, ey, o, ez, o, ex};
-  const Vec3 u[6] = {ez, ex, ex, ey, ey, ez};
-  const Vec3 v[6] = {ex, ez, ey, ex, ez, ey};
-  for (int f = 0; f < 6; ++f) {
-    testing::add_quad(a.scene, corner[f], u[f], v[f],
-                      testing::add_material(a.scene, {albedo, albedo, albedo}, emission[f]));
-    a.scene.instances.back().name = "face" + std::to_string(f);
-  }
-  AtlasSettings atlas;
-  atlas.texel_density = density;
-  Diagnostics diagnostics;
-  const AtlasLayout layout = layout_lightmap_atlas(a.scene, atlas, "box", diagnostics);
-  a.gbuffer = rasterize_texel_gbuffer(a.scene, layout, "box", diagnostics);
-  return a;
-}
-
-AtlasScene furnace_box(float albedo, Vec3 le, float density) {
+testing::AtlasScene furnace_box(float albedo, Vec3 le, float density) {
   const Vec3 emission[6] = {le, le, le, le, le, le};
-  return atlas_box(albedo, emission, density);
+  return testing::atlas_box(albedo, emission, density);
 }
 
 double mean_over_texels(const LightmapEstimate& e, int channel) {
   double sum = 0;
   for (size_t i = 0; i < e.texels.size(); ++i) sum += e.mean_total(i)[channel];
   return sum / double(e.texels.size());
-}
-
-struct SeedStatistics {
-  double mean = 0, standard_error = 0;
-};
-SeedStatistics over_seeds(const std::vector<double>& values) {
-  SeedStatistics s;
-  for (double v : values) s.mean += v;
-  s.mean /= double(values.size());
-  double sq = 0;
-  for (double v : values) sq += (v - s.mean) * (v - s.mean);
-  s.standard_error = std::sqrt(sq / double(values.size() - 1) / double(values.size()));
-  return s;
 }
 
 IntegratorSettings bounce_settings(uint32_t spp, uint64_t seed, int max_bounces = -1) {
@@ -95,7 +55,7 @@ IntegratorSettings bounce_settings(uint32_t spp, uint64_t seed, int max_bounces 
 // to Le (1 - rho^(K+1)) / (1 - rho); no resolution bias (the field is constant).
 void expect_furnace(float rho, int max_bounces, uint32_t spp) {
   const Vec3 le{1.0f, 0.5f, 0.25f};
-  const AtlasScene box = furnace_box(rho, le, 8);
+  const testing::AtlasScene box = furnace_box(rho, le, 8);
   ASSERT_EQ(box.gbuffer.texels.size(), 6u * 64u);
   const CpuReferenceIntegrator integrator(box.scene);
   for (int c = 0; c < 3; ++c) {
@@ -103,13 +63,15 @@ void expect_furnace(float rho, int max_bounces, uint32_t spp) {
     for (int seed = 0; seed < kSeeds; ++seed) {
       const LightmapEstimate e = integrator.bake(box.gbuffer, bounce_settings(spp, uint64_t(seed), max_bounces));
       const int k = e.bounce_statistics.bounces;
-      if (max_bounces >= 0) EXPECT_EQ(k, max_bounces);
+      if (max_bounces >= 0) {
+        EXPECT_EQ(k, max_bounces);
+      }
       EXPECT_EQ(e.bounce_statistics.texelless_hits, 0u) << "a closed box: every gather hit has texels";
       EXPECT_EQ(e.nonfinite_samples, 0u);
       const double expected = le[c] * (1 - std::pow(double(rho), k + 1)) / (1 - rho);
       ratios.push_back(mean_over_texels(e, c) / expected);
     }
-    const SeedStatistics s = over_seeds(ratios);
+    const testing::MeanAndError s = testing::mean_and_standard_error(ratios);
     std::printf("[per-bounce] furnace rho %.2f bounces %d ch%d: estimate/exact %.5f SE %.2g z %+.2f\n", rho, max_bounces,
                 c, s.mean, s.standard_error, (s.mean - 1) / s.standard_error);
     EXPECT_LE(std::fabs(s.mean - 1), kZLimit * s.standard_error) << "channel " << c;
@@ -129,7 +91,7 @@ TEST(PerBounce, FurnaceWithAutomaticBouncesMatchesTheSumOfTheBouncesRun) { expec
 // rho^(K+1) of the total here) below the noise of the total (half of it: kTailToNoise).
 TEST(PerBounce, TailCriterionRunsUntilTheTailIsBelowTheNoise) {
   const float rho = 0.9f;
-  const AtlasScene box = furnace_box(rho, {1, 1, 1}, 8);
+  const testing::AtlasScene box = furnace_box(rho, {1, 1, 1}, 8);
   const CpuReferenceIntegrator integrator(box.scene);
   std::vector<double> ratios;
   for (int seed = 0; seed < 8; ++seed) {
@@ -153,13 +115,13 @@ TEST(PerBounce, TailCriterionRunsUntilTheTailIsBelowTheNoise) {
     EXPECT_GE(k, last_bounce_rule + 15);
     ratios.push_back(mean_over_texels(e, 0) * (1 - rho) / (1 - truncated));
   }
-  const SeedStatistics s = over_seeds(ratios);
+  const testing::MeanAndError s = testing::mean_and_standard_error(ratios);
   std::printf("[per-bounce] rho 0.9: estimate / truncated closed form %.5f SE %.2g\n", s.mean, s.standard_error);
   EXPECT_LE(std::fabs(s.mean - 1), kZLimit * s.standard_error + 1e-6);
 }
 
 TEST(PerBounce, LayersSumToTheTotal) {
-  const AtlasScene box = furnace_box(0.7f, {1, 2, 3}, 4);
+  const testing::AtlasScene box = furnace_box(0.7f, {1, 2, 3}, 4);
   const LightmapEstimate e = CpuReferenceIntegrator(box.scene).bake(box.gbuffer, bounce_settings(8, 3));
   const int layers = e.bounce_statistics.bounces + 1;
   ASSERT_GE(layers, 3);
@@ -182,7 +144,7 @@ TEST(PerBounce, LayersSumToTheTotal) {
 // the layers still sum to the total. A target error stops the whole lightmap when every texel meets
 // it and the tail is below the noise.
 TEST(PerBounce, TimeBudgetAndTargetError) {
-  const AtlasScene box = furnace_box(0.7f, {1, 1, 1}, 8);
+  const testing::AtlasScene box = furnace_box(0.7f, {1, 1, 1}, 8);
   const CpuReferenceIntegrator integrator(box.scene);
   IntegratorSettings timed = bounce_settings(0, 5);
   timed.time_budget_seconds = 0.3;
@@ -210,7 +172,7 @@ TEST(PerBounce, TimeBudgetAndTargetError) {
   // A texel that never sees light (under a tile lying on the floor of a lit box) has no relative
   // error to meet: the run must still end, in both modes, well before a sample cap that only a run
   // the black texel kept going would reach.
-  AtlasScene covered = furnace_box(0.5f, {1, 1, 1}, 4);
+  testing::AtlasScene covered = furnace_box(0.5f, {1, 1, 1}, 4);
   const uint32_t tile = testing::add_material(covered.scene, {0.5f, 0.5f, 0.5f});
   testing::add_quad(covered.scene, {0.2f, 1e-4f, 0.2f}, {0, 0, 0.6f}, {0.6f, 0, 0}, tile);  // faces up
   LiveTexel under = covered.gbuffer.texels.front();
@@ -259,7 +221,7 @@ TEST(PerBounce, HitsWithoutTexelsAreEstimatedOnTheFly) {
 TEST(PerBounce, SmoothSceneAgreesWithThePathTracerWithinNoise) {
   const Vec3 black{0, 0, 0}, le{4, 4, 4};
   const Vec3 emission[6] = {black, le, black, black, black, black};
-  const AtlasScene box = atlas_box(0.6f, emission, 8);
+  const testing::AtlasScene box = testing::atlas_box(0.6f, emission, 8);
   const CpuReferenceIntegrator integrator(box.scene);
   auto face_means = [&](const LightmapEstimate& e) {
     std::vector<double> sum(6, 0.0), count(6, 0.0);
@@ -280,7 +242,7 @@ TEST(PerBounce, SmoothSceneAgreesWithThePathTracerWithinNoise) {
     for (int f = 0; f < 6; ++f) bounce_runs[size_t(f)].push_back(b[size_t(f)]), path_runs[size_t(f)].push_back(p[size_t(f)]);
   }
   for (int f = 0; f < 6; ++f) {
-    const SeedStatistics b = over_seeds(bounce_runs[size_t(f)]), p = over_seeds(path_runs[size_t(f)]);
+    const testing::MeanAndError b = testing::mean_and_standard_error(bounce_runs[size_t(f)]), p = testing::mean_and_standard_error(path_runs[size_t(f)]);
     const double se = std::hypot(b.standard_error, p.standard_error), z = (b.mean - p.mean) / se;
     std::printf("[per-bounce] ceiling-lit box face %d: bounces %.5f path %.5f difference %+.3f%% SE %.3f%% z %+.2f\n", f,
                 b.mean, p.mean, 100 * (b.mean - p.mean) / p.mean, 100 * se / p.mean, z);
@@ -372,7 +334,7 @@ TEST(PerBounce, VulkanBackendRefusesTheMode) {
   const std::vector<VulkanDeviceInfo> devices = enumerate_vulkan_devices();
   if (std::none_of(devices.begin(), devices.end(), [](const VulkanDeviceInfo& d) { return d.usable; }))
     GTEST_SKIP() << "no usable Vulkan device";
-  const AtlasScene box = furnace_box(0.5f, {1, 1, 1}, 4);
+  const testing::AtlasScene box = furnace_box(0.5f, {1, 1, 1}, 4);
   const std::unique_ptr<VulkanIntegrator> vulkan = VulkanIntegrator::create(make_lighting_scene(box.scene));
   EXPECT_THROW(vulkan->bake(box.gbuffer, bounce_settings(4, 1)), std::runtime_error);
 }

@@ -16,6 +16,7 @@
 #include "exitance/bake/command/bake_pipeline.h"
 #include "exitance/runtime/refresh/refresh_session.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
+#include "exitance/runtime/world_box.h"
 #include "support/engine_vulkan_device.h"
 
 namespace exitance {
@@ -210,14 +211,10 @@ CallsToError calls_to_error(uint32_t priority_samples) {
   session->refresh({0, 8});
   const double target = RefreshSession::estimated_relative_mse(session->lightmap());
   const Scene& before = session->persisted().scene;
-  Vec3 lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
+  WorldBox pavilion;
   for (const Instance& instance : before.instances)
-    if (instance.name == "Pavilion")
-      for (size_t v = size_t(instance.first_triangle) * 3; v < size_t(instance.first_triangle + instance.triangle_count) * 3; ++v) {
-        const Vec3& p = before.positions[v];
-        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-      }
+    if (instance.name == "Pavilion") pavilion.grow(instance_world_box(before, instance));
+  Vec3 lo = pavilion.lo, hi = pavilion.hi;
   session->apply_edits(parse_scene_edits(R"({"edits": [{"node": "Pavilion", "translation": [3.5, 0, 7]}]})", "e.json"));
   const TexelGBuffer& gbuffer = session->persisted().gbuffer;
   lo.x -= 3.0f;  // the move: 3 m towards -x

@@ -8,11 +8,13 @@
 #include <fstream>
 #include <limits>
 
+#include <OpenImageIO/imageio.h>
 #include <unistd.h>
 
 #include "exitance/bake/import/gltf_import.h"
 #include "exitance/bake/import/gltf_json_validation.h"
 #include "exitance/bake/input_error.h"
+#include "exitance/runtime/alpha_coverage.h"
 
 namespace exitance {
 namespace {
@@ -307,6 +309,72 @@ TEST(GltfImport, KeepsTheNodeHierarchyCamerasAndLightNodes) {
   for (const std::string& w : diagnostics.warnings)
     warned = warned || w.find("camera 1: invalid projection") != std::string::npos;
   EXPECT_TRUE(warned);
+}
+
+// alphaMode, alphaCutoff and baseColorFactor's alpha reach the material, and an RGBA base colour
+// texture keeps its alpha (linear) for MASK; an OPAQUE material's texture drops it.
+TEST(GltfImport, AlphaModeCutoffAndTextureAlphaReachTheMaterial) {
+  const auto dir = std::filesystem::temp_directory_path() / ("gltf_alpha_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string png = (dir / "rgba.png").string();
+  {
+    const unsigned char pixels[8] = {255, 255, 255, 0, 255, 255, 255, 255};  // 2 x 1: transparent, opaque
+    auto out = OIIO::ImageOutput::create(png);
+    ASSERT_TRUE(out);
+    ASSERT_TRUE(out->open(png, OIIO::ImageSpec(2, 1, 4, OIIO::TypeDesc::UINT8)));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels));
+    out->close();
+  }
+  json document = triangle_document();
+  document["images"] = json::array({{{"uri", "rgba.png"}}});
+  document["textures"] = json::array({{{"source", 0}}});
+  document["materials"] = json::parse(R"([
+    {"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.8], "baseColorTexture": {"index": 0}, "metallicFactor": 0},
+     "alphaMode": "MASK", "alphaCutoff": 0.3},
+    {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0}, "alphaMode": "BLEND"},
+    {"pbrMetallicRoughness": {"metallicFactor": 0}}])");
+  document["meshes"][0]["primitives"][0]["material"] = 0;
+  const std::string path = (dir / "alpha.gltf").string();
+  std::ofstream(path) << document.dump();
+  Diagnostics diagnostics;
+  const Scene scene = import_gltf(path, ImportOptions{}, diagnostics);
+  std::filesystem::remove_all(dir);
+  ASSERT_GE(scene.materials.size(), 3u);
+  EXPECT_EQ(scene.materials[0].alpha_mode, Material::AlphaMode::Mask);
+  EXPECT_FLOAT_EQ(scene.materials[0].alpha_cutoff, 0.3f);
+  EXPECT_FLOAT_EQ(scene.materials[0].base_alpha, 0.8f);
+  EXPECT_EQ(scene.materials[1].alpha_mode, Material::AlphaMode::Blend);
+  EXPECT_FLOAT_EQ(scene.materials[1].base_alpha, 1.0f);
+  EXPECT_EQ(scene.materials[2].alpha_mode, Material::AlphaMode::Opaque);
+  ASSERT_EQ(scene.textures.size(), 1u);
+  ASSERT_EQ(scene.textures[0].alpha.size(), 2u);
+  EXPECT_EQ(scene.textures[0].alpha[0], 0.0f);
+  EXPECT_EQ(scene.textures[0].alpha[1], 1.0f);
+  // Coverage is base alpha times the bilinear texture alpha: the triangle has no TEXCOORD_0, so UV
+  // (0, 0), which the default REPEAT sampler filters halfway between the right and the left texel.
+  EXPECT_NEAR(surface_coverage(scene, 0, 0, 0), 0.8f * 0.5f, 1e-6f);
+}
+
+// A bad alphaCutoff or an alpha outside [0, 1] is an error naming the material.
+TEST(GltfImport, BadAlphaValuesAreErrorsNamingTheMaterial) {
+  const auto dir = std::filesystem::temp_directory_path() / ("gltf_alpha_bad_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  for (const char* material : {R"({"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1.5]}})",
+                               R"({"alphaMode": "MASK", "alphaCutoff": -1})"}) {
+    json document = triangle_document();
+    document["materials"] = json::array({json::parse(material)});
+    document["meshes"][0]["primitives"][0]["material"] = 0;
+    const std::string path = (dir / "bad_alpha.gltf").string();
+    std::ofstream(path) << document.dump();
+    Diagnostics diagnostics;
+    try {
+      import_gltf(path, ImportOptions{}, diagnostics);
+      ADD_FAILURE() << material << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(e.element().find("material 0"), std::string::npos) << e.element();
+    }
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -4,16 +4,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "exitance/runtime/world_box.h"
+
 namespace exitance {
-namespace {
-
-struct Box {
-  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-  void grow(const Box& b) { lo = min(lo, b.lo), hi = max(hi, b.hi); }
-  void grow(Vec3 p) { lo = min(lo, p), hi = max(hi, p); }
-};
-
-}  // namespace
 
 void refit_bvh4(Bvh4& bvh, const std::vector<Vec3>& positions) {
   const size_t triangle_count = positions.size() / 3;
@@ -34,13 +27,13 @@ void refit_bvh4(Bvh4& bvh, const std::vector<Vec3>& positions) {
       }
     }
   // Children come after their parents: one pass from the last node up sees every child's box first.
-  std::vector<Box> node_box(bvh.nodes.size());
+  std::vector<WorldBox> node_box(bvh.nodes.size());
   for (size_t n = bvh.nodes.size(); n-- > 0;) {
     Bvh4Node& node = bvh.nodes[n];
     for (int i = 0; i < 4; ++i) {
       const uint32_t child = node.child[i];
       if (child == kBvhEmptyChild) continue;  // its box stays the builder's empty one
-      Box box;
+      WorldBox box;
       if (child & kBvhLeafBit) {
         const uint32_t first = (child & ~kBvhLeafBit) >> 2, count = (child & 3u) + 1;
         for (uint32_t s = first; s < first + count; ++s)

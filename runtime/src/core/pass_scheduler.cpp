@@ -1,6 +1,7 @@
 #include "exitance/runtime/core/pass_scheduler.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace exitance {
 
@@ -9,12 +10,29 @@ PassScheduler::PassScheduler(const IntegratorSettings& settings, PassPolicy poli
   policy_.largest_pass = std::max(policy_.largest_pass, 1u);
 }
 
-bool PassScheduler::next_pass(uint32_t& begin, uint32_t& count) {
+bool PassScheduler::next_pass(uint32_t& begin, uint32_t& count, double* fraction) {
+  if (fraction) *fraction = 1;
+  pending_fraction_ = 1;
   if (stopped_ || done_ >= limit_) return false;
   uint32_t pass = std::min(limit_ - done_, policy_.largest_pass);
   if (policy_.ramp) pass = std::min(pass, done_ < 4 ? 1u : (done_ < 64 ? 4u : 16u));
   if (policy_.stratified_set > 0 && timed())
     pass = std::min(pass, policy_.stratified_set - done_ % policy_.stratified_set);
+  pass_start_seconds_ = elapsed_seconds();
+  if (timed() && policy_.stratified_set == 0 && seconds_per_sample_ > 0) {
+    const double left = settings_.time_budget_seconds - pass_start_seconds_;
+    const double samples_left = left / seconds_per_sample_;
+    if (samples_left < (fraction ? 0.02 : 0.5)) {
+      stopped_ = true;
+      return false;
+    }
+    if (fraction && samples_left < 1) {
+      pass = 1;
+      *fraction = pending_fraction_ = samples_left;
+    } else {
+      pass = uint32_t(std::min<double>(pass, std::max(1.0, std::floor(samples_left))));
+    }
+  }
   begin = done_;
   count = pending_ = pass;
   return true;
@@ -26,8 +44,9 @@ double PassScheduler::elapsed_seconds() const {
 
 void PassScheduler::finish_pass(uint64_t rays_so_far, bool all_converged) {
   done_ += pending_;
-  pending_ = 0;
   const double elapsed = elapsed_seconds();
+  if (pending_ > 0) seconds_per_sample_ = (elapsed - pass_start_seconds_) / (double(pending_) * pending_fraction_);
+  pending_ = 0;
   if (settings_.progress) {
     const double by_spp = settings_.spp ? double(done_) / double(settings_.spp) : 0.0;
     const double by_time = timed() ? elapsed / settings_.time_budget_seconds : 0.0;

@@ -155,6 +155,10 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     return bake_per_bounce(*impl_->lighting, *impl_->embree, gbuffer, settings);
   }
   const auto start = std::chrono::steady_clock::now();
+  // Started first, so the time budget covers the allocations below too.
+  PassPolicy policy;
+  policy.ramp = true;  // small passes early so progress and the time budget are honoured; larger later
+  PassScheduler passes(settings, policy);
   const size_t texel_count = gbuffer.texels.size();
   LightmapEstimate estimate;
   estimate.recorded_bounces = std::clamp(settings.recorded_bounces, 1, kMaxRecordedBounces);
@@ -165,9 +169,6 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   tbb::combinable<uint64_t> nonfinite_per_thread([] { return uint64_t(0); });
   tbb::combinable<uint64_t> guided_per_thread([] { return uint64_t(0); });
 
-  PassPolicy policy;
-  policy.ramp = true;  // small passes early so progress and the time budget are honoured; larger later
-  PassScheduler passes(settings, policy);
   // Built inside the timed bake: guided results are measured with the cost of their guiding data.
   std::unique_ptr<GridGuidingCache> guide;
   if (settings.guiding == GuidingMode::Grid) {
@@ -177,8 +178,13 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     guide = std::make_unique<GridGuidingCache>(*impl_->lighting, gbuffer, config);
   }
   uint32_t first = 0, count = 0;
-  while (passes.next_pass(first, count)) {
+  double fraction = 1;
+  while (passes.next_pass(first, count, &fraction)) {
     const bool learning = guide && first < kGuidingLearningSamples;
+    // The last pass of a time budget may cover only part of the texels: a hashed choice spread over
+    // the whole atlas (so the pass costs its fraction of a full one), different for every sample.
+    const uint64_t covered_below = fraction < 1 ? uint64_t(fraction * 0x1.0p53) : UINT64_MAX;
+    const uint64_t salt = splitmix64(settings.seed ^ (uint64_t(first) << 32));
     tbb::parallel_for(tbb::blocked_range<size_t>(0, texel_count, 64), [&](const tbb::blocked_range<size_t>& range) {
       uint64_t& rays = rays_per_thread.local();
       uint64_t& nonfinite = nonfinite_per_thread.local();
@@ -186,6 +192,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       PathContributions contributions;
       for (size_t i = range.begin(); i != range.end(); ++i) {
         if (converged[i]) continue;
+        if (covered_below != UINT64_MAX && (splitmix64(salt + i) >> 11) >= covered_below) continue;
         const LiveTexel& texel = gbuffer.texels[i];
         const SurfacePoint point{texel.position, texel.geometric_normal, texel.shading_normal};
         TexelAccumulator& acc = estimate.texels[i];

@@ -15,39 +15,17 @@
 #include "exitance/runtime/bundle/lightmap_assembly.h"
 #include "exitance/runtime/bundle/probe_results.h"
 #include "exitance/runtime/bundle/texel_exitance.h"
+#include "exitance/runtime/stage_clock.h"
 
 namespace exitance {
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
-namespace {
-
-// Mean over live texels with signal of the relative standard error of the luminance (the
-// manifest's estimated_relative_error, as bake reports it).
-double mean_relative_error(const LightmapEstimate& estimate) {
-  double sum = 0;
-  size_t count = 0;
-  for (size_t i = 0; i < estimate.texels.size(); ++i) {
-    const float mean = luminance(estimate.mean_total(i));
-    const float se = std::sqrt(luminance(estimate.variance_of_mean(i)));
-    if (mean > 0) sum += se / mean, ++count;
-  }
-  return count ? sum / double(count) : 0.0;
-}
-
-}  // namespace
-
 json write_refreshed_bundle(RefreshSession& session, const std::string& output, json report,
                             const StageProgress& progress, const std::function<void()>& check_before_write) {
-  using Clock = std::chrono::steady_clock;
-  auto last = Clock::now();
+  StageClock clock;
   json seconds = json::object();
-  auto lap = [&](const char* stage) {
-    const auto now = Clock::now();
-    seconds[stage] = std::chrono::duration<double>(now - last).count();
-    last = now;
-  };
   auto stage = [&](const char* name) {
     if (progress) progress(name, 0, 0);
   };
@@ -66,7 +44,7 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
       if (formats::probe_is_usable(persisted.probes.probes[i])) traced.push_back(i);
     probe_estimate = session.probe_estimate(baked.probe_spp);
     store_probe_radiance(persisted.probes, traced, probe_estimate, baked.probe_dering_window);
-    lap("probes");
+    seconds["probes"] = clock.lap();
   }
 
   std::optional<formats::SparseVoxelOctree> svo;
@@ -74,7 +52,7 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
     stage("exitance");
     svo = *session.svo();
     fill_svo_exitance(*svo, persisted.scene, persisted.gbuffer, estimate);
-    lap("exitance");
+    seconds["exitance"] = clock.lap();
   }
 
   stage("write");
@@ -104,7 +82,7 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   report["seed"] = session.settings().seed;
   report["rays"] = estimate.rays;
   report["probe_rays"] = probe_estimate.rays;
-  report["estimated_relative_error"] = mean_relative_error(estimate);
+  report["estimated_relative_error"] = estimate.mean_relative_standard_error();
   const double relative_mse = RefreshSession::estimated_relative_mse(estimate);
   report["estimated_relative_mse"] = std::isfinite(relative_mse) ? json(relative_mse) : json(nullptr);
   report["live_texels"] = persisted.gbuffer.texels.size();
@@ -146,7 +124,7 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   } catch (const std::exception& e) {
     throw BundleWriteError(e.what());
   }
-  lap("write");
+  seconds["write"] = clock.lap();
   report["seconds"] = seconds;
   report["output"] = fs::absolute(out).string();
   return report;

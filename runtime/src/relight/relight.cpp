@@ -11,6 +11,7 @@
 
 #include "exitance/formats/bundle_manifest.h"
 #include "exitance/runtime/refresh/refreshed_bundle.h"
+#include "exitance/runtime/stage_clock.h"
 #include "exitance/runtime/vulkan/validation_messages.h"
 
 namespace exitance {
@@ -20,13 +21,8 @@ using json = nlohmann::json;
 
 json relight_bundle(const RelightOptions& options) {
   using Clock = std::chrono::steady_clock;
-  auto last = Clock::now();
+  StageClock clock;
   json seconds = json::object();
-  auto lap = [&](const char* stage) {
-    const auto now = Clock::now();
-    seconds[stage] = std::chrono::duration<double>(now - last).count();
-    last = now;
-  };
   auto report = [&](const std::string& stage, double fraction, uint64_t rays) {
     if (options.progress) options.progress(stage, fraction, rays);
   };
@@ -45,7 +41,7 @@ json relight_bundle(const RelightOptions& options) {
   if (options.validation) session_options.device.on_validation_message = ValidationMessages::collector(validation);
   const std::unique_ptr<RefreshSession> session = RefreshSession::open(options.bundle, session_options);
   const formats::BakeSettings baked = session->manifest().settings.value_or(formats::BakeSettings{});
-  lap("load");
+  seconds["load"] = clock.lap();
 
   json edits_report;
   if (!options.edits_file.empty()) {
@@ -66,7 +62,7 @@ json relight_bundle(const RelightOptions& options) {
     } catch (const SceneEditError& e) {
       throw RelightInputError(e.what());
     }
-    lap("edits");
+    seconds["edits"] = clock.lap();
   }
 
   // The sample cap: --spp, else the bake's unless a time budget bounds the run.
@@ -119,7 +115,7 @@ json relight_bundle(const RelightOptions& options) {
     if (r.capped) break;
   }
   const double lighting_seconds = std::chrono::duration<double>(Clock::now() - lighting_start).count();
-  lap("lighting");
+  seconds["lighting"] = clock.lap();
   json stages = json::array();
   if (options.stage_statistics)
     for (const VulkanStageStatistics& s : session->integrator().stage_statistics())

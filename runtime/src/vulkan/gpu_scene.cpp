@@ -67,6 +67,11 @@ void check_supported_by_vulkan(const LightingScene& scene) {
       if (m.base_color_texture.texture >= 0 || m.emissive_texture.texture >= 0)
         throw std::runtime_error("Vulkan backend: textured materials are not supported yet (material '" + m.name +
                                  "'; use the cpu backend)");
+  if (scene.source)
+    for (const Material& m : scene.source->materials)
+      if (m.alpha_mode != Material::AlphaMode::Opaque)
+        throw std::runtime_error("Vulkan backend: alphaMode MASK and BLEND are not supported yet (material '" + m.name +
+                                 "'; use the cpu backend)");
   if (scene.bvh.nodes.empty()) throw std::invalid_argument("Vulkan backend: the scene has no BVH4 (build_bvh4 or scene.bin)");
 }
 

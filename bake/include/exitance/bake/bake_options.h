@@ -35,6 +35,10 @@ struct BakeOptions {
   // Sparse voxel octree with radiant exitance (svo.bin, radiance.vdb): --voxel-resolution.
   bool svo_enabled = true;
   uint32_t voxel_resolution = 0;  // power of two; 0 = automatic (leaves about 4 texels wide)
+  // The bundle cache (bake/cache/bundle_cache.h): a folder, or empty for none. Empty by default
+  // here; the bake command defaults to .exitance-cache beside OUT (--cache DIR, --no-cache).
+  // Not part of the cache key: where results are kept does not change them.
+  std::string cache_directory;
   // Stage reporting for the progress bar: (stage name, fraction done, rays so far).
   std::function<void(const std::string&, double, uint64_t)> progress;
 

@@ -15,6 +15,9 @@ struct Texture {
   int width = 0;
   int height = 0;
   std::vector<float> rgb;  // width * height * 3, linear
+  // width * height coverage in [0, 1] (glTF alpha is linear); empty when the image has no alpha or
+  // no material reads it (only the base colour of a MASK or BLEND material does).
+  std::vector<float> alpha;
   enum class Wrap { Repeat, ClampToEdge, MirroredRepeat };
   Wrap wrap_s = Wrap::Repeat;
   Wrap wrap_t = Wrap::Repeat;
@@ -41,6 +44,13 @@ struct Material {
   Vec3 emission{0, 0, 0};  // emissiveFactor * KHR_materials_emissive_strength
   TextureBinding emissive_texture;
   bool double_sided = false;
+  // glTF alphaMode: coverage = base_alpha * base colour texture alpha. MASK: rays pass where
+  // coverage < alpha_cutoff. BLEND: stochastic transparency, a ray passes with probability
+  // 1 - coverage (alpha_coverage.h).
+  enum class AlphaMode { Opaque, Mask, Blend };
+  AlphaMode alpha_mode = AlphaMode::Opaque;
+  float alpha_cutoff = 0.5f;
+  float base_alpha = 1.0f;  // baseColorFactor[3]
 };
 
 struct PunctualLight {

@@ -49,6 +49,9 @@ struct LightmapEstimate {
   // The target-error test of --target-error: relative standard error of the luminance below `target`;
   // a texel black with no variance after 16 samples or more counts as met.
   bool relative_error_below(size_t texel, double target) const;
+  // Mean over texels with signal of the relative standard error of the luminance (the manifest's
+  // stats.estimated_relative_error).
+  double mean_relative_standard_error() const;
 };
 
 

@@ -23,8 +23,14 @@ class PassScheduler {
  public:
   PassScheduler(const IntegratorSettings& settings, PassPolicy policy);
 
-  // The next pass's samples [begin, begin + count); false when the bake is done.
-  bool next_pass(uint32_t& begin, uint32_t& count);
+  // The next pass's samples [begin, begin + count); false when the bake is done. Under a time budget
+  // (outside stratified sets) a pass is cut to what the budget has left at the last pass's cost per
+  // sample, and the run stops when less than half a sample's time is left (without `fraction`) or
+  // less than 2 % of a sample's time: it ends near the budget instead of overrunning by a pass.
+  // A backend that can run a sample over part of its items passes `fraction`: the last pass of a
+  // time budget may then be one sample over that fraction of the items (else `fraction` is 1), so
+  // the run ends within a small part of a one-sample pass of the budget.
+  bool next_pass(uint32_t& begin, uint32_t& count, double* fraction = nullptr);
   // Reports the pass just run (progress callback) and decides whether the bake stops here: at the
   // sample cap, at the time budget, or when `all_converged` (the integrator's target-error test).
   void finish_pass(uint64_t rays_so_far, bool all_converged = false);
@@ -39,6 +45,9 @@ class PassScheduler {
   uint32_t limit_;
   uint32_t done_ = 0;
   uint32_t pending_ = 0;  // samples of the pass handed out by next_pass
+  double pending_fraction_ = 1;  // of the items that pass covers
+  double pass_start_seconds_ = 0;
+  double seconds_per_sample_ = 0;  // of the last pass: sizes the next one to what the budget has left
   bool stopped_ = false;
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };

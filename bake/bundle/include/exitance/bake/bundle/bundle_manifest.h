@@ -48,7 +48,7 @@ struct BakeResults {
 };
 
 // The manifest (formats/bundle_manifest.h) of the bake: `pages`: the assembled lightmap pages (the manifest lists their channels). `input_sha256`: the
-// input file's hash (input_hash.h). `seconds`: stats.seconds, the stages timed so far. `warnings`:
+// input file's hash (cache/sha256_stream.h). `seconds`: stats.seconds, the stages timed so far. `warnings`:
 // how many warnings the run has given.
 formats::BundleManifest build_bundle_manifest(const BakeResults& results,
                                               const std::vector<formats::LightmapImage>& pages,

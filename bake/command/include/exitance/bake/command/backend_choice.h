@@ -21,4 +21,8 @@ std::shared_ptr<const Integrator> choose_lighting_backend(std::shared_ptr<const 
                                                           std::shared_ptr<const EmbreeScene> embree,
                                                           const BackendRequest& request, Diagnostics& diagnostics);
 
+// What `request` may choose among, for the bake cache's key: "cpu" for --backend cpu, else the
+// Vulkan devices present (name, type, API version, usable).
+std::string backend_candidates(const BackendRequest& request);
+
 }  // namespace exitance
