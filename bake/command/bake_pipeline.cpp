@@ -83,30 +83,17 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   StageTimer clock;
   std::vector<MeshWithoutLightmapUvs> without_lightmap_uvs;
   Scene imported = clock.time("import", [&] { return import_stage(options, diagnostics, without_lightmap_uvs); });
-  std::vector<MeshUvReport> generated_uvs;
-  auto generate_uvs = [&] {
-    if (!without_lightmap_uvs.empty())
-      generated_uvs = clock.time("uv_generation", [&] {
-        return uv_generation_stage(imported, without_lightmap_uvs, options, diagnostics);
-      });
-  };
-  // The cache key is taken from the imported scene before UV generation (which is deterministic in
-  // the scene and the options), so it does not depend on --write-gltf.
+
+  // A bake of the same input with the same options and program is in the cache: reuse it. The key is
+  // taken before UV generation, which it determines (the scene, the options and the program).
   std::optional<BundleCache> cache;
   std::string cache_key;
   if (!options.cache_directory.empty()) {
     cache.emplace(options.cache_directory);
-    cache_key = clock.time("cache_key", [&] {
-      options.announce_stage("cache");
-      return bake_cache_key(imported, options, sha256_of_file(options.input), backend_candidates(options.backend));
-    });
-  }
-  // --write-gltf needs the generated UVs even when the bundle comes from the cache.
-  if (!options.write_gltf.empty()) generate_uvs();
-
-  // A bake of the same input with the same options and program is in the cache: reuse it.
-  if (cache) {
     std::optional<json> reused = clock.time("cache", [&]() -> std::optional<json> {
+      options.announce_stage("cache");
+      cache_key =
+          bake_cache_key(imported, options, sha256_of_file(options.input), backend_candidates(options.backend));
       std::vector<std::string> stored_warnings;
       const std::filesystem::path out = bundle_folder(options);
       auto edit = [&](const std::string& text) { return mark_reused(text, cache_key); };
@@ -118,12 +105,19 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
       return json{{"stats", json::parse(manifest.stats_json)}, {"pages", manifest.pages.size()}};
     });
     if (reused) {
-      if (!options.write_gltf.empty()) write_gltf_stage(generated_uvs, options, diagnostics);
+      if (!options.write_gltf.empty()) {  // the UVs again (their warnings were repeated from the cache)
+        Diagnostics repeated;
+        write_gltf_stage(uv_generation_stage(imported, without_lightmap_uvs, options, repeated), options, diagnostics);
+      }
       return run_report(WrittenBundle{bundle_folder(options), (*reused)["pages"].get<size_t>(), (*reused)["stats"]},
                         clock.seconds());
     }
   }
-  if (options.write_gltf.empty()) generate_uvs();
+  std::vector<MeshUvReport> generated_uvs;
+  if (!without_lightmap_uvs.empty())
+    generated_uvs = clock.time("uv_generation", [&] {
+      return uv_generation_stage(imported, without_lightmap_uvs, options, diagnostics);
+    });
   const AtlasLayout layout = clock.time("layout", [&] { return layout_stage(imported, options, diagnostics); });
   TexelGBuffer gbuffer = clock.time("raster", [&] { return raster_stage(imported, layout, options, diagnostics); });
   const SceneForLighting scene =
@@ -172,12 +166,12 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                             .generated_uvs = &generated_uvs};
   WrittenBundle bundle =
       clock.time("write", [&] { return write_bundle_stage(results, clock.seconds(), diagnostics, options); });
-  // After the bundle, so a failed bake writes neither.
-  if (!options.write_gltf.empty()) write_gltf_stage(generated_uvs, options, diagnostics);
   if (cache) {
     clock.time("cache_store", [&] { cache->store(cache_key, bundle.folder, diagnostics.warnings, diagnostics); });
     bundle.stats["cache"] = {{"reused", false}, {"key", cache_key}};
   }
+  // After the bundle, so a failed bake writes neither.
+  if (!options.write_gltf.empty()) write_gltf_stage(generated_uvs, options, diagnostics);
   return run_report(bundle, clock.seconds());
 }
 

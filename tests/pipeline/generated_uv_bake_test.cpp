@@ -97,5 +97,41 @@ TEST(GeneratedUvBake, WriteGltfHasTheGeneratedTexcoord1) {
   fs::remove_all(dir);
 }
 
+// The bundle cache (issue 12) keys a bake before UV generation, which the scene and options
+// determine: a second bake reuses the first, still writes --write-gltf, and --uv generate is a new key.
+TEST(GeneratedUvBake, CachedBakeIsReusedAndStillWritesTheGltf) {
+  const fs::path dir = fs::temp_directory_path() / ("exitance-test-uv-cache-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  auto options_for = [&](const std::string& out) {
+    BakeOptions options;
+    options.input = std::string(EXITANCE_HOSTILE_DIR) + "/mesh_without_texcoord1.gltf";
+    options.output = (dir / out).string();
+    options.cache_directory = (dir / "cache").string();
+    options.atlas.texel_density = 16;
+    options.lighting.spp = 1;
+    options.backend.name = "cpu";
+    options.probes_enabled = false;
+    options.svo_enabled = false;
+    return options;
+  };
+  Diagnostics first_diagnostics, second_diagnostics, third_diagnostics;
+  const nlohmann::json first = run_bake(options_for("a.bake"), first_diagnostics);
+  BakeOptions second_options = options_for("b.bake");
+  second_options.write_gltf = (dir / "with_uvs.gltf").string();
+  const nlohmann::json second = run_bake(second_options, second_diagnostics);
+  EXPECT_FALSE(first["cache"]["reused"].get<bool>());
+  EXPECT_TRUE(second["cache"]["reused"].get<bool>());
+  EXPECT_EQ(second_diagnostics.warnings, first_diagnostics.warnings);
+  Diagnostics d;
+  const Scene written = import_gltf(second_options.write_gltf, {}, d);  // has TEXCOORD_1
+  EXPECT_EQ(written.triangle_count(), 12u);
+  BakeOptions generate_all = options_for("c.bake");
+  generate_all.import.generate_lightmap_uvs = true;
+  const nlohmann::json third = run_bake(generate_all, third_diagnostics);
+  EXPECT_FALSE(third["cache"]["reused"].get<bool>());
+  EXPECT_NE(third["cache"]["key"], first["cache"]["key"]);
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace exitance
