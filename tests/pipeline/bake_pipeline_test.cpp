@@ -11,19 +11,13 @@
 #include "exitance/bake/input_error.h"
 #include "exitance/formats/lightmap_exr.h"
 #include "scene_builder.h"
+#include "support/fresh_temp_dir.h"
 
 namespace exitance {
 namespace {
 
 namespace fs = std::filesystem;
 using samples::Quad;
-
-fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("exitance-test-" + name + "-" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
 
 // Two quads at different sizes: one 4x4 floor, one 1x2 raised tile, both facing up.
 fs::path write_two_plane_scene(const fs::path& dir) {
@@ -43,7 +37,7 @@ fs::path write_two_plane_scene(const fs::path& dir) {
 }
 
 TEST(BakePipeline, PlanesUnderSkyRoundTrip) {
-  const fs::path dir = fresh_dir("planes");
+  const fs::path dir = testing::fresh_temp_dir("planes");
   BakeOptions options;
   options.input = write_two_plane_scene(dir).string();
   options.output = (dir / "out.bake").string();
@@ -107,7 +101,7 @@ TEST(BakePipeline, PlanesUnderSkyRoundTrip) {
 }
 
 TEST(BakePipeline, BadInputLeavesEarlierBundleUntouched) {
-  const fs::path dir = fresh_dir("atomic");
+  const fs::path dir = testing::fresh_temp_dir("atomic");
   BakeOptions options;
   options.input = write_two_plane_scene(dir).string();
   options.output = (dir / "out.bake").string();
@@ -126,7 +120,7 @@ TEST(BakePipeline, BadInputLeavesEarlierBundleUntouched) {
 
 // Probe and voxel settings that cannot work are bad input: one error naming the option, nothing written.
 TEST(BakePipeline, ImpossibleProbeOrVoxelSettingsAreInputErrors) {
-  const fs::path dir = fresh_dir("settings");
+  const fs::path dir = testing::fresh_temp_dir("settings");
   BakeOptions options;
   options.input = write_two_plane_scene(dir).string();
   options.output = (dir / "out.bake").string();
@@ -158,7 +152,7 @@ TEST(BakePipeline, ImpossibleProbeOrVoxelSettingsAreInputErrors) {
 }
 
 TEST(BakePipeline, SameSeedSameResult) {
-  const fs::path dir = fresh_dir("seed");
+  const fs::path dir = testing::fresh_temp_dir("seed");
   BakeOptions options;
   options.input = write_two_plane_scene(dir).string();
   options.sky = "1,1,1";

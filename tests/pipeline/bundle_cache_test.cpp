@@ -16,6 +16,7 @@
 #include "exitance/bake/cache/sha256_stream.h"
 #include "exitance/bake/command/bake_pipeline.h"
 #include "scene_builder.h"
+#include "support/fresh_temp_dir.h"
 
 namespace exitance {
 namespace {
@@ -23,13 +24,6 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 using samples::Quad;
-
-fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("exitance-cache-test-" + name + "-" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
 
 // A floor lit by a point light of the given intensity.
 fs::path write_lit_floor(const fs::path& dir, float intensity) {
@@ -78,7 +72,7 @@ std::vector<fs::path> entries(const fs::path& cache) {
 }
 
 TEST(BundleCache, SecondBakeReusesTheFirstFileForFile) {
-  const fs::path dir = fresh_dir("reuse");
+  const fs::path dir = testing::fresh_temp_dir("cache-reuse");
   const fs::path input = write_lit_floor(dir, 5);
   Diagnostics first_diagnostics, second_diagnostics;
   const json first = run_bake(options_for(input, dir / "a.bake", dir / "cache"), first_diagnostics);
@@ -101,7 +95,7 @@ TEST(BundleCache, SecondBakeReusesTheFirstFileForFile) {
 }
 
 TEST(BundleCache, AChangedLightOptionOrSeedIsANewBake) {
-  const fs::path dir = fresh_dir("changes");
+  const fs::path dir = testing::fresh_temp_dir("cache-changes");
   const fs::path cache = dir / "cache";
   Diagnostics d;
   const json base = run_bake(options_for(write_lit_floor(dir, 5), dir / "a.bake", cache), d);
@@ -121,7 +115,7 @@ TEST(BundleCache, AChangedLightOptionOrSeedIsANewBake) {
 }
 
 TEST(BundleCache, DamagedEntriesAreRebuiltNeverTrusted) {
-  const fs::path dir = fresh_dir("damaged");
+  const fs::path dir = testing::fresh_temp_dir("cache-damaged");
   const fs::path input = write_lit_floor(dir, 5), cache = dir / "cache";
   Diagnostics d;
   run_bake(options_for(input, dir / "a.bake", cache), d);
@@ -154,7 +148,7 @@ TEST(BundleCache, DamagedEntriesAreRebuiltNeverTrusted) {
 }
 
 TEST(BundleCache, TwoBakesStoringOneKeyAtOnceLeaveOneIntactEntry) {
-  const fs::path dir = fresh_dir("concurrent");
+  const fs::path dir = testing::fresh_temp_dir("cache-concurrent");
   const fs::path input = write_lit_floor(dir, 5), cache = dir / "cache";
   json reports[2];
   std::thread threads[2];
@@ -174,7 +168,7 @@ TEST(BundleCache, TwoBakesStoringOneKeyAtOnceLeaveOneIntactEntry) {
 }
 
 TEST(BundleCache, AFailedBakeStoresNothing) {
-  const fs::path dir = fresh_dir("failed");
+  const fs::path dir = testing::fresh_temp_dir("cache-failed");
   const fs::path input = write_lit_floor(dir, 5), cache = dir / "cache";
   std::ofstream(dir / "blocker") << "a file where the output's parent folder should be";
   const BakeOptions options = options_for(input, dir / "blocker" / "a.bake", cache);

@@ -19,18 +19,25 @@ namespace {
 
 namespace fs = std::filesystem;
 
-TEST(GeneratedUvBake, CubeWithoutTexcoord1BakesWithAWarning) {
-  const fs::path out = fs::temp_directory_path() / ("exitance-test-generated-uv-" + std::to_string(::getpid()));
-  fs::remove_all(out);
+// Bakes the hostile corpus' cube without TEXCOORD_1 into `output` on the CPU at 16 texels per unit,
+// `spp` samples, without probes or the SVO.
+BakeOptions cube_without_texcoord1(const fs::path& output, uint32_t spp) {
   BakeOptions options;
   options.input = std::string(EXITANCE_HOSTILE_DIR) + "/mesh_without_texcoord1.gltf";
-  options.output = out.string();
-  options.sky = "1,1,1";
+  options.output = output.string();
   options.atlas.texel_density = 16;
-  options.lighting.spp = 4;
+  options.lighting.spp = spp;
   options.backend.name = "cpu";
   options.probes_enabled = false;
   options.svo_enabled = false;
+  return options;
+}
+
+TEST(GeneratedUvBake, CubeWithoutTexcoord1BakesWithAWarning) {
+  const fs::path out = fs::temp_directory_path() / ("exitance-test-generated-uv-" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  BakeOptions options = cube_without_texcoord1(out, 4);
+  options.sky = "1,1,1";
   Diagnostics diagnostics;
   const nlohmann::json report = run_bake(options, diagnostics);
 
@@ -69,15 +76,8 @@ TEST(GeneratedUvBake, WriteGltfHasTheGeneratedTexcoord1) {
   const fs::path dir = fs::temp_directory_path() / ("exitance-test-write-gltf-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
-  BakeOptions options;
-  options.input = std::string(EXITANCE_HOSTILE_DIR) + "/mesh_without_texcoord1.gltf";
-  options.output = (dir / "out.bake").string();
+  BakeOptions options = cube_without_texcoord1(dir / "out.bake", 1);
   options.write_gltf = (dir / "with_uvs.gltf").string();
-  options.atlas.texel_density = 16;
-  options.lighting.spp = 1;
-  options.backend.name = "cpu";
-  options.probes_enabled = false;
-  options.svo_enabled = false;
   Diagnostics diagnostics;
   run_bake(options, diagnostics);
 
@@ -103,15 +103,8 @@ TEST(GeneratedUvBake, CachedBakeIsReusedAndStillWritesTheGltf) {
   const fs::path dir = fs::temp_directory_path() / ("exitance-test-uv-cache-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   auto options_for = [&](const std::string& out) {
-    BakeOptions options;
-    options.input = std::string(EXITANCE_HOSTILE_DIR) + "/mesh_without_texcoord1.gltf";
-    options.output = (dir / out).string();
+    BakeOptions options = cube_without_texcoord1(dir / out, 1);
     options.cache_directory = (dir / "cache").string();
-    options.atlas.texel_density = 16;
-    options.lighting.spp = 1;
-    options.backend.name = "cpu";
-    options.probes_enabled = false;
-    options.svo_enabled = false;
     return options;
   };
   Diagnostics first_diagnostics, second_diagnostics, third_diagnostics;
