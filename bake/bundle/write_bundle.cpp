@@ -6,7 +6,6 @@
 #include <string>
 #include <vector>
 
-#include "exitance/bake/cache/sha256_stream.h"
 #include "exitance/bake/bundle/radiance_vdb.h"
 #include "exitance/formats/lightmap_exr.h"
 #include "exitance/formats/probes_file.h"
@@ -31,7 +30,7 @@ WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::jso
   const std::vector<formats::LightmapImage> pages =
       assemble_lightmap_pages(results.gbuffer, results.lightmap, assembly);
   const formats::BundleManifest manifest = build_bundle_manifest(
-      results, pages, sha256_of_file(options.input), seconds, diagnostics.warnings.size(), options);
+      results, pages, results.input_sha256, seconds, diagnostics.warnings.size(), options);
   const std::string manifest_text = formats::write_bundle_manifest(manifest);
 
   const fs::path out = bundle_folder(options);

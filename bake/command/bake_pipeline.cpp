@@ -83,6 +83,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   StageTimer clock;
   std::vector<MeshWithoutLightmapUvs> without_lightmap_uvs;
   Scene imported = clock.time("import", [&] { return import_stage(options, diagnostics, without_lightmap_uvs); });
+  const std::string input_sha256 = sha256_of_file(options.input);  // the manifest's, and the cache key's
 
   // A bake of the same input with the same options and program is in the cache: reuse it. The key is
   // taken before UV generation, which it determines (the scene, the options and the program).
@@ -93,7 +94,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
     std::optional<json> reused = clock.time("cache", [&]() -> std::optional<json> {
       options.announce_stage("cache");
       cache_key =
-          bake_cache_key(imported, options, sha256_of_file(options.input), backend_candidates(options.backend));
+          bake_cache_key(imported, options, input_sha256, backend_candidates(options.backend));
       std::vector<std::string> stored_warnings;
       const std::filesystem::path out = bundle_folder(options);
       auto edit = [&](const std::string& text) { return mark_reused(text, cache_key); };
@@ -163,6 +164,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                             .lightmap = lightmap,
                             .probe_lighting = probe_lighting ? &*probe_lighting : nullptr,
                             .scene_file = scene_file,
+                            .input_sha256 = input_sha256,
                             .generated_uvs = &generated_uvs};
   WrittenBundle bundle =
       clock.time("write", [&] { return write_bundle_stage(results, clock.seconds(), diagnostics, options); });

@@ -32,7 +32,7 @@ void check_bvh_references(const Bvh4& bvh, size_t triangle_count) {
 
 // The material varies over a surface (textures) or over its hits (MASK, BLEND): the CPU reference
 // evaluates it per point from the source Scene.
-bool is_textured(const Material& m) {
+bool varies_per_point(const Material& m) {
   return m.base_color_texture.texture >= 0 || m.emissive_texture.texture >= 0 ||
          m.alpha_mode != Material::AlphaMode::Opaque;
 }
@@ -145,7 +145,7 @@ LightingScene build_lighting_scene(std::shared_ptr<const Scene> source, Bvh4 bvh
   lighting.textured = !scene.vertex_color.empty();
   for (const Material& m : scene.materials) {
     lighting.materials.push_back(material_record(m));
-    lighting.textured = lighting.textured || is_textured(m);
+    lighting.textured = lighting.textured || varies_per_point(m);
   }
   for (const PunctualLight& light : scene.lights) lighting.punctual_lights.push_back(punctual_record(light));
   build_emitter_distribution(lighting);
@@ -175,7 +175,7 @@ void set_material(LightingScene& lighting, uint32_t index, const Material& mater
   scene.materials[index] = material;
   lighting.materials[index] = material_record(material);
   lighting.textured = !scene.vertex_color.empty();
-  for (const Material& m : scene.materials) lighting.textured = lighting.textured || is_textured(m);
+  for (const Material& m : scene.materials) lighting.textured = lighting.textured || varies_per_point(m);
   build_emitter_distribution(lighting);
 }
 

@@ -62,18 +62,19 @@ std::vector<ByteRange> triangle_ranges(const std::vector<uint32_t>& triangles) {
 void check_supported_by_vulkan(const LightingScene& scene) {
   if (scene.environment.enabled())
     throw std::runtime_error("Vulkan backend: environment-map skies are not supported yet (use the cpu backend)");
-  if (scene.textured)
-    for (const Material& m : scene.source->materials)
+  // `textured`: something varies per point, which only the CPU reference evaluates; name what.
+  if (scene.textured) {
+    if (!scene.source->vertex_color.empty())
+      throw std::runtime_error("Vulkan backend: vertex colours (COLOR_0) are not supported yet (use the cpu backend)");
+    for (const Material& m : scene.source->materials) {
       if (m.base_color_texture.texture >= 0 || m.emissive_texture.texture >= 0)
         throw std::runtime_error("Vulkan backend: textured materials are not supported yet (material '" + m.name +
                                  "'; use the cpu backend)");
-  if (scene.source && !scene.source->vertex_color.empty())
-    throw std::runtime_error("Vulkan backend: vertex colours (COLOR_0) are not supported yet (use the cpu backend)");
-  if (scene.source)
-    for (const Material& m : scene.source->materials)
       if (m.alpha_mode != Material::AlphaMode::Opaque)
-        throw std::runtime_error("Vulkan backend: alphaMode MASK and BLEND are not supported yet (material '" + m.name +
-                                 "'; use the cpu backend)");
+        throw std::runtime_error("Vulkan backend: alphaMode MASK and BLEND are not supported yet (material '" +
+                                 m.name + "'; use the cpu backend)");
+    }
+  }
   if (scene.bvh.nodes.empty()) throw std::invalid_argument("Vulkan backend: the scene has no BVH4 (build_bvh4 or scene.bin)");
 }
 

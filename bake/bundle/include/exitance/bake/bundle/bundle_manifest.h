@@ -44,6 +44,7 @@ struct BakeResults {
   const LightmapEstimate& lightmap;     // lighting
   const ProbeEstimate* probe_lighting;  // probe lighting (set exactly when `probes` is)
   const PersistedSceneFile& scene_file;  // scene file
+  const std::string& input_sha256;       // the input file's SHA-256, hashed once per run (manifest, cache key)
   const std::vector<MeshUvReport>* generated_uvs = nullptr;  // uv generation: the meshes whose UVs it made
 };
 

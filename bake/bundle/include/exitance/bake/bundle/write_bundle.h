@@ -24,7 +24,7 @@ std::filesystem::path bundle_folder(const BakeOptions& options);
 
 // Writes manifest.json, lightmap-<page>.exr, and with their stages probes.bin, svo.bin and
 // radiance.vdb. `seconds` (stats.seconds so far) and the warning count go into the manifest.
-// Throws std::runtime_error (nothing written) when the input cannot be hashed or a file not written.
+// Throws std::runtime_error (nothing written) when a file cannot be written.
 WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::json& seconds,
                                  const Diagnostics& diagnostics, const BakeOptions& options);
 
