@@ -2,7 +2,7 @@
 // content hash outside the repository) is the reference; runs at doubling spp record seconds,
 // relMSE, MAE, worst-texel error and rays/s as CSV, and the time to reach a target relMSE.
 //
-//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,bounces,guided] [--guiding-mix M] [--name NAME]
+//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,adaptive,bounces,guided] [--guiding-mix M] [--name NAME]
 //                       [--sky R,G,B] [--texel-density T] [--reference-spp N] [--max-spp N]
 //                       [--max-seconds S] [--target 0.01] [--bounces N] [--min-spp N] [--cache DIR] [--csv FILE]
 //                       [--texel-csv FILE] [--guiding-fields FILE]
@@ -84,7 +84,9 @@ int main(int argc, char** argv) {
   CLI::App app{"time against error of the CPU reference"};
   app.add_option("scene", scene_path)->required();
   app.add_option("--backends", backends, "comma-separated: cpu, vulkan (the reference is always cpu)");
-  app.add_option("--integrators", integrators, "comma-separated: path, bounces, guided (path with --guiding grid)");
+  app.add_option("--integrators", integrators,
+                 "comma-separated: path, adaptive (path with adaptive sampling; spp = mean), bounces, guided (path "
+                 "with --guiding grid)");
   float guiding_mix = 0.5f;
   app.add_option("--guiding-mix", guiding_mix, "guided component's probability (guided runs)");
   std::string guiding_fields;
@@ -170,12 +172,14 @@ int main(int argc, char** argv) {
     IntegratorMode integrator;
     GuidingMode guiding;
     const char* name;
+    bool adaptive = false;
   };
   std::vector<Mode> modes;
   auto listed = [&](const std::string& name) {
     return ("," + integrators + ",").find("," + name + ",") != std::string::npos;
   };
   if (listed("path")) modes.push_back({IntegratorMode::Path, GuidingMode::Off, "path_tracing"});
+  if (listed("adaptive")) modes.push_back({IntegratorMode::Path, GuidingMode::Off, "path_adaptive", true});
   if (listed("guided")) modes.push_back({IntegratorMode::Path, GuidingMode::Grid, "path_guided_grid"});
   if (listed("bounces")) modes.push_back({IntegratorMode::Bounces, GuidingMode::Off, "per_bounce"});
   for (const std::shared_ptr<const Integrator>& backend : measured)
@@ -204,6 +208,7 @@ int main(int argc, char** argv) {
         settings.max_bounces = bounces;
         settings.guiding = m.guiding;
         settings.guiding_mix = guiding_mix;
+        settings.adaptive = m.adaptive;  // spp is then the mean samples per texel
         if (!guiding_fields.empty())
           settings.inspect_guiding = [&](const GridGuidingCache& cache) {
             std::ofstream out(guiding_fields);

@@ -26,6 +26,7 @@ formats::BakeSettings settings_of(const BakeResults& results, const BakeOptions&
   s.spp = options.lighting.spp;
   s.time_budget_seconds = options.lighting.time_budget_seconds;
   s.target_error = options.lighting.target_relative_error;
+  s.adaptive = results.lightmap.adaptive;
   s.bounces = options.lighting.max_bounces;
   s.seed = options.lighting.seed;
   s.texel_density = results.layout.texel_density;
@@ -95,13 +96,34 @@ formats::SvoInfo svo_of(const formats::SparseVoxelOctree& svo) {
   return info;
 }
 
+// stats.error: the distribution over texels of the EXR's error layer (relative standard error with
+// the floor), and the floor itself.
+json error_distribution_json(const LightmapEstimate& estimate) {
+  const double floor = estimate.error_floor();
+  std::vector<float> errors(estimate.texels.size());
+  for (size_t i = 0; i < errors.size(); ++i) errors[i] = estimate.relative_standard_error(i, floor);
+  std::sort(errors.begin(), errors.end());
+  auto quantile = [&](double q) {
+    return errors.empty() ? 0.0 : double(errors[std::min(errors.size() - 1, size_t(q * double(errors.size())))]);
+  };
+  double sum = 0;
+  for (float e : errors) sum += e;
+  return {{"floor", floor},
+          {"mean", errors.empty() ? 0.0 : sum / double(errors.size())},
+          {"p50", quantile(0.5)},
+          {"p90", quantile(0.9)},
+          {"p99", quantile(0.99)},
+          {"max", errors.empty() ? 0.0 : double(errors.back())}};
+}
+
 // "stats": what each stage did and how long it took.
 json stats_json(const BakeResults& results, const json& seconds, size_t warnings, const BakeOptions& options) {
   const TexelGBuffer& gbuffer = results.gbuffer;
   const LightmapEstimate& estimate = results.lightmap;
-  uint64_t min_samples = gbuffer.texels.empty() ? 0 : UINT64_MAX, sample_sum = 0;
+  uint64_t min_samples = gbuffer.texels.empty() ? 0 : UINT64_MAX, max_samples = 0, sample_sum = 0;
   for (size_t i = 0; i < gbuffer.texels.size(); ++i) {
     min_samples = std::min<uint64_t>(min_samples, estimate.texels[i].samples);
+    max_samples = std::max<uint64_t>(max_samples, estimate.texels[i].samples);
     sample_sum += estimate.texels[i].samples;
   }
 
@@ -115,8 +137,11 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
   stats["rays"] = estimate.rays;
   stats["rays_per_second"] = lighting_seconds > 0 ? double(estimate.rays) / lighting_seconds : 0.0;
   stats["samples_per_texel"] = {{"min", min_samples},
+                                {"max", max_samples},
                                 {"mean", gbuffer.texels.empty() ? 0.0 : double(sample_sum) / double(gbuffer.texels.size())}};
+  if (estimate.adaptive) stats["samples_per_texel"]["pilot"] = estimate.adaptive_pilot;
   stats["estimated_relative_error"] = estimate.mean_relative_standard_error();
+  stats["error"] = error_distribution_json(estimate);
   stats["unoccluded_texels"] = results.unoccluded_texels;
   stats["enclosed_texels"] = results.geometry.enclosed_texels;
   stats["coplanar_texels"] = results.geometry.coplanar_texels;

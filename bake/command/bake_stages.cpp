@@ -111,6 +111,11 @@ std::shared_ptr<const Integrator> backend_stage(const SceneForLighting& scene, c
     request.name = "cpu";
     diagnostics.warn("--integrator bounces: using the CPU reference (Embree), the only backend with per-bounce passes yet");
   }
+  if (options.adaptive_request == AdaptiveRequest::On && request.name == "auto") {
+    // Adaptive sampling exists on the CPU backend only for now (the Vulkan backend refuses it).
+    request.name = "cpu";
+    diagnostics.warn("--adaptive on: using the CPU reference (Embree), the only backend with adaptive sampling yet");
+  }
   if (options.lighting.guiding != GuidingMode::Off && request.name == "auto") {
     // Grid guiding exists on the CPU backend only for now (the Vulkan backend refuses it).
     request.name = "cpu";
@@ -156,9 +161,17 @@ ProbePlacement place_probes_stage(const SceneForLighting& scene, const Voxelized
   }
 }
 
+bool adaptive_sampling_applies(const BakeOptions& options, const std::string& backend_name) {
+  if (options.adaptive_request == AdaptiveRequest::Off) return false;
+  if (options.adaptive_request == AdaptiveRequest::On) return true;
+  return backend_name == "cpu" && options.lighting.integrator == IntegratorMode::Path &&
+         (options.lighting.time_budget_seconds > 0 || options.lighting.target_relative_error > 0);
+}
+
 LightmapEstimate lighting_stage(const Integrator& backend, const TexelGBuffer& gbuffer, const BakeOptions& options,
                                 Diagnostics& diagnostics) {
   IntegratorSettings settings = options.lighting;
+  settings.adaptive = adaptive_sampling_applies(options, backend.backend_name());
   settings.progress = [&](double fraction, uint64_t rays) {
     if (options.progress) options.progress("lighting", fraction, rays);
   };

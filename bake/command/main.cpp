@@ -57,8 +57,14 @@ int main(int argc, char** argv) {
   app.add_option("--time", options.lighting.time_budget_seconds, "stop the lighting stage after this many seconds")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--target-error", options.lighting.target_relative_error,
-                 "stop a texel once its relative standard error is below this")
+                 "plan each texel's samples so its relative standard error, SE / (E/pi + 1 % of the scene's "
+                 "mean), reaches this (CPU: adaptive; Vulkan: a texel stops once it is below)")
       ->check(CLI::NonNegativeNumber);
+  std::string adaptive = "auto";
+  app.add_option("--adaptive", adaptive,
+                 "adaptive sampling (samples where the relative error is, unbiased by cross-fitting): auto (= on "
+                 "with --time or --target-error on the CPU backend) | on (CPU backend; --spp is then the mean) | off")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   app.add_option("--bounces", options.lighting.max_bounces,
                  "maximum diffuse bounces (default: path: until Russian roulette ends the path; bounces: until the "
                  "extrapolated tail is below the noise)")
@@ -158,6 +164,20 @@ int main(int argc, char** argv) {
   if (uv == "generate") options.import.generate_lightmap_uvs = true;
   else options.import.lightmap_uv_set = uv == "0" ? 0 : 1;
   if (integrator == "bounces") options.lighting.integrator = exitance::IntegratorMode::Bounces;
+  if (adaptive == "on") {
+    if (integrator != "path") {
+      std::cerr << "bake: error: --adaptive on plans path-tracing samples: it needs --integrator path\n";
+      return 2;
+    }
+    options.adaptive_request = exitance::AdaptiveRequest::On;
+  } else if (adaptive == "off") {
+    if (options.lighting.target_relative_error > 0 && integrator == "path" && options.backend.name == "cpu") {
+      std::cerr << "bake: error: --adaptive off: on the CPU backend --target-error plans each texel's samples "
+                   "(adaptive); drop one of them\n";
+      return 2;
+    }
+    options.adaptive_request = exitance::AdaptiveRequest::Off;
+  }
   if (!directional.empty()) diagnostics.warn("--directional: directional lightmaps are not implemented yet; ignored");
   if (guiding == "svo") {
     std::cerr << "bake: error: --guiding svo is not implemented yet (use grid or off)\n";

@@ -254,6 +254,10 @@ BakeSettings parse_settings(const FieldReader& r, const json& j) {
   if (auto v = field("spp")) s.spp = uint32_t(r.unsigned_integer(*v, path("spp"), 0, UINT32_MAX));
   if (auto v = field("time_budget_seconds")) s.time_budget_seconds = r.non_negative_double(*v, path("time_budget_seconds"));
   if (auto v = field("target_error")) s.target_error = r.non_negative_double(*v, path("target_error"));
+  if (auto v = field("adaptive")) {
+    if (!v->is_boolean()) r.fail(path("adaptive"), std::string("expected true or false, got ") + v->type_name());
+    s.adaptive = v->get<bool>();
+  }
   if (auto v = field("bounces")) s.bounces = int32_t(r.signed_integer(*v, path("bounces"), -1, kIntMax));
   if (auto v = field("seed")) s.seed = r.unsigned_integer(*v, path("seed"), 0, UINT64_MAX);
   if (auto v = field("texel_density")) s.texel_density = r.non_negative_double(*v, path("texel_density"));

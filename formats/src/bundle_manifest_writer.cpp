@@ -20,6 +20,7 @@ json settings_json(const BakeSettings& s) {
             {"spp", s.spp},
             {"time_budget_seconds", s.time_budget_seconds},
             {"target_error", s.target_error},
+            {"adaptive", s.adaptive},
             {"bounces", s.bounces},
             {"seed", s.seed},
             {"texel_density", s.texel_density},

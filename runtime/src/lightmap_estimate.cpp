@@ -60,6 +60,20 @@ double LightmapEstimate::mean_relative_standard_error() const {
   return count ? sum / double(count) : 0.0;
 }
 
+double LightmapEstimate::error_floor() const {
+  double sum = 0;
+  size_t count = 0;
+  for (size_t i = 0; i < texels.size(); ++i)
+    if (texels[i].samples > 0) sum += luminance(mean_total(i)), ++count;
+  return count ? kErrorFloorFraction * sum / double(count) : 0.0;
+}
+
+float LightmapEstimate::relative_standard_error(size_t texel, double floor) const {
+  const double standard_error = std::sqrt(std::max(0.0f, luminance(variance_of_mean(texel))));
+  const double denominator = std::max(0.0f, luminance(mean_total(texel))) + floor;
+  return denominator > 0 ? float(standard_error / denominator) : 0.0f;
+}
+
 ShRgb ProbeEstimate::mean(size_t probe) const {
   ShRgb sh{};
   const uint32_t n = samples[probe];

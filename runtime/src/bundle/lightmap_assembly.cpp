@@ -54,7 +54,9 @@ std::vector<formats::LightmapImage> assemble_lightmap_pages(const TexelGBuffer& 
     for (const std::string& layer : layers)
       for (const char* c : {"R", "G", "B"}) pages[p].channels[layer + c].assign(n, 0.0f);
     pages[p].channels["A"] = source.coverage;
+    pages[p].channels["error.Y"].assign(n, 0.0f);
   }
+  const double error_floor = estimate.error_floor();
   for (size_t i = 0; i < gbuffer.texels.size(); ++i) {
     const LiveTexel& texel = gbuffer.texels[i];
     formats::LightmapImage& page = pages[texel.page];
@@ -67,6 +69,7 @@ std::vector<formats::LightmapImage> assemble_lightmap_pages(const TexelGBuffer& 
       page.channels[std::string("direct.") + names[c]][at] = direct[c];
       page.channels[std::string("indirect.") + names[c]][at] = std::max(0.0f, indirect[c]);
     }
+    page.channels["error.Y"][at] = estimate.relative_standard_error(i, error_floor);
     if (options.bounce_layers)
       for (int k = 0; k < estimate.recorded_bounces; ++k) {
         const Vec3 b = estimate.mean_bounce(k, i);

@@ -48,7 +48,7 @@ void PassScheduler::finish_pass(uint64_t rays_so_far, bool all_converged) {
   if (pending_ > 0) seconds_per_sample_ = (elapsed - pass_start_seconds_) / (double(pending_) * pending_fraction_);
   pending_ = 0;
   if (settings_.progress) {
-    const double by_spp = settings_.spp ? double(done_) / double(settings_.spp) : 0.0;
+    const double by_spp = limit_ != 0xFFFFFFFFu && limit_ > 0 ? double(done_) / double(limit_) : 0.0;
     const double by_time = timed() ? elapsed / settings_.time_budget_seconds : 0.0;
     settings_.progress(std::min(1.0, std::max(by_spp, by_time)), rays_so_far);
   }

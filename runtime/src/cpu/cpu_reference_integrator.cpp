@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "cpu_bounce_integrator.h"
+#include "exitance/runtime/core/adaptive_sampling_plan.h"
 #include "exitance/runtime/core/grid_guiding_cache.h"
 #include "exitance/runtime/core/pass_scheduler.h"
 #include "exitance/runtime/core/scene_access.h"
@@ -26,6 +27,8 @@ constexpr int kMaxRecordedBounces = 16;
 // small scenes the learning (a target per ray, atomic adds) costs as much as the ray itself, and by
 // then the table has stopped improving (bench/results/guiding.md).
 constexpr uint32_t kGuidingLearningSamples = 64;
+// A target error plans at most this many samples for a texel without --spp (documented).
+constexpr uint32_t kMostSamplesForTarget = 1u << 17;
 
 // Per-sample contributions to E/pi, split by the number of diffuse reflections between the
 // light and the texel (0 = direct).
@@ -152,6 +155,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   if (settings.integrator == IntegratorMode::Bounces) {
     if (settings.guiding != GuidingMode::Off)
       throw std::invalid_argument("CPU backend: guiding applies to path tracing, not to --integrator bounces");
+    if (settings.adaptive)
+      throw std::invalid_argument("CPU backend: adaptive sampling applies to path tracing, not to --integrator bounces");
     return bake_per_bounce(*impl_->lighting, *impl_->embree, gbuffer, settings);
   }
   const auto start = std::chrono::steady_clock::now();
@@ -164,7 +169,6 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   estimate.recorded_bounces = std::clamp(settings.recorded_bounces, 1, kMaxRecordedBounces);
   estimate.texels.resize(texel_count);
   estimate.bounces.assign(size_t(estimate.recorded_bounces) * texel_count * 3, 0.0);
-  std::vector<uint8_t> converged(texel_count, 0);
   tbb::combinable<uint64_t> rays_per_thread([] { return uint64_t(0); });
   tbb::combinable<uint64_t> nonfinite_per_thread([] { return uint64_t(0); });
   tbb::combinable<uint64_t> guided_per_thread([] { return uint64_t(0); });
@@ -177,55 +181,111 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     config.cells_on_longest_axis = settings.guiding_grid_cells;
     guide = std::make_unique<GridGuidingCache>(*impl_->lighting, gbuffer, config);
   }
+
+  // Adaptive sampling (adaptive_sampling_plan.h): a uniform pilot, then per-texel rates from the
+  // neighbours' pilot samples. A target error always plans: a rule that stopped a texel on its own
+  // running error would be biased.
+  const bool adaptive = settings.adaptive || settings.target_relative_error > 0;
+  std::vector<TexelSampleSums> pilot_sums(adaptive ? texel_count : 0);
+  // Pilot samples per texel (a ramp boundary, so no pass crosses it).
+  const uint32_t pilot = settings.spp != 0 && settings.spp < 64 ? 4 : 16;
+  AdaptivePlan plan;
+  std::vector<uint32_t> planned;  // target-error mode: each texel's samples
+  bool planning = false;          // past the pilot
+  double progress_after_pilot = 0, planned_progress = 0;
+
+  // One sample `s` of texel `i`.
+  auto take_sample = [&](size_t i, uint32_t s, bool learning, PathContributions& contributions) {
+    uint64_t& rays = rays_per_thread.local();
+    const LiveTexel& texel = gbuffer.texels[i];
+    const SurfacePoint point{texel.position, texel.geometric_normal, texel.shading_normal};
+    TexelAccumulator& acc = estimate.texels[i];
+    Pcg32 rng = pcg_init(settings.seed, i, s);
+    contributions = PathContributions{};
+    contributions.recorded = estimate.recorded_bounces;
+    const uint64_t rays_before = rays;
+    impl_->trace(point, settings, rng, contributions, rays, guide.get(), learning, &guided_per_thread.local());
+    const Vec3 total = contributions.total();
+    if (!is_finite(total)) {
+      ++nonfinite_per_thread.local();
+      return;  // counted and reported; an unbiased estimator never produces these
+    }
+    for (int c = 0; c < 3; ++c) {
+      acc.total[c] += total[c];
+      acc.total_squared[c] += double(total[c]) * double(total[c]);
+      acc.direct[c] += contributions.by_bounce[0][c];
+    }
+    for (int k = 0; k < estimate.recorded_bounces; ++k)
+      for (int c = 0; c < 3; ++c)
+        estimate.bounces[(size_t(k) * texel_count + i) * 3 + size_t(c)] += contributions.by_bounce[k][c];
+    ++acc.samples;
+    if (adaptive && !planning) {
+      TexelSampleSums& p = pilot_sums[i];
+      const double y = luminance(total);
+      ++p.samples, p.rays += rays - rays_before, p.sum += y, p.sum_squared += y * y;
+    }
+  };
+  // Texel `i`'s planned samples once the run has progressed `progress` samples per texel past the
+  // pilot: a hashed offset in [0, 1) makes the expected count exact.
+  auto planned_count = [&](size_t i, double progress) -> uint32_t {
+    if (!planned.empty() && progress >= planned_progress) return planned[i];
+    const double offset = double(splitmix64(settings.seed ^ (0xADA9ull << 40) ^ i) >> 11) * 0x1.0p-53;
+    const double extra = std::floor(double(plan.rate[i]) * progress + offset);
+    const uint32_t count = uint32_t(std::min<double>(extra + pilot, 0xFFFFFFF0u));
+    return planned.empty() ? count : std::min(planned[i], count);
+  };
+
   uint32_t first = 0, count = 0;
   double fraction = 1;
   while (passes.next_pass(first, count, &fraction)) {
     const bool learning = guide && first < kGuidingLearningSamples;
-    // The last pass of a time budget may cover only part of the texels: a hashed choice spread over
-    // the whole atlas (so the pass costs its fraction of a full one), different for every sample.
-    const uint64_t covered_below = fraction < 1 ? uint64_t(fraction * 0x1.0p53) : UINT64_MAX;
-    const uint64_t salt = splitmix64(settings.seed ^ (uint64_t(first) << 32));
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, texel_count, 64), [&](const tbb::blocked_range<size_t>& range) {
-      uint64_t& rays = rays_per_thread.local();
-      uint64_t& nonfinite = nonfinite_per_thread.local();
-      uint64_t& guided = guided_per_thread.local();
-      PathContributions contributions;
-      for (size_t i = range.begin(); i != range.end(); ++i) {
-        if (converged[i]) continue;
-        if (covered_below != UINT64_MAX && (splitmix64(salt + i) >> 11) >= covered_below) continue;
-        const LiveTexel& texel = gbuffer.texels[i];
-        const SurfacePoint point{texel.position, texel.geometric_normal, texel.shading_normal};
-        TexelAccumulator& acc = estimate.texels[i];
-        for (uint32_t s = first; s < first + count; ++s) {
-          Pcg32 rng = pcg_init(settings.seed, i, s);
-          contributions = PathContributions{};
-          contributions.recorded = estimate.recorded_bounces;
-          impl_->trace(point, settings, rng, contributions, rays, guide.get(), learning, &guided);
-          const Vec3 total = contributions.total();
-          if (!is_finite(total)) {
-            ++nonfinite;
-            continue;  // counted and reported; an unbiased estimator never produces these
-          }
-          for (int c = 0; c < 3; ++c) {
-            acc.total[c] += total[c];
-            acc.total_squared[c] += double(total[c]) * double(total[c]);
-            acc.direct[c] += contributions.by_bounce[0][c];
-          }
-          for (int k = 0; k < estimate.recorded_bounces; ++k)
-            for (int c = 0; c < 3; ++c)
-              estimate.bounces[(size_t(k) * texel_count + i) * 3 + size_t(c)] += contributions.by_bounce[k][c];
-          ++acc.samples;
+    if (planning) {
+      const double progress = double(first) - progress_after_pilot + double(count) * fraction;
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, texel_count, 16), [&](const tbb::blocked_range<size_t>& range) {
+        PathContributions contributions;
+        for (size_t i = range.begin(); i != range.end(); ++i)
+          for (uint32_t s = estimate.texels[i].samples, target = planned_count(i, progress); s < target; ++s)
+            take_sample(i, s, learning, contributions);
+      });
+    } else {
+      // The last pass of a time budget may cover only part of the texels: a hashed choice spread over
+      // the whole atlas (so the pass costs its fraction of a full one), different for every sample.
+      const uint64_t covered_below = fraction < 1 ? uint64_t(fraction * 0x1.0p53) : UINT64_MAX;
+      const uint64_t salt = splitmix64(settings.seed ^ (uint64_t(first) << 32));
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, texel_count, 64), [&](const tbb::blocked_range<size_t>& range) {
+        PathContributions contributions;
+        for (size_t i = range.begin(); i != range.end(); ++i) {
+          if (covered_below != UINT64_MAX && (splitmix64(salt + i) >> 11) >= covered_below) continue;
+          for (uint32_t s = first; s < first + count; ++s) take_sample(i, s, learning, contributions);
         }
-        if (settings.target_relative_error > 0 && acc.samples >= 16 &&
-            estimate.relative_error_below(i, settings.target_relative_error))
-          converged[i] = 1;
-      }
-    });
+      });
+    }
     if (learning) guide->swap();  // this pass's learning becomes the next pass's frozen table
-    const bool all_converged = settings.target_relative_error > 0 &&
-                               std::all_of(converged.begin(), converged.end(), [](uint8_t c) { return c != 0; });
-    passes.finish_pass(rays_per_thread.combine(std::plus<uint64_t>()), all_converged);
+    passes.finish_pass(rays_per_thread.combine(std::plus<uint64_t>()));
+    if (adaptive && !planning && passes.samples_done() == pilot && fraction == 1) {
+      // The pilot is complete: every texel's rate from its neighbours' pilot samples.
+      plan = plan_adaptive_rates(gbuffer, pilot_sums);
+      pilot_sums = {};
+      planning = true;
+      estimate.adaptive_pilot = pilot;
+      progress_after_pilot = passes.samples_done();
+      if (settings.target_relative_error > 0) {
+        const uint32_t most = settings.spp ? std::max(pilot, settings.spp) : kMostSamplesForTarget;
+        planned.resize(texel_count);
+        double extra = 0;
+        for (size_t i = 0; i < texel_count; ++i) {
+          planned[i] = samples_for_target(plan.relative_deviation[i], settings.target_relative_error, pilot, most);
+          extra += planned[i] - pilot;
+        }
+        // Every texel reaches its count when the progress reaches the mean extra samples per texel.
+        planned_progress = extra / double(std::max<size_t>(texel_count, 1));
+        for (size_t i = 0; i < texel_count; ++i)
+          plan.rate[i] = planned_progress > 0 ? float((planned[i] - pilot) / planned_progress) : 0.0f;
+        passes.set_sample_limit(uint32_t(std::min<double>(0xFFFFFFFEu, progress_after_pilot + std::ceil(planned_progress))));
+      }
+    }
   }
+  estimate.adaptive = adaptive;
   estimate.rays = rays_per_thread.combine(std::plus<uint64_t>());
   estimate.nonfinite_samples = nonfinite_per_thread.combine(std::plus<uint64_t>());
   estimate.guided_vertices = guided_per_thread.combine(std::plus<uint64_t>());

@@ -17,6 +17,10 @@ struct BackendRequest {
   bool validation = false;    // EXITANCE_VULKAN_VALIDATION=1: validation layers, any message is an error
 };
 
+// --adaptive: auto = adaptive sampling where it is implemented and a budget leaves room for it
+// (CPU backend, path mode, with --time or --target-error); on = always (the CPU backend); off = never.
+enum class AdaptiveRequest : uint8_t { Auto, On, Off };
+
 struct BakeOptions {
   std::string input;
   std::string output;          // empty = SCENE.bake next to the input
@@ -25,7 +29,8 @@ struct BakeOptions {
   BackendRequest backend;
   ImportOptions import;
   AtlasSettings atlas;
-  IntegratorSettings lighting;
+  IntegratorSettings lighting;  // lighting.adaptive is decided by the lighting stage from adaptive_request
+  AdaptiveRequest adaptive_request = AdaptiveRequest::Auto;
   bool bounce_layers = false;
   // Light probes (--probes): spacing in scene units, 0 = automatic; probes_enabled false = none.
   bool probes_enabled = true;

@@ -1,5 +1,7 @@
-// Turns per-texel estimates into atlas page images: E/pi in R,G,B, coverage in A, optional
-// direct/indirect/bounce<k> layers, and gutter texels dilated from their neighbours.
+// Turns per-texel estimates into atlas page images: E/pi in R,G,B, coverage in A, direct/indirect
+// layers, the estimated relative standard error in error.Y (LightmapEstimate::relative_standard_error
+// with the estimate's error_floor), optional bounce<k> layers, and gutter texels dilated from their
+// neighbours.
 #pragma once
 #include <vector>
 

@@ -11,6 +11,12 @@
 
 namespace exitance {
 
+// The error floor of relative errors, as a fraction of the scene's mean E/pi: SE / (mean + floor)
+// keeps dark texels from dominating (the adaptive plan, the error layer and stats.error use it).
+// 1 %: on the sample scenes about the bench's relMSE regularizer (r^2 + 1e-3), and the adaptive plan's
+// best of 1 % and 5 % there (bench/results/adaptive-sampling.md).
+constexpr double kErrorFloorFraction = 0.01;
+
 struct TexelAccumulator {
   double total[3] = {0, 0, 0};
   double total_squared[3] = {0, 0, 0};
@@ -40,18 +46,25 @@ struct LightmapEstimate {
   uint64_t nonfinite_samples = 0;  // samples discarded because they were NaN/Inf (should stay 0)
   BounceGatherStatistics bounce_statistics;
   uint64_t guided_vertices = 0;  // path vertices that sampled a guided mixture (--guiding); 0 unguided
+  bool adaptive = false;         // samples were planned per texel (core/adaptive_sampling_plan.h)
+  uint32_t adaptive_pilot = 0;   // samples per texel of the pilot before the plan (0: no plan made)
 
   Vec3 mean_total(size_t texel) const;
   Vec3 mean_direct(size_t texel) const;
   Vec3 mean_bounce(int bounce, size_t texel) const;
   // Variance of the mean (standard error squared) of the total, per channel.
   Vec3 variance_of_mean(size_t texel) const;
-  // The target-error test of --target-error: relative standard error of the luminance below `target`;
-  // a texel black with no variance after 16 samples or more counts as met.
+  // The target-error stopping test of the Vulkan and per-bounce backends (a stopping rule on a texel's
+  // own estimate, slightly biased; CPU path tracing plans its samples instead): relative standard
+  // error of the luminance below `target`; a texel black with no variance after 16 samples counts as met.
   bool relative_error_below(size_t texel, double target) const;
   // Mean over texels with signal of the relative standard error of the luminance (the manifest's
   // stats.estimated_relative_error).
   double mean_relative_standard_error() const;
+  // kErrorFloorFraction times the mean over sampled texels of the luminance of E/pi.
+  double error_floor() const;
+  // Standard error of the luminance over (its mean + floor): the EXR's error layer.
+  float relative_standard_error(size_t texel, double floor) const;
 };
 
 

@@ -27,7 +27,11 @@ struct IntegratorSettings {
   // every pass is recorded (recorded_bounces is ignored); the roulette settings do not apply.
   uint32_t spp = 128;              // samples per texel; 0 = until the time budget ends
   double time_budget_seconds = 0;  // 0 = no budget
-  double target_relative_error = 0;  // stop a texel when its relative standard error is below this; 0 = off
+  double target_relative_error = 0;  // plan each texel's samples to reach this relative standard error; 0 = off
+  // Adaptive sampling (core/adaptive_sampling_plan.h): after a pilot, texels get samples in proportion
+  // to their estimated relative deviation; spp is then the mean samples per texel. CPU backend, path
+  // mode; the others refuse it. Off: every texel gets the same samples.
+  bool adaptive = false;
   int max_bounces = -1;            // diffuse bounces after the first hit; -1 = until Russian roulette
   uint64_t seed = 0;
   int recorded_bounces = 4;        // layers bounce0 (= direct) .. bounce<K-1> kept separately

@@ -35,6 +35,9 @@ class PassScheduler {
   // sample cap, at the time budget, or when `all_converged` (the integrator's target-error test).
   void finish_pass(uint64_t rays_so_far, bool all_converged = false);
 
+  // Replaces the sample cap (an adaptive plan knows its total only after the pilot); progress follows it.
+  void set_sample_limit(uint32_t limit) { limit_ = limit; }
+
   uint32_t samples_done() const { return done_; }
   double elapsed_seconds() const;
   bool timed() const { return settings_.time_budget_seconds > 0; }

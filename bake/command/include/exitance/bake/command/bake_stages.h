@@ -89,6 +89,9 @@ ProbePlacement place_probes_stage(const SceneForLighting& scene, const Voxelized
 PersistedSceneFile scene_file_stage(const SceneForLighting& scene, const TexelGBuffer& gbuffer, const AtlasLayout& layout,
                                     const ProbePlacement* probes, const BakeOptions& options, Diagnostics& diagnostics);
 
+// Whether the lighting stage samples adaptively on `backend_name` (BakeOptions::adaptive_request).
+bool adaptive_sampling_applies(const BakeOptions& options, const std::string& backend_name);
+
 // lighting: E/pi at every live texel on the backend; warns when samples were NaN/Inf.
 LightmapEstimate lighting_stage(const Integrator& backend, const TexelGBuffer& gbuffer, const BakeOptions& options,
                                 Diagnostics& diagnostics);
