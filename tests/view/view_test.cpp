@@ -30,6 +30,7 @@
 #include "exitance/common/material.h"
 #include "exitance/formats/lightmap_exr.h"
 #include "exitance/formats/scene_file.h"
+#include "exitance/runtime/core/bvh4_walk.h"
 #include "exitance/runtime/view/view_camera.h"
 #include "exitance/runtime/view/view_image_output.h"
 #include "exitance/runtime/view/view_input_error.h"
@@ -367,6 +368,34 @@ TEST_F(Furnace, ProbesModeLightsEverySurfaceFromTheProbes) {
   const view::ViewImage image =
       view::render_view(scene, view::look_at_camera({0.7f, 1.9f, 0}, {0.7f, 0, 0}, {0, 0, -1}, 0.2), options);
   expect_furnace_pixels(image, exact(), probe_standard_deviation(scene), "floor from the probes");
+}
+
+TEST_F(Furnace, NearestChildFirstWalkFindsTheSameNearestDistance) {
+  // The view's walk order (nearest child first) against the runtime's (storage order): the same
+  // nearest distance for every ray (which of two equally near triangles is reported may differ).
+  const formats::SceneFile scene = formats::read_scene_file((*dir_ / "furnace.bake" / "scene.bin").string());
+  const auto corners = [&](uint32_t t, Vec3& p0, Vec3& p1, Vec3& p2) {
+    const auto& p = scene.triangles.positions;
+    p0 = {p[3 * t][0], p[3 * t][1], p[3 * t][2]};
+    p1 = {p[3 * t + 1][0], p[3 * t + 1][1], p[3 * t + 1][2]};
+    p2 = {p[3 * t + 2][0], p[3 * t + 2][1], p[3 * t + 2][2]};
+  };
+  std::vector<uint32_t> stack;
+  uint32_t state = 12345;
+  const auto uniform = [&] {
+    state = state * 1664525u + 1013904223u;
+    return float(state >> 8) / float(1u << 24);
+  };
+  for (int i = 0; i < 4000; ++i) {
+    const Vec3 origin{uniform() * 1.8f - 0.9f, uniform() * 1.8f + 0.1f, uniform() * 1.8f - 0.9f};
+    const Vec3 direction = normalize(Vec3{uniform() - 0.5f, uniform() - 0.5f, uniform() - 0.5f});
+    const Bvh4WalkHit a = bvh4_closest_hit<true>(scene.bvh.nodes.data(), scene.bvh.nodes.size(),
+                                                 scene.bvh.leaf_triangles.data(), corners, origin, direction, 1e30f, stack);
+    const Bvh4WalkHit b = bvh4_closest_hit<false>(scene.bvh.nodes.data(), scene.bvh.nodes.size(),
+                                                  scene.bvh.leaf_triangles.data(), corners, origin, direction, 1e30f, stack);
+    ASSERT_EQ(a.found, b.found) << "ray " << i;
+    ASSERT_EQ(a.distance, b.distance) << "ray " << i;
+  }
 }
 
 // --- A glTF camera node ----------------------------------------------------------------------------

@@ -85,7 +85,7 @@ Vec3 shade_primary_ray(const ViewScene& view, ViewMode mode, Vec3 origin, Vec3 d
     p2 = to_vec3(scene.triangles.positions[3 * size_t(t) + 2]);
   };
   const Bvh4WalkHit hit =
-      bvh4_closest_hit(scene.bvh.nodes.data(), scene.bvh.nodes.size(), scene.bvh.leaf_triangles.data(), corners, origin,
+      bvh4_closest_hit</*kNearestChildFirst=*/true>(scene.bvh.nodes.data(), scene.bvh.nodes.size(), scene.bvh.leaf_triangles.data(), corners, origin,
                        direction, std::numeric_limits<float>::infinity(), scratch.stack);
   const bool lit_mode = mode == ViewMode::Lightmap || mode == ViewMode::Probes;
   if (!hit.found) return lit_mode ? to_vec3(scene.sky) : Vec3(0);

@@ -47,7 +47,10 @@ inline TriangleIntersection intersect_triangle(const Vec3& o, const Vec3& d, con
 
 // The nearest triangle hit at a distance in (0, t_max]. `corners(t, p0, p1, p2)` fills triangle t's
 // corners; `stack` is scratch space (reused across calls to spare allocations).
-template <class Node, class Corners>
+// kNearestChildFirst visits a node's children in the order the ray enters their boxes (leaves
+// first), so the closest hit is found early and shrinks the search: faster for long rays (views),
+// the same hit unless two triangles are equally near (the runtime's host rays keep storage order).
+template <bool kNearestChildFirst = false, class Node, class Corners>
 Bvh4WalkHit bvh4_closest_hit(const Node* nodes, size_t node_count, const uint32_t* leaf_triangles, const Corners& corners,
                              const Vec3& origin, const Vec3& direction, float t_max, std::vector<uint32_t>& stack) {
   Bvh4WalkHit best;
@@ -55,10 +58,28 @@ Bvh4WalkHit bvh4_closest_hit(const Node* nodes, size_t node_count, const uint32_
   double best_t = t_max;
   const double inv[3] = {1.0 / double(direction.x), 1.0 / double(direction.y), 1.0 / double(direction.z)};
   const double o[3] = {origin.x, origin.y, origin.z};
+  const auto intersect_leaf = [&](uint32_t child) {
+    const uint32_t first = (child & ~kBvhLeafBit) >> 2, count = (child & 3u) + 1;
+    for (uint32_t slot = first; slot < first + count; ++slot) {
+      const uint32_t t = leaf_triangles[slot];
+      Vec3 p0, p1, p2;
+      corners(t, p0, p1, p2);
+      const TriangleIntersection hit = intersect_triangle(origin, direction, p0, p1, p2);
+      if (hit.distance > 0 && hit.distance <= best_t) {
+        best_t = hit.distance;
+        best = {true, hit.distance, t, hit.b1, hit.b2};
+      }
+    }
+  };
   stack.assign(1, 0);
   while (!stack.empty()) {
     const Node& node = nodes[stack.back()];
     stack.pop_back();
+    struct Entered {
+      double distance;
+      uint32_t child;
+    } entered[4];
+    int entered_count = 0;
     for (int c = 0; c < 4; ++c) {
       const uint32_t child = node.child[c];
       if (child == kBvhEmptyChild) continue;
@@ -72,21 +93,23 @@ Bvh4WalkHit bvh4_closest_hit(const Node* nodes, size_t node_count, const uint32_
         if (t1 < leave) leave = t1;
       }
       if (enter > leave) continue;
-      if (!(child & kBvhLeafBit)) {
+      if constexpr (kNearestChildFirst) {
+        entered[entered_count++] = {enter, child};
+      } else if (!(child & kBvhLeafBit)) {
         stack.push_back(child);
-        continue;
+      } else {
+        intersect_leaf(child);
       }
-      const uint32_t first = (child & ~kBvhLeafBit) >> 2, count = (child & 3u) + 1;
-      for (uint32_t slot = first; slot < first + count; ++slot) {
-        const uint32_t t = leaf_triangles[slot];
-        Vec3 p0, p1, p2;
-        corners(t, p0, p1, p2);
-        const TriangleIntersection hit = intersect_triangle(origin, direction, p0, p1, p2);
-        if (hit.distance > 0 && hit.distance <= best_t) {
-          best_t = hit.distance;
-          best = {true, hit.distance, t, hit.b1, hit.b2};
-        }
-      }
+    }
+    if constexpr (kNearestChildFirst) {
+      // Insertion sort by entry distance (at most 4), then leaves nearest first, then inner
+      // children pushed farthest first so the nearest is popped next.
+      for (int i = 1; i < entered_count; ++i)
+        for (int j = i; j > 0 && entered[j].distance < entered[j - 1].distance; --j) std::swap(entered[j], entered[j - 1]);
+      for (int i = 0; i < entered_count; ++i)
+        if (entered[i].child & kBvhLeafBit) intersect_leaf(entered[i].child);
+      for (int i = entered_count - 1; i >= 0; --i)
+        if (!(entered[i].child & kBvhLeafBit) && entered[i].distance <= best_t) stack.push_back(entered[i].child);
     }
   }
   return best;
