@@ -44,8 +44,10 @@ ViewImage render_view(const ViewScene& view, const PinholeCamera& camera, const 
       next_row = image.height;
     }
   };
-  const unsigned threads =
-      std::max(1u, std::min(options.threads ? options.threads : std::thread::hardware_concurrency(), unsigned(image.height)));
+  // No more threads than rows, and a sane cap on what a caller may ask for.
+  constexpr unsigned kMaxThreads = 1024;
+  const unsigned asked = options.threads ? options.threads : std::thread::hardware_concurrency();
+  const unsigned threads = std::max(1u, std::min({asked, unsigned(image.height), kMaxThreads}));
   std::vector<std::thread> workers;
   for (unsigned t = 1; t < threads; ++t) workers.emplace_back(render_rows);
   render_rows();

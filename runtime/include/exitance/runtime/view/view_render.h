@@ -22,7 +22,7 @@ struct ViewRenderOptions {
   int width = 512, height = 512;
   int samples_per_axis = 1;  // --aa N
   ViewMode mode = ViewMode::Lightmap;
-  unsigned threads = 0;  // 0: one per hardware thread
+  unsigned threads = 0;  // 0: one per hardware thread; at most one per row and 1024
 };
 
 ViewImage render_view(const ViewScene& view, const PinholeCamera& camera, const ViewRenderOptions& options);
