@@ -4,6 +4,9 @@
 //    bundle's own texel noise (4 standard deviations of the plane's texels; a bilinear mix of
 //    texels has at most one texel's deviation); a ray that misses shows L exactly;
 //  - albedo and normal modes on that plane are exact;
+//  - a point light over a plane (E/pi = I h / (pi d^3), deterministic): pixels follow the closed form
+//    within the lightmap's derived interpolation error, and the same bundle with its scale_offset
+//    mirrored fails that check (what a golden test must catch);
 //  - a white furnace (emission Le, albedo rho, closed) has E/pi = Le / (1 - rho) everywhere, so a
 //    pixel shows rho Le / (1 - rho) + Le = Le / (1 - rho): through the lightmap on the walls, and
 //    through the probes on an inner box whose lightmap texels were removed from scene.bin (what an
@@ -240,6 +243,123 @@ TEST(ViewToneCurve, ExposureCurveAndSrgb) {
   EXPECT_EQ(view::tone_map_to_srgb8({0.5f, 0.5f, 0.5f}, 1)[2], 188);  // 2^1 exposure
   EXPECT_EQ(view::tone_map_to_srgb8({1e30f, 1e30f, 1e30f}, 0)[0], 255);
   EXPECT_EQ(view::tone_map_to_srgb8({NAN, -1, 0}, 0)[0], 0);
+}
+
+// --- A point light over a plane: a lightmap that varies, read through the instance's scale_offset ---
+
+// E/pi at (x, 0, z) under a point light of intensity I (W/sr) at (lx, h, lz): I h / (pi d^3).
+constexpr float kLight[3] = {0.3f, 1.0f, -0.2f};
+double point_light_e_over_pi(double x, double z) {
+  const double dx = x - kLight[0], dz = z - kLight[2], h = kLight[1];
+  const double d2 = dx * dx + h * h + dz * dz;
+  return h / (M_PI * d2 * std::sqrt(d2));
+}
+
+// The largest |grad f| of E/pi over the square |x|, |z| <= half (central differences).
+double max_gradient(double half) {
+  double worst = 0;
+  const double step = 1e-4;
+  for (int i = 0; i <= 100; ++i)
+    for (int j = 0; j <= 100; ++j) {
+      const double x = -half + 2 * half * i / 100, z = -half + 2 * half * j / 100;
+      const double fx = (point_light_e_over_pi(x + step, z) - point_light_e_over_pi(x - step, z)) / (2 * step);
+      const double fz = (point_light_e_over_pi(x, z + step) - point_light_e_over_pi(x, z - step)) / (2 * step);
+      worst = std::max(worst, std::hypot(fx, fz));
+    }
+  return worst;
+}
+
+// The largest |f_xx| + |f_zz| of E/pi over the square |x|, |z| <= half (central differences).
+double max_second_derivative_sum(double half) {
+  double worst = 0;
+  const double step = 1e-3;
+  for (int i = 0; i <= 100; ++i)
+    for (int j = 0; j <= 100; ++j) {
+      const double x = -half + 2 * half * i / 100, z = -half + 2 * half * j / 100, f = point_light_e_over_pi(x, z);
+      const double fxx = (point_light_e_over_pi(x + step, z) - 2 * f + point_light_e_over_pi(x - step, z)) / (step * step);
+      const double fzz = (point_light_e_over_pi(x, z + step) - 2 * f + point_light_e_over_pi(x, z - step)) / (step * step);
+      worst = std::max(worst, std::fabs(fxx) + std::fabs(fzz));
+    }
+  return worst;
+}
+
+struct PointLightComparison {
+  int pixels = 0, outside_tolerance = 0;
+  double worst_ratio = 0;  // |error| / tolerance
+};
+
+// Every pixel of a view from above whose hit lies in |x|, |z| < 0.8 (at least 3 texels inside the
+// quad), against albedo x the closed form. The tolerance is derived, not tuned: bilinear
+// interpolation between texel centres is off by at most (s^2 / 8) (|f_xx| + |f_zz|) for a texel of
+// world size s, a texel holding its area's mean instead of its centre's value by (s^2 / 24) of the
+// same; a texel that the quad's diagonal (x = z) crosses holds E/pi at the centroid of its part on
+// the triangle that covers most of it (the rasterizer's rule), up to s / sqrt(2) from its centre,
+// so within 2 texels of the diagonal |grad f| s / sqrt(2) is added; plus 4 x the bundle's own
+// estimated relative error of a texel.
+PointLightComparison compare_with_point_light(const view::ViewScene& scene, double relative_error) {
+  const view::PinholeCamera camera = view::look_at_camera({0, 1.5f, 0}, {0, 0, 0}, {0, 0, -1}, 1.2);
+  view::ViewRenderOptions options;
+  options.width = options.height = 40;
+  const view::ViewImage image = view::render_view(scene, camera, options);
+  float texel = 0;
+  for (float s : scene.scene.texels.triangle_texel_size) texel = std::max(texel, s);
+  const double curvature = max_second_derivative_sum(0.8), gradient = max_gradient(0.8);
+  PointLightComparison result;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const Vec3 d = view::primary_ray_direction(camera, x + 0.5, y + 0.5, image.width, image.height);
+      const double t = -double(camera.eye.y) / d.y;
+      const double px = camera.eye.x + t * d.x, pz = camera.eye.z + t * d.z;
+      if (!(std::fabs(px) < 0.8 && std::fabs(pz) < 0.8)) continue;
+      const double f = point_light_e_over_pi(px, pz);
+      const bool near_diagonal = std::fabs(px - pz) / std::sqrt(2.0) < 2 * texel;
+      const double off_centre = near_diagonal ? gradient * texel / std::sqrt(2.0) : 0.0;
+      const double tolerance =
+          kPlaneAlbedo[0] * (double(texel) * texel * (1.0 / 8 + 1.0 / 24) * curvature + off_centre + 4 * relative_error * f) +
+          1e-6;
+      const double error = std::fabs(image.pixel(x, y).x - kPlaneAlbedo[0] * f);
+      ++result.pixels;
+      if (error > tolerance) ++result.outside_tolerance;
+      result.worst_ratio = std::max(result.worst_ratio, error / tolerance);
+    }
+  return result;
+}
+
+TEST(ViewPointLight, PixelsFollowTheLightmapThroughScaleOffsetAndABrokenOneFails) {
+  const fs::path dir = testing::fresh_temp_dir("view-point-light");
+  samples::SceneBuilder builder;
+  samples::Material material;
+  material.baseColor = {kPlaneAlbedo[0], kPlaneAlbedo[1], kPlaneAlbedo[2]};
+  samples::MeshBuilder plane;
+  plane.addQuad(samples::Quad::axisAligned({-1, 0, -1}, {1, 0, 1}, {0, 1, 0}), builder.addMaterial(material));
+  builder.addMeshNode("Plane", plane);
+  builder.addPointLight({.name = "Lamp", .position = {kLight[0], kLight[1], kLight[2]}});
+  builder.write((dir / "lamp.gltf").string());
+  BakeOptions options = small_bake(dir / "lamp.gltf", dir / "lamp.bake");
+  options.probes_enabled = false;
+  Diagnostics diagnostics;
+  run_bake(options, diagnostics);
+  const nlohmann::json manifest = nlohmann::json::parse(read_text(dir / "lamp.bake" / "manifest.json"));
+  const double relative_error = manifest["stats"]["estimated_relative_error"].get<double>();
+
+  const PointLightComparison good = compare_with_point_light(view::open_view_scene((dir / "lamp.bake").string()), relative_error);
+  std::printf("[view] point light: %d pixels, estimated relative error %.3g, worst |error| / tolerance %.3f\n", good.pixels,
+              relative_error, good.worst_ratio);
+  EXPECT_GT(good.pixels, 500);
+  EXPECT_EQ(good.outside_tolerance, 0);
+
+  // The same bundle with the instance's scale_offset mirrored in u: the view must disagree.
+  nlohmann::json broken = manifest;
+  auto& so = broken["instances"][0]["scale_offset"];
+  const double sx = so[0].get<double>(), ox = so[2].get<double>();
+  so[0] = -sx;
+  so[2] = ox + sx;
+  std::ofstream(dir / "lamp.bake" / "manifest.json") << broken.dump();
+  const PointLightComparison bad = compare_with_point_light(view::open_view_scene((dir / "lamp.bake").string()), relative_error);
+  std::printf("[view] point light, mirrored scale_offset: %d of %d pixels outside the tolerance\n", bad.outside_tolerance,
+              bad.pixels);
+  EXPECT_GT(bad.outside_tolerance, bad.pixels / 4);
+  fs::remove_all(dir);
 }
 
 // --- The furnace: lightmap on the walls, probes on an inner box without texels ---------------------
