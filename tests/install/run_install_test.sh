@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # run_install_test.sh BUILD_DIR WORK_DIR BUNDLE_DIR CONSUMER_SOURCE CMAKE GENERATOR CC CXX
 # Installs the loader component of BUILD_DIR into WORK_DIR/prefix, builds and runs the consumer
-# through find_package and through pkg-config, and checks what the binaries link.
+# through find_package and through pkg-config, checks what the binaries link, and runs the
+# installed exitance-view.
 set -euo pipefail
 build_dir=$1 work=$2 bundle=$3 consumer=$4 cmake=$5 generator=$6 cc=$7 cxx=$8
 forbidden='libvulkan|libembree|libopenvdb|libCGAL|libtbb'
@@ -52,4 +53,13 @@ for mode in find_package pkg-config; do
   # Run it without LD_LIBRARY_PATH: the build tree's RPATH must find the installed library.
   "$out/consumer" "$bundle" || { echo "FAIL: the $mode consumer failed on $bundle"; exit 1; }
 done
-echo "installed loader: find_package and pkg-config consumers built, ran, and link no forbidden library"
+# exitance-view comes with the loader: it links nothing more and runs from the prefix.
+view="$prefix/bin/exitance-view"
+[ -x "$view" ] || { echo "FAIL: exitance-view not installed under $prefix/bin"; exit 1; }
+check_links "$view"
+if readelf -d "$view" | grep NEEDED | grep -Eqi 'OpenImageIO|libexitance_runtime'; then
+  echo "FAIL: exitance-view links more than the loader"
+  exit 1
+fi
+"$view" --help >/dev/null || { echo "FAIL: the installed exitance-view does not run"; exit 1; }
+echo "installed loader: find_package and pkg-config consumers built, ran, and link no forbidden library; exitance-view runs"

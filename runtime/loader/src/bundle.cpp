@@ -139,15 +139,39 @@ const formats::LightmapImage& Bundle::page_image(size_t page) const {
   return page_images_[page];
 }
 
-Rgb Bundle::lightmap(size_t instance, std::array<float, 2> uv) const {
-  if (instance >= manifest_.instances.size())
-    throw std::out_of_range("instance " + std::to_string(instance) + " of " + std::to_string(manifest_.instances.size()));
+namespace {
+
+// Page UV of an instance's lightmap UV; NaN (from Inf * 0) becomes 0. u, v may overflow to Inf for
+// a huge uv; the lookups clamp to the edge either way.
+std::array<float, 2> page_uv(const std::vector<InstanceInfo>& instances, size_t instance, std::array<float, 2> uv) {
+  if (instance >= instances.size())
+    throw std::out_of_range("instance " + std::to_string(instance) + " of " + std::to_string(instances.size()));
   if (!(std::isfinite(uv[0]) && std::isfinite(uv[1]))) throw std::invalid_argument("lightmap uv is not finite");
-  const InstanceInfo& info = manifest_.instances[instance];
+  const InstanceInfo& info = instances[instance];
   const float u = uv[0] * info.scale_offset[0] + info.scale_offset[2];
   const float v = uv[1] * info.scale_offset[1] + info.scale_offset[3];
-  // u, v may overflow to Inf for huge uv; the lookup clamps to the edge either way.
-  return bilinear_page_rgb(page_images_[info.page], std::isnan(u) ? 0.0f : u, std::isnan(v) ? 0.0f : v);
+  return {std::isnan(u) ? 0.0f : u, std::isnan(v) ? 0.0f : v};
+}
+
+}  // namespace
+
+Rgb Bundle::lightmap(size_t instance, std::array<float, 2> uv) const {
+  const std::array<float, 2> p = page_uv(manifest_.instances, instance, uv);
+  return bilinear_page_rgb(page_images_[manifest_.instances[instance].page], p[0], p[1]);
+}
+
+float Bundle::lightmap_channel(size_t instance, const std::string& channel, std::array<float, 2> uv) const {
+  const std::array<float, 2> p = page_uv(manifest_.instances, instance, uv);
+  const formats::LightmapImage& page = page_images_[manifest_.instances[instance].page];
+  if (!page.channels.count(channel))
+    throw std::out_of_range(manifest_.pages[manifest_.instances[instance].page].file + ": no channel " + channel);
+  return bilinear_page_channel(page, channel, p[0], p[1]);
+}
+
+bool Bundle::has_lightmap_channel(const std::string& channel) const {
+  for (const formats::LightmapImage& page : page_images_)
+    if (!page.channels.count(channel)) return false;
+  return !page_images_.empty();
 }
 
 ProbeShResult Bundle::probe_sh(Point3 point) const {

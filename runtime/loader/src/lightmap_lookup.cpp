@@ -20,20 +20,34 @@ AxisTaps axis_taps(float page_coordinate, int texels) {
   return {i0, i1, float(x - i0)};
 }
 
+// Bilinear weights of the four texels around (u, v), shared by the RGB and the one-channel lookups.
+struct BilinearTaps {
+  size_t top_left, top_right, bottom_left, bottom_right;
+  float tx, ty;
+
+  float apply(const float* d) const {
+    const float top = d[top_left] * (1 - tx) + d[top_right] * tx;
+    const float bottom = d[bottom_left] * (1 - tx) + d[bottom_right] * tx;
+    return top * (1 - ty) + bottom * ty;
+  }
+};
+
+BilinearTaps bilinear_taps(const formats::LightmapImage& page, float u, float v) {
+  const AxisTaps x = axis_taps(u, page.width), y = axis_taps(v, page.height);
+  const size_t w = size_t(page.width);
+  return {size_t(y.i0) * w + x.i0, size_t(y.i0) * w + x.i1, size_t(y.i1) * w + x.i0, size_t(y.i1) * w + x.i1, x.t, y.t};
+}
+
 }  // namespace
 
 Rgb bilinear_page_rgb(const formats::LightmapImage& page, float u, float v) {
-  const AxisTaps x = axis_taps(u, page.width), y = axis_taps(v, page.height);
-  const size_t w = size_t(page.width);
-  const float* channels[3] = {page.channels.at("R").data(), page.channels.at("G").data(), page.channels.at("B").data()};
-  Rgb out{};
-  for (int c = 0; c < 3; ++c) {
-    const float* d = channels[c];
-    const float top = d[size_t(y.i0) * w + x.i0] * (1 - x.t) + d[size_t(y.i0) * w + x.i1] * x.t;
-    const float bottom = d[size_t(y.i1) * w + x.i0] * (1 - x.t) + d[size_t(y.i1) * w + x.i1] * x.t;
-    out[c] = top * (1 - y.t) + bottom * y.t;
-  }
-  return out;
+  const BilinearTaps taps = bilinear_taps(page, u, v);
+  return {taps.apply(page.channels.at("R").data()), taps.apply(page.channels.at("G").data()),
+          taps.apply(page.channels.at("B").data())};
+}
+
+float bilinear_page_channel(const formats::LightmapImage& page, const std::string& channel, float u, float v) {
+  return bilinear_taps(page, u, v).apply(page.channels.at(channel).data());
 }
 
 }  // namespace exitance::loader

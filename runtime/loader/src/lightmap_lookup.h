@@ -1,5 +1,7 @@
-// Bilinear lookup of a lightmap page's R, G, B channels at a page UV.
+// Bilinear lookup of a lightmap page's R, G, B channels (or any one channel) at a page UV.
 #pragma once
+#include <string>
+
 #include "exitance/formats/lightmap_exr.h"
 #include "exitance/loader/lookup_results.h"
 
@@ -10,5 +12,8 @@ namespace exitance::loader {
 // repeated (clamp to edge). The image must hold R, G, B of width * height floats each, and u, v
 // must be finite (Bundle::open and Bundle::lightmap check both).
 Rgb bilinear_page_rgb(const formats::LightmapImage& page, float u, float v);
+
+// The same lookup of one channel (e.g. "error.Y"), which the page must hold.
+float bilinear_page_channel(const formats::LightmapImage& page, const std::string& channel, float u, float v);
 
 }  // namespace exitance::loader

@@ -8,17 +8,12 @@
 #include <optional>
 #include <vector>
 
+#include "exitance/runtime/matrix4d.h"
 #include "exitance/runtime/scene.h"
 
 namespace exitance {
 
-// a * b (column-major).
-Matrix4d multiply(const Matrix4d& a, const Matrix4d& b);
-
-// T * R * S with R from the quaternion (x, y, z, w) divided by its length; the caller makes sure
-// the length is not zero.
-Matrix4d trs_matrix(const std::array<double, 3>& translation, const std::array<double, 4>& rotation,
-                    const std::array<double, 3>& scale);
+// multiply(a, b) and trs_matrix(t, r, s): exitance/runtime/matrix4d.h (header-only).
 
 // The node's local transform: `matrix` when has_matrix, else trs_matrix of its parts.
 Matrix4d local_matrix(const SceneNode& node);

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "exitance/runtime/matrix4d.h"  // Matrix4d
 #include "exitance/runtime/vec_math.h"
 
 namespace exitance {
@@ -72,9 +73,6 @@ struct Sky {
   bool has_environment() const { return environment.width > 0; }
 };
 
-// 4x4 matrix, column-major as glTF stores it; double precision as the importer composes it.
-using Matrix4d = std::array<double, 16>;
-inline constexpr Matrix4d kIdentityMatrix4d{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
 
 // One mesh instance (a glTF node with a mesh). Triangles [first_triangle, first_triangle + triangle_count).
 struct Instance {

@@ -38,6 +38,11 @@ class Bundle {
   // clamp to edge. Throws std::out_of_range for a bad instance, std::invalid_argument for a
   // non-finite uv.
   Rgb lightmap(size_t instance, std::array<float, 2> uv) const;
+  // The same lookup of one other channel of the instance's page (e.g. "error.Y"). Throws
+  // std::out_of_range when that page lacks the channel (has_lightmap_channel says beforehand).
+  float lightmap_channel(size_t instance, const std::string& channel, std::array<float, 2> uv) const;
+  // True when every page holds the channel.
+  bool has_lightmap_channel(const std::string& channel) const;
 
   bool has_probes() const { return probes_.has_value(); }
   const formats::ProbeGrid* probe_grid() const { return probes_ ? &*probes_ : nullptr; }

@@ -1,0 +1,36 @@
+// What one primary ray of exitance-view shows (docs/view.md, "What a pixel shows"): the radiance an
+// engine would draw from the baked data at the first surface the ray meets, or the sky.
+#pragma once
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "exitance/runtime/vec_math.h"
+#include "exitance/runtime/view/view_scene.h"
+
+namespace exitance::view {
+
+enum class ViewMode {
+  Lightmap,  // albedo x lightmap E/pi (probes' E/pi where an instance has no texels) + emission; sky on a miss
+  Probes,    // albedo x probes' E/pi for every surface + emission; sky on a miss
+  Albedo,    // diffuse albedo; 0 on a miss
+  Normal,    // shading normal * 0.5 + 0.5; 0 on a miss
+  Error,     // the lightmap's error.Y channel (grey); 0 on a miss and where an instance has no texels
+};
+
+std::optional<ViewMode> parse_view_mode(const std::string& name);
+const char* view_mode_name(ViewMode mode);
+
+// The lightmap channel the error mode shows (written by bakes that estimate per-texel error).
+inline constexpr const char* kErrorChannel = "error.Y";
+
+// Per-thread scratch for the BVH walk.
+struct RayScratch {
+  std::vector<uint32_t> stack;
+};
+
+// Radiance (or the debug quantity of `mode`) along the ray from `origin` in unit `direction`.
+Vec3 shade_primary_ray(const ViewScene& view, ViewMode mode, Vec3 origin, Vec3 direction, RayScratch& scratch);
+
+}  // namespace exitance::view

@@ -1,0 +1,111 @@
+#include "exitance/runtime/view/view_shading.h"
+
+#include <limits>
+
+#include "exitance/common/material.h"
+#include "exitance/runtime/core/bvh4_walk.h"
+
+namespace exitance::view {
+namespace {
+
+Vec3 to_vec3(const formats::Float3& f) { return {f[0], f[1], f[2]}; }
+
+struct SurfaceAtHit {
+  Vec3 position;
+  Vec3 geometric_normal;  // front side (counter-clockwise winding)
+  Vec3 shading_normal;    // interpolated, facing the viewer on a double-sided surface's back
+  bool back_face_absorbs;  // the back of a single-sided surface: the bake treats it as black
+  uint32_t instance;
+  Vec3 albedo, emission;
+  std::array<float, 2> lightmap_uv;
+};
+
+SurfaceAtHit surface_at(const ViewScene& view, const Bvh4WalkHit& hit, Vec3 direction) {
+  const formats::SceneTriangles& tris = view.scene.triangles;
+  const size_t t = hit.triangle, c = 3 * t;
+  const float b1 = float(hit.b1), b2 = float(hit.b2), b0 = 1 - b1 - b2;
+  const Vec3 p0 = to_vec3(tris.positions[c]), p1 = to_vec3(tris.positions[c + 1]), p2 = to_vec3(tris.positions[c + 2]);
+  SurfaceAtHit s;
+  s.position = p0 * b0 + p1 * b1 + p2 * b2;
+  s.geometric_normal = normalize(cross(p1 - p0, p2 - p0));
+  // As texel_surface.h derives a texel's normal: the interpolated one unless it is zero or points
+  // more than ~87 degrees away from the geometric normal.
+  Vec3 n = to_vec3(tris.normals[c]) * b0 + to_vec3(tris.normals[c + 1]) * b1 + to_vec3(tris.normals[c + 2]) * b2;
+  const float len = length(n);
+  n = len > 0 ? n / len : s.geometric_normal;
+  if (!(dot(n, s.geometric_normal) > 0.05f)) n = s.geometric_normal;
+  const formats::MaterialRecord& m = view.scene.materials[tris.material[t]];
+  const bool front = dot(direction, s.geometric_normal) < 0;
+  s.back_face_absorbs = !front && !m.double_sided;
+  s.shading_normal = front || !m.double_sided ? n : -n;
+  s.instance = tris.instance[t];
+  s.albedo = diffuse_albedo_of(to_vec3(m.base_color), m.metallic);
+  s.emission = front || m.double_sided ? to_vec3(m.emission) : Vec3(0);
+  const formats::Float2 uv0 = tris.lightmap_uv[c], uv1 = tris.lightmap_uv[c + 1], uv2 = tris.lightmap_uv[c + 2];
+  s.lightmap_uv = {uv0[0] * b0 + uv1[0] * b1 + uv2[0] * b2, uv0[1] * b0 + uv1[1] * b1 + uv2[1] * b2};
+  return s;
+}
+
+Vec3 probes_irradiance_over_pi(const ViewScene& view, const SurfaceAtHit& s) {
+  if (!view.bundle.has_probes()) return Vec3(0);
+  const loader::ProbeIrradianceResult e = view.bundle.probe_irradiance_over_pi(
+      {s.position.x, s.position.y, s.position.z}, {s.shading_normal.x, s.shading_normal.y, s.shading_normal.z});
+  return {e.irradiance_over_pi[0], e.irradiance_over_pi[1], e.irradiance_over_pi[2]};
+}
+
+Vec3 lightmap_irradiance_over_pi(const ViewScene& view, const SurfaceAtHit& s) {
+  const loader::Rgb e = view.bundle.lightmap(s.instance, s.lightmap_uv);
+  return {e[0], e[1], e[2]};
+}
+
+}  // namespace
+
+std::optional<ViewMode> parse_view_mode(const std::string& name) {
+  for (ViewMode m : {ViewMode::Lightmap, ViewMode::Probes, ViewMode::Albedo, ViewMode::Normal, ViewMode::Error})
+    if (name == view_mode_name(m)) return m;
+  return std::nullopt;
+}
+
+const char* view_mode_name(ViewMode mode) {
+  switch (mode) {
+    case ViewMode::Lightmap: return "lightmap";
+    case ViewMode::Probes: return "probes";
+    case ViewMode::Albedo: return "albedo";
+    case ViewMode::Normal: return "normal";
+    case ViewMode::Error: return "error";
+  }
+  return "?";
+}
+
+Vec3 shade_primary_ray(const ViewScene& view, ViewMode mode, Vec3 origin, Vec3 direction, RayScratch& scratch) {
+  const formats::SceneFile& scene = view.scene;
+  const auto corners = [&](uint32_t t, Vec3& p0, Vec3& p1, Vec3& p2) {
+    p0 = to_vec3(scene.triangles.positions[3 * size_t(t)]);
+    p1 = to_vec3(scene.triangles.positions[3 * size_t(t) + 1]);
+    p2 = to_vec3(scene.triangles.positions[3 * size_t(t) + 2]);
+  };
+  const Bvh4WalkHit hit =
+      bvh4_closest_hit</*kNearestChildFirst=*/true>(scene.bvh.nodes.data(), scene.bvh.nodes.size(), scene.bvh.leaf_triangles.data(), corners, origin,
+                       direction, std::numeric_limits<float>::infinity(), scratch.stack);
+  const bool lit_mode = mode == ViewMode::Lightmap || mode == ViewMode::Probes;
+  if (!hit.found) return lit_mode ? to_vec3(scene.sky) : Vec3(0);
+  const SurfaceAtHit s = surface_at(view, hit, direction);
+  switch (mode) {
+    case ViewMode::Albedo: return s.albedo;
+    case ViewMode::Normal: return s.shading_normal * 0.5f + Vec3(0.5f);
+    case ViewMode::Error: {
+      if (!view.instance_has_texels[s.instance]) return Vec3(0);
+      return Vec3(view.bundle.lightmap_channel(s.instance, kErrorChannel, s.lightmap_uv));
+    }
+    case ViewMode::Lightmap:
+    case ViewMode::Probes: {
+      if (s.back_face_absorbs) return Vec3(0);
+      const bool from_lightmap = mode == ViewMode::Lightmap && view.instance_has_texels[s.instance];
+      const Vec3 e_over_pi = from_lightmap ? lightmap_irradiance_over_pi(view, s) : probes_irradiance_over_pi(view, s);
+      return s.albedo * e_over_pi + s.emission;
+    }
+  }
+  return Vec3(0);
+}
+
+}  // namespace exitance::view
