@@ -159,7 +159,11 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
                        {"moved", placement.moved},
                        {"invalid_inside_geometry", placement.invalid},
                        {"skipped_far_from_geometry", placement.skipped},
-                       {"rays_per_probe", options.probe_spp},
+                       // What ran: a --time budget can end probes before --probe-spp.
+                       {"rays_per_probe", probe_estimate.samples.empty()
+                                              ? uint64_t(options.probe_spp)
+                                              : uint64_t(*std::min_element(probe_estimate.samples.begin(),
+                                                                           probe_estimate.samples.end()))},
                        {"rays", probe_estimate.rays},
                        {"rays_per_second",
                         probe_estimate.seconds > 0 ? double(probe_estimate.rays) / probe_estimate.seconds : 0.0},

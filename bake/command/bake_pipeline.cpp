@@ -143,14 +143,22 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
     return scene_file_stage(scene, gbuffer, layout, probes ? &*probes : nullptr, options, diagnostics);
   });
 
-  // Lighting stage (runtime/): texels, their exitance into the octree, probes.
-  const LightmapEstimate lightmap =
-      clock.time("lighting", [&] { return lighting_stage(*backend, gbuffer, options, diagnostics); });
-  if (voxels) clock.time("exitance", [&] { exitance_stage(*voxels, scene, gbuffer, lightmap, options); });
+  // Lighting stage (runtime/): probes, texels, their exitance into the octree. A --time budget covers
+  // probes and texels: the probes go first with at most kProbeShareOfTimeBudget of it (and at most
+  // --probe-spp), the texels get what the probes left.
   std::optional<ProbeEstimate> probe_lighting;
-  if (probes)
-    probe_lighting =
-        clock.time("probes", [&] { return probe_lighting_stage(*backend, *probes, options, diagnostics); });
+  BakeOptions lighting_options = options;
+  const double budget = options.lighting.time_budget_seconds;
+  if (probes) {
+    const double probe_budget = budget > 0 ? kProbeShareOfTimeBudget * budget : 0.0;
+    probe_lighting = clock.time(
+        "probes", [&] { return probe_lighting_stage(*backend, *probes, options, diagnostics, probe_budget); });
+    // Never 0 (= no budget): a budget the probes used up leaves the texels one pass.
+    if (budget > 0) lighting_options.lighting.time_budget_seconds = std::max(1e-3, budget - probe_lighting->seconds);
+  }
+  const LightmapEstimate lightmap =
+      clock.time("lighting", [&] { return lighting_stage(*backend, gbuffer, lighting_options, diagnostics); });
+  if (voxels) clock.time("exitance", [&] { exitance_stage(*voxels, scene, gbuffer, lightmap, options); });
 
   // Bundle: everything the stages produced, written at once.
   const BakeResults results{.scene = *scene.scene,

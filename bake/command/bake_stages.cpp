@@ -187,7 +187,7 @@ void exitance_stage(VoxelizedScene& voxels, const SceneForLighting& scene, const
 }
 
 ProbeEstimate probe_lighting_stage(const Integrator& backend, ProbePlacement& probes, const BakeOptions& options,
-                                   Diagnostics& diagnostics) {
+                                   Diagnostics& diagnostics, double time_budget_seconds) {
   std::vector<Vec3> positions;
   std::vector<size_t> traced;  // grid index of each traced probe
   for (size_t i = 0; i < probes.grid.probes.size(); ++i) {
@@ -198,8 +198,9 @@ ProbeEstimate probe_lighting_stage(const Integrator& backend, ProbePlacement& pr
   }
   IntegratorSettings settings = options.lighting;
   settings.spp = options.probe_spp;
-  settings.time_budget_seconds = 0;
+  settings.time_budget_seconds = time_budget_seconds;
   settings.target_relative_error = 0;
+  settings.adaptive = false;
   settings.progress = [&](double fraction, uint64_t rays) {
     if (options.progress) options.progress("probes", fraction, rays);
   };

@@ -100,9 +100,13 @@ LightmapEstimate lighting_stage(const Integrator& backend, const TexelGBuffer& g
 void exitance_stage(VoxelizedScene& voxels, const SceneForLighting& scene, const TexelGBuffer& gbuffer,
                     const LightmapEstimate& lightmap, const BakeOptions& options);
 
-// probes: L2 SH of incident radiance at every usable probe on the backend (--probe-spp rays each),
-// stored into `probes.grid`; warns when samples were NaN/Inf.
+// The part of a --time budget the probes may use (they run first; the texels get the rest).
+constexpr double kProbeShareOfTimeBudget = 0.1;
+
+// probes: L2 SH of incident radiance at every usable probe on the backend (--probe-spp rays each, or
+// fewer, in whole stratified sets, when `time_budget_seconds` > 0 ends them first), stored into
+// `probes.grid`; warns when samples were NaN/Inf.
 ProbeEstimate probe_lighting_stage(const Integrator& backend, ProbePlacement& probes, const BakeOptions& options,
-                                   Diagnostics& diagnostics);
+                                   Diagnostics& diagnostics, double time_budget_seconds = 0);
 
 }  // namespace exitance
