@@ -99,11 +99,16 @@ formats::SvoInfo svo_of(const formats::SparseVoxelOctree& svo) {
 json stats_json(const BakeResults& results, const json& seconds, size_t warnings, const BakeOptions& options) {
   const TexelGBuffer& gbuffer = results.gbuffer;
   const LightmapEstimate& estimate = results.lightmap;
-  uint64_t min_samples = gbuffer.texels.empty() ? 0 : UINT64_MAX, sample_sum = 0;
+  // Samples per traced texel: skipped sealed texels have none by design.
+  auto skipped_sealed = [&](size_t i) { return results.sealed_skipped && results.sealed && results.sealed->sealed[i]; };
+  uint64_t min_samples = UINT64_MAX, sample_sum = 0, traced = 0;
   for (size_t i = 0; i < gbuffer.texels.size(); ++i) {
+    if (skipped_sealed(i)) continue;
     min_samples = std::min<uint64_t>(min_samples, estimate.texels[i].samples);
     sample_sum += estimate.texels[i].samples;
+    ++traced;
   }
+  if (traced == 0) min_samples = 0;
 
   const double lighting_seconds = estimate.seconds;
   json stats;
@@ -115,7 +120,7 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
   stats["rays"] = estimate.rays;
   stats["rays_per_second"] = lighting_seconds > 0 ? double(estimate.rays) / lighting_seconds : 0.0;
   stats["samples_per_texel"] = {{"min", min_samples},
-                                {"mean", gbuffer.texels.empty() ? 0.0 : double(sample_sum) / double(gbuffer.texels.size())}};
+                                {"mean", traced == 0 ? 0.0 : double(sample_sum) / double(traced)}};
   stats["estimated_relative_error"] = estimate.mean_relative_standard_error();
   stats["unoccluded_texels"] = results.unoccluded_texels;
   stats["enclosed_texels"] = results.geometry.enclosed_texels;
@@ -123,6 +128,19 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
   stats["enclosed_lights"] = results.geometry.enclosed_lights;
   stats["nonfinite_samples"] = estimate.nonfinite_samples;
   json skipped = {{"texels_outside_charts", gbuffer.skipped_texels}};
+  if (results.sealed) {
+    // Sealed texels (no light reaches them): found either way, skipped unless --no-skip. The time
+    // saved is an estimate: the lighting stage's seconds per traced texel times the texels skipped
+    // (bench/results/dead-work.md measures it with and without the skip).
+    const SealedTexels& sealed = *results.sealed;
+    stats["sealed_texels"] = {{"found", sealed.texels}, {"instances", sealed.instances},
+                              {"candidates", sealed.candidates}, {"skipped", results.sealed_skipped}};
+    const size_t sealed_skipped = results.sealed_skipped ? sealed.texels : 0;
+    skipped["sealed_texels"] = sealed_skipped;
+    skipped["sealed_instances"] = results.sealed_skipped ? sealed.instances : 0;
+    skipped["sealed_lighting_seconds_saved_estimate"] =
+        traced > 0 ? lighting_seconds / double(traced) * double(sealed_skipped) : 0.0;
+  }
   if (results.probes) {
     const ProbePlacement& placement = *results.probes;
     const ProbeEstimate& probe_estimate = *results.probe_lighting;

@@ -128,6 +128,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   const size_t unoccluded = clock.time("unocclude", [&] { return unocclude_stage(scene, gbuffer); });
   const GeometryCheckReport geometry =
       clock.time("checks", [&] { return scene_checks_stage(scene, gbuffer, options, diagnostics); });
+  const SealedTexels sealed = clock.time("sealed_texels", [&] { return sealed_texels_stage(scene, gbuffer, options); });
 
   // Voxelize and place probes before lighting, so a bad --voxel-resolution or --probes fails before
   // the long stage.
@@ -145,7 +146,9 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
 
   // Lighting stage (runtime/): texels, their exitance into the octree, probes.
   const LightmapEstimate lightmap =
-      clock.time("lighting", [&] { return lighting_stage(*backend, gbuffer, options, diagnostics); });
+      clock.time("lighting", [&] {
+        return lighting_stage(*backend, gbuffer, options.skip_sealed_texels ? &sealed : nullptr, options, diagnostics);
+      });
   if (voxels) clock.time("exitance", [&] { exitance_stage(*voxels, scene, gbuffer, lightmap, options); });
   std::optional<ProbeEstimate> probe_lighting;
   if (probes)
@@ -165,7 +168,9 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                             .probe_lighting = probe_lighting ? &*probe_lighting : nullptr,
                             .scene_file = scene_file,
                             .input_sha256 = input_sha256,
-                            .generated_uvs = &generated_uvs};
+                            .generated_uvs = &generated_uvs,
+                            .sealed = &sealed,
+                            .sealed_skipped = options.skip_sealed_texels};
   WrittenBundle bundle =
       clock.time("write", [&] { return write_bundle_stage(results, clock.seconds(), diagnostics, options); });
   if (cache) {
