@@ -128,7 +128,8 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   const size_t unoccluded = clock.time("unocclude", [&] { return unocclude_stage(scene, gbuffer); });
   const GeometryCheckReport geometry =
       clock.time("checks", [&] { return scene_checks_stage(scene, gbuffer, options, diagnostics); });
-  const SealedTexels sealed = clock.time("sealed_texels", [&] { return sealed_texels_stage(scene, gbuffer, options); });
+  const SealedTexels sealed =
+      clock.time("sealed_texels", [&] { return sealed_texels_stage(scene, gbuffer, geometry, options); });
 
   // Voxelize and place probes before lighting, so a bad --voxel-resolution or --probes fails before
   // the long stage.

@@ -132,9 +132,10 @@ GeometryCheckReport scene_checks_stage(const SceneForLighting& scene, const Texe
   return report;
 }
 
-SealedTexels sealed_texels_stage(const SceneForLighting& scene, const TexelGBuffer& gbuffer, const BakeOptions& options) {
+SealedTexels sealed_texels_stage(const SceneForLighting& scene, const TexelGBuffer& gbuffer,
+                                 const GeometryCheckReport& checks, const BakeOptions& options) {
   options.announce_stage("sealed texels");
-  return find_sealed_texels(*scene.scene, *scene.embree, gbuffer);
+  return find_sealed_texels(*scene.scene, *scene.embree, gbuffer, &checks.closed_texels);
 }
 
 VoxelizedScene voxelize_stage(const Scene& scene, const AtlasLayout& layout, const BakeOptions& options) {

@@ -11,17 +11,14 @@
 #include "exitance/common/sampling.h"
 
 namespace exitance {
-namespace {
 
-// A ray that ends on the back of an opaque single-sided surface brings no light: the lighting
-// stage gives such hits zero radiance. A miss (the sky), a front face, a double-sided surface
-// (its back is a real surface that reflects and may emit) or a surface rays can pass through
-// (alpha MASK/BLEND) may bring light.
-bool hits_dead_back_face(const Scene& scene, const Hit& hit, Vec3 direction) {
+bool ends_on_dead_back_face(const Scene& scene, const Hit& hit, Vec3 direction) {
   if (!hit.found || !(dot(direction, hit.geometric_normal) > 0)) return false;
   const Material& m = scene.materials[scene.triangle_material[hit.triangle]];
   return !m.double_sided && m.alpha_mode == Material::AlphaMode::Opaque;
 }
+
+namespace {
 
 // Whether a punctual light has a clear line to `origin`. glTF's optional `range` is not imported,
 // so every point and spot light counts at any distance; spot cones are ignored (a light aimed
@@ -49,7 +46,8 @@ bool sees_a_punctual_light(const Scene& scene, const EmbreeScene& embree, Vec3 o
 // projected hemisphere, is always found, and a smaller one with probability proportional to its
 // size. What can be missed therefore carries less than ~0.4 % of the light arriving through the
 // opening (plus any light behind a gap smaller than that), and --no-skip measures it.
-SealedTexels find_sealed_texels(const Scene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer) {
+SealedTexels find_sealed_texels(const Scene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer,
+                                const std::vector<uint8_t>* closed) {
   SealedTexels result;
   result.sealed.assign(gbuffer.texels.size(), 0);
   tbb::combinable<size_t> candidates([] { return size_t(0); });
@@ -58,12 +56,16 @@ SealedTexels find_sealed_texels(const Scene& scene, const EmbreeScene& embree, c
     const Vec3 origin = offset_ray_origin(t.position, t.geometric_normal, embree.extent());
     auto closed_along = [&](float u1, float u2) {
       const Vec3 d = to_world(sample_cosine_hemisphere(u1, u2), t.geometric_normal);
-      return hits_dead_back_face(scene, embree.intersect(origin, d, INFINITY), d);
+      return ends_on_dead_back_face(scene, embree.intersect(origin, d, INFINITY), d);
     };
     Pcg32 rng = pcg_init(0x5EA1ED, i, 0);
-    for (int k = 0; k < kSealedFirstRays; ++k) {
-      const float u1 = pcg_uniform(rng), u2 = pcg_uniform(rng);
-      if (!closed_along(u1, u2)) return;
+    if (closed) {
+      if (!(*closed)[i]) return;
+    } else {
+      for (int k = 0; k < kSealedFirstRays; ++k) {
+        const float u1 = pcg_uniform(rng), u2 = pcg_uniform(rng);
+        if (!closed_along(u1, u2)) return;
+      }
     }
     ++candidates.local();
     for (int a = 0; a < kSealedConfirmRaysU; ++a)

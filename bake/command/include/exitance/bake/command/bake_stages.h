@@ -75,8 +75,10 @@ size_t unocclude_stage(const SceneForLighting& scene, TexelGBuffer& gbuffer);
 GeometryCheckReport scene_checks_stage(const SceneForLighting& scene, const TexelGBuffer& gbuffer,
                                        const BakeOptions& options, Diagnostics& diagnostics);
 
-// sealed texels: the live texels no light can reach (bake/raster/sealed_texels.h).
-SealedTexels sealed_texels_stage(const SceneForLighting& scene, const TexelGBuffer& gbuffer, const BakeOptions& options);
+// sealed texels: the live texels no light can reach (bake/raster/sealed_texels.h), starting from
+// the checks' closed texels (their first rays are not traced again).
+SealedTexels sealed_texels_stage(const SceneForLighting& scene, const TexelGBuffer& gbuffer,
+                                 const GeometryCheckReport& checks, const BakeOptions& options);
 
 // voxelize: the sparse voxel octree at --voxel-resolution (automatic: leaves about 4 texels wide).
 // Throws InputError naming --voxel-resolution for a resolution it cannot build.

@@ -29,6 +29,15 @@ struct SealedTexels {
   size_t candidates = 0;        // texels whose first rays all hit single-sided back faces
 };
 
-SealedTexels find_sealed_texels(const Scene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer);
+// `closed`: per live texel, whether its first kSealedFirstRays cosine rays all ended on dead back
+// faces, when already traced (the scene checks' closed_texels); null: traced here.
+SealedTexels find_sealed_texels(const Scene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer,
+                                const std::vector<uint8_t>* closed = nullptr);
+
+// A ray that ends on the back of an opaque single-sided surface brings no light: the lighting
+// stage gives such hits zero radiance. A miss (the sky), a front face, a double-sided surface (its
+// back is a real surface that reflects and may emit) or a surface rays can pass through (alpha
+// MASK/BLEND) may bring light.
+bool ends_on_dead_back_face(const Scene& scene, const Hit& hit, Vec3 direction);
 
 }  // namespace exitance
