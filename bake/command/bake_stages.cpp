@@ -172,10 +172,13 @@ LightmapEstimate lighting_stage(const Integrator& backend, const TexelGBuffer& g
   };
   // The backends light the texel list they are given: hand them the texels light can reach and
   // put the estimate back on the full list (sealed texels with no samples).
-  LightmapEstimate estimate = skip && skip->texels > 0
-                                  ? expand_lightmap_estimate(
-                                        backend.bake(gbuffer_without_skipped(gbuffer, skip->sealed), settings), skip->sealed)
-                                  : backend.bake(gbuffer, settings);
+  LightmapEstimate estimate;
+  if (skip && skip->texels > 0) {
+    const LightmapEstimate traced = backend.bake(gbuffer_without_skipped(gbuffer, skip->sealed), settings);
+    estimate = expand_lightmap_estimate(traced, skip->sealed);
+  } else {
+    estimate = backend.bake(gbuffer, settings);
+  }
   warn_about_nonfinite_samples(estimate.nonfinite_samples, "path", options, diagnostics);
   return estimate;
 }

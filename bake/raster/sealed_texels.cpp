@@ -39,13 +39,15 @@ bool sees_a_punctual_light(const Scene& scene, const EmbreeScene& embree, Vec3 o
 
 }  // namespace
 
-// Why 16 + 240 rays: the first 16 (as the enclosed-texel check) reject almost every open texel at
-// once, so the second set costs only where geometry closes over a texel. The second set is a
-// jittered 16 x 15 grid over the square that sample_cosine_hemisphere warps to the hemisphere:
-// an opening whose cosine-weighted solid angle covers one grid cell, 1/240 = 0.42 % of the
-// projected hemisphere, is always found, and a smaller one with probability proportional to its
-// size. What can be missed therefore carries less than ~0.4 % of the light arriving through the
-// opening (plus any light behind a gap smaller than that), and --no-skip measures it.
+// Why 16 + 240 rays: the first 16 (bake passes the enclosed-texel check's, already traced) reject
+// almost every open texel at once, so the second set costs only where geometry closes over a
+// texel. The second set is a jittered 16 x 15 grid over the square that sample_cosine_hemisphere
+// warps to the hemisphere: an opening whose preimage in the square holds a whole grid cell (1/240
+// = 0.42 % of the cosine-weighted hemisphere) is always found; a smaller or thinner one with a
+// probability about proportional to its cosine-weighted size, so what can be missed is mostly
+// light through gaps of well under 1 % of the view. Against that, a sealed texel traced at
+// 128 spp would get 128 cosine rays of its own. --no-skip measures what was missed
+// (bench/results/dead-work.md: nothing on the sample scenes).
 SealedTexels find_sealed_texels(const Scene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer,
                                 const std::vector<uint8_t>* closed) {
   SealedTexels result;

@@ -103,7 +103,8 @@ bool shrink_to_closer_triangle(RTCPointQueryFunctionArguments* args) {
   const Scene& scene = *static_cast<const Scene*>(args->userPtr);
   const size_t t = args->primID;
   const Vec3 p{args->query->x, args->query->y, args->query->z};
-  const Vec3 q = closest_point_on_triangle(p, scene.positions[t * 3], scene.positions[t * 3 + 1], scene.positions[t * 3 + 2]);
+  const Vec3* v = &scene.positions[t * 3];
+  const Vec3 q = closest_point_on_triangle(p, v[0], v[1], v[2]);
   const float d = length(q - p);
   if (!(d < args->query->radius)) return false;
   args->query->radius = d;
