@@ -96,12 +96,13 @@ formats::SvoInfo svo_of(const formats::SparseVoxelOctree& svo) {
   return info;
 }
 
-// stats.error: the distribution over texels of the EXR's error layer (relative standard error with
+// stats.error: the distribution over traced texels of the EXR's error layer (relative standard error with
 // the floor), and the floor itself.
 json error_distribution_json(const LightmapEstimate& estimate) {
   const double floor = estimate.error_floor();
-  std::vector<float> errors(estimate.texels.size());
-  for (size_t i = 0; i < errors.size(); ++i) errors[i] = estimate.relative_standard_error(i, floor);
+  std::vector<float> errors;  // over traced texels (skipped sealed texels have no samples)
+  for (size_t i = 0; i < estimate.texels.size(); ++i)
+    if (estimate.texels[i].samples > 0) errors.push_back(estimate.relative_standard_error(i, floor));
   std::sort(errors.begin(), errors.end());
   auto quantile = [&](double q) {
     return errors.empty() ? 0.0 : double(errors[std::min(errors.size() - 1, size_t(q * double(errors.size())))]);
@@ -120,12 +121,17 @@ json error_distribution_json(const LightmapEstimate& estimate) {
 json stats_json(const BakeResults& results, const json& seconds, size_t warnings, const BakeOptions& options) {
   const TexelGBuffer& gbuffer = results.gbuffer;
   const LightmapEstimate& estimate = results.lightmap;
-  uint64_t min_samples = gbuffer.texels.empty() ? 0 : UINT64_MAX, max_samples = 0, sample_sum = 0;
+  // Samples per traced texel: skipped sealed texels have none by design.
+  auto skipped_sealed = [&](size_t i) { return results.sealed_skipped && results.sealed && results.sealed->sealed[i]; };
+  uint64_t min_samples = UINT64_MAX, max_samples = 0, sample_sum = 0, traced = 0;
   for (size_t i = 0; i < gbuffer.texels.size(); ++i) {
+    if (skipped_sealed(i)) continue;
     min_samples = std::min<uint64_t>(min_samples, estimate.texels[i].samples);
     max_samples = std::max<uint64_t>(max_samples, estimate.texels[i].samples);
     sample_sum += estimate.texels[i].samples;
+    ++traced;
   }
+  if (traced == 0) min_samples = 0;
 
   const double lighting_seconds = estimate.seconds;
   json stats;
@@ -138,7 +144,7 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
   stats["rays_per_second"] = lighting_seconds > 0 ? double(estimate.rays) / lighting_seconds : 0.0;
   stats["samples_per_texel"] = {{"min", min_samples},
                                 {"max", max_samples},
-                                {"mean", gbuffer.texels.empty() ? 0.0 : double(sample_sum) / double(gbuffer.texels.size())}};
+                                {"mean", traced == 0 ? 0.0 : double(sample_sum) / double(traced)}};
   if (estimate.adaptive) stats["samples_per_texel"]["pilot"] = estimate.adaptive_pilot;
   stats["estimated_relative_error"] = estimate.mean_relative_standard_error();
   stats["error"] = error_distribution_json(estimate);
@@ -148,6 +154,19 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
   stats["enclosed_lights"] = results.geometry.enclosed_lights;
   stats["nonfinite_samples"] = estimate.nonfinite_samples;
   json skipped = {{"texels_outside_charts", gbuffer.skipped_texels}};
+  if (results.sealed) {
+    // Sealed texels (no light reaches them): found either way, skipped unless --no-skip. The time
+    // saved is an estimate: the lighting stage's seconds per traced texel times the texels skipped
+    // (bench/results/dead-work.md measures it with and without the skip).
+    const SealedTexels& sealed = *results.sealed;
+    stats["sealed_texels"] = {{"found", sealed.texels}, {"instances", sealed.instances},
+                              {"candidates", sealed.candidates}, {"skipped", results.sealed_skipped}};
+    const size_t sealed_skipped = results.sealed_skipped ? sealed.texels : 0;
+    skipped["sealed_texels"] = sealed_skipped;
+    skipped["sealed_instances"] = results.sealed_skipped ? sealed.instances : 0;
+    skipped["sealed_lighting_seconds_saved_estimate"] =
+        traced > 0 ? lighting_seconds / double(traced) * double(sealed_skipped) : 0.0;
+  }
   if (results.probes) {
     const ProbePlacement& placement = *results.probes;
     const ProbeEstimate& probe_estimate = *results.probe_lighting;

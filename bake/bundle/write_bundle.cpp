@@ -28,7 +28,8 @@ WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::jso
   assembly.bounce_layers = options.bounce_layers;
   assembly.dilation_texels = std::max(2, options.atlas.padding * 2);
   const std::vector<formats::LightmapImage> pages =
-      assemble_lightmap_pages(results.gbuffer, results.lightmap, assembly);
+      assemble_lightmap_pages(results.gbuffer, results.lightmap, assembly,
+                              results.sealed && results.sealed_skipped ? results.sealed->sealed : std::vector<uint8_t>{});
   const formats::BundleManifest manifest = build_bundle_manifest(
       results, pages, results.input_sha256, seconds, diagnostics.warnings.size(), options);
   const std::string manifest_text = formats::write_bundle_manifest(manifest);

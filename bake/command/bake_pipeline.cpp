@@ -128,6 +128,8 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   const size_t unoccluded = clock.time("unocclude", [&] { return unocclude_stage(scene, gbuffer); });
   const GeometryCheckReport geometry =
       clock.time("checks", [&] { return scene_checks_stage(scene, gbuffer, options, diagnostics); });
+  const SealedTexels sealed =
+      clock.time("sealed_texels", [&] { return sealed_texels_stage(scene, gbuffer, geometry, options); });
 
   // Voxelize and place probes before lighting, so a bad --voxel-resolution or --probes fails before
   // the long stage.
@@ -157,7 +159,10 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
     if (budget > 0) lighting_options.lighting.time_budget_seconds = std::max(1e-3, budget - probe_lighting->seconds);
   }
   const LightmapEstimate lightmap =
-      clock.time("lighting", [&] { return lighting_stage(*backend, gbuffer, lighting_options, diagnostics); });
+      clock.time("lighting", [&] {
+        return lighting_stage(*backend, gbuffer, options.skip_sealed_texels ? &sealed : nullptr, lighting_options,
+                              diagnostics);
+      });
   if (voxels) clock.time("exitance", [&] { exitance_stage(*voxels, scene, gbuffer, lightmap, options); });
 
   // Bundle: everything the stages produced, written at once.
@@ -173,7 +178,9 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                             .probe_lighting = probe_lighting ? &*probe_lighting : nullptr,
                             .scene_file = scene_file,
                             .input_sha256 = input_sha256,
-                            .generated_uvs = &generated_uvs};
+                            .generated_uvs = &generated_uvs,
+                            .sealed = &sealed,
+                            .sealed_skipped = options.skip_sealed_texels};
   WrittenBundle bundle =
       clock.time("write", [&] { return write_bundle_stage(results, clock.seconds(), diagnostics, options); });
   if (cache) {

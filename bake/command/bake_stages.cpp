@@ -5,6 +5,8 @@
 #include <vector>
 
 #include "exitance/bake/command/backend_choice.h"
+#include "exitance/bake/command/expand_lightmap_estimate.h"
+#include "exitance/bake/command/gbuffer_without_skipped.h"
 #include "exitance/bake/import/gltf_import.h"
 #include "exitance/bake/import/gltf_lightmap_uv_writer.h"
 #include "exitance/bake/import/sky_option.h"
@@ -135,6 +137,12 @@ GeometryCheckReport scene_checks_stage(const SceneForLighting& scene, const Texe
   return report;
 }
 
+SealedTexels sealed_texels_stage(const SceneForLighting& scene, const TexelGBuffer& gbuffer,
+                                 const GeometryCheckReport& checks, const BakeOptions& options) {
+  options.announce_stage("sealed texels");
+  return find_sealed_texels(*scene.scene, *scene.embree, gbuffer, &checks.closed_texels);
+}
+
 VoxelizedScene voxelize_stage(const Scene& scene, const AtlasLayout& layout, const BakeOptions& options) {
   options.announce_stage("voxelize");
   SvoBuildSettings settings;
@@ -168,14 +176,22 @@ bool adaptive_sampling_applies(const BakeOptions& options, const std::string& ba
          (options.lighting.time_budget_seconds > 0 || options.lighting.target_relative_error > 0);
 }
 
-LightmapEstimate lighting_stage(const Integrator& backend, const TexelGBuffer& gbuffer, const BakeOptions& options,
-                                Diagnostics& diagnostics) {
+LightmapEstimate lighting_stage(const Integrator& backend, const TexelGBuffer& gbuffer, const SealedTexels* skip,
+                                const BakeOptions& options, Diagnostics& diagnostics) {
   IntegratorSettings settings = options.lighting;
   settings.adaptive = adaptive_sampling_applies(options, backend.backend_name());
   settings.progress = [&](double fraction, uint64_t rays) {
     if (options.progress) options.progress("lighting", fraction, rays);
   };
-  LightmapEstimate estimate = backend.bake(gbuffer, settings);
+  // The backends light the texel list they are given: hand them the texels light can reach and
+  // put the estimate back on the full list (sealed texels with no samples).
+  LightmapEstimate estimate;
+  if (skip && skip->texels > 0) {
+    const LightmapEstimate traced = backend.bake(gbuffer_without_skipped(gbuffer, skip->sealed), settings);
+    estimate = expand_lightmap_estimate(traced, skip->sealed);
+  } else {
+    estimate = backend.bake(gbuffer, settings);
+  }
   warn_about_nonfinite_samples(estimate.nonfinite_samples, "path", options, diagnostics);
   return estimate;
 }

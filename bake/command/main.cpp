@@ -77,6 +77,10 @@ int main(int argc, char** argv) {
   app.add_option("--sky", options.sky, "sky radiance: R,G,B or an equirectangular image (EXR/HDR)");
   app.add_option("--seed", options.lighting.seed, "random seed; results are deterministic per seed and backend");
   app.add_flag("--bounce-layers", options.bounce_layers, "also write bounce<k>.R/G/B debug layers");
+  bool no_skip = false;
+  app.add_flag("--no-skip", no_skip,
+               "trace the sealed texels too (those no light can reach; skipped and dilated by default), to measure "
+               "what skipping them changes");
   std::string probes = "auto", voxels = "auto", directional, guiding = "auto";
   app.add_option("--probes", probes, "light-probe grid spacing in scene units, auto (largest extent / 12) or none");
   app.add_option("--probe-spp", options.probe_spp, "rays per light probe")->check(CLI::Range(1u, 1u << 24));
@@ -178,6 +182,7 @@ int main(int argc, char** argv) {
     }
     options.adaptive_request = exitance::AdaptiveRequest::Off;
   }
+  options.skip_sealed_texels = !no_skip;
   if (!directional.empty()) diagnostics.warn("--directional: directional lightmaps are not implemented yet; ignored");
   if (guiding == "svo") {
     std::cerr << "bake: error: --guiding svo is not implemented yet (use grid or off)\n";

@@ -3,7 +3,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -27,56 +26,6 @@ std::vector<Vec3> fibonacci_sphere(uint32_t count) {
 }
 
 enum class Site { Free, Inside };
-
-// Per grid probe: whether any triangle's bounding box, grown by `reach`, covers it. A 3-D
-// difference array (+1/-1 at the corners of each box's index range, then prefix sums) keeps this
-// O(triangles + probes) however large the triangles are.
-std::vector<uint8_t> probes_near_geometry(const Scene& scene, const formats::ProbeGrid& grid, float reach) {
-  const int64_t nx = grid.counts[0], ny = grid.counts[1], nz = grid.counts[2];
-  std::vector<int32_t> diff(size_t((nx + 1) * (ny + 1) * (nz + 1)), 0);
-  auto at = [&](int64_t x, int64_t y, int64_t z) -> int32_t& { return diff[size_t((z * (ny + 1) + y) * (nx + 1) + x)]; };
-  const int64_t n[3] = {nx, ny, nz};
-  for (size_t t = 0; t < scene.triangle_count(); ++t) {
-    int64_t lo[3], hi[3];
-    bool empty = false;
-    for (int a = 0; a < 3; ++a) {
-      float mn = scene.positions[t * 3][a], mx = mn;
-      for (int k = 1; k < 3; ++k) {
-        mn = std::min(mn, scene.positions[t * 3 + size_t(k)][a]);
-        mx = std::max(mx, scene.positions[t * 3 + size_t(k)][a]);
-      }
-      // Probe indices i with origin + i * spacing in [mn - reach, mx + reach].
-      const double first = std::ceil((double(mn) - reach - grid.origin[a]) / grid.spacing[a]);
-      const double last = std::floor((double(mx) + reach - grid.origin[a]) / grid.spacing[a]);
-      lo[a] = int64_t(std::max(0.0, first));
-      hi[a] = int64_t(std::min(double(n[a] - 1), last));
-      if (!(first <= last) || lo[a] > hi[a]) empty = true;
-    }
-    if (empty) continue;
-    for (int corner = 0; corner < 8; ++corner) {
-      const int64_t x = corner & 1 ? hi[0] + 1 : lo[0], y = corner & 2 ? hi[1] + 1 : lo[1],
-                    z = corner & 4 ? hi[2] + 1 : lo[2];
-      at(x, y, z) += (std::popcount(unsigned(corner)) % 2) ? -1 : 1;
-    }
-  }
-  for (int64_t z = 0; z <= nz; ++z)
-    for (int64_t y = 0; y <= ny; ++y)
-      for (int64_t x = 0; x <= nx; ++x) {
-        int32_t& v = at(x, y, z);
-        if (x > 0) v += at(x - 1, y, z);
-        if (y > 0) v += at(x, y - 1, z);
-        if (z > 0) v += at(x, y, z - 1);
-        if (x > 0 && y > 0) v -= at(x - 1, y - 1, z);
-        if (x > 0 && z > 0) v -= at(x - 1, y, z - 1);
-        if (y > 0 && z > 0) v -= at(x, y - 1, z - 1);
-        if (x > 0 && y > 0 && z > 0) v += at(x - 1, y - 1, z - 1);
-      }
-  std::vector<uint8_t> near(size_t(nx * ny * nz));
-  for (int64_t z = 0; z < nz; ++z)
-    for (int64_t y = 0; y < ny; ++y)
-      for (int64_t x = 0; x < nx; ++x) near[size_t((z * ny + y) * nx + x)] = at(x, y, z) > 0;
-  return near;
-}
 
 struct SiteTester {
   const Scene& scene;
@@ -146,10 +95,19 @@ ProbePlacement place_probes(const Scene& scene, const EmbreeScene& embree, const
                           use_occupancy ? svo : nullptr,
                           fibonacci_sphere(std::max<uint32_t>(8, settings.test_rays)),
                           settings.inside_backface_fraction};
-  const std::vector<uint8_t> near =
-      settings.skip_distance_in_spacings > 0
-          ? probes_near_geometry(scene, grid, settings.skip_distance_in_spacings * spacing)
-          : std::vector<uint8_t>(grid.probes.size(), 1);
+  // Far from geometry: no triangle within the skip distance by a real distance query (Embree's
+  // point query, not grown bounding boxes: a long diagonal triangle's box reaches far from it), and
+  // in the open: more than a quarter of the test rays escape. Without the second test the middle of
+  // any room more than 6 spacings across (every room at the automatic spacing) would lose its
+  // probes, which dynamic objects there need; a closed room lets no ray out.
+  const float skip_distance = settings.skip_distance_in_spacings * spacing;
+  auto far_from_geometry = [&](Vec3 p) {
+    if (!(settings.skip_distance_in_spacings > 0)) return false;
+    if (std::isfinite(embree.distance_to_nearest_triangle(p, skip_distance))) return false;
+    size_t escaped = 0;
+    for (const Vec3& d : tester.directions) escaped += !embree.occluded(p, d, std::numeric_limits<float>::infinity());
+    return 4 * escaped > tester.directions.size();
+  };
   // Move candidates: 26 lattice directions at growing radii up to half a spacing, nearest first.
   std::vector<Vec3> offsets;
   for (float radius : {0.125f, 0.25f, 0.375f, 0.5f})
@@ -170,7 +128,7 @@ ProbePlacement place_probes(const Scene& scene, const EmbreeScene& embree, const
                  grid.origin[2] + float(z) * spacing};
     formats::ProbeRecord& record = grid.probes[i];
     record.position = {p.x, p.y, p.z};
-    if (!near[i]) {
+    if (far_from_geometry(p)) {
       record.state = formats::ProbeState::Skipped;
       return;
     }

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "exitance/bake/raster/sealed_texels.h"
 #include "exitance/runtime/material_eval.h"
 #include "exitance/common/ray_offset.h"
 #include "exitance/common/rng.h"
@@ -13,7 +14,7 @@
 namespace exitance {
 namespace {
 
-constexpr int kHemisphereRays = 16;
+constexpr int kHemisphereRays = kSealedFirstRays;
 constexpr int kLightRays = 64;
 
 bool hits_back_face(const Hit& hit, Vec3 direction) { return hit.found && dot(direction, hit.geometric_normal) > 0; }
@@ -22,18 +23,22 @@ bool hits_back_face(const Hit& hit, Vec3 direction) { return hit.found && dot(di
 
 GeometryCheckReport check_scene_geometry(const Scene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer) {
   GeometryCheckReport report;
+  report.closed_texels.assign(gbuffer.texels.size(), 0);
   tbb::combinable<size_t> enclosed([] { return size_t(0); }), coplanar([] { return size_t(0); });
   tbb::parallel_for(size_t(0), gbuffer.texels.size(), [&](size_t i) {
     const LiveTexel& t = gbuffer.texels[i];
     const Vec3 origin = offset_ray_origin(t.position, t.geometric_normal, embree.extent());
     Pcg32 rng = pcg_init(0xC0FFEE, i, 0);
-    int back = 0;
+    int back = 0, dead = 0;
     for (int k = 0; k < kHemisphereRays; ++k) {
       const float u1 = pcg_uniform(rng), u2 = pcg_uniform(rng);
       const Vec3 d = to_world(sample_cosine_hemisphere(u1, u2), t.geometric_normal);
-      if (hits_back_face(embree.intersect(origin, d, INFINITY), d)) ++back;
+      const Hit hit = embree.intersect(origin, d, INFINITY);
+      if (hits_back_face(hit, d)) ++back;
+      if (ends_on_dead_back_face(scene, hit, d)) ++dead;
     }
     if (back * 2 > kHemisphereRays) ++enclosed.local();
+    report.closed_texels[i] = dead == kHemisphereRays ? 1 : 0;
     // Look back through the texel: another instance's surface within a few offsets, facing the
     // same way, overlaps it in the same plane (opposite-facing contact, a box on a floor, is fine).
     // Every hit within reach is tested, not only the closest: the floor under a box meets both the

@@ -75,6 +75,42 @@ RTCRayHit make_ray(Vec3 origin, Vec3 direction, float t_max) {
   return rayhit;
 }
 
+// Closest point of triangle (a, b, c) to p: Ericson, Real-Time Collision Detection, 5.1.5 (the
+// Voronoi regions of the vertices, then the edges, then the face).
+Vec3 closest_point_on_triangle(Vec3 p, Vec3 a, Vec3 b, Vec3 c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const float d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Vec3 bp = p - b;
+  const float d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const float vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
+  const Vec3 cp = p - c;
+  const float d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const float vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
+  const float va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  const float denominator = va + vb + vc;
+  if (!(denominator > 0)) return a;  // degenerate triangle: its vertices are as close as it gets
+  return a + ab * (vb / denominator) + ac * (vc / denominator);
+}
+
+// Point-query callback: shrinks the query radius to the distance of every closer triangle.
+bool shrink_to_closer_triangle(RTCPointQueryFunctionArguments* args) {
+  const Scene& scene = *static_cast<const Scene*>(args->userPtr);
+  const size_t t = args->primID;
+  const Vec3 p{args->query->x, args->query->y, args->query->z};
+  const Vec3* v = &scene.positions[t * 3];
+  const Vec3 q = closest_point_on_triangle(p, v[0], v[1], v[2]);
+  const float d = length(q - p);
+  if (!(d < args->query->radius)) return false;
+  args->query->radius = d;
+  return true;
+}
+
 }  // namespace
 
 EmbreeScene::EmbreeScene(const Scene& scene) : scene_(scene) {
@@ -134,6 +170,17 @@ bool EmbreeScene::any_hit_where(Vec3 origin, Vec3 direction, float t_max,
   RTCRay ray = make_ray(origin, direction, t_max).ray;
   rtcOccluded1(rtc_scene_, &filter.context, &ray);
   return ray.tfar < 0.0f;  // Embree sets tfar = -inf once a hit passes the filter
+}
+
+float EmbreeScene::distance_to_nearest_triangle(Vec3 point, float max_distance) const {
+  RTCPointQuery query{};
+  query.x = point.x, query.y = point.y, query.z = point.z;
+  query.time = 0;
+  query.radius = max_distance;
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  rtcPointQuery(rtc_scene_, &query, &context, shrink_to_closer_triangle, const_cast<Scene*>(&scene_));
+  return query.radius < max_distance ? query.radius : INFINITY;
 }
 
 bool EmbreeScene::occluded(Vec3 origin, Vec3 direction, float t_max) const {

@@ -2,6 +2,7 @@
 // lighting and the bundle writer; the EXR and manifest are read back and checked.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -167,6 +168,69 @@ TEST(BakePipeline, SameSeedSameResult) {
   const auto a = formats::read_lightmap_exr((dir / "a.bake" / "lightmap-0.exr").string());
   const auto b = formats::read_lightmap_exr((dir / "b.bake" / "lightmap-0.exr").string());
   EXPECT_EQ(a.channels, b.channels);
+  fs::remove_all(dir);
+}
+
+// A box standing on a floor under the sky: the floor under it is sealed. The bake skips it
+// (stats.skipped, valid = 0, A kept, filled from lit neighbours, never NaN); --no-skip traces it,
+// and what it gets there is exactly black (the skip changes nothing but the fill).
+TEST(BakePipeline, SealedTexelsAreSkippedAndWouldBeBlack) {
+  const fs::path dir = testing::fresh_temp_dir("sealed");
+  samples::SceneBuilder builder;
+  samples::Material grey;
+  grey.baseColor = {0.5f, 0.5f, 0.5f};
+  const auto material = builder.addMaterial(grey);
+  samples::MeshBuilder floor;
+  floor.addQuad(Quad::axisAligned({-2, 0, -2}, {2, 0, 2}, {0, 1, 0}), material);
+  builder.addMeshNode("Floor", floor);
+  samples::MeshBuilder box;
+  box.addBox({.center = {0, 0.5f, 0}, .size = {1, 1, 1}}, material, samples::FaceDirection::Outward,
+             samples::BoxFace::AllButBottom);
+  builder.addMeshNode("Box", box);
+  BakeOptions options;
+  options.input = (dir / "box.gltf").string();
+  builder.write(options.input);
+  options.sky = "1,1,1";
+  options.atlas.texel_density = 16;
+  options.lighting.spp = 4;
+  options.probes_enabled = false;
+  Diagnostics diagnostics;
+  options.output = (dir / "skip.bake").string();
+  const nlohmann::json skip = run_bake(options, diagnostics);
+  options.skip_sealed_texels = false;
+  options.output = (dir / "no-skip.bake").string();
+  const nlohmann::json traced = run_bake(options, diagnostics);
+
+  const size_t sealed = skip["sealed_texels"]["found"].get<size_t>();
+  EXPECT_GT(sealed, 100u);  // about 16 x 16 under the box
+  EXPECT_EQ(skip["skipped"]["sealed_texels"].get<size_t>(), sealed);
+  EXPECT_EQ(skip["skipped"]["sealed_instances"].get<size_t>(), 0u);
+  EXPECT_GT(skip["skipped"]["sealed_lighting_seconds_saved_estimate"].get<double>(), 0.0);
+  EXPECT_EQ(traced["sealed_texels"]["found"].get<size_t>(), sealed);
+  EXPECT_EQ(traced["skipped"]["sealed_texels"].get<size_t>(), 0u);
+  EXPECT_EQ(skip["samples_per_texel"]["min"].get<uint64_t>(), 4u);  // over traced texels
+
+  const auto a = formats::read_lightmap_exr((dir / "skip.bake" / "lightmap-0.exr").string());
+  const auto b = formats::read_lightmap_exr((dir / "no-skip.bake" / "lightmap-0.exr").string());
+  ASSERT_TRUE(a.channels.count("valid"));
+  ASSERT_TRUE(b.channels.count("valid"));
+  EXPECT_EQ(a.channels.at("A"), b.channels.at("A"));
+  for (const auto& [name, data] : a.channels)
+    for (float v : data) ASSERT_TRUE(std::isfinite(v)) << name;
+  size_t invalid = 0, lit_fill = 0;
+  for (size_t i = 0; i < a.channels.at("A").size(); ++i) {
+    if (!(a.channels.at("A")[i] > 0)) {
+      EXPECT_EQ(a.channels.at("valid")[i], 0.0f);
+      continue;
+    }
+    EXPECT_EQ(b.channels.at("valid")[i], 1.0f);
+    if (a.channels.at("valid")[i] > 0) continue;
+    ++invalid;
+    for (const char* c : {"R", "G", "B"}) EXPECT_EQ(b.channels.at(c)[i], 0.0f) << "traced sealed texel " << i;
+    lit_fill += a.channels.at("R")[i] > 0;
+  }
+  EXPECT_EQ(invalid, sealed);
+  EXPECT_GT(lit_fill, 0u);  // filled from the lit floor around the box
   fs::remove_all(dir);
 }
 

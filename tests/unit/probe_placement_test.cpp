@@ -2,6 +2,8 @@
 // far from all geometry skipped, and the spacing limit.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "exitance/bake/probes/probe_placement.h"
 #include "support/test_scenes.h"
 
@@ -105,6 +107,41 @@ TEST(ProbePlacement, ProbesFarFromGeometryAreSkipped) {
   EXPECT_GT(placement.valid, 0u);
   EXPECT_EQ(probe_nearest(placement.grid, {45, 5, 0}).state, ProbeState::Skipped);
   EXPECT_EQ(probe_nearest(placement.grid, {5, 5, 0}).state, ProbeState::Valid);
+}
+
+// The middle of a closed room far more than 3 spacings from every wall keeps its probes: they are
+// far from geometry but not in the open (no test ray escapes), and objects moving there need them.
+TEST(ProbePlacement, MiddleOfAClosedRoomIsNotSkipped) {
+  Scene scene;
+  const uint32_t grey = add_material(scene, {0.5f, 0.5f, 0.5f});
+  testing::add_inward_box(scene, {0, 0, 0}, {12, 12, 12}, grey);
+  const EmbreeScene embree(scene);
+  ProbePlacementSettings settings;
+  settings.spacing = 1.0f;
+  const ProbePlacement placement = place_probes(scene, embree, nullptr, settings);
+  EXPECT_EQ(placement.skipped, 0u);
+  EXPECT_EQ(probe_nearest(placement.grid, {6, 6, 6}).state, ProbeState::Valid);
+  // The same distance from a lone floor in the open is skipped.
+  Scene open;
+  const uint32_t floor_grey = add_material(open, {0.5f, 0.5f, 0.5f});
+  add_quad(open, {0, 0, 12}, {12, 0, 0}, {0, 0, -12}, floor_grey);
+  add_quad(open, {0, 12, 0}, {12, 0, 0}, {0, 0, 12}, floor_grey);  // a ceiling 12 above: the room's bounds, open sides
+  const EmbreeScene open_embree(open);
+  const ProbePlacement open_placement = place_probes(open, open_embree, nullptr, settings);
+  EXPECT_EQ(probe_nearest(open_placement.grid, {6, 6, 6}).state, ProbeState::Skipped);
+}
+
+// The point query measures the distance to the triangle itself, not to its bounding box: a long
+// diagonal triangle's box corner is far from it.
+TEST(ProbePlacement, DistanceQueryIsToTheTriangle) {
+  Scene scene;
+  const uint32_t grey = add_material(scene, {0.5f, 0.5f, 0.5f});
+  add_quad(scene, {0, 0, 0}, {10, 10, 0}, {0, 0, 1}, grey);  // a strip along the diagonal y = x
+  const EmbreeScene embree(scene);
+  EXPECT_NEAR(embree.distance_to_nearest_triangle({5, 5, 0.5f}, 100), 0.0f, 1e-5f);
+  EXPECT_NEAR(embree.distance_to_nearest_triangle({10, 0, 0.5f}, 100), std::sqrt(50.0f), 1e-4f);  // box corner
+  EXPECT_NEAR(embree.distance_to_nearest_triangle({-3, -4, 0.5f}, 100), 5.0f, 1e-4f);            // a vertex
+  EXPECT_EQ(embree.distance_to_nearest_triangle({10, 0, 0.5f}, 7.0f), INFINITY);                  // beyond the radius
 }
 
 TEST(ProbePlacement, OccupiedVoxelMovesAProbeOffASurface) {

@@ -116,6 +116,7 @@ class PlaneUnderSky : public ::testing::Test {
     delete dir_;
   }
   static fs::path bundle() { return *dir_ / "plane.bake"; }
+  static fs::path bundle_without_error_layer();
   // From 1 m above the plane's centre looking down: every pixel lies inside the plane (|x|, |z| < 0.6).
   static view::PinholeCamera top_camera() { return view::look_at_camera({0, 1, 0}, {0, 0, 0}, {0, 0, -1}, 1.0); }
   static fs::path* dir_;
@@ -171,6 +172,22 @@ TEST_F(PlaneUnderSky, AlbedoAndNormalModesAreExact) {
       }
 }
 
+// bake writes error.Y into every bundle; a bundle of another writer may lack it (a copy without it).
+fs::path PlaneUnderSky::bundle_without_error_layer() {
+  const fs::path copy = *dir_ / "without-error.bake";
+  if (fs::exists(copy)) return copy;
+  fs::copy(bundle(), copy, fs::copy_options::recursive);
+  const std::string page_file = (copy / "lightmap-0.exr").string();
+  formats::LightmapImage page = formats::read_lightmap_exr(page_file);
+  page.channels.erase("error.Y");
+  formats::write_lightmap_exr(page_file, page);
+  nlohmann::json manifest = nlohmann::json::parse(std::ifstream(copy / "manifest.json"));
+  auto& channels = manifest["pages"][0]["channels"];
+  channels.erase(std::remove(channels.begin(), channels.end(), "error.Y"), channels.end());
+  std::ofstream(copy / "manifest.json") << manifest.dump(2);
+  return copy;
+}
+
 TEST_F(PlaneUnderSky, ErrorModeReadsTheErrorLayer) {
   // A copy of the bundle whose page gains error.Y = 0.25 (+ 0.5 on the west half of the page).
   const fs::path copy = *dir_ / "with-error.bake";
@@ -188,8 +205,9 @@ TEST_F(PlaneUnderSky, ErrorModeReadsTheErrorLayer) {
   const view::ViewImage image = view::render_view(scene, top_camera(), options);
   for (int y = 0; y < 8; ++y)
     for (int x = 0; x < 8; ++x) ASSERT_NEAR(image.pixel(x, y).y, 0.25f, 1e-7f);
-  // Without the layer the tool refuses the mode (ExitanceViewBinary below); the library reports its absence.
-  EXPECT_FALSE(view::open_view_scene(bundle().string()).bundle.has_lightmap_channel(view::kErrorChannel));
+  // Without the layer the tool refuses the mode (below); the library reports its absence.
+  EXPECT_TRUE(view::open_view_scene(bundle().string()).bundle.has_lightmap_channel(view::kErrorChannel));
+  EXPECT_FALSE(view::open_view_scene(bundle_without_error_layer().string()).bundle.has_lightmap_channel(view::kErrorChannel));
 }
 
 int run(const std::string& command) {
@@ -228,9 +246,10 @@ TEST_F(PlaneUnderSky, TheBinaryWritesTheSamePixelsAndRefusesBadInput) {
 
   // The mode the bundle cannot show: exit 2, one line naming the bundle and the layer, no file.
   const std::string err = (*dir_ / "stderr.txt").string();
-  EXPECT_EQ(run(tool + " " + b + camera + "--mode error -o " + out + "-error.png 2>" + err), 2);
+  const std::string without = bundle_without_error_layer().string();
+  EXPECT_EQ(run(tool + " " + without + camera + "--mode error -o " + out + "-error.png 2>" + err), 2);
   const std::string message = read_text(err);
-  EXPECT_NE(message.find(b), std::string::npos) << message;
+  EXPECT_NE(message.find(without), std::string::npos) << message;
   EXPECT_NE(message.find("error.Y"), std::string::npos) << message;
   EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
   EXPECT_FALSE(fs::exists(out + "-error.png"));

@@ -1,6 +1,8 @@
 #include "exitance/runtime/bundle/lightmap_assembly.h"
 
+#include <cstdint>
 #include <string>
+#include <utility>
 
 namespace exitance {
 
@@ -8,15 +10,20 @@ void dilate_into_gutter(int width, int height, const std::vector<float>& coverag
                         int passes) {
   std::vector<uint8_t> filled(coverage.size());
   for (size_t i = 0; i < coverage.size(); ++i) filled[i] = coverage[i] > 0 ? 1 : 0;
+  dilate_into(width, height, std::move(filled), std::vector<uint8_t>(coverage.size(), 1), std::move(channels), passes);
+}
+
+void dilate_into(int width, int height, std::vector<uint8_t> filled, const std::vector<uint8_t>& fillable,
+                 std::vector<float*> channels, int passes) {
   std::vector<size_t> newly;
   std::vector<float> values;
-  for (int pass = 0; pass < passes; ++pass) {
+  for (int pass = 0; passes < 0 || pass < passes; ++pass) {
     newly.clear();
     values.clear();
     for (int y = 0; y < height; ++y)
       for (int x = 0; x < width; ++x) {
         const size_t i = size_t(y) * size_t(width) + size_t(x);
-        if (filled[i]) continue;
+        if (filled[i] || !fillable[i]) continue;
         std::vector<double> sum(channels.size(), 0.0);
         int n = 0;
         for (int dy = -1; dy <= 1; ++dy)
@@ -41,7 +48,8 @@ void dilate_into_gutter(int width, int height, const std::vector<float>& coverag
 }
 
 std::vector<formats::LightmapImage> assemble_lightmap_pages(const TexelGBuffer& gbuffer, const LightmapEstimate& estimate,
-                                                            const AssemblyOptions& options) {
+                                                            const AssemblyOptions& options,
+                                                            const std::vector<uint8_t>& untraced) {
   std::vector<std::string> layers = {"", "direct.", "indirect."};
   if (options.bounce_layers)
     for (int k = 0; k < estimate.recorded_bounces; ++k) layers.push_back("bounce" + std::to_string(k) + ".");
@@ -55,12 +63,21 @@ std::vector<formats::LightmapImage> assemble_lightmap_pages(const TexelGBuffer& 
       for (const char* c : {"R", "G", "B"}) pages[p].channels[layer + c].assign(n, 0.0f);
     pages[p].channels["A"] = source.coverage;
     pages[p].channels["error.Y"].assign(n, 0.0f);
+    pages[p].channels["valid"].assign(n, 0.0f);
   }
   const double error_floor = estimate.error_floor();
+  // Per page, the texels to fill from traced neighbours before the gutter is dilated.
+  std::vector<std::vector<uint8_t>> skipped(pages.size());
   for (size_t i = 0; i < gbuffer.texels.size(); ++i) {
     const LiveTexel& texel = gbuffer.texels[i];
     formats::LightmapImage& page = pages[texel.page];
     const size_t at = size_t(texel.y) * size_t(page.width) + size_t(texel.x);
+    if (!untraced.empty() && untraced[i]) {
+      if (skipped[texel.page].empty()) skipped[texel.page].assign(page.channels["valid"].size(), 0);
+      skipped[texel.page][at] = 1;
+      continue;
+    }
+    page.channels["valid"][at] = 1.0f;
     const Vec3 total = estimate.mean_total(i), direct = estimate.mean_direct(i);
     const Vec3 indirect = total - direct;
     const char* names[3] = {"R", "G", "B"};
@@ -79,7 +96,15 @@ std::vector<formats::LightmapImage> assemble_lightmap_pages(const TexelGBuffer& 
   for (size_t p = 0; p < pages.size(); ++p) {
     std::vector<float*> channels;
     for (auto& [name, data] : pages[p].channels)
-      if (name != "A") channels.push_back(data.data());
+      if (name != "A" && name != "valid") channels.push_back(data.data());
+    if (!skipped[p].empty()) {
+      // Untraced texels from the traced ones only, as deep as the untraced region is, and only
+      // across chart texels (never from another chart through the gutter).
+      const std::vector<float>& valid = pages[p].channels["valid"];
+      std::vector<uint8_t> traced(valid.size());
+      for (size_t i = 0; i < valid.size(); ++i) traced[i] = valid[i] > 0 ? 1 : 0;
+      dilate_into(pages[p].width, pages[p].height, std::move(traced), skipped[p], channels, -1);
+    }
     dilate_into_gutter(pages[p].width, pages[p].height, gbuffer.pages[p].coverage, channels, options.dilation_texels);
   }
   return pages;

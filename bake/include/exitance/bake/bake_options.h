@@ -32,6 +32,9 @@ struct BakeOptions {
   IntegratorSettings lighting;  // lighting.adaptive is decided by the lighting stage from adaptive_request
   AdaptiveRequest adaptive_request = AdaptiveRequest::Auto;
   bool bounce_layers = false;
+  // Sealed texels (bake/raster/sealed_texels.h) are found either way; true: the lighting stage
+  // does not trace them (they are dilated from lit neighbours). --no-skip: false.
+  bool skip_sealed_texels = true;
   // Light probes (--probes): spacing in scene units, 0 = automatic; probes_enabled false = none.
   bool probes_enabled = true;
   float probe_spacing = 0;

@@ -31,6 +31,9 @@ class EmbreeScene {
   // rejects the rest), so the answer does not depend on which of several equidistant hits the
   // CPU's Embree kernels would report as the closest.
   bool any_hit_where(Vec3 origin, Vec3 direction, float t_max, const std::function<bool(const Hit&)>& accept) const;
+  // Distance from `point` to the nearest triangle (any side, any material), by Embree's point
+  // query (rtcPointQuery); +infinity when no triangle is within `max_distance`.
+  float distance_to_nearest_triangle(Vec3 point, float max_distance) const;
   // Largest side of the scene's bounding box: the scale of ray-offset error floors.
   float extent() const { return extent_; }
 

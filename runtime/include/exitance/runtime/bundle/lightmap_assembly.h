@@ -1,8 +1,9 @@
-// Turns per-texel estimates into atlas page images: E/pi in R,G,B, coverage in A, direct/indirect
-// layers, the estimated relative standard error in error.Y (LightmapEstimate::relative_standard_error
-// with the estimate's error_floor), optional bounce<k> layers, and gutter texels dilated from their
-// neighbours.
+// Turns per-texel estimates into atlas page images: E/pi in R,G,B, coverage in A, `valid` (1 where
+// the texel was traced), direct/indirect layers, the estimated relative standard error in error.Y
+// (LightmapEstimate::relative_standard_error with the estimate's error_floor), optional bounce<k>
+// layers, and gutter texels dilated from their neighbours.
 #pragma once
+#include <cstdint>
 #include <vector>
 
 #include "exitance/formats/lightmap_exr.h"
@@ -16,11 +17,21 @@ struct AssemblyOptions {
   int dilation_texels = 4;     // how far colour is pushed into the gutter
 };
 
+// `untraced`: per live texel, 1 for a texel the lighting stage skipped (sealed: no light reaches
+// it), or empty for none. Untraced texels keep their coverage in A, get valid = 0 and take every
+// colour channel from their traced neighbours (dilated within the charts, as far as it takes); one
+// with no traced texel connected to it stays 0.
 std::vector<formats::LightmapImage> assemble_lightmap_pages(const TexelGBuffer& gbuffer, const LightmapEstimate& estimate,
-                                                            const AssemblyOptions& options);
+                                                            const AssemblyOptions& options,
+                                                            const std::vector<uint8_t>& untraced = {});
 
 // Fills texels whose coverage is 0 with the mean of already-filled 8-neighbours, `passes` rings deep.
 void dilate_into_gutter(int width, int height, const std::vector<float>& coverage, std::vector<float*> channels,
                         int passes);
+
+// The same ring by ring fill in general: texels with `filled` = 0 and `fillable` = 1 take the mean of
+// their filled 8-neighbours, `passes` rings deep (a negative count: until nothing changes).
+void dilate_into(int width, int height, std::vector<uint8_t> filled, const std::vector<uint8_t>& fillable,
+                 std::vector<float*> channels, int passes);
 
 }  // namespace exitance

@@ -12,6 +12,7 @@
 #include "exitance/bake/layout/atlas_layout.h"
 #include "exitance/bake/probes/probe_placement.h"
 #include "exitance/bake/raster/geometry_checks.h"
+#include "exitance/bake/raster/sealed_texels.h"
 #include "exitance/bake/uvgen/scene_uv_generation.h"
 #include "exitance/bake/voxelize/svo_build.h"
 #include "exitance/formats/bundle_manifest.h"
@@ -46,6 +47,8 @@ struct BakeResults {
   const PersistedSceneFile& scene_file;  // scene file
   const std::string& input_sha256;       // the input file's SHA-256, hashed once per run (manifest, cache key)
   const std::vector<MeshUvReport>* generated_uvs = nullptr;  // uv generation: the meshes whose UVs it made
+  const SealedTexels* sealed = nullptr;  // sealed texels (found before lighting); null: not looked for
+  bool sealed_skipped = false;           // the lighting stage skipped them (not --no-skip)
 };
 
 // The manifest (formats/bundle_manifest.h) of the bake: `pages`: the assembled lightmap pages (the manifest lists their channels). `input_sha256`: the

@@ -15,6 +15,7 @@
 #include "exitance/bake/layout/atlas_layout.h"
 #include "exitance/bake/probes/probe_placement.h"
 #include "exitance/bake/raster/geometry_checks.h"
+#include "exitance/bake/raster/sealed_texels.h"
 #include "exitance/bake/uvgen/scene_uv_generation.h"
 #include "exitance/bake/voxelize/svo_build.h"
 #include "exitance/runtime/core/estimates.h"
@@ -74,6 +75,11 @@ size_t unocclude_stage(const SceneForLighting& scene, TexelGBuffer& gbuffer);
 GeometryCheckReport scene_checks_stage(const SceneForLighting& scene, const TexelGBuffer& gbuffer,
                                        const BakeOptions& options, Diagnostics& diagnostics);
 
+// sealed texels: the live texels no light can reach (bake/raster/sealed_texels.h), starting from
+// the checks' closed texels (their first rays are not traced again).
+SealedTexels sealed_texels_stage(const SceneForLighting& scene, const TexelGBuffer& gbuffer,
+                                 const GeometryCheckReport& checks, const BakeOptions& options);
+
 // voxelize: the sparse voxel octree at --voxel-resolution (automatic: leaves about 4 texels wide).
 // Throws InputError naming --voxel-resolution for a resolution it cannot build.
 VoxelizedScene voxelize_stage(const Scene& scene, const AtlasLayout& layout, const BakeOptions& options);
@@ -92,9 +98,10 @@ PersistedSceneFile scene_file_stage(const SceneForLighting& scene, const TexelGB
 // Whether the lighting stage samples adaptively on `backend_name` (BakeOptions::adaptive_request).
 bool adaptive_sampling_applies(const BakeOptions& options, const std::string& backend_name);
 
-// lighting: E/pi at every live texel on the backend; warns when samples were NaN/Inf.
-LightmapEstimate lighting_stage(const Integrator& backend, const TexelGBuffer& gbuffer, const BakeOptions& options,
-                                Diagnostics& diagnostics);
+// lighting: E/pi at every live texel on the backend; warns when samples were NaN/Inf. The texels
+// marked in `skip` (when not null) are not traced: they come back with no samples.
+LightmapEstimate lighting_stage(const Integrator& backend, const TexelGBuffer& gbuffer, const SealedTexels* skip,
+                                const BakeOptions& options, Diagnostics& diagnostics);
 
 // exitance: the lit texels' radiant exitance into the octree's nodes, in `voxels`.
 void exitance_stage(VoxelizedScene& voxels, const SceneForLighting& scene, const TexelGBuffer& gbuffer,

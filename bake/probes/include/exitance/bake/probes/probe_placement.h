@@ -2,8 +2,9 @@
 // centres of ceil(extent / spacing) cells per axis (two layers straddling a flat axis). A grid point inside
 // geometry (most of its test rays hit back faces of single-sided surfaces) or in an occupied SVO
 // leaf (closer to a surface than a voxel) is moved to the nearest free candidate within half a
-// spacing, or marked invalid; a point with no triangle bounding box within a few spacings is
-// skipped (far from all geometry: nothing there for a probe to light). Positions and states
+// spacing, or marked invalid; a point in the open (over a quarter of its test rays escape) with no triangle within
+// a few spacings (Embree's point query) is skipped (far from all geometry: nothing there for a
+// probe to light). Positions and states
 // only: the lighting stage fills the coefficients.
 #pragma once
 #include <cstdint>
@@ -21,7 +22,8 @@ struct ProbePlacementSettings {
   uint64_t max_probes = 1u << 20;      // a finer grid is refused with an error naming the option
   uint32_t test_rays = 64;             // Fibonacci-sphere rays per candidate position
   float inside_backface_fraction = 0.25f;  // more back-face hits than this: inside geometry
-  // No triangle's bounding box within this many spacings: skipped (0 = never skip).
+  // No triangle within this many spacings (distance to the nearest point of any triangle) and over
+  // a quarter of the test rays escape: skipped (0 = never skip).
   float skip_distance_in_spacings = 3.0f;
 };
 

@@ -2,6 +2,7 @@
 // geometry, texels on coplanar overlapping surfaces (z-fighting), punctual lights shut inside
 // closed geometry, and emitters that can never be sampled.
 #pragma once
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,9 @@ struct GeometryCheckReport {
   size_t coplanar_texels = 0;        // another surface lies in the texel's plane
   std::vector<int> enclosed_lights;  // indices into Scene::lights
   size_t unsampled_emitters = 0;     // emissive triangles with zero area
+  // Per live texel: 1 when every hemisphere ray ended on the back of an opaque single-sided surface
+  // (sealed_texels.h's first test, so finding sealed texels does not trace those rays again).
+  std::vector<uint8_t> closed_texels;
 };
 
 GeometryCheckReport check_scene_geometry(const Scene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer);
