@@ -1,7 +1,8 @@
 // lightmap-<page>.exr: OpenEXR, float32, scanline, ZIP compressed. Channel layers are named
 // "<layer>.R/G/B" except the main one, which is plain R, G, B plus A (texel coverage) and `valid`
 // (1 = the texel was traced; 0 = gutter, or a sealed texel that no light reaches, skipped by bake and
-// filled by dilation from its traced neighbours: docs/bundle.md).
+// filled by dilation from its traced neighbours: docs/bundle.md), and the single-channel `error.Y`
+// (the texel's estimated relative standard error).
 #pragma once
 #include <map>
 #include <string>
