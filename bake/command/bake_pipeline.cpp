@@ -48,6 +48,9 @@ class StageTimer {
 json run_report(const WrittenBundle& bundle, const json& seconds) {
   json report = bundle.stats;
   report["seconds"] = seconds;
+  // --preview runs inside the write stage; its own time is kept from the manifest.
+  if (bundle.stats.contains("seconds") && bundle.stats["seconds"].contains("preview"))
+    report["seconds"]["preview"] = bundle.stats["seconds"]["preview"];
   report["output"] = std::filesystem::absolute(bundle.folder).string();
   report["pages"] = bundle.pages;
   return report;
@@ -166,6 +169,9 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                             .scene_file = scene_file,
                             .input_sha256 = input_sha256,
                             .generated_uvs = &generated_uvs};
+  if (options.preview && scene_file.bytes.empty())
+    diagnostics.warn("--preview: no views, only the lightmap pages: the bundle has no scene.bin (" +
+                     scene_file.skipped + ")");
   WrittenBundle bundle =
       clock.time("write", [&] { return write_bundle_stage(results, clock.seconds(), diagnostics, options); });
   if (cache) {
