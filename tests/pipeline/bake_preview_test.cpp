@@ -261,7 +261,7 @@ int run(const std::string& command) {
 TEST(BakePreview, APreviewSizeOutOfRangeIsOneLineAndExit2) {
   const fs::path dir = testing::fresh_temp_dir("preview-size");
   const std::string input = write_tile_scene(dir, false).string();
-  for (const char* size : {"8", "5000", "-3"}) {
+  for (const char* size : {"8", "5000", "-3", "abc", "64px"}) {
     SCOPED_TRACE(size);
     const fs::path err = dir / "stderr.txt";
     EXPECT_EQ(run(std::string(EXITANCE_BAKE) + " " + input + " --no-cache --preview-size " + size + " -o " +
