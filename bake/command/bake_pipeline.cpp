@@ -48,9 +48,6 @@ class StageTimer {
 json run_report(const WrittenBundle& bundle, const json& seconds) {
   json report = bundle.stats;
   report["seconds"] = seconds;
-  // --preview runs inside the write stage; its own time is kept from the manifest.
-  if (bundle.stats.contains("seconds") && bundle.stats["seconds"].contains("preview"))
-    report["seconds"]["preview"] = bundle.stats["seconds"]["preview"];
   report["output"] = std::filesystem::absolute(bundle.folder).string();
   report["pages"] = bundle.pages;
   return report;
@@ -180,7 +177,10 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   }
   // After the bundle, so a failed bake writes neither.
   if (!options.write_gltf.empty()) write_gltf_stage(generated_uvs, options, diagnostics);
-  return run_report(bundle, clock.seconds());
+  json seconds = clock.seconds();
+  // --preview runs inside the write stage; the report shows its own time too, from the manifest.
+  if (options.preview) seconds["preview"] = bundle.stats["seconds"]["preview"];
+  return run_report(bundle, seconds);
 }
 
 }  // namespace exitance

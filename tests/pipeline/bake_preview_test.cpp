@@ -252,6 +252,29 @@ TEST(BakePreview, WithoutSceneBinThePagesAreWrittenAndTheViewsExplained) {
   fs::remove_all(dir);
 }
 
+// A preview that cannot be written (here a view of width 0, which the command line refuses but the
+// library passes on) fails the bake through the bundle writer's path: the earlier bundle at OUT stays
+// as it was and no staging folder is left.
+TEST(BakePreview, APreviewThatCannotBeWrittenLeavesTheEarlierBundle) {
+  const fs::path dir = testing::fresh_temp_dir("preview-fail");
+  const fs::path bundle = dir / "tile.bake";
+  BakeOptions options = small_bake(write_tile_scene(dir, true), bundle);
+  options.preview = false;
+  Diagnostics first;
+  run_bake(options, first);
+  const std::string manifest = read_text(bundle / "manifest.json");
+  options.preview = true;
+  options.preview_size = 0;
+  options.lighting.seed = 1;  // a different bundle, had it been written
+  Diagnostics second;
+  EXPECT_ANY_THROW(run_bake(options, second));
+  EXPECT_EQ(read_text(bundle / "manifest.json"), manifest);
+  EXPECT_FALSE(fs::exists(bundle / "preview"));
+  for (const fs::directory_entry& e : fs::directory_iterator(dir))
+    EXPECT_EQ(e.path().filename().string().find("tile.bake.tmp"), std::string::npos) << e.path();
+  fs::remove_all(dir);
+}
+
 int run(const std::string& command) {
   const int status = std::system(command.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
