@@ -105,6 +105,9 @@ std::vector<formats::PreviewViewInfo> write_views(const fs::path& folder, int wi
 
 formats::PreviewInfo write_bundle_preview(const fs::path& folder, const std::vector<formats::LightmapImage>& pages,
                                           uint32_t view_width, const std::string& no_scene_reason) {
+  if (view_width < 1 || view_width > uint32_t(kMaxViewEdge))  // the view library's size range
+    throw std::runtime_error("--preview-size: " + std::to_string(view_width) + " is outside 1.." +
+                             std::to_string(kMaxViewEdge));
   fs::create_directories(folder / kPreviewFolder);
   formats::PreviewInfo preview;
   try {

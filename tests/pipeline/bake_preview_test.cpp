@@ -252,8 +252,8 @@ TEST(BakePreview, WithoutSceneBinThePagesAreWrittenAndTheViewsExplained) {
   fs::remove_all(dir);
 }
 
-// A preview that cannot be written (here a view of width 0, which the command line refuses but the
-// library passes on) fails the bake through the bundle writer's path: the earlier bundle at OUT stays
+// A preview that cannot be written (here a view of width 0, which the command line refuses and the
+// preview writer throws for) fails the bake through the bundle writer's path: the earlier bundle at OUT stays
 // as it was and no staging folder is left.
 TEST(BakePreview, APreviewThatCannotBeWrittenLeavesTheEarlierBundle) {
   const fs::path dir = testing::fresh_temp_dir("preview-fail");
