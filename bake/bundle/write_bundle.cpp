@@ -1,11 +1,13 @@
 #include "exitance/bake/bundle/write_bundle.h"
 
 #include <algorithm>
+#include <chrono>
 #include <fstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "exitance/bake/bundle/bundle_preview.h"
 #include "exitance/bake/bundle/radiance_vdb.h"
 #include "exitance/formats/lightmap_exr.h"
 #include "exitance/formats/probes_file.h"
@@ -21,6 +23,27 @@ fs::path bundle_folder(const BakeOptions& options) {
   return options.output.empty() ? fs::path(options.input).replace_extension(".bake") : fs::path(options.output);
 }
 
+namespace {
+
+// Writes dir/preview/ and rewrites dir/manifest.json with its "preview" block and
+// stats.seconds.preview; returns the new stats.
+std::string write_preview_into_manifest(const fs::path& dir, const std::vector<formats::LightmapImage>& pages,
+                                        formats::BundleManifest manifest, const BakeResults& results,
+                                        const BakeOptions& options) {
+  options.announce_stage("preview");
+  const auto start = std::chrono::steady_clock::now();
+  manifest.preview = write_bundle_preview(dir, pages, options.preview_size, results.scene_file.skipped);
+  nlohmann::json stats = nlohmann::json::parse(manifest.stats_json);
+  stats["seconds"]["preview"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  manifest.stats_json = stats.dump();
+  std::ofstream file(dir / "manifest.json", std::ios::trunc);
+  file << formats::write_bundle_manifest(manifest);
+  if (!file) throw std::runtime_error("cannot write " + (dir / "manifest.json").string());
+  return manifest.stats_json;
+}
+
+}  // namespace
+
 WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::json& seconds,
                                  const Diagnostics& diagnostics, const BakeOptions& options) {
   options.announce_stage("write");
@@ -34,6 +57,7 @@ WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::jso
       results, pages, results.input_sha256, seconds, diagnostics.warnings.size(), options);
   const std::string manifest_text = formats::write_bundle_manifest(manifest);
 
+  std::string stats_json = manifest.stats_json;
   const fs::path out = bundle_folder(options);
   write_bundle_atomically(out, [&](const fs::path& dir) {
     for (size_t p = 0; p < pages.size(); ++p)
@@ -52,8 +76,12 @@ WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::jso
     std::ofstream file(dir / "manifest.json");
     file << manifest_text;
     if (!file) throw std::runtime_error("cannot write " + (dir / "manifest.json").string());
+    file.close();
+    // The preview's views are drawn from the staged bundle, so it comes last and then the manifest
+    // is written again listing it.
+    if (options.preview) stats_json = write_preview_into_manifest(dir, pages, manifest, results, options);
   });
-  return {out, pages.size(), nlohmann::json::parse(manifest.stats_json)};
+  return {out, pages.size(), nlohmann::json::parse(stats_json)};
 }
 
 }  // namespace exitance

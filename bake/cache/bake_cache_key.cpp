@@ -12,7 +12,7 @@ static_assert(sizeof(IntegratorSettings) == 136, "IntegratorSettings changed: ha
 static_assert(sizeof(AtlasSettings) == 24, "AtlasSettings changed: hash the new field in bake_cache_key");
 // Not hashed: input and output paths (the input's name and bytes are), cache_directory and
 // write_gltf (where results go does not change them), progress.
-static_assert(sizeof(BakeOptions) == 424, "BakeOptions changed: hash the new field in bake_cache_key (or say why not)");
+static_assert(sizeof(BakeOptions) == 432, "BakeOptions changed: hash the new field in bake_cache_key (or say why not)");
 static_assert(sizeof(ImportOptions) == 8, "ImportOptions changed: hash the new field in bake_cache_key");
 static_assert(sizeof(Material) == 136, "Material changed: hash the new field in bake_cache_key");
 static_assert(sizeof(PunctualLight) == 88, "PunctualLight changed: hash the new field in bake_cache_key");
@@ -80,6 +80,7 @@ void hash_options(Sha256Stream& h, const BakeOptions& o) {
   h.value(o.bounce_layers), h.value(o.probes_enabled), h.value(o.probe_spacing), h.value(o.probe_spp);
   h.value(o.probe_sh_window), h.value(o.svo_enabled), h.value(o.voxel_resolution);
   h.value(o.skip_sealed_texels);
+  h.value(o.preview), h.value(o.preview_size);
 }
 
 }  // namespace

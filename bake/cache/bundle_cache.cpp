@@ -35,6 +35,28 @@ std::string unique_suffix() {
          std::to_string(random()) + "-" + std::to_string(counter++);
 }
 
+// A bundle file as an entry names it: a plain name, or one folder and a plain name (preview/...),
+// none starting with '.', so a damaged entry.json cannot point outside the entry.
+bool is_plain_bundle_path(const std::string& name) {
+  const fs::path path(name);
+  if (name.empty() || name == kEntryFile || path.has_root_path()) return false;
+  size_t parts = 0;
+  for (const fs::path& part : path) {
+    const std::string text = part.string();
+    if (text.empty() || text[0] == '.') return false;
+    ++parts;
+  }
+  return parts <= 2;
+}
+
+// The regular files under a bundle folder, as paths relative to it ("preview/lightmap-0.png").
+std::vector<std::string> bundle_files(const fs::path& folder) {
+  std::vector<std::string> names;
+  for (const fs::directory_entry& e : fs::recursive_directory_iterator(folder))
+    if (!e.is_directory()) names.push_back(e.path().lexically_relative(folder).generic_string());
+  return names;
+}
+
 // The files an entry lists, with their sizes and hashes, or "" and the problem.
 std::map<std::string, std::pair<uintmax_t, std::string>> read_entry(const fs::path& folder, const std::string& key,
                                                                      std::vector<std::string>& warnings,
@@ -57,7 +79,7 @@ std::map<std::string, std::pair<uintmax_t, std::string>> read_entry(const fs::pa
     }
     warnings = entry.at("warnings").get<std::vector<std::string>>();
     for (const auto& [name, file] : entry.at("files").items()) {
-      if (name.empty() || name.find('/') != std::string::npos || name == kEntryFile || name[0] == '.') {
+      if (!is_plain_bundle_path(name)) {
         problem = "entry.json lists a file name that is not a plain bundle file";
         return {};
       }
@@ -75,21 +97,21 @@ std::map<std::string, std::pair<uintmax_t, std::string>> read_entry(const fs::pa
 bool entry_is_intact(const fs::path& folder, const std::map<std::string, std::pair<uintmax_t, std::string>>& files,
                      std::string& problem) {
   size_t present = 0;
-  for (const fs::directory_entry& e : fs::directory_iterator(folder)) {
-    const std::string name = e.path().filename().string();
+  for (const std::string& name : bundle_files(folder)) {
     if (name == kEntryFile) continue;
     ++present;
+    const fs::path path = folder / name;
     auto listed = files.find(name);
-    if (listed == files.end() || !e.is_regular_file()) {
+    if (listed == files.end() || !fs::is_regular_file(path)) {
       problem = name + " is not listed in entry.json";
       return false;
     }
-    if (e.file_size() != listed->second.first) {
-      problem = name + " has " + std::to_string(e.file_size()) + " bytes, entry.json says " +
+    if (fs::file_size(path) != listed->second.first) {
+      problem = name + " has " + std::to_string(fs::file_size(path)) + " bytes, entry.json says " +
                 std::to_string(listed->second.first);
       return false;
     }
-    if (sha256_of_file(e.path().string()) != listed->second.second) {
+    if (sha256_of_file(path.string()) != listed->second.second) {
       problem = name + " does not match its SHA-256";
       return false;
     }
@@ -148,7 +170,10 @@ bool BundleCache::restore(const std::string& key, const fs::path& out,
   }
   write_bundle_atomically(out, [&](const fs::path& dir) {
     for (const auto& [name, file] : files)
-      if (name != "manifest.json") fs::copy_file(folder / name, dir / name);
+      if (name != "manifest.json") {
+        fs::create_directories((dir / name).parent_path());
+        fs::copy_file(folder / name, dir / name);
+      }
     std::ofstream file(dir / "manifest.json", std::ios::binary);
     file << manifest;
     if (!file) throw std::runtime_error("cannot write " + (dir / "manifest.json").string());
@@ -164,10 +189,10 @@ void BundleCache::store(const std::string& key, const fs::path& bundle, const st
     fs::create_directories(staging);
     json entry = {{"format", kEntryFormat}, {"version", kEntryVersion}, {"key", key},
                   {"warnings", warnings},   {"files", json::object()}};
-    for (const fs::directory_entry& e : fs::directory_iterator(bundle)) {
-      if (!e.is_regular_file()) continue;
-      const std::string name = e.path().filename().string();
-      fs::copy_file(e.path(), staging / name);
+    for (const std::string& name : bundle_files(bundle)) {  // the preview/ folder too
+      if (!fs::is_regular_file(bundle / name)) continue;
+      fs::create_directories((staging / name).parent_path());
+      fs::copy_file(bundle / name, staging / name);
       entry["files"][name] = {{"bytes", fs::file_size(staging / name)}, {"sha256", sha256_of_file((staging / name).string())}};
     }
     {

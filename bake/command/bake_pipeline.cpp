@@ -181,6 +181,9 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                             .generated_uvs = &generated_uvs,
                             .sealed = &sealed,
                             .sealed_skipped = options.skip_sealed_texels};
+  if (options.preview && scene_file.bytes.empty())
+    diagnostics.warn("--preview: no views, only the lightmap pages: the bundle has no scene.bin (" +
+                     scene_file.skipped + ")");
   WrittenBundle bundle =
       clock.time("write", [&] { return write_bundle_stage(results, clock.seconds(), diagnostics, options); });
   if (cache) {
@@ -189,7 +192,10 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   }
   // After the bundle, so a failed bake writes neither.
   if (!options.write_gltf.empty()) write_gltf_stage(generated_uvs, options, diagnostics);
-  return run_report(bundle, clock.seconds());
+  json seconds = clock.seconds();
+  // --preview runs inside the write stage; the report shows its own time too, from the manifest.
+  if (options.preview) seconds["preview"] = bundle.stats["seconds"]["preview"];
+  return run_report(bundle, seconds);
 }
 
 }  // namespace exitance

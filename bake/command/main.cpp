@@ -103,6 +103,11 @@ int main(int argc, char** argv) {
                  "bundle cache folder: a bake of the same input with the same options reuses the stored bundle "
                  "(default: .exitance-cache beside the output)");
   app.add_flag("--no-cache", no_cache, "neither read nor fill the bundle cache");
+  app.add_flag("--preview", options.preview,
+               "also write tone-mapped PNGs of the lightmap pages and default views into OUT/preview/");
+  std::string preview_size;  // parsed below, so any bad value gets the same one-line error
+  CLI::Option* preview_size_option = app.add_option(
+      "--preview-size", preview_size, "preview view width in pixels, 16..4096 (default 512; implies --preview)");
   bool json_report = false;
   app.add_flag("--json", json_report, "print the run report as JSON on stdout");
   // --list-devices needs no scene: parse it before the required positional is enforced.
@@ -164,6 +169,20 @@ int main(int argc, char** argv) {
   if (!options.write_gltf.empty() && std::filesystem::path(options.write_gltf).extension() != ".gltf") {
     std::cerr << "bake: error: --write-gltf " << options.write_gltf << ": the file name must end in .gltf\n";
     return 2;
+  }
+  if (preview_size_option->count() > 0) {
+    size_t used = 0;
+    long width = 0;
+    try {
+      width = std::stol(preview_size, &used);
+    } catch (...) {
+    }
+    if (used == 0 || used != preview_size.size() || width < 16 || width > 4096) {
+      std::cerr << "bake: error: --preview-size " << preview_size << ": expected 16..4096 pixels\n";
+      return 2;
+    }
+    options.preview = true;
+    options.preview_size = uint32_t(width);
   }
   if (uv == "generate") options.import.generate_lightmap_uvs = true;
   else options.import.lightmap_uv_set = uv == "0" ? 0 : 1;

@@ -215,6 +215,42 @@ SceneFileInfo parse_scene(const FieldReader& r, const json& j) {
   return scene;
 }
 
+// The largest preview image edge, as exitance-view's --size.
+constexpr uint64_t kMaxPreviewEdge = 16384;
+
+PreviewViewInfo parse_preview_view(const FieldReader& r, const json& j, const std::string& where) {
+  PreviewViewInfo view;
+  view.file = r.bundle_file(r.member(j, where, "file"), where + ".file");
+  view.camera = r.string(r.member(j, where, "camera"), where + ".camera");
+  view.look_from = r.float_array<3>(r.member(j, where, "look_from"), where + ".look_from");
+  view.look_at = r.float_array<3>(r.member(j, where, "look_at"), where + ".look_at");
+  if (view.look_at == view.look_from) r.fail(where + ".look_at", "equals look_from");
+  view.up = r.float_array<3>(r.member(j, where, "up"), where + ".up");
+  if (view.up == std::array<float, 3>{0, 0, 0}) r.fail(where + ".up", "zero vector");
+  view.yfov = r.finite_float(r.member(j, where, "yfov"), where + ".yfov");
+  if (!(view.yfov > 0 && view.yfov < 3.14159265f)) r.fail(where + ".yfov", "not in (0, pi)");
+  view.width = uint32_t(r.unsigned_integer(r.member(j, where, "width"), where + ".width", 1, kMaxPreviewEdge));
+  view.height = uint32_t(r.unsigned_integer(r.member(j, where, "height"), where + ".height", 1, kMaxPreviewEdge));
+  return view;
+}
+
+PreviewInfo parse_preview(const FieldReader& r, const json& j, size_t page_count) {
+  const std::string where = "preview";
+  PreviewInfo preview;
+  const json& pages = r.array(r.member(j, where, "pages"), where + ".pages", page_count);
+  for (size_t p = 0; p < pages.size(); ++p)
+    preview.pages.push_back(r.bundle_file(pages[p], where + ".pages[" + std::to_string(p) + "]"));
+  const json& views = r.array(r.member(j, where, "views"), where + ".views");
+  for (size_t v = 0; v < views.size(); ++v)
+    preview.views.push_back(parse_preview_view(r, views[v], where + ".views[" + std::to_string(v) + "]"));
+  if (j.contains("views_skipped")) {
+    preview.views_skipped = r.string(j["views_skipped"], where + ".views_skipped");
+    if (preview.views_skipped.empty()) r.fail(where + ".views_skipped", "empty reason");
+    if (!preview.views.empty()) r.fail(where, "both views and a reason there are none");
+  }
+  return preview;
+}
+
 InputInfo parse_input(const FieldReader& r, const json& j) {
   InputInfo input;
   input.file = r.string(r.member(j, "input", "file"), "input.file");
@@ -342,6 +378,7 @@ BundleManifest parse_bundle_manifest(std::string_view json_text, const std::stri
   if (root.contains("probes") && !root["probes"].is_null()) manifest.probes = parse_probes(r, root["probes"]);
   if (root.contains("svo") && !root["svo"].is_null()) manifest.svo = parse_svo(r, root["svo"]);
   if (root.contains("scene")) manifest.scene = parse_scene(r, root["scene"]);
+  if (root.contains("preview")) manifest.preview = parse_preview(r, root["preview"], manifest.pages.size());
   if (root.contains("input")) manifest.input = parse_input(r, root["input"]);
   if (root.contains("settings")) manifest.settings = parse_settings(r, root["settings"]);
   if (root.contains("stats")) manifest.stats_json = object_text(r, root["stats"], "stats");

@@ -65,6 +65,21 @@ json svo_json(const SvoInfo& s) {
   return j;
 }
 
+json preview_json(const PreviewInfo& p) {
+  json j = {{"pages", p.pages}, {"views", json::array()}};
+  for (const PreviewViewInfo& v : p.views)
+    j["views"].push_back({{"file", v.file},
+                          {"camera", v.camera},
+                          {"look_from", array_json(v.look_from)},
+                          {"look_at", array_json(v.look_at)},
+                          {"up", array_json(v.up)},
+                          {"yfov", v.yfov},
+                          {"width", v.width},
+                          {"height", v.height}});
+  if (!p.views_skipped.empty()) j["views_skipped"] = p.views_skipped;
+  return j;
+}
+
 json free_form(const std::string& text, const char* key) {
   json j;
   try {
@@ -102,6 +117,7 @@ std::string write_bundle_manifest(const BundleManifest& m) {
     else
       root["scene"] = {{"file", m.scene->file}, {"format_version", m.scene->format_version}, {"bytes", m.scene->bytes}};
   }
+  if (m.preview) root["preview"] = preview_json(*m.preview);
   if (!m.stats_json.empty()) root["stats"] = free_form(m.stats_json, "stats");
   if (!m.relight_json.empty()) root["relight"] = free_form(m.relight_json, "relight");
 

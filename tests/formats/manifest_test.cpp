@@ -219,5 +219,52 @@ TEST(BundleManifest, SettingsAndSceneFieldsAreCheckedByName) {
   EXPECT_EQ(m.scene->skipped, "textures are not stored by version 1");
 }
 
+// "preview" (bake --preview): page PNGs, one per page, and views with their cameras; round trip
+// and every field checked by name.
+json preview_block() {
+  return {{"pages", {"preview/lightmap-0.png", "preview/lightmap-1.png"}},
+          {"views",
+           {{{"file", "preview/Camera.png"}, {"camera", "Camera"}, {"look_from", {0, 1, 5}}, {"look_at", {0, 1, 4}},
+             {"up", {0, 1, 0}}, {"yfov", 0.8}, {"width", 512}, {"height", 384}}}}};
+}
+
+TEST(BundleManifest, PreviewRoundTripsAndIsCheckedByName) {
+  json j = full_manifest();
+  j["preview"] = preview_block();
+  const Manifest first = parse(j);
+  ASSERT_TRUE(first.preview.has_value());
+  ASSERT_EQ(first.preview->pages.size(), 2u);
+  ASSERT_EQ(first.preview->views.size(), 1u);
+  EXPECT_EQ(first.preview->views[0].camera, "Camera");
+  EXPECT_EQ(first.preview->views[0].height, 384u);
+  const std::string written = formats::write_bundle_manifest(first);
+  EXPECT_EQ(formats::write_bundle_manifest(parse_manifest(written, "written")), written);
+  EXPECT_FALSE(parse(full_manifest()).preview.has_value());
+
+  j["preview"] = {{"pages", {"preview/lightmap-0.png", "preview/lightmap-1.png"}}, {"views", json::array()},
+                  {"views_skipped", "no scene.bin"}};
+  EXPECT_EQ(parse(j).preview->views_skipped, "no scene.bin");
+
+  const std::pair<void (*)(json&), const char*> refused[] = {
+      {[](json& p) { p["pages"].erase(1); }, "preview.pages: expected 2 elements, got 1"},
+      {[](json& p) { p["pages"][0] = "../x.png"; }, "preview.pages[0]: \"../x.png\" leaves the bundle folder"},
+      {[](json& p) { p.erase("views"); }, "preview.views: missing"},
+      {[](json& p) { p["views"][0]["yfov"] = 3.5; }, "preview.views[0].yfov: not in (0, pi)"},
+      {[](json& p) { p["views"][0]["width"] = 0; }, "preview.views[0].width: 0 is outside 1..16384"},
+      {[](json& p) { p["views"][0]["camera"] = 3; }, "preview.views[0].camera: expected a string, got number"},
+      {[](json& p) { p["views"][0]["look_at"] = {0, 1, 5}; }, "preview.views[0].look_at: equals look_from"},
+      {[](json& p) { p["views"][0]["up"] = {0, 0, 0}; }, "preview.views[0].up: zero vector"},
+      {[](json& p) { p["views_skipped"] = "why"; }, "preview: both views and a reason there are none"},
+      {[](json& p) { p = 5; }, "preview: expected an object, got number"},
+  };
+  for (const auto& [edit, message] : refused) {
+    SCOPED_TRACE(message);
+    json bad = full_manifest();
+    bad["preview"] = preview_block();
+    edit(bad["preview"]);
+    expect_format_error([&] { parse(bad); }, message);
+  }
+}
+
 }  // namespace
 }  // namespace exitance::loader

@@ -43,6 +43,10 @@ struct BakeOptions {
   // Sparse voxel octree with radiant exitance (svo.bin, radiance.vdb): --voxel-resolution.
   bool svo_enabled = true;
   uint32_t voxel_resolution = 0;  // power of two; 0 = automatic (leaves about 4 texels wide)
+  // --preview: PNGs of the pages and default views in OUT/preview/ (bake/bundle/bundle_preview.h),
+  // views preview_size pixels wide.
+  bool preview = false;
+  uint32_t preview_size = 512;
   // The bundle cache (bake/cache/bundle_cache.h): a folder, or empty for none. Empty by default
   // here; the bake command defaults to .exitance-cache beside OUT (--cache DIR, --no-cache).
   // Not part of the cache key: where results are kept does not change them.

@@ -69,6 +69,23 @@ struct SceneFileInfo {
   std::string skipped;  // non-empty exactly when file is empty
 };
 
+// "preview" (bake --preview, docs/bundle.md): tone-mapped PNGs for people, never read by an engine.
+struct PreviewViewInfo {
+  std::string file;    // e.g. "preview/Camera.png"
+  std::string camera;  // the glTF camera it shows, "" for the automatic view
+  std::array<float, 3> look_from{0, 0, 0};
+  std::array<float, 3> look_at{0, 0, -1};  // differs from look_from
+  std::array<float, 3> up{0, 1, 0};
+  float yfov = 1;  // radians, in (0, pi)
+  uint32_t width = 0, height = 0;  // 1..16384
+};
+
+struct PreviewInfo {
+  std::vector<std::string> pages;  // one PNG per atlas page, in page order
+  std::vector<PreviewViewInfo> views;
+  std::string views_skipped;  // why there are no views (no scene.bin), or ""
+};
+
 // The input the bundle was baked from.
 struct InputInfo {
   std::string file;    // file name without folders
@@ -112,6 +129,7 @@ struct BundleManifest {
   std::optional<ProbeGridInfo> probes;
   std::optional<SvoInfo> svo;
   std::optional<SceneFileInfo> scene;
+  std::optional<PreviewInfo> preview;
   std::string stats_json;    // "stats": a JSON object as text, "" when absent
   std::string relight_json;  // "relight": a JSON object as text, "" when absent
 
