@@ -34,7 +34,8 @@ cmake --build build-asan -j"$jobs" --target bake stress_tests geometry_warning_t
   pipeline_tests formats_tests exitance_loader_sample make_loader_test_bundle spherical_harmonics_tests \
   svo_exitance_tests svo_build_tests probe_placement_tests bundle_end_to_end_tests common_math_tests \
   lighting_scene_edit_tests scene_edits_tests radiance_vdb_tests scene_file_tests exitance-relight \
-  exitance_runtime exitance_loader bundle_cache_tests lightmap_uv_generation_tests adaptive_sampling_plan_tests
+  exitance_runtime exitance_loader bundle_cache_tests lightmap_uv_generation_tests adaptive_sampling_plan_tests \
+  exitance-view
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1

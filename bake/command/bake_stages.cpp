@@ -180,6 +180,10 @@ LightmapEstimate lighting_stage(const Integrator& backend, const TexelGBuffer& g
                                 const BakeOptions& options, Diagnostics& diagnostics) {
   IntegratorSettings settings = options.lighting;
   settings.adaptive = adaptive_sampling_applies(options, backend.backend_name());
+  if (options.adaptive_request == AdaptiveRequest::Off && settings.target_relative_error > 0 &&
+      backend.backend_name() == "cpu" && settings.integrator == IntegratorMode::Path)
+    diagnostics.warn("--adaptive off: the CPU backend plans --target-error samples per texel (adaptive sampling) "
+                     "all the same; the manifest's settings.adaptive says so");
   settings.progress = [&](double fraction, uint64_t rays) {
     if (options.progress) options.progress("lighting", fraction, rays);
   };

@@ -20,12 +20,14 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -153,6 +155,17 @@ TEST_F(PlaneUnderSky, ARayThatMissesShowsTheSky) {
   options.mode = ViewMode::Albedo;
   const view::ViewImage empty = view::render_view(scene, view::look_at_camera({0, 1, 0}, {0, 2, 0}, {0, 0, -1}, 1.0), options);
   EXPECT_EQ(empty.pixel(8, 8).x, 0.0f);
+}
+
+// The library refuses a size or sampling it cannot draw (the tool and the preview check first).
+TEST_F(PlaneUnderSky, RenderViewRefusesAnEmptyOrHugeImage) {
+  const view::ViewScene scene = view::open_view_scene(bundle().string());
+  for (const auto [w, h, aa] : {std::array{0, 8, 1}, std::array{8, 0, 1}, std::array{16385, 8, 1}, std::array{8, 8, 0},
+                                std::array{8, 8, 17}}) {
+    view::ViewRenderOptions options;
+    options.width = w, options.height = h, options.samples_per_axis = aa;
+    EXPECT_THROW(view::render_view(scene, top_camera(), options), std::invalid_argument) << w << "x" << h << " aa " << aa;
+  }
 }
 
 TEST_F(PlaneUnderSky, AlbedoAndNormalModesAreExact) {

@@ -4,11 +4,20 @@
 #include <atomic>
 #include <exception>
 #include <mutex>
+#include <stdexcept>
+#include <string>
 #include <thread>
 
 namespace exitance::view {
 
 ViewImage render_view(const ViewScene& view, const PinholeCamera& camera, const ViewRenderOptions& options) {
+  // The tool and the preview check their options first; the library refuses what it cannot draw.
+  if (options.width < 1 || options.height < 1 || options.width > 16384 || options.height > 16384)
+    throw std::invalid_argument("render_view: image size " + std::to_string(options.width) + " x " +
+                                std::to_string(options.height) + " is outside 1..16384");
+  if (options.samples_per_axis < 1 || options.samples_per_axis > 16)
+    throw std::invalid_argument("render_view: " + std::to_string(options.samples_per_axis) +
+                                " samples per axis is outside 1..16");
   ViewImage image;
   image.width = options.width;
   image.height = options.height;

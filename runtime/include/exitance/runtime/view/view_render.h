@@ -25,6 +25,7 @@ struct ViewRenderOptions {
   unsigned threads = 0;  // 0: one per hardware thread; at most one per row and 1024
 };
 
+// Throws std::invalid_argument for a size outside 1..16384 or samples per axis outside 1..16.
 ViewImage render_view(const ViewScene& view, const PinholeCamera& camera, const ViewRenderOptions& options);
 
 }  // namespace exitance::view
