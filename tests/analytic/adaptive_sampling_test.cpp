@@ -25,6 +25,7 @@
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "support/atlas_box.h"
 #include "support/independent_estimates.h"
+#include "support/region_and_furnace_checks.h"
 
 namespace exitance {
 namespace {
@@ -40,22 +41,10 @@ IntegratorSettings settings(uint32_t spp, uint64_t seed, bool adaptive) {
   return s;
 }
 
-// Luminance of E/pi per texel of one run.
-using TexelMeans = std::vector<double>;
+using TexelMeans = std::vector<double>;  // luminance of E/pi per texel of one run
 using Estimator = std::function<TexelMeans(uint64_t seed)>;
-
-TexelMeans luminance_means(const LightmapEstimate& e) {
-  TexelMeans m(e.texels.size());
-  for (size_t i = 0; i < m.size(); ++i) m[i] = luminance(e.mean_total(i));
-  return m;
-}
-
-std::map<uint32_t, double> region_means(const TexelGBuffer& gbuffer, const TexelMeans& texel) {
-  std::map<uint32_t, double> sum, count;
-  for (size_t i = 0; i < texel.size(); ++i) sum[gbuffer.texels[i].instance] += texel[i], count[gbuffer.texels[i].instance] += 1;
-  for (auto& [region, s] : sum) s /= count[region];
-  return sum;
-}
+using testing::luminance_means;
+using testing::region_means;
 
 // The largest |z| over regions of `tested` against `reference` (kSeeds independent seeds each).
 double largest_region_z(const std::string& label, const TexelGBuffer& gbuffer, const Estimator& tested,
@@ -90,23 +79,13 @@ TEST(AdaptiveSampling, FurnaceReachesLeOverOneMinusAlbedo) {
   const Vec3 emission[6] = {le, le, le, le, le, le};
   const testing::AtlasScene box = testing::atlas_box(rho, emission, 8);
   const CpuReferenceIntegrator integrator(box.scene);
-  for (int c = 0; c < 3; ++c) {
-    std::vector<double> means;
-    for (int seed = 0; seed < kSeeds; ++seed) {
-      const LightmapEstimate e = integrator.bake(box.gbuffer, settings(64, uint64_t(seed), true));
-      ASSERT_TRUE(e.adaptive);
-      ASSERT_EQ(e.adaptive_pilot, 16u);
-      EXPECT_EQ(e.nonfinite_samples, 0u);
-      double sum = 0;
-      for (size_t i = 0; i < e.texels.size(); ++i) sum += e.mean_total(i)[c];
-      means.push_back(sum / double(e.texels.size()));
-    }
-    const testing::MeanAndError s = testing::mean_and_standard_error(means);
-    const double exact = le[c] / (1 - rho);
-    std::printf("[adaptive] furnace ch%d: exact %.5g estimate %.6g SE %.2g\n", c, exact, s.mean, s.standard_error);
-    EXPECT_LE(std::fabs(s.mean - exact), kZLimit * s.standard_error + 1e-6 * exact);
-    EXPECT_LT(s.standard_error, 0.01 * exact);
-  }
+  testing::expect_furnace_closed_form("adaptive", le, rho, kSeeds, kZLimit, [&](uint64_t seed) {
+    LightmapEstimate e = integrator.bake(box.gbuffer, settings(64, seed, true));
+    EXPECT_TRUE(e.adaptive);
+    EXPECT_EQ(e.adaptive_pilot, 16u);
+    EXPECT_EQ(e.nonfinite_samples, 0u);
+    return e;
+  });
 }
 
 TEST(AdaptiveSampling, AjarRoomAgreesWithUniformWhereAnEarlyZeroRuleDoesNot) {

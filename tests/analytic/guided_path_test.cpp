@@ -23,6 +23,7 @@
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "support/atlas_box.h"
 #include "support/independent_estimates.h"
+#include "support/region_and_furnace_checks.h"
 
 namespace exitance {
 namespace {
@@ -40,17 +41,6 @@ IntegratorSettings settings(uint32_t spp, uint64_t seed, GuidingMode guiding, fl
   return s;
 }
 
-// Luminance of E/pi averaged per instance (region), for one run.
-std::map<uint32_t, double> region_means(const TexelGBuffer& gbuffer, const LightmapEstimate& e) {
-  std::map<uint32_t, double> sum, count;
-  for (size_t i = 0; i < e.texels.size(); ++i) {
-    sum[gbuffer.texels[i].instance] += luminance(e.mean_total(i));
-    count[gbuffer.texels[i].instance] += 1;
-  }
-  for (auto& [region, s] : sum) s /= count[region];
-  return sum;
-}
-
 // Guided against unguided, per region, over kSeeds independent seeds each. Returns the median over
 // regions of the relative standard error of the difference.
 double expect_regions_agree(const std::string& label, const Scene& scene, const TexelGBuffer& gbuffer, uint32_t spp,
@@ -66,8 +56,8 @@ double expect_regions_agree(const std::string& label, const Scene& scene, const 
     EXPECT_EQ(u.guided_vertices, 0u);
     guided_vertices += g.guided_vertices;
     vertices_possible += uint64_t(gbuffer.texels.size()) * spp;
-    for (auto& [region, m] : region_means(gbuffer, g)) guided[region].push_back(m);
-    for (auto& [region, m] : region_means(gbuffer, u)) unguided[region].push_back(m);
+    for (auto& [region, m] : testing::region_means(gbuffer, testing::luminance_means(g))) guided[region].push_back(m);
+    for (auto& [region, m] : testing::region_means(gbuffer, testing::luminance_means(u))) unguided[region].push_back(m);
   }
   // Guiding must really be on: after the first passes most texel vertices sample the mixture.
   EXPECT_GT(double(guided_vertices), 0.5 * double(vertices_possible)) << label;
@@ -91,22 +81,12 @@ TEST(GridGuiding, FurnaceReachesLeOverOneMinusAlbedo) {
   const Vec3 emission[6] = {le, le, le, le, le, le};
   const testing::AtlasScene box = testing::atlas_box(rho, emission, 8);
   const CpuReferenceIntegrator integrator(box.scene);
-  for (int c = 0; c < 3; ++c) {
-    std::vector<double> means;
-    for (int seed = 0; seed < kSeeds; ++seed) {
-      const LightmapEstimate e = integrator.bake(box.gbuffer, settings(16, uint64_t(seed), GuidingMode::Grid));
-      EXPECT_EQ(e.nonfinite_samples, 0u);
-      EXPECT_GT(e.guided_vertices, 0u);
-      double sum = 0;
-      for (size_t i = 0; i < e.texels.size(); ++i) sum += e.mean_total(i)[c];
-      means.push_back(sum / double(e.texels.size()));
-    }
-    const testing::MeanAndError s = testing::mean_and_standard_error(means);
-    const double exact = le[c] / (1 - rho);
-    std::printf("[guided] furnace ch%d: exact %.5g estimate %.6g SE %.2g\n", c, exact, s.mean, s.standard_error);
-    EXPECT_LE(std::fabs(s.mean - exact), kZLimit * s.standard_error + 1e-6 * exact);
-    EXPECT_LT(s.standard_error, 0.01 * exact);
-  }
+  testing::expect_furnace_closed_form("guided", le, rho, kSeeds, kZLimit, [&](uint64_t seed) {
+    LightmapEstimate e = integrator.bake(box.gbuffer, settings(16, seed, GuidingMode::Grid));
+    EXPECT_EQ(e.nonfinite_samples, 0u);
+    EXPECT_GT(e.guided_vertices, 0u);
+    return e;
+  });
 }
 
 // A 20 cm emitter of radiance 200 under the ceiling of a grey unit box (4 % of the ceiling): next-event
