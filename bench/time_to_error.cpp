@@ -5,7 +5,10 @@
 //   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,adaptive,bounces,guided] [--guiding-mix M] [--name NAME]
 //                       [--sky R,G,B] [--texel-density T] [--reference-spp N] [--max-spp N]
 //                       [--max-seconds S] [--target 0.01] [--bounces N] [--min-spp N] [--cache DIR] [--csv FILE]
-//                       [--texel-csv FILE] [--guiding-fields FILE]
+//                       [--texel-csv FILE] [--guiding-fields FILE] [--samplers sobol,independent]
+//
+// --samplers: each integrator runs with each listed sampler (path_sampler.h); an `independent` run's
+// integrator column gets the suffix "_independent".
 //
 // The reference is always the CPU path tracer. For the per-bounce mode (integrator per_bounce) the
 // CSV also has the bounces run, the fraction of gather hits without texels, and bias_rel_mse: at
@@ -32,6 +35,7 @@
 
 #include "exitance/runtime/embree_scene.h"
 #include "exitance/runtime/core/grid_guiding_cache.h"
+#include "exitance/common/path_sampler.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/bake/command/backend_choice.h"
 #include "exitance/bake/cache/sha256_stream.h"
@@ -104,6 +108,8 @@ int main(int argc, char** argv) {
   app.add_option("--texel-csv", texel_csv_path, "per-texel reference and estimate of each integrator's last run");
   app.add_option("--cache", cache_dir, "reference cache folder (default ~/.cache/exitance)");
   app.add_option("--csv", csv_path);
+  std::string samplers = "sobol";
+  app.add_option("--samplers", samplers, "sobol,independent: the samplers each integrator runs with");
   CLI11_PARSE(app, argc, argv);
   if (scene_name.empty()) scene_name = fs::path(scene_path).stem().string();
   if (cache_dir.empty()) cache_dir = std::string(std::getenv("HOME") ? std::getenv("HOME") : "/tmp") + "/.cache/exitance";
@@ -132,7 +138,7 @@ int main(int argc, char** argv) {
   }
 
   // Reference: keyed by scene bytes + settings, so a changed scene or setting rebuilds it.
-  const std::string key = "v2-" + sha256_of_file(scene_path).substr(0, 16) + "-d" + std::to_string(density) + "-s" +
+  const std::string key = "v3-independent-" + sha256_of_file(scene_path).substr(0, 16) + "-d" + std::to_string(density) + "-s" +
                           std::to_string(reference_spp) + "-sky" + sky;
   fs::create_directories(cache_dir);
   const fs::path cache_file = fs::path(cache_dir) / ("reference-" + key + ".f32");
@@ -144,6 +150,9 @@ int main(int argc, char** argv) {
     IntegratorSettings settings;
     settings.spp = reference_spp;
     settings.seed = 0x5EED5EED;  // independent of the measured runs
+    // Independent samples: the reference's noise below comes from its per-texel sample variances,
+    // which would overstate a stratified (Sobol) reference's noise and so flatter every run.
+    settings.sampler = kSamplerIndependent;
     const LightmapEstimate estimate = integrator.bake(gbuffer, settings);
     reference = flatten(estimate);
     std::ofstream out(cache_file, std::ios::binary);
@@ -171,8 +180,9 @@ int main(int argc, char** argv) {
   struct Mode {
     IntegratorMode integrator;
     GuidingMode guiding;
-    const char* name;
+    std::string name;
     bool adaptive = false;
+    uint32_t sampler = kSamplerSobol;
   };
   std::vector<Mode> modes;
   auto listed = [&](const std::string& name) {
@@ -182,10 +192,20 @@ int main(int argc, char** argv) {
   if (listed("adaptive")) modes.push_back({IntegratorMode::Path, GuidingMode::Off, "path_adaptive", true});
   if (listed("guided")) modes.push_back({IntegratorMode::Path, GuidingMode::Grid, "path_guided_grid"});
   if (listed("bounces")) modes.push_back({IntegratorMode::Bounces, GuidingMode::Off, "per_bounce"});
+  if (("," + samplers + ",").find(",independent,") != std::string::npos) {
+    const size_t sobol_modes = modes.size();
+    for (size_t k = 0; k < sobol_modes; ++k) {
+      Mode m = modes[k];
+      m.name += "_independent";
+      m.sampler = kSamplerIndependent;
+      modes.push_back(m);
+    }
+    if (("," + samplers + ",").find(",sobol,") == std::string::npos) modes.erase(modes.begin(), modes.begin() + long(sobol_modes));
+  }
   for (const std::shared_ptr<const Integrator>& backend : measured)
     for (const Mode& m : modes) {
       const IntegratorMode mode = m.integrator;
-      const char* mode_name = m.name;
+      const char* mode_name = m.name.c_str();
       {  // Warm-up, not recorded: lavapipe and GPU drivers compile pipelines at the first dispatch.
         IntegratorSettings warm_up;
         warm_up.spp = 1;
@@ -209,6 +229,7 @@ int main(int argc, char** argv) {
         settings.guiding = m.guiding;
         settings.guiding_mix = guiding_mix;
         settings.adaptive = m.adaptive;  // spp is then the mean samples per texel
+        settings.sampler = m.sampler;
         if (!guiding_fields.empty())
           settings.inspect_guiding = [&](const GridGuidingCache& cache) {
             std::ofstream out(guiding_fields);

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <filesystem>
 
+#include "exitance/common/path_sampler.h"
 #include "exitance/common/sampling.h"
 #include "exitance/runtime/material_eval.h"
 
@@ -27,6 +28,7 @@ formats::BakeSettings settings_of(const BakeResults& results, const BakeOptions&
   s.time_budget_seconds = options.lighting.time_budget_seconds;
   s.target_error = options.lighting.target_relative_error;
   s.adaptive = results.lightmap.adaptive;
+  s.sampler = options.lighting.sampler == kSamplerIndependent ? "independent" : "sobol";
   s.bounces = options.lighting.max_bounces;
   s.seed = options.lighting.seed;
   s.texel_density = results.layout.texel_density;

@@ -10,6 +10,7 @@
 #include "exitance/bake/bundle/write_bundle.h"
 #include "exitance/bake/command/bake_pipeline.h"
 #include "exitance/bake/input_error.h"
+#include "exitance/common/path_sampler.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "exitance/runtime/tools/progress_bar.h"
 
@@ -62,8 +63,8 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   std::string adaptive = "auto";
   app.add_option("--adaptive", adaptive,
-                 "adaptive sampling (samples where the relative error is, unbiased by cross-fitting): auto (= on "
-                 "with --time or --target-error on the CPU backend) | on (CPU backend; --spp is then the mean) | off")
+                 "adaptive sampling (samples where the relative error is; unbiased: a texel's samples follow its "
+                 "neighbours' pilot samples, not its own): auto (= on with --time or --target-error on the CPU backend) | on (CPU backend; --spp is then the mean) | off")
       ->check(CLI::IsMember({"auto", "on", "off"}));
   app.add_option("--bounces", options.lighting.max_bounces,
                  "maximum diffuse bounces (default: path: until Russian roulette ends the path; bounces: until the "
@@ -97,6 +98,11 @@ int main(int argc, char** argv) {
   app.add_option("--guiding-mix", options.lighting.guiding_mix,
                  "probability of the guided direction in the one-sample mixture with cosine sampling (default 0.5)")
       ->check(CLI::Range(0.0f, 1.0f));
+  std::string sampler = "sobol";
+  app.add_option("--sampler", sampler,
+                 "sobol (Owen-scrambled Sobol points per texel, the default) | independent (independent random "
+                 "numbers): bench/results/low-discrepancy.md")
+      ->check(CLI::IsMember({"sobol", "independent"}));
   std::string cache_directory;
   bool no_cache = false;
   app.add_option("--cache", cache_directory,
@@ -202,6 +208,7 @@ int main(int argc, char** argv) {
     options.adaptive_request = exitance::AdaptiveRequest::Off;
   }
   options.skip_sealed_texels = !no_skip;
+  options.lighting.sampler = sampler == "independent" ? exitance::kSamplerIndependent : exitance::kSamplerSobol;
   if (!directional.empty()) diagnostics.warn("--directional: directional lightmaps are not implemented yet; ignored");
   if (guiding == "svo") {
     std::cerr << "bake: error: --guiding svo is not implemented yet (use grid or off)\n";

@@ -21,6 +21,7 @@ json settings_json(const BakeSettings& s) {
             {"time_budget_seconds", s.time_budget_seconds},
             {"target_error", s.target_error},
             {"adaptive", s.adaptive},
+            {"sampler", s.sampler},
             {"bounces", s.bounces},
             {"seed", s.seed},
             {"texel_density", s.texel_density},

@@ -24,7 +24,7 @@ layout(std430, set = 0, binding = kBindingIndirect) buffer IndirectBuffer { uint
 // Path state, structure of arrays, one entry per path slot.
 layout(std430, set = 0, binding = kBindingPathWork) buffer PathWorkBuffer { uint path_work[]; };  // work item or kInvalid
 layout(std430, set = 0, binding = kBindingPathDepth) buffer PathDepthBuffer { uint path_depth[]; };
-layout(std430, set = 0, binding = kBindingPathRng) buffer PathRngBuffer { u64vec2 path_rng[]; };  // (state, increment)
+layout(std430, set = 0, binding = kBindingPathRng) buffer PathRngBuffer { uvec4 path_rng[]; };  // PathSampler (item_hash, index, dimension, mode)
 layout(std430, set = 0, binding = kBindingPathThroughput) buffer PathThroughputBuffer { vec4 path_throughput[]; };  // rgb, pdf of the ray
 layout(std430, set = 0, binding = kBindingPathRayOrigin) buffer PathRayOriginBuffer { vec4 path_ray_o[]; };
 layout(std430, set = 0, binding = kBindingPathRayDirection) buffer PathRayDirBuffer { vec4 path_ray_d[]; };

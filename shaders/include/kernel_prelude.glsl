@@ -40,7 +40,7 @@ void generate_probe_ray(uint p, uint w, uint64_t seed) {
   uint n = params.batch_item_count;
   uint probe = batch_items[params.batch_item_offset + w % n];
   uint sample_index = params.batch_sample_begin + w / n;
-  Pcg32 rng = pcg_init(seed, kProbeRngStreamBase + uint64_t(probe), uint64_t(sample_index));
+  PathSampler rng = path_sampler(seed, kProbeRngStreamBase + uint64_t(probe), sample_index, params.sampler_mode);
   vec3 d = probe_ray_direction(sample_index, params.probe_spp, rng);
   uint e = probe_extra_index(w);
   results[e + 3u] = d.x;
@@ -48,7 +48,7 @@ void generate_probe_ray(uint p, uint w, uint64_t seed) {
   results[e + 5u] = d.z;
   path_work[p] = w;
   path_depth[p] = 0u;
-  path_rng[p] = u64vec2(rng.state, rng.increment);
+  path_rng[p] = uvec4(rng.item_hash, rng.index, rng.dimension, rng.mode);
   path_ray_o[p] = vec4(start_points[probe].position.xyz, 0.0);
   path_ray_d[p] = vec4(d, 0.0);
   path_throughput[p] = vec4(1.0, 1.0, 1.0, 0.0);
@@ -71,7 +71,7 @@ void regenerate(uint p) {
     uint n = params.batch_item_count;
     uint texel = batch_items[params.batch_item_offset + w % n];
     uint sample_index = params.batch_sample_begin + w / n;
-    Pcg32 rng = pcg_init(seed, uint64_t(texel), uint64_t(sample_index));
+    PathSampler rng = path_sampler(seed, uint64_t(texel), sample_index, params.sampler_mode);
     SurfacePoint x;
     x.position = start_points[texel].position.xyz;
     x.geometric_normal = start_points[texel].geometric_normal.xyz;
@@ -79,7 +79,7 @@ void regenerate(uint p) {
     path_work[p] = w;
     path_depth[p] = 0u;
     uint r = sample_vertex(p, x, vec3(1.0), rng);
-    path_rng[p] = u64vec2(rng.state, rng.increment);
+    path_rng[p] = uvec4(rng.item_hash, rng.index, rng.dimension, rng.mode);
     if (dispatch_vertex_result(p, r)) return;
   }
 }

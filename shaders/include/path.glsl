@@ -33,7 +33,7 @@ uint connect_shadow_rays(uint p, inout uint steps) {
 // At surface point x of path p (state: work, depth, throughput, rng): next-event estimation, then the
 // continuation. Returns 0 when the path ends here, 1 when it continues with a ray; bit 1 set when
 // shadow rays are pending.
-uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout Pcg32 rng) {
+uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rng) {
   vec3 origin = offset_ray_origin(x.position, x.geometric_normal, params.scene_extent);
   path_ray_o[p] = vec4(origin, 0.0);
   ShadowRay area, punctual_light, environment;  // the environment ray is never made here (kShadowSlotsPerPath)

@@ -18,10 +18,12 @@ void main() {
   uint work = path_work[p], depth = path_depth[p];
   vec4 tp = path_throughput[p];
   vec3 wi = path_ray_d[p].xyz;
-  u64vec2 rs = path_rng[p];
-  Pcg32 rng;
-  rng.state = rs.x;
-  rng.increment = rs.y;
+  uvec4 rs = path_rng[p];
+  PathSampler rng;
+  rng.item_hash = rs.x;
+  rng.index = rs.y;
+  rng.dimension = rs.z;
+  rng.mode = rs.w;
 
   bool continues = false;
   vec3 throughput = tp.xyz;
@@ -55,7 +57,7 @@ void main() {
   if (continues) {
     path_depth[p] = depth + 1u;
     uint r = sample_vertex(p, x, throughput, rng);
-    path_rng[p] = u64vec2(rng.state, rng.increment);
+    path_rng[p] = uvec4(rng.item_hash, rng.index, rng.dimension, rng.mode);
     if (dispatch_vertex_result(p, r)) return;
   }
   regenerate(p);

@@ -190,9 +190,9 @@ TEST(GuidedDirection, SampledDirectionsFollowTheMixturePdf) {
     if (phi < 0) phi += 2 * M_PI;
     return iz * kPhi + std::min(int(phi / (2 * M_PI) * kPhi), kPhi - 1);
   };
-  Pcg32 rng = pcg_init(21, 3, 0);
   int ended = 0;
   for (int k = 0; k < n_samples; ++k) {
+    PathSampler rng = path_sampler(21, 3, uint32_t(k), kSamplerIndependent);  // independent draws: a chi-square test
     const DirectionSample d = sample_continuation(g, x, rng);
     ASSERT_TRUE(std::isfinite(d.pdf));
     if (d.pdf > 0) EXPECT_NEAR(d.pdf, continuation_pdf(g, x, d.direction), 1e-6f * d.pdf);
@@ -268,7 +268,7 @@ TEST(GuidedDirection, DegenerateInputsGiveNoNaN) {
   // A cosine vertex is exactly the cosine strategy.
   const Vec3 n = normalize(Vec3(0.1f, 0.2f, 1.0f));
   const SurfacePoint x{Vec3(0, 0, 0), n, n};
-  Pcg32 a = pcg_init(1, 2, 3), b = pcg_init(1, 2, 3);
+  PathSampler a = path_sampler(1, 2, 3, kSamplerSobol), b = path_sampler(1, 2, 3, kSamplerSobol);
   const DirectionSample da = sample_continuation(guide_vertex_cosine(), x, a);
   const DirectionSample db = sample_continuation(kStrategyCosine, x, b);
   EXPECT_EQ(da.pdf, db.pdf);

@@ -85,7 +85,7 @@ class BounceGather {
 
   // One sample of B_0 at x: path.h's estimator stopped after the direct light. `back_face`: its
   // continuation ray met the back of a single-sided surface (x is inside or under geometry).
-  Vec3 direct(SurfacePoint x, Pcg32& rng, Counters& c, bool& back_face) const {
+  Vec3 direct(SurfacePoint x, PathSampler& rng, Counters& c, bool& back_face) const {
     back_face = false;
     const LightingScene& scene = scene_;
     const Vec3 origin = offset_ray_origin(x.position, x.geometric_normal, scene.extent);
@@ -107,7 +107,7 @@ class BounceGather {
   }
 
   // One sample of B_{layer+1} at x: a continuation ray, the hit's albedo times B_layer there.
-  Vec3 gather(SurfacePoint x, int layer, Pcg32& rng, Counters& c) const {
+  Vec3 gather(SurfacePoint x, int layer, PathSampler& rng, Counters& c) const {
     const LightingScene& scene = scene_;
     const DirectionSample d = sample_continuation(settings_.sampling_strategy, x, rng);
     if (!(d.pdf > 0)) return {0, 0, 0};
@@ -139,7 +139,7 @@ class BounceGather {
 
  private:
   // B_layer at a surface point that has no texels: one sample, from the layer below.
-  Vec3 on_the_fly(SurfacePoint y, int layer, Pcg32& rng, Counters& c) const {
+  Vec3 on_the_fly(SurfacePoint y, int layer, PathSampler& rng, Counters& c) const {
     bool back_face = false;
     return layer == 0 ? direct(y, rng, c, back_face) : gather(y, layer - 1, rng, c);
   }
@@ -262,7 +262,8 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
           const LiveTexel& texel = gbuffer.texels[i];
           const SurfacePoint x{texel.position, texel.geometric_normal, texel.shading_normal};
           for (uint32_t s = layer.samples; s < layer.samples + add; ++s) {
-            Pcg32 rng = k == 0 ? pcg_init(settings.seed, i, s) : pcg_init(settings.seed, kBounceRngStreamBase * k + i, s);
+            PathSampler rng = k == 0 ? path_sampler(settings.seed, i, s, settings.sampler)
+                                     : path_sampler(settings.seed, kBounceRngStreamBase * k + i, s, settings.sampler);
             bool back_face = false;
             const Vec3 value = k == 0 ? gather.direct(x, rng, c, back_face) : gather.gather(x, int(k) - 1, rng, c);
             if (back_face) ++layer.back_faces[i];

@@ -82,7 +82,7 @@ struct CpuReferenceIntegrator::Impl {
 
   // One path sample of E/pi at x; `first_bounce` is the bounce x stands for (0 at a texel). With a
   // guiding cache, vertices sample its frozen table's mixture and every ray teaches its back table.
-  void trace(SurfacePoint x, const IntegratorSettings& settings, Pcg32& rng, PathContributions& out,
+  void trace(SurfacePoint x, const IntegratorSettings& settings, PathSampler& rng, PathContributions& out,
              uint64_t& rays, GridGuidingCache* guide = nullptr, bool learn = false,
              uint64_t* guided_vertices = nullptr) const {
     const LightingScene& s = scene();
@@ -119,7 +119,7 @@ struct CpuReferenceIntegrator::Impl {
   }
 
   // Incident radiance at `origin` from direction -`direction` (see ProbeEstimate).
-  Vec3 radiance_along_ray(Vec3 origin, Vec3 direction, const IntegratorSettings& settings, Pcg32& rng,
+  Vec3 radiance_along_ray(Vec3 origin, Vec3 direction, const IntegratorSettings& settings, PathSampler& rng,
                           uint64_t& rays, bool& backface) const {
     backface = false;
     ++rays;
@@ -200,7 +200,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     const LiveTexel& texel = gbuffer.texels[i];
     const SurfacePoint point{texel.position, texel.geometric_normal, texel.shading_normal};
     TexelAccumulator& acc = estimate.texels[i];
-    Pcg32 rng = pcg_init(settings.seed, i, s);
+    PathSampler rng = path_sampler(settings.seed, i, s, settings.sampler);
     contributions = PathContributions{};
     contributions.recorded = estimate.recorded_bounces;
     const uint64_t rays_before = rays;
@@ -318,7 +318,7 @@ ProbeEstimate CpuReferenceIntegrator::bake_probes(const std::vector<Vec3>& posit
       uint64_t& nonfinite = nonfinite_per_thread.local();
       for (size_t i = range.begin(); i != range.end(); ++i) {
         for (uint32_t s = first; s < first + count; ++s) {
-          Pcg32 rng = pcg_init(settings.seed, kProbeRngStreamBase + i, s);
+          PathSampler rng = path_sampler(settings.seed, kProbeRngStreamBase + i, s, settings.sampler);
           const Vec3 direction = probe_ray_direction(s, spp, rng);
           bool backface = false;
           const Vec3 radiance = impl_->radiance_along_ray(positions[i], direction, settings, rng, rays, backface);

@@ -1,3 +1,4 @@
+#include "exitance/common/path_sampler.h"
 #include "exitance/runtime/refresh/refresh_session.h"
 
 #include <algorithm>
@@ -106,6 +107,7 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   settings.max_bounces = baked.bounces;
   settings.russian_roulette_start = baked.russian_roulette_start;
   settings.safety_bounce_cap = baked.safety_bounce_cap;
+  settings.sampler = baked.sampler == "independent" ? kSamplerIndependent : kSamplerSobol;
 
   auto scene = std::make_shared<const Scene>(state->persisted.scene);
   try {

@@ -53,6 +53,7 @@ GpuParams WavefrontBatchRunner::bake_params(const IntegratorSettings& settings, 
   params.path_capacity = sizes_.paths;
   params.seed_lo = uint32_t(settings.seed), params.seed_hi = uint32_t(settings.seed >> 32);
   params.sampling_strategy = settings.sampling_strategy;
+  params.sampler_mode = settings.sampler;
   params.collect_stats = collect_statistics_ ? 1u : 0u;
   params.item_count_total = item_count;
   return params;

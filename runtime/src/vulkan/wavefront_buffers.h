@@ -28,7 +28,7 @@ struct WavefrontControl {
 struct PathStateBuffers {
   Buffer work;           // work item of the batch, or kInvalid
   Buffer depth;          // vertices so far
-  Buffer rng;            // Pcg32 state and increment
+  Buffer rng;            // PathSampler (path_sampler.h): four uints
   Buffer throughput;     // rgb, pdf of the ray
   Buffer ray_origin;
   Buffer ray_direction;

@@ -102,6 +102,7 @@ struct BakeSettings {
   double time_budget_seconds = 0;
   double target_error = 0;
   bool adaptive = false;  // samples planned per texel (bake --adaptive)
+  std::string sampler = "sobol";  // "sobol" | "independent" (bake --sampler)
   int32_t bounces = -1;  // -1: until Russian roulette
   uint64_t seed = 0;
   double texel_density = 0;

@@ -12,7 +12,7 @@
 #include "exitance/common/dialect.h"
 EXITANCE_NAMESPACE_BEGIN
 
-// Random streams of bounce pass k >= 1: Pcg32(seed, kBounceRngStreamBase * k + texel, sample),
+// Random streams of bounce pass k >= 1: path_sampler(seed, kBounceRngStreamBase * k + texel, sample),
 // apart from the texels' B_0 streams (texel) and the probes' (kProbeRngStreamBase + probe, 2^40).
 const uint64_t kBounceRngStreamBase = 17592186044416ul;  // 2^44
 

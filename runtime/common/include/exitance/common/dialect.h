@@ -61,6 +61,13 @@ inline bool isinf(float a) { return std::isinf(a); }
 inline bool isnan(float a) { return std::isnan(a); }
 inline uint floatBitsToUint(float f) { return std::bit_cast<uint>(f); }
 inline float uintBitsToFloat(uint u) { return std::bit_cast<float>(u); }
+inline uint bitfieldReverse(uint x) {
+  x = ((x >> 1u) & 0x55555555u) | ((x & 0x55555555u) << 1u);
+  x = ((x >> 2u) & 0x33333333u) | ((x & 0x33333333u) << 2u);
+  x = ((x >> 4u) & 0x0F0F0F0Fu) | ((x & 0x0F0F0F0Fu) << 4u);
+  x = ((x >> 8u) & 0x00FF00FFu) | ((x & 0x00FF00FFu) << 8u);
+  return (x >> 16u) | (x << 16u);
+}
 inline vec3 abs(vec3 a) { return vec3(std::fabs(a.x), std::fabs(a.y), std::fabs(a.z)); }
 
 }  // namespace exitance

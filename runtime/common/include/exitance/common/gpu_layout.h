@@ -77,7 +77,7 @@ struct GpuParams {
   uint item_count_total;   // items (texels, probes) of the whole bake: the bounce accumulator's stride
   uint probe_spp;          // probes: samples per probe of the whole bake (0xFFFFFFFF: until the time budget)
   uint sampling_strategy;  // kStrategy* (path.h)
-  uint pad0;
+  uint sampler_mode;       // kSampler* (path_sampler.h); "sampler" is a GLSL keyword
 };
 
 // Descriptor bindings of the wavefront (one set).
@@ -128,7 +128,7 @@ const uint kCounterStatShadeItems = 24u;
 const uint kCounterStatShadeLanes = 26u;
 const uint kCounterCount = 32u;
 
-// Light probes: random streams Pcg32(seed, kProbeRngStreamBase + probe, sample), and stratified
+// Light probes: random streams path_sampler(seed, kProbeRngStreamBase + probe, sample), and stratified
 // sets of kProbeStratifiedSetSize consecutive samples (sampling.h probe_direction).
 const uint64_t kProbeRngStreamBase = 1099511627776ul;  // 2^40
 const uint kProbeStratifiedSetSize = 256u;

@@ -29,7 +29,7 @@
 #include "exitance/common/guided_direction.h"
 #include "exitance/common/punctual_light.h"
 #include "exitance/common/ray_offset.h"
-#include "exitance/common/rng.h"
+#include "exitance/common/path_sampler.h"
 #include "exitance/common/sampling.h"
 EXITANCE_NAMESPACE_BEGIN
 
@@ -75,11 +75,10 @@ EXITANCE_FN float continuation_pdf(uint strategy, SurfacePoint x, vec3 wi) {
   return continuation_pdf(guide_vertex_cosine(), x, wi);
 }
 
-// Draws u1 then u2. A direction under the geometric surface would leave through the back: none.
-EXITANCE_FN DirectionSample sample_continuation(uint strategy, SurfacePoint x, INOUT(Pcg32) rng) {
-  float u1 = pcg_uniform(rng);
-  float u2 = pcg_uniform(rng);
-  vec3 local = sample_cosine_hemisphere(u1, u2);
+// Draws one 2-D sample. A direction under the geometric surface would leave through the back: none.
+EXITANCE_FN DirectionSample sample_continuation(uint strategy, SurfacePoint x, INOUT(PathSampler) rng) {
+  vec2 u = sample_2d(rng);
+  vec3 local = sample_cosine_hemisphere(u.x, u.y);
   DirectionSample s;
   s.direction = to_world(local, x.shading_normal);
   s.pdf = local.z * kInvPi;
@@ -87,20 +86,20 @@ EXITANCE_FN DirectionSample sample_continuation(uint strategy, SurfacePoint x, I
   return s;
 }
 
-// Cosine vertices: as above. Guided vertices draw the component choice, u1, u2, and for the guided
-// component a third number (bin, then the point in it). A guided direction under the surface
-// (shading or geometric) ends the path: the integrand is 0 there.
-EXITANCE_FN DirectionSample sample_continuation(GuideVertex g, SurfacePoint x, INOUT(Pcg32) rng) {
+// Cosine vertices: as above. Guided vertices draw the component choice, a 2-D sample (u1, u2) and a
+// third number u3 that only the guided component uses (bin, then the point in it); u3 is drawn either
+// way so the later dimensions of the path line up across its samples. A guided direction under the
+// surface (shading or geometric) ends the path: the integrand is 0 there.
+EXITANCE_FN DirectionSample sample_continuation(GuideVertex g, SurfacePoint x, INOUT(PathSampler) rng) {
   if (!(g.guided_probability > 0.0f)) return sample_continuation(kStrategyCosine, x, rng);
-  float u_choose = pcg_uniform(rng);
-  float u1 = pcg_uniform(rng);
-  float u2 = pcg_uniform(rng);
+  float u_choose = sample_1d(rng);
+  vec2 u = sample_2d(rng);
+  float u3 = sample_1d(rng);
   DirectionSample s;
   if (u_choose < g.guided_probability) {
-    float u3 = pcg_uniform(rng);
-    s.direction = guided_component_sample(g, u1, u2, u3);
+    s.direction = guided_component_sample(g, u.x, u.y, u3);
   } else {
-    s.direction = to_world(sample_cosine_hemisphere(u1, u2), x.shading_normal);
+    s.direction = to_world(sample_cosine_hemisphere(u.x, u.y), x.shading_normal);
   }
   s.pdf = continuation_pdf(g, x, s.direction);
   if (!(dot(s.direction, x.geometric_normal) > 0.0f) || !(dot(s.direction, x.shading_normal) > 0.0f)) s.pdf = 0.0f;
@@ -131,24 +130,24 @@ EXITANCE_FN vec3 triangle_geometric_normal(SCENE_PARAM uint tri) {
 EXITANCE_FN bool material_double_sided(GpuMaterial m) { return m.albedo_double_sided.w != 0.0f; }
 
 // One sample of each light strategy at x: (1/pi) * integral of direct radiance * cos, as shadow rays.
-// Random numbers, in order: area light (choice, u1, u2), punctual light (choice), environment (u1, u2);
+// Random numbers, in order: area light (choice, then a 2-D point), punctual light (choice),
+// environment (a 2-D direction);
 // each only when the scene has lights of that kind.
 // Three named outputs (area light, punctual light, environment) rather than an array.
 // `guide`: the vertex's continuation strategy, whose pdf weighs the area and environment samples.
 EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, vec3 throughput, GuideVertex guide,
-                                       INOUT(Pcg32) rng, OUT(ShadowRay) area_ray, OUT(ShadowRay) punctual_ray,
+                                       INOUT(PathSampler) rng, OUT(ShadowRay) area_ray, OUT(ShadowRay) punctual_ray,
                                        OUT(ShadowRay) environment_ray) {
   area_ray = no_shadow_ray();
   punctual_ray = no_shadow_ray();
   environment_ray = no_shadow_ray();
   uint emitters = scene_emitter_count(SCENE_ALONE_ARG);
   if (emitters > 0u) {
-    float u_choose = pcg_uniform(rng);
-    float u1 = pcg_uniform(rng);
-    float u2 = pcg_uniform(rng);
+    float u_choose = sample_1d(rng);
+    vec2 u = sample_2d(rng);
     float pmf;
     uint tri = scene_emitter_triangle(SCENE_ARG sample_cdf(scene_emitter_cdf(SCENE_ALONE_ARG), emitters, u_choose, pmf));
-    vec2 bary = sample_triangle_barycentrics(u1, u2);
+    vec2 bary = sample_triangle_barycentrics(u.x, u.y);
     vec3 p0 = scene_triangle_vertex(SCENE_ARG tri, 0u);
     vec3 p1 = scene_triangle_vertex(SCENE_ARG tri, 1u);
     vec3 p2 = scene_triangle_vertex(SCENE_ARG tri, 2u);
@@ -182,7 +181,7 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
   }
   uint punctual = scene_punctual_count(SCENE_ALONE_ARG);
   if (punctual > 0u) {
-    float u_choose = pcg_uniform(rng);
+    float u_choose = sample_1d(rng);
     float probability;
     GpuPunctualLight light = scene_punctual_light(SCENE_ARG sample_cdf(scene_punctual_cdf(SCENE_ALONE_ARG), punctual, u_choose, probability));
     uint type = floatBitsToUint(light.position_type.w);
@@ -208,10 +207,9 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
     }
   }
   if (scene_has_environment(SCENE_ALONE_ARG)) {
-    float u1 = pcg_uniform(rng);
-    float u2 = pcg_uniform(rng);
+    vec2 u = sample_2d(rng);
     float pdf_env;
-    vec3 wi = scene_sample_environment(SCENE_ARG u1, u2, pdf_env);
+    vec3 wi = scene_sample_environment(SCENE_ARG u.x, u.y, pdf_env);
     float cos_x = dot(x.shading_normal, wi);
     if (pdf_env > 0.0f && cos_x > 0.0f && dot(x.geometric_normal, wi) > 0.0f) {
       float weight = power_heuristic(pdf_env, continuation_pdf(guide, x, wi));
@@ -223,7 +221,7 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
 }
 
 EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, vec3 throughput, uint strategy,
-                                       INOUT(Pcg32) rng, OUT(ShadowRay) area_ray, OUT(ShadowRay) punctual_ray,
+                                       INOUT(PathSampler) rng, OUT(ShadowRay) area_ray, OUT(ShadowRay) punctual_ray,
                                        OUT(ShadowRay) environment_ray) {
   next_event_estimation(SCENE_ARG x, origin, throughput, guide_vertex_cosine(), rng, area_ray, punctual_ray,
                         environment_ray);
@@ -267,7 +265,7 @@ struct HitResult {
 // Russian roulette is played.
 EXITANCE_FN HitResult shade_continuation_hit(SCENE_PARAM uint tri, float t_hit, float b1, float b2, vec3 wi,
                                              float pdf_continuation, vec3 throughput, int bounce, PathLimits limits,
-                                             INOUT(Pcg32) rng) {
+                                             INOUT(PathSampler) rng) {
   HitResult h;
   h.radiance = vec3(0.0f);
   h.continues = false;
@@ -292,7 +290,7 @@ EXITANCE_FN HitResult shade_continuation_hit(SCENE_PARAM uint tri, float t_hit, 
   if (bounce + 1 >= limits.rr_start) {
     float survive = min(1.0f, max_component(h.throughput));
     if (!(survive > 0.0f)) return h;
-    float u = pcg_uniform(rng);
+    float u = sample_1d(rng);
     if (u >= survive) return h;
     h.throughput = h.throughput / survive;
   } else if (max_component(h.throughput) <= 0.0f) {
@@ -305,11 +303,12 @@ EXITANCE_FN HitResult shade_continuation_hit(SCENE_PARAM uint tri, float t_hit, 
 
 // ---- Light probes ----
 // Probe sample `sample` of `spp` (0xFFFFFFFF: unbounded) at probe `probe`: its stratified sphere
-// direction, drawn from Pcg32(seed, kProbeRngStreamBase + probe, sample), u1 then u2; the generator
+// direction, from the 2-D draw of path_sampler(seed, kProbeRngStreamBase + probe, sample); the sampler
 // is left positioned for the path that continues from the ray's hit.
-EXITANCE_FN vec3 probe_ray_direction(uint sample_index, uint spp, INOUT(Pcg32) rng) {
-  float u1 = pcg_uniform(rng);
-  float u2 = pcg_uniform(rng);
+EXITANCE_FN vec3 probe_ray_direction(uint sample_index, uint spp, INOUT(PathSampler) rng) {
+  vec2 u = sample_2d(rng);
+  float u1 = u.x;
+  float u2 = u.y;
   uint set_begin = sample_index - sample_index % kProbeStratifiedSetSize;
   uint set_count = min(kProbeStratifiedSetSize, spp - set_begin);
   return probe_direction(sample_index - set_begin, set_count, u1, u2);

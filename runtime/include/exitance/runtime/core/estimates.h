@@ -70,7 +70,7 @@ struct LightmapEstimate {
 
 // Light probes: per probe, `spp` rays in uniform sphere directions, stratified in sets of
 // kProbeStratifiedSetSize consecutive samples (path.h probe_ray_direction; random numbers
-// pcg_init(seed, kProbeRngStreamBase + probe, s), u1 then u2 drawn first). Each ray's incident
+// path_sampler(seed, kProbeRngStreamBase + probe, s), its first 2-D draw). Each ray's incident
 // radiance L(w) is: the sky on a miss; on a front face (or a double-sided one) Le at the hit, at full
 // weight (a probe is no surface: there is no next-event estimation at it, so nothing to MIS with),
 // plus albedo times one path sample of E/pi at the hit, exactly the lightmap texel estimator started

@@ -38,6 +38,7 @@ struct IntegratorSettings {
   int russian_roulette_start = 3;  // first bounce at which roulette may end a path
   int safety_bounce_cap = 4096;    // never reached by paths of albedo < 0.998 in practice; documented
   uint32_t sampling_strategy = 0;  // continuation directions: kStrategyCosine (path.h)
+  uint32_t sampler = 0;            // random numbers: kSamplerSobol (0) or kSamplerIndependent (path_sampler.h)
   GuidingMode guiding = GuidingMode::Off;  // Path mode only; backends refuse modes they lack
   float guiding_mix = 0.5f;         // probability of the guided component at a guided vertex (0..1)
   int guiding_grid_cells = 16;      // grid cells along the scene's longest axis (cubic cells)
