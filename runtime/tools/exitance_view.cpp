@@ -1,7 +1,9 @@
 // exitance-view BUNDLE (--look-from X,Y,Z --look-at X,Y,Z --yfov RADIANS [--up X,Y,Z] | --camera NAME)
-//               [--size W[,H]] [--aa N] [--mode lightmap|probes|albedo|normal|error] [--exposure EV] -o FILE.exr|FILE.png
+//               [--size W[,H]] [--aa N] [--mode lightmap|probes|albedo|normal|error] [--exposure EV]
+//               [--path-traced [--spp N] [--seed N]] -o FILE.exr|FILE.png
 // Renders a view of a baked bundle as an engine would draw it from the baked data (docs/view.md), on
-// the CPU. Links the loader and formats only: no GPU, no Embree, runs anywhere an engine team works.
+// the CPU, or with --path-traced the reference view lit by the runtime's Vulkan backend. No Embree:
+// the baked view needs the loader and formats; the path-traced one a Vulkan device (GPU or lavapipe).
 #include <CLI/CLI.hpp>
 
 #include <charconv>
