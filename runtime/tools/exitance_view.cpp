@@ -1,7 +1,9 @@
 // exitance-view BUNDLE (--look-from X,Y,Z --look-at X,Y,Z --yfov RADIANS [--up X,Y,Z] | --camera NAME)
-//               [--size W[,H]] [--aa N] [--mode lightmap|probes|albedo|normal|error] [--exposure EV] -o FILE.exr|FILE.png
+//               [--size W[,H]] [--aa N] [--mode lightmap|probes|albedo|normal|error] [--exposure EV]
+//               [--path-traced [--spp N] [--seed N]] -o FILE.exr|FILE.png
 // Renders a view of a baked bundle as an engine would draw it from the baked data (docs/view.md), on
-// the CPU. Links the loader and formats only: no GPU, no Embree, runs anywhere an engine team works.
+// the CPU, or with --path-traced the reference view lit by the runtime's Vulkan backend. No Embree:
+// the baked view needs the loader and formats; the path-traced one a Vulkan device (GPU or lavapipe).
 #include <CLI/CLI.hpp>
 
 #include <charconv>
@@ -13,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "exitance/runtime/vulkan/vulkan_integrator.h"
+#include "exitance/runtime/view/path_traced_view.h"
 #include "exitance/runtime/view/view_camera.h"
 #include "exitance/runtime/view/view_image_output.h"
 #include "exitance/runtime/view/view_input_error.h"
@@ -98,15 +102,20 @@ ImageSize parse_size(const std::string& text) {
 
 struct CommandLine {
   std::string bundle, output, camera, mode = "lightmap";
-  std::optional<std::string> look_from, look_at, up, yfov, size, aa, exposure;
+  std::optional<std::string> look_from, look_at, up, yfov, size, aa, exposure, spp, seed;
   unsigned threads = 0;
+  bool path_traced = false;
 };
 
 struct ViewRequest {
   exitance::view::ViewRenderOptions render;
   ImageSize size;
   float exposure_ev = 0;
+  uint32_t path_traced_spp = 0;  // 0: the baked view
+  uint64_t seed = 0;
 };
+
+constexpr int kMaxPathTracedSpp = 1 << 20;
 
 // Every check that needs no file, in the order of the synopsis.
 ViewRequest check_options(const CommandLine& cl) {
@@ -132,6 +141,24 @@ ViewRequest check_options(const CommandLine& cl) {
   request.render.mode = *mode;
   if (cl.exposure) request.exposure_ev = float(parse_scalar("--exposure", *cl.exposure));
   request.render.threads = cl.threads;
+  if (cl.path_traced) {
+    // The reference view: one ray per pixel centre, the lighting it shows is path traced.
+    if (cl.aa) throw ViewInputError("--aa: cannot be combined with --path-traced (one ray through each pixel centre)");
+    if (request.render.mode != exitance::view::ViewMode::Lightmap)
+      throw ViewInputError("--mode: " + cl.mode + " cannot be combined with --path-traced (it shows the lit view)");
+    const auto spp = parse_integer(cl.spp.value_or("64"));
+    if (!spp || *spp < 1 || *spp > kMaxPathTracedSpp)
+      throw ViewInputError("--spp: \"" + *cl.spp + "\" is not a whole number within 1 .. " + std::to_string(kMaxPathTracedSpp));
+    request.path_traced_spp = uint32_t(*spp);
+    if (cl.seed) {
+      const auto seed = parse_integer(*cl.seed);
+      if (!seed || *seed < 0) throw ViewInputError("--seed: \"" + *cl.seed + "\" is not a whole number >= 0");
+      request.seed = uint64_t(*seed);
+    }
+  } else {
+    if (cl.spp) throw ViewInputError("--spp: needs --path-traced");
+    if (cl.seed) throw ViewInputError("--seed: needs --path-traced");
+  }
   exitance::view::view_image_format(cl.output);
   return request;
 }
@@ -159,6 +186,18 @@ void check_bundle_for_mode(const exitance::view::ViewScene& view, exitance::view
       }
 }
 
+// --path-traced: the camera-ray batch lit by the runtime's Vulkan backend (a GPU, else lavapipe).
+exitance::view::ViewImage path_traced_image(const exitance::view::ViewScene& view, const exitance::view::PinholeCamera& camera,
+                                            const ViewRequest& request) {
+  const auto integrator = exitance::VulkanIntegrator::create(exitance::view::lighting_scene_of(view));
+  exitance::IntegratorSettings settings;
+  settings.spp = request.path_traced_spp;
+  settings.seed = request.seed;
+  settings.recorded_bounces = 1;
+  return exitance::view::render_path_traced_view(view, camera, request.render.width, request.render.height, *integrator, settings)
+      .image;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -175,6 +214,9 @@ int main(int argc, char** argv) {
   app.add_option("--aa", cl.aa, "N x N stratified rays per pixel, N in 1..16 (default 1: the pixel centre)");
   app.add_option("--mode", cl.mode, "lightmap (default) | probes | albedo | normal | error");
   app.add_option("--exposure", cl.exposure, "PNG only: multiply by 2^EV before the tone curve (default 0)");
+  app.add_flag("--path-traced", cl.path_traced, "path trace the lighting at each pixel's first hit (Vulkan) instead of reading the bundle");
+  app.add_option("--spp", cl.spp, "--path-traced: paths per pixel, 1..1048576 (default 64)");
+  app.add_option("--seed", cl.seed, "--path-traced: random seed (default 0)");
   app.add_option("--threads", cl.threads, "render threads (default: one per hardware thread)");
   app.add_option("-o,--out", cl.output, "output image: FILE.exr (linear) or FILE.png (tone-mapped, sRGB)")->required();
   try {
@@ -207,15 +249,18 @@ int main(int argc, char** argv) {
                                 ? std::clamp(int(std::lround(request.size.width / camera_aspect)), 1, kMaxImageSide)
                                 : request.size.width;
     const auto rendering = Clock::now();
-    const exitance::view::ViewImage image = exitance::view::render_view(view, *camera, request.render);
+    const exitance::view::ViewImage image =
+        request.path_traced_spp ? path_traced_image(view, *camera, request) : exitance::view::render_view(view, *camera, request.render);
     const auto writing = Clock::now();
     exitance::view::write_view_image(cl.output, image, request.exposure_ev);
     const auto seconds = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
-    std::fprintf(stderr, "exitance-view: wrote %s (%d x %d, %d ray(s) per pixel, %s; open %.3f s, render %.3f s, write %.3f s)\n",
-                 cl.output.c_str(), image.width, image.height,
-                 request.render.samples_per_axis * request.render.samples_per_axis,
-                 exitance::view::view_mode_name(request.render.mode), seconds(opened, rendering), seconds(rendering, writing),
-                 seconds(writing, Clock::now()));
+    const std::string what = request.path_traced_spp
+                                 ? "1 ray per pixel, path traced at " + std::to_string(request.path_traced_spp) + " spp"
+                                 : std::to_string(request.render.samples_per_axis * request.render.samples_per_axis) +
+                                       " ray(s) per pixel, " + exitance::view::view_mode_name(request.render.mode);
+    std::fprintf(stderr, "exitance-view: wrote %s (%d x %d, %s; open %.3f s, render %.3f s, write %.3f s)\n",
+                 cl.output.c_str(), image.width, image.height, what.c_str(), seconds(opened, rendering),
+                 seconds(rendering, writing), seconds(writing, Clock::now()));
     return 0;
   } catch (const ViewInputError& e) {
     std::cerr << "exitance-view: error: " << one_line(e.what()) << "\n";

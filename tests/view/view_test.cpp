@@ -36,6 +36,8 @@
 #include "exitance/formats/lightmap_exr.h"
 #include "exitance/formats/scene_file.h"
 #include "exitance/runtime/core/bvh4_walk.h"
+#include "exitance/runtime/cpu_reference_integrator.h"
+#include "exitance/runtime/view/path_traced_view.h"
 #include "exitance/runtime/view/view_camera.h"
 #include "exitance/runtime/view/view_image_output.h"
 #include "exitance/runtime/view/view_input_error.h"
@@ -141,6 +143,36 @@ TEST_F(PlaneUnderSky, PixelsOnThePlaneAreAlbedoTimesTheSky) {
         if (component(sd, c) > 0) worst_z = std::max(worst_z, std::fabs(got - exact) / (kPlaneAlbedo[c] * component(sd, c)));
       }
   std::printf("[view] plane under sky: texel sd %.3g %.3g %.3g, worst pixel %.2f texel sd\n", sd.x, sd.y, sd.z, worst_z);
+}
+
+// The path-traced view (docs/view.md, "The path-traced view") on the CPU reference: albedo x sky on the
+// plane within 4 of the pixels' own standard errors, 0 on the back of the single-sided plane, the sky
+// exactly on a miss.
+TEST_F(PlaneUnderSky, PathTracedPixelsAreAlbedoTimesTheSkyBlackBehindAndSkyOnAMiss) {
+  const view::ViewScene scene = view::open_view_scene(bundle().string());
+  const CpuReferenceIntegrator reference(*view::lighting_scene_of(scene)->source);
+  IntegratorSettings settings;
+  settings.spp = 16;
+  settings.recorded_bounces = 1;
+  const view::PathTracedView top = view::render_path_traced_view(scene, top_camera(), 16, 16, reference, settings);
+  ASSERT_EQ(top.estimate.texels.size(), 16u * 16u);
+  for (size_t p = 0; p < 16 * 16; ++p)
+    for (int c = 0; c < 3; ++c) {
+      const double exact = double(kPlaneAlbedo[c]) * kSky[c], got = top.image.rgb[p * 3 + size_t(c)];
+      ASSERT_LE(std::fabs(got - exact), 4.0 * std::sqrt(double(top.variance[p * 3 + size_t(c)])) + 1e-5 * exact)
+          << "pixel " << p << " channel " << c;
+    }
+  // From below: the back of a single-sided plane absorbs (no texel is traced, the pixel is 0).
+  const view::PathTracedView below = view::render_path_traced_view(
+      scene, view::look_at_camera({0, -1, 0}, {0, 0, 0}, {0, 0, -1}, 1.0), 8, 8, reference, settings);
+  EXPECT_TRUE(below.estimate.texels.empty());
+  for (float v : below.image.rgb) ASSERT_EQ(v, 0.0f);
+  // Looking up: every ray misses and shows the sky.
+  const view::PathTracedView up = view::render_path_traced_view(
+      scene, view::look_at_camera({0, 1, 0}, {0, 2, 0}, {0, 0, -1}, 1.0), 8, 8, reference, settings);
+  EXPECT_TRUE(up.estimate.texels.empty());
+  for (size_t p = 0; p < 8 * 8; ++p)
+    for (int c = 0; c < 3; ++c) ASSERT_EQ(up.image.rgb[p * 3 + size_t(c)], kSky[c]);
 }
 
 TEST_F(PlaneUnderSky, ARayThatMissesShowsTheSky) {

@@ -10,16 +10,6 @@ namespace {
 
 Vec3 to_vec3(const formats::Float3& f) { return {f[0], f[1], f[2]}; }
 
-struct SurfaceAtHit {
-  Vec3 position;
-  Vec3 geometric_normal;  // front side (counter-clockwise winding)
-  Vec3 shading_normal;    // interpolated, facing the viewer on a double-sided surface's back
-  bool back_face_absorbs;  // the back of a single-sided surface: the bake treats it as black
-  uint32_t instance;
-  Vec3 albedo, emission;
-  std::array<float, 2> lightmap_uv;
-};
-
 SurfaceAtHit surface_at(const ViewScene& view, const Bvh4WalkHit& hit, Vec3 direction) {
   const formats::SceneTriangles& tris = view.scene.triangles;
   const size_t t = hit.triangle, c = 3 * t;
@@ -39,6 +29,7 @@ SurfaceAtHit surface_at(const ViewScene& view, const Bvh4WalkHit& hit, Vec3 dire
   s.back_face_absorbs = !front && !m.double_sided;
   s.shading_normal = front || !m.double_sided ? n : -n;
   s.instance = tris.instance[t];
+  s.triangle = uint32_t(t);
   s.albedo = diffuse_albedo_of(to_vec3(m.base_color), m.metallic);
   s.emission = front || m.double_sided ? to_vec3(m.emission) : Vec3(0);
   const formats::Float2 uv0 = tris.lightmap_uv[c], uv1 = tris.lightmap_uv[c + 1], uv2 = tris.lightmap_uv[c + 2];
@@ -77,7 +68,7 @@ const char* view_mode_name(ViewMode mode) {
   return "?";
 }
 
-Vec3 shade_primary_ray(const ViewScene& view, ViewMode mode, Vec3 origin, Vec3 direction, RayScratch& scratch) {
+std::optional<SurfaceAtHit> first_surface(const ViewScene& view, Vec3 origin, Vec3 direction, RayScratch& scratch) {
   const formats::SceneFile& scene = view.scene;
   const auto corners = [&](uint32_t t, Vec3& p0, Vec3& p1, Vec3& p2) {
     p0 = to_vec3(scene.triangles.positions[3 * size_t(t)]);
@@ -87,9 +78,15 @@ Vec3 shade_primary_ray(const ViewScene& view, ViewMode mode, Vec3 origin, Vec3 d
   const Bvh4WalkHit hit =
       bvh4_closest_hit</*kNearestChildFirst=*/true>(scene.bvh.nodes.data(), scene.bvh.nodes.size(), scene.bvh.leaf_triangles.data(), corners, origin,
                        direction, std::numeric_limits<float>::infinity(), scratch.stack);
+  if (!hit.found) return std::nullopt;
+  return surface_at(view, hit, direction);
+}
+
+Vec3 shade_primary_ray(const ViewScene& view, ViewMode mode, Vec3 origin, Vec3 direction, RayScratch& scratch) {
   const bool lit_mode = mode == ViewMode::Lightmap || mode == ViewMode::Probes;
-  if (!hit.found) return lit_mode ? to_vec3(scene.sky) : Vec3(0);
-  const SurfaceAtHit s = surface_at(view, hit, direction);
+  const std::optional<SurfaceAtHit> hit = first_surface(view, origin, direction, scratch);
+  if (!hit) return lit_mode ? to_vec3(view.scene.sky) : Vec3(0);
+  const SurfaceAtHit& s = *hit;
   switch (mode) {
     case ViewMode::Albedo: return s.albedo;
     case ViewMode::Normal: return s.shading_normal * 0.5f + Vec3(0.5f);

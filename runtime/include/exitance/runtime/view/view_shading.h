@@ -1,6 +1,7 @@
 // What one primary ray of exitance-view shows (docs/view.md, "What a pixel shows"): the radiance an
 // engine would draw from the baked data at the first surface the ray meets, or the sky.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -29,6 +30,21 @@ inline constexpr const char* kErrorChannel = "error.Y";
 struct RayScratch {
   std::vector<uint32_t> stack;
 };
+
+// The first surface a primary ray meets, as the view shades it.
+struct SurfaceAtHit {
+  Vec3 position;
+  Vec3 geometric_normal;   // front side (counter-clockwise winding)
+  Vec3 shading_normal;     // interpolated, facing the viewer on a double-sided surface's back
+  bool back_face_absorbs;  // the back of a single-sided surface: the bake treats it as black
+  uint32_t instance;
+  uint32_t triangle;
+  Vec3 albedo, emission;
+  std::array<float, 2> lightmap_uv;
+};
+
+// The nearest surface along the ray from `origin` in unit `direction`; std::nullopt on a miss.
+std::optional<SurfaceAtHit> first_surface(const ViewScene& view, Vec3 origin, Vec3 direction, RayScratch& scratch);
 
 // Radiance (or the debug quantity of `mode`) along the ray from `origin` in unit `direction`.
 Vec3 shade_primary_ray(const ViewScene& view, ViewMode mode, Vec3 origin, Vec3 direction, RayScratch& scratch);
