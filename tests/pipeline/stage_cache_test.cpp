@@ -221,6 +221,17 @@ TEST(StageCache, DamagedStageEntriesAreComputedAgainWithAWarning) {
   fs::remove_all(dir);
 }
 
+TEST(StageCache, ABundleCopiedWholeFromTheCacheSaysEveryStageWasReused) {
+  const fs::path dir = testing::fresh_temp_dir("stage-cache-whole");
+  const fs::path input = write_scene(dir, {});
+  Diagnostics d;
+  run_bake(options_for(input, dir / "a.bake", dir / "cache"), d);
+  const json again = run_bake(options_for(input, dir / "b.bake", dir / "cache"), d);
+  EXPECT_TRUE(again["cache"]["reused"].get<bool>());
+  for (const std::string& stage : kOfflineStages) EXPECT_EQ(stage_outcomes(again)[stage], "reused") << stage;
+  fs::remove_all(dir);
+}
+
 TEST(StageCache, WithoutTheCacheTheManifestHasNoStageOutcomes) {
   const fs::path dir = testing::fresh_temp_dir("stage-cache-none");
   Diagnostics d;
