@@ -32,7 +32,7 @@ void textures(Sha256Stream& h, const Scene& scene) {
 }
 
 void albedo(Sha256Stream& h, const Scene& scene) {
-  h.array(scene.triangle_material), h.array(scene.uv0), h.array(scene.vertex_color);
+  h.array(scene.triangle_material), h.array(scene.uv0), h.array(scene.lightmap_uv), h.array(scene.vertex_color);
   h.value(uint64_t(scene.materials.size()));
   for (const Material& m : scene.materials) {
     scene_hashing::vec3(h, m.base_color), scene_hashing::binding(h, m.base_color_texture), h.value(m.metallic);
@@ -41,7 +41,8 @@ void albedo(Sha256Stream& h, const Scene& scene) {
 }
 
 void visibility(Sha256Stream& h, const Scene& scene) {
-  h.array(scene.triangle_material), h.array(scene.uv0), h.array(scene.vertex_alpha);
+  // The alpha texture may be read through either UV set (its binding's tex_coord).
+  h.array(scene.triangle_material), h.array(scene.uv0), h.array(scene.lightmap_uv), h.array(scene.vertex_alpha);
   h.value(uint64_t(scene.materials.size()));
   for (const Material& m : scene.materials) {
     h.value(m.double_sided), h.value(m.alpha_mode), h.value(m.alpha_cutoff), h.value(m.base_alpha);

@@ -16,8 +16,8 @@
 //   probe_placement  positions, instances, visibility, the voxelize key (or none), --probes
 //
 // Visibility: what decides whether a ray stops at a surface or which side is dead: triangle
-// materials' alphaMode, cutoff, base alpha, base colour texture, doubleSided, with TEXCOORD_0,
-// COLOR_0 alpha and the textures. Light intensity and colour, spot cones, emission strength, the sky
+// materials' alphaMode, cutoff, base alpha, base colour texture, doubleSided, with both UV sets
+// (a texture binding may read either), COLOR_0 alpha and the textures. Light intensity and colour, spot cones, emission strength, the sky
 // and every lighting option are in no key: they change the lighting stage only.
 #pragma once
 #include <string>
