@@ -197,6 +197,14 @@ TEST(StageCache, DamagedStageEntriesAreComputedAgainWithAWarning) {
       {"probe_placement", [](const fs::path& e) { std::ofstream(e / "extra.bin") << "x"; }},
       {"sealed_texels", [](const fs::path& e) { std::ofstream(e / "entry.json") << "{\"format\": 1"; }},
       {"layout", [](const fs::path& e) { fs::remove(e / "layout.json"); }},
+      {"checks",  // a foreign entry: entry.json written for another key
+       [](const fs::path& e) {
+         std::ifstream in(e / "entry.json");
+         json entry = json::parse(in);
+         in.close();
+         entry["key"] = std::string(64, '0');
+         std::ofstream(e / "entry.json") << entry.dump();
+       }},
   };
   float intensity = 6;
   for (const Damage& damage : damages) {
