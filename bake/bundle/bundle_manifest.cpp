@@ -155,6 +155,7 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
   stats["coplanar_texels"] = results.geometry.coplanar_texels;
   stats["enclosed_lights"] = results.geometry.enclosed_lights;
   stats["nonfinite_samples"] = estimate.nonfinite_samples;
+  if (results.stage_cache) stats["cache"]["stages"] = *results.stage_cache;
   json skipped = {{"texels_outside_charts", gbuffer.skipped_texels}};
   if (results.sealed) {
     // Sealed texels (no light reaches them): found either way, skipped unless --no-skip. The time

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 
+#include "exitance/bake/cache/scene_hashing.h"
 #include "exitance/bake/cache/sha256_stream.h"
 
 namespace exitance {
@@ -17,17 +18,8 @@ static_assert(sizeof(ImportOptions) == 8, "ImportOptions changed: hash the new f
 static_assert(sizeof(Material) == 136, "Material changed: hash the new field in bake_cache_key");
 static_assert(sizeof(PunctualLight) == 88, "PunctualLight changed: hash the new field in bake_cache_key");
 
-void hash_binding(Sha256Stream& h, const TextureBinding& b) {
-  h.value(b.texture);
-  h.value(b.transform.offset.x), h.value(b.transform.offset.y), h.value(b.transform.rotation);
-  h.value(b.transform.scale.x), h.value(b.transform.scale.y), h.value(b.transform.tex_coord);
-}
-
-void hash_vec3(Sha256Stream& h, const Vec3& v) { h.value(v.x), h.value(v.y), h.value(v.z); }
-
-void hash_texture(Sha256Stream& h, const Texture& t) {
-  h.value(t.width), h.value(t.height), h.array(t.rgb), h.array(t.alpha), h.value(t.wrap_s), h.value(t.wrap_t);
-}
+using scene_hashing::binding;
+using scene_hashing::vec3;
 
 void hash_scene(Sha256Stream& h, const Scene& scene) {
   h.array(scene.positions), h.array(scene.normals), h.array(scene.uv0), h.array(scene.lightmap_uv);
@@ -36,12 +28,12 @@ void hash_scene(Sha256Stream& h, const Scene& scene) {
   h.value(uint64_t(scene.materials.size()));
   for (const Material& m : scene.materials) {
     h.text(m.name);
-    hash_vec3(h, m.base_color), hash_binding(h, m.base_color_texture), h.value(m.metallic);
-    hash_vec3(h, m.emission), hash_binding(h, m.emissive_texture), h.value(m.double_sided);
+    vec3(h, m.base_color), binding(h, m.base_color_texture), h.value(m.metallic);
+    vec3(h, m.emission), binding(h, m.emissive_texture), h.value(m.double_sided);
     h.value(m.alpha_mode), h.value(m.alpha_cutoff), h.value(m.base_alpha);
   }
   h.value(uint64_t(scene.textures.size()));
-  for (const Texture& t : scene.textures) hash_texture(h, t);
+  for (const Texture& t : scene.textures) scene_hashing::texture(h, t);
   h.value(uint64_t(scene.instances.size()));
   for (const Instance& i : scene.instances) {
     h.value(i.node), h.text(i.name), h.value(i.mesh), h.value(i.first_triangle), h.value(i.triangle_count);
@@ -49,10 +41,10 @@ void hash_scene(Sha256Stream& h, const Scene& scene) {
   }
   h.value(uint64_t(scene.lights.size()));
   for (const PunctualLight& l : scene.lights) {
-    h.value(l.type), h.text(l.name), hash_vec3(h, l.position), hash_vec3(h, l.direction), hash_vec3(h, l.intensity);
+    h.value(l.type), h.text(l.name), vec3(h, l.position), vec3(h, l.direction), vec3(h, l.intensity);
     h.value(l.cos_inner), h.value(l.cos_outer), h.value(l.node);
   }
-  hash_vec3(h, scene.sky.constant), hash_texture(h, scene.sky.environment);
+  vec3(h, scene.sky.constant), scene_hashing::texture(h, scene.sky.environment);
   h.value(uint64_t(scene.nodes.size()));
   for (const SceneNode& n : scene.nodes) {
     h.text(n.name), h.value(n.parent), h.value(n.mesh), h.value(n.light), h.value(n.camera), h.value(n.in_scene);

@@ -1,17 +1,13 @@
 #include "exitance/bake/cache/bundle_cache.h"
 
-#include <unistd.h>
-
-#include <atomic>
-#include <chrono>
 #include <fstream>
 #include <iterator>
 #include <map>
-#include <random>
 #include <system_error>
 
 #include <nlohmann/json.hpp>
 
+#include "exitance/bake/cache/cache_entry_folder.h"
 #include "exitance/bake/cache/sha256_stream.h"
 #include "exitance/runtime/bundle/bundle_directory.h"
 
@@ -19,21 +15,14 @@ namespace exitance {
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
+using cache_entry::discard;
+using cache_entry::unique_suffix;
 
 namespace {
 
 constexpr const char* kEntryFile = "entry.json";
 constexpr const char* kEntryFormat = "exitance-bundle-cache-entry";
 constexpr int kEntryVersion = 1;
-
-// A name no other process uses at the same time: pid, time and a random number.
-std::string unique_suffix() {
-  static std::atomic<uint64_t> counter{0};
-  std::random_device random;
-  return std::to_string(::getpid()) + "-" +
-         std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + "-" +
-         std::to_string(random()) + "-" + std::to_string(counter++);
-}
 
 // A bundle file as an entry names it: a plain name, or one folder and a plain name (preview/...),
 // none starting with '.', so a damaged entry.json cannot point outside the entry.
@@ -123,15 +112,6 @@ bool entry_is_intact(const fs::path& folder, const std::map<std::string, std::pa
   return true;
 }
 
-// Moves a damaged entry out of the way (a rename, so a concurrent reader sees it whole or not at
-// all), then deletes it.
-void discard(const fs::path& folder) {
-  std::error_code error;
-  const fs::path trash = folder.parent_path() / (".discard-" + unique_suffix());
-  fs::rename(folder, trash, error);
-  fs::remove_all(error ? folder : trash, error);
-}
-
 }  // namespace
 
 BundleCache::BundleCache(fs::path directory) : directory_(std::move(directory)) {}
@@ -200,9 +180,7 @@ void BundleCache::store(const std::string& key, const fs::path& bundle, const st
       out << entry.dump(1) << "\n";
       if (!out) throw std::runtime_error("cannot write " + (staging / kEntryFile).string());
     }
-    std::error_code error;
-    fs::rename(staging, folder, error);  // fails when another bake stored this key first: theirs stays
-    if (error) fs::remove_all(staging, error);
+    cache_entry::publish(staging, folder);  // another bake that stored this key first keeps its entry
   } catch (const std::exception& e) {
     std::error_code ignored;
     fs::remove_all(staging, ignored);

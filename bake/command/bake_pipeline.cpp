@@ -14,6 +14,7 @@
 #include "exitance/bake/cache/sha256_stream.h"
 #include "exitance/bake/command/backend_choice.h"
 #include "exitance/bake/command/bake_stages.h"
+#include "exitance/bake/command/cached_offline_stages.h"
 #include "exitance/formats/bundle_manifest.h"
 #include "exitance/runtime/stage_clock.h"
 
@@ -58,7 +59,12 @@ json run_report(const WrittenBundle& bundle, const json& seconds) {
 std::string mark_reused(const std::string& manifest_text, const std::string& key) {
   formats::BundleManifest manifest = formats::parse_bundle_manifest(manifest_text, "manifest.json");
   json stats = manifest.stats_json.empty() ? json::object() : json::parse(manifest.stats_json);
-  stats["cache"] = {{"reused", true}, {"key", key}};
+  json& cache = stats["cache"];
+  cache["reused"] = true;
+  cache["key"] = key;
+  // Nothing ran this time: every stage the stored bake cached is reused.
+  if (cache.contains("stages"))
+    for (auto& outcome : cache["stages"]) outcome = "reused";
   manifest.stats_json = stats.dump();
   return formats::write_bundle_manifest(manifest);
 }
@@ -119,27 +125,29 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
     generated_uvs = clock.time("uv_generation", [&] {
       return uv_generation_stage(imported, without_lightmap_uvs, options, diagnostics);
     });
-  const AtlasLayout layout = clock.time("layout", [&] { return layout_stage(imported, options, diagnostics); });
-  TexelGBuffer gbuffer = clock.time("raster", [&] { return raster_stage(imported, layout, options, diagnostics); });
+  // Each offline stage's products come from the per-stage cache when its inputs are unchanged.
+  CachedOfflineStages stages(imported, options);
+  const AtlasLayout layout = clock.time("layout", [&] { return stages.layout(imported, diagnostics); });
+  TexelGBuffer gbuffer = clock.time("raster", [&] { return stages.raster(imported, layout, diagnostics); });
   const SceneForLighting scene =
       clock.time("bvh", [&] { return build_lighting_scene_stage(std::move(imported), options); });
   const std::shared_ptr<const Integrator> backend =
       clock.time("backend", [&] { return backend_stage(scene, options, diagnostics); });
-  const size_t unoccluded = clock.time("unocclude", [&] { return unocclude_stage(scene, gbuffer); });
+  const size_t unoccluded = clock.time("unocclude", [&] { return stages.unocclude(scene, gbuffer, layout, diagnostics); });
   const GeometryCheckReport geometry =
-      clock.time("checks", [&] { return scene_checks_stage(scene, gbuffer, options, diagnostics); });
+      clock.time("checks", [&] { return stages.checks(scene, gbuffer, diagnostics); });
   const SealedTexels sealed =
-      clock.time("sealed_texels", [&] { return sealed_texels_stage(scene, gbuffer, geometry, options); });
+      clock.time("sealed_texels", [&] { return stages.sealed_texels(scene, gbuffer, geometry, diagnostics); });
 
   // Voxelize and place probes before lighting, so a bad --voxel-resolution or --probes fails before
   // the long stage.
   std::optional<VoxelizedScene> voxels;
   if (options.svo_enabled)
-    voxels = clock.time("voxelize", [&] { return voxelize_stage(*scene.scene, layout, options); });
+    voxels = clock.time("voxelize", [&] { return stages.voxelize(*scene.scene, layout, diagnostics); });
   std::optional<ProbePlacement> probes;
   if (options.probes_enabled)
     probes = clock.time("probe_placement",
-                        [&] { return place_probes_stage(scene, voxels ? &*voxels : nullptr, options); });
+                        [&] { return stages.place_probes(scene, voxels ? &*voxels : nullptr, diagnostics); });
 
   const PersistedSceneFile scene_file = clock.time("scene_file", [&] {
     return scene_file_stage(scene, gbuffer, layout, probes ? &*probes : nullptr, options, diagnostics);
@@ -180,7 +188,8 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                             .input_sha256 = input_sha256,
                             .generated_uvs = &generated_uvs,
                             .sealed = &sealed,
-                            .sealed_skipped = options.skip_sealed_texels};
+                            .sealed_skipped = options.skip_sealed_texels,
+                            .stage_cache = cache ? &stages.outcomes() : nullptr};
   if (options.preview && scene_file.bytes.empty())
     diagnostics.warn("--preview: no views, only the lightmap pages: the bundle has no scene.bin (" +
                      scene_file.skipped + ")");
@@ -188,7 +197,8 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
       clock.time("write", [&] { return write_bundle_stage(results, clock.seconds(), diagnostics, options); });
   if (cache) {
     clock.time("cache_store", [&] { cache->store(cache_key, bundle.folder, diagnostics.warnings, diagnostics); });
-    bundle.stats["cache"] = {{"reused", false}, {"key", cache_key}};
+    bundle.stats["cache"]["reused"] = false;  // its "stages" are in the manifest already
+    bundle.stats["cache"]["key"] = cache_key;
   }
   // After the bundle, so a failed bake writes neither.
   if (!options.write_gltf.empty()) write_gltf_stage(generated_uvs, options, diagnostics);

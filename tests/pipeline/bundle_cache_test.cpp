@@ -67,7 +67,8 @@ bool reused(const json& report) { return report.contains("cache") && report["cac
 std::vector<fs::path> entries(const fs::path& cache) {
   std::vector<fs::path> found;
   if (fs::exists(cache / "v1"))
-    for (const auto& e : fs::directory_iterator(cache / "v1")) found.push_back(e.path());
+    for (const auto& e : fs::directory_iterator(cache / "v1"))
+      if (e.path().filename() != "stages") found.push_back(e.path());  // the per-stage cache (stage_cache.h)
   return found;
 }
 

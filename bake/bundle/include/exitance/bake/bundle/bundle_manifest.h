@@ -49,6 +49,7 @@ struct BakeResults {
   const std::vector<MeshUvReport>* generated_uvs = nullptr;  // uv generation: the meshes whose UVs it made
   const SealedTexels* sealed = nullptr;  // sealed texels (found before lighting); null: not looked for
   bool sealed_skipped = false;           // the lighting stage skipped them (not --no-skip)
+  const nlohmann::json* stage_cache = nullptr;  // --cache: {stage: "reused" | "computed"} (stats.cache.stages)
 };
 
 // The manifest (formats/bundle_manifest.h) of the bake: `pages`: the assembled lightmap pages (the manifest lists their channels). `input_sha256`: the
