@@ -46,6 +46,10 @@ struct BakeOptions {
   // --preview: PNGs of the pages and default views in OUT/preview/ (bake/bundle/bundle_preview.h),
   // views preview_size pixels wide.
   bool preview = false;
+  // --seams stitch|off: least-squares seam stitching of the lightmap pages (bake/seams/).
+  // NOT yet in the cache key (bake/cache/bake_cache_key.cpp hash_options needs h.value(o.stitch_seams));
+  // it sits in padding so BakeOptions' size, which that file checks, is unchanged.
+  bool stitch_seams = true;
   uint32_t preview_size = 512;
   // The bundle cache (bake/cache/bundle_cache.h): a folder, or empty for none. Empty by default
   // here; the bake command defaults to .exitance-cache beside OUT (--cache DIR, --no-cache).
