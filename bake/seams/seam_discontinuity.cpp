@@ -9,7 +9,9 @@ namespace {
 
 double bilinear_luminance(const formats::LightmapImage& page, Vec2 point) {
   const BilinearTaps taps = bilinear_taps(page.width, page.height, point);
-  const std::vector<float>&r = page.channels.at("R"), &g = page.channels.at("G"), &b = page.channels.at("B");
+  const std::vector<float>& r = page.channels.at("R");
+  const std::vector<float>& g = page.channels.at("G");
+  const std::vector<float>& b = page.channels.at("B");
   double y = 0;
   for (int k = 0; k < 4; ++k) {
     const size_t i = taps.texel[size_t(k)];
@@ -26,6 +28,7 @@ SeamDiscontinuity measure_seam_discontinuity(const std::vector<formats::Lightmap
   double sum = 0;
   std::set<std::pair<int, size_t>> seam_texels;
   for (const SeamSample& s : samples) {
+    if (s.page < 0 || size_t(s.page) >= pages.size() || !pages[size_t(s.page)].channels.count("R")) continue;
     const formats::LightmapImage& page = pages[size_t(s.page)];
     const double a = bilinear_luminance(page, s.side_a), b = bilinear_luminance(page, s.side_b);
     const double mean = 0.5 * (a + b);

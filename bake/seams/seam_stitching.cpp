@@ -2,6 +2,7 @@
 
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCore>
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <unordered_map>
@@ -148,7 +149,9 @@ void solve_page(formats::LightmapImage& page, const PageSystem& system, double l
     const Eigen::VectorXd rhs = lambda * x0 - r.transpose() * c;
     const Eigen::VectorXd x = cg.solveWithGuess(rhs, x0);
     if (cg.info() != Eigen::Success || !x.allFinite()) continue;  // keep the unstitched values
-    for (int j = 0; j < n; ++j) values[system.unknown_texel[size_t(j)]] = float(x[j]);
+    // Irradiance is never negative: a texel that was not keeps to >= 0 (the solve can overshoot
+    // where a bright texel's footprint neighbours a dark one).
+    for (int j = 0; j < n; ++j) values[system.unknown_texel[size_t(j)]] = float(x0[j] >= 0 ? std::max(0.0, x[j]) : x[j]);
   }
 }
 
@@ -170,10 +173,13 @@ SeamStitchReport stitch_lightmap_seams(std::vector<formats::LightmapImage>& page
                                        const SeamStitchSettings& settings) {
   SeamStitchReport report = measure_lightmap_seams(pages, seams, settings);
   const std::vector<SeamSample> samples = seam_samples(seams, settings.samples_per_texel);
+  std::vector<bool> page_has_samples(pages.size(), false);
+  for (const SeamSample& s : samples)
+    if (size_t(s.page) < pages.size()) page_has_samples[size_t(s.page)] = true;
   for (size_t p = 0; p < pages.size(); ++p) {
     formats::LightmapImage& page = pages[p];
     const auto coverage = page.channels.find("A");
-    if (coverage == page.channels.end()) continue;
+    if (!page_has_samples[p] || coverage == page.channels.end()) continue;
     DilationMap dilation(page.width, page.height,
                          dilation_passes(page.width, page.height, coverage->second, settings.dilation_passes));
     const PageSystem system = page_system(page, samples, int(p), dilation);

@@ -1,4 +1,4 @@
-// A baked scene with seams (a sphere with generated UVs over a floor, under a white sky): the bake
+// A baked scene with seams (a sphere with generated UVs over a floor, under a sky and a sun): the bake
 // finds the sphere's seams and stitching cuts their mean discontinuity at least 5x, to below the
 // seam texels' own relative standard error (issue 13, "Seams"). --seams off writes the same stats
 // with nothing adjusted.
@@ -22,7 +22,7 @@ BakeOptions sphere_bake(const fs::path& dir, bool stitch) {
   BakeOptions options;
   options.input = (dir / "sphere.gltf").string();
   options.output = (dir / (stitch ? "stitched.bake" : "unstitched.bake")).string();
-  options.sky = "1,1,1";
+  options.sky = "0.3,0.35,0.45";
   options.atlas.texel_density = 12;
   options.lighting.spp = 64;
   options.lighting.seed = 7;
@@ -37,7 +37,7 @@ TEST(SeamStitchingBake, SphereSeamsDropAtLeastFiveFold) {
   const fs::path dir = fs::temp_directory_path() / ("exitance-test-seams-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
-  test::write_sphere_over_floor_gltf((dir / "sphere.gltf").string());
+  test::write_sphere_over_floor_gltf((dir / "sphere.gltf").string(), 48, 24, /*sun=*/true);
 
   Diagnostics diagnostics;
   const nlohmann::json stitched = run_bake(sphere_bake(dir, true), diagnostics)["seams"];

@@ -1,6 +1,8 @@
 // A glTF scene with lightmap UV seams: a smooth UV sphere (radius 1, centre 1.2 m up) over a 6 m
 // floor, neither with TEXCOORD_1, so the bake generates their UVs (charts cut the sphere). Lit by
-// the --sky the caller gives. Written with its buffer inline (a data: URI).
+// the --sky the caller gives and, with `sun`, a directional light (3 W/m^2, from 40° above the
+// horizon) whose terminator and shadow cross the sphere's seams. Written with its buffer inline
+// (a data: URI).
 #pragma once
 #include <cmath>
 #include <cstdint>
@@ -27,7 +29,8 @@ inline std::string base64(const std::vector<uint8_t>& bytes) {
   return out;
 }
 
-inline void write_sphere_over_floor_gltf(const std::string& path, int segments = 48, int rings = 24) {
+inline void write_sphere_over_floor_gltf(const std::string& path, int segments = 48, int rings = 24,
+                                         bool sun = false) {
   const double pi = 3.14159265358979323846;
   struct Mesh {
     std::vector<float> positions, normals;
@@ -83,6 +86,21 @@ inline void write_sphere_over_floor_gltf(const std::string& path, int segments =
   gltf["scenes"] = json::array({json{{"nodes", {0, 1}}}});
   gltf["nodes"] = json::array({json{{"mesh", 0}, {"name", "Sphere"}}, json{{"mesh", 1}, {"name", "Floor"}}});
   gltf["meshes"] = meshes;
+  if (sun) {
+    // A glTF light shines along its node's -Z: rotate -Z onto the sun's direction d.
+    const double e = 40 * pi / 180, a = 30 * pi / 180;
+    const double d[3] = {-std::cos(e) * std::cos(a), -std::sin(e), -std::cos(e) * std::sin(a)};
+    const double axis[3] = {d[1], -d[0], 0};  // cross((0,0,-1), d)
+    const double axis_length = std::hypot(axis[0], axis[1]), angle = std::acos(-d[2]);
+    const double s = std::sin(angle / 2) / axis_length;
+    gltf["extensionsUsed"] = {"KHR_lights_punctual"};
+    gltf["extensions"]["KHR_lights_punctual"]["lights"] =
+        json::array({json{{"type", "directional"}, {"color", {1.0, 1.0, 1.0}}, {"intensity", 3.0}}});
+    gltf["nodes"].push_back({{"name", "Sun"},
+                             {"rotation", {axis[0] * s, axis[1] * s, axis[2] * s, std::cos(angle / 2)}},
+                             {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+    gltf["scenes"][0]["nodes"].push_back(2);
+  }
   json pbr = {{"baseColorFactor", {0.8, 0.8, 0.8, 1.0}}, {"metallicFactor", 0.0}};
   gltf["materials"] = json::array({json{{"pbrMetallicRoughness", pbr}}});
   gltf["accessors"] = accessors;
