@@ -4,6 +4,7 @@
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <string>
 #include <unordered_map>
 
@@ -19,50 +20,41 @@ bool is_colour_channel(const std::string& name) {
          (name.back() == 'R' || name.back() == 'G' || name.back() == 'B') && name != "error.Y";
 }
 
-// The pass in which dilate_into_gutter fills each texel: 0 covered, k >= 1 filled by pass k from
-// its 8 neighbours of passes < k, -1 never filled (left as it is).
-std::vector<int> dilation_passes(int width, int height, const std::vector<float>& coverage, int passes) {
-  std::vector<int> pass(coverage.size(), -1);
-  for (size_t i = 0; i < coverage.size(); ++i)
-    if (coverage[i] > 0) pass[i] = 0;
-  for (int k = 1; k <= passes; ++k) {
-    bool any = false;
-    for (int y = 0; y < height; ++y)
-      for (int x = 0; x < width; ++x) {
-        const size_t i = size_t(y) * size_t(width) + size_t(x);
-        if (pass[i] != -1) continue;
-        for (int dy = -1; dy <= 1 && pass[i] == -1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int nx = x + dx, ny = y + dy;
-            if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
-            const int p = pass[size_t(ny) * size_t(width) + size_t(nx)];
-            if (p != -1 && p < k) {
-              pass[i] = k;
-              any = true;
-              break;
-            }
-          }
-      }
-    if (!any) break;
-  }
-  return pass;
-}
-
 using TexelWeights = std::vector<std::pair<size_t, double>>;
 
 // A texel as a weighted sum of covered texels (itself if covered; the dilation's average of its
 // earlier-filled neighbours if not), memoized. A never-filled texel maps to itself: a constant.
+// dilate_into_gutter fills in pass k exactly the texels at Chebyshev distance k from the nearest
+// covered texel (8 neighbours per pass), so a texel's pass is found in the window around it
+// without running the dilation over the page.
 class DilationMap {
  public:
-  DilationMap(int width, int height, std::vector<int> pass) : width_(width), height_(height), pass_(std::move(pass)) {}
+  DilationMap(int width, int height, const std::vector<float>& coverage, int passes)
+      : width_(width), height_(height), coverage_(coverage), passes_(passes) {}
 
-  int pass(size_t texel) const { return pass_[texel]; }
+  // 0 covered, k in 1..passes filled by pass k, -1 never filled.
+  int pass(size_t texel) {
+    auto found = pass_memo_.find(texel);
+    if (found != pass_memo_.end()) return found->second;
+    const int x = int(texel % size_t(width_)), y = int(texel / size_t(width_));
+    int best = -1;
+    for (int dy = -passes_; dy <= passes_; ++dy)
+      for (int dx = -passes_; dx <= passes_; ++dx) {
+        const int nx = x + dx, ny = y + dy;
+        if (nx < 0 || ny < 0 || nx >= width_ || ny >= height_) continue;
+        if (!(coverage_[size_t(ny) * size_t(width_) + size_t(nx)] > 0)) continue;
+        const int distance = std::max(std::abs(dx), std::abs(dy));
+        if (best == -1 || distance < best) best = distance;
+      }
+    pass_memo_.emplace(texel, best);
+    return best;
+  }
 
   const TexelWeights& weights(size_t texel) {
     auto found = memo_.find(texel);
     if (found != memo_.end()) return found->second;
     TexelWeights result;
-    const int p = pass_[texel];
+    const int p = pass(texel);
     if (p <= 0) {
       result.push_back({texel, 1.0});
     } else {
@@ -73,7 +65,8 @@ class DilationMap {
           const int nx = x + dx, ny = y + dy;
           if (nx < 0 || ny < 0 || nx >= width_ || ny >= height_) continue;
           const size_t j = size_t(ny) * size_t(width_) + size_t(nx);
-          if (pass_[j] != -1 && pass_[j] < p) sources.push_back(j);
+          const int q = pass(j);
+          if (q != -1 && q < p) sources.push_back(j);
         }
       std::unordered_map<size_t, double> sum;
       for (size_t j : sources)
@@ -85,7 +78,9 @@ class DilationMap {
 
  private:
   int width_, height_;
-  std::vector<int> pass_;
+  const std::vector<float>& coverage_;
+  int passes_;
+  std::unordered_map<size_t, int> pass_memo_;
   std::unordered_map<size_t, TexelWeights> memo_;
 };
 
@@ -134,7 +129,7 @@ void solve_page(formats::LightmapImage& page, const PageSystem& system, double l
   identity.setIdentity();
   const Eigen::SparseMatrix<double> normal = Eigen::SparseMatrix<double>(r.transpose() * r) + lambda * identity;
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg;
-  cg.setTolerance(1e-10);
+  cg.setTolerance(1e-7);  // relative residual; the pages hold floats (24-bit mantissa)
   cg.setMaxIterations(10 * n + 100);
   cg.compute(normal);
   for (auto& [name, values] : page.channels) {
@@ -180,8 +175,7 @@ SeamStitchReport stitch_lightmap_seams(std::vector<formats::LightmapImage>& page
     formats::LightmapImage& page = pages[p];
     const auto coverage = page.channels.find("A");
     if (!page_has_samples[p] || coverage == page.channels.end()) continue;
-    DilationMap dilation(page.width, page.height,
-                         dilation_passes(page.width, page.height, coverage->second, settings.dilation_passes));
+    DilationMap dilation(page.width, page.height, coverage->second, settings.dilation_passes);
     const PageSystem system = page_system(page, samples, int(p), dilation);
     if (system.unknown_texel.empty()) continue;
     solve_page(page, system, settings.value_weight);
