@@ -22,7 +22,7 @@ struct SeamStitchSettings {
   // lambda, against a weight of 1 per sample: how much a texel holds to its own value. The seam
   // terms see only differences, so lambda alone fixes the sides' common level (at their values'
   // mean, whatever its size) and otherwise only leaves a remainder ~lambda/(lambda + 3/4) of each
-  // difference. Not 0, which would leave the system singular; 0.005 left 4-6 % of the discontinuity
+  // difference. Not 0, which would leave the system singular; 0.005 left 3-9 % of the discontinuity
   // on the benchmark sphere (0.02: 7-10 %, 0.001: 2-3 % at 3x the solve time; bench/results/seams.md).
   double value_weight = 0.005;
   int dilation_passes = 2;       // the assembly's gutter dilation (AssemblyOptions::dilation_texels)
