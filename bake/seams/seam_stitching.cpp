@@ -30,14 +30,14 @@ using TexelWeights = std::vector<std::pair<size_t, double>>;
 class DilationMap {
  public:
   DilationMap(int width, int height, const std::vector<float>& coverage, int passes)
-      : width_(width), height_(height), coverage_(coverage), passes_(passes) {}
+      : width_(width), height_(height), coverage_(coverage), passes_(std::max(0, passes)) {}
 
   // 0 covered, k in 1..passes filled by pass k, -1 never filled.
   int pass(size_t texel) {
     auto found = pass_memo_.find(texel);
     if (found != pass_memo_.end()) return found->second;
     const int x = int(texel % size_t(width_)), y = int(texel / size_t(width_));
-    int best = -1;
+    int best = coverage_[texel] > 0 ? 0 : -1;
     for (int dy = -passes_; dy <= passes_; ++dy)
       for (int dx = -passes_; dx <= passes_; ++dx) {
         const int nx = x + dx, ny = y + dy;

@@ -25,7 +25,7 @@ struct SeamStitchSettings {
   // difference. Not 0, which would leave the system singular; 0.005 left 3-9 % of the discontinuity
   // on the benchmark sphere (0.02: 7-10 %, 0.001: 2-3 % at 3x the solve time; bench/results/seams.md).
   double value_weight = 0.005;
-  int dilation_passes = 2;       // the assembly's gutter dilation (AssemblyOptions::dilation_texels)
+  int dilation_passes = 2;       // the assembly's gutter dilation (AssemblyOptions::dilation_texels), >= 0
 };
 
 struct SeamStitchReport {
