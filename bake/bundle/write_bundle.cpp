@@ -9,6 +9,8 @@
 
 #include "exitance/bake/bundle/bundle_preview.h"
 #include "exitance/bake/bundle/radiance_vdb.h"
+#include "exitance/bake/seams/seam_detection.h"
+#include "exitance/bake/seams/seam_stitching.h"
 #include "exitance/formats/lightmap_exr.h"
 #include "exitance/formats/probes_file.h"
 #include "exitance/formats/svo_file.h"
@@ -42,6 +44,28 @@ std::string write_preview_into_manifest(const fs::path& dir, const std::vector<f
   return manifest.stats_json;
 }
 
+// Seams (bake/seams/): found on the scene and the layout, stitched on the assembled pages (after
+// their gutter dilation, which the stitching repeats: seam_stitching.h says why). With --seams off
+// they are still found and measured, so the manifest shows what stitching would address.
+nlohmann::json stitch_seams_stage(std::vector<formats::LightmapImage>& pages, const BakeResults& results,
+                                  int dilation_passes, const BakeOptions& options) {
+  options.announce_stage("seams");
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<SeamEdge> seams = find_lightmap_seams(results.scene, results.layout);
+  SeamStitchSettings settings;
+  settings.dilation_passes = dilation_passes;
+  const SeamStitchReport report = options.stitch_seams ? stitch_lightmap_seams(pages, seams, settings)
+                                                       : measure_lightmap_seams(pages, seams, settings);
+  return {{"mode", options.stitch_seams ? "stitch" : "off"},
+          {"edges", report.edges},
+          {"samples", report.samples},
+          {"texels_adjusted", report.texels_adjusted},
+          {"discontinuity_before", report.discontinuity_before},
+          {"discontinuity_after", report.discontinuity_after},
+          {"texel_relative_error", report.texel_relative_error},
+          {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};
+}
+
 }  // namespace
 
 WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::json& seconds,
@@ -50,11 +74,17 @@ WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::jso
   AssemblyOptions assembly;
   assembly.bounce_layers = options.bounce_layers;
   assembly.dilation_texels = std::max(2, options.atlas.padding * 2);
-  const std::vector<formats::LightmapImage> pages =
+  std::vector<formats::LightmapImage> pages =
       assemble_lightmap_pages(results.gbuffer, results.lightmap, assembly,
                               results.sealed && results.sealed_skipped ? results.sealed->sealed : std::vector<uint8_t>{});
-  const formats::BundleManifest manifest = build_bundle_manifest(
+  const nlohmann::json seams = stitch_seams_stage(pages, results, assembly.dilation_texels, options);
+  formats::BundleManifest manifest = build_bundle_manifest(
       results, pages, results.input_sha256, seconds, diagnostics.warnings.size(), options);
+  {
+    nlohmann::json stats = nlohmann::json::parse(manifest.stats_json);
+    stats["seams"] = seams;
+    manifest.stats_json = stats.dump();
+  }
   const std::string manifest_text = formats::write_bundle_manifest(manifest);
 
   std::string stats_json = manifest.stats_json;

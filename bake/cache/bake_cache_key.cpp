@@ -71,7 +71,7 @@ void hash_options(Sha256Stream& h, const BakeOptions& o) {
   h.value(l.guiding_grid_cells), h.value(l.adaptive), h.value(o.adaptive_request);
   h.value(o.bounce_layers), h.value(o.probes_enabled), h.value(o.probe_spacing), h.value(o.probe_spp);
   h.value(o.probe_sh_window), h.value(o.svo_enabled), h.value(o.voxel_resolution);
-  h.value(o.skip_sealed_texels);
+  h.value(o.skip_sealed_texels), h.value(o.stitch_seams);
   h.value(o.preview), h.value(o.preview_size);
 }
 

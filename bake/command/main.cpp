@@ -82,6 +82,10 @@ int main(int argc, char** argv) {
   app.add_flag("--no-skip", no_skip,
                "trace the sealed texels too (those no light can reach; skipped and dilated by default), to measure "
                "what skipping them changes");
+  std::string seams = "stitch";
+  app.add_option("--seams", seams,
+                 "stitch (default: least-squares stitching of the texels on both sides of lightmap UV seams) | off")
+      ->check(CLI::IsMember({"stitch", "off"}));
   std::string probes = "auto", voxels = "auto", directional, guiding = "auto";
   app.add_option("--probes", probes, "light-probe grid spacing in scene units, auto (largest extent / 12) or none");
   app.add_option("--probe-spp", options.probe_spp, "rays per light probe")->check(CLI::Range(1u, 1u << 24));
@@ -209,6 +213,7 @@ int main(int argc, char** argv) {
   }
   options.skip_sealed_texels = !no_skip;
   options.lighting.sampler = sampler == "independent" ? exitance::kSamplerIndependent : exitance::kSamplerSobol;
+  options.stitch_seams = seams == "stitch";
   if (!directional.empty()) diagnostics.warn("--directional: directional lightmaps are not implemented yet; ignored");
   if (guiding == "svo") {
     std::cerr << "bake: error: --guiding svo is not implemented yet (use grid or off)\n";

@@ -46,6 +46,8 @@ struct BakeOptions {
   // --preview: PNGs of the pages and default views in OUT/preview/ (bake/bundle/bundle_preview.h),
   // views preview_size pixels wide.
   bool preview = false;
+  // --seams stitch|off: least-squares seam stitching of the lightmap pages (bake/seams/).
+  bool stitch_seams = true;
   uint32_t preview_size = 512;
   // The bundle cache (bake/cache/bundle_cache.h): a folder, or empty for none. Empty by default
   // here; the bake command defaults to .exitance-cache beside OUT (--cache DIR, --no-cache).

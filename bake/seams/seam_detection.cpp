@@ -1,0 +1,119 @@
+#include "exitance/bake/seams/seam_detection.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <unordered_map>
+
+#include "exitance/runtime/texel_surface.h"
+
+namespace exitance {
+namespace {
+
+// Welds corners by position: a grid of cells one tolerance wide, each corner joined to an earlier
+// point within the tolerance in its own or a neighbouring cell.
+class PositionWeld {
+ public:
+  explicit PositionWeld(float tolerance) : tolerance_(tolerance) {}
+
+  uint32_t id(Vec3 p) {
+    const std::array<int64_t, 3> cell = cell_of(p);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          auto found = cells_.find(key({cell[0] + dx, cell[1] + dy, cell[2] + dz}));
+          if (found == cells_.end()) continue;
+          for (uint32_t candidate : found->second)
+            if (length(points_[candidate] - p) <= tolerance_) return candidate;
+        }
+    points_.push_back(p);
+    cells_[key(cell)].push_back(uint32_t(points_.size() - 1));
+    return uint32_t(points_.size() - 1);
+  }
+
+ private:
+  std::array<int64_t, 3> cell_of(Vec3 p) const {
+    return {int64_t(std::floor(p.x / tolerance_)), int64_t(std::floor(p.y / tolerance_)),
+            int64_t(std::floor(p.z / tolerance_))};
+  }
+  static uint64_t key(const std::array<int64_t, 3>& c) {
+    return (uint64_t(c[0]) * 73856093u) ^ (uint64_t(c[1]) * 19349663u) ^ (uint64_t(c[2]) * 83492791u);
+  }
+
+  float tolerance_;
+  std::vector<Vec3> points_;
+  std::unordered_map<uint64_t, std::vector<uint32_t>> cells_;
+};
+
+// One triangle's edge from corner `from` to corner `to` (indices into the scene's corner arrays).
+struct HalfEdge {
+  size_t from, to;
+};
+
+bool normals_agree(Vec3 a, Vec3 b, float min_cosine) { return dot(a, b) >= min_cosine * length(a) * length(b); }
+
+float distance(Vec2 a, Vec2 b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+}  // namespace
+
+std::vector<SeamEdge> find_lightmap_seams(const Scene& scene, const AtlasLayout& layout,
+                                          const SeamDetectionSettings& settings) {
+  const float min_cosine = std::cos(settings.max_normal_angle_degrees * 3.14159265358979f / 180.0f);
+  std::vector<SeamEdge> seams;
+  for (size_t i = 0; i < scene.instances.size() && i < layout.rects.size(); ++i) {
+    const Instance& instance = scene.instances[i];
+    const InstanceRect& rect = layout.rects[i];
+    if (instance.triangle_count == 0 || size_t(rect.page) >= layout.page_sizes.size()) continue;
+    const auto [page_width, page_height] = layout.page_sizes[size_t(rect.page)];
+    const size_t first_corner = size_t(instance.first_triangle) * 3;
+    const size_t end_corner = first_corner + size_t(instance.triangle_count) * 3;
+    Vec3 lo = scene.positions[first_corner], hi = lo;
+    for (size_t c = first_corner; c < end_corner; ++c) lo = min(lo, scene.positions[c]), hi = max(hi, scene.positions[c]);
+    const float diagonal = length(hi - lo);
+    if (!(diagonal > 0)) continue;
+    PositionWeld weld(settings.weld_tolerance * diagonal);
+    std::vector<uint32_t> welded(end_corner - first_corner);
+    for (size_t c = first_corner; c < end_corner; ++c) welded[c - first_corner] = weld.id(scene.positions[c]);
+    std::vector<Vec2> texel(end_corner - first_corner);
+    for (uint32_t t = instance.first_triangle; t < instance.first_triangle + instance.triangle_count; ++t) {
+      Vec2 tri[3];
+      chart_triangle_in_texels(scene, t, rect.scale_offset, page_width, page_height, tri);
+      for (int k = 0; k < 3; ++k) texel[size_t(t) * 3 + size_t(k) - first_corner] = tri[k];
+    }
+    // Undirected welded edge -> the half-edges on it (ordered map: the output order is deterministic).
+    std::map<std::pair<uint32_t, uint32_t>, std::vector<HalfEdge>> edges;
+    for (size_t t = instance.first_triangle; t < size_t(instance.first_triangle) + instance.triangle_count; ++t)
+      for (size_t k = 0; k < 3; ++k) {
+        const size_t from = t * 3 + k, to = t * 3 + (k + 1) % 3;
+        const uint32_t a = welded[from - first_corner], b = welded[to - first_corner];
+        if (a == b) continue;  // degenerate edge
+        edges[{std::min(a, b), std::max(a, b)}].push_back({from, to});
+      }
+    for (const auto& entry : edges) {
+      const std::vector<HalfEdge>& pair = entry.second;
+      if (pair.size() != 2) continue;  // a border, or non-manifold
+      const HalfEdge e0 = pair[0];
+      // The second half-edge's corners in the order of the first's 3-D endpoints.
+      HalfEdge e1 = pair[1];
+      if (welded[e1.from - first_corner] != welded[e0.from - first_corner]) std::swap(e1.from, e1.to);
+      const Vec2 a0 = texel[e0.from - first_corner], a1 = texel[e0.to - first_corner];
+      const Vec2 b0 = texel[e1.from - first_corner], b1 = texel[e1.to - first_corner];
+      const float tol = settings.same_uv_tolerance_texels;
+      if (distance(a0, b0) <= tol && distance(a1, b1) <= tol) continue;  // one edge in the atlas too
+      if (!(distance(a0, a1) > tol) || !(distance(b0, b1) > tol)) continue;  // collapsed in UV
+      if (!normals_agree(scene.normals[e0.from], scene.normals[e1.from], min_cosine) ||
+          !normals_agree(scene.normals[e0.to], scene.normals[e1.to], min_cosine))
+        continue;  // a hard edge
+      SeamEdge seam;
+      seam.instance = uint32_t(i);
+      seam.page = rect.page;
+      seam.side_a[0] = a0, seam.side_a[1] = a1;
+      seam.side_b[0] = b0, seam.side_b[1] = b1;
+      seams.push_back(seam);
+    }
+  }
+  return seams;
+}
+
+}  // namespace exitance

@@ -1,0 +1,192 @@
+#include "exitance/bake/seams/seam_stitching.h"
+
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseCore>
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+#include <unordered_map>
+
+#include "exitance/bake/seams/seam_discontinuity.h"
+#include "exitance/runtime/bundle/lightmap_assembly.h"
+
+namespace exitance {
+namespace {
+
+bool is_colour_channel(const std::string& name) {
+  if (name == "R" || name == "G" || name == "B") return true;
+  return name.size() > 2 && name[name.size() - 2] == '.' &&
+         (name.back() == 'R' || name.back() == 'G' || name.back() == 'B') && name != "error.Y";
+}
+
+using TexelWeights = std::vector<std::pair<size_t, double>>;
+
+// A texel as a weighted sum of covered texels (itself if covered; the dilation's average of its
+// earlier-filled neighbours if not), memoized. A never-filled texel maps to itself: a constant.
+// dilate_into_gutter fills in pass k exactly the texels at Chebyshev distance k from the nearest
+// covered texel (8 neighbours per pass), so a texel's pass is found in the window around it
+// without running the dilation over the page.
+class DilationMap {
+ public:
+  DilationMap(int width, int height, const std::vector<float>& coverage, int passes)
+      : width_(width), height_(height), coverage_(coverage), passes_(std::max(0, passes)) {}
+
+  // 0 covered, k in 1..passes filled by pass k, -1 never filled.
+  int pass(size_t texel) {
+    auto found = pass_memo_.find(texel);
+    if (found != pass_memo_.end()) return found->second;
+    const int x = int(texel % size_t(width_)), y = int(texel / size_t(width_));
+    int best = coverage_[texel] > 0 ? 0 : -1;
+    for (int dy = -passes_; dy <= passes_; ++dy)
+      for (int dx = -passes_; dx <= passes_; ++dx) {
+        const int nx = x + dx, ny = y + dy;
+        if (nx < 0 || ny < 0 || nx >= width_ || ny >= height_) continue;
+        if (!(coverage_[size_t(ny) * size_t(width_) + size_t(nx)] > 0)) continue;
+        const int distance = std::max(std::abs(dx), std::abs(dy));
+        if (best == -1 || distance < best) best = distance;
+      }
+    pass_memo_.emplace(texel, best);
+    return best;
+  }
+
+  const TexelWeights& weights(size_t texel) {
+    auto found = memo_.find(texel);
+    if (found != memo_.end()) return found->second;
+    TexelWeights result;
+    const int p = pass(texel);
+    if (p <= 0) {
+      result.push_back({texel, 1.0});
+    } else {
+      const int x = int(texel % size_t(width_)), y = int(texel / size_t(width_));
+      std::vector<size_t> sources;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int nx = x + dx, ny = y + dy;
+          if (nx < 0 || ny < 0 || nx >= width_ || ny >= height_) continue;
+          const size_t j = size_t(ny) * size_t(width_) + size_t(nx);
+          const int q = pass(j);
+          if (q != -1 && q < p) sources.push_back(j);
+        }
+      std::unordered_map<size_t, double> sum;
+      for (size_t j : sources)
+        for (const auto& [covered, w] : weights(j)) sum[covered] += w / double(sources.size());
+      result.assign(sum.begin(), sum.end());
+    }
+    return memo_.emplace(texel, std::move(result)).first->second;
+  }
+
+ private:
+  int width_, height_;
+  const std::vector<float>& coverage_;
+  int passes_;
+  std::unordered_map<size_t, int> pass_memo_;
+  std::unordered_map<size_t, TexelWeights> memo_;
+};
+
+// One page's least-squares system: rows = seam samples, columns = covered texels in footprints.
+struct PageSystem {
+  std::vector<size_t> unknown_texel;                  // column -> texel
+  std::vector<Eigen::Triplet<double>> row_terms;      // on unknowns
+  std::vector<std::vector<std::pair<size_t, double>>> row_constants;  // on never-filled texels
+  size_t rows = 0;
+};
+
+PageSystem page_system(const formats::LightmapImage& page, const std::vector<SeamSample>& samples, int page_index,
+                       DilationMap& dilation) {
+  PageSystem system;
+  std::unordered_map<size_t, size_t> column_of;
+  for (const SeamSample& s : samples) {
+    if (s.page != page_index) continue;
+    std::unordered_map<size_t, double> row, constants;
+    for (int side = 0; side < 2; ++side) {
+      const BilinearTaps taps = bilinear_taps(page.width, page.height, side == 0 ? s.side_a : s.side_b);
+      const double sign = side == 0 ? 1.0 : -1.0;
+      for (size_t k = 0; k < 4; ++k) {
+        if (taps.weight[k] == 0) continue;
+        for (const auto& [texel, w] : dilation.weights(taps.texel[k]))
+          (dilation.pass(texel) == 0 ? row : constants)[texel] += sign * taps.weight[k] * w;
+      }
+    }
+    for (const auto& [texel, w] : row) {
+      auto [it, inserted] = column_of.emplace(texel, system.unknown_texel.size());
+      if (inserted) system.unknown_texel.push_back(texel);
+      system.row_terms.emplace_back(int(system.rows), int(it->second), w);
+    }
+    system.row_constants.emplace_back(constants.begin(), constants.end());
+    ++system.rows;
+  }
+  return system;
+}
+
+// Solves (R^T R + lambda I) x = lambda x0 - R^T c for each colour channel and writes x back.
+void solve_page(formats::LightmapImage& page, const PageSystem& system, double lambda) {
+  const int n = int(system.unknown_texel.size());
+  if (n == 0) return;
+  Eigen::SparseMatrix<double> r(int(system.rows), n);
+  r.setFromTriplets(system.row_terms.begin(), system.row_terms.end());
+  Eigen::SparseMatrix<double> identity(n, n);
+  identity.setIdentity();
+  const Eigen::SparseMatrix<double> normal = Eigen::SparseMatrix<double>(r.transpose() * r) + lambda * identity;
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg;
+  cg.setTolerance(1e-7);  // relative residual; the pages hold floats (24-bit mantissa)
+  cg.setMaxIterations(10 * n + 100);
+  cg.compute(normal);
+  for (auto& [name, values] : page.channels) {
+    if (!is_colour_channel(name)) continue;
+    Eigen::VectorXd x0(n), c(int(system.rows));
+    for (int j = 0; j < n; ++j) x0[j] = values[system.unknown_texel[size_t(j)]];
+    for (size_t row = 0; row < system.rows; ++row) {
+      double sum = 0;
+      for (const auto& [texel, w] : system.row_constants[row]) sum += w * values[texel];
+      c[int(row)] = sum;
+    }
+    const Eigen::VectorXd rhs = lambda * x0 - r.transpose() * c;
+    const Eigen::VectorXd x = cg.solveWithGuess(rhs, x0);
+    if (cg.info() != Eigen::Success || !x.allFinite()) continue;  // keep the unstitched values
+    // Irradiance is never negative: a texel that was not keeps to >= 0 (the solve can overshoot
+    // where a bright texel's footprint neighbours a dark one).
+    for (int j = 0; j < n; ++j) values[system.unknown_texel[size_t(j)]] = float(x0[j] >= 0 ? std::max(0.0, x[j]) : x[j]);
+  }
+}
+
+}  // namespace
+
+SeamStitchReport measure_lightmap_seams(const std::vector<formats::LightmapImage>& pages,
+                                        const std::vector<SeamEdge>& seams, const SeamStitchSettings& settings) {
+  SeamStitchReport report;
+  report.edges = seams.size();
+  const std::vector<SeamSample> samples = seam_samples(seams, settings.samples_per_texel);
+  report.samples = samples.size();
+  const SeamDiscontinuity measured = measure_seam_discontinuity(pages, samples);
+  report.discontinuity_before = report.discontinuity_after = measured.mean_relative_difference;
+  report.texel_relative_error = measured.mean_texel_relative_error;
+  return report;
+}
+
+SeamStitchReport stitch_lightmap_seams(std::vector<formats::LightmapImage>& pages, const std::vector<SeamEdge>& seams,
+                                       const SeamStitchSettings& settings) {
+  SeamStitchReport report = measure_lightmap_seams(pages, seams, settings);
+  const std::vector<SeamSample> samples = seam_samples(seams, settings.samples_per_texel);
+  std::vector<bool> page_has_samples(pages.size(), false);
+  for (const SeamSample& s : samples)
+    if (size_t(s.page) < pages.size()) page_has_samples[size_t(s.page)] = true;
+  for (size_t p = 0; p < pages.size(); ++p) {
+    formats::LightmapImage& page = pages[p];
+    const auto coverage = page.channels.find("A");
+    if (!page_has_samples[p] || coverage == page.channels.end()) continue;
+    DilationMap dilation(page.width, page.height, coverage->second, settings.dilation_passes);
+    const PageSystem system = page_system(page, samples, int(p), dilation);
+    if (system.unknown_texel.empty()) continue;
+    solve_page(page, system, settings.value_weight);
+    report.texels_adjusted += system.unknown_texel.size();
+    std::vector<float*> colour;
+    for (auto& [name, values] : page.channels)
+      if (is_colour_channel(name)) colour.push_back(values.data());
+    dilate_into_gutter(page.width, page.height, coverage->second, colour, settings.dilation_passes);
+  }
+  report.discontinuity_after = measure_seam_discontinuity(pages, samples).mean_relative_difference;
+  return report;
+}
+
+}  // namespace exitance
