@@ -42,8 +42,8 @@ for n in $SAMPLES; do
   read -r vs ratio < <("$COMPARE" "$PAGE" "$PAGE" "$OUT/cycles-$n-1-0.pfm" | sed -n 's/.*rel_mse \([^ ]*\) mean_ratio \(.*\)/\1 \2/p')
   echo "cycles,path,$n,${times[0]},${times[1]},$noise,$vs,$ratio"
   budget=$(python3 -c "print(min(float('${times[0]}'), float('${times[1]}')))")
-  for config in "uniform:--adaptive off" "adaptive:--adaptive on" "guided:--adaptive off --guiding grid" \
-                "adaptive-guided:--adaptive on --guiding grid" "bounces:--integrator bounces"; do
+  for config in "uniform-independent:--adaptive off --sampler independent" "uniform:--adaptive off" \
+                "adaptive:--adaptive on" "adaptive-guided:--adaptive on --guiding grid" "bounces:--integrator bounces"; do
     name=${config%%:*}
     read -r -a flags <<<"${config#*:}"
     secs=()

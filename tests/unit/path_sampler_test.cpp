@@ -28,6 +28,20 @@ TEST(PathSampler, BitReverseMatchesTheDefinition) {
   }
 }
 
+// The closed form of the second Sobol dimension equals its definition: direction numbers v_0 = 1/2,
+// v_{k+1} = v_k ^ (v_k >> 1), XORed for the index's set bits.
+TEST(PathSampler, SecondSobolDimensionMatchesItsDirectionNumbers) {
+  uint x = 12345u;
+  for (int n = 0; n < 20000; ++n) {
+    x = hash_u32(x + uint(n));
+    const uint index = n < 1000 ? uint(n) : x;
+    uint expected = 0, v = 1u << 31;
+    for (uint i = index; i != 0; i >>= 1, v ^= v >> 1)
+      if (i & 1u) expected ^= v;
+    ASSERT_EQ(sobol_second_dimension(index), expected) << "index " << index;
+  }
+}
+
 // Across items (texels) one dimension is uniform: 64 bins, 64 k items, 5 standard deviations.
 TEST(PathSampler, EveryDimensionIsUniformAcrossItems) {
   for (uint mode : {kSamplerSobol, kSamplerIndependent}) {
