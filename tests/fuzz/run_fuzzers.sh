@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # run_fuzzers.sh [SECONDS]: builds the libFuzzer targets with clang++ in build-fuzz/, seeds a corpus
-# with valid files from the writers, and runs each fuzzer (probes.bin, svo.bin, scene.bin,
-# manifest.json, EDITS.json) for SECONDS (default 30); EXITANCE_FUZZERS="scene" runs only the ones named. Exits non-zero if any fuzzer finds a crash, a sanitizer error, an escaped
+# with valid files from the writers (and, for the glTF importer, the hostile files of tests/badinput),
+# and runs each fuzzer (probes.bin, svo.bin, scene.bin, manifest.json, EDITS.json, glTF/GLB) for SECONDS (default 30); EXITANCE_FUZZERS="scene" runs only the ones named. Exits non-zero if any fuzzer finds a crash, a sanitizer error, an escaped
 # exception or a timeout; the failing input is left in build-fuzz/artifacts/.
 # Needs clang and libclang-rt-14-dev (scripts/install-deps.sh).
 set -euo pipefail
@@ -15,12 +15,14 @@ cmake -S "$root/tests/fuzz" -B "$build" "${generator[@]}" -DCMAKE_CXX_COMPILER=c
 cmake --build "$build" -j"$(nproc)"
 rm -rf "$build/seeds"
 "$build/write_fuzz_seeds" "$build/seeds"
+mkdir -p "$build/seeds/gltf"
+cp "$root"/tests/badinput/hostile/*.gltf "$root"/tests/badinput/hostile/*.glb "$build/seeds/gltf/" 2>/dev/null || true
 mkdir -p "$build/artifacts"
 
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 failed=()
-for reader in ${EXITANCE_FUZZERS:-probes svo scene manifest edits}; do
+for reader in ${EXITANCE_FUZZERS:-probes svo scene manifest edits gltf}; do
   corpus="$build/corpus/$reader"  # kept between runs so each run starts where the last one stopped
   mkdir -p "$corpus"
   options=(-max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1
@@ -38,4 +40,4 @@ if [ "${#failed[@]}" -ne 0 ]; then
   echo "fuzzers failed: ${failed[*]} (inputs in $build/artifacts/)"
   exit 1
 fi
-echo "fuzzers ran clean: ${EXITANCE_FUZZERS:-probes svo scene manifest edits}, ${seconds}s each"
+echo "fuzzers ran clean: ${EXITANCE_FUZZERS:-probes svo scene manifest edits gltf}, ${seconds}s each"
