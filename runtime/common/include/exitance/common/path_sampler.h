@@ -69,10 +69,12 @@ EXITANCE_FN uint superset_parity(uint x) {
 // (which, for a shuffled index, are all 32 and cost a sixth of a CPU bake).
 EXITANCE_FN uint sobol_second_dimension(uint index) { return bitfieldReverse(superset_parity(index)); }
 
-// The index shuffled by a nested uniform scramble, kept in bit-reversed form, which is also its
-// first Sobol dimension (van der Corput): bitfieldReverse(nested_uniform_scramble(index, seed)).
-EXITANCE_FN uint shuffled_first_dimension(uint index, uint seed) {
-  return laine_karras_permutation(bitfieldReverse(index), seed);
+// An Owen-scrambled 0.32 fixed-point number given by its digits in bit-reversed order:
+// nested_uniform_scramble(bitfieldReverse(reversed_digits), seed) with two reversals cancelled. The
+// Sobol dimensions come this way: the first's reversed digits are the index itself, the second's are
+// superset_parity(index).
+EXITANCE_FN uint scrambled_from_reversed_digits(uint reversed_digits, uint seed) {
+  return bitfieldReverse(laine_karras_permutation(reversed_digits, seed));
 }
 
 EXITANCE_FN float fixed_point_to_unit(uint x) { return float(x >> 8u) * (1.0f / 16777216.0f); }
@@ -97,13 +99,11 @@ EXITANCE_FN uint next_dimension_seed(INOUT(PathSampler) s) {
 EXITANCE_FN float sample_1d(INOUT(PathSampler) s) {
   uint seed = next_dimension_seed(s);
   if (s.mode == kSamplerIndependent) return fixed_point_to_unit(hash_u32(seed ^ hash_u32(s.index)));
-  // Owen-scrambled van der Corput (bitfieldReverse) at a shuffled index. The shuffle is what keeps two
-  // dimensions independent: scrambled copies of one sequence at the same index share its digits up to
-  // a flip (the first bit of every dimension would be index & 1, flipped or not).
-  // nested_uniform_scramble(first, seed') = bitfieldReverse(laine_karras_permutation(shuffled, seed')):
-  // written out so each draw reverses bits three times, not five.
-  uint shuffled = bitfieldReverse(shuffled_first_dimension(s.index, seed));
-  return fixed_point_to_unit(bitfieldReverse(laine_karras_permutation(shuffled, hash_u32(seed ^ 0x68E31DA4u))));
+  // Owen-scrambled van der Corput (Sobol's first dimension) at a shuffled index. The shuffle is what
+  // keeps two dimensions independent: scrambled copies of one sequence at the same index share its
+  // digits up to a flip (the first bit of every dimension would be index & 1, flipped or not).
+  uint shuffled = nested_uniform_scramble(s.index, seed);
+  return fixed_point_to_unit(scrambled_from_reversed_digits(shuffled, hash_u32(seed ^ 0x68E31DA4u)));
 }
 
 // Uniform on [0, 1)^2; one dimension of the stream.
@@ -113,10 +113,9 @@ EXITANCE_FN vec2 sample_2d(INOUT(PathSampler) s) {
     uint h = hash_u32(seed ^ hash_u32(s.index));
     return vec2(fixed_point_to_unit(h), fixed_point_to_unit(hash_u32(h ^ 0x85EBCA6Bu)));
   }
-  uint shuffled = bitfieldReverse(shuffled_first_dimension(s.index, seed));
-  uint x = bitfieldReverse(laine_karras_permutation(shuffled, hash_u32(seed ^ 0x68E31DA4u)));
-  // nested_uniform_scramble(sobol_second_dimension(shuffled), seed'), its bit reversals cancelled.
-  uint y = bitfieldReverse(laine_karras_permutation(superset_parity(shuffled), hash_u32(seed ^ 0xB5297A4Du)));
+  uint shuffled = nested_uniform_scramble(s.index, seed);
+  uint x = scrambled_from_reversed_digits(shuffled, hash_u32(seed ^ 0x68E31DA4u));
+  uint y = scrambled_from_reversed_digits(superset_parity(shuffled), hash_u32(seed ^ 0xB5297A4Du));
   return vec2(fixed_point_to_unit(x), fixed_point_to_unit(y));
 }
 
