@@ -34,6 +34,7 @@
 #include <iostream>
 
 #include "exitance/runtime/embree_scene.h"
+#include "rel_mse_weight.h"
 #include "exitance/runtime/core/grid_guiding_cache.h"
 #include "exitance/common/path_sampler.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
@@ -49,8 +50,6 @@ namespace {
 struct ErrorFigures {
   double rel_mse = 0, mae = 0, worst = 0;
 };
-
-double rel_mse_weight(double reference) { return 1.0 / (reference * reference + 1e-3); }
 
 ErrorFigures compare(const std::vector<float>& x, const std::vector<float>& reference) {
   ErrorFigures e;

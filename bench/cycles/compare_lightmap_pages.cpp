@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "exitance/formats/lightmap_exr.h"
+#include "../rel_mse_weight.h"
 
 namespace {
 
@@ -72,7 +73,7 @@ int main(int argc, char** argv) {
         for (int c = 0; c < 3; ++c) {
           const double x = test.rgb[3 * i + c], r = reference.rgb[3 * i + c];
           const double d = pair ? x - other.rgb[3 * i + c] : x - r;
-          rel_mse += d * d / ((pair ? 2.0 : 1.0) * (r * r + 1e-3));
+          rel_mse += d * d * rel_mse_weight(r) / (pair ? 2.0 : 1.0);
           sum_x += x, sum_r += r;
         }
       }
