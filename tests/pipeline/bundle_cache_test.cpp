@@ -17,6 +17,7 @@
 #include "exitance/bake/command/bake_pipeline.h"
 #include "scene_builder.h"
 #include "support/fresh_temp_dir.h"
+#include "support/small_cached_bake_options.h"
 
 namespace exitance {
 namespace {
@@ -44,18 +45,6 @@ fs::path write_lit_floor(const fs::path& dir, float intensity) {
   return path;
 }
 
-BakeOptions options_for(const fs::path& input, const fs::path& out, const fs::path& cache) {
-  BakeOptions options;
-  options.input = input.string();
-  options.output = out.string();
-  options.cache_directory = cache.string();
-  options.backend.name = "cpu";
-  options.atlas.texel_density = 8;
-  options.lighting.spp = 4;
-  options.probe_spp = 16;
-  return options;
-}
-
 std::map<std::string, std::string> file_hashes(const fs::path& folder) {
   std::map<std::string, std::string> hashes;
   for (const auto& e : fs::directory_iterator(folder)) hashes[e.path().filename().string()] = sha256_of_file(e.path().string());
@@ -76,8 +65,8 @@ TEST(BundleCache, SecondBakeReusesTheFirstFileForFile) {
   const fs::path dir = testing::fresh_temp_dir("cache-reuse");
   const fs::path input = write_lit_floor(dir, 5);
   Diagnostics first_diagnostics, second_diagnostics;
-  const json first = run_bake(options_for(input, dir / "a.bake", dir / "cache"), first_diagnostics);
-  const json second = run_bake(options_for(input, dir / "b.bake", dir / "cache"), second_diagnostics);
+  const json first = run_bake(small_cached_bake_options(input, dir / "a.bake", dir / "cache"), first_diagnostics);
+  const json second = run_bake(small_cached_bake_options(input, dir / "b.bake", dir / "cache"), second_diagnostics);
   EXPECT_FALSE(reused(first));
   EXPECT_TRUE(reused(second));
   EXPECT_EQ(first["cache"]["key"], second["cache"]["key"]);
@@ -99,12 +88,12 @@ TEST(BundleCache, AChangedLightOptionOrSeedIsANewBake) {
   const fs::path dir = testing::fresh_temp_dir("cache-changes");
   const fs::path cache = dir / "cache";
   Diagnostics d;
-  const json base = run_bake(options_for(write_lit_floor(dir, 5), dir / "a.bake", cache), d);
-  const json light = run_bake(options_for(write_lit_floor(dir, 6), dir / "b.bake", cache), d);
-  BakeOptions seeded = options_for(write_lit_floor(dir, 5), dir / "c.bake", cache);
+  const json base = run_bake(small_cached_bake_options(write_lit_floor(dir, 5), dir / "a.bake", cache), d);
+  const json light = run_bake(small_cached_bake_options(write_lit_floor(dir, 6), dir / "b.bake", cache), d);
+  BakeOptions seeded = small_cached_bake_options(write_lit_floor(dir, 5), dir / "c.bake", cache);
   seeded.lighting.seed = 1;
   const json seed = run_bake(seeded, d);
-  BakeOptions denser = options_for(write_lit_floor(dir, 5), dir / "d.bake", cache);
+  BakeOptions denser = small_cached_bake_options(write_lit_floor(dir, 5), dir / "d.bake", cache);
   denser.atlas.texel_density = 9;
   const json density = run_bake(denser, d);
   for (const json* r : {&light, &seed, &density}) {
@@ -119,7 +108,7 @@ TEST(BundleCache, DamagedEntriesAreRebuiltNeverTrusted) {
   const fs::path dir = testing::fresh_temp_dir("cache-damaged");
   const fs::path input = write_lit_floor(dir, 5), cache = dir / "cache";
   Diagnostics d;
-  run_bake(options_for(input, dir / "a.bake", cache), d);
+  run_bake(small_cached_bake_options(input, dir / "a.bake", cache), d);
   ASSERT_EQ(entries(cache).size(), 1u);
   const fs::path entry = entries(cache)[0];
   // Each damage in turn: a flipped byte, a truncation, an unlisted file, a broken entry.json.
@@ -137,13 +126,13 @@ TEST(BundleCache, DamagedEntriesAreRebuiltNeverTrusted) {
     SCOPED_TRACE("damage " + std::to_string(k));
     damages[k]();
     Diagnostics damaged;
-    const json rebuilt = run_bake(options_for(input, dir / "b.bake", cache), damaged);
+    const json rebuilt = run_bake(small_cached_bake_options(input, dir / "b.bake", cache), damaged);
     EXPECT_FALSE(reused(rebuilt));
     bool warned = false;
     for (const std::string& w : damaged.warnings) warned = warned || w.find("rebuilding it") != std::string::npos;
     EXPECT_TRUE(warned);
     Diagnostics again;
-    EXPECT_TRUE(reused(run_bake(options_for(input, dir / "c.bake", cache), again))) << "the rebuilt entry is used";
+    EXPECT_TRUE(reused(run_bake(small_cached_bake_options(input, dir / "c.bake", cache), again))) << "the rebuilt entry is used";
   }
   fs::remove_all(dir);
 }
@@ -156,13 +145,13 @@ TEST(BundleCache, TwoBakesStoringOneKeyAtOnceLeaveOneIntactEntry) {
   for (int i = 0; i < 2; ++i)
     threads[i] = std::thread([&, i] {
       Diagnostics d;
-      reports[i] = run_bake(options_for(input, dir / ("out" + std::to_string(i)), cache), d);
+      reports[i] = run_bake(small_cached_bake_options(input, dir / ("out" + std::to_string(i)), cache), d);
     });
   for (auto& t : threads) t.join();
   EXPECT_EQ(reports[0]["cache"]["key"], reports[1]["cache"]["key"]);
   ASSERT_EQ(entries(cache).size(), 1u) << "no staging folder left behind";
   Diagnostics d;
-  const json third = run_bake(options_for(input, dir / "out2", cache), d);
+  const json third = run_bake(small_cached_bake_options(input, dir / "out2", cache), d);
   EXPECT_TRUE(reused(third));
   EXPECT_TRUE(d.warnings.empty() || d.warnings.back().find("rebuilding") == std::string::npos);
   fs::remove_all(dir);
@@ -172,7 +161,7 @@ TEST(BundleCache, AFailedBakeStoresNothing) {
   const fs::path dir = testing::fresh_temp_dir("cache-failed");
   const fs::path input = write_lit_floor(dir, 5), cache = dir / "cache";
   std::ofstream(dir / "blocker") << "a file where the output's parent folder should be";
-  const BakeOptions options = options_for(input, dir / "blocker" / "a.bake", cache);
+  const BakeOptions options = small_cached_bake_options(input, dir / "blocker" / "a.bake", cache);
   Diagnostics d;
   EXPECT_THROW(run_bake(options, d), std::exception);  // every stage ran; the write failed
   EXPECT_TRUE(entries(cache).empty());

@@ -16,6 +16,7 @@
 #include "exitance/bake/command/bake_pipeline.h"
 #include "scene_builder.h"
 #include "support/fresh_temp_dir.h"
+#include "support/small_cached_bake_options.h"
 
 namespace exitance {
 namespace {
@@ -65,18 +66,6 @@ fs::path write_scene(const fs::path& dir, const Edit& edit) {
   return path;
 }
 
-BakeOptions options_for(const fs::path& input, const fs::path& out, const fs::path& cache) {
-  BakeOptions options;
-  options.input = input.string();
-  options.output = out.string();
-  options.cache_directory = cache.string();
-  options.backend.name = "cpu";
-  options.atlas.texel_density = 8;
-  options.lighting.spp = 4;
-  options.probe_spp = 16;
-  return options;
-}
-
 // OpenVDB stamps every file with a random UUID (36 characters after the 21-byte start of the
 // header): two writes of one grid differ there and only there.
 constexpr size_t kVdbUuidOffset = 21, kVdbUuidSize = 36;
@@ -104,7 +93,7 @@ std::map<std::string, std::string> file_hashes(const fs::path& folder) {
 // The bundle an uncached bake of the same scene writes.
 void expect_same_as_uncached(const fs::path& input, const fs::path& dir, const fs::path& cached_bundle,
                              const Diagnostics& cached_diagnostics) {
-  BakeOptions plain = options_for(input, dir / "uncached.bake", "");
+  BakeOptions plain = small_cached_bake_options(input, dir / "uncached.bake", "");
   Diagnostics d;
   run_bake(plain, d);
   const auto cached = file_hashes(cached_bundle), uncached = file_hashes(dir / "uncached.bake");
@@ -129,7 +118,7 @@ TEST(StageCache, AnEditedLightReusesEveryOfflineStageAndBakesWhatAnUncachedBakeD
   const fs::path dir = testing::fresh_temp_dir("stage-cache-light");
   const fs::path cache = dir / "cache";
   Diagnostics first_d;
-  const json first = run_bake(options_for(write_scene(dir, {}), dir / "a.bake", cache), first_d);
+  const json first = run_bake(small_cached_bake_options(write_scene(dir, {}), dir / "a.bake", cache), first_d);
   for (const std::string& stage : kOfflineStages) EXPECT_EQ(stage_outcomes(first)[stage], "computed") << stage;
   EXPECT_GT(first["sealed_texels"]["found"].get<size_t>(), 0u) << "the scene should have sealed texels to cache";
 
@@ -139,7 +128,7 @@ TEST(StageCache, AnEditedLightReusesEveryOfflineStageAndBakesWhatAnUncachedBakeD
   brighter.emissive_strength = 3;
   const fs::path input = write_scene(dir, brighter);
   Diagnostics second_d;
-  const json second = run_bake(options_for(input, dir / "b.bake", cache), second_d);
+  const json second = run_bake(small_cached_bake_options(input, dir / "b.bake", cache), second_d);
   EXPECT_FALSE(second["cache"]["reused"].get<bool>()) << "not the same bake: the whole bundle is not reused";
   for (const std::string& stage : kOfflineStages) EXPECT_EQ(stage_outcomes(second)[stage], "reused") << stage;
   std::ifstream manifest(dir / "b.bake" / "manifest.json");
@@ -152,7 +141,7 @@ TEST(StageCache, AnEditedLightReusesEveryOfflineStageAndBakesWhatAnUncachedBakeD
   moved_light.light_position = {-0.5f, 1.2f, 0.4f};
   const fs::path moved_input = write_scene(dir, moved_light);
   Diagnostics third_d;
-  const json third = run_bake(options_for(moved_input, dir / "c.bake", cache), third_d);
+  const json third = run_bake(small_cached_bake_options(moved_input, dir / "c.bake", cache), third_d);
   for (const std::string& stage : kOfflineStages) {
     const bool traces_to_lights = stage == "checks" || stage == "sealed_texels";
     EXPECT_EQ(stage_outcomes(third)[stage], traces_to_lights ? "computed" : "reused") << stage;
@@ -165,12 +154,12 @@ TEST(StageCache, AMovedMeshComputesTheGeometryStagesAgain) {
   const fs::path dir = testing::fresh_temp_dir("stage-cache-mesh");
   const fs::path cache = dir / "cache";
   Diagnostics d;
-  run_bake(options_for(write_scene(dir, {}), dir / "a.bake", cache), d);
+  run_bake(small_cached_bake_options(write_scene(dir, {}), dir / "a.bake", cache), d);
   Edit moved;
   moved.box_position = {0.6f, 0, -0.4f};
   const fs::path input = write_scene(dir, moved);
   Diagnostics moved_d;
-  const json report = run_bake(options_for(input, dir / "b.bake", cache), moved_d);
+  const json report = run_bake(small_cached_bake_options(input, dir / "b.bake", cache), moved_d);
   for (const std::string& stage : kOfflineStages) EXPECT_EQ(stage_outcomes(report)[stage], "computed") << stage;
   expect_same_as_uncached(input, dir, dir / "b.bake", moved_d);
   fs::remove_all(dir);
@@ -180,7 +169,7 @@ TEST(StageCache, DamagedStageEntriesAreComputedAgainWithAWarning) {
   const fs::path dir = testing::fresh_temp_dir("stage-cache-damaged");
   const fs::path cache = dir / "cache";
   Diagnostics d;
-  run_bake(options_for(write_scene(dir, {}), dir / "a.bake", cache), d);
+  run_bake(small_cached_bake_options(write_scene(dir, {}), dir / "a.bake", cache), d);
   // Each damage to one stage's entry, then a bake of an edited light (so the bundle cache misses).
   struct Damage {
     std::string stage;
@@ -214,7 +203,7 @@ TEST(StageCache, DamagedStageEntriesAreComputedAgainWithAWarning) {
     edit.intensity = intensity++;
     const fs::path input = write_scene(dir, edit);
     Diagnostics damaged;
-    const json report = run_bake(options_for(input, dir / "b.bake", cache), damaged);
+    const json report = run_bake(small_cached_bake_options(input, dir / "b.bake", cache), damaged);
     bool warned = false;
     for (const std::string& w : damaged.warnings)
       warned = warned || (w.find("computing the " + damage.stage + " stage again") != std::string::npos);
@@ -223,7 +212,7 @@ TEST(StageCache, DamagedStageEntriesAreComputedAgainWithAWarning) {
     expect_same_as_uncached(input, dir, dir / "b.bake", damaged);
     Diagnostics again;
     edit.intensity = intensity++;
-    const json next = run_bake(options_for(write_scene(dir, edit), dir / "c.bake", cache), again);
+    const json next = run_bake(small_cached_bake_options(write_scene(dir, edit), dir / "c.bake", cache), again);
     EXPECT_EQ(stage_outcomes(next)[damage.stage], "reused") << "the recomputed entry is stored again";
   }
   fs::remove_all(dir);
@@ -233,8 +222,8 @@ TEST(StageCache, ABundleCopiedWholeFromTheCacheSaysEveryStageWasReused) {
   const fs::path dir = testing::fresh_temp_dir("stage-cache-whole");
   const fs::path input = write_scene(dir, {});
   Diagnostics d;
-  run_bake(options_for(input, dir / "a.bake", dir / "cache"), d);
-  const json again = run_bake(options_for(input, dir / "b.bake", dir / "cache"), d);
+  run_bake(small_cached_bake_options(input, dir / "a.bake", dir / "cache"), d);
+  const json again = run_bake(small_cached_bake_options(input, dir / "b.bake", dir / "cache"), d);
   EXPECT_TRUE(again["cache"]["reused"].get<bool>());
   for (const std::string& stage : kOfflineStages) EXPECT_EQ(stage_outcomes(again)[stage], "reused") << stage;
   fs::remove_all(dir);
@@ -243,7 +232,7 @@ TEST(StageCache, ABundleCopiedWholeFromTheCacheSaysEveryStageWasReused) {
 TEST(StageCache, WithoutTheCacheTheManifestHasNoStageOutcomes) {
   const fs::path dir = testing::fresh_temp_dir("stage-cache-none");
   Diagnostics d;
-  const json report = run_bake(options_for(write_scene(dir, {}), dir / "a.bake", ""), d);
+  const json report = run_bake(small_cached_bake_options(write_scene(dir, {}), dir / "a.bake", ""), d);
   EXPECT_FALSE(report.contains("cache"));
   fs::remove_all(dir);
 }
