@@ -2,7 +2,8 @@
 # The README's "Pictures": bakes each sample scene at modest settings with `bake --preview` and copies
 # its preview views to docs/images/<scene>-<view>.png. Run by hand when the pictures should change
 # (CI does not regenerate them); commit the PNGs it writes.
-#   scripts/make_readme_pictures.sh [BUILD_DIR] [SIZE]     (default: build, 384 pixels wide)
+#   scripts/make_readme_pictures.sh [BUILD_DIR] [SIZE] [BUNDLE_DIR]
+#   (default: build, 384 pixels wide; BUNDLE_DIR keeps the bundles for make_readme_references.sh)
 # Needs the `bake` and `sample_scenes` targets (built here). CPU backend: runs on any machine.
 set -euo pipefail
 
@@ -13,8 +14,13 @@ case "$build" in /*) ;; *) build="$root/$build" ;; esac
 ninja -C "$build" bake sample_scenes >/dev/null
 images="$root/docs/images"
 mkdir -p "$images"
-work="$(mktemp -d)"
-trap 'rm -rf "$work"' EXIT
+if [ -n "${3:-}" ]; then
+  work="$3"
+  mkdir -p "$work"
+else
+  work="$(mktemp -d)"
+  trap 'rm -rf "$work"' EXIT
+fi
 
 # bake_sample NAME [bake options...]: bakes build/samples/NAME.gltf and copies its views.
 bake_sample() {
