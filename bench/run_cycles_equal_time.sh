@@ -29,7 +29,14 @@ lighting_seconds() { python3 -c "import json,sys; print(json.load(open(sys.argv[
 if [ ! -f "$OUT/reference/manifest.json" ]; then
   "$BAKE" "$SCENE" -o "$OUT/reference" --spp "$REFERENCE_SPP" --seed 99 "${COMMON[@]}" >/dev/null 2>&1
 fi
+if [ ! -f "$OUT/reference2/manifest.json" ]; then
+  "$BAKE" "$SCENE" -o "$OUT/reference2" --spp "$REFERENCE_SPP" --seed 98 "${COMMON[@]}" >/dev/null 2>&1
+fi
 PAGE=$OUT/reference/lightmap-0.exr
+# The reference's own noise (relMSE of one reference run), from two seeds: vs_reference minus it is a
+# run's whole error, noise and bias, against the converged answer.
+reference_noise=$("$COMPARE" "$PAGE" "$PAGE" --pair "$PAGE" "$OUT/reference2/lightmap-0.exr" | sed -n 's/.*noise_rel_mse //p')
+echo "# reference noise relMSE $reference_noise"
 echo "renderer,config,cycles_samples,seconds_seed1,seconds_seed2,noise_rel_mse,rel_mse_vs_reference,mean_ratio"
 for n in $SAMPLES; do
   times=()

@@ -55,6 +55,9 @@ constexpr int kMaxLayers = 257;
 constexpr size_t kLayerMemoryLimit = size_t(2) << 30;
 // Rings of gutter texels filled around charts: a bilinear footprint reaches one texel past a chart.
 constexpr int kCacheDilation = 2;
+// Tails of ratios above this (a nearly white closed room) are not completed: r / (1 - r) would
+// multiply the last bounce's noise by 19 or more; the stopping rule alone bounds their truncation.
+constexpr double kMaxCompletedTailRatio = 0.95;
 
 struct Counters {
   uint64_t rays = 0, gathers = 0, texelless = 0, back_faces = 0, nonfinite = 0;
@@ -328,6 +331,12 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
   while (layers.size() > 1 && layers.back().samples == 0) layers.pop_back();
   if (!tail_known && layers.size() >= 2) tail = tail_after(layers, gbuffer);
 
+  // The bounces not run, added as the geometric tail B_k r / (1 - r) of the last one (automatic
+  // bounce count only: --bounces N asks for exactly N). Without it the stop leaves a truncation bias
+  // of up to kTailToNoise times the noise, always dark; with it what remains is the error of r.
+  const bool complete_tail = !forced && layers.size() >= 2 && tail.ratio > 0 && tail.ratio < kMaxCompletedTailRatio;
+  const double tail_factor = complete_tail ? double(geometric_tail_factor(float(tail.ratio))) : 0.0;
+
   LightmapEstimate estimate;
   const int layer_count = int(layers.size());
   estimate.recorded_bounces = layer_count;
@@ -339,12 +348,15 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
     acc.samples = layers[0].samples;
     double total[3] = {0, 0, 0}, variance[3] = {0, 0, 0};
     for (int k = 0; k < layer_count; ++k) {
-      const Vec3 mean = layers[size_t(k)].mean(i);
+      const Layer& layer = layers[size_t(k)];
+      const Vec3 mean = layer.mean(i);
+      // The last recorded bounce carries the completed tail, so the bounces still sum to the total.
+      const double scale = k == layer_count - 1 ? 1.0 + tail_factor : 1.0;
       for (int c = 0; c < 3; ++c) {
         // The layer's mean as a sum over the texel's B_0 samples, so mean_bounce() reads it back.
-        estimate.bounces[(size_t(k) * n + i) * 3 + size_t(c)] = n0 * mean[c];
-        total[c] += mean[c];
-        variance[c] += layers[size_t(k)].variance_of_mean(i, c);
+        estimate.bounces[(size_t(k) * n + i) * 3 + size_t(c)] = n0 * scale * mean[c];
+        total[c] += scale * mean[c];
+        variance[c] += scale * scale * layer.variance_of_mean(i, c);
       }
     }
     for (int c = 0; c < 3; ++c) {
@@ -365,6 +377,7 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
   stats.tail_rms = tail.tail_rms;
   stats.noise_rms = tail.noise_rms;
   stats.tail_below_noise = layer_count >= 2 && tail.below_noise;
+  stats.tail_completed = complete_tail;
   estimate.rays = c.rays;
   estimate.nonfinite_samples = c.nonfinite;
   estimate.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

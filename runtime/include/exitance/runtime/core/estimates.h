@@ -35,6 +35,7 @@ struct BounceGatherStatistics {
   double tail_rms = 0;             // the extrapolated tail at the stop, relative RMS (bounce_tail.h)
   double noise_rms = 0;            // the total's noise at the stop, relative RMS
   bool tail_below_noise = false;   // false: stopped by --bounces, the time budget or the layer cap
+  bool tail_completed = false;     // the geometric tail B_k r / (1 - r) was added to the last layer
 };
 
 struct LightmapEstimate {
