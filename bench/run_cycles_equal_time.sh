@@ -24,7 +24,8 @@ mkdir -p "$OUT"
 SCENE=$BUILD/samples/cornell_room.gltf
 COMMON=(--texel-density "$DENSITY" --probes none --voxel-resolution none --no-cache --backend cpu)
 
-lighting_seconds() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['stats']['seconds']['lighting'])" "$1/manifest.json"; }
+# shellcheck source=bench/manifest_fields.sh
+. "$(cd "$(dirname "$0")" && pwd)/manifest_fields.sh"
 
 if [ ! -f "$OUT/reference/manifest.json" ]; then
   "$BAKE" "$SCENE" -o "$OUT/reference" --spp "$REFERENCE_SPP" --seed 99 "${COMMON[@]}" >/dev/null 2>&1

@@ -17,7 +17,8 @@ BAKE=$BUILD/bake/bake
 COMPARE=$BUILD/bench/bench_compare_lightmap_pages
 mkdir -p "$OUT"
 [ -f "$BUILD/samples/cornell_room.gltf" ] || "$BUILD/samples/generate_samples" "$BUILD/samples" >/dev/null
-lighting_seconds() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['stats']['seconds']['lighting'])" "$1/manifest.json"; }
+# shellcheck source=bench/manifest_fields.sh
+. "$(cd "$(dirname "$0")" && pwd)/manifest_fields.sh"
 largest=${SPP##* }
 echo "scene,sampler,spp,seconds,noise_rel_mse"
 for scene in $SCENES; do
