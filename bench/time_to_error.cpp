@@ -88,8 +88,8 @@ int main(int argc, char** argv) {
   app.add_option("scene", scene_path)->required();
   app.add_option("--backends", backends, "comma-separated: cpu, vulkan (the reference is always cpu)");
   app.add_option("--integrators", integrators,
-                 "comma-separated: path, adaptive (path with adaptive sampling; spp = mean), bounces, guided (path "
-                 "with --guiding grid)");
+                 "comma-separated: path, adaptive (path with adaptive sampling; spp = mean), bounces, bounces_cached "
+                 "(bounces with --first-bounce cached), guided (path with --guiding grid)");
   float guiding_mix = 0.5f;
   app.add_option("--guiding-mix", guiding_mix, "guided component's probability (guided runs)");
   std::string guiding_fields;
@@ -182,6 +182,7 @@ int main(int argc, char** argv) {
     std::string name;
     bool adaptive = false;
     uint32_t sampler = kSamplerSobol;
+    bool trace_first_bounce = true;  // bounces: B_1 traced (true) or read from the B_0 lightmap
   };
   std::vector<Mode> modes;
   auto listed = [&](const std::string& name) {
@@ -191,6 +192,8 @@ int main(int argc, char** argv) {
   if (listed("adaptive")) modes.push_back({IntegratorMode::Path, GuidingMode::Off, "path_adaptive", true});
   if (listed("guided")) modes.push_back({IntegratorMode::Path, GuidingMode::Grid, "path_guided_grid"});
   if (listed("bounces")) modes.push_back({IntegratorMode::Bounces, GuidingMode::Off, "per_bounce"});
+  if (listed("bounces_cached"))
+    modes.push_back({IntegratorMode::Bounces, GuidingMode::Off, "per_bounce_cached", false, kSamplerSobol, false});
   if (("," + samplers + ",").find(",independent,") != std::string::npos) {
     const size_t sobol_modes = modes.size();
     for (size_t k = 0; k < sobol_modes; ++k) {
@@ -229,6 +232,7 @@ int main(int argc, char** argv) {
         settings.guiding_mix = guiding_mix;
         settings.adaptive = m.adaptive;  // spp is then the mean samples per texel
         settings.sampler = m.sampler;
+        settings.trace_first_bounce = m.trace_first_bounce;
         if (!guiding_fields.empty())
           settings.inspect_guiding = [&](const GridGuidingCache& cache) {
             std::ofstream out(guiding_fields);

@@ -68,6 +68,7 @@ void hash_options(Sha256Stream& h, const BakeOptions& o) {
   h.value(l.integrator), h.value(l.spp), h.value(l.time_budget_seconds), h.value(l.target_relative_error);
   h.value(l.max_bounces), h.value(l.seed), h.value(l.recorded_bounces), h.value(l.russian_roulette_start);
   h.value(l.safety_bounce_cap), h.value(l.sampling_strategy), h.value(l.sampler), h.value(l.guiding), h.value(l.guiding_mix);
+  h.value(l.trace_first_bounce);
   h.value(l.guiding_grid_cells), h.value(l.adaptive), h.value(o.adaptive_request);
   h.value(o.bounce_layers), h.value(o.probes_enabled), h.value(o.probe_spacing), h.value(o.probe_spp);
   h.value(o.probe_sh_window), h.value(o.svo_enabled), h.value(o.voxel_resolution);

@@ -107,6 +107,11 @@ int main(int argc, char** argv) {
                  "sobol (Owen-scrambled Sobol points per texel, the default) | independent (independent random "
                  "numbers): bench/results/low-discrepancy.md")
       ->check(CLI::IsMember({"sobol", "independent"}));
+  std::string first_bounce = "traced";
+  app.add_option("--first-bounce", first_bounce,
+                 "--integrator bounces: traced (B_1 traces one direct-light sample at each gather hit, the "
+                 "default) | cached (B_1 reads the B_0 lightmap: cheaper, blurs direct light to the texel size)")
+      ->check(CLI::IsMember({"traced", "cached"}));
   std::string cache_directory;
   bool no_cache = false;
   app.add_option("--cache", cache_directory,
@@ -213,6 +218,7 @@ int main(int argc, char** argv) {
   }
   options.skip_sealed_texels = !no_skip;
   options.lighting.sampler = sampler == "independent" ? exitance::kSamplerIndependent : exitance::kSamplerSobol;
+  options.lighting.trace_first_bounce = first_bounce == "traced";
   options.stitch_seams = seams == "stitch";
   if (!directional.empty()) diagnostics.warn("--directional: directional lightmaps are not implemented yet; ignored");
   if (guiding == "svo") {

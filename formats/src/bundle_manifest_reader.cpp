@@ -294,6 +294,11 @@ BakeSettings parse_settings(const FieldReader& r, const json& j) {
     if (!v->is_boolean()) r.fail(path("adaptive"), std::string("expected true or false, got ") + v->type_name());
     s.adaptive = v->get<bool>();
   }
+  if (auto v = field("first_bounce")) {
+    s.first_bounce = r.string(*v, path("first_bounce"));
+    if (s.first_bounce != "traced" && s.first_bounce != "cached")
+      r.fail(path("first_bounce"), "\"" + s.first_bounce + "\" is not traced or cached");
+  }
   if (auto v = field("sampler")) {
     s.sampler = r.string(*v, path("sampler"));
     if (s.sampler != "sobol" && s.sampler != "independent")

@@ -22,6 +22,7 @@ json settings_json(const BakeSettings& s) {
             {"target_error", s.target_error},
             {"adaptive", s.adaptive},
             {"sampler", s.sampler},
+            {"first_bounce", s.first_bounce},
             {"bounces", s.bounces},
             {"seed", s.seed},
             {"texel_density", s.texel_density},

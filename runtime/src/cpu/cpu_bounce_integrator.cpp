@@ -132,8 +132,10 @@ class BounceGather {
     if (!(max_component(albedo) > 0)) return {0, 0, 0};
     Vec3 b;
     const SurfacePoint y = surface_point_on_triangle(scene, tri, ng, hit.b1, hit.b2, front);
-    if (!front ||
-        !caches_[size_t(layer)].lookup(gbuffer_, instance_of(tri), lightmap_uv(tri, hit.b1, hit.b2), y.position, ng, b)) {
+    if (layer == 0 && settings_.trace_first_bounce) {
+      b = on_the_fly(y, layer, rng, c);
+    } else if (!front || !caches_[size_t(layer)].lookup(gbuffer_, instance_of(tri), lightmap_uv(tri, hit.b1, hit.b2),
+                                                        y.position, ng, b)) {
       ++c.texelless;
       b = on_the_fly(y, layer, rng, c);
     }
@@ -334,7 +336,12 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
   // The bounces not run, added as the geometric tail B_k r / (1 - r) of the last one (automatic
   // bounce count only: --bounces N asks for exactly N). Without it the stop leaves a truncation bias
   // of up to kTailToNoise times the noise, always dark; with it what remains is the error of r.
-  const bool complete_tail = !forced && layers.size() >= 2 && tail.ratio > 0 && tail.ratio < kMaxCompletedTailRatio;
+  // Only when the tail criterion itself stopped the run, on layers of at least two samples: r is then
+  // measured net of the noise and the tail added is at most about half the noise. A budget that ends
+  // first (or spp 1, where r is noise) leaves the truncation as it is rather than extrapolate it.
+  const bool noise_known = std::all_of(layers.begin(), layers.end(), [](const Layer& l) { return l.samples >= 2; });
+  const bool complete_tail = !forced && layers.size() >= 2 && noise_known && tail.below_noise && tail.ratio > 0 &&
+                             tail.ratio < kMaxCompletedTailRatio;
   const double tail_factor = complete_tail ? double(geometric_tail_factor(float(tail.ratio))) : 0.0;
 
   LightmapEstimate estimate;

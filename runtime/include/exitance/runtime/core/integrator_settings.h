@@ -32,6 +32,10 @@ struct IntegratorSettings {
   // to their estimated relative deviation; spp is then the mean samples per texel. CPU backend, path
   // mode; the others refuse it. Off: every texel gets the same samples.
   bool adaptive = false;
+  // Bounces mode: B_1 gathers B_0 at its hits by tracing one direct-light sample there (true) rather
+  // than reading the B_0 lightmap (false). Direct light carries the sharp shadows a texel-resolution
+  // cache blurs; traced, the lookup's resolution bias only enters from B_2 on, through the smoother B_1.
+  bool trace_first_bounce = true;
   int max_bounces = -1;            // diffuse bounces after the first hit; -1 = until Russian roulette
   uint64_t seed = 0;
   int recorded_bounces = 4;        // layers bounce0 (= direct) .. bounce<K-1> kept separately
