@@ -773,7 +773,7 @@ std::vector<uint8_t> encode_scene(const SceneFile& s, uint32_t version) {
   for (float a : s.vertex_alpha) p.f32(a);
   for (const TextureRecord& texture : s.textures) put_texture(p, texture);
   if (has_environment) put_texture(p, s.sky_environment);
-  const framing::FileKind kind{kSceneMagic, version, kSceneHeaderSize};
+  const framing::FileKind kind{kSceneMagic, version, kSceneHeaderSize, version};
   return framing::build_frame(kind, header, payload);
 }
 
