@@ -39,9 +39,10 @@ FramedView open_frame(const uint8_t* data, size_t size, const FileKind& kind, co
   if (version > kind.version)
     throw FormatError(name + ": format version " + std::to_string(version) + " is newer than this loader (" +
                       std::to_string(kind.version) + ")");
-  if (version < kind.version)
+  const uint32_t oldest = kind.oldest_version != 0 ? kind.oldest_version : kind.version;
+  if (version < oldest)
     throw FormatError(name + ": format version " + std::to_string(version) + " is older than this loader supports (" +
-                      std::to_string(kind.version) + ")");
+                      std::to_string(oldest) + ")");
   const uint32_t header_size = reader.u32();
   if (header_size != kind.header_size)
     throw FormatError(name + ": header: size " + std::to_string(header_size) + " is not " +
@@ -68,7 +69,7 @@ FramedView open_frame(const uint8_t* data, size_t size, const FileKind& kind, co
   if (kCheckCrc && actual_payload_crc != payload_crc)
     throw FormatError(name + ": payload: checksum " + hex32(actual_payload_crc) + " does not match the stored " +
                       hex32(payload_crc) + " (corrupt data)");
-  return {data, payload, payload_size};
+  return {data, payload, payload_size, version};
 }
 
 std::vector<uint8_t> build_frame(const FileKind& kind, const std::vector<uint8_t>& header_fields,

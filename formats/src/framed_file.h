@@ -11,14 +11,16 @@ namespace exitance::formats::framing {
 
 struct FileKind {
   const char* magic;  // 8 bytes, may contain NULs
-  uint32_t version;
+  uint32_t version;  // the newest version; build_frame writes it
   uint32_t header_size;
+  uint32_t oldest_version = 0;  // the oldest version readers still accept; 0: only `version`
 };
 
 struct FramedView {
   const uint8_t* header;  // header_size bytes
   const uint8_t* payload;
   uint64_t payload_size;
+  uint32_t version;  // the file's format version, oldest_version .. version
 };
 
 // Checks, in this order, and throws FormatError naming the first problem: enough bytes for the

@@ -8,7 +8,7 @@
 namespace exitance::formats {
 namespace {
 
-constexpr framing::FileKind kProbesKind{kProbesMagic, kProbesFormatVersion, kProbesHeaderSize};
+constexpr framing::FileKind kProbesKind{kProbesMagic, kProbesFormatVersion, kProbesHeaderSize, kProbesFormatVersion};
 constexpr uint32_t kSupportedShOrder = 2;  // L2: 9 coefficients, the only order ProbeRecord holds
 constexpr uint32_t kHighestProbeState = uint32_t(ProbeState::Skipped);
 

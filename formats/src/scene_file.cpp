@@ -10,7 +10,7 @@
 namespace exitance::formats {
 namespace {
 
-constexpr framing::FileKind kSceneKind{kSceneMagic, kSceneFormatVersion, kSceneHeaderSize};
+constexpr framing::FileKind kSceneKind{kSceneMagic, kSceneFormatVersion, kSceneHeaderSize, kOldestSceneFormatVersion};
 
 // Bytes per triangle of the seven per-triangle arrays: positions, normals, lightmap UVs, TEXCOORD_0
 // (3 corners each), material, instance and world texel size.
@@ -19,6 +19,11 @@ constexpr uint64_t kPageRecordSize = 12;
 constexpr uint64_t kProbeRecordBytes = 16;
 // Smallest size of the variable-length records (an empty name): bounds their counts by the file size.
 constexpr uint64_t kMinMaterialBytes = 4 + 12 + 4 + 12 + 4 + 4 + 4;
+// Version 2 appends to each material: two bindings' tex_coord, offset, rotation, scale; alpha mode,
+// cutoff and base alpha.
+constexpr uint64_t kMaterialVersion2Bytes = 2 * (4 + 8 + 4 + 8) + 4 + 4 + 4;
+constexpr uint64_t kTextureHeaderBytes = 5 * 4;   // width, height, wrap_s, wrap_t, has_alpha
+constexpr uint64_t kVertexColorBytes = 4 * 4;     // per corner: f32[3] colour, f32 alpha
 constexpr uint64_t kMinInstanceBytes = 4 + 4 + 4 + 4 + 4 + 128 + 4 + 16 + 16;
 constexpr uint64_t kMinNodeBytes = 4 + 4 * 5 + 24 + 32 + 24 + 128;
 constexpr uint64_t kMinCameraBytes = 4 + 4 + 4 + 6 * 4;
@@ -90,6 +95,15 @@ void validate_triangles(const SceneFile& s, const std::string& name) {
   }
 }
 
+void validate_binding(const TextureBindingRecord& b, size_t textures, const std::string& where) {
+  if (b.texture != -1 && !index_in(b.texture, textures))
+    throw FormatError(where + "texture " + std::to_string(b.texture) + " does not exist (" + std::to_string(textures) +
+                      " textures)");
+  if (b.tex_coord > 1) throw FormatError(where + "tex_coord " + std::to_string(b.tex_coord) + " is not 0 or 1");
+  if (!finite(b.offset) || !finite(b.rotation) || !finite(b.scale))
+    throw FormatError(where + "texture transform is not finite");
+}
+
 void validate_materials(const SceneFile& s, const std::string& name) {
   for (size_t i = 0; i < s.materials.size(); ++i) {
     const MaterialRecord& m = s.materials[i];
@@ -100,12 +114,66 @@ void validate_materials(const SceneFile& s, const std::string& name) {
       throw FormatError(at(name, "material", i) + "metallic must be in [0, 1]");
     if (!finite(m.emission) || !non_negative(m.emission))
       throw FormatError(at(name, "material", i) + "emission must be finite and >= 0");
-    if (m.base_color_texture != -1)
-      throw FormatError(at(name, "material", i) + "base colour texture " + std::to_string(m.base_color_texture) +
-                        ": textures are not stored by scene.bin version 1 (must be -1)");
-    if (m.emissive_texture != -1)
-      throw FormatError(at(name, "material", i) + "emissive texture " + std::to_string(m.emissive_texture) +
-                        ": textures are not stored by scene.bin version 1 (must be -1)");
+    validate_binding(m.base_color_texture, s.textures.size(), at(name, "material", i) + "base colour texture: ");
+    validate_binding(m.emissive_texture, s.textures.size(), at(name, "material", i) + "emissive texture: ");
+    if (uint32_t(m.alpha_mode) > uint32_t(AlphaMode::Blend))
+      throw FormatError(at(name, "material", i) + "alpha mode " + std::to_string(uint32_t(m.alpha_mode)) +
+                        " is not OPAQUE (0), MASK (1) or BLEND (2)");
+    if (!(finite(m.alpha_cutoff) && m.alpha_cutoff >= 0))
+      throw FormatError(at(name, "material", i) + "alpha cutoff must be finite and >= 0");
+    if (!(m.base_alpha >= 0 && m.base_alpha <= 1))
+      throw FormatError(at(name, "material", i) + "base alpha must be in [0, 1]");
+  }
+}
+
+void validate_texture(const TextureRecord& t, const std::string& where) {
+  if (t.width == 0 || t.height == 0 || t.width > kMaxSceneTextureSize || t.height > kMaxSceneTextureSize)
+    throw FormatError(where + "size " + std::to_string(t.width) + " x " + std::to_string(t.height) +
+                      " is not within 1 .. " + std::to_string(kMaxSceneTextureSize));
+  if (uint32_t(t.wrap_s) > uint32_t(TextureWrap::MirroredRepeat) ||
+      uint32_t(t.wrap_t) > uint32_t(TextureWrap::MirroredRepeat))
+    throw FormatError(where + "wrap modes " + std::to_string(uint32_t(t.wrap_s)) + ", " +
+                      std::to_string(uint32_t(t.wrap_t)) + " are not repeat (0), clamp (1) or mirrored repeat (2)");
+  const uint64_t texels = uint64_t(t.width) * t.height;
+  if (t.rgb.size() != 3 * texels || (!t.alpha.empty() && t.alpha.size() != texels))
+    throw FormatError(where + "pixel arrays do not hold " + std::to_string(texels) + " texels");
+  for (size_t k = 0; k < t.rgb.size(); ++k)
+    if (!finite(t.rgb[k])) throw FormatError(where + "texel " + std::to_string(k / 3) + ": colour is not finite");
+  for (size_t k = 0; k < t.alpha.size(); ++k)
+    if (!(t.alpha[k] >= 0 && t.alpha[k] <= 1))
+      throw FormatError(where + "texel " + std::to_string(k) + ": alpha is not in [0, 1]");
+}
+
+void validate_textures(const SceneFile& s, const std::string& name) {
+  for (size_t i = 0; i < s.textures.size(); ++i) validate_texture(s.textures[i], at(name, "texture", i));
+  const TextureRecord& sky = s.sky_environment;
+  if (sky.width != 0 || sky.height != 0 || !sky.rgb.empty() || !sky.alpha.empty())
+    validate_texture(sky, name + ": sky environment: ");
+}
+
+void validate_vertex_colors(const SceneFile& s, const std::string& name) {
+  if (s.vertex_color.empty() && s.vertex_alpha.empty()) return;
+  const size_t corners = 3 * s.triangles.count();
+  if (s.vertex_color.size() != corners || s.vertex_alpha.size() != corners)
+    throw FormatError(name + ": vertex colours: " + std::to_string(s.vertex_color.size()) + " colours and " +
+                      std::to_string(s.vertex_alpha.size()) + " alphas for " + std::to_string(corners) + " corners");
+  for (size_t c = 0; c < corners; ++c)
+    if (!finite(s.vertex_color[c]) || !finite(s.vertex_alpha[c]))
+      throw FormatError(at(name, "triangle", c / 3) + "vertex colour is not finite");
+}
+
+// What version 1 cannot hold, for encode_scene(scene, 1).
+void refuse_version2_content(const SceneFile& s, const std::string& name) {
+  const std::string why = " is not stored by scene.bin version 1";
+  if (!s.textures.empty()) throw FormatError(name + ": textures:" + why);
+  if (s.sky_environment.width != 0) throw FormatError(name + ": sky environment:" + why);
+  if (!s.vertex_color.empty()) throw FormatError(name + ": vertex colours:" + why);
+  const MaterialRecord defaults;
+  for (size_t i = 0; i < s.materials.size(); ++i) {
+    const MaterialRecord& m = s.materials[i];
+    if (m.alpha_mode != AlphaMode::Opaque || m.alpha_cutoff != defaults.alpha_cutoff ||
+        m.base_alpha != defaults.base_alpha || m.base_color_texture.texture != -1 || m.emissive_texture.texture != -1)
+      throw FormatError(at(name, "material", i) + "textures and alpha modes are" + why.substr(3));
   }
 }
 
@@ -491,6 +559,16 @@ void put(binary_io::LittleEndianWriter& w, const std::array<double, N>& v) {
   for (double x : v) w.f64(x);
 }
 
+void put_texture(binary_io::LittleEndianWriter& w, const TextureRecord& t) {
+  w.u32(t.width);
+  w.u32(t.height);
+  w.u32(uint32_t(t.wrap_s));
+  w.u32(uint32_t(t.wrap_t));
+  w.u32(t.alpha.empty() ? 0 : 1);
+  for (float v : t.rgb) w.f32(v);
+  for (float v : t.alpha) w.f32(v);
+}
+
 std::string get_name(binary_io::LittleEndianReader& r, const std::string& where) {
   const uint32_t length = r.u32();
   if (length > kMaxSceneNameBytes)
@@ -513,11 +591,40 @@ bool get_bool(binary_io::LittleEndianReader& r, const std::string& where, const 
   return v == 1;
 }
 
+// The size and flags are checked, and the pixel bytes against what is left of the payload, before
+// anything is allocated.
+TextureRecord get_texture(binary_io::LittleEndianReader& r, const std::string& where) {
+  if (r.remaining() < kTextureHeaderBytes) throw FormatError(where + "record runs past the end of the payload");
+  TextureRecord t;
+  t.width = r.u32();
+  t.height = r.u32();
+  t.wrap_s = TextureWrap(r.u32());
+  t.wrap_t = TextureWrap(r.u32());
+  const bool has_alpha = get_bool(r, where, "has_alpha");
+  if (t.width == 0 || t.height == 0 || t.width > kMaxSceneTextureSize || t.height > kMaxSceneTextureSize)
+    throw FormatError(where + "size " + std::to_string(t.width) + " x " + std::to_string(t.height) +
+                      " is not within 1 .. " + std::to_string(kMaxSceneTextureSize));
+  const uint64_t texels = uint64_t(t.width) * t.height;
+  const uint64_t bytes = texels * (has_alpha ? 16 : 12);
+  if (bytes > r.remaining())
+    throw FormatError(where + std::to_string(t.width) + " x " + std::to_string(t.height) + " texels need " +
+                      std::to_string(bytes) + " bytes, the payload has " + std::to_string(r.remaining()) + " left");
+  t.rgb.resize(size_t(texels) * 3);
+  for (float& v : t.rgb) v = r.f32();
+  if (has_alpha) {
+    t.alpha.resize(size_t(texels));
+    for (float& v : t.alpha) v = r.f32();
+  }
+  return t;
+}
+
 }  // namespace
 
 void validate_scene_file(const SceneFile& s, const std::string& name) {
   validate_globals(s, name);
+  validate_textures(s, name);
   validate_materials(s, name);
+  validate_vertex_colors(s, name);
   validate_pages(s, name);
   validate_nodes(s, name);
   validate_triangles(s, name);
@@ -529,8 +636,14 @@ void validate_scene_file(const SceneFile& s, const std::string& name) {
   validate_bvh(s, name);
 }
 
-std::vector<uint8_t> encode_scene(const SceneFile& s) {
-  validate_scene_file(s, "scene.bin (writing)");
+std::vector<uint8_t> encode_scene(const SceneFile& s, uint32_t version) {
+  const std::string writing = "scene.bin (writing)";
+  if (version < kOldestSceneFormatVersion || version > kSceneFormatVersion)
+    throw FormatError(writing + ": format version " + std::to_string(version) + " is not one this writer writes");
+  validate_scene_file(s, writing);
+  if (version == 1) refuse_version2_content(s, writing);
+  const bool has_environment = s.sky_environment.width != 0;
+  const bool has_vertex_colors = !s.vertex_color.empty();
   const SceneTriangles& t = s.triangles;
   std::vector<uint8_t> header;
   binary_io::LittleEndianWriter h(header);
@@ -550,12 +663,14 @@ std::vector<uint8_t> encode_scene(const SceneFile& s) {
   h.u32(s.bvh.stack_entries);
   h.u32(s.bvh.depth);
   put(h, s.sky);
-  h.u32(0);  // sky environment map: none (not stored by version 1)
+  h.u32(has_environment ? 1 : 0);  // sky_environment (always 0 in version 1)
   h.f32(s.texel_density);
   put(h, s.probes.origin);
   put(h, s.probes.spacing);
   for (uint32_t c : s.probes.counts) h.u32(c);
-  for (int k = 0; k < 3; ++k) h.u32(0);  // reserved
+  h.u32(uint32_t(s.textures.size()));    // texture_count (version 2; reserved 0 in version 1)
+  h.u32(has_vertex_colors ? 1 : 0);       // vertex_colors (version 2; reserved 0 in version 1)
+  h.u32(0);                               // reserved
 
   const uint64_t fixed = fixed_payload_bytes(
       t.count(), s.bvh.nodes.size(), s.bvh.leaf_triangles.size(), s.texels.pages.size(), s.texels.texels.size(),
@@ -600,8 +715,19 @@ std::vector<uint8_t> encode_scene(const SceneFile& s) {
     p.f32(m.metallic);
     put(p, m.emission);
     p.u32(m.double_sided ? 1 : 0);
-    p.u32(uint32_t(m.base_color_texture));
-    p.u32(uint32_t(m.emissive_texture));
+    p.u32(uint32_t(m.base_color_texture.texture));
+    p.u32(uint32_t(m.emissive_texture.texture));
+    if (version >= 2) {
+      for (const TextureBindingRecord* b : {&m.base_color_texture, &m.emissive_texture}) {
+        p.u32(b->tex_coord);
+        put(p, b->offset);
+        p.f32(b->rotation);
+        put(p, b->scale);
+      }
+      p.u32(uint32_t(m.alpha_mode));
+      p.f32(m.alpha_cutoff);
+      p.f32(m.base_alpha);
+    }
   }
   for (const InstanceRecord& r : s.instances) {
     put_name(p, r.name);
@@ -642,7 +768,13 @@ std::vector<uint8_t> encode_scene(const SceneFile& s) {
     p.f32(l.cos_inner);
     p.f32(l.cos_outer);
   }
-  return framing::build_frame(kSceneKind, header, payload);
+  // Version 2's sections after the lights (none of them is present in a version 1 file).
+  for (const Float3& c : s.vertex_color) put(p, c);
+  for (float a : s.vertex_alpha) p.f32(a);
+  for (const TextureRecord& texture : s.textures) put_texture(p, texture);
+  if (has_environment) put_texture(p, s.sky_environment);
+  const framing::FileKind kind{kSceneMagic, version, kSceneHeaderSize, version};
+  return framing::build_frame(kind, header, payload);
 }
 
 void write_scene_file(const std::string& path, const SceneFile& scene) {
@@ -666,14 +798,21 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
   get(h, s.probes.origin);
   get(h, s.probes.spacing);
   for (uint32_t& c : s.probes.counts) c = h.u32();
-  for (int k = 0; k < 3; ++k)
-    if (const uint32_t reserved = h.u32(); reserved != 0)
+  const uint32_t texture_count = h.u32(), vertex_colors = h.u32();
+  const uint32_t version = frame.version;
+  // Version 1 reserves offsets 132..143; version 2 uses the first two of them.
+  const uint32_t reserved[3] = {texture_count, vertex_colors, h.u32()};
+  for (int k = version >= 2 ? 2 : 0; k < 3; ++k)
+    if (reserved[k] != 0)
       throw FormatError(name + ": header: reserved field at offset " + std::to_string(132 + 4 * k) + " is " +
-                        std::to_string(reserved) + ", not 0");
-
-  if (environment != 0)
+                        std::to_string(reserved[k]) + ", not 0");
+  if (version < 2 && environment != 0)
     throw FormatError(name + ": header: sky environment " + std::to_string(environment) +
                       " is not 0 (environment maps are not stored by version 1)");
+  if (environment > 1)
+    throw FormatError(name + ": header: sky environment " + std::to_string(environment) + " is not 0 or 1");
+  if (vertex_colors > 1)
+    throw FormatError(name + ": header: vertex_colors " + std::to_string(vertex_colors) + " is not 0 or 1");
   if (triangle_count > kMaxSceneTriangles)
     throw FormatError(name + ": header: " + std::to_string(triangle_count) + " triangles exceed the limit of " +
                       std::to_string(kMaxSceneTriangles));
@@ -688,8 +827,12 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
                       std::to_string(s.probes.counts[2]));
   const uint64_t fixed = fixed_payload_bytes(triangle_count, bvh_node_count, leaf_count, page_count, texel_count,
                                              partial_count, moved_count, probe_count);
-  const uint64_t minimum = fixed + material_count * kMinMaterialBytes + instance_count * kMinInstanceBytes +
-                           node_count * kMinNodeBytes + camera_count * kMinCameraBytes + light_count * kMinLightBytes;
+  const uint64_t material_bytes = kMinMaterialBytes + (version >= 2 ? kMaterialVersion2Bytes : 0);
+  const uint64_t version2_bytes = uint64_t(vertex_colors) * triangle_count * 3 * kVertexColorBytes +
+                                  (uint64_t(texture_count) + environment) * kTextureHeaderBytes;
+  const uint64_t minimum = fixed + material_count * material_bytes + instance_count * kMinInstanceBytes +
+                           node_count * kMinNodeBytes + camera_count * kMinCameraBytes + light_count * kMinLightBytes +
+                           version2_bytes;
   if (frame.payload_size < minimum)
     throw FormatError(name + ": payload: " + std::to_string(frame.payload_size) +
                       " bytes, the header's counts need at least " + std::to_string(minimum));
@@ -755,8 +898,21 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
     m.metallic = p.f32();
     get(p, m.emission);
     m.double_sided = get_bool(p, where, "double_sided");
-    m.base_color_texture = int32_t(p.u32());
-    m.emissive_texture = int32_t(p.u32());
+    m.base_color_texture.texture = int32_t(p.u32());
+    m.emissive_texture.texture = int32_t(p.u32());
+    if (version >= 2) {
+      for (TextureBindingRecord* b : {&m.base_color_texture, &m.emissive_texture}) {
+        b->tex_coord = p.u32();
+        get(p, b->offset);
+        b->rotation = p.f32();
+        get(p, b->scale);
+      }
+      m.alpha_mode = AlphaMode(p.u32());
+      m.alpha_cutoff = p.f32();
+      m.base_alpha = p.f32();
+    } else if (m.base_color_texture.texture != -1 || m.emissive_texture.texture != -1) {
+      throw FormatError(where + "texture indices must be -1 in version 1 (textures are not stored by version 1)");
+    }
   }
   s.instances.resize(instance_count);
   for (size_t i = 0; i < s.instances.size(); ++i) {
@@ -810,8 +966,19 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
     l.cos_inner = p.f32();
     l.cos_outer = p.f32();
   }
+  if (vertex_colors) {
+    s.vertex_color.resize(size_t(triangle_count) * 3);
+    s.vertex_alpha.resize(size_t(triangle_count) * 3);
+    for (Float3& c : s.vertex_color) get(p, c);
+    for (float& a : s.vertex_alpha) a = p.f32();
+  }
+  // Each texture's pixels are checked against the bytes left before they are allocated.
+  s.textures.reserve(texture_count);  // bounded by the payload size check above
+  for (uint32_t i = 0; i < texture_count; ++i) s.textures.push_back(get_texture(p, at(name, "texture", i)));
+  if (environment) s.sky_environment = get_texture(p, name + ": sky environment: ");
   if (p.remaining() != 0)
-    throw FormatError(name + ": payload: " + std::to_string(p.remaining()) + " bytes after the last light");
+    throw FormatError(name + ": payload: " + std::to_string(p.remaining()) + " bytes after the last " +
+                      (version >= 2 ? "section" : "light"));
   validate_scene_file(s, name);
   return s;
 }

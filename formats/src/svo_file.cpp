@@ -10,7 +10,7 @@
 namespace exitance::formats {
 namespace {
 
-constexpr framing::FileKind kSvoKind{kSvoMagic, kSvoFormatVersion, kSvoHeaderSize};
+constexpr framing::FileKind kSvoKind{kSvoMagic, kSvoFormatVersion, kSvoHeaderSize, kSvoFormatVersion};
 constexpr uint16_t kKnownSvoFlags = kSvoLeaf | kSvoFrontLit | kSvoBackLit | kSvoFrontFilled | kSvoBackFilled;
 
 constexpr float kLargestHalf = 65504.0f;

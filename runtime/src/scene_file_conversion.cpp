@@ -16,8 +16,53 @@ formats::Float2 to_record(Vec2 v) { return {v.x, v.y}; }
 Vec3 from_record(const formats::Float3& v) { return {v[0], v[1], v[2]}; }
 Vec2 from_record(const formats::Float2& v) { return {v[0], v[1]}; }
 
-std::string material_where(size_t i, const Material& m) {
-  return "scene.bin (writing): material " + std::to_string(i) + " '" + m.name + "': ";
+formats::TextureRecord to_record(const Texture& t, const std::string& what) {
+  if (t.width < 0 || t.height < 0)
+    throw FormatError("scene.bin (writing): " + what + ": size " + std::to_string(t.width) + " x " +
+                      std::to_string(t.height) + " is negative");
+  formats::TextureRecord r;
+  r.width = uint32_t(t.width);
+  r.height = uint32_t(t.height);
+  r.wrap_s = formats::TextureWrap(uint32_t(t.wrap_s));
+  r.wrap_t = formats::TextureWrap(uint32_t(t.wrap_t));
+  r.rgb = t.rgb;
+  r.alpha = t.alpha;
+  return r;
+}
+Texture from_record(const formats::TextureRecord& r) {
+  Texture t;
+  t.width = int(r.width);
+  t.height = int(r.height);
+  t.wrap_s = Texture::Wrap(uint32_t(r.wrap_s));
+  t.wrap_t = Texture::Wrap(uint32_t(r.wrap_t));
+  t.rgb = r.rgb;
+  t.alpha = r.alpha;
+  return t;
+}
+static_assert(uint32_t(Texture::Wrap::Repeat) == uint32_t(formats::TextureWrap::Repeat) &&
+              uint32_t(Texture::Wrap::ClampToEdge) == uint32_t(formats::TextureWrap::ClampToEdge) &&
+              uint32_t(Texture::Wrap::MirroredRepeat) == uint32_t(formats::TextureWrap::MirroredRepeat));
+static_assert(uint32_t(Material::AlphaMode::Opaque) == uint32_t(formats::AlphaMode::Opaque) &&
+              uint32_t(Material::AlphaMode::Mask) == uint32_t(formats::AlphaMode::Mask) &&
+              uint32_t(Material::AlphaMode::Blend) == uint32_t(formats::AlphaMode::Blend));
+
+formats::TextureBindingRecord to_record(const TextureBinding& b) {
+  formats::TextureBindingRecord r;
+  r.texture = b.texture < 0 ? -1 : b.texture;
+  r.tex_coord = uint32_t(b.transform.tex_coord);  // validation refuses anything but 0 and 1
+  r.offset = to_record(b.transform.offset);
+  r.rotation = b.transform.rotation;
+  r.scale = to_record(b.transform.scale);
+  return r;
+}
+TextureBinding from_record(const formats::TextureBindingRecord& r) {
+  TextureBinding b;
+  b.texture = r.texture;
+  b.transform.tex_coord = int(r.tex_coord);
+  b.transform.offset = from_record(r.offset);
+  b.transform.rotation = r.rotation;
+  b.transform.scale = from_record(r.scale);
+  return b;
 }
 
 uint32_t non_negative(int v, const std::string& what) {
@@ -48,22 +93,26 @@ formats::SceneFile make_scene_file(const Scene& scene, const TexelGBuffer& gbuff
   t.material = scene.triangle_material;
   t.instance = scene.triangle_instance;
 
-  if (!scene.vertex_color.empty())
-    throw FormatError("scene.bin (writing): COLOR_0: vertex colours are not stored by scene.bin version 1");
-  for (size_t i = 0; i < scene.materials.size(); ++i) {
-    const Material& m = scene.materials[i];
-    if (m.base_color_texture.texture >= 0)
-      throw FormatError(material_where(i, m) + "base colour texture: textures are not stored by scene.bin version 1");
-    if (m.emissive_texture.texture >= 0)
-      throw FormatError(material_where(i, m) + "emissive texture: textures are not stored by scene.bin version 1");
-    if (m.alpha_mode != Material::AlphaMode::Opaque)
-      throw FormatError(material_where(i, m) + "alphaMode: MASK and BLEND are not stored by scene.bin version 1");
+  if (scene.vertex_color.size() != scene.vertex_alpha.size() ||
+      (!scene.vertex_color.empty() && scene.vertex_color.size() != corners))
+    throw FormatError("scene.bin (writing): COLOR_0: vertex colours and alphas do not hold one entry per corner");
+  file.vertex_color.reserve(scene.vertex_color.size());
+  for (const Vec3& c : scene.vertex_color) file.vertex_color.push_back(to_record(c));
+  file.vertex_alpha = scene.vertex_alpha;
+  for (size_t i = 0; i < scene.textures.size(); ++i)
+    file.textures.push_back(to_record(scene.textures[i], "texture " + std::to_string(i)));
+  for (const Material& m : scene.materials) {
     formats::MaterialRecord r;
     r.name = m.name;
     r.base_color = to_record(m.base_color);
     r.metallic = m.metallic;
     r.emission = to_record(m.emission);
     r.double_sided = m.double_sided;
+    r.base_color_texture = to_record(m.base_color_texture);
+    r.emissive_texture = to_record(m.emissive_texture);
+    r.alpha_mode = formats::AlphaMode(uint32_t(m.alpha_mode));
+    r.alpha_cutoff = m.alpha_cutoff;
+    r.base_alpha = m.base_alpha;
     file.materials.push_back(std::move(r));
   }
 
@@ -130,9 +179,8 @@ formats::SceneFile make_scene_file(const Scene& scene, const TexelGBuffer& gbuff
     file.lights.push_back(std::move(r));
   }
 
-  if (scene.sky.has_environment())
-    throw FormatError("scene.bin (writing): sky: environment maps are not stored by scene.bin version 1");
   file.sky = to_record(scene.sky.constant);
+  if (scene.sky.has_environment()) file.sky_environment = to_record(scene.sky.environment, "sky environment");
   file.texel_density = atlas.texel_density;
 
   if (atlas.page_sizes.size() != gbuffer.pages.size())
@@ -179,8 +227,17 @@ PersistedScene restore_scene(const formats::SceneFile& file) {
     m.metallic = r.metallic;
     m.emission = from_record(r.emission);
     m.double_sided = r.double_sided;
+    m.base_color_texture = from_record(r.base_color_texture);
+    m.emissive_texture = from_record(r.emissive_texture);
+    m.alpha_mode = Material::AlphaMode(uint32_t(r.alpha_mode));
+    m.alpha_cutoff = r.alpha_cutoff;
+    m.base_alpha = r.base_alpha;
     scene.materials.push_back(std::move(m));
   }
+  for (const formats::TextureRecord& r : file.textures) scene.textures.push_back(from_record(r));
+  scene.vertex_color.reserve(file.vertex_color.size());
+  for (const formats::Float3& c : file.vertex_color) scene.vertex_color.push_back(from_record(c));
+  scene.vertex_alpha = file.vertex_alpha;
   out.atlas.texel_density = file.texel_density;
   for (const formats::TexelPageRecord& p : file.texels.pages)
     out.atlas.page_sizes.emplace_back(int(p.width), int(p.height));
@@ -239,6 +296,7 @@ PersistedScene restore_scene(const formats::SceneFile& file) {
     scene.lights.push_back(std::move(l));
   }
   scene.sky.constant = from_record(file.sky);
+  if (file.sky_environment.width != 0) scene.sky.environment = from_record(file.sky_environment);
 
   out.gbuffer = decode_texel_gbuffer(file.texels, scene);
   out.gbuffer.instance_rects = out.atlas.rects;  // as the raster stage's G-buffer has them

@@ -22,7 +22,9 @@ import shutil
 import signal
 import subprocess
 import sys
+import struct
 import tempfile
+import zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
@@ -64,9 +66,57 @@ def make_fixtures(bake, root):
         data = f.read()
     with open(scene_bin, "wb") as f:
         f.write(data[: len(data) // 2])
+    make_textured_fixtures(bake, root, fixtures)
     fixtures["empty_folder"] = os.path.join(root, "empty_folder")
     os.mkdir(fixtures["empty_folder"])
     return fixtures
+
+
+SCENE_HEADER = 160
+
+
+def refresh_scene_checksums(data):
+    """Recomputes scene.bin's payload and header CRC-32s (formats/scene_format.md) after an edit."""
+    struct.pack_into("<I", data, 152, zlib.crc32(bytes(data[SCENE_HEADER:])) & 0xFFFFFFFF)
+    struct.pack_into("<I", data, 156, zlib.crc32(bytes(data[:156])) & 0xFFFFFFFF)
+
+
+def last_texture_record(data):
+    """Offset of the last texture record of a version 2 scene.bin with textures and no environment
+    map: the record that ends the file (u32 width, height, wrap_s, wrap_t, has_alpha, then pixels)."""
+    for offset in range(len(data) - 20, SCENE_HEADER - 4, -4):
+        w, h, _, _, alpha = struct.unpack_from("<5I", data, offset)
+        if alpha in (0, 1) and 0 < w <= 65535 and 0 < h <= 65535 and offset + 20 + w * h * (12 + 4 * alpha) == len(data):
+            return offset
+    raise SystemExit("textured fixture: no texture record ends scene.bin")
+
+
+def make_textured_fixtures(bake, root, fixtures):
+    """hostile/valid_texture.gltf baked (scene.bin version 2 with one texture), and its scene.bin
+    truncated inside the texture, with an oversized texture (right checksums) and with a flipped
+    texel byte (wrong checksum)."""
+    out = os.path.join(root, "textured.bake")
+    subprocess.run([bake, os.path.join(HERE, "hostile", "valid_texture.gltf"), "-o", out, "--spp", "1",
+                    "--texel-density", "4", "--no-cache", "--probes", "none"],
+                   check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    fixtures["textured"] = out
+    with open(os.path.join(out, "scene.bin"), "rb") as f:
+        original = bytearray(f.read())
+    if struct.unpack_from("<I", original, 8)[0] != 2 or struct.unpack_from("<I", original, 132)[0] != 1:
+        raise SystemExit("textured fixture: scene.bin is not version 2 with one texture")
+    texture = last_texture_record(original)
+    truncated = original[: texture + 20 + 8]
+    oversized = bytearray(original)
+    struct.pack_into("<2I", oversized, texture, 65535, 65535)
+    refresh_scene_checksums(oversized)
+    flipped = bytearray(original)
+    flipped[texture + 20 + 5] ^= 0x40
+    for name, data in (("textured_truncated", truncated), ("textured_oversized", oversized),
+                       ("textured_flipped", flipped)):
+        fixtures[name] = os.path.join(root, name + ".bake")
+        shutil.copytree(out, fixtures[name])
+        with open(os.path.join(fixtures[name], "scene.bin"), "wb") as f:
+            f.write(data)
 
 
 def run_case(case, view, fixtures, timeout):

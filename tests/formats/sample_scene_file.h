@@ -57,9 +57,18 @@ inline formats::SceneFile make_sample_scene_file() {
       s.triangles.instance.push_back(uint32_t(quad));
     }
 
-  MaterialRecord white{"White", {0.8f, 0.8f, 0.8f}, 0.0f, {0, 0, 0}, false, -1, -1};
-  MaterialRecord lamp{"Lamp panel", {1, 1, 1}, 0.25f, {4, 3.5f, 3}, true, -1, -1};
-  MaterialRecord dark{"", {0.05f, 0.1f, 0.2f}, 1.0f, {0, 0, 0}, false, -1, -1};
+  auto material = [](const char* name, Float3 base_color, float metallic, Float3 emission, bool double_sided) {
+    MaterialRecord m;
+    m.name = name;
+    m.base_color = base_color;
+    m.metallic = metallic;
+    m.emission = emission;
+    m.double_sided = double_sided;
+    return m;
+  };
+  MaterialRecord white = material("White", {0.8f, 0.8f, 0.8f}, 0.0f, {0, 0, 0}, false);
+  MaterialRecord lamp = material("Lamp panel", {1, 1, 1}, 0.25f, {4, 3.5f, 3}, true);
+  MaterialRecord dark = material("", {0.05f, 0.1f, 0.2f}, 1.0f, {0, 0, 0}, false);
   s.materials = {white, lamp, dark};
 
   // Nodes: 0 "root" (TRS) -> 1 "Floor" (mesh 0), 2 "Wall" (matrix, mesh 1) -> 3 "Sun" (light,
@@ -139,6 +148,45 @@ inline formats::SceneFile make_sample_scene_file() {
   set_child_box(s.bvh.nodes[1], 2, s, {0});
   s.bvh.stack_entries = 4;  // root pushes 2, node 1 pushes 2
   s.bvh.depth = 2;
+  return s;
+}
+
+// The sample plus everything only format version 2 stores: two textures (one with alpha, other wrap
+// modes), a MASK material reading texture 1 through TEXCOORD_1 with a KHR_texture_transform, an
+// emissive texture, a BLEND material, per-corner vertex colours and an environment-map sky.
+inline formats::SceneFile make_textured_sample_scene_file() {
+  using namespace formats;
+  SceneFile s = make_sample_scene_file();
+  TextureRecord albedo;
+  albedo.width = 3;
+  albedo.height = 2;
+  albedo.wrap_s = TextureWrap::ClampToEdge;
+  albedo.wrap_t = TextureWrap::MirroredRepeat;
+  for (int i = 0; i < 18; ++i) albedo.rgb.push_back(0.05f * float(i));
+  albedo.rgb[0] = -0.0f;  // the sign of zero must survive
+  TextureRecord leaf;
+  leaf.width = 2;
+  leaf.height = 2;
+  leaf.rgb = {0.2f, 0.7f, 0.1f, 0.3f, 0.6f, 0.2f, std::numeric_limits<float>::denorm_min(), 0.5f, 0.0f, 1.0f, 1.0f, 1.0f};
+  leaf.alpha = {1.0f, 0.25f, 0.0f, 0.75f};
+  s.textures = {albedo, leaf};
+  MaterialRecord& white = s.materials[0];
+  white.alpha_mode = AlphaMode::Mask;
+  white.alpha_cutoff = 0.3f;
+  white.base_alpha = 0.875f;
+  white.base_color_texture = {1, 1, {0.25f, -0.5f}, 0.125f, {2.0f, 0.5f}};
+  MaterialRecord& lamp = s.materials[1];
+  lamp.emissive_texture = {0, 0, {0, 0}, 0, {1, 1}};
+  lamp.base_color_texture = {0, 0, {1.5f, 0}, -3.0f, {1, -1}};
+  s.materials[2].alpha_mode = AlphaMode::Blend;
+  s.materials[2].base_alpha = 0.5f;
+  for (size_t c = 0; c < s.triangles.positions.size(); ++c) {
+    s.vertex_color.push_back({float(c % 3) * 0.5f, 1.0f, 0.25f * float(c % 5)});
+    s.vertex_alpha.push_back(c % 4 == 0 ? 0.5f : 1.0f);
+  }
+  s.sky_environment.width = 4;
+  s.sky_environment.height = 2;
+  for (int i = 0; i < 24; ++i) s.sky_environment.rgb.push_back(i < 12 ? 1.5f + float(i) : 0.125f);
   return s;
 }
 

@@ -44,14 +44,23 @@ int main(int argc, char** argv) {
   const uint64_t partial_bytes = file.texels.partial_coverage.size() * formats::kScenePartialCoverageSize;
   const uint64_t moved_bytes = file.texels.moved.size() * formats::kSceneMovedTexelSize;
   const uint64_t probe_bytes = file.probes.probes.size() * 16;
+  // Version 2: textures and the environment map (20-byte head + f32 pixels), vertex colours.
+  uint64_t texture_bytes = 0;
+  for (const formats::TextureRecord& tex : file.textures) texture_bytes += 20 + 4 * (tex.rgb.size() + tex.alpha.size());
+  if (file.sky_environment.width != 0)
+    texture_bytes += 20 + 4 * (file.sky_environment.rgb.size() + file.sky_environment.alpha.size());
+  const uint64_t colour_bytes = 16 * file.vertex_color.size();
   std::printf(
       "scene.bin %.2f MiB: %zu triangles %.2f MiB (incl. leaf slots and texel sizes), BVH %zu nodes %.2f MiB, "
       "texels %.2f MiB, partial coverage %zu %.2f MiB, moved %zu %.3f MiB, probes %zu %.3f MiB, "
-      "header and named records %.3f MiB\n",
+      "textures %zu %.3f MiB, vertex colours %.3f MiB, header and named records %.3f MiB\n",
       double(file_size) / mib, t, double(triangle_bytes) / mib, file.bvh.nodes.size(), double(bvh_bytes) / mib,
       double(texel_bytes) / mib, file.texels.partial_coverage.size(), double(partial_bytes) / mib,
       file.texels.moved.size(), double(moved_bytes) / mib, file.probes.probes.size(), double(probe_bytes) / mib,
-      double(file_size - triangle_bytes - bvh_bytes - texel_bytes - partial_bytes - moved_bytes - probe_bytes) / mib);
+      file.textures.size(), double(texture_bytes) / mib, double(colour_bytes) / mib,
+      double(file_size - triangle_bytes - bvh_bytes - texel_bytes - partial_bytes - moved_bytes - probe_bytes -
+             texture_bytes - colour_bytes) /
+          mib);
   std::printf("lightmap pages uncompressed (float32 R,G,B,A + direct.RGB + indirect.RGB = 40 B/texel): %.2f MiB\n",
               double(atlas_texels * 40) / mib);
   return 0;

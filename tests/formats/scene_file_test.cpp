@@ -76,6 +76,14 @@ const std::vector<uint8_t>& sample_bytes() {
   static const std::vector<uint8_t> bytes = encode_scene(sample());
   return bytes;
 }
+const SceneFile& textured() {
+  static const SceneFile s = test::make_textured_sample_scene_file();
+  return s;
+}
+const std::vector<uint8_t>& textured_bytes() {
+  static const std::vector<uint8_t> bytes = encode_scene(textured());
+  return bytes;
+}
 
 SceneFile read(const std::vector<uint8_t>& bytes) { return read_scene(bytes.data(), bytes.size(), "scene.bin"); }
 
@@ -85,6 +93,12 @@ void expect_same_bytes(const std::vector<T>& a, const std::vector<T>& b, const c
   if (!a.empty()) {
     EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(T)), 0) << what;
   }
+}
+
+void expect_same_texture(const TextureRecord& a, const TextureRecord& b, const char* what) {
+  EXPECT_EQ(std::tie(a.width, a.height, a.wrap_s, a.wrap_t), std::tie(b.width, b.height, b.wrap_s, b.wrap_t)) << what;
+  expect_same_bytes(a.rgb, b.rgb, what);
+  expect_same_bytes(a.alpha, b.alpha, what);
 }
 
 // Every field, bit for bit (floats by memcmp, so -0 and denormals count).
@@ -103,9 +117,18 @@ void expect_bitwise_equal(const SceneFile& a, const SceneFile& b) {
     EXPECT_EQ(x.metallic, y.metallic);
     EXPECT_EQ(x.emission, y.emission);
     EXPECT_EQ(x.double_sided, y.double_sided);
-    EXPECT_EQ(x.base_color_texture, y.base_color_texture);
-    EXPECT_EQ(x.emissive_texture, y.emissive_texture);
+    for (auto [u, v] : {std::pair{&x.base_color_texture, &y.base_color_texture},
+                        std::pair{&x.emissive_texture, &y.emissive_texture}}) {
+      EXPECT_EQ(std::tie(u->texture, u->tex_coord, u->offset, u->scale), std::tie(v->texture, v->tex_coord, v->offset, v->scale));
+      EXPECT_EQ(std::bit_cast<uint32_t>(u->rotation), std::bit_cast<uint32_t>(v->rotation));
+    }
+    EXPECT_EQ(std::tie(x.alpha_mode, x.alpha_cutoff, x.base_alpha), std::tie(y.alpha_mode, y.alpha_cutoff, y.base_alpha));
   }
+  ASSERT_EQ(a.textures.size(), b.textures.size());
+  for (size_t i = 0; i < a.textures.size(); ++i) expect_same_texture(a.textures[i], b.textures[i], "texture");
+  expect_same_texture(a.sky_environment, b.sky_environment, "sky environment");
+  expect_same_bytes(a.vertex_color, b.vertex_color, "vertex colours");
+  expect_same_bytes(a.vertex_alpha, b.vertex_alpha, "vertex alphas");
   ASSERT_EQ(a.instances.size(), b.instances.size());
   for (size_t i = 0; i < a.instances.size(); ++i) {
     const InstanceRecord &x = a.instances[i], &y = b.instances[i];
@@ -192,6 +215,105 @@ TEST(SceneFile, RoundTripIsBitwiseExact) {
   expect_bitwise_equal(s, read_scene_file(path));
 }
 
+// Version 2's sections in the textured sample, located from the end of the file: vertex colours
+// (12 corners), texture 0 (3 x 2, no alpha), texture 1 (2 x 2 with alpha), the 4 x 2 environment.
+struct TexturedOffsets {
+  size_t vertex_color, vertex_alpha, texture0, texture1, environment;
+};
+TexturedOffsets textured_offsets(size_t size) {
+  TexturedOffsets o{};
+  o.environment = size - (20 + 4 * 2 * 12);
+  o.texture1 = o.environment - (20 + 2 * 2 * 16);
+  o.texture0 = o.texture1 - (20 + 3 * 2 * 12);
+  o.vertex_alpha = o.texture0 - 12 * 4;
+  o.vertex_color = o.vertex_alpha - 12 * 12;
+  return o;
+}
+
+// Textures (with alpha, wrap modes, -0 and a denormal), bindings with transforms, MASK and BLEND,
+// vertex colours and the environment sky: bit for bit, and re-encoded to the same bytes.
+TEST(SceneFile, TexturedSceneRoundTripsBitwiseExact) {
+  const std::vector<uint8_t>& bytes = textured_bytes();
+  const SceneFile back = read(bytes);
+  expect_bitwise_equal(textured(), back);
+  EXPECT_TRUE(std::signbit(back.textures[0].rgb[0]));
+  EXPECT_EQ(encode_scene(back), bytes);
+  // The documented layout of what version 2 adds.
+  auto u32 = [&](size_t offset) { return test::get_u32(bytes, offset); };
+  auto f32 = [&](size_t offset) { return std::bit_cast<float>(u32(offset)); };
+  EXPECT_EQ(u32(8), 2u);
+  EXPECT_EQ(u32(88), 1u);   // environment stored
+  EXPECT_EQ(u32(132), 2u);  // texture count
+  EXPECT_EQ(u32(136), 1u);  // vertex colours
+  EXPECT_EQ(u32(140), 0u);
+  const size_t m = sample_offsets().materials + 9;  // material 0 after its name "White"
+  EXPECT_EQ(u32(m + 32), 1u);                       // base colour texture 1
+  EXPECT_EQ(u32(m + 36), 0xFFFFFFFFu);              // no emissive texture
+  EXPECT_EQ(u32(m + 40), 1u);                       // TEXCOORD_1
+  EXPECT_EQ(f32(m + 48), -0.5f);                    // offset[1]
+  EXPECT_EQ(f32(m + 52), 0.125f);                   // rotation
+  EXPECT_EQ(f32(m + 56), 2.0f);                     // scale[0]
+  EXPECT_EQ(u32(m + 88), 1u);                       // MASK
+  EXPECT_EQ(f32(m + 92), 0.3f);                     // cutoff
+  EXPECT_EQ(f32(m + 96), 0.875f);                   // base alpha
+  const TexturedOffsets o = textured_offsets(bytes.size());
+  EXPECT_EQ(f32(o.vertex_color + 12 + 4), 1.0f);  // corner 1 green
+  EXPECT_EQ(f32(o.vertex_alpha), 0.5f);
+  EXPECT_EQ(u32(o.texture0), 3u);
+  EXPECT_EQ(u32(o.texture0 + 8), 1u);  // clamp
+  EXPECT_EQ(u32(o.texture0 + 12), 2u);  // mirrored repeat
+  EXPECT_EQ(u32(o.texture0 + 16), 0u);  // no alpha
+  EXPECT_EQ(u32(o.texture1 + 16), 1u);
+  EXPECT_EQ(f32(o.texture1 + 20 + 48 + 4), 0.25f);
+  EXPECT_EQ(u32(o.environment), 4u);
+  EXPECT_EQ(f32(bytes.size() - 4), 0.125f);
+}
+
+TEST(SceneFile, EveryTruncationAndByteCorruptionOfTheVersion2SectionsIsRefused) {
+  const std::vector<uint8_t>& original = textured_bytes();
+  const size_t first = textured_offsets(original.size()).vertex_color;
+  for (size_t length = 0; length < original.size(); ++length)
+    EXPECT_THROW(read_scene(original.data(), length, "scene.bin"), FormatError) << "length " << length;
+  for (size_t position = first; position < original.size(); ++position) {
+    std::vector<uint8_t> bytes = original;
+    bytes[position] ^= 0x10;
+    EXPECT_THROW(read(bytes), FormatError) << "byte " << position;
+  }
+}
+
+// Version 1 files (no textures, bindings, alpha modes, vertex colours or environment) are still
+// read; the version 1 writer refuses what only version 2 holds.
+TEST(SceneFile, Version1FilesAreStillRead) {
+  const std::vector<uint8_t> bytes = encode_scene(sample(), 1);
+  EXPECT_EQ(test::get_u32(bytes, 8), 1u);
+  // Version 1's material record ends after the two texture indices: 60 bytes less per material.
+  EXPECT_EQ(sample_bytes().size() - bytes.size(), 60 * sample().materials.size());
+  const SceneFile back = read(bytes);
+  expect_bitwise_equal(sample(), back);
+  EXPECT_EQ(encode_scene(back, 1), bytes);
+  EXPECT_EQ(encode_scene(back), sample_bytes());  // upgraded on rewrite
+
+  std::vector<uint8_t> textured_v1 = bytes;
+  put_u32(textured_v1, sample_offsets().materials + 9 + 32, 0);
+  refresh_checksums(textured_v1, kHeader);
+  expect_format_error([&] { read(textured_v1); }, "scene.bin: material 0: texture indices must be -1 in version 1");
+  std::vector<uint8_t> environment_v1 = bytes;
+  put_u32(environment_v1, 88, 1);
+  refresh_checksums(environment_v1, kHeader);
+  expect_format_error([&] { read(environment_v1); }, "environment maps are not stored by version 1");
+  std::vector<uint8_t> colours_v1 = bytes;
+  put_u32(colours_v1, 136, 1);
+  refresh_checksums(colours_v1, kHeader);
+  expect_format_error([&] { read(colours_v1); }, "header: reserved field at offset 136 is 1, not 0");
+
+  expect_format_error([&] { encode_scene(textured(), 1); }, "textures: is not stored by scene.bin version 1");
+  SceneFile masked = sample();
+  masked.materials[2].alpha_mode = AlphaMode::Mask;
+  expect_format_error([&] { encode_scene(masked, 1); },
+                      "material 2: textures and alpha modes are not stored by scene.bin version 1");
+  expect_format_error([&] { encode_scene(sample(), 3); }, "format version 3 is not one this writer writes");
+}
+
 TEST(SceneFile, SceneWithoutProbesOrTrianglesRoundTrips) {
   SceneFile s;
   s.materials.push_back({});
@@ -210,7 +332,7 @@ TEST(SceneFile, HeaderAndPayloadHaveTheDocumentedLayout) {
   auto f32 = [&](size_t offset) { return std::bit_cast<float>(test::get_u32(b, offset)); };
   auto u32 = [&](size_t offset) { return test::get_u32(b, offset); };
   EXPECT_EQ(std::memcmp(b.data(), "EXSCENE\0", 8), 0);
-  EXPECT_EQ(u32(8), 1u);
+  EXPECT_EQ(u32(8), 2u);
   EXPECT_EQ(u32(12), 160u);
   const uint32_t counts[15] = {4, 3, 2, 5, 2, 3, 2, 5, 3, 1, 4, 2, 4, 4, 2};
   for (int i = 0; i < 15; ++i) EXPECT_EQ(u32(16 + 4 * size_t(i)), counts[i]) << "header field at " << 16 + 4 * i;
@@ -223,7 +345,7 @@ TEST(SceneFile, HeaderAndPayloadHaveTheDocumentedLayout) {
   EXPECT_EQ(u32(120), 2u);    // probe counts
   EXPECT_EQ(u32(124), 1u);
   EXPECT_EQ(u32(128), 2u);
-  EXPECT_EQ(u32(132) | u32(136) | u32(140), 0u);  // reserved
+  EXPECT_EQ(u32(132) | u32(136) | u32(140), 0u);  // no textures, no vertex colours, reserved
   EXPECT_EQ(test::get_u64(b, 144), b.size() - kHeader);
   EXPECT_EQ(u32(152), crc32(b.data() + kHeader, b.size() - kHeader));
   EXPECT_EQ(u32(156), crc32(b.data(), 156));
@@ -284,13 +406,13 @@ TEST(SceneFile, EverySingleByteCorruptionIsRefused) {
 
 TEST(SceneFile, OtherVersionsAreRefusedByName) {
   std::vector<uint8_t> bytes = sample_bytes();
-  put_u32(bytes, 8, 2);
+  put_u32(bytes, 8, 3);
   refresh_checksums(bytes, kHeader);
   try {
     read(bytes);
-    FAIL() << "version 2 accepted";
+    FAIL() << "version 3 accepted";
   } catch (const FormatError& e) {
-    EXPECT_STREQ(e.what(), "scene.bin: format version 2 is newer than this loader (1)");
+    EXPECT_STREQ(e.what(), "scene.bin: format version 3 is newer than this loader (2)");
   }
   put_u32(bytes, 8, 0);
   refresh_checksums(bytes, kHeader);
@@ -379,15 +501,32 @@ const StructuralCase kStructuralCases[] = {
      "probe 1: position is not finite"},
     {"probe counts", [](auto& b, auto&) { put_u32(b, 120, 3); }, "probe count 4 is not 3 x 1 x 2"},
     {"probe spacing", [](auto& b, auto&) { put_f32(b, 112, 0.0f); }, "probe spacing on axis 1 is not a positive"},
-    {"sky environment", [](auto& b, auto&) { put_u32(b, 88, 1); }, "environment maps are not stored by version 1"},
+    {"sky environment flag", [](auto& b, auto&) { put_u32(b, 88, 2); }, "header: sky environment 2 is not 0 or 1"},
+    {"sky environment missing", [](auto& b, auto&) { put_u32(b, 88, 1); },
+     "scene.bin: sky environment: record runs past the end of the payload"},
+    {"vertex colours flag", [](auto& b, auto&) { put_u32(b, 136, 2); }, "header: vertex_colors 2 is not 0 or 1"},
+    {"vertex colours missing", [](auto& b, auto&) { put_u32(b, 136, 1); }, "the header's counts need at least"},
+    {"textures missing", [](auto& b, auto&) { put_u32(b, 132, 1); },
+     "scene.bin: texture 0: record runs past the end of the payload"},
+    {"huge texture count", [](auto& b, auto&) { put_u32(b, 132, 0xFFFFFFFFu); }, "the header's counts need at least"},
     {"negative sky", [](auto& b, auto&) { put_f32(b, 80, -0.5f); }, "sky radiance must be finite and >= 0"},
     {"texel density", [](auto& b, auto&) { put_f32(b, 92, std::nanf("")); }, "texel density nan"},
-    {"reserved", [](auto& b, auto&) { put_u32(b, 136, 1); }, "header: reserved field at offset 136 is 1, not 0"},
+    {"reserved", [](auto& b, auto&) { put_u32(b, 140, 1); }, "header: reserved field at offset 140 is 1, not 0"},
     {"too many triangles", [](auto& b, auto&) { put_u32(b, 16, 1u << 29); }, "triangles exceed the limit"},
     {"counts beyond the payload", [](auto& b, auto&) { put_u32(b, 44, 0x40000000u); },
      "the header's counts need at least"},
     {"material texture", [](auto& b, auto& o) { put_u32(b, o.materials + 9 + 32, 0); },
-     "material 0: base colour texture 0: textures are not stored by scene.bin version 1"},
+     "material 0: base colour texture: texture 0 does not exist (0 textures)"},
+    {"material tex_coord", [](auto& b, auto& o) { put_u32(b, o.materials + 9 + 40, 2); },
+     "material 0: base colour texture: tex_coord 2 is not 0 or 1"},
+    {"material texture transform", [](auto& b, auto& o) { put_f32(b, o.materials + 9 + 52, INFINITY); },
+     "material 0: base colour texture: texture transform is not finite"},
+    {"material alpha mode", [](auto& b, auto& o) { put_u32(b, o.materials + 9 + 88, 3); },
+     "material 0: alpha mode 3 is not OPAQUE (0), MASK (1) or BLEND (2)"},
+    {"material alpha cutoff", [](auto& b, auto& o) { put_f32(b, o.materials + 9 + 92, -1.0f); },
+     "material 0: alpha cutoff must be finite and >= 0"},
+    {"material base alpha", [](auto& b, auto& o) { put_f32(b, o.materials + 9 + 96, 1.5f); },
+     "material 0: base alpha must be in [0, 1]"},
     {"material metallic", [](auto& b, auto& o) { put_f32(b, o.materials + 9 + 12, 1.5f); },
      "material 0: metallic must be in [0, 1]"},
     {"material double_sided", [](auto& b, auto& o) { put_u32(b, o.materials + 9 + 28, 2); },
@@ -403,6 +542,53 @@ TEST(SceneFile, StructurallyWrongFilesWithRightChecksumsAreRefused) {
     SCOPED_TRACE(c.name);
     std::vector<uint8_t> bytes = sample_bytes();
     c.edit(bytes, sample_offsets());
+    refresh_checksums(bytes, kHeader);
+    expect_format_error([&] { read(bytes); }, c.expected);
+  }
+}
+
+struct TexturedCase {
+  const char* name;
+  void (*edit)(std::vector<uint8_t>&, const TexturedOffsets&);
+  const char* expected;
+};
+
+const TexturedCase kTexturedCases[] = {
+    {"texture too wide", [](auto& b, auto& o) { put_u32(b, o.texture0, 65536); },
+     "scene.bin: texture 0: size 65536 x 2 is not within 1 .. 65535"},
+    {"texture pixels beyond the payload",
+     [](auto& b, auto& o) {
+       put_u32(b, o.texture0, 65535), put_u32(b, o.texture0 + 4, 65535);
+     },
+     "scene.bin: texture 0: 65535 x 65535 texels need 51538034700 bytes, the payload has"},
+    {"texture has_alpha", [](auto& b, auto& o) { put_u32(b, o.texture1 + 16, 2); },
+     "scene.bin: texture 1: has_alpha is 2, not 0 or 1"},
+    {"texture wrap", [](auto& b, auto& o) { put_u32(b, o.texture0 + 8, 3); }, "scene.bin: texture 0: wrap modes 3, 2"},
+    {"texture colour nan", [](auto& b, auto& o) { put_f32(b, o.texture0 + 20 + 12, NAN); },
+     "scene.bin: texture 0: texel 1: colour is not finite"},
+    {"texture alpha", [](auto& b, auto& o) { put_f32(b, o.texture1 + 20 + 48 + 4, 2.0f); },
+     "scene.bin: texture 1: texel 1: alpha is not in [0, 1]"},
+    {"environment wrap", [](auto& b, auto& o) { put_u32(b, o.environment + 12, 7); },
+     "scene.bin: sky environment: wrap modes 0, 7 are not"},
+    {"environment infinite", [](auto& b, auto& o) { put_f32(b, o.environment + 20 + 4 * 23, INFINITY); },
+     "scene.bin: sky environment: texel 7: colour is not finite"},
+    {"environment zero height", [](auto& b, auto& o) { put_u32(b, o.environment + 4, 0); },
+     "scene.bin: sky environment: size 4 x 0 is not within 1 .. 65535"},
+    {"vertex colour nan", [](auto& b, auto& o) { put_f32(b, o.vertex_color + 12 * 4 + 8, NAN); },
+     "scene.bin: triangle 1: vertex colour is not finite"},
+    {"vertex alpha infinite", [](auto& b, auto& o) { put_f32(b, o.vertex_alpha + 4 * 11, -INFINITY); },
+     "scene.bin: triangle 3: vertex colour is not finite"},
+    {"material texture out of range", [](auto& b, auto&) { put_u32(b, sample_offsets().materials + 9 + 32, 2); },
+     "scene.bin: material 0: base colour texture: texture 2 does not exist (2 textures)"},
+    {"version 1 with textures", [](auto& b, auto&) { put_u32(b, 8, 1); },
+     "scene.bin: header: reserved field at offset 132 is 2, not 0"},
+};
+
+TEST(SceneFile, StructurallyWrongVersion2SectionsAreRefused) {
+  for (const TexturedCase& c : kTexturedCases) {
+    SCOPED_TRACE(c.name);
+    std::vector<uint8_t> bytes = textured_bytes();
+    c.edit(bytes, textured_offsets(bytes.size()));
     refresh_checksums(bytes, kHeader);
     expect_format_error([&] { read(bytes); }, c.expected);
   }
@@ -464,8 +650,28 @@ const RecordCase kRecordCases[] = {
     {"light type", [](SceneFile& s) { s.lights[2].type = LightType(3); }, "light 2: type 3 is not point (0)"},
     {"camera znear", [](SceneFile& s) { s.cameras[0].znear = 0; }, "camera 0: perspective needs yfov > 0"},
     {"camera zfar", [](SceneFile& s) { s.cameras[1].zfar = 0; }, "camera 1: orthographic needs"},
-    {"emissive texture", [](SceneFile& s) { s.materials[1].emissive_texture = 2; },
-     "material 1: emissive texture 2: textures are not stored by scene.bin version 1 (must be -1)"},
+    {"emissive texture", [](SceneFile& s) { s.materials[1].emissive_texture.texture = 2; },
+     "material 1: emissive texture: texture 2 does not exist (0 textures)"},
+    {"texture pixels", [](SceneFile& s) { s.textures.push_back({2, 1, {}, {}, {1, 2, 3}, {}}); },
+     "texture 0: pixel arrays do not hold 2 texels"},
+    {"texture nan", [](SceneFile& s) { s.textures.push_back({1, 1, {}, {}, {1, NAN, 3}, {}}); },
+     "texture 0: texel 0: colour is not finite"},
+    {"texture alpha", [](SceneFile& s) { s.textures.push_back({1, 1, {}, {}, {1, 2, 3}, {1.5f}}); },
+     "texture 0: texel 0: alpha is not in [0, 1]"},
+    {"texture wrap", [](SceneFile& s) { s.textures.push_back({1, 1, TextureWrap(3), {}, {1, 2, 3}, {}}); },
+     "texture 0: wrap modes 3, 0 are not"},
+    {"texture size", [](SceneFile& s) { s.textures.push_back({0, 1, {}, {}, {}, {}}); },
+     "texture 0: size 0 x 1 is not within 1 .. 65535"},
+    {"sky environment size", [](SceneFile& s) { s.sky_environment.rgb = {1, 1, 1}; },
+     "sky environment: size 0 x 0 is not within 1 .. 65535"},
+    {"vertex colours per corner", [](SceneFile& s) { s.vertex_color.assign(3, {1, 1, 1}), s.vertex_alpha.assign(3, 1); },
+     "vertex colours: 3 colours and 3 alphas for 12 corners"},
+    {"vertex colour nan",
+     [](SceneFile& s) {
+       s.vertex_color.assign(12, {1, 1, 1}), s.vertex_alpha.assign(12, 1);
+       s.vertex_alpha[7] = NAN;
+     },
+     "triangle 2: vertex colour is not finite"},
     {"moved texels out of order", [](SceneFile& s) { s.texels.moved.push_back(s.texels.moved[0]); },
      "moved texel 1: texel 3 is out of range or not after the previous moved texel"},
     {"probe grid without counts",

@@ -1,5 +1,6 @@
 // scene.bin reader: any input is either refused with a FormatError or yields a scene that
-//  - re-encodes to exactly the input bytes (the checksums aside: fuzzing builds do not check them),
+//  - re-encodes, in its format version (1 or 2), to exactly the input bytes (the checksums aside:
+//    fuzzing builds do not check them),
 //  - has a BVH that a traversal with a stack of bvh.stack_entries walks without overflowing it,
 //    visiting every node once and reading only existing leaf slots and triangles,
 //  - restores into runtime types and decodes its texel G-buffer without faults (AddressSanitizer
@@ -50,7 +51,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   } catch (const formats::FormatError&) {
     return 0;  // refused cleanly; any other exception escapes and counts as a crash
   }
-  const std::vector<uint8_t> bytes = formats::encode_scene(scene);
+  // Re-encoded in the input's own format version (1 or 2; read_scene accepted it, so it is one of them).
+  uint32_t version = 0;
+  std::memcpy(&version, data + 8, 4);
+  const std::vector<uint8_t> bytes = formats::encode_scene(scene, version);
   constexpr size_t kCrcs = formats::kSceneHeaderSize - 8;  // payload and header CRC
   if (bytes.size() != size || std::memcmp(bytes.data(), data, kCrcs) != 0 ||
       std::memcmp(bytes.data() + formats::kSceneHeaderSize, data + formats::kSceneHeaderSize,
@@ -64,7 +68,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (atlas_texels > (uint64_t(1) << 24)) return 0;
   const PersistedScene restored = restore_scene(scene);
   if (restored.gbuffer.texels.size() != scene.texels.texels.size() ||
-      restored.scene.triangle_count() != scene.triangles.count())
+      restored.scene.triangle_count() != scene.triangles.count() ||
+      restored.scene.textures.size() != scene.textures.size() ||
+      restored.scene.vertex_color.size() != scene.vertex_color.size() ||
+      restored.scene.sky.has_environment() != (scene.sky_environment.width != 0))
     __builtin_trap();
   // Writing it back refuses texels whose normal or albedo the rasterizer's barycentrics for the
   // texel do not give (the codec derives them from the atlas) with a FormatError; what it writes

@@ -101,6 +101,12 @@ int main(int argc, char** argv) {
   scene.probes = SceneFile::no_probe_grid();
   scene.texels.moved.clear();
   write_scene_file((dir / "scene" / "no-probes.bin").string(), scene);
+  // Version 2's sections (textures, bindings, alpha modes, vertex colours, environment sky), and the
+  // same sample in the version 1 layout.
+  write_scene_file((dir / "scene" / "textured.bin").string(), exitance::test::make_textured_sample_scene_file());
+  const std::vector<uint8_t> version1 = encode_scene(exitance::test::make_sample_scene_file(), 1);
+  std::ofstream((dir / "scene" / "version1.bin").string(), std::ios::binary)
+      .write(reinterpret_cast<const char*>(version1.data()), std::streamsize(version1.size()));
   SceneFile empty_scene;
   empty_scene.bvh.nodes.resize(1);
   exitance::test::set_empty_children(empty_scene.bvh.nodes[0]);

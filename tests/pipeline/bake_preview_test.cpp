@@ -19,6 +19,7 @@
 #include "exitance/bake/command/bake_pipeline.h"
 #include "exitance/formats/bundle_manifest.h"
 #include "exitance/formats/lightmap_exr.h"
+#include "exitance/formats/scene_file.h"
 #include "scene_builder.h"
 #include "support/fresh_temp_dir.h"
 
@@ -226,10 +227,10 @@ TEST(BakePreview, TheCacheRestoresThePreviewAndKeysOnIt) {
   fs::remove_all(dir);
 }
 
-// A bundle without scene.bin (an environment-map sky is not stored by scene.bin version 1): the
-// page PNGs, no views, the reason in the manifest and a warning.
-TEST(BakePreview, WithoutSceneBinThePagesAreWrittenAndTheViewsExplained) {
-  const fs::path dir = testing::fresh_temp_dir("preview-nosb");
+// An environment-map sky is stored by scene.bin version 2: the bundle has scene.bin, so the
+// preview has its view as well as the page PNGs, and no warning about either.
+TEST(BakePreview, AnEnvironmentSkyBundleHasSceneBinAndItsViews) {
+  const fs::path dir = testing::fresh_temp_dir("preview-envsky");
   formats::LightmapImage sky;
   sky.width = 8;
   sky.height = 4;
@@ -240,15 +241,18 @@ TEST(BakePreview, WithoutSceneBinThePagesAreWrittenAndTheViewsExplained) {
   Diagnostics diagnostics;
   run_bake(options, diagnostics);
   const formats::BundleManifest manifest = read_manifest(dir / "tile.bake");
-  ASSERT_FALSE(fs::exists(dir / "tile.bake" / "scene.bin"));
+  ASSERT_TRUE(fs::exists(dir / "tile.bake" / "scene.bin"));
+  ASSERT_TRUE(manifest.scene.has_value());
+  EXPECT_EQ(manifest.scene->format_version, formats::kSceneFormatVersion);
   ASSERT_TRUE(manifest.preview.has_value());
-  EXPECT_TRUE(manifest.preview->views.empty());
-  EXPECT_NE(manifest.preview->views_skipped.find("no scene.bin"), std::string::npos);
+  ASSERT_EQ(manifest.preview->views.size(), 1u);
+  EXPECT_TRUE(fs::exists(dir / "tile.bake" / manifest.preview->views[0].file));
   ASSERT_EQ(manifest.preview->pages.size(), manifest.pages.size());
   EXPECT_EQ(decode_png(dir / "tile.bake" / manifest.preview->pages[0]).width, int(manifest.pages[0].width));
-  bool warned = false;
-  for (const std::string& w : diagnostics.warnings) warned |= w.find("--preview: no views") != std::string::npos;
-  EXPECT_TRUE(warned);
+  for (const std::string& w : diagnostics.warnings) {
+    EXPECT_EQ(w.find("--preview: no views"), std::string::npos) << w;
+    EXPECT_EQ(w.find("scene.bin not written"), std::string::npos) << w;
+  }
   fs::remove_all(dir);
 }
 

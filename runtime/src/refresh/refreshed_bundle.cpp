@@ -101,6 +101,7 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   }
   const std::vector<uint8_t> scene_bytes = formats::encode_scene(session.scene_file());
   manifest.scene->bytes = scene_bytes.size();
+  manifest.scene->format_version = formats::kSceneFormatVersion;  // a version 1 input is rewritten as the current one
   manifest.relight_json = report.dump();
   const std::string manifest_text = formats::write_bundle_manifest(manifest);
   if (check_before_write) check_before_write();

@@ -21,7 +21,8 @@
 namespace exitance::formats {
 
 inline constexpr char kSceneMagic[8] = {'E', 'X', 'S', 'C', 'E', 'N', 'E', '\0'};
-constexpr uint32_t kSceneFormatVersion = 1;
+constexpr uint32_t kSceneFormatVersion = 2;        // what writers write
+constexpr uint32_t kOldestSceneFormatVersion = 1;  // readers accept 1 .. kSceneFormatVersion
 constexpr uint32_t kSceneHeaderSize = 160;
 // Fixed record sizes (bytes) of the payload's arrays; scene_format.md has the layouts.
 constexpr uint32_t kSceneBvhNodeSize = 112;
@@ -35,6 +36,7 @@ constexpr uint32_t kMaxScenePageSize = 65535;                 // texel x and y a
 constexpr uint64_t kMaxSceneAtlasTexels = uint64_t(1) << 30;  // sum of width * height over all pages
 constexpr uint32_t kMaxSceneNameBytes = 65535;
 constexpr uint32_t kMaxSceneNodeDepth = 256;  // deepest node depth (root 0), as the glTF importer
+constexpr uint32_t kMaxSceneTextureSize = 65535;  // texture width and height (version 2)
 
 // BVH4 child words, as runtime/.../core/bvh4.h and shaders/include/bvh.glsl use them.
 constexpr uint32_t kSceneBvhEmptyChild = 0xFFFFFFFFu;
@@ -57,15 +59,41 @@ struct SceneTriangles {
   size_t count() const { return material.size(); }
 };
 
+// A texture exactly as the lighting stage samples it (runtime Texture): linear float RGB after the
+// importer's sRGB decode, optional linear alpha, wrap modes. Row 0 = top. Version 2.
+enum class TextureWrap : uint32_t { Repeat = 0, ClampToEdge = 1, MirroredRepeat = 2 };
+
+struct TextureRecord {
+  uint32_t width = 0, height = 0;
+  TextureWrap wrap_s = TextureWrap::Repeat, wrap_t = TextureWrap::Repeat;
+  std::vector<float> rgb;    // width * height * 3
+  std::vector<float> alpha;  // width * height in [0, 1], or empty
+};
+
+// A material's texture: index into SceneFile::textures (-1: none), which TEXCOORD_n it reads and
+// its KHR_texture_transform (uv' = T * R * S * uv).
+struct TextureBindingRecord {
+  int32_t texture = -1;
+  uint32_t tex_coord = 0;  // 0 or 1
+  Float2 offset{0, 0};
+  float rotation = 0;
+  Float2 scale{1, 1};
+};
+
+enum class AlphaMode : uint32_t { Opaque = 0, Mask = 1, Blend = 2 };
+
 struct MaterialRecord {
   std::string name;
   Float3 base_color{1, 1, 1};  // linear factor
   float metallic = 1.0f;
   Float3 emission{0, 0, 0};  // emissiveFactor * KHR_materials_emissive_strength
   bool double_sided = false;
-  // Reserved for textures (not stored by version 1): must be -1.
-  int32_t base_color_texture = -1;
-  int32_t emissive_texture = -1;
+  // Version 2 (version 1 files read back as no textures, OPAQUE, cutoff 0.5, base alpha 1).
+  TextureBindingRecord base_color_texture;
+  TextureBindingRecord emissive_texture;
+  AlphaMode alpha_mode = AlphaMode::Opaque;
+  float alpha_cutoff = 0.5f;
+  float base_alpha = 1.0f;  // baseColorFactor[3]
 };
 
 struct InstanceRecord {
@@ -174,7 +202,12 @@ struct SceneFile {
   std::vector<NodeRecord> nodes;  // every glTF node, in glTF order
   std::vector<CameraRecord> cameras;
   std::vector<LightRecord> lights;
-  Float3 sky{0, 0, 0};         // constant sky radiance (environment maps are not stored by version 1)
+  Float3 sky{0, 0, 0};         // constant sky radiance
+  TextureRecord sky_environment;  // equirectangular radiance map replacing `sky`; width 0: none (version 2)
+  std::vector<TextureRecord> textures;  // version 2
+  // COLOR_0 per corner (3 per triangle), or both empty: no vertex colours (version 2).
+  std::vector<Float3> vertex_color;
+  std::vector<float> vertex_alpha;
   float texel_density = 0;     // lightmap texels per scene unit
   TexelGBufferRecords texels;  // includes the atlas page sizes
   // Probe positions and states only (SH coefficients are not stored: they read back as zero).
@@ -206,8 +239,9 @@ inline uint32_t texel_morton_code(uint32_t x, uint32_t y) {
 // scene_format.md, "What readers refuse").
 void validate_scene_file(const SceneFile& scene, const std::string& name_for_errors);
 
-// The exact bytes of scene.bin; throws FormatError if the scene is invalid.
-std::vector<uint8_t> encode_scene(const SceneFile& scene);
+// The exact bytes of scene.bin; throws FormatError if the scene is invalid. format_version 1
+// writes the old layout (tests, fixtures) and refuses a scene with anything only version 2 holds.
+std::vector<uint8_t> encode_scene(const SceneFile& scene, uint32_t format_version = kSceneFormatVersion);
 void write_scene_file(const std::string& path, const SceneFile& scene);
 
 // Throws FormatError (FileAccessError when the file cannot be read at all).

@@ -25,9 +25,11 @@ struct PersistedScene {
   bool has_probe_grid() const { return !probes.probes.empty(); }
 };
 
-// Throws formats::FormatError naming what scene.bin version 1 cannot hold (a texture on a
-// material, an environment-map sky, an atlas rectangle per instance missing, a page over 65535
-// texels, ...) and, through encode_scene's validation when writing, anything else invalid.
+// Textures, bindings, alpha modes, vertex colours and the environment-map sky are stored as the
+// lighting stage evaluates them (format version 2), so a scene read back lights bit-identically.
+// Throws formats::FormatError naming what scene.bin cannot hold (an atlas rectangle per instance
+// missing, a page over 65535 texels, ...) and, through encode_scene's validation when writing,
+// anything else invalid.
 // `probes` may be null (no probe grid); its SH coefficients are not stored.
 formats::SceneFile make_scene_file(const Scene& scene, const TexelGBuffer& gbuffer, const AtlasLayout& atlas,
                                    const formats::ProbeGrid* probes, const formats::SceneBvh& bvh);

@@ -26,8 +26,8 @@ namespace exitance {
 
 // What the stages produced, as the bundle records it, in stage order. The optional stages' entries
 // are null when the options turned them off (--voxel-resolution none, --probes none).
-// scene.bin as encoded by the scene-file stage, or why this scene cannot have one (version 1 holds no
-// textures or environment maps).
+// scene.bin as encoded by the scene-file stage, or why this scene cannot have one (the encoder's
+// one-line error).
 struct PersistedSceneFile {
   std::vector<uint8_t> bytes;
   std::string skipped;  // non-empty when `bytes` is

@@ -90,8 +90,8 @@ ProbePlacement place_probes_stage(const SceneForLighting& scene, const Voxelized
                                   const BakeOptions& options);
 
 // scene file: scene.bin's bytes (the scene, the texel G-buffer the lighting stage will light, the
-// atlas, the probe layout, the BVH4), so exitance-relight reproduces this bake; a scene version 1
-// cannot hold (textures, an environment-map sky) gets none, with a warning saying why.
+// atlas, the probe layout, the BVH4, textures, vertex colours and the sky), so exitance-relight
+// reproduces this bake; a scene scene.bin cannot hold gets none, with a warning saying why.
 PersistedSceneFile scene_file_stage(const SceneForLighting& scene, const TexelGBuffer& gbuffer, const AtlasLayout& layout,
                                     const ProbePlacement* probes, const BakeOptions& options, Diagnostics& diagnostics);
 
