@@ -192,10 +192,10 @@ TEST(SceneFileConversion, SceneRoundTripsThroughTheFile) {
   const Scene &a = p.scene, &b = back.scene;
 
   auto same_vec3s = [](const std::vector<Vec3>& x, const std::vector<Vec3>& y) {
-    return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(Vec3)) == 0;
+    return x.size() == y.size() && (x.empty() || std::memcmp(x.data(), y.data(), x.size() * sizeof(Vec3)) == 0);
   };
   auto same_vec2s = [](const std::vector<Vec2>& x, const std::vector<Vec2>& y) {
-    return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(Vec2)) == 0;
+    return x.size() == y.size() && (x.empty() || std::memcmp(x.data(), y.data(), x.size() * sizeof(Vec2)) == 0);
   };
   EXPECT_TRUE(same_vec3s(a.positions, b.positions));
   EXPECT_TRUE(same_vec3s(a.normals, b.normals));
@@ -357,7 +357,8 @@ const TexturedCornell& textured_cornell() {
 }
 
 bool same_floats(const std::vector<float>& a, const std::vector<float>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+  // Bit for bit (-0 and NaN payloads included); empty vectors may hold null data, which memcmp must not see.
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
 }
 
 void expect_same_texture(const Texture& a, const Texture& b) {
