@@ -3,22 +3,11 @@
 #include <cmath>
 
 #include "exitance/common/material.h"
+#include "exitance/common/texture_sampling.h"
 #include "exitance/runtime/alpha_coverage.h"
 
 namespace exitance {
 namespace {
-
-int wrap_index(int i, int n, Texture::Wrap wrap) {
-  switch (wrap) {
-    case Texture::Wrap::ClampToEdge: return std::clamp(i, 0, n - 1);
-    case Texture::Wrap::MirroredRepeat: {
-      const int period = 2 * n;
-      int m = ((i % period) + period) % period;
-      return m < n ? m : period - 1 - m;
-    }
-    default: return ((i % n) + n) % n;
-  }
-}
 
 Vec3 texel(const Texture& t, int x, int y) {
   const size_t i = (size_t(y) * size_t(t.width) + size_t(x)) * 3;
@@ -36,19 +25,12 @@ Vec3 lookup(const Scene& scene, const TextureBinding& binding, uint32_t triangle
   return sample_texture(scene.textures[size_t(binding.texture)], binding_uv(scene, binding, triangle, b1, b2));
 }
 
-// Bilinear filtering of fetch(x, y) over the texture's texels with its wrap modes.
+// Bilinear filtering of fetch(x, y) over the texture's texels with its wrap modes (the footprint
+// and weights are texture_sampling.h's, shared with the kernels).
 template <typename Fetch>
 auto bilinear(const Texture& texture, Vec2 uv, const Fetch& fetch) {
-  if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return fetch(0, 0);
-  // Keep the coordinate small before flooring so huge UVs cannot overflow int.
-  const float x = float(std::fmod(double(uv.x), 2.0 * 65536.0)) * float(texture.width) - 0.5f;
-  const float y = float(std::fmod(double(uv.y), 2.0 * 65536.0)) * float(texture.height) - 0.5f;
-  const float fx = std::floor(x), fy = std::floor(y);
-  const float tx = x - fx, ty = y - fy;
-  const int x0 = int(fx), y0 = int(fy);
-  const int xa = wrap_index(x0, texture.width, texture.wrap_s), xb = wrap_index(x0 + 1, texture.width, texture.wrap_s);
-  const int ya = wrap_index(y0, texture.height, texture.wrap_t), yb = wrap_index(y0 + 1, texture.height, texture.wrap_t);
-  return (fetch(xa, ya) * (1 - tx) + fetch(xb, ya) * tx) * (1 - ty) + (fetch(xa, yb) * (1 - tx) + fetch(xb, yb) * tx) * ty;
+  const BilinearTaps taps = bilinear_taps(uv, texture.width, texture.height, uint32_t(texture.wrap_s), uint32_t(texture.wrap_t));
+  return bilinear_mix(fetch(taps.x0, taps.y0), fetch(taps.x1, taps.y0), fetch(taps.x0, taps.y1), fetch(taps.x1, taps.y1), taps);
 }
 
 }  // namespace
@@ -68,12 +50,7 @@ float sample_texture_alpha(const Texture& texture, Vec2 uv) {
 }
 
 Vec2 apply_texture_transform(const TextureTransform& t, Vec2 uv) {
-  if (t.rotation == 0.0f && t.scale.x == 1.0f && t.scale.y == 1.0f && t.offset.x == 0.0f && t.offset.y == 0.0f)
-    return uv;
-  const float c = std::cos(t.rotation), s = std::sin(t.rotation);
-  const Vec2 scaled{uv.x * t.scale.x, uv.y * t.scale.y};
-  // KHR_texture_transform's rotation matrix: [c s; -s c] applied to (u, v).
-  return {c * scaled.x + s * scaled.y + t.offset.x, -s * scaled.x + c * scaled.y + t.offset.y};
+  return transform_texture_coordinate(uv, t.offset, t.scale, t.rotation);
 }
 
 Vec3 diffuse_albedo(const Scene& scene, uint32_t triangle, float b1, float b2) {

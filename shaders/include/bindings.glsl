@@ -20,6 +20,8 @@ layout(std430, set = 0, binding = kBindingStartPoints) readonly buffer StartPoin
 layout(std430, set = 0, binding = kBindingBatchItems) readonly buffer BatchItemBuffer { uint batch_items[]; };
 layout(std430, set = 0, binding = kBindingCounters) coherent buffer CounterBuffer { uint counters[]; };
 layout(std430, set = 0, binding = kBindingIndirect) buffer IndirectBuffer { uint indirect_args[]; };
+// Per-point surfaces (textures, COLOR_0, alphaMode), packed (gpu_layout.h kBindingSurfaces).
+layout(std430, set = 0, binding = kBindingSurfaces) readonly buffer SurfaceBuffer { vec4 surfaces[]; };
 
 // Path state, structure of arrays, one entry per path slot.
 layout(std430, set = 0, binding = kBindingPathWork) buffer PathWorkBuffer { uint path_work[]; };  // work item or kInvalid

@@ -4,6 +4,8 @@
 // quantized: 4 uvec4 (64 bytes): origin, per-axis power-of-two scales and 8-bit child planes
 // (quantize_bvh4_nodes in runtime/src/vulkan/bvh_quantization.h), then child[4].
 // Child word: kInvalid = empty, bit 31 set = leaf (first triangle << 2 | count - 1), else inner node index.
+// MASK/BLEND (params.surface_flags & kSurfaceAlphaMaterials): a hit where scene_hit_stops_ray says
+// the surface lets the ray pass is skipped, and the search goes on, as Embree's filter does on the CPU.
 // Triangles: watertight test of Woop, Benthin & Wald (JCGT 2013), double-precision fallback on edges.
 //
 // Traversal keeps the next node in a register: of the children a ray enters, the nearest is visited
@@ -137,7 +139,8 @@ vec4 trace_closest(vec3 o, vec3 d, float t_max, inout uint steps) {
         vec4 p0 = leaf_tris[base], p1 = leaf_tris[base + 1u], p2 = leaf_tris[base + 2u];
         float t;
         vec3 bary = intersect_triangle(r, p0.xyz, p1.xyz, p2.xyz, t);
-        if (t > 0.0 && t < best_t) {
+        if (t > 0.0 && t < best_t &&
+            ((params.surface_flags & kSurfaceAlphaMaterials) == 0u || scene_hit_stops_ray(floatBitsToUint(p0.w), bary.y, bary.z, o, d))) {
           best_t = t;
           best_tri = floatBitsToUint(p0.w);
           best_b1 = bary.y;
@@ -190,8 +193,11 @@ bool trace_any(vec3 o, vec3 d, float t_max, inout uint steps) {
     for (uint i = 0u; i < count; ++i) {
       uint base = (first + i) * 3u;
       float t;
-      intersect_triangle(r, leaf_tris[base].xyz, leaf_tris[base + 1u].xyz, leaf_tris[base + 2u].xyz, t);
-      if (t > 0.0 && t <= t_max) return true;
+      vec3 bary = intersect_triangle(r, leaf_tris[base].xyz, leaf_tris[base + 1u].xyz, leaf_tris[base + 2u].xyz, t);
+      if (t > 0.0 && t <= t_max &&
+          ((params.surface_flags & kSurfaceAlphaMaterials) == 0u ||
+           scene_hit_stops_ray(floatBitsToUint(leaf_tris[base].w), bary.y, bary.z, o, d)))
+        return true;
     }
     node = sp == 0u ? kInvalid : stack[--sp];
   }

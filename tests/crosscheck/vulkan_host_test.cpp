@@ -21,6 +21,7 @@
 #include "support/analytic_scenes.h"
 #include "support/engine_vulkan_device.h"
 #include "support/lightmap_comparison.h"
+#include "support/textured_scenes.h"
 #include "support/validated_vulkan_backend.h"
 
 namespace exitance {
@@ -156,6 +157,45 @@ TEST(VulkanRuntimeEdits, MaterialEditEqualsAFreshIntegratorAndTheReference) {
     drop += before.mean_total(i).x - updated.mean_total(i).x,
         variance += before.variance_of_mean(i).x + updated.variance_of_mean(i).x;
   EXPECT_GT(drop, 20 * std::sqrt(variance));
+}
+
+// Material edits that make an untextured scene textured (its texels and corners are uploaded then)
+// and then change a textured scene's alpha mode (only the material records are uploaded).
+TEST(VulkanRuntimeEdits, TexturedMaterialEditsEqualAFreshIntegratorAndTheReference) {
+  Scene scene = lit_box();
+  scene.textures.push_back(testing::checker_texture(4, {0.9f, 0.8f, 0.2f}, {0.1f, 0.3f, 0.7f}, Texture::Wrap::Repeat));
+  scene.textures.push_back(testing::two_halves_texture(8, {1, 1, 1}, 0.0f, {0.8f, 0.2f, 0.2f}, 1.0f));
+  TexelGBuffer g;
+  for (Vec2 p : testing::grid_points(4, 0.1f)) {
+    g.texels.push_back(testing::texel_at({p.x, 0.0f, p.y}, {0, 1, 0}));   // floor
+    g.texels.push_back(testing::texel_at({1.0f, p.x, p.y}, {-1, 0, 0}));  // right wall, facing the panel
+  }
+  const std::shared_ptr<const LightingScene> original = make_lighting_scene(scene);
+  ASSERT_FALSE(original->textured);
+  CREATE_VULKAN_OR_SKIP(vk, original, VulkanDeviceOptions{});
+  IntegratorSettings settings;
+  settings.spp = 256;
+  settings.seed = 5;
+  LightingScene edited = *original;
+  for (int step = 0; step < 2; ++step) {
+    Material walls = scene.materials[0], panel = scene.materials[2];
+    walls.base_color_texture.texture = 0;
+    walls.base_color_texture.transform.scale = {2.0f, 2.0f};
+    panel.base_color_texture.texture = 1;
+    panel.alpha_mode = step == 0 ? Material::AlphaMode::Mask : Material::AlphaMode::Blend;
+    panel.base_alpha = step == 0 ? 1.0f : 0.5f;  // BLEND: the opaque half passes half the rays
+    set_material(edited, 0, walls);
+    set_material(edited, 2, panel);
+    ASSERT_TRUE(edited.textured);
+    vk->update_materials(edited);
+    settings.seed = 5;
+    const LightmapEstimate updated = vk->bake(g, settings);
+    CREATE_VULKAN_OR_SKIP(fresh, std::make_shared<const LightingScene>(edited), VulkanDeviceOptions{});
+    expect_identical(updated, fresh->bake(g, settings), step == 0 ? "textured + MASK: updated vs fresh" : "BLEND: updated vs fresh");
+    settings.seed = 6;
+    testing::compare_estimates(updated, CpuReferenceIntegrator(*edited.source).bake(g, settings), 8,
+                               step == 0 ? "textured + MASK edit" : "BLEND edit");
+  }
 }
 
 TEST(VulkanRuntimeEdits, LightEditEqualsAFreshIntegratorAndTheClosedForm) {

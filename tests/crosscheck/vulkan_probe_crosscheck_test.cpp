@@ -19,6 +19,7 @@
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "support/analytic_scenes.h"
 #include "support/independent_estimates.h"
+#include "support/textured_scenes.h"
 #include "support/validated_vulkan_backend.h"
 
 namespace exitance {
@@ -285,6 +286,14 @@ PreparedScene load_sample(const std::string& name, const std::string& sky) {
 // Probes in the 4 m Cornell room: centre-back, low front-left, under the light, 1 cm above the
 // floor in a corner, and one inside the tall box (its faces point outward: back faces above, the
 // floor below).
+// Textures, COLOR_0, an emissive texture, MASK and BLEND (traversal of probe rays and the paths after).
+TEST(VulkanProbeCrosscheck, TexturedMaskedVertexColouredScene) {
+  const testing::TexturedScene t = testing::textured_masked_scene();
+  IntegratorSettings settings;
+  settings.spp = 256;
+  compare_backends(t.scene, t.probes, settings, "textured scene");
+}
+
 TEST(VulkanProbeCrosscheck, CornellRoom) {
   PreparedScene s = load_sample("cornell_room", "");
   const std::vector<Vec3> positions = {

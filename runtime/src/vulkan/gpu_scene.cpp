@@ -7,6 +7,7 @@
 #include <string>
 
 #include "bvh_quantization.h"
+#include "gpu_surfaces.h"
 #include "exitance/runtime/core/scene_access.h"
 
 namespace exitance::vulkan {
@@ -62,19 +63,6 @@ std::vector<ByteRange> triangle_ranges(const std::vector<uint32_t>& triangles) {
 void check_supported_by_vulkan(const LightingScene& scene) {
   if (scene.environment.enabled())
     throw std::runtime_error("Vulkan backend: environment-map skies are not supported yet (use the cpu backend)");
-  // `textured`: something varies per point, which only the CPU reference evaluates; name what.
-  if (scene.textured) {
-    if (!scene.source->vertex_color.empty())
-      throw std::runtime_error("Vulkan backend: vertex colours (COLOR_0) are not supported yet (use the cpu backend)");
-    for (const Material& m : scene.source->materials) {
-      if (m.base_color_texture.texture >= 0 || m.emissive_texture.texture >= 0)
-        throw std::runtime_error("Vulkan backend: textured materials are not supported yet (material '" + m.name +
-                                 "'; use the cpu backend)");
-      if (m.alpha_mode != Material::AlphaMode::Opaque)
-        throw std::runtime_error("Vulkan backend: alphaMode MASK and BLEND are not supported yet (material '" +
-                                 m.name + "'; use the cpu backend)");
-    }
-  }
   if (scene.bvh.nodes.empty()) throw std::invalid_argument("Vulkan backend: the scene has no BVH4 (build_bvh4 or scene.bin)");
 }
 
@@ -99,7 +87,24 @@ GpuScene::GpuScene(Context& context, const LightingScene& scene, bool quantized_
       stack_bound_(std::max<uint32_t>(scene.bvh.stack_entries + 1, 8)),
       node_count_(uint32_t(scene.bvh.nodes.size())),
       leaf_slots_(uint32_t(scene.bvh.leaf_triangles.size())),
-      quantized_(quantized_nodes) {}
+      quantized_(quantized_nodes) {
+  upload_surfaces(scene);
+}
+
+void GpuScene::upload_surfaces(const LightingScene& scene) {
+  surface_flags_ = vulkan::surface_flags(scene);
+  // Textures and corners exist only in textured scenes; a material edit cannot change them, so it
+  // uploads the header and the material records alone. An edit that makes an untextured scene
+  // textured uploads everything (the buffer grows; the integrator binds it again before each bake).
+  if (surfaces_.size() == 0 || (scene.textured && !surfaces_textured_)) {
+    const std::vector<Vec4> words = surface_words(scene, surface_layout_);
+    upload_growing(surfaces_, words.data(), words.size() * sizeof(Vec4));
+    surfaces_textured_ = scene.textured;
+    return;
+  }
+  const std::vector<Vec4> words = material_surface_words(*scene.source, surface_layout_);
+  context_.upload(surfaces_, words.data(), words.size() * sizeof(Vec4));
+}
 
 size_t GpuScene::bvh_bytes() const {
   return size_t(node_count_) * (quantized_ ? kQuantizedNodeWords * 4 : sizeof(Bvh4Node)) + size_t(leaf_slots_) * 48;
@@ -114,6 +119,7 @@ void GpuScene::bind(DescriptorWrites& writes) const {
   writes.set(kBindingEmitterTriangles, emitter_triangles_);
   writes.set(kBindingPunctualLights, punctual_lights_);
   writes.set(kBindingPunctualCdf, punctual_cdf_);
+  writes.set(kBindingSurfaces, surfaces_);
 }
 
 void GpuScene::check_same_shape(const LightingScene& edited) const {
@@ -141,6 +147,7 @@ void GpuScene::update_materials(const LightingScene& edited) {
   const std::vector<uint32_t> emitters = at_least_one(edited.emitter_triangles);
   upload_growing(emitter_triangles_, emitters.data(), emitters.size() * 4);
   emitters_ = edited.emitter_triangles;
+  upload_surfaces(edited);
 }
 
 void GpuScene::update_geometry(const LightingScene& edited) {

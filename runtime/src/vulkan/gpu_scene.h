@@ -8,13 +8,15 @@
 #include <vector>
 
 #include "exitance/runtime/core/lighting_scene.h"
+#include "gpu_surfaces.h"
 #include "vulkan_context.h"
 #include "wavefront_kernels.h"
 
 namespace exitance::vulkan {
 
-// Throws std::runtime_error for what the kernels cannot evaluate yet: environment-map skies,
-// textured materials (naming the first), a scene without a BVH4.
+// Throws std::runtime_error for what the kernels cannot evaluate yet: environment-map skies, and
+// std::invalid_argument for a scene without a BVH4. Textures, COLOR_0 and MASK/BLEND are evaluated
+// per point (gpu_surfaces.h, shaders/include/scene_access.glsl).
 void check_supported_by_vulkan(const LightingScene& scene);
 
 class GpuScene {
@@ -24,7 +26,9 @@ class GpuScene {
 
   // `edited`: the scene this one was uploaded from, after set_material (lighting_scene.h): uploads
   // the materials, the emitter list and CDF, and the triangle records of old and new emitters
-  // (their area pdfs). Throws std::invalid_argument when the scene's shape differs.
+  // (their area pdfs), and the per-material surface records (textures, alphaMode); when the edit
+  // makes the scene textured, its textures and corners too. Throws std::invalid_argument when the
+  // scene's shape differs.
   void update_materials(const LightingScene& edited);
   // After set_punctual_light: uploads the punctual lights and their CDF, and takes the constant sky.
   void update_lights(const LightingScene& edited);
@@ -44,6 +48,7 @@ class GpuScene {
   Vec3 bounds_hi() const { return bounds_hi_; }
   uint32_t emitter_count() const { return uint32_t(emitters_.size()); }
   uint32_t punctual_count() const { return punctual_count_; }
+  uint32_t surface_flags() const { return surface_flags_; }  // kSurface* (gpu_layout.h)
 
   uint32_t traversal_stack_bound() const { return stack_bound_; }
   bool quantized_nodes() const { return quantized_; }
@@ -55,9 +60,14 @@ class GpuScene {
   // Uploads `bytes` of `data` into `buffer`, first growing it when they do not fit (a material edit
   // can add emitters); the integrator writes its descriptors again before each bake.
   void upload_growing(Buffer& buffer, const void* data, size_t bytes);
+  void upload_surfaces(const LightingScene& scene);
 
   Context& context_;
   Buffer nodes_, leaf_triangles_, triangles_, materials_, emitter_cdf_, emitter_triangles_, punctual_lights_, punctual_cdf_;
+  Buffer surfaces_;  // gpu_surfaces.h
+  SurfaceLayout surface_layout_;
+  bool surfaces_textured_ = false;  // the buffer holds the textures and corners too
+  uint32_t surface_flags_ = 0;
   std::vector<uint32_t> emitters_;  // uploaded emitter triangles: their records change with the next edit
   size_t triangle_count_ = 0, material_count_ = 0;
   uint32_t punctual_count_ = 0;

@@ -4,6 +4,7 @@
 #pragma once
 #include <cstdint>
 
+#include "exitance/common/surface_alpha.h"
 #include "exitance/runtime/scene.h"
 
 namespace exitance {
@@ -18,8 +19,6 @@ bool hit_is_opaque(const Scene& scene, uint32_t triangle, float b1, float b2, fl
 // True when some material is MASK or BLEND (the scene needs the filter at all).
 bool has_alpha_tested_materials(const Scene& scene);
 
-// A uniform number in [0, 1) from a ray and the triangle it met: the same ray meeting the same
-// surface again (Embree may report a hit twice) decides the same way; different rays independently.
-float blend_decision_number(Vec3 origin, Vec3 direction, uint32_t triangle);
+// blend_decision_number (the u of BLEND hits): exitance/common/surface_alpha.h, shared with the kernels.
 
 }  // namespace exitance

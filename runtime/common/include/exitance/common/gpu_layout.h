@@ -16,11 +16,40 @@ struct GpuTriangle {
   vec4 n2;
 };
 
-// Constant-factor material (textured materials are evaluated by the CPU reference only, for now).
+// A material's constant factors: all an untextured scene reads.
 struct GpuMaterial {
   vec4 albedo_double_sided;  // xyz diffuse albedo (material.h); w 1 when double sided
   vec4 emission;             // xyz emitted radiance; w 0
 };
+
+// What a material needs where it varies per point (scenes with GpuParams::surface_flags &
+// kSurfaceTextured): its factors before the diffuse conversion, its textures and its alphaMode.
+struct GpuMaterialSurface {
+  vec4 base_color_metallic;    // xyz baseColorFactor (linear); w metallic
+  vec4 base_offset_scale;      // base colour texture's KHR_texture_transform: xy offset, zw scale
+  vec4 emissive_offset_scale;  // the emissive texture's
+  vec4 rotations_alpha;        // x base colour texture rotation, y emissive rotation, z alpha cutoff, w base alpha
+  vec4 textures_mode;          // uint bits: x base colour texture, y emissive texture (kNoTexture: none),
+                               // z tex_coord sets (base | emissive << 8), w alpha mode (surface_alpha.h)
+};
+const uint kNoTexture = 0xFFFFFFFFu;
+
+// One texture: its texels (vec4 rgb + alpha, linear floats as the CPU reference holds them) start
+// at texel_offset in the texels' part of the surface words, row by row from the top.
+struct GpuTexture {
+  uint texel_offset;
+  uint width;
+  uint height;
+  uint wrap_alpha;  // wrap_s | wrap_t << 8 (texture_sampling.h), bit 16: the texture has alpha
+};
+const uint kTextureHasAlpha = 0x10000u;
+
+// GpuParams::surface_flags: what of the per-point surface data a scene has. 0: constant materials,
+// and traversal never looks at materials.
+const uint kSurfaceTextured = 1u;        // materials are evaluated per point (GpuMaterialSurface)
+const uint kSurfaceVertexColor = 2u;     // per-corner COLOR_0 rgb multiplies the base colour
+const uint kSurfaceVertexAlpha = 4u;     // per-corner COLOR_0 alpha multiplies coverage
+const uint kSurfaceAlphaMaterials = 8u;  // some material is MASK or BLEND: traversal tests hits
 
 struct GpuPunctualLight {
   vec4 position_type;        // xyz position; w type (uint bits: kPunctualPoint/Spot/Directional)
@@ -78,6 +107,7 @@ struct GpuParams {
   uint probe_spp;          // probes: samples per probe of the whole bake (0xFFFFFFFF: until the time budget)
   uint sampling_strategy;  // kStrategy* (path.h)
   uint sampler_mode;       // kSampler* (path_sampler.h); "sampler" is a GLSL keyword
+  uint surface_flags;      // kSurface* above
 };
 
 // Descriptor bindings of the wavefront (one set).
@@ -110,7 +140,16 @@ const uint kBindingBounceSums = 25u;
 const uint kBindingTexelSamples = 26u;
 const uint kBindingProbeShSums = 27u;
 const uint kBindingProbeCounts = 28u;
-const uint kBindingCount = 29u;
+// Per-point surfaces, one vec4 array (a 1-element stand-in unless the scene is textured): lavapipe
+// allows 32 storage buffers per stage, so they share one binding. Word 0 is a header (uint bits:
+// first word of the texture records, of the corner UVs, of the corner colours, of the texels); then
+// kMaterialSurfaceWords per material (GpuMaterialSurface), one word per texture (GpuTexture), per
+// triangle corner uv0 and lightmap uv (xy, zw), per corner COLOR_0 rgba (only with kSurfaceVertexColor),
+// and the texels (rgb, alpha), each texture's from its texel_offset.
+const uint kBindingSurfaces = 29u;
+const uint kBindingCount = 30u;
+const uint kSurfaceHeaderWords = 1u;
+const uint kMaterialSurfaceWords = 5u;
 
 // Counter slots (uint each; statistics are 64-bit lo/hi pairs).
 const uint kCounterRayQueue0 = 0u;  // ray queue sizes, ping-pong (0 and 1)

@@ -76,7 +76,7 @@ class VulkanIntegrator final : public Integrator {
  public:
   // Uploads the scene (its BVH4 as built by the offline stage or read from scene.bin). Throws
   // std::runtime_error when no usable Vulkan device exists (or the adopted one lacks a feature), and
-  // for scenes the backend does not support yet (textured materials, environment-map skies): never
+  // for scenes the backend does not support yet (environment-map skies): never
   // a silently wrong result. The integrator keeps no reference to `scene`.
   static std::unique_ptr<VulkanIntegrator> create(std::shared_ptr<const LightingScene> scene,
                                                   const VulkanDeviceOptions& options = {});
