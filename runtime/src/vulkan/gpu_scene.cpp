@@ -57,11 +57,20 @@ std::vector<ByteRange> triangle_ranges(const std::vector<uint32_t>& triangles) {
   return ranges;
 }
 
+// The image sky's buffers (placeholders when the sky is constant).
+std::vector<float> environment_texels(const LightingScene& scene) {
+  return scene.environment.enabled() ? scene.environment.texels() : std::vector<float>(1);
+}
+std::vector<double> environment_marginal_cdf(const LightingScene& scene) {
+  return scene.environment.enabled() ? scene.environment.marginal_cdf() : std::vector<double>(1);
+}
+std::vector<double> environment_row_cdfs(const LightingScene& scene) {
+  return scene.environment.enabled() ? scene.environment.row_cdfs() : std::vector<double>(1);
+}
+
 }  // namespace
 
 void check_supported_by_vulkan(const LightingScene& scene) {
-  if (scene.environment.enabled())
-    throw std::runtime_error("Vulkan backend: environment-map skies are not supported yet (use the cpu backend)");
   // `textured`: something varies per point, which only the CPU reference evaluates; name what.
   if (scene.textured) {
     if (!scene.source->vertex_color.empty())
@@ -88,6 +97,9 @@ GpuScene::GpuScene(Context& context, const LightingScene& scene, bool quantized_
       emitter_triangles_(upload_new(context, at_least_one(scene.emitter_triangles))),
       punctual_lights_(upload_new(context, at_least_one(scene.punctual_lights))),
       punctual_cdf_(upload_new(context, scene.punctual_cdf)),
+      environment_texels_(upload_new(context, environment_texels(scene))),
+      environment_marginal_cdf_(upload_new(context, environment_marginal_cdf(scene))),
+      environment_row_cdfs_(upload_new(context, environment_row_cdfs(scene))),
       emitters_(scene.emitter_triangles),
       triangle_count_(scene.triangles.size()),
       material_count_(scene.materials.size()),
@@ -96,6 +108,8 @@ GpuScene::GpuScene(Context& context, const LightingScene& scene, bool quantized_
       bounds_lo_(scene.bounds_lo),
       bounds_hi_(scene.bounds_hi),
       extent_(scene.extent),
+      environment_width_(scene.environment.enabled() ? scene.environment.width() : 0),
+      environment_height_(scene.environment.enabled() ? scene.environment.height() : 0),
       stack_bound_(std::max<uint32_t>(scene.bvh.stack_entries + 1, 8)),
       node_count_(uint32_t(scene.bvh.nodes.size())),
       leaf_slots_(uint32_t(scene.bvh.leaf_triangles.size())),
@@ -114,6 +128,9 @@ void GpuScene::bind(DescriptorWrites& writes) const {
   writes.set(kBindingEmitterTriangles, emitter_triangles_);
   writes.set(kBindingPunctualLights, punctual_lights_);
   writes.set(kBindingPunctualCdf, punctual_cdf_);
+  writes.set(kBindingEnvironmentTexels, environment_texels_);
+  writes.set(kBindingEnvironmentMarginalCdf, environment_marginal_cdf_);
+  writes.set(kBindingEnvironmentRowCdfs, environment_row_cdfs_);
 }
 
 void GpuScene::check_same_shape(const LightingScene& edited) const {
@@ -168,6 +185,24 @@ void GpuScene::update_lights(const LightingScene& edited) {
     context_.upload(punctual_lights_, edited.punctual_lights.data(), edited.punctual_lights.size() * sizeof(GpuPunctualLight));
   context_.upload(punctual_cdf_, edited.punctual_cdf.data(), edited.punctual_cdf.size() * sizeof(double));
   sky_ = edited.sky;
+  update_environment(edited);
+}
+
+void GpuScene::update_environment(const LightingScene& edited) {
+  const uint32_t width = edited.environment.enabled() ? edited.environment.width() : 0;
+  const uint32_t height = edited.environment.enabled() ? edited.environment.height() : 0;
+  // The EnvironmentSampler was rebuilt from the edited sky (lighting_scene_refresh.cpp), so an
+  // image of the same size may still hold other texels: upload whenever there is an image.
+  if (width > 0) {
+    const std::vector<float>& texels = edited.environment.texels();
+    upload_growing(environment_texels_, texels.data(), texels.size() * sizeof(float));
+    const std::vector<double>& marginal = edited.environment.marginal_cdf();
+    upload_growing(environment_marginal_cdf_, marginal.data(), marginal.size() * sizeof(double));
+    const std::vector<double>& rows = edited.environment.row_cdfs();
+    upload_growing(environment_row_cdfs_, rows.data(), rows.size() * sizeof(double));
+  }
+  environment_width_ = width;
+  environment_height_ = height;
 }
 
 }  // namespace exitance::vulkan

@@ -13,8 +13,8 @@
 
 namespace exitance::vulkan {
 
-// Throws std::runtime_error for what the kernels cannot evaluate yet: environment-map skies,
-// textured materials (naming the first), a scene without a BVH4.
+// Throws std::runtime_error for what the kernels cannot evaluate yet: textured materials (naming
+// the first), vertex colours, alpha modes, a scene without a BVH4.
 void check_supported_by_vulkan(const LightingScene& scene);
 
 class GpuScene {
@@ -26,7 +26,9 @@ class GpuScene {
   // the materials, the emitter list and CDF, and the triangle records of old and new emitters
   // (their area pdfs). Throws std::invalid_argument when the scene's shape differs.
   void update_materials(const LightingScene& edited);
-  // After set_punctual_light: uploads the punctual lights and their CDF, and takes the constant sky.
+  // After set_punctual_light or a sky edit: uploads the punctual lights and their CDF, takes the
+  // constant sky, and uploads the image sky (texels and CDFs, growing their buffers when the new
+  // image is larger) or switches it off when the edited sky is constant.
   void update_lights(const LightingScene& edited);
 
   // After set_geometry (lighting_scene.h): uploads the triangles, the BVH nodes (in this scene's
@@ -35,7 +37,7 @@ class GpuScene {
   // BVH nodes and leaf slots, traversal stack bound) differs.
   void update_geometry(const LightingScene& edited);
 
-  void bind(DescriptorWrites& writes) const;  // kBindingBvhNodes .. kBindingPunctualCdf
+  void bind(DescriptorWrites& writes) const;  // kBindingBvhNodes .. kBindingPunctualCdf, kBindingEnvironment*
 
   // What the kernels' parameters (GpuParams) take from the scene, current after updates.
   Vec3 sky() const { return sky_; }
@@ -44,6 +46,8 @@ class GpuScene {
   Vec3 bounds_hi() const { return bounds_hi_; }
   uint32_t emitter_count() const { return uint32_t(emitters_.size()); }
   uint32_t punctual_count() const { return punctual_count_; }
+  uint32_t environment_width() const { return environment_width_; }  // 0: constant sky
+  uint32_t environment_height() const { return environment_height_; }
 
   uint32_t traversal_stack_bound() const { return stack_bound_; }
   bool quantized_nodes() const { return quantized_; }
@@ -55,14 +59,17 @@ class GpuScene {
   // Uploads `bytes` of `data` into `buffer`, first growing it when they do not fit (a material edit
   // can add emitters); the integrator writes its descriptors again before each bake.
   void upload_growing(Buffer& buffer, const void* data, size_t bytes);
+  void update_environment(const LightingScene& edited);
 
   Context& context_;
   Buffer nodes_, leaf_triangles_, triangles_, materials_, emitter_cdf_, emitter_triangles_, punctual_lights_, punctual_cdf_;
+  Buffer environment_texels_, environment_marginal_cdf_, environment_row_cdfs_;
   std::vector<uint32_t> emitters_;  // uploaded emitter triangles: their records change with the next edit
   size_t triangle_count_ = 0, material_count_ = 0;
   uint32_t punctual_count_ = 0;
   Vec3 sky_{0, 0, 0}, bounds_lo_{0, 0, 0}, bounds_hi_{0, 0, 0};
   float extent_ = 1.0f;
+  uint32_t environment_width_ = 0, environment_height_ = 0;  // 0: constant sky
   uint32_t stack_bound_ = 8, node_count_ = 0, leaf_slots_ = 0;
   bool quantized_ = false;
 };

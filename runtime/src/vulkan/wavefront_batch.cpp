@@ -5,7 +5,7 @@
 namespace exitance::vulkan {
 namespace {
 
-static_assert(sizeof(GpuParams) == 128);
+static_assert(sizeof(GpuParams) == 144);
 static_assert(sizeof(GpuSurfacePoint) == 48 && sizeof(ShadowRay) == 32);
 
 uint64_t stat64(const uint32_t* c, uint32_t slot) { return uint64_t(c[slot]) | (uint64_t(c[slot + 1]) << 32); }
@@ -46,6 +46,9 @@ GpuParams WavefrontBatchRunner::bake_params(const IntegratorSettings& settings, 
   params.scene_extent = scene_.extent();
   params.emitter_count = scene_.emitter_count();
   params.punctual_count = scene_.punctual_count();
+  params.environment_width = scene_.environment_width();
+  params.environment_height = scene_.environment_height();
+  params.shadow_slots = scene_.environment_width() > 0 ? kShadowRaysPerVertex : kShadowSlotsWithoutEnvironment;
   params.recorded = recorded;
   params.max_bounces = settings.max_bounces;
   params.rr_start = settings.russian_roulette_start;

@@ -40,10 +40,10 @@ struct GpuSurfacePoint {
 // unoccluded (path throughput included). state: kShadowNone, kShadowTrace, or kShadowCountOnly
 // (counted as a traced ray, as the reference counts it, but its segment has zero length).
 const uint kShadowRaysPerVertex = 3u;  // area light, punctual light, environment
-// The wavefront keeps the first two per path slot: the Vulkan backend refuses environment-map skies
-// until it samples them (the host checks), and a third slot cost 32 B per path and 7 % of the shade
-// stage's GPU time on the H200 (0.327 -> 0.304 s, bench/results/vulkan-gpu.md).
-const uint kShadowSlotsPerPath = 2u;
+// The wavefront's shadow-ray buffer has room for all three per path slot, but its stride is
+// GpuParams::shadow_slots: 2 unless the sky is an image, since a third slot written per vertex cost
+// 7 % of the shade stage's GPU time on the H200 (0.327 -> 0.304 s, bench/results/vulkan-gpu.md).
+const uint kShadowSlotsWithoutEnvironment = 2u;
 const float kShadowNone = 0.0f;
 const float kShadowTrace = 1.0f;
 const float kShadowCountOnly = 2.0f;
@@ -78,6 +78,10 @@ struct GpuParams {
   uint probe_spp;          // probes: samples per probe of the whole bake (0xFFFFFFFF: until the time budget)
   uint sampling_strategy;  // kStrategy* (path.h)
   uint sampler_mode;       // kSampler* (path_sampler.h); "sampler" is a GLSL keyword
+  uint environment_width;  // equirect sky (environment_map.h) in texels; 0: the constant sky
+  uint environment_height;
+  uint shadow_slots;       // shadow rays kept per path slot: 3 with an environment map, else 2
+  uint params_pad;
 };
 
 // Descriptor bindings of the wavefront (one set).
@@ -110,7 +114,10 @@ const uint kBindingBounceSums = 25u;
 const uint kBindingTexelSamples = 26u;
 const uint kBindingProbeShSums = 27u;
 const uint kBindingProbeCounts = 28u;
-const uint kBindingCount = 29u;
+const uint kBindingEnvironmentTexels = 29u;       // rgb floats, row 0 = +Y (environment_map.h)
+const uint kBindingEnvironmentMarginalCdf = 30u;  // doubles: rows
+const uint kBindingEnvironmentRowCdfs = 31u;      // doubles: per row, its columns (width + 1 apart)
+const uint kBindingCount = 32u;
 
 // Counter slots (uint each; statistics are 64-bit lo/hi pairs).
 const uint kCounterRayQueue0 = 0u;  // ray queue sizes, ping-pong (0 and 1)
