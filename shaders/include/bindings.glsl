@@ -16,6 +16,7 @@ layout(std430, set = 0, binding = kBindingEmitterCdf) readonly buffer EmitterCdf
 layout(std430, set = 0, binding = kBindingEmitterTriangles) readonly buffer EmitterTriBuffer { uint emitter_tris[]; };
 layout(std430, set = 0, binding = kBindingPunctualLights) readonly buffer PunctualBuffer { GpuPunctualLight punctual[]; };
 layout(std430, set = 0, binding = kBindingPunctualCdf) readonly buffer PunctualCdfBuffer { double punctual_cdf[]; };
+layout(std430, set = 0, binding = kBindingEnvironment) readonly buffer EnvironmentBuffer { double environment[]; };  // CDFs, packed rgb texels
 layout(std430, set = 0, binding = kBindingStartPoints) readonly buffer StartPointBuffer { GpuSurfacePoint start_points[]; };
 layout(std430, set = 0, binding = kBindingBatchItems) readonly buffer BatchItemBuffer { uint batch_items[]; };
 layout(std430, set = 0, binding = kBindingCounters) coherent buffer CounterBuffer { uint counters[]; };
@@ -31,7 +32,7 @@ layout(std430, set = 0, binding = kBindingPathThroughput) buffer PathThroughputB
 layout(std430, set = 0, binding = kBindingPathRayOrigin) buffer PathRayOriginBuffer { vec4 path_ray_o[]; };
 layout(std430, set = 0, binding = kBindingPathRayDirection) buffer PathRayDirBuffer { vec4 path_ray_d[]; };
 layout(std430, set = 0, binding = kBindingPathHit) buffer PathHitBuffer { vec4 path_hit[]; };  // t, triangle bits, b1, b2
-layout(std430, set = 0, binding = kBindingShadowRays) buffer ShadowBuffer { ShadowRay shadow_rays[]; };  // kShadowSlotsPerPath per path
+layout(std430, set = 0, binding = kBindingShadowRays) buffer ShadowBuffer { ShadowRay shadow_rays[]; };  // params.shadow_slots per path
 layout(std430, set = 0, binding = kBindingRayQueue) buffer RayQueueBuffer { uint ray_queue[]; };  // 2 x P (ping-pong)
 layout(std430, set = 0, binding = kBindingShadowQueue) buffer ShadowQueueBuffer { uint shadow_queue[]; };  // P
 layout(std430, set = 0, binding = kBindingResults) buffer ResultBuffer { float results[]; };  // [work][slot 0..K][rgb]

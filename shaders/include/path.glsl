@@ -17,8 +17,8 @@ uint connect_shadow_rays(uint p, inout uint steps) {
   uint work = path_work[p], depth = path_depth[p];
   vec3 origin = path_ray_o[p].xyz;
   uint rays = 0u;
-  for (uint k = 0u; k < kShadowSlotsPerPath; ++k) {
-    uint slot = p * kShadowSlotsPerPath + k;
+  for (uint k = 0u; k < params.shadow_slots; ++k) {
+    uint slot = p * params.shadow_slots + k;
     vec4 contribution = shadow_rays[slot].contribution_state;
     if (contribution.w == kShadowNone) continue;
     ++rays;
@@ -36,11 +36,16 @@ uint connect_shadow_rays(uint p, inout uint steps) {
 uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rng) {
   vec3 origin = offset_ray_origin(x.position, x.geometric_normal, params.scene_extent);
   path_ray_o[p] = vec4(origin, 0.0);
-  ShadowRay area, punctual_light, environment;  // the environment ray is never made here (kShadowSlotsPerPath)
+  ShadowRay area, punctual_light, environment;  // the environment ray exists only with an image sky (3 slots)
   next_event_estimation(x, origin, throughput, params.sampling_strategy, rng, area, punctual_light, environment);
-  shadow_rays[p * kShadowSlotsPerPath] = area;
-  shadow_rays[p * kShadowSlotsPerPath + 1u] = punctual_light;
+  uint first = p * params.shadow_slots;
+  shadow_rays[first] = area;
+  shadow_rays[first + 1u] = punctual_light;
   bool shadows = area.contribution_state.w != kShadowNone || punctual_light.contribution_state.w != kShadowNone;
+  if (params.shadow_slots > kShadowSlotsWithoutEnvironment) {
+    shadow_rays[first + 2u] = environment;
+    shadows = shadows || environment.contribution_state.w != kShadowNone;
+  }
   DirectionSample d = sample_continuation(params.sampling_strategy, x, rng);
   uint pending = shadows ? 2u : 0u;
   if (!(d.pdf > 0.0)) return pending;

@@ -1,7 +1,8 @@
 // The scene accessors of runtime/common/.../path.h over the descriptor set (C++ twin of the
 // interface, over a LightingScene: runtime/include/exitance/runtime/core/scene_access.h). Materials
 // with textures, COLOR_0 and alphaMode are evaluated per point as runtime/src/material_eval.cpp and
-// alpha_coverage.cpp do, through the same shared math; the host refuses environment-map skies.
+// alpha_coverage.cpp do, through the same shared math; an image sky through environment_map.h over the
+// environment buffer, as the C++ EnvironmentSampler does.
 #include "exitance/common/material.h"
 #include "exitance/common/surface_alpha.h"
 #include "exitance/common/texture_sampling.h"
@@ -19,11 +20,29 @@ uint scene_emitter_triangle(uint i) { return emitter_tris[i]; }
 uint scene_punctual_count() { return params.punctual_count; }
 float scene_extent() { return params.scene_extent; }
 
+// CDF handles (distribution.h): a buffer each, and past kCdfEnvironmentRows an offset into the
+// environment's row CDFs (handle kCdfEnvironmentRows + k starts at row entry k; environment_map.h
+// has the buffer's offsets).
 const uint kCdfEmitters = 0u;
 const uint kCdfPunctual = 1u;
+const uint kCdfEnvironmentMarginal = 2u;
+const uint kCdfEnvironmentRows = 3u;
 uint scene_emitter_cdf() { return kCdfEmitters; }
 uint scene_punctual_cdf() { return kCdfPunctual; }
-double cdf_at(uint cdf, uint i) { return cdf == kCdfEmitters ? emitter_cdf[i] : punctual_cdf[i]; }
+double cdf_at(uint cdf, uint i) {
+  if (cdf == kCdfEmitters) return emitter_cdf[i];
+  if (cdf == kCdfPunctual) return punctual_cdf[i];
+  if (cdf == kCdfEnvironmentMarginal) return environment[i];
+  return environment[params.environment_height + 1u + cdf - kCdfEnvironmentRows + i];
+}
+// After cdf_at, which its CDF sampling reads.
+#include "exitance/common/environment_map.h"
+
+// Texel rgb k of the image sky: floats packed two to a double after the CDFs.
+float environment_texel_channel(uint k) {
+  uvec2 halves = unpackDouble2x32(environment[environment_texels_offset(params.environment_width, params.environment_height) + k / 2u]);
+  return uintBitsToFloat((k & 1u) == 0u ? halves.x : halves.y);
+}
 
 // ---- Per-point surfaces (params.surface_flags), read from the packed surface words ----
 uvec4 surface_header() { return floatBitsToUint(surfaces[0]); }  // textures, corner uvs, corner colours, texels
@@ -139,12 +158,21 @@ vec3 scene_emission(uint t, float b1, float b2) {
   if ((params.surface_flags & kSurfaceTextured) != 0u) return textured_emission(t, b1, b2);
   return materials[scene_triangle_material(t)].emission.xyz;
 }
-vec3 scene_sky_radiance(vec3 direction) { return params.sky.xyz; }
-bool scene_has_environment() { return false; }
-float scene_environment_pdf(vec3 direction) { return 0.0; }
+bool scene_has_environment() { return params.environment_width > 0u; }
+vec3 scene_sky_radiance(vec3 direction) {
+  if (!scene_has_environment()) return params.sky.xyz;
+  uint i = environment_texel(direction, params.environment_width, params.environment_height) * 3u;
+  return vec3(environment_texel_channel(i), environment_texel_channel(i + 1u), environment_texel_channel(i + 2u));
+}
+float scene_environment_pdf(vec3 direction) {
+  return environment_direction_pdf(kCdfEnvironmentMarginal, kCdfEnvironmentRows, params.environment_width,
+                                   params.environment_height, direction);
+}
 vec3 scene_sample_environment(float u1, float u2, out float pdf) {
-  pdf = 0.0;
-  return vec3(0.0);
+  vec3 direction = sample_environment_direction(kCdfEnvironmentMarginal, kCdfEnvironmentRows, params.environment_width,
+                                                params.environment_height, u1, u2);
+  pdf = scene_environment_pdf(direction);
+  return direction;
 }
 
 // Guiding tables are not on the device yet (issue 11: the Vulkan backend refuses --guiding grid),

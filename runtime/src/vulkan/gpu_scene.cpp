@@ -8,6 +8,7 @@
 
 #include "bvh_quantization.h"
 #include "gpu_surfaces.h"
+#include "exitance/common/environment_map.h"
 #include "exitance/runtime/core/scene_access.h"
 
 namespace exitance::vulkan {
@@ -58,11 +59,31 @@ std::vector<ByteRange> triangle_ranges(const std::vector<uint32_t>& triangles) {
   return ranges;
 }
 
+// The image sky as the kernels read it (gpu_layout.h kBindingEnvironment): marginal CDF, row CDFs,
+// then the rgb texels bit-copied two floats to a double; a placeholder when the sky is constant.
+std::vector<double> environment_words(const LightingScene& scene) {
+  if (!scene.environment.enabled()) return std::vector<double>(1);
+  const uint32_t width = scene.environment.width(), height = scene.environment.height();
+  const std::vector<double>& marginal = scene.environment.marginal_cdf();
+  const std::vector<double>& rows = scene.environment.row_cdfs();
+  const std::vector<float>& texels = scene.environment.texels();
+  const size_t texels_offset = size_t(height) + 1 + size_t(height) * (size_t(width) + 1);
+  const size_t words = texels_offset + (texels.size() + 1) / 2;
+  if (marginal.size() != environment_rows_offset(height) || marginal.size() + rows.size() != texels_offset)
+    throw std::logic_error("Vulkan backend: the environment CDFs do not have the layout the kernels read");
+  if (words > size_t(UINT32_MAX))
+    throw std::runtime_error("Vulkan backend: the environment map is too large (" + std::to_string(width) + " x " +
+                             std::to_string(height) + " texels)");
+  std::vector<double> packed(words, 0.0);
+  std::copy(marginal.begin(), marginal.end(), packed.begin());
+  std::copy(rows.begin(), rows.end(), packed.begin() + marginal.size());
+  std::memcpy(packed.data() + texels_offset, texels.data(), texels.size() * sizeof(float));
+  return packed;
+}
+
 }  // namespace
 
 void check_supported_by_vulkan(const LightingScene& scene) {
-  if (scene.environment.enabled())
-    throw std::runtime_error("Vulkan backend: environment-map skies are not supported yet (use the cpu backend)");
   if (scene.bvh.nodes.empty()) throw std::invalid_argument("Vulkan backend: the scene has no BVH4 (build_bvh4 or scene.bin)");
 }
 
@@ -76,6 +97,7 @@ GpuScene::GpuScene(Context& context, const LightingScene& scene, bool quantized_
       emitter_triangles_(upload_new(context, at_least_one(scene.emitter_triangles))),
       punctual_lights_(upload_new(context, at_least_one(scene.punctual_lights))),
       punctual_cdf_(upload_new(context, scene.punctual_cdf)),
+      environment_(upload_new(context, environment_words(scene))),
       emitters_(scene.emitter_triangles),
       triangle_count_(scene.triangles.size()),
       material_count_(scene.materials.size()),
@@ -84,6 +106,8 @@ GpuScene::GpuScene(Context& context, const LightingScene& scene, bool quantized_
       bounds_lo_(scene.bounds_lo),
       bounds_hi_(scene.bounds_hi),
       extent_(scene.extent),
+      environment_width_(scene.environment.enabled() ? scene.environment.width() : 0),
+      environment_height_(scene.environment.enabled() ? scene.environment.height() : 0),
       stack_bound_(std::max<uint32_t>(scene.bvh.stack_entries + 1, 8)),
       node_count_(uint32_t(scene.bvh.nodes.size())),
       leaf_slots_(uint32_t(scene.bvh.leaf_triangles.size())),
@@ -120,6 +144,7 @@ void GpuScene::bind(DescriptorWrites& writes) const {
   writes.set(kBindingPunctualLights, punctual_lights_);
   writes.set(kBindingPunctualCdf, punctual_cdf_);
   writes.set(kBindingSurfaces, surfaces_);
+  writes.set(kBindingEnvironment, environment_);
 }
 
 void GpuScene::check_same_shape(const LightingScene& edited) const {
@@ -175,6 +200,20 @@ void GpuScene::update_lights(const LightingScene& edited) {
     context_.upload(punctual_lights_, edited.punctual_lights.data(), edited.punctual_lights.size() * sizeof(GpuPunctualLight));
   context_.upload(punctual_cdf_, edited.punctual_cdf.data(), edited.punctual_cdf.size() * sizeof(double));
   sky_ = edited.sky;
+  update_environment(edited);
+}
+
+void GpuScene::update_environment(const LightingScene& edited) {
+  const uint32_t width = edited.environment.enabled() ? edited.environment.width() : 0;
+  const uint32_t height = edited.environment.enabled() ? edited.environment.height() : 0;
+  // The EnvironmentSampler was rebuilt from the edited sky (lighting_scene_refresh.cpp), so an
+  // image of the same size may still hold other texels: upload whenever there is an image.
+  if (width > 0) {
+    const std::vector<double> words = environment_words(edited);
+    upload_growing(environment_, words.data(), words.size() * sizeof(double));
+  }
+  environment_width_ = width;
+  environment_height_ = height;
 }
 
 }  // namespace exitance::vulkan

@@ -14,9 +14,9 @@
 
 namespace exitance::vulkan {
 
-// Throws std::runtime_error for what the kernels cannot evaluate yet: environment-map skies, and
-// std::invalid_argument for a scene without a BVH4. Textures, COLOR_0 and MASK/BLEND are evaluated
-// per point (gpu_surfaces.h, shaders/include/scene_access.glsl).
+// Throws std::invalid_argument for a scene without a BVH4. Textures, COLOR_0 and MASK/BLEND are
+// evaluated per point (gpu_surfaces.h, shaders/include/scene_access.glsl), image skies through
+// environment_map.h.
 void check_supported_by_vulkan(const LightingScene& scene);
 
 class GpuScene {
@@ -30,7 +30,9 @@ class GpuScene {
   // makes the scene textured, its textures and corners too. Throws std::invalid_argument when the
   // scene's shape differs.
   void update_materials(const LightingScene& edited);
-  // After set_punctual_light: uploads the punctual lights and their CDF, and takes the constant sky.
+  // After set_punctual_light or a sky edit: uploads the punctual lights and their CDF, takes the
+  // constant sky, and uploads the image sky (texels and CDFs, growing their buffers when the new
+  // image is larger) or switches it off when the edited sky is constant.
   void update_lights(const LightingScene& edited);
 
   // After set_geometry (lighting_scene.h): uploads the triangles, the BVH nodes (in this scene's
@@ -39,7 +41,7 @@ class GpuScene {
   // BVH nodes and leaf slots, traversal stack bound) differs.
   void update_geometry(const LightingScene& edited);
 
-  void bind(DescriptorWrites& writes) const;  // kBindingBvhNodes .. kBindingPunctualCdf
+  void bind(DescriptorWrites& writes) const;  // kBindingBvhNodes .. kBindingPunctualCdf, kBindingSurfaces, kBindingEnvironment
 
   // What the kernels' parameters (GpuParams) take from the scene, current after updates.
   Vec3 sky() const { return sky_; }
@@ -49,6 +51,8 @@ class GpuScene {
   uint32_t emitter_count() const { return uint32_t(emitters_.size()); }
   uint32_t punctual_count() const { return punctual_count_; }
   uint32_t surface_flags() const { return surface_flags_; }  // kSurface* (gpu_layout.h)
+  uint32_t environment_width() const { return environment_width_; }  // 0: constant sky
+  uint32_t environment_height() const { return environment_height_; }
 
   uint32_t traversal_stack_bound() const { return stack_bound_; }
   bool quantized_nodes() const { return quantized_; }
@@ -61,6 +65,7 @@ class GpuScene {
   // can add emitters); the integrator writes its descriptors again before each bake.
   void upload_growing(Buffer& buffer, const void* data, size_t bytes);
   void upload_surfaces(const LightingScene& scene);
+  void update_environment(const LightingScene& edited);
 
   Context& context_;
   Buffer nodes_, leaf_triangles_, triangles_, materials_, emitter_cdf_, emitter_triangles_, punctual_lights_, punctual_cdf_;
@@ -68,11 +73,13 @@ class GpuScene {
   SurfaceLayout surface_layout_;
   bool surfaces_textured_ = false;  // the buffer holds the textures and corners too
   uint32_t surface_flags_ = 0;
+  Buffer environment_;  // gpu_layout.h kBindingEnvironment
   std::vector<uint32_t> emitters_;  // uploaded emitter triangles: their records change with the next edit
   size_t triangle_count_ = 0, material_count_ = 0;
   uint32_t punctual_count_ = 0;
   Vec3 sky_{0, 0, 0}, bounds_lo_{0, 0, 0}, bounds_hi_{0, 0, 0};
   float extent_ = 1.0f;
+  uint32_t environment_width_ = 0, environment_height_ = 0;  // 0: constant sky
   uint32_t stack_bound_ = 8, node_count_ = 0, leaf_slots_ = 0;
   bool quantized_ = false;
 };

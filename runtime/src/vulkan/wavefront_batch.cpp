@@ -47,6 +47,9 @@ GpuParams WavefrontBatchRunner::bake_params(const IntegratorSettings& settings, 
   params.emitter_count = scene_.emitter_count();
   params.punctual_count = scene_.punctual_count();
   params.surface_flags = scene_.surface_flags();
+  params.environment_width = scene_.environment_width();
+  params.environment_height = scene_.environment_height();
+  params.shadow_slots = scene_.environment_width() > 0 ? kShadowRaysPerVertex : kShadowSlotsWithoutEnvironment;
   params.recorded = recorded;
   params.max_bounces = settings.max_bounces;
   params.rr_start = settings.russian_roulette_start;

@@ -30,7 +30,7 @@ PathStateBuffers::PathStateBuffers(Context& context, uint32_t paths)
       ray_origin(context.create_storage_buffer(size_t(paths) * 16)),
       ray_direction(context.create_storage_buffer(size_t(paths) * 16)),
       hit(context.create_storage_buffer(size_t(paths) * 16)),
-      shadow_rays(context.create_storage_buffer(size_t(paths) * kShadowSlotsPerPath * sizeof(ShadowRay))) {}
+      shadow_rays(context.create_storage_buffer(size_t(paths) * kShadowRaysPerVertex * sizeof(ShadowRay))) {}
 
 void PathStateBuffers::bind(DescriptorWrites& writes) const {
   writes.set(kBindingPathWork, work);

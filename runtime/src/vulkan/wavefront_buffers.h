@@ -33,11 +33,11 @@ struct PathStateBuffers {
   Buffer ray_origin;
   Buffer ray_direction;
   Buffer hit;            // t, triangle bits, b1, b2
-  Buffer shadow_rays;    // kShadowSlotsPerPath next-event shadow rays, waiting for connect
+  Buffer shadow_rays;    // next-event shadow rays waiting for connect: room for kShadowRaysPerVertex, stride GpuParams::shadow_slots
 
   PathStateBuffers(Context& context, uint32_t paths);
   void bind(DescriptorWrites& writes) const;
-  static constexpr size_t kBytesPerPath = 4 + 4 + 16 + 16 + 16 + 16 + 16 + kShadowSlotsPerPath * sizeof(ShadowRay);
+  static constexpr size_t kBytesPerPath = 4 + 4 + 16 + 16 + 16 + 16 + 16 + kShadowRaysPerVertex * sizeof(ShadowRay);
 };
 
 // Paths whose continuation ray waits for extend, then shade: two queues of a slot per path,

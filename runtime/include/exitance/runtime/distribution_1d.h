@@ -29,10 +29,7 @@ class Distribution1D {
   size_t sample(float u, float* remapped = nullptr) const {
     float probability = 0;
     const size_t i = sample_cdf(cdf_.data(), uint32_t(size()), u, probability);  // shared with the shaders
-    if (remapped) {
-      const double width = cdf_[i + 1] - cdf_[i];
-      *remapped = width > 0 ? float(std::clamp((double(u) - cdf_[i]) / width, 0.0, 0.99999994)) : 0.5f;
-    }
+    if (remapped) *remapped = cdf_remap(cdf_.data(), uint32_t(i), u);
     return i;
   }
 

@@ -52,6 +52,11 @@ inline uint max(uint a, uint b) { return a < b ? b : a; }
 inline int max(int a, int b) { return a < b ? b : a; }
 inline float clamp(float x, float lo, float hi) { return min(max(x, lo), hi); }
 inline float sqrt(float a) { return std::sqrt(a); }
+inline double sqrt(double a) { return std::sqrt(a); }
+inline double min(double a, double b) { return b < a ? b : a; }
+inline double max(double a, double b) { return a < b ? b : a; }
+inline double clamp(double x, double lo, double hi) { return min(max(x, lo), hi); }
+inline float acos(float a) { return std::acos(a); }
 inline float floor(float a) { return std::floor(a); }
 inline float cos(float a) { return std::cos(a); }
 inline float sin(float a) { return std::sin(a); }

@@ -69,10 +69,10 @@ struct GpuSurfacePoint {
 // unoccluded (path throughput included). state: kShadowNone, kShadowTrace, or kShadowCountOnly
 // (counted as a traced ray, as the reference counts it, but its segment has zero length).
 const uint kShadowRaysPerVertex = 3u;  // area light, punctual light, environment
-// The wavefront keeps the first two per path slot: the Vulkan backend refuses environment-map skies
-// until it samples them (the host checks), and a third slot cost 32 B per path and 7 % of the shade
-// stage's GPU time on the H200 (0.327 -> 0.304 s, bench/results/vulkan-gpu.md).
-const uint kShadowSlotsPerPath = 2u;
+// The wavefront's shadow-ray buffer has room for all three per path slot, but its stride is
+// GpuParams::shadow_slots: 2 unless the sky is an image, since a third slot written per vertex cost
+// 7 % of the shade stage's GPU time on the H200 (0.327 -> 0.304 s, bench/results/vulkan-gpu.md).
+const uint kShadowSlotsWithoutEnvironment = 2u;
 const float kShadowNone = 0.0f;
 const float kShadowTrace = 1.0f;
 const float kShadowCountOnly = 2.0f;
@@ -108,6 +108,9 @@ struct GpuParams {
   uint sampling_strategy;  // kStrategy* (path.h)
   uint sampler_mode;       // kSampler* (path_sampler.h); "sampler" is a GLSL keyword
   uint surface_flags;      // kSurface* above
+  uint environment_width;  // equirect sky (environment_map.h) in texels; 0: the constant sky
+  uint environment_height;
+  uint shadow_slots;       // shadow rays kept per path slot: 3 with an environment map, else 2
 };
 
 // Descriptor bindings of the wavefront (one set).
@@ -147,9 +150,13 @@ const uint kBindingProbeCounts = 28u;
 // triangle corner uv0 and lightmap uv (xy, zw), per corner COLOR_0 rgba (only with kSurfaceVertexColor),
 // and the texels (rgb, alpha), each texture's from its texel_offset.
 const uint kBindingSurfaces = 29u;
-const uint kBindingCount = 30u;
 const uint kSurfaceHeaderWords = 1u;
 const uint kMaterialSurfaceWords = 5u;
+// The image sky, one array of doubles (a 1-element stand-in when the sky is constant), for the same
+// reason: the marginal CDF over rows (height + 1 entries), then one CDF per row (width + 1 entries
+// each), then the texels' rgb floats packed two to a double (offsets: environment_map.h).
+const uint kBindingEnvironment = 30u;
+const uint kBindingCount = 31u;
 
 // Counter slots (uint each; statistics are 64-bit lo/hi pairs).
 const uint kCounterRayQueue0 = 0u;  // ray queue sizes, ping-pong (0 and 1)

@@ -1,7 +1,7 @@
 // The scene as every lighting backend reads it, built once by the offline stage (or from scene.bin)
 // and handed to the backends: triangles, materials and lights in the GPU layout
 // (runtime/common/.../gpu_layout.h), the light-selection CDFs, the BVH, and the source Scene for
-// names, instances and what only the CPU reference evaluates today (textures, environment maps).
+// names, instances and what only the CPU reference evaluates today (textures).
 #pragma once
 #include <memory>
 #include <vector>
@@ -22,7 +22,7 @@ struct LightingScene {
   std::vector<double> emitter_cdf;           // emitter_triangles.size() + 1 entries (at least 2)
   std::vector<double> punctual_cdf;          // punctual_lights.size() + 1 entries (at least 2), by power
   Vec3 sky{0, 0, 0};                         // constant sky radiance (when there is no environment map)
-  EnvironmentSampler environment;            // enabled when the sky is an image (CPU reference only)
+  EnvironmentSampler environment;            // enabled when the sky is an image
   Vec3 bounds_lo{0, 0, 0}, bounds_hi{0, 0, 0};
   float extent = 1.0f;                       // largest side of the bounds: the scale of ray-offset floors
   bool textured = false;  // materials vary per point (textures, MASK/BLEND, COLOR_0): CPU reference only

@@ -1,7 +1,7 @@
 // The scene accessors of runtime/common/.../path.h for C++ code (the CPU reference, tests): reads a
-// LightingScene. Textured materials and environment-map skies are evaluated here from the source
-// Scene; the shaders' accessors (shaders/include/scene_access.glsl) read constant factors only and
-// the Vulkan backend refuses scenes that need more (LightingScene::textured, environment).
+// LightingScene. Textured materials are evaluated here from the source Scene; the shaders' accessors
+// (shaders/include/scene_access.glsl) read constant factors only and the Vulkan backend refuses
+// scenes that need more (LightingScene::textured). Image skies go through environment_map.h on both.
 #pragma once
 #include "exitance/common/gpu_layout.h"
 #include "exitance/runtime/core/lighting_scene.h"
