@@ -29,6 +29,7 @@ formats::BakeSettings settings_of(const BakeResults& results, const BakeOptions&
   s.target_error = options.lighting.target_relative_error;
   s.adaptive = results.lightmap.adaptive;
   s.sampler = options.lighting.sampler == kSamplerIndependent ? "independent" : "sobol";
+  s.directional = results.lightmap.has_sh1() ? "sh1" : "off";
   s.bounces = options.lighting.max_bounces;
   s.seed = options.lighting.seed;
   s.texel_density = results.layout.texel_density;

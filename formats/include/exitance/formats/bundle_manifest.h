@@ -103,6 +103,7 @@ struct BakeSettings {
   double target_error = 0;
   bool adaptive = false;  // samples planned per texel (bake --adaptive)
   std::string sampler = "sobol";  // "sobol" | "independent" (bake --sampler)
+  std::string directional = "off";  // "off" | "sh1" (bake --directional; written only when "sh1")
   int32_t bounces = -1;  // -1: until Russian roulette
   uint64_t seed = 0;
   double texel_density = 0;
