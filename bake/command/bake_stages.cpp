@@ -123,11 +123,6 @@ std::shared_ptr<const Integrator> backend_stage(const SceneForLighting& scene, c
     request.name = "cpu";
     diagnostics.warn("--guiding grid: using the CPU reference (Embree), the only backend with guiding yet");
   }
-  if (options.lighting.directional != DirectionalMode::Off && request.name == "auto") {
-    // Directional layers exist on the CPU backend only for now (the Vulkan backend refuses them).
-    request.name = "cpu";
-    diagnostics.warn("--directional sh1: using the CPU reference (Embree), the only backend with directional layers yet");
-  }
   return choose_lighting_backend(scene.lighting, scene.embree, request, diagnostics);
 }
 

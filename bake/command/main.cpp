@@ -95,8 +95,7 @@ int main(int argc, char** argv) {
   app.add_option("--voxel-resolution", voxels,
                  "SVO leaves per axis: a power of two 2..4096, auto (leaves about 4 texels wide) or none");
   app.add_option("--directional", directional,
-                 "sh1: also write L1 SH directional layers sh1.x.R .. sh1.z.B (docs/bundle.md; path tracing, CPU "
-                 "backend for now)");
+                 "sh1: also write L1 SH directional layers sh1.x.R .. sh1.z.B (docs/bundle.md; path tracing)");
   app.add_option("--guiding", guiding,
                  "auto (= off for now) | off | svo (not implemented yet) | grid (regular-grid SARSA cache, seed 002; "
                  "CPU backend only)")

@@ -38,6 +38,8 @@ layout(std430, set = 0, binding = kBindingBounceSums) buffer BounceAccumulatorBu
 layout(std430, set = 0, binding = kBindingTexelSamples) buffer SampleCountBuffer { uint acc_samples[]; };
 layout(std430, set = 0, binding = kBindingProbeShSums) buffer ProbeShBuffer { double acc_probe_sh[]; };  // [probe][coefficient][rgb]
 layout(std430, set = 0, binding = kBindingProbeCounts) buffer ProbeCountBuffer { uint acc_probe_counts[]; };  // [probe][samples, back faces]
+layout(std430, set = 0, binding = kBindingPathSh1Factor) buffer PathSh1Buffer { vec4 path_sh1_factor[]; };  // xyz per path
+layout(std430, set = 0, binding = kBindingTexelSh1Sums) buffer Sh1AccumulatorBuffer { double acc_sh1[]; };  // [texel][axis][rgb]
 
 layout(push_constant) uniform Push {
   uint cur;    // which ray queue is read this iteration (0/1)
@@ -71,4 +73,23 @@ void add_result(uint work, uint depth, vec3 value) {
   results[i] += value.x;
   results[i + 1u] += value.y;
   results[i + 2u] += value.z;
+}
+
+// Directional texel batches: per work item 9 floats of L1 [axis][rgb] after all the bounce slots.
+uint sh1_result_index(uint work) { return params.batch_work_total * (params.recorded + 1u) * 3u + work * 9u; }
+
+void add_sh1_result(uint work, vec3 value, vec3 factor) {
+  uint i = sh1_result_index(work);
+  for (uint axis = 0u; axis < 3u; ++axis) {
+    results[i + axis * 3u] += value.x * factor[axis];
+    results[i + axis * 3u + 1u] += value.y * factor[axis];
+    results[i + axis * 3u + 2u] += value.z * factor[axis];
+  }
+}
+
+// A contribution of path p: its E/pi slot, and on a directional texel batch its L1 through the
+// path's first continuation (path.h sh1_direction_factor).
+void add_path_result(uint p, uint work, uint depth, vec3 value) {
+  add_result(work, depth, value);
+  if (params.directional != 0u) add_sh1_result(work, value, path_sh1_factor[p].xyz);
 }

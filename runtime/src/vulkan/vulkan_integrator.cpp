@@ -57,7 +57,6 @@ VulkanIntegrator::~VulkanIntegrator() = default;
 LightmapEstimate VulkanIntegrator::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const {
   if (settings.integrator == IntegratorMode::Bounces) throw std::runtime_error("Vulkan backend: --integrator bounces is implemented on the CPU backend only (use --backend cpu)");
   if (settings.guiding != GuidingMode::Off) throw std::runtime_error("Vulkan backend: --guiding grid is implemented on the CPU backend only (use --backend cpu)");
-  if (settings.directional != DirectionalMode::Off) throw std::runtime_error("Vulkan backend: --directional sh1 is implemented on the CPU backend only (use --backend cpu)");
   if (settings.adaptive) throw std::runtime_error("Vulkan backend: --adaptive on is implemented on the CPU backend only (use --backend cpu)");
   if (settings.spp == 0 && !(settings.time_budget_seconds > 0) && !(settings.target_relative_error > 0))
     throw std::invalid_argument("Vulkan backend: spp 0 needs a time budget or a target error");
@@ -71,7 +70,7 @@ ProbeEstimate VulkanIntegrator::bake_probes(const std::vector<Vec3>& positions, 
 }
 
 void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) {
-  if (settings.directional != DirectionalMode::Off) throw std::runtime_error("Vulkan backend: --directional sh1 is implemented on the CPU backend only (use --backend cpu)");
+  if (settings.directional != DirectionalMode::Off) throw std::runtime_error("Vulkan backend: progressive refresh estimates no directional layers yet");
   if (settings.guiding != GuidingMode::Off) throw std::runtime_error("Vulkan backend: --guiding grid is implemented on the CPU backend only (use --backend cpu)");
   impl_->lightmap.start(gbuffer, settings);
 }

@@ -30,7 +30,8 @@ PathStateBuffers::PathStateBuffers(Context& context, uint32_t paths)
       ray_origin(context.create_storage_buffer(size_t(paths) * 16)),
       ray_direction(context.create_storage_buffer(size_t(paths) * 16)),
       hit(context.create_storage_buffer(size_t(paths) * 16)),
-      shadow_rays(context.create_storage_buffer(size_t(paths) * kShadowSlotsPerPath * sizeof(ShadowRay))) {}
+      shadow_rays(context.create_storage_buffer(size_t(paths) * kShadowSlotsPerPath * sizeof(ShadowRay))),
+      sh1_factor(context.create_storage_buffer(size_t(paths) * 16)) {}
 
 void PathStateBuffers::bind(DescriptorWrites& writes) const {
   writes.set(kBindingPathWork, work);
@@ -41,6 +42,7 @@ void PathStateBuffers::bind(DescriptorWrites& writes) const {
   writes.set(kBindingPathRayDirection, ray_direction);
   writes.set(kBindingPathHit, hit);
   writes.set(kBindingShadowRays, shadow_rays);
+  writes.set(kBindingPathSh1Factor, sh1_factor);
 }
 
 RayQueue::RayQueue(Context& context, uint32_t paths) : entries(context.create_storage_buffer(size_t(paths) * kBytesPerPath)) {}
@@ -74,22 +76,25 @@ void SampleResults::bind(DescriptorWrites& writes) const { writes.set(kBindingRe
 TexelAccumulators::TexelAccumulators(Context& context)
     : sums(context.create_storage_buffer(kPlaceholder)),
       bounce_sums(context.create_storage_buffer(kPlaceholder)),
-      samples(context.create_storage_buffer(kPlaceholder)) {}
+      samples(context.create_storage_buffer(kPlaceholder)),
+      sh1_sums(context.create_storage_buffer(kPlaceholder)) {}
 
-void TexelAccumulators::reserve(Context& context, size_t texels, int layers) {
+void TexelAccumulators::reserve(Context& context, size_t texels, int layers, bool directional) {
   grow(context, sums, texels * 6 * 8);
   grow(context, bounce_sums, size_t(layers) * texels * 3 * 8);
   grow(context, samples, texels * 4);
+  if (directional) grow(context, sh1_sums, texels * 9 * 8);
 }
 
 void TexelAccumulators::clear(VkCommandBuffer cmd) const {
-  for (const Buffer* b : {&sums, &bounce_sums, &samples}) vkCmdFillBuffer(cmd, b->handle(), 0, VK_WHOLE_SIZE, 0);
+  for (const Buffer* b : {&sums, &bounce_sums, &samples, &sh1_sums}) vkCmdFillBuffer(cmd, b->handle(), 0, VK_WHOLE_SIZE, 0);
 }
 
 void TexelAccumulators::bind(DescriptorWrites& writes) const {
   writes.set(kBindingTexelSums, sums);
   writes.set(kBindingBounceSums, bounce_sums);
   writes.set(kBindingTexelSamples, samples);
+  writes.set(kBindingTexelSh1Sums, sh1_sums);
 }
 
 ProbeAccumulators::ProbeAccumulators(Context& context)

@@ -34,6 +34,7 @@ struct PathStateBuffers {
   Buffer ray_direction;
   Buffer hit;            // t, triangle bits, b1, b2
   Buffer shadow_rays;    // kShadowSlotsPerPath next-event shadow rays, waiting for connect
+  Buffer sh1_factor;     // xyz: the first continuation's sh1_direction_factor (directional texel batches)
 
   PathStateBuffers(Context& context, uint32_t paths);
   void bind(DescriptorWrites& writes) const;
@@ -106,9 +107,10 @@ struct TexelAccumulators {
   Buffer sums;         // [texel][total rgb, squared rgb]
   Buffer bounce_sums;  // [layer][texel][rgb]
   Buffer samples;      // [texel]
+  Buffer sh1_sums;     // [texel][axis][rgb], directional bakes only (placeholder otherwise)
 
   explicit TexelAccumulators(Context& context);
-  void reserve(Context& context, size_t texels, int layers);
+  void reserve(Context& context, size_t texels, int layers, bool directional = false);
   void clear(VkCommandBuffer cmd) const;
   void bind(DescriptorWrites& writes) const;
 };

@@ -78,6 +78,10 @@ struct GpuParams {
   uint probe_spp;          // probes: samples per probe of the whole bake (0xFFFFFFFF: until the time budget)
   uint sampling_strategy;  // kStrategy* (path.h)
   uint sampler_mode;       // kSampler* (path_sampler.h); "sampler" is a GLSL keyword
+  uint directional;        // texel batches: 1 = also estimate the L1 SH layers (DirectionalMode::Sh1)
+  uint pad0;
+  uint pad1;
+  uint pad2;
 };
 
 // Descriptor bindings of the wavefront (one set).
@@ -110,7 +114,12 @@ const uint kBindingBounceSums = 25u;
 const uint kBindingTexelSamples = 26u;
 const uint kBindingProbeShSums = 27u;
 const uint kBindingProbeCounts = 28u;
-const uint kBindingCount = 29u;
+// Directional (L1 SH) texels: per path the first continuation's sh1_direction_factor (xyz), and per
+// texel the 9 L1 sums [texel][axis][rgb]. The per-sample L1 results follow the batch's bounce slots
+// in the results buffer (bindings.glsl sh1_result_index).
+const uint kBindingPathSh1Factor = 29u;
+const uint kBindingTexelSh1Sums = 30u;
+const uint kBindingCount = 31u;
 
 // Counter slots (uint each; statistics are 64-bit lo/hi pairs).
 const uint kCounterRayQueue0 = 0u;  // ray queue sizes, ping-pong (0 and 1)

@@ -22,7 +22,8 @@ enum class GuidingMode { Off, Grid };
 // Directional lightmaps (bake --directional, issue 14). Sh1: per texel also the world-space L1 SH
 // coefficients of cosine-convolved irradiance in units of E/pi (LightmapEstimate::sh1,
 // docs/bundle.md "Directional layers"); the texel's first continuation then samples a defensive
-// mixture with the uniform hemisphere (path.h). Path mode only.
+// mixture with the uniform hemisphere (path.h). Path mode only; both backends (not the Vulkan
+// progressive refresh).
 enum class DirectionalMode { Off, Sh1 };
 
 struct IntegratorSettings {
