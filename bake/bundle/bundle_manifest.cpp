@@ -30,6 +30,7 @@ formats::BakeSettings settings_of(const BakeResults& results, const BakeOptions&
   s.adaptive = results.lightmap.adaptive;
   s.sampler = options.lighting.sampler == kSamplerIndependent ? "independent" : "sobol";
   s.first_bounce = options.lighting.trace_first_bounce ? "traced" : "cached";
+  s.directional = results.lightmap.has_sh1() ? "sh1" : "off";
   s.bounces = options.lighting.max_bounces;
   s.seed = options.lighting.seed;
   s.texel_density = results.layout.texel_density;

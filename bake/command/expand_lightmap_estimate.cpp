@@ -32,7 +32,7 @@ std::vector<T> scatter_per_texel(const std::vector<T>& traced, const std::vector
 // A new per-texel field of LightmapEstimate (estimates.h) must be added below: the copy at the top
 // carries every other field over unchanged, which for a per-texel vector would leave it indexed by
 // traced texel. The static_assert is there to make a new field fail the build here until it is.
-static_assert(sizeof(LightmapEstimate) == 184,
+static_assert(sizeof(LightmapEstimate) == 208,
               "LightmapEstimate changed: scatter its new per-texel fields in expand_lightmap_estimate, then update "
               "this size");
 
@@ -48,6 +48,7 @@ LightmapEstimate expand_lightmap_estimate(const LightmapEstimate& traced, const 
   LightmapEstimate full = traced;  // the fields that are not per texel
   full.texels = scatter_per_texel(traced.texels, full_index, all, 1, "texels");
   full.bounces = scatter_per_texel(traced.bounces, full_index, all, size_t(traced.recorded_bounces), "bounces");
+  full.sh1 = scatter_per_texel(traced.sh1, full_index, all, 1, "sh1");  // [texel][axis][rgb]: 9 elements
   return full;
 }
 

@@ -94,7 +94,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0f, 16.0f));
   app.add_option("--voxel-resolution", voxels,
                  "SVO leaves per axis: a power of two 2..4096, auto (leaves about 4 texels wide) or none");
-  app.add_option("--directional", directional, "sh1: L1 directional lightmaps (not implemented yet)");
+  app.add_option("--directional", directional,
+                 "sh1: also write L1 SH directional layers sh1.x.R .. sh1.z.B (docs/bundle.md; path tracing)");
   app.add_option("--guiding", guiding,
                  "auto (= off for now) | off | svo (not implemented yet) | grid (regular-grid SARSA cache, seed 002; "
                  "CPU backend only)")
@@ -220,7 +221,17 @@ int main(int argc, char** argv) {
   options.lighting.sampler = sampler == "independent" ? exitance::kSamplerIndependent : exitance::kSamplerSobol;
   options.lighting.trace_first_bounce = first_bounce == "traced";
   options.stitch_seams = seams == "stitch";
-  if (!directional.empty()) diagnostics.warn("--directional: directional lightmaps are not implemented yet; ignored");
+  if (!directional.empty()) {
+    if (directional != "sh1") {
+      std::cerr << "bake: error: --directional " << directional << ": expected sh1\n";
+      return 2;
+    }
+    if (integrator != "path") {
+      std::cerr << "bake: error: --directional sh1 is estimated by path tracing: it needs --integrator path\n";
+      return 2;
+    }
+    options.lighting.directional = exitance::DirectionalMode::Sh1;
+  }
   if (guiding == "svo") {
     std::cerr << "bake: error: --guiding svo is not implemented yet (use grid or off)\n";
     return 1;

@@ -304,6 +304,11 @@ BakeSettings parse_settings(const FieldReader& r, const json& j) {
     if (s.sampler != "sobol" && s.sampler != "independent")
       r.fail(path("sampler"), "\"" + s.sampler + "\" is not sobol or independent");
   }
+  if (auto v = field("directional")) {
+    s.directional = r.string(*v, path("directional"));
+    if (s.directional != "off" && s.directional != "sh1")
+      r.fail(path("directional"), "\"" + s.directional + "\" is not off or sh1");
+  }
   if (auto v = field("bounces")) s.bounces = int32_t(r.signed_integer(*v, path("bounces"), -1, kIntMax));
   if (auto v = field("seed")) s.seed = r.unsigned_integer(*v, path("seed"), 0, UINT64_MAX);
   if (auto v = field("texel_density")) s.texel_density = r.non_negative_double(*v, path("texel_density"));

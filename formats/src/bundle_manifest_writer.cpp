@@ -38,6 +38,7 @@ json settings_json(const BakeSettings& s) {
             {"probe_dering_window", s.probe_dering_window},
             {"voxel_resolution", s.voxel_resolution ? json(*s.voxel_resolution) : json("none")}};
   if (!s.backend.empty()) j["backend"] = s.backend;
+  if (s.directional != "off") j["directional"] = s.directional;
   return j;
 }
 

@@ -27,6 +27,13 @@ Vec3 LightmapEstimate::mean_bounce(int bounce, size_t texel) const {
   return {float(bounces[base] / a.samples), float(bounces[base + 1] / a.samples), float(bounces[base + 2] / a.samples)};
 }
 
+Vec3 LightmapEstimate::mean_sh1(int axis, size_t texel) const {
+  const TexelAccumulator& a = texels[texel];
+  if (sh1.empty() || a.samples == 0 || axis < 0 || axis > 2) return {0, 0, 0};
+  const size_t base = (texel * 3 + size_t(axis)) * 3;
+  return {float(sh1[base] / a.samples), float(sh1[base + 1] / a.samples), float(sh1[base + 2] / a.samples)};
+}
+
 Vec3 LightmapEstimate::variance_of_mean(size_t texel) const {
   const TexelAccumulator& a = texels[texel];
   if (a.samples < 2) return {0, 0, 0};

@@ -70,6 +70,8 @@ int main(int argc, char** argv) {
   try {
     const nlohmann::json report = exitance::relight_bundle(options);
     bar.finish();
+    if (report.contains("warnings"))
+      for (const auto& w : report["warnings"]) std::cerr << "exitance-relight: warning: " << w.get<std::string>() << "\n";
     if (json_report) {
       std::cout << report.dump(2) << "\n";
     } else {

@@ -75,3 +75,27 @@ void add_result(uint work, uint depth, vec3 value) {
   results[i + 1u] += value.y;
   results[i + 2u] += value.z;
 }
+
+// Directional texel state (gpu_layout.h): path p's first-continuation factor after the P
+// throughputs, a texel's 9 L1 sums after all the texels' total sums.
+uint sh1_factor_index(uint p) { return params.path_capacity + p; }
+uint sh1_sum_index(uint texel) { return params.item_count_total * 6u + texel * 9u; }
+
+// Directional texel batches: per work item 9 floats of L1 [axis][rgb] after all the bounce slots.
+uint sh1_result_index(uint work) { return params.batch_work_total * (params.recorded + 1u) * 3u + work * 9u; }
+
+void add_sh1_result(uint work, vec3 value, vec3 factor) {
+  uint i = sh1_result_index(work);
+  for (uint axis = 0u; axis < 3u; ++axis) {
+    results[i + axis * 3u] += value.x * factor[axis];
+    results[i + axis * 3u + 1u] += value.y * factor[axis];
+    results[i + axis * 3u + 2u] += value.z * factor[axis];
+  }
+}
+
+// A contribution of path p: its E/pi slot, and on a directional texel batch its L1 through the
+// path's first continuation (path.h sh1_direction_factor).
+void add_path_result(uint p, uint work, uint depth, vec3 value) {
+  add_result(work, depth, value);
+  if (params.directional != 0u) add_sh1_result(work, value, path_throughput[sh1_factor_index(p)].xyz);
+}

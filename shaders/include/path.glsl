@@ -25,7 +25,18 @@ uint connect_shadow_rays(uint p, inout uint steps) {
     shadow_rays[slot].contribution_state.w = kShadowNone;
     if (contribution.w != kShadowTrace) continue;
     vec4 ray = shadow_rays[slot].direction_length;
-    if (!trace_any(origin, ray.xyz, ray.w, steps)) add_result(work, depth, contribution.xyz);
+    if (trace_any(origin, ray.xyz, ray.w, steps)) continue;
+    add_result(work, depth, contribution.xyz);
+    if (params.directional != 0u) {
+      // The texel's own next-event samples carry their shadow ray's direction; deeper ones the first continuation's.
+      vec3 factor = path_throughput[sh1_factor_index(p)].xyz;
+      if (depth == 0u) {
+        SurfacePoint texel;
+        texel.shading_normal = start_points[batch_items[params.batch_item_offset + work % params.batch_item_count]].shading_normal.xyz;
+        factor = sh1_direction_factor(texel, ray.xyz);
+      }
+      add_sh1_result(work, contribution.xyz, factor);
+    }
   }
   return rays;
 }
@@ -37,7 +48,11 @@ uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rn
   vec3 origin = offset_ray_origin(x.position, x.geometric_normal, params.scene_extent);
   path_ray_o[p] = vec4(origin, 0.0);
   ShadowRay area, punctual_light, environment;  // the environment ray exists only with an image sky (3 slots)
-  next_event_estimation(x, origin, throughput, params.sampling_strategy, rng, area, punctual_light, environment);
+  // A directional texel's own vertex samples the defensive mixture (path.h); every other vertex cosine.
+  bool directional_texel = !kProbeMode && params.directional != 0u && path_depth[p] == 0u;
+  GuideVertex guide = guide_vertex_cosine();
+  if (directional_texel) guide = with_uniform_component(guide, kDirectionalUniformProbability);
+  next_event_estimation(x, origin, throughput, guide, rng, area, punctual_light, environment);
   uint first = p * params.shadow_slots;
   shadow_rays[first] = area;
   shadow_rays[first + 1u] = punctual_light;
@@ -46,10 +61,11 @@ uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rn
     shadow_rays[first + 2u] = environment;
     shadows = shadows || environment.contribution_state.w != kShadowNone;
   }
-  DirectionSample d = sample_continuation(params.sampling_strategy, x, rng);
+  DirectionSample d = sample_continuation(guide, x, rng);
   uint pending = shadows ? 2u : 0u;
+  if (directional_texel) path_throughput[sh1_factor_index(p)] = vec4(d.pdf > 0.0 ? sh1_direction_factor(x, d.direction) : vec3(0.0), 0.0);
   if (!(d.pdf > 0.0)) return pending;
   path_ray_d[p] = vec4(d.direction, 0.0);
-  path_throughput[p] = vec4(throughput, d.pdf);
+  path_throughput[p] = vec4(throughput * continuation_weight(guide, x, d), d.pdf);  // weight 1 for cosine vertices
   return pending | 1u;
 }

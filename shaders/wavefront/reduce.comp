@@ -1,7 +1,8 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 // Stage "accumulate": per texel of the batch, adds each sample's total (sum of its bounce slots),
-// its square and its bounce layers to double-precision sums, in sample order (one writer per texel).
+// its square, its bounce layers and (directional batches) its L1 to double-precision sums, in sample
+// order (one writer per texel).
 layout(local_size_x = 64) in;
 #include "../include/kernel_prelude.glsl"
 
@@ -19,7 +20,12 @@ void main() {
       uint r = result_index(w, k);
       total += vec3(results[r], results[r + 1u], results[r + 2u]);
     }
-    if (any(isnan(total)) || any(isinf(total))) { ++nonfinite; continue; }
+    bool finite = !(any(isnan(total)) || any(isinf(total)));
+    if (params.directional != 0u)
+      for (uint k = 0u; k < 9u; ++k) finite = finite && !isnan(results[sh1_result_index(w) + k]) && !isinf(results[sh1_result_index(w) + k]);
+    if (!finite) { ++nonfinite; continue; }
+    if (params.directional != 0u)
+      for (uint k = 0u; k < 9u; ++k) acc_total[sh1_sum_index(texel) + k] += double(results[sh1_result_index(w) + k]);
     for (uint c = 0u; c < 3u; ++c) {
       acc_total[texel * 6u + c] += double(total[c]);
       acc_total[texel * 6u + 3u + c] += double(total[c]) * double(total[c]);

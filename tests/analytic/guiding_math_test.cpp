@@ -50,6 +50,7 @@ GuideVertex guided(const std::vector<float>& cdf, uint normal_class, float m) {
   g.guided_probability = m;
   g.normal_class = normal_class;
   g.cdf = cdf.data();
+  g.uniform_probability = 0;
   return g;
 }
 

@@ -296,3 +296,56 @@ TEST(VulkanCrosscheck, CourtyardUnderConstantSky) {
 
 }  // namespace
 }  // namespace exitance
+
+namespace exitance {
+namespace {
+
+// --directional sh1 (issue 14): both backends with the defensive first continuation and L1 sums.
+// E/pi as every crosscheck; each L1 coefficient per region of `group` texels: the mean of the
+// per-texel differences GPU - CPU (each of expectation 0) within 4 standard errors from their
+// sample variance.
+void crosscheck_directional(const Scene& scene, const TexelGBuffer& g, uint32_t spp, size_t group, const char* what) {
+  CREATE_VULKAN_OR_SKIP(vk, scene);
+  IntegratorSettings settings;
+  settings.spp = spp;
+  settings.directional = DirectionalMode::Sh1;
+  settings.seed = 1001;
+  const LightmapEstimate gpu = vk->bake(g, settings);
+  const LightmapEstimate cpu = cpu_bake(scene, g, settings, 2002);
+  ASSERT_TRUE(gpu.has_sh1());
+  ASSERT_TRUE(cpu.has_sh1());
+  EXPECT_EQ(gpu.nonfinite_samples, 0u);
+  const Comparison c = compare_estimates(gpu, cpu, group, what);
+  EXPECT_LT(c.rel_mse, 0.005) << what;
+  double worst = 0;
+  for (size_t begin = 0; begin + group <= g.texels.size(); begin += group)
+    for (int axis = 0; axis < 3; ++axis)
+      for (int ch = 0; ch < 3; ++ch) {
+        double sum = 0, squares = 0;
+        for (size_t i = begin; i < begin + group; ++i) {
+          const double d = double(gpu.mean_sh1(axis, i)[ch]) - double(cpu.mean_sh1(axis, i)[ch]);
+          sum += d, squares += d * d;
+        }
+        const double n = double(group), mean = sum / n;
+        const double se = std::sqrt(std::max(0.0, squares / n - mean * mean) / (n - 1));
+        const double z = se > 0 ? mean / se : (mean == 0 ? 0 : 1e9);
+        worst = std::max(worst, std::fabs(z));
+        EXPECT_LT(std::fabs(z), 4.0) << what << " texels " << begin << "+" << group << " L1 axis " << axis << " channel "
+                                     << ch << ": mean GPU - CPU " << mean << " SE " << se;
+      }
+  std::printf("[crosscheck] %s directional sh1: E/pi relMSE %.3g, largest L1 region |z| %.2f\n", what, c.rel_mse, worst);
+}
+
+TEST(VulkanCrosscheck, DirectionalSh1CornellRoom) {
+  PreparedScene s = load_sample("cornell_room", "", 2.0f);
+  ASSERT_GT(s.gbuffer.texels.size(), 50u);
+  crosscheck_directional(s.scene, s.gbuffer, 1024, 32, "cornell_room");
+}
+
+TEST(VulkanCrosscheck, DirectionalSh1EmittingSquare) {
+  const AnalyticScene a = testing::two_parallel_unit_squares();
+  crosscheck_directional(a.scene, a.gbuffer, 256, 16, "emitting square");
+}
+
+}  // namespace
+}  // namespace exitance

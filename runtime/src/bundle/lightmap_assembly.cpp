@@ -53,6 +53,8 @@ std::vector<formats::LightmapImage> assemble_lightmap_pages(const TexelGBuffer& 
   std::vector<std::string> layers = {"", "direct.", "indirect."};
   if (options.bounce_layers)
     for (int k = 0; k < estimate.recorded_bounces; ++k) layers.push_back("bounce" + std::to_string(k) + ".");
+  if (estimate.has_sh1())
+    for (const char* axis : {"x", "y", "z"}) layers.push_back(std::string("sh1.") + axis + ".");
   std::vector<formats::LightmapImage> pages(gbuffer.pages.size());
   for (size_t p = 0; p < pages.size(); ++p) {
     const AtlasPage& source = gbuffer.pages[p];
@@ -91,6 +93,11 @@ std::vector<formats::LightmapImage> assemble_lightmap_pages(const TexelGBuffer& 
       for (int k = 0; k < estimate.recorded_bounces; ++k) {
         const Vec3 b = estimate.mean_bounce(k, i);
         for (int c = 0; c < 3; ++c) page.channels["bounce" + std::to_string(k) + "." + names[c]][at] = b[c];
+      }
+    if (estimate.has_sh1())
+      for (int axis = 0; axis < 3; ++axis) {
+        const Vec3 l1 = estimate.mean_sh1(axis, i);
+        for (int c = 0; c < 3; ++c) page.channels[std::string("sh1.") + "xyz"[axis] + "." + names[c]][at] = l1[c];
       }
   }
   for (size_t p = 0; p < pages.size(); ++p) {

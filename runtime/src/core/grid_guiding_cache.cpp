@@ -99,6 +99,7 @@ GuideVertex GridGuidingCache::vertex(uint32_t record) const {
   g.guided_probability = 0;
   g.normal_class = 0;
   g.cdf = nullptr;
+  g.uniform_probability = 0;
   if (record == kNoRecord) return g;
   const Front& f = front_[record];
   g.guided_probability = f.guided_probability;

@@ -41,6 +41,14 @@ struct PathContributions {
     for (int k = 0; k <= recorded; ++k) sum += by_bounce[k];
     return sum;
   }
+  // Directional texels (DirectionalMode::Sh1): the L1 estimate of the texel's next-event samples,
+  // their E/pi, and the first continuation's sh1_direction_factor, which every other contribution shares.
+  bool directional = false;
+  Vec3 texel_nee_sh1[3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+  Vec3 texel_nee{0, 0, 0};
+  Vec3 first_factor{0, 0, 0};
+  // The path's L1 coefficient along `axis` (RGB).
+  Vec3 sh1(int axis) const { return texel_nee_sh1[axis] + (total() - texel_nee) * first_factor[axis]; }
 };
 
 }  // namespace
@@ -51,8 +59,10 @@ struct CpuReferenceIntegrator::Impl {
 
   const LightingScene& scene() const { return *lighting; }
 
-  // Traces the shadow rays of one vertex; returns what the unoccluded ones carry.
-  Vec3 connect(const ShadowRay (&rays)[3], Vec3 origin, uint64_t& traced) const {
+  // Traces the shadow rays of one vertex; returns what the unoccluded ones carry. With `sh1` (a
+  // directional texel's own vertex), also adds their L1 estimates there.
+  Vec3 connect(const ShadowRay (&rays)[3], Vec3 origin, uint64_t& traced, const SurfacePoint& x,
+               Vec3* sh1 = nullptr) const {
     Vec3 sum{0, 0, 0};
     for (const ShadowRay& r : rays) {
       const float state = r.contribution_state.w;
@@ -60,8 +70,14 @@ struct CpuReferenceIntegrator::Impl {
       ++traced;
       if (state != kShadowTrace) continue;
       const Vec3 d{r.direction_length.x, r.direction_length.y, r.direction_length.z};
-      if (!embree->occluded(origin, d, r.direction_length.w))
-        sum += Vec3{r.contribution_state.x, r.contribution_state.y, r.contribution_state.z};
+      if (!embree->occluded(origin, d, r.direction_length.w)) {
+        const Vec3 c{r.contribution_state.x, r.contribution_state.y, r.contribution_state.z};
+        sum += c;
+        if (sh1) {
+          const Vec3 f = sh1_direction_factor(x, d);
+          for (int axis = 0; axis < 3; ++axis) sh1[axis] += c * f[axis];
+        }
+      }
     }
     return sum;
   }
@@ -91,13 +107,18 @@ struct CpuReferenceIntegrator::Impl {
     for (int bounce = 0;; ++bounce) {
       const Vec3 origin = offset_ray_origin(x.position, x.geometric_normal, s.extent);
       const uint32_t record = guide ? guide->record_of(x.position, x.shading_normal) : GridGuidingCache::kNoRecord;
-      const GuideVertex g = guide ? guide->vertex(record) : guide_vertex_cosine();
+      GuideVertex g = guide ? guide->vertex(record) : guide_vertex_cosine();
       if (guided_vertices && g.guided_probability > 0) ++*guided_vertices;
+      const bool directional_texel = out.directional && bounce == 0;
+      if (directional_texel) g = with_uniform_component(g, kDirectionalUniformProbability);
       ShadowRay shadow[kShadowRaysPerVertex];
       next_event_estimation(s, x, origin, throughput, g, rng, shadow[0], shadow[1], shadow[2]);
-      out.add(bounce, connect(shadow, origin, rays));
+      const Vec3 direct = connect(shadow, origin, rays, x, directional_texel ? out.texel_nee_sh1 : nullptr);
+      out.add(bounce, direct);
+      if (directional_texel) out.texel_nee = direct;
       const DirectionSample d = sample_continuation(g, x, rng);
       if (!(d.pdf > 0)) return;
+      if (directional_texel) out.first_factor = sh1_direction_factor(x, d.direction);
       const Vec3 ray_throughput = throughput * continuation_weight(g, x, d);
       ++rays;
       const Hit hit = embree->intersect(origin, d.direction, INFINITY);
@@ -153,6 +174,8 @@ std::string CpuReferenceIntegrator::device_description() const {
 
 LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const {
   if (settings.integrator == IntegratorMode::Bounces) {
+    if (settings.directional != DirectionalMode::Off)
+      throw std::invalid_argument("CPU backend: --directional sh1 applies to path tracing, not to --integrator bounces");
     if (settings.guiding != GuidingMode::Off)
       throw std::invalid_argument("CPU backend: guiding applies to path tracing, not to --integrator bounces");
     if (settings.adaptive)
@@ -169,6 +192,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   estimate.recorded_bounces = std::clamp(settings.recorded_bounces, 1, kMaxRecordedBounces);
   estimate.texels.resize(texel_count);
   estimate.bounces.assign(size_t(estimate.recorded_bounces) * texel_count * 3, 0.0);
+  const bool directional = settings.directional == DirectionalMode::Sh1;
+  if (directional) estimate.sh1.assign(texel_count * 9, 0.0);
   tbb::combinable<uint64_t> rays_per_thread([] { return uint64_t(0); });
   tbb::combinable<uint64_t> nonfinite_per_thread([] { return uint64_t(0); });
   tbb::combinable<uint64_t> guided_per_thread([] { return uint64_t(0); });
@@ -203,10 +228,15 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     PathSampler rng = path_sampler(settings.seed, i, s, settings.sampler);
     contributions = PathContributions{};
     contributions.recorded = estimate.recorded_bounces;
+    contributions.directional = directional;
     const uint64_t rays_before = rays;
     impl_->trace(point, settings, rng, contributions, rays, guide.get(), learning, &guided_per_thread.local());
     const Vec3 total = contributions.total();
-    if (!is_finite(total)) {
+    Vec3 l1[3];
+    bool l1_finite = true;
+    if (directional)
+      for (int axis = 0; axis < 3; ++axis) l1[axis] = contributions.sh1(axis), l1_finite = l1_finite && is_finite(l1[axis]);
+    if (!is_finite(total) || !l1_finite) {
       ++nonfinite_per_thread.local();
       return;  // counted and reported; an unbiased estimator never produces these
     }
@@ -218,6 +248,9 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     for (int k = 0; k < estimate.recorded_bounces; ++k)
       for (int c = 0; c < 3; ++c)
         estimate.bounces[(size_t(k) * texel_count + i) * 3 + size_t(c)] += contributions.by_bounce[k][c];
+    if (directional)
+      for (int axis = 0; axis < 3; ++axis)
+        for (int c = 0; c < 3; ++c) estimate.sh1[(i * 3 + size_t(axis)) * 3 + size_t(c)] += l1[axis][c];
     ++acc.samples;
     if (adaptive && !planning) {
       TexelSampleSums& p = pilot_sums[i];

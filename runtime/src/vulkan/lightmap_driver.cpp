@@ -22,7 +22,8 @@ void LightmapDriver::prepare(const TexelGBuffer& gbuffer, const IntegratorSettin
   if (a.texel_count >= (1ull << 31)) throw std::runtime_error("Vulkan backend: too many texels");
   // Per work item, result slots 0..K of RGB floats; enough items per batch to keep every path slot
   // busy between drains, within the largest storage buffer.
-  a.result_bytes = size_t(a.recorded + 1) * 12;
+  a.directional = settings.directional == DirectionalMode::Sh1;
+  a.result_bytes = size_t(a.recorded + 1) * 12 + (a.directional ? 36 : 0);  // + 9 floats of L1 (sh1_result_index)
   a.max_work = runner_.work_items_per_batch(a.result_bytes);
   a.start_points.resize(a.texel_count);
   for (size_t i = 0; i < a.texel_count; ++i) {
@@ -32,12 +33,13 @@ void LightmapDriver::prepare(const TexelGBuffer& gbuffer, const IntegratorSettin
   a.work_list.resize(a.texel_count);
   for (size_t i = 0; i < a.texel_count; ++i) a.work_list[i] = uint32_t(i);
   a.params = runner_.bake_params(settings, uint32_t(a.recorded), uint32_t(a.texel_count));
+  a.params.directional = a.directional ? 1u : 0u;
   if (a.texel_count == 0) return;
 
   Context& context = runner_.context();
   WavefrontBuffers& buffers = runner_.buffers();
   buffers.items.reserve(context, a.texel_count);
-  buffers.texels.reserve(context, a.texel_count, a.recorded);
+  buffers.texels.reserve(context, a.texel_count, a.recorded, a.directional);
   buffers.results.reserve(context, a.max_work * a.result_bytes);
   runner_.bind_buffers();
   upload_items(a);
@@ -77,6 +79,10 @@ LightmapEstimate LightmapDriver::download(const Accumulation& a) {
     context.download(buffers.texels.sums, sums.data(), sums.size() * 8);
     context.download(buffers.texels.samples, samples.data(), samples.size() * 4);
     context.download(buffers.texels.bounce_sums, estimate.bounces.data(), estimate.bounces.size() * 8);
+    if (a.directional) {
+      estimate.sh1.assign(texel_count * 9, 0.0);
+      context.download(buffers.texels.sums, estimate.sh1.data(), estimate.sh1.size() * 8, texel_count * 6 * 8);
+    }
     for (size_t i = 0; i < texel_count; ++i) {
       TexelAccumulator& t = estimate.texels[i];
       for (int c = 0; c < 3; ++c) {

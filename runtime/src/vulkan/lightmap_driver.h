@@ -39,6 +39,7 @@ class LightmapDriver {
     size_t texel_count = 0;
     int recorded = 1;
     size_t result_bytes = 0;
+    bool directional = false;  // DirectionalMode::Sh1: L1 results and sums too
     size_t max_work = 0;
     GpuParams params{};
     BatchTotals totals;

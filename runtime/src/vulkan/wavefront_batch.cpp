@@ -5,7 +5,7 @@
 namespace exitance::vulkan {
 namespace {
 
-static_assert(sizeof(GpuParams) == 144);  // 132 bytes of fields, padded to Vec4 alignment
+static_assert(sizeof(GpuParams) == 160);  // 148 bytes of fields, padded to Vec4 alignment
 static_assert(sizeof(GpuSurfacePoint) == 48 && sizeof(ShadowRay) == 32);
 
 uint64_t stat64(const uint32_t* c, uint32_t slot) { return uint64_t(c[slot]) | (uint64_t(c[slot + 1]) << 32); }

@@ -26,7 +26,7 @@ PathStateBuffers::PathStateBuffers(Context& context, uint32_t paths)
     : work(context.create_storage_buffer(size_t(paths) * 4)),
       depth(context.create_storage_buffer(size_t(paths) * 4)),
       rng(context.create_storage_buffer(size_t(paths) * 16)),
-      throughput(context.create_storage_buffer(size_t(paths) * 16)),
+      throughput(context.create_storage_buffer(size_t(paths) * 2 * 16)),  // + directional state (gpu_layout.h)
       ray_origin(context.create_storage_buffer(size_t(paths) * 16)),
       ray_direction(context.create_storage_buffer(size_t(paths) * 16)),
       hit(context.create_storage_buffer(size_t(paths) * 16)),
@@ -76,8 +76,8 @@ TexelAccumulators::TexelAccumulators(Context& context)
       bounce_sums(context.create_storage_buffer(kPlaceholder)),
       samples(context.create_storage_buffer(kPlaceholder)) {}
 
-void TexelAccumulators::reserve(Context& context, size_t texels, int layers) {
-  grow(context, sums, texels * 6 * 8);
+void TexelAccumulators::reserve(Context& context, size_t texels, int layers, bool directional) {
+  grow(context, sums, texels * (directional ? 6 + 9 : 6) * 8);  // + the L1 sums (gpu_layout.h)
   grow(context, bounce_sums, size_t(layers) * texels * 3 * 8);
   grow(context, samples, texels * 4);
 }

@@ -29,7 +29,7 @@ struct PathStateBuffers {
   Buffer work;           // work item of the batch, or kInvalid
   Buffer depth;          // vertices so far
   Buffer rng;            // PathSampler (path_sampler.h): four uints
-  Buffer throughput;     // rgb, pdf of the ray
+  Buffer throughput;     // rgb, pdf of the ray; then P more: the directional state (gpu_layout.h)
   Buffer ray_origin;
   Buffer ray_direction;
   Buffer hit;            // t, triangle bits, b1, b2
@@ -103,12 +103,12 @@ struct SampleResults {
 
 // Per texel, over the bake's samples: total and squared total (doubles), per bounce layer, counts.
 struct TexelAccumulators {
-  Buffer sums;         // [texel][total rgb, squared rgb]
+  Buffer sums;         // [texel][total rgb, squared rgb], then for directional bakes [texel][axis][rgb] of L1
   Buffer bounce_sums;  // [layer][texel][rgb]
   Buffer samples;      // [texel]
 
   explicit TexelAccumulators(Context& context);
-  void reserve(Context& context, size_t texels, int layers);
+  void reserve(Context& context, size_t texels, int layers, bool directional = false);
   void clear(VkCommandBuffer cmd) const;
   void bind(DescriptorWrites& writes) const;
 };

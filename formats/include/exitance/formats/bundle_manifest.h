@@ -104,6 +104,7 @@ struct BakeSettings {
   bool adaptive = false;  // samples planned per texel (bake --adaptive)
   std::string sampler = "sobol";  // "sobol" | "independent" (bake --sampler)
   std::string first_bounce = "traced";  // "traced" | "cached" (bake --first-bounce; bounces mode)
+  std::string directional = "off";  // "off" | "sh1" (bake --directional; written only when "sh1")
   int32_t bounces = -1;  // -1: until Russian roulette
   uint64_t seed = 0;
   double texel_density = 0;

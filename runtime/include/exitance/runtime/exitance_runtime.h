@@ -87,7 +87,10 @@ uint32_t exitance_runtime_page_count(const ExitanceRuntime* runtime);
 ExitanceRuntimeError exitance_runtime_page_info(const ExitanceRuntime* runtime, uint32_t page,
                                                 ExitanceRuntimePageInfo* out_info);
 /* Lightmap page `page` as it would be written (E/pi, gutters dilated): width x height RGB floats,
- * row 0 at the top, into out_rgb (3 * width * height floats; width and height must match). */
+ * row 0 at the top, into out_rgb (3 * width * height floats; width and height must match).
+ * The refresh estimates no directional layers yet: an engine lighting normal maps from a bundle's
+ * sh1.* layers (bake --directional sh1) must stop using them once it shows refreshed pages, which
+ * they no longer match (docs/bundle.md, "Directional layers"). */
 ExitanceRuntimeError exitance_runtime_read_page(ExitanceRuntime* runtime, uint32_t page, float* out_rgb, uint32_t width,
                                                 uint32_t height);
 

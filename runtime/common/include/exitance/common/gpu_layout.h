@@ -111,6 +111,10 @@ struct GpuParams {
   uint environment_width;  // equirect sky (environment_map.h) in texels; 0: the constant sky
   uint environment_height;
   uint shadow_slots;       // shadow rays kept per path slot: 3 with an environment map, else 2
+  uint directional;        // texel batches: 1 = also estimate the L1 SH layers (DirectionalMode::Sh1)
+  uint params_pad0;
+  uint params_pad1;
+  uint params_pad2;
 };
 
 // Descriptor bindings of the wavefront (one set).
@@ -156,6 +160,10 @@ const uint kMaterialSurfaceWords = 5u;
 // reason: the marginal CDF over rows (height + 1 entries), then one CDF per row (width + 1 entries
 // each), then the texels' rgb floats packed two to a double (offsets: environment_map.h).
 const uint kBindingEnvironment = 30u;
+// Directional (L1 SH) texels keep their state in existing buffers, for the same reason: per path
+// the first continuation's sh1_direction_factor (xyz) at path_throughput[path_capacity + p], per texel
+// the 9 L1 sums [texel][axis][rgb] after the texel sums (acc_total from item_count_total * 6), and
+// per sample the L1 results after the batch's bounce slots (bindings.glsl sh1_result_index).
 const uint kBindingCount = 31u;
 
 // Counter slots (uint each; statistics are 64-bit lo/hi pairs).

@@ -39,6 +39,9 @@ struct GuideVertex {
   float guided_probability;  // of the guided component in the one-sample mixture; 0: cosine only
   uint normal_class;         // guide_normal_class of the vertex's shading normal
   GUIDE_CDF_REF cdf;         // kGuideBins + 1 values, cdf[0] = 0, cdf[kGuideBins] = 1, non-decreasing
+  // Defensive uniform-hemisphere component (path.h): the strategy above is taken with probability
+  // 1 - uniform_probability. Non-zero only at texels of directional bakes; 0: none.
+  float uniform_probability;
 };
 
 // Class 2a + (n[a] < 0) for the axis a of the largest |component| (ties: the lower axis).

@@ -61,14 +61,35 @@ EXITANCE_FN GuideVertex guide_vertex_cosine() {
   g.guided_probability = 0.0f;
   g.normal_class = 0u;
   g.cdf = GUIDE_CDF_NONE;
+  g.uniform_probability = 0.0f;
   return g;
 }
 
-// A vertex with guided_probability 0 computes exactly what the cosine strategy computes.
-EXITANCE_FN float continuation_pdf(GuideVertex g, SurfacePoint x, vec3 wi) {
+// Directional (L1 SH) bakes sample a texel's FIRST continuation from the defensive mixture
+// (1 - kDirectionalUniformProbability) * strategy + kDirectionalUniformProbability * uniform hemisphere:
+// the L1 estimate c * w / (2 cos) of a contribution c = L cos / (pi p) is then bounded by
+// L / (2 * kDirectionalUniformProbability), where pure cosine sampling has infinite variance at
+// grazing angles (docs/bundle.md, "Directional layers").
+const float kDirectionalUniformProbability = 0.25f;
+
+EXITANCE_FN GuideVertex with_uniform_component(GuideVertex g, float probability) {
+  g.uniform_probability = probability;
+  return g;
+}
+
+// The pdf of the vertex's strategy without the defensive component.
+EXITANCE_FN float strategy_pdf(GuideVertex g, SurfacePoint x, vec3 wi) {
   float cosine = max(dot(x.shading_normal, wi), 0.0f) * kInvPi;
   if (!(g.guided_probability > 0.0f)) return cosine;
   return g.guided_probability * guided_component_pdf(g, wi) + (1.0f - g.guided_probability) * cosine;
+}
+
+// A vertex with guided_probability 0 and uniform_probability 0 computes exactly what the cosine
+// strategy computes.
+EXITANCE_FN float continuation_pdf(GuideVertex g, SurfacePoint x, vec3 wi) {
+  if (!(g.uniform_probability > 0.0f)) return strategy_pdf(g, x, wi);
+  float uniform_pdf = dot(x.shading_normal, wi) > 0.0f ? 0.5f * kInvPi : 0.0f;
+  return (1.0f - g.uniform_probability) * strategy_pdf(g, x, wi) + g.uniform_probability * uniform_pdf;
 }
 
 EXITANCE_FN float continuation_pdf(uint strategy, SurfacePoint x, vec3 wi) {
@@ -86,20 +107,28 @@ EXITANCE_FN DirectionSample sample_continuation(uint strategy, SurfacePoint x, I
   return s;
 }
 
-// Cosine vertices: as above. Guided vertices draw the component choice, a 2-D sample (u1, u2) and a
-// third number u3 that only the guided component uses (bin, then the point in it); u3 is drawn either
-// way so the later dimensions of the path line up across its samples. A guided direction under the
-// surface (shading or geometric) ends the path: the integrand is 0 there.
+// Cosine vertices: as above. Guided (or defensive) vertices draw the component choice, a 2-D sample
+// (u1, u2) and a third number u3 that only the guided component uses (bin, then the point in it); u3
+// is drawn either way so the later dimensions of the path line up across its samples. The defensive
+// choice reuses the component number: u_choose < uniform_probability takes the uniform component,
+// the rest, rescaled to [0, 1), chooses between guided and cosine. A direction under the surface
+// (shading or geometric) ends the path: the integrand is 0 there.
 EXITANCE_FN DirectionSample sample_continuation(GuideVertex g, SurfacePoint x, INOUT(PathSampler) rng) {
-  if (!(g.guided_probability > 0.0f)) return sample_continuation(kStrategyCosine, x, rng);
+  if (!(g.guided_probability > 0.0f) && !(g.uniform_probability > 0.0f))
+    return sample_continuation(kStrategyCosine, x, rng);
   float u_choose = sample_1d(rng);
   vec2 u = sample_2d(rng);
   float u3 = sample_1d(rng);
   DirectionSample s;
-  if (u_choose < g.guided_probability) {
-    s.direction = guided_component_sample(g, u.x, u.y, u3);
+  if (u_choose < g.uniform_probability) {
+    s.direction = to_world(sample_uniform_hemisphere(u.x, u.y), x.shading_normal);
   } else {
-    s.direction = to_world(sample_cosine_hemisphere(u.x, u.y), x.shading_normal);
+    float u_strategy = (u_choose - g.uniform_probability) / (1.0f - g.uniform_probability);
+    if (u_strategy < g.guided_probability) {
+      s.direction = guided_component_sample(g, u.x, u.y, u3);
+    } else {
+      s.direction = to_world(sample_cosine_hemisphere(u.x, u.y), x.shading_normal);
+    }
   }
   s.pdf = continuation_pdf(g, x, s.direction);
   if (!(dot(s.direction, x.geometric_normal) > 0.0f) || !(dot(s.direction, x.shading_normal) > 0.0f)) s.pdf = 0.0f;
@@ -109,8 +138,20 @@ EXITANCE_FN DirectionSample sample_continuation(GuideVertex g, SurfacePoint x, I
 // The factor (cos / pi) / pdf the continuation carries into the path's throughput (the albedo is
 // applied at the hit): exactly 1 for cosine vertices, so unguided results do not change.
 EXITANCE_FN float continuation_weight(GuideVertex g, SurfacePoint x, DirectionSample d) {
-  if (!(g.guided_probability > 0.0f)) return 1.0f;
+  if (!(g.guided_probability > 0.0f) && !(g.uniform_probability > 0.0f)) return 1.0f;
   return max(dot(x.shading_normal, d.direction), 0.0f) * kInvPi / d.pdf;
+}
+
+// ---- Directional (L1 SH) texels ----
+// A contribution c to a texel's E/pi whose path left the texel in direction w (the shadow ray's for
+// next-event samples at the texel, the first continuation's for everything else) adds
+// c[channel] * f[axis] to L1[axis][channel], f = w / (2 cos), cos = dot(shading normal, w): since
+// c = L cos / (pi p), that is L w / (2 pi p), an unbiased estimate of (1 / 2 pi) * integral of L w.
+// 0 for directions at or under the shading horizon (c is 0 there too).
+EXITANCE_FN vec3 sh1_direction_factor(SurfacePoint x, vec3 w) {
+  float cosine = dot(x.shading_normal, w);
+  if (!(cosine > 0.0f)) return vec3(0.0f);
+  return w * (0.5f / cosine);
 }
 
 // ---- Next-event estimation ----

@@ -27,6 +27,14 @@ EXITANCE_FN vec3 sample_cosine_hemisphere(float u1, float u2) {
   return vec3(x, y, sqrt(max(0.0f, 1.0f - x * x - y * y)));
 }
 
+// Uniform over the hemisphere z >= 0: pdf = 1 / (2 pi).
+EXITANCE_FN vec3 sample_uniform_hemisphere(float u1, float u2) {
+  float z = u1;
+  float r = sqrt(max(0.0f, 1.0f - z * z));
+  float phi = 2.0f * kPi * u2;
+  return vec3(r * cos(phi), r * sin(phi), z);
+}
+
 EXITANCE_FN vec3 to_world(vec3 local, vec3 n) {
   vec3 t;
   vec3 b;

@@ -1,7 +1,8 @@
 // Turns per-texel estimates into atlas page images: E/pi in R,G,B, coverage in A, `valid` (1 where
 // the texel was traced), direct/indirect layers, the estimated relative standard error in error.Y
 // (LightmapEstimate::relative_standard_error with the estimate's error_floor), optional bounce<k>
-// layers, and gutter texels dilated from their neighbours.
+// layers, the L1 SH layers sh1.x/y/z.R/G/B when the estimate has them, and gutter texels dilated
+// from their neighbours.
 #pragma once
 #include <cstdint>
 #include <vector>

@@ -49,10 +49,16 @@ struct LightmapEstimate {
   uint64_t guided_vertices = 0;  // path vertices that sampled a guided mixture (--guiding); 0 unguided
   bool adaptive = false;         // samples were planned per texel (core/adaptive_sampling_plan.h)
   uint32_t adaptive_pilot = 0;   // samples per texel of the pilot before the plan (0: no plan made)
+  // DirectionalMode::Sh1: per texel the sums of the L1 estimates (path.h sh1_direction_factor),
+  // [texel][axis x,y,z][rgb] flattened: (i * 3 + axis) * 3 + c; empty otherwise.
+  std::vector<double> sh1;
 
   Vec3 mean_total(size_t texel) const;
   Vec3 mean_direct(size_t texel) const;
   Vec3 mean_bounce(int bounce, size_t texel) const;
+  // The L1 coefficient along world axis `axis` (0 x, 1 y, 2 z), RGB; 0 without sh1 sums.
+  Vec3 mean_sh1(int axis, size_t texel) const;
+  bool has_sh1() const { return !sh1.empty(); }
   // Variance of the mean (standard error squared) of the total, per channel.
   Vec3 variance_of_mean(size_t texel) const;
   // The target-error stopping test of the Vulkan and per-bounce backends (a stopping rule on a texel's

@@ -19,6 +19,13 @@ enum class IntegratorMode { Path, Bounces };
 // choice of `auto` is made by the caller (bake), which hands Off or a mode here.
 enum class GuidingMode { Off, Grid };
 
+// Directional lightmaps (bake --directional, issue 14). Sh1: per texel also the world-space L1 SH
+// coefficients of cosine-convolved irradiance in units of E/pi (LightmapEstimate::sh1,
+// docs/bundle.md "Directional layers"); the texel's first continuation then samples a defensive
+// mixture with the uniform hemisphere (path.h). Path mode only; both backends (not the Vulkan
+// progressive refresh).
+enum class DirectionalMode { Off, Sh1 };
+
 struct IntegratorSettings {
   IntegratorMode integrator = IntegratorMode::Path;
   // spp, time_budget_seconds and target_relative_error mean the same in both modes. Bounces: spp is
@@ -44,6 +51,7 @@ struct IntegratorSettings {
   uint32_t sampling_strategy = 0;  // continuation directions: kStrategyCosine (path.h)
   uint32_t sampler = 0;            // random numbers: kSamplerSobol (0) or kSamplerIndependent (path_sampler.h)
   GuidingMode guiding = GuidingMode::Off;  // Path mode only; backends refuse modes they lack
+  DirectionalMode directional = DirectionalMode::Off;  // Path mode only
   float guiding_mix = 0.5f;         // probability of the guided component at a guided vertex (0..1)
   int guiding_grid_cells = 16;      // grid cells along the scene's longest axis (cubic cells)
   std::function<void(double fraction_done, uint64_t rays)> progress;  // called between passes
