@@ -108,6 +108,8 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   settings.russian_roulette_start = baked.russian_roulette_start;
   settings.safety_bounce_cap = baked.safety_bounce_cap;
   settings.sampler = baked.sampler == "independent" ? kSamplerIndependent : kSamplerSobol;
+  // A bundle baked with directional layers is refreshed with them (the same estimator, path.h).
+  if (baked.directional == "sh1") settings.directional = DirectionalMode::Sh1;
 
   auto scene = std::make_shared<const Scene>(state->persisted.scene);
   try {

@@ -95,14 +95,7 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   settings.spp = session.samples_per_texel();
   settings.seed = session.settings().seed;
   settings.time_budget_seconds = report.value("time_budget_seconds", 0.0);
-  if (settings.directional != "off") {
-    // The progressive refresh estimates no directional layers yet: the relit pages are assembled without them
-    // (never the input's, which would be stale), and the manifest says so.
-    settings.directional = "off";
-    report["warnings"].push_back("directional " + baked.directional +
-                                 " layers dropped: the relight's progressive refresh does not estimate them yet; re-bake with "
-                                 "bake --directional " + baked.directional + " for them");
-  }
+  settings.directional = estimate.has_sh1() ? "sh1" : "off";  // the session refreshes what the bake estimated
   if (svo) {
     manifest.svo->vdb.clear();
     manifest.svo->vdb_note = "radiance.vdb is an inspection export of bake; exitance-relight does not write it";

@@ -70,7 +70,6 @@ ProbeEstimate VulkanIntegrator::bake_probes(const std::vector<Vec3>& positions, 
 }
 
 void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) {
-  if (settings.directional != DirectionalMode::Off) throw std::runtime_error("Vulkan backend: progressive refresh estimates no directional layers yet");
   if (settings.guiding != GuidingMode::Off) throw std::runtime_error("Vulkan backend: --guiding grid is implemented on the CPU backend only (use --backend cpu)");
   impl_->lightmap.start(gbuffer, settings);
 }
