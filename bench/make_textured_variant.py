@@ -6,9 +6,11 @@ Every non-emissive material gets a base-colour texture: a 64x64 sRGB checker of 
 wrap), so each triangle's albedo varies per point and the kernels take the textured path. The
 mean albedo changes by the checker's mean factor; geometry, lights and lightmap UVs stay.
 Buffers referenced by relative URIs are resolved against the input's folder (the output is
-written beside it).
+written beside it). With --flat the texture is uniformly white (sRGB 255 = 1.0): the albedo and
+so every path stay those of the input, and only the texture lookups are added (the cost of the
+textured path, measured alone).
 
-  bench/make_textured_variant.py IN.gltf OUT.gltf
+  bench/make_textured_variant.py [--flat] IN.gltf OUT.gltf
 """
 import base64
 import json
@@ -36,9 +38,12 @@ def checker_png(size=64, cells=8, dark=90, light=220):
 
 
 def main():
-    if len(sys.argv) != 3:
+    args = sys.argv[1:]
+    flat = "--flat" in args
+    args = [a for a in args if a != "--flat"]
+    if len(args) != 2:
         sys.exit(__doc__)
-    source, target = sys.argv[1], sys.argv[2]
+    source, target = args
     with open(source) as f:
         gltf = json.load(f)
     base = os.path.relpath(os.path.dirname(os.path.abspath(source)), os.path.dirname(os.path.abspath(target)))
@@ -47,7 +52,7 @@ def main():
         if uri and not uri.startswith("data:") and base != ".":
             b["uri"] = os.path.join(base, uri)
     gltf.setdefault("images", []).append(
-        {"uri": "data:image/png;base64," + base64.b64encode(checker_png()).decode()})
+        {"uri": "data:image/png;base64," + base64.b64encode(checker_png(dark=255, light=255) if flat else checker_png()).decode()})
     gltf.setdefault("samplers", []).append({"wrapS": 10497, "wrapT": 10497})
     gltf.setdefault("textures", []).append({"source": len(gltf["images"]) - 1, "sampler": len(gltf["samplers"]) - 1})
     texture = len(gltf["textures"]) - 1
