@@ -160,6 +160,63 @@ TEST(VulkanTextures, BlendSquareShadowsInProportionToItsCoverage) {
   EXPECT_GT(o.z_alternative, 10.0) << "the test could not tell BLEND from OPAQUE";
 }
 
+// White textures (and white COLOR_0) multiply every factor by 1, so on each backend the textured
+// path must give the untextured scene's lightmap up to float rounding: the same albedo, emission and
+// random decisions at every vertex. The two paths round the albedo product differently (one ulp in
+// 1 of 216 texel channels here), so the bound is 1e-5 relative; any changed decision (a Russian
+// roulette or light choice) moves a texel by about one sample's share, 1/64 of its value, and a
+// wrong fetch, a bilinear weight sum other than 1, or a lookup drawing a random number more.
+// (bench/results/relight-gpu-assets.md measures the same on the building on the H200.)
+TEST(VulkanTextures, WhiteTexturesChangeNoResultOnEitherBackend) {
+  auto build = [](bool textured) {
+    Scene s;
+    s.sky.constant = {0.6f, 0.7f, 1.0f};
+    const uint32_t floor = add_material(s, {0.8f, 0.6f, 0.4f});
+    const uint32_t wall = add_material(s, {0.5f, 0.7f, 0.9f});
+    const uint32_t panel = add_material(s, {0.5f, 0.5f, 0.5f}, {3.0f, 2.5f, 2.0f});
+    if (textured) {
+      s.textures.push_back(testing::checker_texture(8, {1, 1, 1}, {1, 1, 1}, Texture::Wrap::Repeat));
+      s.textures.push_back(testing::checker_texture(4, {1, 1, 1}, {1, 1, 1}, Texture::Wrap::MirroredRepeat));
+      s.materials[floor].base_color_texture.texture = 0;
+      s.materials[floor].base_color_texture.transform.scale = {1.5f, 2.0f};
+      s.materials[floor].base_color_texture.transform.rotation = 0.3f;
+      s.materials[wall].base_color_texture.texture = 1;
+      s.materials[wall].base_color_texture.transform.tex_coord = 1;
+      s.materials[panel].emissive_texture.texture = 0;
+    }
+    add_quad(s, {-1, 0, 1}, {2, 0, 0}, {0, 0, -2}, floor);
+    add_quad(s, {-1, 0, -1}, {2, 0, 0}, {0, 1.5f, 0}, wall);
+    add_quad(s, {-0.3f, 1.2f, -0.3f}, {0.6f, 0, 0}, {0, 0, 0.6f}, panel);
+    if (textured)
+      for (size_t i = 0; i < s.positions.size(); ++i) s.vertex_color.push_back({1, 1, 1}), s.vertex_alpha.push_back(1.0f);
+    return s;
+  };
+  const Scene plain = build(false), white = build(true);
+  TexelGBuffer gbuffer;
+  for (Vec2 p : grid_points(6, 0.1f)) {
+    gbuffer.texels.push_back(texel_at({1.8f * p.x - 0.9f, 0, 1.8f * p.y - 0.9f}, {0, 1, 0}));
+    gbuffer.texels.push_back(texel_at({1.8f * p.x - 0.9f, 0.05f + 1.4f * p.y, -1}, {0, 0, 1}));
+  }
+  IntegratorSettings settings;
+  settings.spp = 64;
+  settings.seed = 21;
+  auto expect_same = [&](const LightmapEstimate& a, const LightmapEstimate& b, const char* backend) {
+    ASSERT_EQ(a.texels.size(), b.texels.size());
+    size_t lit = 0;
+    for (size_t i = 0; i < a.texels.size(); ++i) {
+      const Vec3 x = a.mean_total(i), y = b.mean_total(i);
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(x[c], y[c], 1e-5f * std::max(std::fabs(x[c]), 1e-4f)) << backend << " texel " << i << " channel " << c;
+      lit += x[0] > 0 ? 1 : 0;
+    }
+    EXPECT_GT(lit, a.texels.size() / 2) << backend;
+  };
+  expect_same(CpuReferenceIntegrator(plain).bake(gbuffer, settings), CpuReferenceIntegrator(white).bake(gbuffer, settings), "cpu");
+  CREATE_VULKAN_OR_SKIP(vk_plain, plain);
+  CREATE_VULKAN_OR_SKIP(vk_white, white);
+  expect_same(vk_plain->bake(gbuffer, settings), vk_white->bake(gbuffer, settings), "vulkan");
+}
+
 // Everything at once, CPU reference against the GPU: per region of 8 texels, z-tests with both
 // estimators' variances (compare_estimates, |z| < 4), and relMSE of the converged results.
 TEST(VulkanTextures, TexturedMaskedVertexColouredSceneMatchesTheReference) {
