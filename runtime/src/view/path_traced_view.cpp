@@ -4,6 +4,7 @@
 #include <string>
 
 #include "exitance/runtime/scene_file_conversion.h"
+#include "exitance/runtime/view/view_materials.h"
 #include "exitance/runtime/view/view_shading.h"
 
 namespace exitance::view {
@@ -20,7 +21,6 @@ CameraRayBatch camera_ray_batch(const ViewScene& view, const PinholeCamera& came
   batch.texel_of_pixel.assign(pixels, -1);
   batch.albedo.assign(pixels, Vec3(0));
   batch.constant.assign(pixels, Vec3(0));
-  const Vec3 sky{view.scene.sky[0], view.scene.sky[1], view.scene.sky[2]};
   RayScratch scratch;
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
@@ -28,7 +28,7 @@ CameraRayBatch camera_ray_batch(const ViewScene& view, const PinholeCamera& came
       const Vec3 d = primary_ray_direction(camera, x + 0.5, y + 0.5, width, height);
       const std::optional<SurfaceAtHit> hit = first_surface(view, camera.eye, d, scratch);
       if (!hit) {
-        batch.constant[p] = sky;
+        batch.constant[p] = sky_radiance(view.scene, d);
         continue;
       }
       if (hit->back_face_absorbs) continue;  // black, as the bake and the baked view treat it

@@ -1,9 +1,11 @@
 #include "exitance/runtime/view/view_shading.h"
 
+#include <algorithm>
 #include <limits>
 
 #include "exitance/common/material.h"
 #include "exitance/runtime/core/bvh4_walk.h"
+#include "exitance/runtime/view/view_materials.h"
 
 namespace exitance::view {
 namespace {
@@ -30,8 +32,9 @@ SurfaceAtHit surface_at(const ViewScene& view, const Bvh4WalkHit& hit, Vec3 dire
   s.shading_normal = front || !m.double_sided ? n : -n;
   s.instance = tris.instance[t];
   s.triangle = uint32_t(t);
-  s.albedo = diffuse_albedo_of(to_vec3(m.base_color), m.metallic);
-  s.emission = front || m.double_sided ? to_vec3(m.emission) : Vec3(0);
+  s.albedo = surface_albedo(view.scene, s.triangle, b1, b2);
+  s.emission = front || m.double_sided ? surface_emission(view.scene, s.triangle, b1, b2) : Vec3(0);
+  s.opacity = surface_opacity(view.scene, s.triangle, b1, b2);
   const formats::Float2 uv0 = tris.lightmap_uv[c], uv1 = tris.lightmap_uv[c + 1], uv2 = tris.lightmap_uv[c + 2];
   s.lightmap_uv = {uv0[0] * b0 + uv1[0] * b1 + uv2[0] * b2, uv0[1] * b0 + uv1[1] * b1 + uv2[1] * b2};
   return s;
@@ -68,12 +71,19 @@ const char* view_mode_name(ViewMode mode) {
   return "?";
 }
 
-std::optional<SurfaceAtHit> first_surface(const ViewScene& view, Vec3 origin, Vec3 direction, RayScratch& scratch) {
+namespace {
+
+// The nearest surface along the ray that is not in `passed` (surfaces the ray already went through).
+std::optional<SurfaceAtHit> nearest_surface_not_in(const ViewScene& view, Vec3 origin, Vec3 direction, RayScratch& scratch,
+                                                   const std::vector<uint32_t>& passed) {
   const formats::SceneFile& scene = view.scene;
   const auto corners = [&](uint32_t t, Vec3& p0, Vec3& p1, Vec3& p2) {
     p0 = to_vec3(scene.triangles.positions[3 * size_t(t)]);
     p1 = to_vec3(scene.triangles.positions[3 * size_t(t) + 1]);
     p2 = to_vec3(scene.triangles.positions[3 * size_t(t) + 2]);
+    // A degenerate triangle is never hit: the walk then finds the next surface along the same ray,
+    // without moving the origin (no offset to tune, no self-hit).
+    if (std::find(passed.begin(), passed.end(), t) != passed.end()) p1 = p2 = p0;
   };
   const Bvh4WalkHit hit =
       bvh4_closest_hit</*kNearestChildFirst=*/true>(scene.bvh.nodes.data(), scene.bvh.nodes.size(), scene.bvh.leaf_triangles.data(), corners, origin,
@@ -82,11 +92,10 @@ std::optional<SurfaceAtHit> first_surface(const ViewScene& view, Vec3 origin, Ve
   return surface_at(view, hit, direction);
 }
 
-Vec3 shade_primary_ray(const ViewScene& view, ViewMode mode, Vec3 origin, Vec3 direction, RayScratch& scratch) {
-  const bool lit_mode = mode == ViewMode::Lightmap || mode == ViewMode::Probes;
-  const std::optional<SurfaceAtHit> hit = first_surface(view, origin, direction, scratch);
-  if (!hit) return lit_mode ? to_vec3(view.scene.sky) : Vec3(0);
-  const SurfaceAtHit& s = *hit;
+// At most this many surfaces are passed through or composited per primary ray.
+constexpr size_t kMaxLayers = 16;
+
+Vec3 shade_surface(const ViewScene& view, ViewMode mode, const SurfaceAtHit& s) {
   switch (mode) {
     case ViewMode::Albedo: return s.albedo;
     case ViewMode::Normal: return s.shading_normal * 0.5f + Vec3(0.5f);
@@ -103,6 +112,36 @@ Vec3 shade_primary_ray(const ViewScene& view, ViewMode mode, Vec3 origin, Vec3 d
     }
   }
   return Vec3(0);
+}
+
+}  // namespace
+
+std::optional<SurfaceAtHit> first_surface(const ViewScene& view, Vec3 origin, Vec3 direction, RayScratch& scratch) {
+  std::vector<uint32_t> passed;
+  while (passed.size() < kMaxLayers) {
+    std::optional<SurfaceAtHit> hit = nearest_surface_not_in(view, origin, direction, scratch, passed);
+    if (!hit || hit->opacity > 0.0f) return hit;
+    passed.push_back(hit->triangle);  // a MASK cut-out or a fully transparent BLEND surface
+  }
+  return std::nullopt;
+}
+
+Vec3 shade_primary_ray(const ViewScene& view, ViewMode mode, Vec3 origin, Vec3 direction, RayScratch& scratch) {
+  const bool lit_mode = mode == ViewMode::Lightmap || mode == ViewMode::Probes;
+  // Front to back: each surface adds its shade times its opacity times what the nearer ones let
+  // through (alpha blending, "over"); OPAQUE and MASK surfaces end the ray.
+  std::vector<uint32_t> passed;
+  Vec3 result(0);
+  float transmitted = 1.0f;
+  while (passed.size() < kMaxLayers) {
+    const std::optional<SurfaceAtHit> hit = nearest_surface_not_in(view, origin, direction, scratch, passed);
+    if (!hit) return result + (lit_mode ? sky_radiance(view.scene, direction) : Vec3(0)) * transmitted;
+    if (hit->opacity > 0.0f) result = result + shade_surface(view, mode, *hit) * (transmitted * hit->opacity);
+    transmitted *= 1.0f - hit->opacity;
+    if (!(transmitted > 0.0f)) break;
+    passed.push_back(hit->triangle);
+  }
+  return result;
 }
 
 }  // namespace exitance::view

@@ -39,14 +39,18 @@ struct SurfaceAtHit {
   bool back_face_absorbs;  // the back of a single-sided surface: the bake treats it as black
   uint32_t instance;
   uint32_t triangle;
-  Vec3 albedo, emission;
+  Vec3 albedo, emission;    // textured, COLOR_0 (view_materials.h)
+  float opacity;            // 1 opaque; MASK 0 or 1; BLEND its coverage
   std::array<float, 2> lightmap_uv;
 };
 
-// The nearest surface along the ray from `origin` in unit `direction`; std::nullopt on a miss.
+// The nearest surface along the ray from `origin` in unit `direction` that a ray does not pass
+// through (MASK cut-outs and BLEND surfaces of coverage 0 are passed); std::nullopt on a miss.
 std::optional<SurfaceAtHit> first_surface(const ViewScene& view, Vec3 origin, Vec3 direction, RayScratch& scratch);
 
-// Radiance (or the debug quantity of `mode`) along the ray from `origin` in unit `direction`.
+// Radiance (or the debug quantity of `mode`) along the ray from `origin` in unit `direction`: BLEND
+// surfaces composited front to back over what lies behind them, the sky (image or constant) on a
+// miss in the lit modes.
 Vec3 shade_primary_ray(const ViewScene& view, ViewMode mode, Vec3 origin, Vec3 direction, RayScratch& scratch);
 
 }  // namespace exitance::view
