@@ -13,7 +13,7 @@ static_assert(sizeof(IntegratorSettings) == 144, "IntegratorSettings changed: ha
 static_assert(sizeof(AtlasSettings) == 24, "AtlasSettings changed: hash the new field in bake_cache_key");
 // Not hashed: input and output paths (the input's name and bytes are), cache_directory and
 // write_gltf (where results go does not change them), progress.
-static_assert(sizeof(BakeOptions) == 440, "BakeOptions changed: hash the new field in bake_cache_key (or say why not)");
+static_assert(sizeof(BakeOptions) == 448, "BakeOptions changed: hash the new field in bake_cache_key (or say why not)");
 static_assert(sizeof(ImportOptions) == 8, "ImportOptions changed: hash the new field in bake_cache_key");
 static_assert(sizeof(Material) == 136, "Material changed: hash the new field in bake_cache_key");
 static_assert(sizeof(PunctualLight) == 88, "PunctualLight changed: hash the new field in bake_cache_key");
@@ -69,6 +69,7 @@ void hash_options(Sha256Stream& h, const BakeOptions& o) {
   h.value(l.max_bounces), h.value(l.seed), h.value(l.recorded_bounces), h.value(l.russian_roulette_start);
   h.value(l.safety_bounce_cap), h.value(l.sampling_strategy), h.value(l.sampler), h.value(l.guiding), h.value(l.guiding_mix);
   h.value(l.trace_first_bounce);
+  h.value(o.integrator_auto);
   h.value(l.directional);
   h.value(l.guiding_grid_cells), h.value(l.adaptive), h.value(o.adaptive_request);
   h.value(o.bounce_layers), h.value(o.probes_enabled), h.value(o.probe_spacing), h.value(o.probe_spp);

@@ -14,6 +14,7 @@
 #include "exitance/bake/cache/sha256_stream.h"
 #include "exitance/bake/command/backend_choice.h"
 #include "exitance/bake/command/bake_stages.h"
+#include "exitance/bake/command/automatic_integrator.h"
 #include "exitance/bake/command/cached_offline_stages.h"
 #include "exitance/formats/bundle_manifest.h"
 #include "exitance/runtime/stage_clock.h"
@@ -133,6 +134,9 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
       clock.time("bvh", [&] { return build_lighting_scene_stage(std::move(imported), options); });
   const std::shared_ptr<const Integrator> backend =
       clock.time("backend", [&] { return backend_stage(scene, options, diagnostics); });
+  // --integrator auto becomes path or bounces here, where the backend is known; every later stage
+  // (lighting, the manifest) sees the decided integrator.
+  const BakeOptions decided = with_integrator_decided(options, *backend);
   const size_t unoccluded = clock.time("unocclude", [&] { return stages.unocclude(scene, gbuffer, layout, diagnostics); });
   const GeometryCheckReport geometry =
       clock.time("checks", [&] { return stages.checks(scene, gbuffer, diagnostics); });
@@ -157,12 +161,12 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   // probes and texels: the probes go first with at most kProbeShareOfTimeBudget of it (and at most
   // --probe-spp), the texels get what the probes left.
   std::optional<ProbeEstimate> probe_lighting;
-  BakeOptions lighting_options = options;
+  BakeOptions lighting_options = decided;
   const double budget = options.lighting.time_budget_seconds;
   if (probes) {
     const double probe_budget = budget > 0 ? kProbeShareOfTimeBudget * budget : 0.0;
     probe_lighting = clock.time(
-        "probes", [&] { return probe_lighting_stage(*backend, *probes, options, diagnostics, probe_budget); });
+        "probes", [&] { return probe_lighting_stage(*backend, *probes, decided, diagnostics, probe_budget); });
     // Never 0 (= no budget): a budget the probes used up leaves the texels one pass.
     if (budget > 0) lighting_options.lighting.time_budget_seconds = std::max(1e-3, budget - probe_lighting->seconds);
   }
@@ -194,7 +198,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
     diagnostics.warn("--preview: no views, only the lightmap pages: the bundle has no scene.bin (" +
                      scene_file.skipped + ")");
   WrittenBundle bundle =
-      clock.time("write", [&] { return write_bundle_stage(results, clock.seconds(), diagnostics, options); });
+      clock.time("write", [&] { return write_bundle_stage(results, clock.seconds(), diagnostics, decided); });
   if (cache) {
     clock.time("cache_store", [&] { cache->store(cache_key, bundle.folder, diagnostics.warnings, diagnostics); });
     bundle.stats["cache"]["reused"] = false;  // its "stages" are in the manifest already

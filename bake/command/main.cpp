@@ -70,11 +70,12 @@ int main(int argc, char** argv) {
                  "maximum diffuse bounces (default: path: until Russian roulette ends the path; bounces: until the "
                  "extrapolated tail is below the noise)")
       ->check(CLI::NonNegativeNumber);
-  std::string integrator = "path";
+  std::string integrator = "auto";
   app.add_option("--integrator", integrator,
-                 "path (unbiased path tracing) | bounces (per-bounce gather passes; CPU backend only, biased by the "
-                 "lightmap resolution: bench/results/per-bounce.md)")
-      ->check(CLI::IsMember({"path", "bounces"}));
+                 "auto (default: bounces on the CPU backend unless --directional, --guiding or --adaptive on needs path "
+                 "tracing; path on the Vulkan backend) | path (unbiased path tracing) | bounces (per-bounce gather "
+                 "passes; CPU backend only, biased by the lightmap resolution: bench/results/per-bounce-traced.md)")
+      ->check(CLI::IsMember({"auto", "path", "bounces"}));
   app.add_option("--sky", options.sky, "sky radiance: R,G,B or an equirectangular image (EXR/HDR)");
   app.add_option("--seed", options.lighting.seed, "random seed; results are deterministic per seed and backend");
   app.add_flag("--bounce-layers", options.bounce_layers, "also write bounce<k>.R/G/B debug layers");
@@ -203,8 +204,9 @@ int main(int argc, char** argv) {
   if (uv == "generate") options.import.generate_lightmap_uvs = true;
   else options.import.lightmap_uv_set = uv == "0" ? 0 : 1;
   if (integrator == "bounces") options.lighting.integrator = exitance::IntegratorMode::Bounces;
+  options.integrator_auto = integrator == "auto";
   if (adaptive == "on") {
-    if (integrator != "path") {
+    if (integrator == "bounces") {
       std::cerr << "bake: error: --adaptive on plans path-tracing samples: it needs --integrator path\n";
       return 2;
     }
@@ -226,7 +228,7 @@ int main(int argc, char** argv) {
       std::cerr << "bake: error: --directional " << directional << ": expected sh1\n";
       return 2;
     }
-    if (integrator != "path") {
+    if (integrator == "bounces") {
       std::cerr << "bake: error: --directional sh1 is estimated by path tracing: it needs --integrator path\n";
       return 2;
     }
@@ -237,7 +239,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (guiding == "grid") {
-    if (integrator != "path") {
+    if (integrator == "bounces") {
       std::cerr << "bake: error: --guiding grid guides path tracing: it needs --integrator path\n";
       return 2;
     }

@@ -31,6 +31,9 @@ struct BakeOptions {
   AtlasSettings atlas;
   IntegratorSettings lighting;  // lighting.adaptive is decided by the lighting stage from adaptive_request
   AdaptiveRequest adaptive_request = AdaptiveRequest::Auto;
+  // --integrator auto (the bake command's default): lighting.integrator is decided once the backend is
+  // chosen (bake/command/automatic_integrator.h); false: lighting.integrator as given.
+  bool integrator_auto = false;
   bool bounce_layers = false;
   // Sealed texels (bake/raster/sealed_texels.h) are found either way; true: the lighting stage
   // does not trace them (they are dilated from lit neighbours). --no-skip: false.

@@ -1,0 +1,19 @@
+// `bake --integrator auto` (the default): which lighting integrator a bake runs once its backend is
+// chosen. The per-bounce mode reached 1 % relMSE first on 4 of the 5 sample scenes on the CPU
+// backend (bench/results/per-bounce-traced.md: 0.18-0.5x the path tracer's time, its resolution
+// bias measured at relMSE 2e-6..2.5e-3), so it is the default where it exists and nothing in the
+// bake needs path tracing; elsewhere the unbiased path tracer.
+#pragma once
+#include "exitance/bake/bake_options.h"
+#include "exitance/runtime/core/integrator.h"
+
+namespace exitance {
+
+// Path tracing on the Vulkan backend (no per-bounce passes there yet) and for what only it
+// estimates: --directional sh1, --guiding grid, --adaptive on; else the per-bounce mode.
+IntegratorMode automatic_integrator(const BakeOptions& options, const Integrator& backend);
+
+// `options` with lighting.integrator decided by automatic_integrator when options.integrator_auto.
+BakeOptions with_integrator_decided(const BakeOptions& options, const Integrator& backend);
+
+}  // namespace exitance
