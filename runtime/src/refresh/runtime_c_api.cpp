@@ -2,6 +2,7 @@
 // ExitanceRuntimeError plus a thread-local message, so no C++ exception crosses into C.
 #include "exitance/runtime/exitance_runtime.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -144,27 +145,53 @@ ExitanceRuntimeError exitance_runtime_page_info(const ExitanceRuntime* runtime, 
   });
 }
 
+namespace {
+
+// Page `page` of the runtime's published lightmap as bake would write it, after checking the
+// caller's size (one error naming the page and both sizes).
+formats::LightmapImage assembled_page(const ExitanceRuntime* runtime, uint32_t page, uint32_t width, uint32_t height) {
+  if (page >= runtime->pages.size())
+    throw std::out_of_range("page " + std::to_string(page) + " of " + std::to_string(runtime->pages.size()));
+  const AtlasPage& info = runtime->pages[page];
+  if (width != uint32_t(info.width) || height != uint32_t(info.height))
+    throw std::invalid_argument("page " + std::to_string(page) + " is " + std::to_string(info.width) + " x " +
+                                std::to_string(info.height) + ", not " + std::to_string(width) + " x " +
+                                std::to_string(height));
+  const formats::BakeSettings baked = runtime->session->manifest().settings.value_or(formats::BakeSettings{});
+  AssemblyOptions assembly;
+  assembly.dilation_texels = std::max(2, int(baked.padding) * 2);
+  std::vector<formats::LightmapImage> pages =
+      assemble_lightmap_pages(runtime->session->persisted().gbuffer, runtime->session->published_lightmap(), assembly);
+  return std::move(pages.at(page));
+}
+
+}  // namespace
+
 ExitanceRuntimeError exitance_runtime_read_page(ExitanceRuntime* runtime, uint32_t page, float* out_rgb, uint32_t width,
                                                 uint32_t height) {
   return guarded("exitance_runtime_read_page", [&] {
     require(runtime != nullptr && out_rgb != nullptr, "runtime or out_rgb is NULL");
-    if (page >= runtime->pages.size())
-      throw std::out_of_range("page " + std::to_string(page) + " of " + std::to_string(runtime->pages.size()));
-    const AtlasPage& info = runtime->pages[page];
-    if (width != uint32_t(info.width) || height != uint32_t(info.height))
-      throw std::invalid_argument("page " + std::to_string(page) + " is " + std::to_string(info.width) + " x " +
-                                  std::to_string(info.height) + ", not " + std::to_string(width) + " x " +
-                                  std::to_string(height));
-    const formats::BakeSettings baked = runtime->session->manifest().settings.value_or(formats::BakeSettings{});
-    AssemblyOptions assembly;
-    assembly.dilation_texels = std::max(2, int(baked.padding) * 2);
-    const std::vector<formats::LightmapImage> pages =
-        assemble_lightmap_pages(runtime->session->persisted().gbuffer, runtime->session->published_lightmap(), assembly);
-    const formats::LightmapImage& image = pages.at(page);
+    const formats::LightmapImage image = assembled_page(runtime, page, width, height);
     const float* channel[3] = {image.channels.at("R").data(), image.channels.at("G").data(), image.channels.at("B").data()};
     const size_t texels = size_t(width) * height;
     for (size_t i = 0; i < texels; ++i)
       for (int c = 0; c < 3; ++c) out_rgb[i * 3 + size_t(c)] = channel[c][i];
+  });
+}
+
+ExitanceRuntimeError exitance_runtime_read_page_channel(ExitanceRuntime* runtime, uint32_t page, const char* channel,
+                                                        float* out_values, uint32_t width, uint32_t height) {
+  return guarded("exitance_runtime_read_page_channel", [&] {
+    require(runtime != nullptr && out_values != nullptr && channel != nullptr, "runtime, channel or out_values is NULL");
+    const formats::LightmapImage image = assembled_page(runtime, page, width, height);
+    const auto found = image.channels.find(channel);
+    if (found == image.channels.end()) {
+      std::string names;
+      for (const auto& entry : image.channels) names += (names.empty() ? "" : ", ") + entry.first;
+      throw std::invalid_argument("channel \"" + std::string(channel) + "\" is not in page " + std::to_string(page) +
+                                  " (it has " + names + ")");
+    }
+    std::copy(found->second.begin(), found->second.end(), out_values);
   });
 }
 

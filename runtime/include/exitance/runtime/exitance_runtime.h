@@ -87,12 +87,17 @@ uint32_t exitance_runtime_page_count(const ExitanceRuntime* runtime);
 ExitanceRuntimeError exitance_runtime_page_info(const ExitanceRuntime* runtime, uint32_t page,
                                                 ExitanceRuntimePageInfo* out_info);
 /* Lightmap page `page` as it would be written (E/pi, gutters dilated): width x height RGB floats,
- * row 0 at the top, into out_rgb (3 * width * height floats; width and height must match).
- * The refresh estimates no directional layers yet: an engine lighting normal maps from a bundle's
- * sh1.* layers (bake --directional sh1) must stop using them once it shows refreshed pages, which
- * they no longer match (docs/bundle.md, "Directional layers"). */
+ * row 0 at the top, into out_rgb (3 * width * height floats; width and height must match). */
 ExitanceRuntimeError exitance_runtime_read_page(ExitanceRuntime* runtime, uint32_t page, float* out_rgb, uint32_t width,
                                                 uint32_t height);
+
+/* One channel of page `page` as it would be written, width x height floats into out_values: any
+ * channel of the bundle's pages ("R", "direct.G", "error.Y", ...), and for a bundle baked with
+ * --directional sh1 the refreshed L1 layers "sh1.x.R" .. "sh1.z.B" (docs/bundle.md, "Directional
+ * layers"), which an engine lighting normal maps reads with the refreshed E/pi. An unknown channel
+ * is EXITANCE_RUNTIME_INVALID_ARGUMENT naming it. */
+ExitanceRuntimeError exitance_runtime_read_page_channel(ExitanceRuntime* runtime, uint32_t page, const char* channel,
+                                                        float* out_values, uint32_t width, uint32_t height);
 
 /* Writes the refreshed bundle (lightmaps, probes, voxel exitance, the edited scene.bin) to
  * `output_folder` atomically; the loader (exitance_loader.h) opens it. */
