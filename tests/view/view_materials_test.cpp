@@ -3,7 +3,8 @@
 // sky on a miss. A plane under a constant sky is baked once; its scene.bin records are then given
 // textures in memory, and rays straight down (or up, into the sky) are shaded: each expected value
 // is a closed form of the texel or colour the ray meets, and each would differ if the view ignored
-// what it tests (the untextured value is checked to be far from it).
+// what it tests (the untextured value is checked to be far from it). Also an orthographic glTF
+// camera over the same plane.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,6 +14,8 @@
 #include "exitance/bake/command/bake_pipeline.h"
 #include "exitance/common/environment_map.h"
 #include "exitance/common/material.h"
+#include "exitance/runtime/view/view_camera.h"
+#include "exitance/runtime/view/view_render.h"
 #include "exitance/runtime/view/view_scene.h"
 #include "exitance/runtime/view/view_shading.h"
 #include "scene_builder.h"
@@ -171,4 +174,47 @@ TEST(ViewMaterials, AMissShowsTheImageSkysTexel) {
 }
 
 }  // namespace
+// An orthographic camera (glTF xmag 0.8, ymag 0.4) looking straight down at the two-coloured plane:
+// every ray is parallel, so the image is the same from 1 m and from 5 m above (a perspective camera's
+// footprint would grow fivefold), the aspect ratio is xmag / ymag, and pixel column x sees world
+// x = (2 (x + 0.5) / W - 1) * xmag: the left quarter the left colour, the right quarter the right one.
+TEST(ViewOrthographicCamera, ParallelRaysSeeTheSameFromAnyDistance) {
+  view::ViewScene view = textured_plane();
+  formats::MaterialRecord& m = plane_material(view);
+  m.base_color_texture.texture = 0;
+  formats::SceneFile& scene = view.scene;
+  scene.cameras.push_back({});
+  formats::CameraRecord& camera = scene.cameras.back();
+  camera.name = "TopCam";
+  camera.node = int32_t(scene.nodes.size());
+  camera.type = formats::CameraType::Orthographic;
+  camera.xmag = 0.8f, camera.ymag = 0.4f, camera.znear = 0.01f, camera.zfar = 100.0f;
+  formats::NodeRecord node;
+  node.name = "Top";
+  node.camera = int32_t(scene.cameras.size() - 1);
+  node.in_scene = true;
+  node.rotation = {-std::sqrt(0.5), 0, 0, std::sqrt(0.5)};  // -Z looks down -Y, +Y becomes -Z
+  scene.nodes.push_back(node);
+  view::ViewRenderOptions render;
+  render.width = 32;
+  render.height = 16;
+  render.mode = ViewMode::Albedo;
+  std::vector<view::ViewImage> images;
+  for (double height : {1.0, 5.0}) {
+    scene.nodes.back().translation = {0, height, 0};
+    const view::GltfCameraView top = view::gltf_camera(scene, "TopCam");
+    EXPECT_TRUE(top.camera.orthographic);
+    EXPECT_NEAR(top.aspect_ratio, 2.0f, 1e-6f);
+    images.push_back(view::render_view(view, top.camera, render));
+  }
+  const Vec3 base{kBase[0], kBase[1], kBase[2]};
+  const Vec3 left = diffuse_albedo_of(base * kLeft, m.metallic), right = diffuse_albedo_of(base * kRight, m.metallic);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 32; ++x) {
+      expect_close(images[1].pixel(x, y), images[0].pixel(x, y), "pixel " + std::to_string(x) + "," + std::to_string(y));
+      if (x < 8) expect_close(images[0].pixel(x, y), left, "left quarter");
+      if (x >= 24) expect_close(images[0].pixel(x, y), right, "right quarter");
+    }
+}
+
 }  // namespace exitance

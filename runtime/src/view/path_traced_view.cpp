@@ -25,8 +25,9 @@ CameraRayBatch camera_ray_batch(const ViewScene& view, const PinholeCamera& came
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
       const size_t p = size_t(y) * size_t(width) + size_t(x);
-      const Vec3 d = primary_ray_direction(camera, x + 0.5, y + 0.5, width, height);
-      const std::optional<SurfaceAtHit> hit = first_surface(view, camera.eye, d, scratch);
+      const PrimaryRay ray = primary_ray(camera, x + 0.5, y + 0.5, width, height);
+      const Vec3 d = ray.direction;
+      const std::optional<SurfaceAtHit> hit = first_surface(view, ray.origin, d, scratch);
       if (!hit) {
         batch.constant[p] = sky_radiance(view.scene, d);
         continue;

@@ -68,15 +68,22 @@ GltfCameraView gltf_camera(const formats::SceneFile& scene, const std::string& n
     throw ViewInputError("--camera: no camera named \"" + name + "\" in scene.bin (cameras: " +
                          (names.empty() ? "none" : names) + ")");
   }
-  if (found->type != formats::CameraType::Perspective)
-    throw ViewInputError("--camera: \"" + name + "\" is orthographic; views support perspective cameras");
   if (found->node < 0 || !scene.nodes[size_t(found->node)].in_scene)
     throw ViewInputError("--camera: \"" + name + "\" is not placed by a node of the default scene");
   const Matrix4d world = node_world(scene, found->node);
   const Vec3 eye{float(world[12]), float(world[13]), float(world[14])};
   const Vec3 forward = transform_direction(world, {0, 0, -1}), up = transform_direction(world, {0, 1, 0});
+  const bool orthographic = found->type == formats::CameraType::Orthographic;
+  if (orthographic && !(found->xmag > 0 && found->ymag > 0 && std::isfinite(found->xmag) && std::isfinite(found->ymag)))
+    throw ViewInputError("--camera: \"" + name + "\" is orthographic with xmag " + std::to_string(found->xmag) +
+                         ", ymag " + std::to_string(found->ymag) + ": both must be positive");
   try {
-    return {look_at_camera(eye, eye + forward, up, found->yfov), found->aspect_ratio};
+    // An orthographic camera's yfov is unused: any valid angle lets look_at_camera build the frame.
+    GltfCameraView view{look_at_camera(eye, eye + forward, up, orthographic ? 1.0 : found->yfov),
+                        orthographic ? found->xmag / found->ymag : found->aspect_ratio};
+    view.camera.orthographic = orthographic;
+    view.camera.ortho_half_height = orthographic ? found->ymag : 1.0;
+    return view;
   } catch (const ViewInputError& e) {
     throw ViewInputError("--camera: \"" + name + "\": its node's transform gives no view (" + e.what() + ")");
   }
@@ -87,6 +94,14 @@ Vec3 primary_ray_direction(const PinholeCamera& camera, double x, double y, int 
   const double sx = (2 * x / width - 1) * camera.tan_half_yfov * aspect;
   const double sy = (1 - 2 * y / height) * camera.tan_half_yfov;
   return normalize(camera.forward + camera.right * float(sx) + camera.up * float(sy));
+}
+
+PrimaryRay primary_ray(const PinholeCamera& camera, double x, double y, int width, int height) {
+  if (!camera.orthographic) return {camera.eye, primary_ray_direction(camera, x, y, width, height)};
+  const double aspect = double(width) / double(height);
+  const double sx = (2 * x / width - 1) * camera.ortho_half_height * aspect;
+  const double sy = (1 - 2 * y / height) * camera.ortho_half_height;
+  return {camera.eye + camera.right * float(sx) + camera.up * float(sy), camera.forward};
 }
 
 }  // namespace exitance::view

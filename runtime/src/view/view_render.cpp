@@ -30,8 +30,8 @@ ViewImage render_view(const ViewScene& view, const PinholeCamera& camera, const 
         Vec3 sum(0);
         for (int j = 0; j < n; ++j)
           for (int i = 0; i < n; ++i) {
-            const Vec3 d = primary_ray_direction(camera, x + (i + 0.5) / n, y + (j + 0.5) / n, image.width, image.height);
-            sum += shade_primary_ray(view, options.mode, camera.eye, d, scratch);
+            const PrimaryRay ray = primary_ray(camera, x + (i + 0.5) / n, y + (j + 0.5) / n, image.width, image.height);
+            sum += shade_primary_ray(view, options.mode, ray.origin, ray.direction, scratch);
           }
         const Vec3 mean = sum / float(n * n);
         float* out = &image.rgb[(size_t(y) * size_t(image.width) + size_t(x)) * 3];
