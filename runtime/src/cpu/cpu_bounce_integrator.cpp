@@ -254,12 +254,22 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
   PassPolicy policy;
   policy.ramp = settings.time_budget_seconds > 0 || settings.target_relative_error > 0;
   PassScheduler passes(settings, policy);
+  std::vector<double> seconds_per_sample;  // per layer: the last pass's seconds per sample of every texel
   uint32_t first = 0, count = 0;
   while (passes.next_pass(first, count)) {
     bool wants_more = false;
     for (size_t k = 0; k < layers.size(); ++k) {
       Layer& layer = layers[k];
-      const uint32_t add = settings.spp > 0 ? std::min(count, settings.spp - std::min(settings.spp, layer.samples)) : count;
+      uint32_t add = settings.spp > 0 ? std::min(count, settings.spp - std::min(settings.spp, layer.samples)) : count;
+      // Under a time budget, a layer pass that would end past it takes the samples that fit, by this
+      // layer's measured seconds per sample (every texel still gets the same count): the budget is
+      // kept to about a pass of one sample rather than overrun by a whole ramped pass.
+      if (passes.timed() && k < seconds_per_sample.size() && seconds_per_sample[k] > 0) {
+        const double left = settings.time_budget_seconds - passes.elapsed_seconds();
+        add = uint32_t(std::clamp(std::floor(left / seconds_per_sample[k]), 0.0, double(add)));
+        if (add == 0) break;
+      }
+      const auto layer_start = std::chrono::steady_clock::now();
       const BounceGather gather(scene, embree, gbuffer, caches, settings);
       tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& range) {
         Counters& c = counters_per_thread.local();
@@ -284,6 +294,9 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
         }
       });
       layer.samples += add;
+      if (seconds_per_sample.size() <= k) seconds_per_sample.resize(k + 1, 0.0);
+      if (add > 0)
+        seconds_per_sample[k] = std::chrono::duration<double>(std::chrono::steady_clock::now() - layer_start).count() / add;
       if (k == 0)
         for (size_t i = 0; i < n; ++i) valid[i] = 2 * layers[0].back_faces[i] <= layers[0].samples ? 1 : 0;
       std::vector<Vec3> means(n);
