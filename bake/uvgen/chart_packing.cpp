@@ -1,6 +1,8 @@
 #include "chart_packing.h"
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <cmath>
 #include <numbers>
 #include <numeric>
@@ -140,33 +142,164 @@ ChartMask turned(const ChartMask& m, int turns) {
   return t;
 }
 
-// What the skyline needs of a turned mask: per column its lowest texel (or none), and per column of
-// the mask widened by the dilation its dilated top (one past the highest texel, plus the dilation).
-struct Profile {
-  int width = 0, height = 0;
-  std::vector<int> bottom;       // per column; INT32_MAX when the column is empty
-  std::vector<int> dilated_top;  // per column x - dilation .. width - 1 + dilation; INT32_MIN when empty
+// A turned mask as bit rows for the bottom-left search: its own texels (tested against the grid)
+// and its texels dilated by the gutter in every direction (stamped into the grid once placed).
+struct BitMask {
+  int width = 0, height = 0, words = 0;  // `words` 64-bit words per row of the own texels
+  std::vector<uint64_t> rows;            // height x words
+  int dilated_words = 0;                 // per row of the dilated mask: width + 2 dilation bits
+  std::vector<uint64_t> dilated_rows;    // (height + 2 dilation) x dilated_words
+  int key_row = 0, key_start = 0, key_length = 0;  // the longest run of texels in one row
+  std::vector<std::array<int, 2>> first_run;       // per row: start and length of its first run of texels
 };
 
-Profile profile_of(const ChartMask& m, int dilation) {
-  Profile p;
-  p.width = m.width;
-  p.height = m.height;
-  p.bottom.assign(size_t(m.width), INT32_MAX);
-  std::vector<int> top(size_t(m.width), INT32_MIN);
-  for (int x = 0; x < m.width; ++x)
-    for (int y = 0; y < m.height; ++y)
-      if (m.at(x, y)) {
-        p.bottom[size_t(x)] = std::min(p.bottom[size_t(x)], y);
-        top[size_t(x)] = y + 1;
+void set_bit(std::vector<uint64_t>& bits, size_t row_start, int x) { bits[row_start + size_t(x >> 6)] |= uint64_t(1) << (x & 63); }
+
+BitMask bit_mask_of(const ChartMask& m, int dilation) {
+  BitMask b;
+  b.width = m.width;
+  b.height = m.height;
+  b.words = (m.width + 63) / 64;
+  b.rows.assign(size_t(b.height) * size_t(b.words), 0);
+  const int dilated_width = m.width + 2 * dilation, dilated_height = m.height + 2 * dilation;
+  b.dilated_words = (dilated_width + 63) / 64;
+  b.dilated_rows.assign(size_t(dilated_height) * size_t(b.dilated_words), 0);
+  // Dilate rows first (each texel widened to 2 dilation + 1), then columns.
+  std::vector<uint8_t> wide(size_t(m.height) * size_t(dilated_width), 0);
+  b.first_run.assign(size_t(m.height), {0, 0});
+  for (int y = 0; y < m.height; ++y) {
+    int run = 0;
+    bool first_run_ended = false;
+    for (int x = 0; x < m.width; ++x) {
+      if (!m.at(x, y)) {
+        first_run_ended |= run > 0;
+        run = 0;
+        continue;
       }
-  p.dilated_top.assign(size_t(m.width + 2 * dilation), INT32_MIN);
-  for (int x = 0; x < m.width; ++x)
-    if (top[size_t(x)] != INT32_MIN)
-      for (int d = 0; d <= 2 * dilation; ++d)
-        p.dilated_top[size_t(x + d)] = std::max(p.dilated_top[size_t(x + d)], top[size_t(x)] + dilation);
-  return p;
+      if (!first_run_ended) {
+        if (run == 0) b.first_run[size_t(y)][0] = x;
+        b.first_run[size_t(y)][1] = run + 1;
+      }
+      set_bit(b.rows, size_t(y) * size_t(b.words), x);
+      if (++run > b.key_length) b.key_length = run, b.key_row = y, b.key_start = x - run + 1;
+      for (int d = 0; d <= 2 * dilation; ++d) wide[size_t(y) * size_t(dilated_width) + size_t(x + d)] = 1;
+    }
+  }
+  for (int y = 0; y < m.height; ++y)
+    for (int x = 0; x < dilated_width; ++x)
+      if (wide[size_t(y) * size_t(dilated_width) + size_t(x)])
+        for (int d = 0; d <= 2 * dilation; ++d) set_bit(b.dilated_rows, size_t(y + d) * size_t(b.dilated_words), x);
+  return b;
 }
+
+// Texel occupancy of the strip (placed charts dilated by the gutter), one bit per texel, rows
+// added as the packing grows upwards.
+class OccupancyGrid {
+ public:
+  explicit OccupancyGrid(int width) : width_(width), words_((width + 63) / 64 + 1) {}
+
+  // The 64 bits of row `y` from column `x` (zero past the top; the padding word keeps x + 64 in range).
+  uint64_t bits_at(int y, int x) const {
+    if (y >= rows()) return 0;
+    const uint64_t* row = &bits_[size_t(y) * size_t(words_)];
+    const int word = x >> 6, shift = x & 63;
+    return shift == 0 ? row[word] : (row[word] >> shift) | (row[word + 1] << (64 - shift));
+  }
+
+  // 0 when the mask at (x, y) overlaps no occupied texel, else how far right the next position
+  // that can fit lies: an occupied run met by a row's first run of texels rules out every position
+  // until that run is passed.
+  int collision_skip(const BitMask& m, int x, int y) const {
+    auto row_skip = [&](int r) {
+      if (y + r >= rows() || m.first_run[size_t(r)][1] == 0) return 0;
+      const int start = x + m.first_run[size_t(r)][0];
+      const int occupied = next_set(y + r, start);
+      if (occupied < start + m.first_run[size_t(r)][1]) return next_clear(y + r, occupied) - start;
+      for (int k = 0; k < m.words; ++k)
+        if (bits_at(y + r, x + 64 * k) & m.rows[size_t(r) * size_t(m.words) + size_t(k)]) return 1;
+      return 0;
+    };
+    // The key row first: it fails most often.
+    for (int r = m.key_row; r < m.height; ++r)
+      if (const int skip = row_skip(r)) return skip;
+    for (int r = 0; r < m.key_row; ++r)
+      if (const int skip = row_skip(r)) return skip;
+    return 0;
+  }
+
+  // Free runs [start, end) of row `y` of at least `length` texels, in order.
+  template <typename Visit>
+  bool for_each_free_run(int y, int length, Visit&& visit) const {
+    if (y < rows() && longest_free_[size_t(y)] < length) return false;
+    int x = 0;
+    while (x < width_) {
+      const int free_end = next_set(y, x);  // first occupied at or after x
+      if (free_end - x >= length && visit(x, free_end)) return true;
+      if (free_end >= width_) break;
+      x = next_clear(y, free_end);
+    }
+    return false;
+  }
+
+  void stamp(const BitMask& m, int x, int y, int dilation) {
+    const int dilated_height = m.height + 2 * dilation, dilated_width = m.width + 2 * dilation;
+    const int top = y + m.height + dilation;
+    if (top > rows()) {
+      bits_.resize(size_t(top) * size_t(words_), 0);
+      longest_free_.resize(size_t(top), width_);
+    }
+    for (int r = 0; r < dilated_height; ++r) {
+      const int gy = y + r - dilation;
+      if (gy < 0) continue;
+      for (int c = 0; c < dilated_width; ++c) {
+        const int gx = x + c - dilation;
+        if (gx < 0 || gx >= width_) continue;
+        if (m.dilated_rows[size_t(r) * size_t(m.dilated_words) + size_t(c >> 6)] >> (c & 63) & 1)
+          set_bit(bits_, size_t(gy) * size_t(words_), gx);
+      }
+      longest_free_[size_t(gy)] = longest_free_run(gy);
+    }
+  }
+
+  int rows() const { return int(bits_.size() / size_t(words_)); }
+
+  int next_set(int y, int x) const {
+    if (y >= rows()) return width_;
+    const uint64_t* row = &bits_[size_t(y) * size_t(words_)];
+    for (int word = x >> 6; word * 64 < width_; ++word) {
+      uint64_t w = row[word];
+      if (word == x >> 6) w &= ~uint64_t(0) << (x & 63);
+      if (w) return std::min(width_, word * 64 + std::countr_zero(w));
+    }
+    return width_;
+  }
+  int next_clear(int y, int x) const {
+    if (y >= rows()) return x;
+    const uint64_t* row = &bits_[size_t(y) * size_t(words_)];
+    for (int word = x >> 6; word * 64 < width_; ++word) {
+      uint64_t w = ~row[word];
+      if (word == x >> 6) w &= ~uint64_t(0) << (x & 63);
+      if (w) return std::min(width_, word * 64 + std::countr_zero(w));
+    }
+    return width_;
+  }
+
+ private:
+  int longest_free_run(int y) const {
+    int longest = 0;
+    for (int x = 0; x < width_;) {
+      const int end = next_set(y, x);
+      longest = std::max(longest, end - x);
+      if (end >= width_) break;
+      x = next_clear(y, end);
+    }
+    return longest;
+  }
+
+  int width_, words_;
+  std::vector<uint64_t> bits_;
+  std::vector<int> longest_free_;  // per row: the longest run of free texels, to skip rows fast
+};
 
 struct StripResult {
   std::vector<std::array<int, 2>> position;  // per chart
@@ -174,44 +307,60 @@ struct StripResult {
   int width = 0, height = 0;
 };
 
-// Charts in `order` dropped one by one onto a skyline `strip_width` texels wide, each at the column
-// and turn where its top ends lowest (then leftmost, then fewest turns).
-StripResult pack_strip(const std::vector<std::array<Profile, 4>>& profiles, const std::vector<size_t>& order,
-                       int strip_width, int dilation, int turn_choices) {
-  StripResult result;
-  result.position.resize(profiles.size());
-  result.turns.resize(profiles.size());
-  std::vector<int> skyline(size_t(strip_width), 0);
-  for (size_t chart : order) {
-    int best_top = INT32_MAX, best_x = 0, best_y = 0, best_turns = 0;
-    int64_t best_waste = INT64_MAX;
-    for (int turns = 0; turns < turn_choices; ++turns) {
-      const Profile& p = profiles[chart][size_t(turns)];
-      for (int x = 0; x + p.width <= strip_width; ++x) {
-        int y = 0;
-        for (int c = 0; c < p.width; ++c)
-          if (p.bottom[size_t(c)] != INT32_MAX) y = std::max(y, skyline[size_t(x + c)] - p.bottom[size_t(c)]);
-        if (y + p.height > best_top) continue;
-        // Equal tops: the least area left unreachable under the chart (an arch opening up, not down,
-        // so later charts can fill it).
-        int64_t waste = 0;
-        for (int c = 0; c < p.width; ++c)
-          if (p.bottom[size_t(c)] != INT32_MAX) waste += y + p.bottom[size_t(c)] - skyline[size_t(x + c)];
-        if (y + p.height < best_top || waste < best_waste)
-          best_top = y + p.height, best_waste = waste, best_x = x, best_y = y, best_turns = turns;
+// The lowest, then leftmost position where the mask overlaps no occupied texel: rows bottom up, and
+// in each row only the columns where the mask's longest run lies in a free run of the grid.
+std::array<int, 2> bottom_left_position(const OccupancyGrid& grid, const BitMask& m, int strip_width) {
+  std::array<int, 2> found{-1, -1};
+  for (int y = 0;; ++y) {
+    const bool searched = grid.for_each_free_run(y + m.key_row, m.key_length, [&](int start, int end) {
+      const int first = std::max(0, start - m.key_start);
+      const int last = std::min(strip_width - m.width, end - m.key_length - m.key_start);
+      for (int x = first; x <= last;) {
+        const int skip = grid.collision_skip(m, x, y);
+        if (skip == 0) {
+          found = {x, y};
+          return true;
+        }
+        x += skip;
       }
+      return false;
+    });
+    if (searched) return found;
+    if (y >= grid.rows()) return found;  // wider than the strip: no position in empty rows either
+  }
+}
+
+// Charts in `order` placed one by one by bottom-left fill on the strip's texel occupancy, each in
+// the turn whose bottom-left position ends lowest (then lowest, leftmost, fewest turns), or with
+// `least_growth` first the one that grows the packed rectangle least: a chart can nest inside
+// another's arch, which a skyline cannot reach.
+StripResult pack_strip(const std::vector<std::array<BitMask, 4>>& masks, const std::vector<size_t>& order,
+                       int strip_width, int dilation, int turn_choices, bool least_growth) {
+  StripResult result;
+  result.position.resize(masks.size());
+  result.turns.resize(masks.size());
+  OccupancyGrid grid(strip_width);
+  for (size_t chart : order) {
+    int best_top = INT32_MAX, best_x = 0, best_y = 0, best_turns = -1;
+    int64_t best_area = INT64_MAX;
+    for (int turns = 0; turns < turn_choices; ++turns) {
+      const BitMask& m = masks[chart][size_t(turns)];
+      if (m.width > strip_width) continue;
+      const auto [x, y] = bottom_left_position(grid, m, strip_width);
+      if (y < 0) continue;
+      const int top = y + m.height;
+      const int64_t area =
+          least_growth ? int64_t(std::max(result.width, x + m.width)) * std::max(result.height, top) : 0;
+      if (area < best_area || (area == best_area && (top < best_top || (top == best_top && (y < best_y || (y == best_y && x < best_x))))))
+        best_area = area, best_top = top, best_x = x, best_y = y, best_turns = turns;
     }
-    if (best_top == INT32_MAX) return {};  // wider than the strip in every turn
-    const Profile& p = profiles[chart][size_t(best_turns)];
-    for (int c = 0; c < int(p.dilated_top.size()); ++c) {
-      const int column = best_x + c - dilation;
-      if (column < 0 || column >= strip_width || p.dilated_top[size_t(c)] == INT32_MIN) continue;
-      skyline[size_t(column)] = std::max(skyline[size_t(column)], best_y + p.dilated_top[size_t(c)]);
-    }
+    if (best_turns < 0) return {};  // wider than the strip in every turn
+    const BitMask& m = masks[chart][size_t(best_turns)];
+    grid.stamp(m, best_x, best_y, dilation);
     result.position[chart] = {best_x, best_y};
     result.turns[chart] = best_turns;
-    result.width = std::max(result.width, best_x + p.width);
-    result.height = std::max(result.height, best_top);
+    result.width = std::max(result.width, best_x + m.width);
+    result.height = std::max(result.height, best_y + m.height);
   }
   return result;
 }
@@ -267,7 +416,7 @@ PackedCharts pack_charts(const std::vector<ChartOutline>& charts, const PackingS
     // The charts' own texels alone exceed the page: not worth rasterizing (it is slow at a density
     // far too high).
     if (chart_area * density * density > double(max_side) * max_side) return Attempt{};
-    std::vector<std::array<Profile, 4>> profiles(charts.size());
+    std::vector<std::array<BitMask, 4>> masks(charts.size());
     std::vector<size_t> mask_area(charts.size());
     double total_area = 0;
     int widest_needed = 1;
@@ -277,7 +426,7 @@ PackedCharts pack_charts(const std::vector<ChartOutline>& charts, const PackingS
       p.mask_width = mask.width;
       p.mask_height = mask.height;
       for (int turns = 0; turns < turn_choices; ++turns)
-        profiles[c][size_t(turns)] = profile_of(turned(mask, turns), dilation);
+        masks[c][size_t(turns)] = bit_mask_of(turned(mask, turns), dilation);
       mask_area[c] = size_t(std::count(mask.texels.begin(), mask.texels.end(), uint8_t(1)));
       total_area += double(mask.width + dilation) * double(mask.height + dilation);
       widest_needed = std::max(widest_needed, std::min(mask.width, mask.height));
@@ -292,9 +441,12 @@ PackedCharts pack_charts(const std::vector<ChartOutline>& charts, const PackingS
     // A few strip widths around the square; keep the smallest rectangle that fits the page.
     StripResult best;
     bool have_best = false, best_fits = false;
+    // Neither turn choice wins everywhere (the least growth fills small sets of charts better, the
+    // lowest top some tori): both, for every width.
+    for (const bool least_growth : {true, false})
     for (double factor : {0.8, 0.9, 1.0, 1.15, 1.3, 1.6}) {
       const int strip = std::max(widest_needed, int(std::ceil(std::sqrt(total_area) * factor)));
-      StripResult r = pack_strip(profiles, order, strip, dilation, turn_choices);
+      StripResult r = pack_strip(masks, order, strip, dilation, turn_choices, least_growth);
       if (r.position.empty()) continue;
       const bool fits = std::max(r.width, r.height) <= max_side;
       const double area = double(r.width) * r.height, best_area = double(best.width) * best.height;

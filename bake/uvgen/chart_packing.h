@@ -1,8 +1,9 @@
 // Charts into one rectangle: each turned to its minimal-area bounding box and rasterized into a texel
-// mask, then dropped onto a per-column skyline (Tetris-like: a chart's bottom profile rests on the
-// tops of the charts below, dilated by the gutter), at the largest density, up to the one asked,
-// whose rectangle fits the page. Masks make round and C-shaped charts nest, which their bounding
-// boxes cannot.
+// mask, then placed by bottom-left fill on the rectangle's texel occupancy (each chart, in one of its
+// quarter turns, at the lowest then leftmost position where its mask overlaps no texel of the charts
+// already placed dilated by the gutter), at the largest density, up to the one asked, whose
+// rectangle fits the page. Masks let a chart nest inside another's arch or C, which bounding boxes
+// and skylines cannot.
 #pragma once
 #include <vector>
 

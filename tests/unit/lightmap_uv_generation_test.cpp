@@ -250,12 +250,14 @@ struct Shape {
 
 TEST(LightmapUvGeneration, ClosedPrimitivesGiveFewChartsAndNoOverlap) {
   // At 32 texels per unit the 3.1-texel gaps cost much of a small chart; a torus's charts are arches
-  // whose inside the skyline cannot reach (bench/results/uvgen.md): the bounds are what the packer
-  // achieves here (cube 0.85, sphere 0.65, cylinder 0.73, torus 0.515), not 60 % everywhere.
+  // with little that fits inside them (bench/results/uvgen.md): the bounds are what the bottom-left
+  // packer achieves here (cube 0.848, sphere 0.648, cylinder 0.776, torus 0.548) less about three
+  // texel rows of the packed rectangle (~0.02), for LSCM round-off moving a mask texel on another
+  // machine, not 60 % everywhere.
   const Shape shapes[] = {{"cube", cube(), 6, 0.8, 1.01},
                           {"uv sphere", uv_sphere(), 4, 0.6, 1.3},
-                          {"cylinder", cylinder(), 6, 0.7, 1.01},
-                          {"torus", torus(), 6, 0.5, 1.35}};
+                          {"cylinder", cylinder(), 6, 0.75, 1.01},
+                          {"torus", torus(), 6, 0.525, 1.35}};
   for (const Shape& shape : shapes) {
     SCOPED_TRACE(shape.name);
     const GeneratedUvs uvs = generate(shape.mesh);
