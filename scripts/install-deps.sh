@@ -14,6 +14,7 @@ packages=(
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools glslang-tools
   libgtest-dev libgmock-dev libbenchmark-dev
   libssl-dev
+  libopenmpi-dev openmpi-bin
   assimp-testmodels
   python3-matplotlib gnuplot-nox
 )

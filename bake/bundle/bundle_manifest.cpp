@@ -158,6 +158,8 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
   stats["enclosed_lights"] = results.geometry.enclosed_lights;
   stats["nonfinite_samples"] = estimate.nonfinite_samples;
   if (results.stage_cache) stats["cache"]["stages"] = *results.stage_cache;
+  if (results.distribution)
+    for (const auto& [key, value] : results.distribution->items()) stats[key] = value;
   json skipped = {{"texels_outside_charts", gbuffer.skipped_texels}};
   if (results.sealed) {
     // Sealed texels (no light reaches them): found either way, skipped unless --no-skip. The time

@@ -17,6 +17,8 @@
 #include "exitance/bake/command/automatic_integrator.h"
 #include "exitance/bake/command/cached_offline_stages.h"
 #include "exitance/formats/bundle_manifest.h"
+#include "exitance/bake/input_error.h"
+#include "exitance/runtime/core/work_share.h"
 #include "exitance/runtime/stage_clock.h"
 
 namespace exitance {
@@ -83,9 +85,32 @@ void repeat_stored_warnings(const std::vector<std::string>& stored, Diagnostics&
   }
 }
 
+// stats.ranks and stats.rank_work (docs/bundle.md) from every rank's work.
+json distribution_json(const std::vector<RankWork>& work) {
+  json ranks = json::array();
+  for (const RankWork& w : work)
+    ranks.push_back({{"texel_samples", w.texel_samples},
+                     {"probe_samples", w.probe_samples},
+                     {"rays", w.rays},
+                     {"seconds", w.seconds}});
+  return {{"ranks", work.size()}, {"rank_work", ranks}};
+}
+
+// Tests: the rank named by EXITANCE_TEST_FAIL_RANK fails before lighting while the others wait in
+// the lighting stage's first exchange (a rank that dies must end the job, not hang it).
+void fail_here_if_asked(const WorkShare& share) {
+  const char* rank = std::getenv("EXITANCE_TEST_FAIL_RANK");
+  if (rank && std::to_string(share.rank()) == rank)
+    throw std::runtime_error("rank " + std::string(rank) + " failed on purpose (EXITANCE_TEST_FAIL_RANK)");
+}
+
 }  // namespace
 
 json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
+  // Under mpirun (work_share.h) every rank runs the offline stages (replicated) and lights its share;
+  // rank 0 alone uses the caches and writes. One process: share null.
+  WorkShare* share = distributed(options.lighting.work_share);
+  const bool writer = !share || share->rank() == 0;
   // Offline stage (DESIGN §1): scene, atlas, texel G-buffer, the BVHs, the backend that will light them.
   StageTimer clock;
   std::vector<MeshWithoutLightmapUvs> without_lightmap_uvs;
@@ -96,9 +121,10 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   // taken before UV generation, which it determines (the scene, the options and the program).
   std::optional<BundleCache> cache;
   std::string cache_key;
+  std::optional<json> reused;
   if (!options.cache_directory.empty()) {
     cache.emplace(options.cache_directory);
-    std::optional<json> reused = clock.time("cache", [&]() -> std::optional<json> {
+    reused = clock.time("cache", [&]() -> std::optional<json> {
       options.announce_stage("cache");
       cache_key =
           bake_cache_key(imported, options, input_sha256, backend_candidates(options.backend));
@@ -112,14 +138,16 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
           std::string(std::istreambuf_iterator<char>(in), {}), (out / "manifest.json").string());
       return json{{"stats", json::parse(manifest.stats_json)}, {"pages", manifest.pages.size()}};
     });
-    if (reused) {
-      if (!options.write_gltf.empty()) {  // the UVs again (their warnings were repeated from the cache)
-        Diagnostics repeated;
-        write_gltf_stage(uv_generation_stage(imported, without_lightmap_uvs, options, repeated), options, diagnostics);
-      }
-      return run_report(WrittenBundle{bundle_folder(options), (*reused)["pages"].get<size_t>(), (*reused)["stats"]},
-                        clock.seconds());
+  }
+  // Under mpirun only rank 0 has a cache: the others learn here whether it reused a bundle (and stop).
+  if (share && agreed(*share, uint8_t(reused ? 1 : 0)) && !writer) return json{{"rank", share->rank()}};
+  if (reused) {
+    if (!options.write_gltf.empty()) {  // the UVs again (their warnings were repeated from the cache)
+      Diagnostics repeated;
+      write_gltf_stage(uv_generation_stage(imported, without_lightmap_uvs, options, repeated), options, diagnostics);
     }
+    return run_report(WrittenBundle{bundle_folder(options), (*reused)["pages"].get<size_t>(), (*reused)["stats"]},
+                      clock.seconds());
   }
   std::vector<MeshUvReport> generated_uvs;
   if (!without_lightmap_uvs.empty())
@@ -137,6 +165,9 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   // --integrator auto becomes path or bounces here, where the backend is known; every later stage
   // (lighting, the manifest) sees the decided integrator.
   const BakeOptions decided = with_integrator_decided(options, *backend);
+  if (share && decided.lighting.integrator == IntegratorMode::Path && decided.lighting.target_relative_error > 0)
+    throw InputError(options.input, "--target-error",
+                     "with path tracing plans each texel's samples in one process; under mpirun use --integrator bounces");
   const size_t unoccluded = clock.time("unocclude", [&] { return stages.unocclude(scene, gbuffer, layout, diagnostics); });
   const GeometryCheckReport geometry =
       clock.time("checks", [&] { return stages.checks(scene, gbuffer, diagnostics); });
@@ -170,11 +201,15 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
     // Never 0 (= no budget): a budget the probes used up leaves the texels one pass.
     if (budget > 0) lighting_options.lighting.time_budget_seconds = std::max(1e-3, budget - probe_lighting->seconds);
   }
+  if (share) fail_here_if_asked(*share);
   const LightmapEstimate lightmap =
       clock.time("lighting", [&] {
         return lighting_stage(*backend, gbuffer, options.skip_sealed_texels ? &sealed : nullptr, lighting_options,
                               diagnostics);
       });
+  std::optional<json> distribution;
+  if (options.lighting.work_share) distribution = distribution_json(gather_rank_work(*options.lighting.work_share));
+  if (!writer) return json{{"rank", share->rank()}};
   if (voxels) clock.time("exitance", [&] { exitance_stage(*voxels, scene, gbuffer, lightmap, options); });
 
   // Bundle: everything the stages produced, written at once.
@@ -193,7 +228,8 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                             .generated_uvs = &generated_uvs,
                             .sealed = &sealed,
                             .sealed_skipped = options.skip_sealed_texels,
-                            .stage_cache = cache ? &stages.outcomes() : nullptr};
+                            .stage_cache = cache ? &stages.outcomes() : nullptr,
+                            .distribution = distribution ? &*distribution : nullptr};
   if (options.preview && scene_file.bytes.empty())
     diagnostics.warn("--preview: no views, only the lightmap pages: the bundle has no scene.bin (" +
                      scene_file.skipped + ")");

@@ -18,6 +18,7 @@
 #include "exitance/runtime/scene_file_conversion.h"
 #include "exitance/runtime/bundle/probe_results.h"
 #include "exitance/runtime/bundle/texel_exitance.h"
+#include "exitance/runtime/core/work_share.h"
 #include "exitance/runtime/cpu/bvh4_builder.h"
 
 namespace exitance {
@@ -172,6 +173,8 @@ ProbePlacement place_probes_stage(const SceneForLighting& scene, const Voxelized
 bool adaptive_sampling_applies(const BakeOptions& options, const std::string& backend_name) {
   if (options.adaptive_request == AdaptiveRequest::Off) return false;
   if (options.adaptive_request == AdaptiveRequest::On) return true;
+  // Under mpirun the pilot's plan is not split over ranks: auto stays off there.
+  if (distributed(options.lighting.work_share)) return false;
   return backend_name == "cpu" && options.lighting.integrator == IntegratorMode::Path &&
          (options.lighting.time_budget_seconds > 0 || options.lighting.target_relative_error > 0);
 }

@@ -6,9 +6,14 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <memory>
+
+#include <fcntl.h>
+#include <unistd.h>
 
 #include "exitance/bake/bundle/write_bundle.h"
 #include "exitance/bake/command/bake_pipeline.h"
+#include "exitance/bake/distributed/mpi_work_share.h"
 #include "exitance/bake/input_error.h"
 #include "exitance/common/path_sampler.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
@@ -26,9 +31,40 @@ void print_warnings(const exitance::Diagnostics& diagnostics) {
   for (const std::string& w : diagnostics.warnings) std::cerr << "bake: warning: " << one_line(w) << "\n";
 }
 
+// Under mpirun the ranks other than 0 keep quiet (rank 0 prints progress, warnings and errors every
+// rank would give alike); their own failures go to the stderr kept here.
+FILE* rank_stderr = stderr;
+
+void quiet_unless_rank_zero(const exitance::MpiWorkShare* share) {
+  if (!share || share->rank() == 0) return;
+  const int kept = dup(STDERR_FILENO);
+  const int null = open("/dev/null", O_WRONLY);
+  if (kept < 0 || null < 0) return;
+  rank_stderr = fdopen(kept, "w");
+  dup2(null, STDERR_FILENO);
+  close(null);
+}
+
+// What `bake` cannot split over ranks yet: a one-line reason, or empty.
+std::string refused_under_mpirun(const exitance::BakeOptions& options, const std::string& adaptive,
+                                 const std::string& guiding, const std::string& integrator) {
+  if (options.backend.name == "vulkan")
+    return "--backend vulkan: under mpirun only the CPU backend splits the work over ranks yet";
+  if (adaptive == "on") return "--adaptive on: adaptive sampling runs in one process only, not under mpirun";
+  if (guiding == "grid") return "--guiding grid: guiding runs in one process only, not under mpirun";
+  if (integrator == "path" && options.lighting.target_relative_error > 0)
+    return "--target-error: with --integrator path it plans each texel's samples in one process; under mpirun use "
+           "--integrator bounces";
+  return {};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Launched by mpirun: this process lights its share of the texels and probes (docs/cli.md).
+  const std::unique_ptr<exitance::MpiWorkShare> mpi = exitance::MpiWorkShare::start_if_launched_by_mpirun(argc, argv);
+  quiet_unless_rank_zero(mpi.get());
+  const bool several_ranks = mpi && mpi->ranks() > 1;
   exitance::BakeOptions options;
   CLI::App app{"Exitance lightmap baker: bake SCENE.{gltf,glb} [-o OUT] [options]"};
   app.add_option("scene", options.input, "input glTF 2.0 scene (.gltf or .glb)")->required();
@@ -262,11 +298,28 @@ int main(int argc, char** argv) {
     }
   }
 
+  if (mpi) {
+    options.lighting.work_share = mpi.get();
+    if (several_ranks) {
+      const std::string refused = refused_under_mpirun(options, adaptive, guiding, integrator);
+      if (!refused.empty()) {
+        std::cerr << "bake: error: " << refused << "\n";
+        return 2;
+      }
+      if (options.backend.name == "auto") {
+        options.backend.name = "cpu";
+        diagnostics.warn("under mpirun: using the CPU reference (Embree), the only backend that splits the work over ranks yet");
+      }
+    }
+    if (mpi->rank() != 0) options.cache_directory.clear();  // rank 0 alone reads and fills the caches
+  }
+
   exitance::ProgressBar bar;
   options.progress = [&](const std::string& stage, double fraction, uint64_t rays) { bar.update(stage, fraction, rays); };
   try {
     const nlohmann::json report = exitance::run_bake(options, diagnostics);
     bar.finish();
+    if (mpi && mpi->rank() != 0) return 0;  // rank 0 wrote the bundle and reports it
     print_warnings(diagnostics);
     if (json_report) {
       std::cout << report.dump(2) << "\n";
@@ -282,11 +335,21 @@ int main(int argc, char** argv) {
     bar.finish();
     print_warnings(diagnostics);
     std::cerr << "bake: error: " << one_line(e.what()) << "\n";
+    // Every rank meets the same bad input alike, but one that met it alone (rank 0's cache or
+    // output folder) must not leave the others waiting in an exchange.
+    if (several_ranks) mpi->abort(2);
     return 2;
   } catch (const std::exception& e) {
     bar.finish();
     print_warnings(diagnostics);
-    std::cerr << "bake: error: " << one_line(e.what()) << "\n";
-    return 1;
+    if (!several_ranks) {
+      std::cerr << "bake: error: " << one_line(e.what()) << "\n";
+      return 1;
+    }
+    // The other ranks may be waiting for this one in an exchange: end the whole job, so the run fails
+    // (the earlier bundle intact: rank 0 writes atomically) instead of hanging.
+    std::fprintf(rank_stderr, "bake: error: rank %d: %s\n", mpi->rank(), one_line(e.what()).c_str());
+    std::fflush(rank_stderr);
+    mpi->abort(1);
   }
 }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "exitance/runtime/core/work_share.h"
+
 namespace exitance {
 
 PassScheduler::PassScheduler(const IntegratorSettings& settings, PassPolicy policy)
@@ -11,6 +13,29 @@ PassScheduler::PassScheduler(const IntegratorSettings& settings, PassPolicy poli
 }
 
 bool PassScheduler::next_pass(uint32_t& begin, uint32_t& count, double* fraction) {
+  WorkShare* share = distributed(settings_.work_share);
+  if (!share) return next_pass_here(begin, count, fraction);
+  double local_fraction = 1;
+  struct Decision {
+    uint32_t more, begin, count;
+    double fraction;
+  } decision{};
+  decision.more = next_pass_here(decision.begin, decision.count, fraction ? &local_fraction : nullptr) ? 1 : 0;
+  decision.fraction = local_fraction;
+  decision = agreed(*share, decision);
+  if (!decision.more) {
+    stopped_ = true;
+    return false;
+  }
+  // A fraction only where the caller can run one; rank 0 offered it only then too.
+  if (fraction) *fraction = decision.fraction;
+  pending_fraction_ = fraction ? decision.fraction : 1;
+  begin = decision.begin;
+  count = pending_ = decision.count;
+  return true;
+}
+
+bool PassScheduler::next_pass_here(uint32_t& begin, uint32_t& count, double* fraction) {
   if (fraction) *fraction = 1;
   pending_fraction_ = 1;
   if (stopped_ || done_ >= limit_) return false;

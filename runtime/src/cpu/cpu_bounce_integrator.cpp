@@ -45,6 +45,7 @@
 #include "exitance/runtime/core/bounce_tail.h"
 #include "exitance/runtime/core/pass_scheduler.h"
 #include "exitance/runtime/core/scene_access.h"
+#include "exitance/runtime/core/work_share.h"
 #include "exitance/runtime/embree_scene.h"
 
 namespace exitance {
@@ -254,6 +255,13 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
   PassPolicy policy;
   policy.ramp = settings.time_budget_seconds > 0 || settings.target_relative_error > 0;
   PassScheduler passes(settings, policy);
+  // Split over processes (work_share.h): each layer pass estimates this rank's texels, then every
+  // rank gathers the layer's sums, so the caches, the tail and the stop are computed from the whole
+  // layer, identically everywhere. The split follows the rays each texel traced in the last pass.
+  WorkShare* share = distributed(settings.work_share);
+  std::vector<size_t> bounds = share ? split_by_cost(n, {}, share->ranks()) : std::vector<size_t>{};
+  std::vector<uint64_t> texel_rays(share ? n : 0);
+  uint64_t own_samples = 0;
   std::vector<double> seconds_per_sample;  // per layer: the last pass's seconds per sample of every texel
   uint32_t first = 0, count = 0;
   while (passes.next_pass(first, count)) {
@@ -267,13 +275,17 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
       if (passes.timed() && k < seconds_per_sample.size() && seconds_per_sample[k] > 0) {
         const double left = settings.time_budget_seconds - passes.elapsed_seconds();
         add = uint32_t(std::clamp(std::floor(left / seconds_per_sample[k]), 0.0, double(add)));
+        if (share) add = agreed(*share, add);  // rank 0's clock decides
         if (add == 0) break;
       }
       const auto layer_start = std::chrono::steady_clock::now();
       const BounceGather gather(scene, embree, gbuffer, caches, settings);
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& range) {
+      const size_t own_begin = share ? bounds[size_t(share->rank())] : 0;
+      const size_t own_end = share ? bounds[size_t(share->rank()) + 1] : n;
+      tbb::parallel_for(tbb::blocked_range<size_t>(own_begin, own_end, 64), [&](const tbb::blocked_range<size_t>& range) {
         Counters& c = counters_per_thread.local();
         for (size_t i = range.begin(); i != range.end(); ++i) {
+          const uint64_t rays_before = c.rays;
           const LiveTexel& texel = gbuffer.texels[i];
           const SurfacePoint x{texel.position, texel.geometric_normal, texel.shading_normal};
           for (uint32_t s = layer.samples; s < layer.samples + add; ++s) {
@@ -291,8 +303,18 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
               layer.sum_squared[i * 3 + size_t(ch)] += double(value[ch]) * double(value[ch]);
             }
           }
+          if (share) texel_rays[i] = c.rays - rays_before;
         }
       });
+      if (share) {
+        share->work.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - layer_start).count();
+        own_samples += uint64_t(own_end - own_begin) * add;
+        allgather_items(*share, layer.sum.data(), 3, bounds);
+        allgather_items(*share, layer.sum_squared.data(), 3, bounds);
+        if (k == 0) allgather_items(*share, layer.back_faces.data(), 1, bounds);
+        allgather_items(*share, texel_rays.data(), 1, bounds);
+        bounds = split_by_cost(n, texel_rays, share->ranks());
+      }
       layer.samples += add;
       if (seconds_per_sample.size() <= k) seconds_per_sample.resize(k + 1, 0.0);
       if (add > 0)
@@ -322,7 +344,9 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
       }
       if (settings.progress && !passes.timed())
         settings.progress(forced ? double(k + 1) / double(layer_cap) : double(k + 1) / double(k + 2), counters().rays);
-      if (passes.timed() && passes.elapsed_seconds() >= settings.time_budget_seconds) break;
+      bool out_of_time = passes.timed() && passes.elapsed_seconds() >= settings.time_budget_seconds;
+      if (share && passes.timed()) out_of_time = agreed(*share, out_of_time);
+      if (out_of_time) break;
     }
     bool all_converged = false;
     // At least 16 samples, as in path mode; a texel that stayed black with no variance (inside
@@ -386,7 +410,21 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
       acc.total_squared[c] = n0 * total[c] * total[c] + (n0 >= 2 ? (n0 - 1) * n0 * variance[c] : 0.0);
     }
   }
-  const Counters c = counters();
+  Counters c = counters();
+  if (settings.work_share) {
+    RankWork& work = settings.work_share->work;
+    work.rays += c.rays;
+    if (share) {
+      work.texel_samples += own_samples;
+    } else {
+      for (const Layer& layer : layers) work.texel_samples += uint64_t(layer.samples) * n;
+      work.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+  }
+  if (share) {
+    c.rays = share->sum(c.rays), c.gathers = share->sum(c.gathers), c.texelless = share->sum(c.texelless);
+    c.back_faces = share->sum(c.back_faces), c.nonfinite = share->sum(c.nonfinite);
+  }
   BounceGatherStatistics& stats = estimate.bounce_statistics;
   stats.bounces = layer_count - 1;
   for (const Layer& layer : layers) stats.samples.push_back(layer.samples);

@@ -17,6 +17,7 @@
 #include "exitance/runtime/core/grid_guiding_cache.h"
 #include "exitance/runtime/core/pass_scheduler.h"
 #include "exitance/runtime/core/scene_access.h"
+#include "exitance/runtime/core/work_share.h"
 #include "exitance/runtime/embree_scene.h"
 
 namespace exitance {
@@ -50,6 +51,17 @@ struct PathContributions {
   // The path's L1 coefficient along `axis` (RGB).
   Vec3 sh1(int axis) const { return texel_nee_sh1[axis] + (total() - texel_nee) * first_factor[axis]; }
 };
+
+// After a pass split over ranks: every rank's texels' sums (and their rays, the next split's cost)
+// onto every rank, so each holds the whole estimate and any texel can continue anywhere.
+void gather_texel_sums(WorkShare& share, LightmapEstimate& estimate, const std::vector<size_t>& bounds,
+                       std::vector<uint64_t>& texel_rays) {
+  const size_t n = estimate.texels.size();
+  allgather_items(share, estimate.texels.data(), 1, bounds);
+  for (int k = 0; k < estimate.recorded_bounces; ++k) allgather_items(share, estimate.bounces.data() + size_t(k) * n * 3, 3, bounds);
+  if (!estimate.sh1.empty()) allgather_items(share, estimate.sh1.data(), 9, bounds);
+  allgather_items(share, texel_rays.data(), 1, bounds);
+}
 
 }  // namespace
 
@@ -183,6 +195,11 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     return bake_per_bounce(*impl_->lighting, *impl_->embree, gbuffer, settings);
   }
   const auto start = std::chrono::steady_clock::now();
+  // Split over processes (work_share.h): this rank estimates the texels [bounds[rank], bounds[rank + 1]).
+  WorkShare* share = distributed(settings.work_share);
+  if (share && (settings.guiding != GuidingMode::Off || settings.adaptive || settings.target_relative_error > 0))
+    throw std::invalid_argument("CPU backend: guiding, adaptive sampling and --target-error (planned samples) run in "
+                                "one process only, not under mpirun with several ranks");
   // Started first, so the time budget covers the allocations below too.
   PassPolicy policy;
   policy.ramp = true;  // small passes early so progress and the time budget are honoured; larger later
@@ -197,6 +214,9 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   tbb::combinable<uint64_t> rays_per_thread([] { return uint64_t(0); });
   tbb::combinable<uint64_t> nonfinite_per_thread([] { return uint64_t(0); });
   tbb::combinable<uint64_t> guided_per_thread([] { return uint64_t(0); });
+  std::vector<size_t> bounds = share ? split_by_cost(texel_count, {}, share->ranks()) : std::vector<size_t>{};
+  std::vector<uint64_t> texel_rays(share ? texel_count : 0);  // this pass's, per texel: the next split's cost
+  tbb::combinable<uint64_t> shared_samples_per_thread([] { return uint64_t(0); });  // this rank's (stats.rank_work)
 
   // Built inside the timed bake: guided results are measured with the cost of their guiding data.
   std::unique_ptr<GridGuidingCache> guide;
@@ -252,6 +272,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       for (int axis = 0; axis < 3; ++axis)
         for (int c = 0; c < 3; ++c) estimate.sh1[(i * 3 + size_t(axis)) * 3 + size_t(c)] += l1[axis][c];
     ++acc.samples;
+    if (share) texel_rays[i] += rays - rays_before, ++shared_samples_per_thread.local();
     if (adaptive && !planning) {
       TexelSampleSums& p = pilot_sums[i];
       const double y = luminance(total);
@@ -285,13 +306,22 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       // the whole atlas (so the pass costs its fraction of a full one), different for every sample.
       const uint64_t covered_below = fraction < 1 ? uint64_t(fraction * 0x1.0p53) : UINT64_MAX;
       const uint64_t salt = splitmix64(settings.seed ^ (uint64_t(first) << 32));
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, texel_count, 64), [&](const tbb::blocked_range<size_t>& range) {
+      const size_t own_begin = share ? bounds[size_t(share->rank())] : 0;
+      const size_t own_end = share ? bounds[size_t(share->rank()) + 1] : texel_count;
+      const auto pass_start = std::chrono::steady_clock::now();
+      tbb::parallel_for(tbb::blocked_range<size_t>(own_begin, own_end, 64), [&](const tbb::blocked_range<size_t>& range) {
         PathContributions contributions;
         for (size_t i = range.begin(); i != range.end(); ++i) {
           if (covered_below != UINT64_MAX && (splitmix64(salt + i) >> 11) >= covered_below) continue;
           for (uint32_t s = first; s < first + count; ++s) take_sample(i, s, learning, contributions);
         }
       });
+      if (share) {
+        share->work.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - pass_start).count();
+        gather_texel_sums(*share, estimate, bounds, texel_rays);
+        bounds = split_by_cost(texel_count, texel_rays, share->ranks());
+        std::fill(texel_rays.begin(), texel_rays.end(), 0);
+      }
     }
     if (learning) guide->swap();  // this pass's learning becomes the next pass's frozen table
     passes.finish_pass(rays_per_thread.combine(std::plus<uint64_t>()));
@@ -321,9 +351,20 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   estimate.adaptive = adaptive;
   estimate.rays = rays_per_thread.combine(std::plus<uint64_t>());
   estimate.nonfinite_samples = nonfinite_per_thread.combine(std::plus<uint64_t>());
+  if (settings.work_share) {
+    settings.work_share->work.rays += estimate.rays;
+    uint64_t samples = 0;
+    for (const TexelAccumulator& t : estimate.texels) samples += t.samples;
+    settings.work_share->work.texel_samples += share ? shared_samples_per_thread.combine(std::plus<uint64_t>()) : samples;
+  }
+  if (share) {
+    estimate.rays = share->sum(estimate.rays);
+    estimate.nonfinite_samples = share->sum(estimate.nonfinite_samples);
+  }
   estimate.guided_vertices = guided_per_thread.combine(std::plus<uint64_t>());
   if (guide && settings.inspect_guiding) settings.inspect_guiding(*guide);
   estimate.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (settings.work_share && !share) settings.work_share->work.seconds += estimate.seconds;
   return estimate;
 }
 
@@ -344,12 +385,21 @@ ProbeEstimate CpuReferenceIntegrator::bake_probes(const std::vector<Vec3>& posit
   policy.largest_pass = kProbeStratifiedSetSize;
   policy.stratified_set = kProbeStratifiedSetSize;
   PassScheduler passes(settings, policy);
+  // Split over processes (work_share.h) as the texels are: global probe indices, gathered after every pass.
+  WorkShare* share = distributed(settings.work_share);
+  std::vector<size_t> bounds = share ? split_by_cost(probe_count, {}, share->ranks()) : std::vector<size_t>{};
+  std::vector<uint64_t> probe_rays(share ? probe_count : 0);  // this pass's: the next split's cost
+  uint64_t own_samples = 0;
   uint32_t first = 0, count = 0;
   while (passes.next_pass(first, count)) {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, probe_count, 1), [&](const tbb::blocked_range<size_t>& range) {
+    const size_t own_begin = share ? bounds[size_t(share->rank())] : 0;
+    const size_t own_end = share ? bounds[size_t(share->rank()) + 1] : probe_count;
+    const auto pass_start = std::chrono::steady_clock::now();
+    tbb::parallel_for(tbb::blocked_range<size_t>(own_begin, own_end, 1), [&](const tbb::blocked_range<size_t>& range) {
       uint64_t& rays = rays_per_thread.local();
       uint64_t& nonfinite = nonfinite_per_thread.local();
       for (size_t i = range.begin(); i != range.end(); ++i) {
+        const uint64_t rays_before = rays;
         for (uint32_t s = first; s < first + count; ++s) {
           PathSampler rng = path_sampler(settings.seed, kProbeRngStreamBase + i, s, settings.sampler);
           const Vec3 direction = probe_ray_direction(s, spp, rng);
@@ -372,13 +422,38 @@ ProbeEstimate CpuReferenceIntegrator::bake_probes(const std::vector<Vec3>& posit
           }
           ++estimate.samples[i];
         }
+        if (share) probe_rays[i] = rays - rays_before;
       }
     });
+    if (share) {
+      share->work.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - pass_start).count();
+      own_samples += uint64_t(own_end - own_begin) * count;
+      allgather_items(*share, estimate.sh_sum.data(), 1, bounds);
+      allgather_items(*share, estimate.axis_irradiance_sum.data(), 1, bounds);
+      allgather_items(*share, estimate.samples.data(), 1, bounds);
+      allgather_items(*share, estimate.backface_hits.data(), 1, bounds);
+      allgather_items(*share, probe_rays.data(), 1, bounds);
+      bounds = split_by_cost(probe_count, probe_rays, share->ranks());
+    }
     passes.finish_pass(rays_per_thread.combine(std::plus<uint64_t>()));
   }
   estimate.rays = rays_per_thread.combine(std::plus<uint64_t>());
   estimate.nonfinite_samples = nonfinite_per_thread.combine(std::plus<uint64_t>());
   estimate.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (settings.work_share) {
+    RankWork& work = settings.work_share->work;
+    work.rays += estimate.rays;
+    if (share) {
+      work.probe_samples += own_samples;
+    } else {
+      for (uint32_t n : estimate.samples) work.probe_samples += n;
+      work.seconds += estimate.seconds;
+    }
+  }
+  if (share) {
+    estimate.rays = share->sum(estimate.rays);
+    estimate.nonfinite_samples = share->sum(estimate.nonfinite_samples);
+  }
   return estimate;
 }
 

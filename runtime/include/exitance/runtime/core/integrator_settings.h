@@ -6,6 +6,7 @@
 namespace exitance {
 
 class GridGuidingCache;
+class WorkShare;
 
 // How texels are lit (bake --integrator). Path: the unbiased path tracer of path.h, one path per
 // sample. Bounces: per-bounce passes (seed 003, issue 10): B_0 = direct light; pass k+1 gathers, at
@@ -57,6 +58,9 @@ struct IntegratorSettings {
   std::function<void(double fraction_done, uint64_t rays)> progress;  // called between passes
   // Called once at the end of a guided bake with its cache (plots of the learned fields, tests).
   std::function<void(const GridGuidingCache&)> inspect_guiding;
+  // This process's share of a bake split over processes (core/work_share.h; bake under mpirun); null:
+  // the whole bake. Backends without it refuse more than one rank before lighting (bake does).
+  WorkShare* work_share = nullptr;
 };
 
 }  // namespace exitance

@@ -30,6 +30,8 @@ class PassScheduler {
   // A backend that can run a sample over part of its items passes `fraction`: the last pass of a
   // time budget may then be one sample over that fraction of the items (else `fraction` is 1), so
   // the run ends within a small part of a one-sample pass of the budget.
+  // With settings.work_share over several ranks, every rank gets rank 0's decision (its clock alone
+  // decides a time budget's cuts), so all run the same passes.
   bool next_pass(uint32_t& begin, uint32_t& count, double* fraction = nullptr);
   // Reports the pass just run (progress callback) and decides whether the bake stops here: at the
   // sample cap, at the time budget, or when `all_converged` (the integrator's target-error test).
@@ -43,6 +45,8 @@ class PassScheduler {
   bool timed() const { return settings_.time_budget_seconds > 0; }
 
  private:
+  bool next_pass_here(uint32_t& begin, uint32_t& count, double* fraction);
+
   const IntegratorSettings& settings_;
   PassPolicy policy_;
   uint32_t limit_;

@@ -50,6 +50,8 @@ struct BakeResults {
   const SealedTexels* sealed = nullptr;  // sealed texels (found before lighting); null: not looked for
   bool sealed_skipped = false;           // the lighting stage skipped them (not --no-skip)
   const nlohmann::json* stage_cache = nullptr;  // --cache: {stage: "reused" | "computed"} (stats.cache.stages)
+  // Under mpirun: {"ranks": N, "rank_work": [...]} (stats.ranks, stats.rank_work); null: one process.
+  const nlohmann::json* distribution = nullptr;
 };
 
 // The manifest (formats/bundle_manifest.h) of the bake: `pages`: the assembled lightmap pages (the manifest lists their channels). `input_sha256`: the

@@ -1,0 +1,75 @@
+#include "exitance/bake/distributed/mpi_work_share.h"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <climits>
+#include <cstdlib>
+#include <stdexcept>
+
+namespace exitance {
+namespace {
+
+// MPI counts are ints: exchanges go in rounds of at most this many bytes per rank.
+constexpr size_t kLargestPiece = size_t(1) << 30;
+
+void check(int status, const char* call) {
+  if (status != MPI_SUCCESS) throw std::runtime_error(std::string("MPI: ") + call + " failed");
+}
+
+}  // namespace
+
+std::unique_ptr<MpiWorkShare> MpiWorkShare::start_if_launched_by_mpirun(int& argc, char**& argv) {
+  if (!std::getenv("OMPI_COMM_WORLD_SIZE") && !std::getenv("PMIX_RANK")) return nullptr;
+  // Only the main thread calls MPI (the TBB workers never do).
+  int provided = 0;
+  check(MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided), "MPI_Init_thread");
+  std::unique_ptr<MpiWorkShare> share(new MpiWorkShare);
+  MPI_Comm_rank(MPI_COMM_WORLD, &share->rank_);
+  MPI_Comm_size(MPI_COMM_WORLD, &share->ranks_);
+  return share;
+}
+
+MpiWorkShare::~MpiWorkShare() { MPI_Finalize(); }
+
+void MpiWorkShare::allgather_ranges(void* data, const std::vector<size_t>& byte_bounds) {
+  const size_t parts = size_t(ranks_);
+  if (byte_bounds.size() != parts + 1) throw std::logic_error("allgather_ranges: one range per rank expected");
+  size_t rounds = 0;
+  for (size_t r = 0; r < parts; ++r)
+    rounds = std::max(rounds, (byte_bounds[r + 1] - byte_bounds[r] + kLargestPiece - 1) / kLargestPiece);
+  std::vector<int> counts(parts), displacements(parts);
+  for (size_t round = 0; round < rounds; ++round) {
+    // This round's piece of each range; displacements relative to the lowest piece's start.
+    const size_t base = byte_bounds[0] + std::min(round * kLargestPiece, byte_bounds[1] - byte_bounds[0]);
+    for (size_t r = 0; r < parts; ++r) {
+      const size_t length = byte_bounds[r + 1] - byte_bounds[r];
+      const size_t begin = std::min(round * kLargestPiece, length);
+      counts[r] = int(std::min(kLargestPiece, length - begin));
+      const size_t offset = byte_bounds[r] + begin - base;
+      if (offset > size_t(INT_MAX)) throw std::runtime_error("MPI: exchange over 2 GiB apart");
+      displacements[r] = int(offset);
+    }
+    check(MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, static_cast<char*>(data) + base, counts.data(),
+                         displacements.data(), MPI_BYTE, MPI_COMM_WORLD),
+          "MPI_Allgatherv");
+  }
+}
+
+void MpiWorkShare::broadcast(void* data, size_t bytes) {
+  if (bytes > size_t(INT_MAX)) throw std::logic_error("broadcast: too large");
+  check(MPI_Bcast(data, int(bytes), MPI_BYTE, 0, MPI_COMM_WORLD), "MPI_Bcast");
+}
+
+uint64_t MpiWorkShare::sum(uint64_t value) {
+  uint64_t total = 0;
+  check(MPI_Allreduce(&value, &total, 1, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD), "MPI_Allreduce");
+  return total;
+}
+
+void MpiWorkShare::abort(int code) {
+  MPI_Abort(MPI_COMM_WORLD, code);
+  std::_Exit(code);
+}
+
+}  // namespace exitance

@@ -1,0 +1,71 @@
+// One process's share of a bake split over several (bake under mpirun, issue 15 "Scale out"). The
+// scene is replicated; each process estimates a contiguous range of the live texels (or probe
+// origins) and the integrators exchange the per-item sums after every pass through the collectives
+// below, so every process holds the whole estimate before anything global (error stats, the
+// per-bounce tail, the next bounce's cache) is computed from it. Items keep their global indices, so
+// their random streams - and the result bits - do not depend on the split.
+//
+// The runtime stays free of MPI: this is an interface; bake/distributed implements it over MPI.
+// No share (IntegratorSettings::work_share null) or one rank: the integrators run as before.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <type_traits>
+#include <vector>
+
+namespace exitance {
+
+// What one process did (stats.rank_work in the manifest).
+struct RankWork {
+  uint64_t texel_samples = 0;  // samples estimated (path mode) or layer samples (per-bounce mode), summed over texels
+  uint64_t probe_samples = 0;  // probe rays' samples, summed over probes
+  uint64_t rays = 0;           // rays this process traced
+  double seconds = 0;          // spent estimating its items (not waiting for the others)
+};
+
+class WorkShare {
+ public:
+  virtual ~WorkShare() = default;
+  virtual int rank() const = 0;
+  virtual int ranks() const = 0;
+  // In place over `data`, the same size on every rank: rank r has filled bytes
+  // [byte_bounds[r], byte_bounds[r + 1]); afterwards every rank holds every range.
+  virtual void allgather_ranges(void* data, const std::vector<size_t>& byte_bounds) = 0;
+  // Rank 0's `bytes` bytes at `data` onto every rank (its decisions: pass sizes under a time budget).
+  virtual void broadcast(void* data, size_t bytes) = 0;
+  // The sum over ranks (exact: integers).
+  virtual uint64_t sum(uint64_t value) = 0;
+
+  RankWork work;  // this rank's, added to by the integrators
+};
+
+// The share to exchange through, or null where there is nothing to exchange (none, or one rank).
+inline WorkShare* distributed(WorkShare* share) { return share && share->ranks() > 1 ? share : nullptr; }
+
+// Item bounds [b[r], b[r + 1]) per rank, contiguous, by counted cost (`cost[i]` + 1 per item, so
+// items that cost nothing are still spread): deterministic, the same on every rank. Empty `cost`:
+// `items` split evenly.
+std::vector<size_t> split_by_cost(size_t items, const std::vector<uint64_t>& cost, int ranks);
+
+// Gathers the items [bounds[r], bounds[r + 1]) of `values_per_item` consecutive T each at `base`.
+template <class T>
+void allgather_items(WorkShare& share, T* base, size_t values_per_item, const std::vector<size_t>& bounds) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  std::vector<size_t> bytes(bounds.size());
+  for (size_t r = 0; r < bounds.size(); ++r) bytes[r] = bounds[r] * values_per_item * sizeof(T);
+  share.allgather_ranges(base, bytes);
+}
+
+// Every rank's `work`, on every rank, in rank order.
+std::vector<RankWork> gather_rank_work(WorkShare& share);
+
+// Rank 0's `value` on every rank.
+template <class T>
+T agreed(WorkShare& share, T value) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  share.broadcast(&value, sizeof(T));
+  return value;
+}
+
+}  // namespace exitance
