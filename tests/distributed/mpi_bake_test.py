@@ -91,6 +91,20 @@ def main():
                 fail(f"{integrator}: a rank did no work: {stats['rank_work']}")
             print(f"{integrator}: {len(compared)} files identical; rank_work {stats['rank_work']}")
 
+        # A time budget: rank 0's clock cuts the passes, the others follow (no hang, a whole bundle).
+        # (The per-bounce mode: the CPU default, whose bounce passes are cut and stopped by rank 0 too.)
+        for integrator in ["bounces"]:
+            timed_out = os.path.join(work, "timed_" + integrator)
+            timed = run(mpirun_command(mpirun, 2) + [args.bake, args.scene, "--backend", "cpu", "--no-cache",
+                        "--texel-density", "6", "--probe-spp", "16", "--integrator", integrator, "--time", "0.3",
+                        "-o", timed_out])
+            if timed.returncode != 0:
+                fail(f"--time under 2 ranks ({integrator}): exit {timed.returncode}: {timed.stderr}")
+            with open(os.path.join(timed_out, "manifest.json")) as f:
+                stats = json.load(f)["stats"]
+            if stats.get("ranks") != 2 or stats["samples_per_texel"]["min"] < 1:
+                fail(f"--time under 2 ranks ({integrator}): {stats.get('ranks')} {stats['samples_per_texel']}")
+
         # Refused before any work: one line, exit 2, nothing written.
         refused_out = os.path.join(work, "refused")
         refused = run(mpirun_command(mpirun, 2) + [args.bake] + common + ["--adaptive", "on", "-o", refused_out])

@@ -272,12 +272,20 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
       // Under a time budget, a layer pass that would end past it takes the samples that fit, by this
       // layer's measured seconds per sample (every texel still gets the same count): the budget is
       // kept to about a pass of one sample rather than overrun by a whole ramped pass.
+      bool cut = false;
       if (passes.timed() && k < seconds_per_sample.size() && seconds_per_sample[k] > 0) {
         const double left = settings.time_budget_seconds - passes.elapsed_seconds();
         add = uint32_t(std::clamp(std::floor(left / seconds_per_sample[k]), 0.0, double(add)));
-        if (share) add = agreed(*share, add);  // rank 0's clock decides
-        if (add == 0) break;
+        cut = true;
       }
+      if (share && passes.timed()) {  // rank 0's clock decides
+        struct {
+          uint32_t add, cut;
+        } decision{add, cut ? 1u : 0u};
+        decision = agreed(*share, decision);
+        add = decision.add, cut = decision.cut != 0;
+      }
+      if (cut && add == 0) break;
       const auto layer_start = std::chrono::steady_clock::now();
       const BounceGather gather(scene, embree, gbuffer, caches, settings);
       const size_t own_begin = share ? bounds[size_t(share->rank())] : 0;
@@ -306,7 +314,7 @@ LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& 
           if (share) texel_rays[i] = c.rays - rays_before;
         }
       });
-      if (share) {
+      if (share && add > 0) {  // `add` is the same on every rank
         share->work.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - layer_start).count();
         own_samples += uint64_t(own_end - own_begin) * add;
         allgather_items(*share, layer.sum.data(), 3, bounds);
