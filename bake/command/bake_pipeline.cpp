@@ -164,10 +164,17 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
       clock.time("backend", [&] { return backend_stage(scene, options, diagnostics); });
   // --integrator auto becomes path or bounces here, where the backend is known; every later stage
   // (lighting, the manifest) sees the decided integrator.
+  // The ranks exchange as their backend does (the CPU after every pass, Vulkan at the end): all must
+  // have the same one (a rank whose GPU failed and fell back to the CPU ends the job).
+  if (share && agreed(*share, uint8_t(backend->backend_name() == "vulkan")) != (backend->backend_name() == "vulkan"))
+    throw std::runtime_error("rank " + std::to_string(share->rank()) + " runs the " + backend->backend_name() +
+                             " backend, rank 0 another: under mpirun every rank must light on the same backend");
   const BakeOptions decided = with_integrator_decided(options, *backend);
-  if (share && decided.lighting.integrator == IntegratorMode::Path && decided.lighting.target_relative_error > 0)
+  if (share && backend->backend_name() == "cpu" && decided.lighting.integrator == IntegratorMode::Path &&
+      decided.lighting.target_relative_error > 0)
     throw InputError(options.input, "--target-error",
-                     "with path tracing plans each texel's samples in one process; under mpirun use --integrator bounces");
+                     "on the CPU backend path tracing plans each texel's samples in one process; under mpirun use "
+                     "--integrator bounces");
   const size_t unoccluded = clock.time("unocclude", [&] { return stages.unocclude(scene, gbuffer, layout, diagnostics); });
   const GeometryCheckReport geometry =
       clock.time("checks", [&] { return stages.checks(scene, gbuffer, diagnostics); });

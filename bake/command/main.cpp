@@ -48,13 +48,11 @@ void quiet_unless_rank_zero(const exitance::MpiWorkShare* share) {
 // What `bake` cannot split over ranks yet: a one-line reason, or empty.
 std::string refused_under_mpirun(const exitance::BakeOptions& options, const std::string& adaptive,
                                  const std::string& guiding, const std::string& integrator) {
-  if (options.backend.name == "vulkan")
-    return "--backend vulkan: under mpirun only the CPU backend splits the work over ranks yet";
   if (adaptive == "on") return "--adaptive on: adaptive sampling runs in one process only, not under mpirun";
   if (guiding == "grid") return "--guiding grid: guiding runs in one process only, not under mpirun";
-  if (integrator == "path" && options.lighting.target_relative_error > 0)
-    return "--target-error: with --integrator path it plans each texel's samples in one process; under mpirun use "
-           "--integrator bounces";
+  if (integrator == "path" && options.lighting.target_relative_error > 0 && options.backend.name == "cpu")
+    return "--target-error: on the CPU backend with --integrator path it plans each texel's samples in one process; "
+           "under mpirun use --integrator bounces";
   return {};
 }
 
@@ -306,9 +304,15 @@ int main(int argc, char** argv) {
         std::cerr << "bake: error: " << refused << "\n";
         return 2;
       }
-      if (options.backend.name == "auto") {
-        options.backend.name = "cpu";
-        diagnostics.warn("under mpirun: using the CPU reference (Embree), the only backend that splits the work over ranks yet");
+      // One GPU per rank: without --device, the ranks on one host take its GPUs in turn.
+      const char* local_rank = std::getenv("OMPI_COMM_WORLD_LOCAL_RANK");
+      if (options.backend.name != "cpu" && options.backend.device_index < 0 && local_rank) {
+        std::vector<uint32_t> gpus;
+        for (const auto& d : exitance::enumerate_vulkan_devices())
+          if (d.usable && (d.type == exitance::VulkanDeviceType::Discrete || d.type == exitance::VulkanDeviceType::Integrated ||
+                           d.type == exitance::VulkanDeviceType::Virtual))
+            gpus.push_back(d.index);
+        if (!gpus.empty()) options.backend.device_index = int(gpus[size_t(std::atoi(local_rank)) % gpus.size()]);
       }
     }
     if (mpi->rank() != 0) options.cache_directory.clear();  // rank 0 alone reads and fills the caches

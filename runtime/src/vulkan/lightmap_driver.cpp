@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "exitance/runtime/core/pass_scheduler.h"
+#include "exitance/runtime/core/work_share.h"
 
 namespace exitance::vulkan {
 namespace {
@@ -131,11 +132,28 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   policy.largest_pass = uint32_t(std::max<size_t>(1, a.max_work / std::min(a.texel_count, a.max_work)));
   policy.ramp = settings.time_budget_seconds > 0 || settings.target_relative_error > 0;
   PassScheduler passes(settings, policy);
+  // Split over processes (core/work_share.h): this rank's device runs its contiguous range of the
+  // texels through the work list (global indices, so the same random streams); the sums are
+  // gathered once at the end. Every rank follows every pass (rank 0 decides them), work or not.
+  WorkShare* share = distributed(settings.work_share);
+  std::vector<size_t> bounds;
+  if (share) {
+    bounds = split_by_cost(a.texel_count, {}, share->ranks());
+    const size_t own_begin = bounds[size_t(share->rank())], own_end = bounds[size_t(share->rank()) + 1];
+    a.work_list.resize(own_end - own_begin);
+    for (size_t i = own_begin; i < own_end; ++i) a.work_list[i - own_begin] = uint32_t(i);
+    if (!a.work_list.empty())
+      runner_.context().upload(runner_.buffers().items.batch_items, a.work_list.data(), a.work_list.size() * 4);
+  }
   uint32_t first = 0, pass = 0;
-  while (!a.work_list.empty() && passes.next_pass(first, pass)) {
-    const size_t chunk = std::min(a.work_list.size(), a.max_work);
-    pass = std::min<uint32_t>(pass, uint32_t(std::max<size_t>(1, a.max_work / chunk)));
-    run_pass(a, first, pass);
+  while ((share || !a.work_list.empty()) && passes.next_pass(first, pass)) {
+    const auto pass_start = Clock::now();
+    if (!a.work_list.empty()) {
+      const size_t chunk = std::min(a.work_list.size(), a.max_work);
+      pass = std::min<uint32_t>(pass, uint32_t(std::max<size_t>(1, a.max_work / chunk)));
+      run_pass(a, first, pass);
+      if (share) share->work.texel_samples += uint64_t(a.work_list.size()) * pass;
+    }
     const uint32_t done = first + pass;
     if (settings.target_relative_error > 0 && done >= 16 && done < spp_limit) {
       std::vector<uint32_t> still = unconverged(a.work_list, a.texel_count, settings.target_relative_error);
@@ -145,11 +163,29 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
           runner_.context().upload(runner_.buffers().items.batch_items, a.work_list.data(), a.work_list.size() * 4);
       }
     }
-    passes.finish_pass(a.totals.rays(), a.work_list.empty());
+    bool all_converged = a.work_list.empty();
+    if (share) {
+      share->work.seconds += std::chrono::duration<double>(Clock::now() - pass_start).count();
+      all_converged = share->sum(a.work_list.size()) == 0;
+    }
+    passes.finish_pass(a.totals.rays(), all_converged);
   }
   a.seconds = std::chrono::duration<double>(Clock::now() - start_time).count();
   runner_.record_statistics(a.totals, kTexelBatch);
-  return download(a);
+  LightmapEstimate estimate = download(a);
+  if (settings.work_share) settings.work_share->work.rays += estimate.rays;
+  if (share) {
+    allgather_items(*share, estimate.texels.data(), 1, bounds);
+    for (int k = 0; k < estimate.recorded_bounces; ++k)
+      allgather_items(*share, estimate.bounces.data() + size_t(k) * a.texel_count * 3, 3, bounds);
+    if (!estimate.sh1.empty()) allgather_items(*share, estimate.sh1.data(), 9, bounds);
+    estimate.rays = share->sum(estimate.rays);
+    estimate.nonfinite_samples = share->sum(estimate.nonfinite_samples);
+  } else if (settings.work_share) {
+    for (const TexelAccumulator& t : estimate.texels) settings.work_share->work.texel_samples += t.samples;
+    settings.work_share->work.seconds += estimate.seconds;
+  }
+  return estimate;
 }
 
 void LightmapDriver::start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) {

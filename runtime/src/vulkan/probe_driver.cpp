@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "exitance/runtime/core/pass_scheduler.h"
+#include "exitance/runtime/core/work_share.h"
 
 namespace exitance::vulkan {
 namespace {
@@ -15,16 +16,16 @@ constexpr size_t kProbeResultBytes = 48;
 
 }  // namespace
 
-// Start points with the position only, and the work list of every probe in order.
-void ProbeDriver::upload_probes(const std::vector<Vec3>& positions) {
+// Start points with the position only, and the work list: the probes [first, end) in order.
+void ProbeDriver::upload_probes(const std::vector<Vec3>& positions, size_t first, size_t end) {
   Context& context = runner_.context();
   WavefrontBuffers& buffers = runner_.buffers();
   std::vector<GpuSurfacePoint> records(positions.size());
   for (size_t i = 0; i < positions.size(); ++i) records[i].position = Vec4(positions[i], 0.0f);
   context.upload(buffers.items.start_points, records.data(), records.size() * sizeof(GpuSurfacePoint));
-  std::vector<uint32_t> order(positions.size());
-  for (size_t i = 0; i < positions.size(); ++i) order[i] = uint32_t(i);
-  context.upload(buffers.items.batch_items, order.data(), order.size() * 4);
+  std::vector<uint32_t> order(end - first);
+  for (size_t i = first; i < end; ++i) order[i - first] = uint32_t(i);
+  if (!order.empty()) context.upload(buffers.items.batch_items, order.data(), order.size() * 4);
   buffers.items.owner = WorkItems::Owner::Probes;
   VkCommandBuffer cmd = context.begin();
   buffers.probes.clear(cmd);
@@ -50,7 +51,14 @@ ProbeEstimate ProbeDriver::bake(const std::vector<Vec3>& positions, const Integr
   buffers.probes.reserve(context, probe_count);
   buffers.results.reserve(context, max_work * kProbeResultBytes);
   runner_.bind_buffers();
-  upload_probes(positions);
+  // Split over processes (core/work_share.h): this rank's device traces its contiguous range of the
+  // probes (global indices: the same random streams); the sums are gathered at the end.
+  WorkShare* share = distributed(settings.work_share);
+  const std::vector<size_t> bounds = share ? split_by_cost(probe_count, {}, share->ranks()) : std::vector<size_t>{};
+  const size_t own_begin = share ? bounds[size_t(share->rank())] : 0;
+  const size_t own_end = share ? bounds[size_t(share->rank()) + 1] : probe_count;
+  const size_t own_count = own_end - own_begin;
+  upload_probes(positions, own_begin, own_end);
 
   GpuParams params = runner_.bake_params(settings, 1, uint32_t(probe_count));  // slot 0: what the probe ray meets; 1: E/pi at its hit
   params.probe_spp = settings.spp == 0 ? std::numeric_limits<uint32_t>::max() : settings.spp;
@@ -64,9 +72,14 @@ ProbeEstimate ProbeDriver::bake(const std::vector<Vec3>& positions, const Integr
   PassScheduler passes(settings, policy);
   uint32_t first = 0, pass = 0;
   while (passes.next_pass(first, pass)) {
-    for (size_t offset = 0; offset < probe_count; offset += chunk) {
-      const uint32_t n = uint32_t(std::min<size_t>(chunk, probe_count - offset));
+    const auto pass_start = Clock::now();
+    for (size_t offset = 0; offset < own_count; offset += chunk) {
+      const uint32_t n = uint32_t(std::min<size_t>(chunk, own_count - offset));
       runner_.run(params, {uint32_t(offset), n, first, pass}, kProbeResultBytes, kProbeBatch, totals);
+    }
+    if (share) {
+      share->work.probe_samples += uint64_t(own_count) * pass;
+      share->work.seconds += std::chrono::duration<double>(Clock::now() - pass_start).count();
     }
     passes.finish_pass(totals.rays());
   }
@@ -84,6 +97,17 @@ ProbeEstimate ProbeDriver::bake(const std::vector<Vec3>& positions, const Integr
   estimate.nonfinite_samples = totals.nonfinite;
   estimate.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   runner_.record_statistics(totals, kProbeBatch);
+  if (settings.work_share) settings.work_share->work.rays += estimate.rays;
+  if (share) {
+    allgather_items(*share, estimate.sh_sum.data(), 1, bounds);
+    allgather_items(*share, estimate.samples.data(), 1, bounds);
+    allgather_items(*share, estimate.backface_hits.data(), 1, bounds);
+    estimate.rays = share->sum(estimate.rays);
+    estimate.nonfinite_samples = share->sum(estimate.nonfinite_samples);
+  } else if (settings.work_share) {
+    for (uint32_t n : estimate.samples) settings.work_share->work.probe_samples += n;
+    settings.work_share->work.seconds += estimate.seconds;
+  }
   return estimate;
 }
 

@@ -17,7 +17,7 @@ class ProbeDriver {
   ProbeEstimate bake(const std::vector<Vec3>& positions, const IntegratorSettings& settings);
 
  private:
-  void upload_probes(const std::vector<Vec3>& positions);
+  void upload_probes(const std::vector<Vec3>& positions, size_t first, size_t end);
 
   WavefrontBatchRunner& runner_;
 };
