@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
     TexelGBuffer gbuffer = raster_stage(imported, layout, options, diagnostics);
     const SceneForLighting scene = build_lighting_scene_stage(std::move(imported), options);
     const auto backend = backend_stage(scene, options, diagnostics);
-    unocclude_stage(scene, gbuffer);
+    unocclude_stage(scene, gbuffer, options);
     const GeometryCheckReport checks = scene_checks_stage(scene, gbuffer, options, diagnostics);
     const auto find_start = std::chrono::steady_clock::now();
     const SealedTexels sealed = sealed_texels_stage(scene, gbuffer, checks, options);

@@ -1,6 +1,7 @@
 // check_lightmap_uvs FILE.gltf...: reads glTF files back and checks, per mesh,
 // what the baker relies on and the generator promises: TEXCOORD_1 inside [0,1]²,
-// no two triangles overlapping in TEXCOORD_1, charts (connected triangle groups)
+// no two triangles overlapping in TEXCOORD_1, charts (triangle groups connected through
+// corners equal in POSITION and TEXCOORD_1)
 // at least kLightmapChartPadding apart by their bounding rectangles, unit NORMALs,
 // and counter-clockwise winding on the NORMAL side. Exit status 1 on any failure.
 // It shares no code with the generator's own checks beyond the padding constant.
@@ -11,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <map>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -26,7 +28,7 @@ struct MeshTriangles {
   std::vector<std::array<Vec2, 3>> uv;  // TEXCOORD_1 corners
   std::vector<std::array<Vec3f, 3>> position;
   std::vector<Vec3f> normal;                      // NORMAL of the first corner
-  std::vector<std::array<size_t, 3>> vertexKey;  // global vertex ids, to find charts
+  std::vector<std::array<size_t, 3>> vertexKey;  // ids of distinct (POSITION, TEXCOORD_1), to find charts
 };
 
 // The accessor's bytes as an array of T: tight or strided, as written by any tool
@@ -159,7 +161,7 @@ int main(int argc, char** argv) {
     size_t triangles = 0;
     for (size_t m = 0; m < model.meshes.size(); ++m) {
       MeshTriangles mesh;
-      size_t vertexBase = 0;
+      std::map<std::array<float, 5>, size_t> cornerIds;
       for (const tinygltf::Primitive& primitive : model.meshes[m].primitives) {
         const std::vector<float> uv = readAccessor<float>(model, primitive.attributes.at("TEXCOORD_1"));
         const std::vector<float> position = readAccessor<float>(model, primitive.attributes.at("POSITION"));
@@ -178,7 +180,10 @@ int main(int argc, char** argv) {
             const size_t v = indices[i + c];
             tuv[c] = {uv[2 * v], uv[2 * v + 1]};
             tp[c] = {position[3 * v], position[3 * v + 1], position[3 * v + 2]};
-            keys[c] = vertexBase + v;
+            // A chart may fold (a crease duplicates vertices for their normals): corners
+            // equal in position and lightmap UV join triangles, whatever their index.
+            const std::array<float, 5> corner{tp[c][0], tp[c][1], tp[c][2], tuv[c][0], tuv[c][1]};
+            keys[c] = cornerIds.try_emplace(corner, cornerIds.size()).first->second;
           }
           const size_t v0 = indices[i];
           mesh.uv.push_back(tuv);
@@ -186,7 +191,6 @@ int main(int argc, char** argv) {
           mesh.normal.push_back({normal[3 * v0], normal[3 * v0 + 1], normal[3 * v0 + 2]});
           mesh.vertexKey.push_back(keys);
         }
-        vertexBase += position.size() / 3;
       }
       triangles += mesh.uv.size();
       failures += checkMesh(std::string(argv[arg]) + " mesh " + std::to_string(m) + " '" + model.meshes[m].name + "'",

@@ -21,6 +21,7 @@ constexpr SampleScene kScenes[] = {
     {"building", exitance::samples::buildBuilding},
     {"ajar_room", exitance::samples::buildAjarRoom},
     {"thin_walls", exitance::samples::buildThinWalls},
+    {"open_city", exitance::samples::buildOpenCity},
 };
 
 int usage() {
@@ -47,7 +48,8 @@ int main(int argc, char** argv) {
       sample.build(scene);
       const std::filesystem::path file = outDir / (std::string(sample.name) + ".gltf");
       scene.write(file.string());
-      std::printf("%s: %zu triangles\n", file.string().c_str(), scene.triangleCount());
+      std::printf("%s: %zu triangles, %zu instances of %zu meshes\n", file.string().c_str(), scene.triangleCount(),
+                  scene.instanceCount(), scene.meshCount());
     }
   } catch (const std::exception& error) {
     std::fprintf(stderr, "generate_samples: %s\n", error.what());

@@ -1,7 +1,9 @@
 #include "mesh_builder.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 #include <string>
 
@@ -108,19 +110,87 @@ void MeshBuilder::addBox(const Box& box, MaterialId material, FaceDirection dire
   }
 }
 
+void MeshBuilder::addPanel(std::vector<PanelPiece> pieces) {
+  if (pieces.empty()) throw std::invalid_argument("MeshBuilder::addPanel: no pieces");
+  for (const PanelPiece& piece : pieces) {
+    const std::array<Vec3, 4>& c = piece.corners;
+    const float width = piece.s1 - piece.s0, height = piece.t1 - piece.t0;
+    // A relative tolerance: the generator's corners carry float rounding.
+    auto sameLength = [](float a, float b) { return std::abs(a - b) <= 1e-4f * std::max(1.0f, b); };
+    if (piece.s0 < 0.0f || piece.t0 < 0.0f || !(width > 0.0f) || !(height > 0.0f))
+      throw std::invalid_argument("MeshBuilder::addPanel: piece rectangle empty or below (0, 0)");
+    if (!sameLength(length(c[1] - c[0]), width) || !sameLength(length(c[2] - c[3]), width) ||
+        !sameLength(length(c[3] - c[0]), height) || !sameLength(length(c[2] - c[1]), height))
+      throw std::invalid_argument("MeshBuilder::addPanel: piece corners do not match its rectangle");
+  }
+  panels_.push_back(std::move(pieces));
+}
+
+namespace {
+
+ChartSize panelExtent(const std::vector<PanelPiece>& pieces) {
+  ChartSize extent;
+  for (const PanelPiece& piece : pieces) {
+    extent.width = std::max(extent.width, piece.s1);
+    extent.height = std::max(extent.height, piece.t1);
+  }
+  return extent;
+}
+
+MeshPrimitiveData& primitiveFor(std::vector<MeshPrimitiveData>& primitives, MaterialId material) {
+  auto found = std::find_if(primitives.begin(), primitives.end(),
+                            [&](const MeshPrimitiveData& p) { return p.material == material; });
+  MeshPrimitiveData& primitive = found != primitives.end() ? *found : primitives.emplace_back();
+  primitive.material = material;
+  return primitive;
+}
+
+using PanelVertexKey = std::pair<MaterialId, std::array<float, 10>>;
+
+// Emits a panel's pieces; a corner equal in position, normal and both UVs to one
+// already emitted in the same primitive reuses its vertex.
+void emitPanel(const std::vector<PanelPiece>& pieces, const ChartSize& extent, const PlacedChart& place,
+               std::vector<MeshPrimitiveData>& primitives, std::map<PanelVertexKey, std::uint32_t>& vertexIndex) {
+  for (const PanelPiece& piece : pieces) {
+    MeshPrimitiveData& primitive = primitiveFor(primitives, piece.material);
+    const Vec3 normal = normalize(cross(piece.corners[1] - piece.corners[0], piece.corners[3] - piece.corners[0]));
+    const std::array<float, 2> local[4] = {
+        {piece.s0, piece.t0}, {piece.s1, piece.t0}, {piece.s1, piece.t1}, {piece.s0, piece.t1}};
+    std::uint32_t index[4];
+    for (int k = 0; k < 4; ++k) {
+      const Vec3 p = piece.corners[size_t(k)];
+      const float s = local[k][0] / extent.width, t = local[k][1] / extent.height;
+      // Same turn convention as the quad charts: rotated by 90°, never mirrored.
+      const std::array<float, 2> uv1 = place.turned
+                                           ? std::array<float, 2>{place.x + t * place.width, place.y + (1.0f - s) * place.height}
+                                           : std::array<float, 2>{place.x + s * place.width, place.y + t * place.height};
+      const std::array<float, 10> key{p.x, p.y, p.z, normal.x, normal.y, normal.z, local[k][0], local[k][1], uv1[0], uv1[1]};
+      const auto inserted = vertexIndex.try_emplace({piece.material, key}, std::uint32_t(primitive.positions.size() / 3));
+      if (inserted.second) {
+        primitive.positions.insert(primitive.positions.end(), {p.x, p.y, p.z});
+        primitive.normals.insert(primitive.normals.end(), {normal.x, normal.y, normal.z});
+        primitive.texcoord0.insert(primitive.texcoord0.end(), local[k].begin(), local[k].end());
+        primitive.texcoord1.insert(primitive.texcoord1.end(), uv1.begin(), uv1.end());
+      }
+      index[k] = inserted.first->second;
+    }
+    primitive.indices.insert(primitive.indices.end(), {index[0], index[1], index[2], index[0], index[2], index[3]});
+  }
+}
+
+}  // namespace
+
 std::vector<MeshPrimitiveData> MeshBuilder::build() const {
   std::vector<ChartSize> sizes;
   for (const Chart& chart : charts_) sizes.push_back({length(chart.quad.edgeU), length(chart.quad.edgeV)});
+  for (const std::vector<PanelPiece>& panel : panels_) sizes.push_back(panelExtent(panel));
   const std::vector<PlacedChart> placements = packLightmapCharts(sizes);
 
   std::vector<MeshPrimitiveData> primitives;
   for (size_t c = 0; c < charts_.size(); ++c) {
     const Chart& chart = charts_[c];
     const PlacedChart& place = placements[c];
-    auto found = std::find_if(primitives.begin(), primitives.end(),
-                              [&](const MeshPrimitiveData& p) { return p.material == chart.material; });
-    MeshPrimitiveData& primitive = found != primitives.end() ? *found : primitives.emplace_back();
-    primitive.material = chart.material;
+    MeshPrimitiveData& primitive = primitiveFor(primitives, chart.material);
 
     const Vec3 normal = chart.quad.frontNormal();
     const float lengthU = length(chart.quad.edgeU), lengthV = length(chart.quad.edgeV);
@@ -149,6 +219,9 @@ std::vector<MeshPrimitiveData> MeshBuilder::build() const {
       }
     }
   }
+  std::map<PanelVertexKey, std::uint32_t> panelVertices;
+  for (size_t p = 0; p < panels_.size(); ++p)
+    emitPanel(panels_[p], sizes[charts_.size() + p], placements[charts_.size() + p], primitives, panelVertices);
   for (const MeshPrimitiveData& primitive : primitives) verifyWindingMatchesNormals(primitive);
   return primitives;
 }

@@ -3,6 +3,7 @@
 // TEXCOORD_1 lightmap layout.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -63,6 +64,18 @@ struct QuadGrid {
   int cellsV = 1;
 };
 
+// One piece of a panel chart: a planar quadrilateral, corners counter-clockwise seen
+// from its front, laid flat in the chart as the rectangle [s0,s1] × [t0,t1] metres
+// (corner 0 at (s0,t0), 1 at (s1,t0), 2 at (s1,t1), 3 at (s0,t1)), at its true size.
+// Pieces of one panel may fold (a profile strip) or leave holes (a facade around its
+// openings). Corners given bit-identically in two pieces become one vertex, so a panel
+// built from shared points is one connected chart without cracks.
+struct PanelPiece {
+  std::array<Vec3, 4> corners;
+  float s0 = 0.0f, t0 = 0.0f, s1 = 0.0f, t1 = 0.0f;
+  MaterialId material = 0;
+};
+
 // Triangles of one material, ready to become one glTF primitive.
 struct MeshPrimitiveData {
   MaterialId material = 0;
@@ -84,8 +97,12 @@ class MeshBuilder {
   void addQuadWithOpening(const Quad& quad, const Opening& opening, MaterialId material);
   void addBox(const Box& box, MaterialId material, FaceDirection direction,
               std::uint8_t faces = BoxFace::All);
+  // Several pieces, possibly of different materials, as one lightmap chart whose
+  // extent is the pieces' bounding rectangle in (s, t) from (0, 0). Two triangles a
+  // piece. Throws std::invalid_argument for a piece whose rectangle is not its size.
+  void addPanel(std::vector<PanelPiece> pieces);
 
-  size_t chartCount() const { return charts_.size(); }
+  size_t chartCount() const { return charts_.size() + panels_.size(); }
 
   // Packs the lightmap charts and emits one primitive per material, in the order
   // the materials were first used. Checks that charts are disjoint and that every
@@ -100,6 +117,7 @@ class MeshBuilder {
   };
   float maxEdgeLength_;
   std::vector<Chart> charts_;
+  std::vector<std::vector<PanelPiece>> panels_;  // packed after charts_
 };
 
 }  // namespace exitance::samples

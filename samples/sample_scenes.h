@@ -15,5 +15,8 @@ void buildBuilding(SceneBuilder& scene);
 void buildAjarRoom(SceneBuilder& scene);
 // Two rooms sharing a 5 mm wall, one lit, one dark: light-leak measurement.
 void buildThinWalls(SceneBuilder& scene);
+// Open city: 64 instanced office blocks (five meshes) with lit and dark windows on
+// kerbed plots along streets, under a directional sun; the sky is given to `bake --sky`.
+void buildOpenCity(SceneBuilder& scene);
 
 }  // namespace exitance::samples

@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 #include "light_orientation.h"
 
@@ -91,6 +93,13 @@ int SceneBuilder::addAccessor(const void* data, size_t byteLength, size_t count,
 }
 
 int SceneBuilder::addMeshNode(const std::string& name, const MeshBuilder& mesh, Vec3 translation) {
+  return addInstance(name, addMesh(name, mesh), translation);
+}
+
+size_t SceneBuilder::meshCount() const { return model_->meshes.size(); }
+
+int SceneBuilder::addMesh(const std::string& name, const MeshBuilder& mesh) {
+  size_t triangles = 0;
   tinygltf::Mesh gltfMesh;
   gltfMesh.name = name;
   for (const MeshPrimitiveData& data : mesh.build()) {
@@ -118,15 +127,28 @@ int SceneBuilder::addMeshNode(const std::string& name, const MeshBuilder& mesh, 
       positions.minValues[i % 3] = std::min(positions.minValues[i % 3], double(data.positions[i]));
       positions.maxValues[i % 3] = std::max(positions.maxValues[i % 3], double(data.positions[i]));
     }
-    triangleCount_ += data.indices.size() / 3;
+    triangles += data.indices.size() / 3;
     gltfMesh.primitives.push_back(std::move(primitive));
   }
   model_->meshes.push_back(std::move(gltfMesh));
+  meshTriangles_.push_back(triangles);
+  return int(model_->meshes.size() - 1);
+}
 
+int SceneBuilder::addInstance(const std::string& name, int meshIndex, Vec3 translation, float yawRadians) {
+  if (meshIndex < 0 || size_t(meshIndex) >= meshTriangles_.size())
+    throw std::invalid_argument("instance '" + name + "': no mesh " + std::to_string(meshIndex));
   tinygltf::Node node;
   node.name = name;
-  node.mesh = int(model_->meshes.size() - 1);
+  node.mesh = meshIndex;
+  if (yawRadians != 0.0f) {
+    // Unit quaternion [x, y, z, w] of a turn about +Y.
+    const double half = 0.5 * double(yawRadians);
+    node.rotation = {0.0, std::sin(half), 0.0, std::cos(half)};
+  }
   if (translation != Vec3{}) node.translation = toDoubles(translation);
+  triangleCount_ += meshTriangles_[size_t(meshIndex)];
+  ++instanceCount_;
   model_->nodes.push_back(std::move(node));
   model_->scenes[0].nodes.push_back(int(model_->nodes.size() - 1));
   return int(model_->nodes.size() - 1);

@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "mesh_builder.h"
 #include "vec3.h"
@@ -64,11 +65,21 @@ class SceneBuilder {
   // `name`, translated by `translation`. Returns the node index.
   int addMeshNode(const std::string& name, const MeshBuilder& mesh, Vec3 translation = {});
 
+  // Builds `mesh` into a glTF mesh without placing it; returns the mesh index for addInstance.
+  int addMesh(const std::string& name, const MeshBuilder& mesh);
+  // A node showing mesh `meshIndex` (from addMesh), turned by `yawRadians` about +Y and then
+  // translated. Several nodes may share a mesh: each is an instance with its own lightmap
+  // rectangle in the baker, all sharing the mesh's TEXCOORD_1 layout. Returns the node index.
+  int addInstance(const std::string& name, int meshIndex, Vec3 translation = {}, float yawRadians = 0.0f);
+
   int addPointLight(const PointLight& light);
   int addSpotLight(const SpotLight& light);
   int addDirectionalLight(const DirectionalLight& light);
 
+  // Triangles as the baker sees them: every instance of a mesh counts.
   size_t triangleCount() const { return triangleCount_; }
+  size_t instanceCount() const { return instanceCount_; }
+  size_t meshCount() const;
 
   // Writes `path` (.gltf) and its buffer next to it (same stem, .bin).
   // Throws std::runtime_error when tinygltf cannot write.
@@ -79,7 +90,9 @@ class SceneBuilder {
   int addLightNode(const std::string& name, Vec3 position, const Vec3* pointing, int lightIndex);
 
   std::unique_ptr<tinygltf::Model> model_;
+  std::vector<size_t> meshTriangles_;  // per glTF mesh
   size_t triangleCount_ = 0;
+  size_t instanceCount_ = 0;
 };
 
 }  // namespace exitance::samples

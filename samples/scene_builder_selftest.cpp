@@ -1,14 +1,19 @@
 // scene_builder_selftest: checks the builder's geometric pieces on their own.
 // Prints each failed check and exits 1 if any failed.
+#include <tiny_gltf.h>
+
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <random>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "light_orientation.h"
 #include "lightmap_chart_packer.h"
 #include "mesh_builder.h"
+#include "scene_builder.h"
 
 using namespace exitance::samples;
 
@@ -88,6 +93,82 @@ void packedChartsAreDisjointAndScaledAlike() {
   expect(threw, "too many charts for the padding is an error, not an overlap");
 }
 
+// Two coplanar pieces sharing an edge and a third folded up from it: one chart, shared
+// corners written once, and every edge as long in TEXCOORD_1 (over the chart's scale)
+// as in space.
+void panelsShareCornersAndKeepTheirSize() {
+  const Vec3 a{0, 0, 0}, b{2, 0, 0}, c{3, 0, 0}, d{0, 0, -1}, e{2, 0, -1}, f{3, 0, -1}, g{0, 1, -1}, h{3, 1, -1};
+  MeshBuilder mesh;
+  mesh.addPanel({{{a, b, e, d}, 0, 0, 2, 1, 0}, {{b, c, f, e}, 2, 0, 3, 1, 0}, {{d, f, h, g}, 0, 1, 3, 2, 0}});
+  const std::vector<MeshPrimitiveData> primitives = mesh.build();
+  expect(primitives.size() == 1 && primitives[0].indices.size() == 18, "a panel gives two triangles per piece");
+  if (primitives.size() != 1) return;
+  const MeshPrimitiveData& p = primitives[0];
+  // a b c d e f shared by the flat pieces (6), the fold's d f are new vertices (other normal), g h.
+  expect(p.positions.size() / 3 == 10, "corners shared by coplanar pieces are one vertex");
+  float scale = -1.0f;
+  bool isometric = true;
+  for (size_t t = 0; t < p.indices.size(); t += 3)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t i = p.indices[t + size_t(k)], j = p.indices[t + size_t((k + 1) % 3)];
+      const float world = length(Vec3{p.positions[3 * i], p.positions[3 * i + 1], p.positions[3 * i + 2]} -
+                                 Vec3{p.positions[3 * j], p.positions[3 * j + 1], p.positions[3 * j + 2]});
+      const float uv = std::hypot(p.texcoord1[2 * i] - p.texcoord1[2 * j], p.texcoord1[2 * i + 1] - p.texcoord1[2 * j + 1]);
+      if (scale < 0.0f) scale = uv / world;
+      isometric = isometric && std::abs(uv / world - scale) < 1e-4f * scale;
+    }
+  expect(isometric, "a panel keeps one texel density over all its pieces");
+  bool threw = false;
+  try {
+    MeshBuilder wrong;
+    wrong.addPanel({{{a, b, e, d}, 0, 0, 3, 1, 0}});  // rectangle 3 m wide for a 2 m piece
+  } catch (const std::invalid_argument&) {
+    threw = true;
+  }
+  expect(threw, "a panel piece whose rectangle is not its size is refused");
+}
+
+// One mesh on two nodes: written once, referenced by both, the second turned about +Y.
+void meshesCanBeInstancedOnSeveralNodes() {
+  SceneBuilder scene;
+  const MaterialId grey = scene.addMaterial({.name = "Grey"});
+  MeshBuilder box;
+  box.addBox({.center = {0, 1, 0}, .size = {2, 2, 1}}, grey, FaceDirection::Outward, BoxFace::AllButBottom);
+  const int mesh = scene.addMesh("Box", box);
+  const float yaw = 0.5f * 3.14159265f;
+  scene.addInstance("First", mesh, {5, 0, 0});
+  scene.addInstance("Second", mesh, {-5, 0, 0}, yaw);
+  expect(scene.instanceCount() == 2 && scene.meshCount() == 1 && scene.triangleCount() == 2 * 10,
+         "instances count the shared mesh's triangles once each");
+
+  const std::filesystem::path directory =
+      std::filesystem::temp_directory_path() / ("scene_builder_selftest_" + std::to_string(std::random_device{}()));
+  std::filesystem::create_directories(directory);
+  const std::string file = (directory / "instances.gltf").string();
+  scene.write(file);
+  tinygltf::Model model;
+  tinygltf::TinyGLTF loader;
+  std::string error, warning;
+  const bool loaded = loader.LoadASCIIFromFile(&model, &error, &warning, file);
+  std::filesystem::remove_all(directory);
+  expect(loaded, "the instanced scene loads back");
+  if (!loaded) return;
+  expect(model.meshes.size() == 1, "a shared mesh is written once");
+  int users = 0;
+  const tinygltf::Node* turned = nullptr;
+  for (const tinygltf::Node& node : model.nodes)
+    if (node.mesh == 0) {
+      ++users;
+      if (node.name == "Second") turned = &node;
+    }
+  expect(users == 2, "both nodes reference the shared mesh");
+  expect(turned && turned->rotation.size() == 4, "the turned instance has a rotation");
+  if (turned && turned->rotation.size() == 4) {
+    const std::array<double, 4> q{turned->rotation[0], turned->rotation[1], turned->rotation[2], turned->rotation[3]};
+    expect(near(rotate(q, {1, 0, 0}), rotateAboutY({1, 0, 0}, yaw)), "the node's rotation is the yaw about +Y");
+  }
+}
+
 }  // namespace
 
 int main() {
@@ -96,6 +177,8 @@ int main() {
   openingPiecesCoverTheQuadMinusTheHole();
   boxesFaceInOrOut();
   packedChartsAreDisjointAndScaledAlike();
+  panelsShareCornersAndKeepTheirSize();
+  meshesCanBeInstancedOnSeveralNodes();
   std::printf(failures ? "%d checks failed\n" : "all checks passed\n", failures);
   return failures ? 1 : 0;
 }

@@ -32,6 +32,12 @@ void warn_about_nonfinite_samples(uint64_t count, const char* what, const BakeOp
                      " samples were NaN/Inf and were discarded (please report this scene)");
 }
 
+// The stage's share done, for the progress bar (none without one).
+FractionDone stage_fraction(const BakeOptions& options, const char* stage) {
+  if (!options.progress) return {};
+  return [&options, stage](double fraction) { options.progress(stage, fraction, 0); };
+}
+
 }  // namespace
 
 Scene import_stage(const BakeOptions& options, Diagnostics& diagnostics,
@@ -93,7 +99,7 @@ AtlasLayout layout_stage(const Scene& scene, const BakeOptions& options, Diagnos
 TexelGBuffer raster_stage(const Scene& scene, const AtlasLayout& layout, const BakeOptions& options,
                           Diagnostics& diagnostics) {
   options.announce_stage("raster");
-  return rasterize_texel_gbuffer(scene, layout, options.input, diagnostics);
+  return rasterize_texel_gbuffer(scene, layout, options.input, diagnostics, stage_fraction(options, "raster"));
 }
 
 SceneForLighting build_lighting_scene_stage(Scene scene, const BakeOptions& options) {
@@ -127,13 +133,15 @@ std::shared_ptr<const Integrator> backend_stage(const SceneForLighting& scene, c
   return choose_lighting_backend(scene.lighting, scene.embree, request, diagnostics);
 }
 
-size_t unocclude_stage(const SceneForLighting& scene, TexelGBuffer& gbuffer) {
-  return unocclude_texels(*scene.embree, gbuffer).moved;
+size_t unocclude_stage(const SceneForLighting& scene, TexelGBuffer& gbuffer, const BakeOptions& options) {
+  options.announce_stage("unocclude");
+  return unocclude_texels(*scene.embree, gbuffer, stage_fraction(options, "unocclude")).moved;
 }
 
 GeometryCheckReport scene_checks_stage(const SceneForLighting& scene, const TexelGBuffer& gbuffer,
                                        const BakeOptions& options, Diagnostics& diagnostics) {
-  GeometryCheckReport report = check_scene_geometry(*scene.scene, *scene.embree, gbuffer);
+  options.announce_stage("checks");
+  GeometryCheckReport report = check_scene_geometry(*scene.scene, *scene.embree, gbuffer, stage_fraction(options, "checks"));
   for (std::string& line : describe_geometry_problems(report, *scene.scene, options.input)) diagnostics.warn(line);
   return report;
 }
@@ -141,7 +149,8 @@ GeometryCheckReport scene_checks_stage(const SceneForLighting& scene, const Texe
 SealedTexels sealed_texels_stage(const SceneForLighting& scene, const TexelGBuffer& gbuffer,
                                  const GeometryCheckReport& checks, const BakeOptions& options) {
   options.announce_stage("sealed texels");
-  return find_sealed_texels(*scene.scene, *scene.embree, gbuffer, &checks.closed_texels);
+  return find_sealed_texels(*scene.scene, *scene.embree, gbuffer, &checks.closed_texels,
+                            stage_fraction(options, "sealed texels"));
 }
 
 VoxelizedScene voxelize_stage(const Scene& scene, const AtlasLayout& layout, const BakeOptions& options) {

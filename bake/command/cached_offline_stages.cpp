@@ -285,7 +285,7 @@ TexelGBuffer CachedOfflineStages::raster(const Scene& scene, const AtlasLayout& 
 size_t CachedOfflineStages::unocclude(const SceneForLighting& scene, TexelGBuffer& gbuffer, const AtlasLayout& layout,
                                       Diagnostics& diagnostics) {
   if (restored_unoccluded_) return *restored_unoccluded_;
-  const size_t unoccluded = unocclude_stage(scene, gbuffer);
+  const size_t unoccluded = unocclude_stage(scene, gbuffer, options_);
   if (!cache_) return unoccluded;
   outcomes_["gbuffer"] = "computed";
   StageEntry entry;

@@ -1,5 +1,6 @@
 #include "exitance/bake/raster/geometry_checks.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
 
@@ -21,11 +22,13 @@ bool hits_back_face(const Hit& hit, Vec3 direction) { return hit.found && dot(di
 
 }  // namespace
 
-GeometryCheckReport check_scene_geometry(const Scene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer) {
+GeometryCheckReport check_scene_geometry(const Scene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer,
+                                         const FractionDone& progress) {
   GeometryCheckReport report;
   report.closed_texels.assign(gbuffer.texels.size(), 0);
   tbb::combinable<size_t> enclosed([] { return size_t(0); }), coplanar([] { return size_t(0); });
-  tbb::parallel_for(size_t(0), gbuffer.texels.size(), [&](size_t i) {
+  ParallelProgress done(progress, gbuffer.texels.size());
+  auto check_texel = [&](size_t i) {
     const LiveTexel& t = gbuffer.texels[i];
     const Vec3 origin = offset_ray_origin(t.position, t.geometric_normal, embree.extent());
     Pcg32 rng = pcg_init(0xC0FFEE, i, 0);
@@ -36,6 +39,13 @@ GeometryCheckReport check_scene_geometry(const Scene& scene, const EmbreeScene& 
       const Hit hit = embree.intersect(origin, d, INFINITY);
       if (hits_back_face(hit, d)) ++back;
       if (ends_on_dead_back_face(scene, hit, d)) ++dead;
+      // Stop once both answers are settled: a ray that did not end on a dead back face means not
+      // closed, and the majority test is decided when the rays left cannot change it. Each
+      // texel draws from its own sequence, so stopping early changes no other texel's rays.
+      const int left = kHemisphereRays - 1 - k;
+      const bool closed_decided = dead < k + 1;
+      const bool enclosed_decided = back * 2 > kHemisphereRays || (back + left) * 2 <= kHemisphereRays;
+      if (closed_decided && enclosed_decided) break;
     }
     if (back * 2 > kHemisphereRays) ++enclosed.local();
     report.closed_texels[i] = dead == kHemisphereRays ? 1 : 0;
@@ -52,6 +62,10 @@ GeometryCheckReport check_scene_geometry(const Scene& scene, const EmbreeScene& 
       return inside && dot(other.geometric_normal, t.geometric_normal) > 0.999f;
     });
     if (overlapped) ++coplanar.local();
+  };
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, gbuffer.texels.size()), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) check_texel(i);
+    done.add(range.size());
   });
   report.enclosed_texels = enclosed.combine(std::plus<size_t>());
   report.coplanar_texels = coplanar.combine(std::plus<size_t>());

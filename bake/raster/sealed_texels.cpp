@@ -1,5 +1,6 @@
 #include "exitance/bake/raster/sealed_texels.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
 
@@ -49,11 +50,12 @@ bool sees_a_punctual_light(const Scene& scene, const EmbreeScene& embree, Vec3 o
 // 128 spp would get 128 cosine rays of its own. --no-skip measures what was missed
 // (bench/results/dead-work.md: nothing on the sample scenes).
 SealedTexels find_sealed_texels(const Scene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer,
-                                const std::vector<uint8_t>* closed) {
+                                const std::vector<uint8_t>* closed, const FractionDone& progress) {
   SealedTexels result;
   result.sealed.assign(gbuffer.texels.size(), 0);
   tbb::combinable<size_t> candidates([] { return size_t(0); });
-  tbb::parallel_for(size_t(0), gbuffer.texels.size(), [&](size_t i) {
+  ParallelProgress done(progress, gbuffer.texels.size());
+  auto decide_texel = [&](size_t i) {
     const LiveTexel& t = gbuffer.texels[i];
     const Vec3 origin = offset_ray_origin(t.position, t.geometric_normal, embree.extent());
     auto closed_along = [&](float u1, float u2) {
@@ -78,6 +80,10 @@ SealedTexels find_sealed_texels(const Scene& scene, const EmbreeScene& embree, c
       }
     if (sees_a_punctual_light(scene, embree, origin)) return;
     result.sealed[i] = 1;
+  };
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, gbuffer.texels.size()), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) decide_texel(i);
+    done.add(range.size());
   });
   result.candidates = candidates.combine(std::plus<size_t>());
 

@@ -69,7 +69,7 @@ std::shared_ptr<const Integrator> backend_stage(const SceneForLighting& scene, c
 
 // unocclude: moves texel centres inside or behind nearby geometry to the visible side, in `gbuffer`;
 // returns how many moved.
-size_t unocclude_stage(const SceneForLighting& scene, TexelGBuffer& gbuffer);
+size_t unocclude_stage(const SceneForLighting& scene, TexelGBuffer& gbuffer, const BakeOptions& options);
 
 // checks: enclosed and coplanar texels, enclosed lights, unsampled emitters; one warning per kind.
 GeometryCheckReport scene_checks_stage(const SceneForLighting& scene, const TexelGBuffer& gbuffer,

@@ -2,6 +2,8 @@
 // geometry, texels on coplanar overlapping surfaces (z-fighting), punctual lights shut inside
 // closed geometry, and emitters that can never be sampled.
 #pragma once
+
+#include "exitance/bake/raster/parallel_progress.h"
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -22,7 +24,9 @@ struct GeometryCheckReport {
   std::vector<uint8_t> closed_texels;
 };
 
-GeometryCheckReport check_scene_geometry(const Scene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer);
+// `progress` (optional) hears the share of texels checked.
+GeometryCheckReport check_scene_geometry(const Scene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer,
+                                         const FractionDone& progress = {});
 
 // One warning line per kind of problem found (empty when the scene is clean).
 std::vector<std::string> describe_geometry_problems(const GeometryCheckReport& report, const Scene& scene,

@@ -5,6 +5,8 @@
 // light has a clear line to it. What such a texel would receive is then only light that slipped
 // through a gap narrower than the rays' stratification (bench/results/dead-work.md measures it).
 #pragma once
+
+#include "exitance/bake/raster/parallel_progress.h"
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -31,8 +33,9 @@ struct SealedTexels {
 
 // `closed`: per live texel, whether its first kSealedFirstRays cosine rays all ended on dead back
 // faces, when already traced (the scene checks' closed_texels); null: traced here.
+// `progress` (optional) hears the share of texels decided.
 SealedTexels find_sealed_texels(const Scene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer,
-                                const std::vector<uint8_t>* closed = nullptr);
+                                const std::vector<uint8_t>* closed = nullptr, const FractionDone& progress = {});
 
 // A ray that ends on the back of an opaque single-sided surface brings no light: the lighting
 // stage gives such hits zero radiance. A miss (the sky), a front face, a double-sided surface (its
