@@ -813,6 +813,10 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
     throw FormatError(name + ": header: sky environment " + std::to_string(environment) + " is not 0 or 1");
   if (vertex_colors > 1)
     throw FormatError(name + ": header: vertex_colors " + std::to_string(vertex_colors) + " is not 0 or 1");
+  // Colours are stored per triangle corner: a scene without triangles has none to flag (the writer
+  // writes 0 there, so accepting 1 would read a file that does not re-encode to itself).
+  if (vertex_colors == 1 && triangle_count == 0)
+    throw FormatError(name + ": header: vertex_colors is 1 but the scene has no triangles");
   if (triangle_count > kMaxSceneTriangles)
     throw FormatError(name + ": header: " + std::to_string(triangle_count) + " triangles exceed the limit of " +
                       std::to_string(kMaxSceneTriangles));

@@ -16,6 +16,10 @@ cmake --build "$build" -j"$(nproc)"
 rm -rf "$build/seeds"
 "$build/write_fuzz_seeds" "$build/seeds"
 mkdir -p "$build/seeds/gltf"
+# Inputs that once failed a fuzzer: every run replays them first (tests/fuzz/regressions/READER/).
+for dir in "$root"/tests/fuzz/regressions/*/; do
+  mkdir -p "$build/seeds/$(basename "$dir")" && cp "$dir"* "$build/seeds/$(basename "$dir")/"
+done
 cp "$root"/tests/badinput/hostile/*.gltf "$root"/tests/badinput/hostile/*.glb "$build/seeds/gltf/" 2>/dev/null || true
 mkdir -p "$build/artifacts"
 
