@@ -9,8 +9,7 @@
 
 #include "exitance/bake/bundle/bundle_preview.h"
 #include "exitance/bake/bundle/radiance_vdb.h"
-#include "exitance/bake/seams/seam_detection.h"
-#include "exitance/bake/seams/seam_stitching.h"
+#include "exitance/runtime/bundle/seam_stage.h"
 #include "exitance/formats/lightmap_exr.h"
 #include "exitance/formats/probes_file.h"
 #include "exitance/formats/svo_file.h"
@@ -44,28 +43,6 @@ std::string write_preview_into_manifest(const fs::path& dir, const std::vector<f
   return manifest.stats_json;
 }
 
-// Seams (bake/seams/): found on the scene and the layout, stitched on the assembled pages (after
-// their gutter dilation, which the stitching repeats: seam_stitching.h says why). With --seams off
-// they are still found and measured, so the manifest shows what stitching would address.
-nlohmann::json stitch_seams_stage(std::vector<formats::LightmapImage>& pages, const BakeResults& results,
-                                  int dilation_passes, const BakeOptions& options) {
-  options.announce_stage("seams");
-  const auto start = std::chrono::steady_clock::now();
-  const std::vector<SeamEdge> seams = find_lightmap_seams(results.scene, results.layout);
-  SeamStitchSettings settings;
-  settings.dilation_passes = dilation_passes;
-  const SeamStitchReport report = options.stitch_seams ? stitch_lightmap_seams(pages, seams, settings)
-                                                       : measure_lightmap_seams(pages, seams, settings);
-  return {{"mode", options.stitch_seams ? "stitch" : "off"},
-          {"edges", report.edges},
-          {"samples", report.samples},
-          {"texels_adjusted", report.texels_adjusted},
-          {"discontinuity_before", report.discontinuity_before},
-          {"discontinuity_after", report.discontinuity_after},
-          {"texel_relative_error", report.texel_relative_error},
-          {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};
-}
-
 }  // namespace
 
 WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::json& seconds,
@@ -77,7 +54,11 @@ WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::jso
   std::vector<formats::LightmapImage> pages =
       assemble_lightmap_pages(results.gbuffer, results.lightmap, assembly,
                               results.sealed && results.sealed_skipped ? results.sealed->sealed : std::vector<uint8_t>{});
-  const nlohmann::json seams = stitch_seams_stage(pages, results, assembly.dilation_texels, options);
+  // Seams (runtime/include/exitance/runtime/bundle/seam_stage.h): stitched on the assembled pages,
+  // after their gutter dilation (which the stitching repeats); with --seams off only measured.
+  options.announce_stage("seams");
+  const nlohmann::json seams =
+      stitch_bundle_seams(pages, results.scene, results.layout, assembly.dilation_texels, options.stitch_seams);
   formats::BundleManifest manifest = build_bundle_manifest(
       results, pages, results.input_sha256, seconds, diagnostics.warnings.size(), options);
   {

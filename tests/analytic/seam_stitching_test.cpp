@@ -1,4 +1,4 @@
-// Seam stitching on a known lightmap (bake/seams/seam_stitching.h): two charts that are one surface
+// Seam stitching on a known lightmap (runtime/include/exitance/runtime/bundle/seam_stitching.h): two charts that are one surface
 // cut along a seam hold a smooth linear function, with a step added on one side. After stitching
 // the sides agree (up to the value term's pull, bounded below), texels two or more texels from the
 // seam are unchanged bit for bit, and nothing is non-finite.
@@ -6,8 +6,8 @@
 
 #include <cmath>
 
-#include "exitance/bake/seams/seam_discontinuity.h"
-#include "exitance/bake/seams/seam_stitching.h"
+#include "exitance/runtime/bundle/seam_discontinuity.h"
+#include "exitance/runtime/bundle/seam_stitching.h"
 #include "exitance/runtime/bundle/lightmap_assembly.h"
 
 namespace exitance {

@@ -22,6 +22,7 @@
 #include "exitance/runtime/relight/relight.h"
 #include "exitance/runtime/scene_file_conversion.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
+#include "support/sphere_over_floor_gltf.h"
 
 namespace exitance {
 namespace {
@@ -149,6 +150,61 @@ TEST(Relight, ReproducesADirectionalBakeBitForBit) {
     ++pages;
   }
   EXPECT_GE(pages, 1u);
+  fs::remove_all(dir);
+}
+
+// A scene with smooth lightmap UV seams (a sphere with generated UVs over a floor): the bake stitches
+// them, and so does the relight, from scene.bin's scene and atlas, bit for bit as the bake did; a bake
+// written with --seams off is relit unstitched (the mode follows the bundle's stats.seams.mode).
+TEST(Relight, StitchesSeamsAsTheBakeDid) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const fs::path dir = fs::temp_directory_path() / ("exitance-relight-seams-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  test::write_sphere_over_floor_gltf((dir / "sphere.gltf").string(), 24, 12, /*sun=*/true);
+  for (const bool stitch : {true, false}) {
+    SCOPED_TRACE(stitch ? "stitch" : "off");
+    const fs::path baked = dir / (stitch ? "stitched.bake" : "off.bake");
+    const fs::path output = dir / (stitch ? "stitched-relit.bake" : "off-relit.bake");
+    BakeOptions bake;
+    bake.input = (dir / "sphere.gltf").string();
+    bake.output = baked.string();
+    bake.sky = "0.3,0.35,0.45";
+    bake.backend.name = "vulkan";
+    bake.atlas.texel_density = 6;
+    bake.lighting.spp = 4;
+    bake.lighting.seed = 3;
+    bake.probes_enabled = false;
+    bake.svo_enabled = false;
+    bake.skip_sealed_texels = false;
+    bake.stitch_seams = stitch;
+    Diagnostics diagnostics;
+    const nlohmann::json baked_seams = run_bake(bake, diagnostics)["seams"];
+    RelightOptions options;
+    options.bundle = baked.string();
+    options.output = output.string();
+    options.seed = 3;
+    options.spp = 4;
+    const nlohmann::json seams = relight_bundle(options)["seams"];
+    ASSERT_TRUE(seams.is_object());
+    EXPECT_EQ(seams["mode"], stitch ? "stitch" : "off");
+    EXPECT_EQ(seams["edges"], baked_seams["edges"]);
+    EXPECT_GT(seams["edges"].get<size_t>(), 10u);
+    if (stitch) {
+      EXPECT_GT(seams["texels_adjusted"].get<size_t>(), 0u);
+      EXPECT_LT(seams["discontinuity_after"].get<double>(), seams["discontinuity_before"].get<double>());
+    } else {
+      EXPECT_EQ(seams["texels_adjusted"], 0);
+    }
+    size_t pages = 0;
+    for (const auto& entry : fs::directory_iterator(baked)) {
+      if (entry.path().extension() != ".exr") continue;
+      EXPECT_TRUE(file_bytes(entry.path()) == file_bytes(output / entry.path().filename()))
+          << entry.path().filename() << " differs from the bake's";
+      ++pages;
+    }
+    EXPECT_GE(pages, 1u);
+  }
   fs::remove_all(dir);
 }
 

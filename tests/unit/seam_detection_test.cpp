@@ -1,4 +1,4 @@
-// Seam detection (bake/seams/seam_detection.h) on primitives: a cube of six charts has only hard
+// Seam detection (runtime/include/exitance/runtime/bundle/seam_detection.h) on primitives: a cube of six charts has only hard
 // edges (nothing stitched), a cylinder side with one UV cut has exactly that cut, a sphere with
 // generated UVs has seams between its charts.
 #include <gtest/gtest.h>
@@ -6,7 +6,7 @@
 #include <cmath>
 #include <functional>
 
-#include "exitance/bake/seams/seam_detection.h"
+#include "exitance/runtime/bundle/seam_detection.h"
 #include "exitance/bake/uvgen/lightmap_uv_generation.h"
 
 namespace exitance {

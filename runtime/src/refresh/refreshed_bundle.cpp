@@ -14,6 +14,7 @@
 #include "exitance/runtime/bundle/bundle_directory.h"
 #include "exitance/runtime/bundle/lightmap_assembly.h"
 #include "exitance/runtime/bundle/probe_results.h"
+#include "exitance/runtime/bundle/seam_stage.h"
 #include "exitance/runtime/bundle/texel_exitance.h"
 #include "exitance/runtime/stage_clock.h"
 
@@ -59,7 +60,10 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   AssemblyOptions assembly;
   assembly.bounce_layers = manifest.has_bounce_layers();
   assembly.dilation_texels = std::max(2, int(baked.padding) * 2);
-  const std::vector<formats::LightmapImage> pages = assemble_lightmap_pages(persisted.gbuffer, estimate, assembly);
+  std::vector<formats::LightmapImage> pages = assemble_lightmap_pages(persisted.gbuffer, estimate, assembly);
+  // Seams stitched as `bake` stitched them (seam_stage.h), or only measured where it ran --seams off.
+  const json seams = stitch_bundle_seams(pages, persisted.scene, persisted.atlas, assembly.dilation_texels,
+                                         bundle_stitches_seams(manifest.stats_json));
   // The pages as assembled now, under the file names the manifest gave them.
   if (pages.size() != manifest.pages.size())
     throw BundleInputError((bundle / "manifest.json").string() + ": pages: " + std::to_string(manifest.pages.size()) +
@@ -87,6 +91,7 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   report["estimated_relative_mse"] = std::isfinite(relative_mse) ? json(relative_mse) : json(nullptr);
   report["live_texels"] = persisted.gbuffer.texels.size();
   report["nonfinite_samples"] = estimate.nonfinite_samples + probe_estimate.nonfinite_samples;
+  report["seams"] = seams;
 
   manifest.generator = "exitance-relight 0.1.0";
   formats::BakeSettings& settings = manifest.settings.emplace(baked);

@@ -49,7 +49,7 @@ struct BakeOptions {
   // --preview: PNGs of the pages and default views in OUT/preview/ (bake/bundle/bundle_preview.h),
   // views preview_size pixels wide.
   bool preview = false;
-  // --seams stitch|off: least-squares seam stitching of the lightmap pages (bake/seams/).
+  // --seams stitch|off: least-squares seam stitching of the lightmap pages (runtime/src/bundle/seam_*.cpp).
   bool stitch_seams = true;
   uint32_t preview_size = 512;
   // The bundle cache (bake/cache/bundle_cache.h): a folder, or empty for none. Empty by default

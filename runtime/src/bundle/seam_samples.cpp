@@ -1,4 +1,4 @@
-#include "exitance/bake/seams/seam_samples.h"
+#include "exitance/runtime/bundle/seam_samples.h"
 
 #include <algorithm>
 #include <cmath>

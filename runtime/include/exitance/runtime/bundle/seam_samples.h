@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "exitance/bake/seams/seam_detection.h"
+#include "exitance/runtime/bundle/seam_detection.h"
 
 namespace exitance {
 

@@ -1,4 +1,4 @@
-#include "exitance/bake/seams/seam_detection.h"
+#include "exitance/runtime/bundle/seam_detection.h"
 
 #include <algorithm>
 #include <array>

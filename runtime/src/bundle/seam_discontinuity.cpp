@@ -1,4 +1,4 @@
-#include "exitance/bake/seams/seam_discontinuity.h"
+#include "exitance/runtime/bundle/seam_discontinuity.h"
 
 #include <cmath>
 #include <set>

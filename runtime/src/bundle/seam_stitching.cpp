@@ -1,4 +1,4 @@
-#include "exitance/bake/seams/seam_stitching.h"
+#include "exitance/runtime/bundle/seam_stitching.h"
 
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCore>
@@ -8,7 +8,7 @@
 #include <string>
 #include <unordered_map>
 
-#include "exitance/bake/seams/seam_discontinuity.h"
+#include "exitance/runtime/bundle/seam_discontinuity.h"
 #include "exitance/runtime/bundle/lightmap_assembly.h"
 
 namespace exitance {

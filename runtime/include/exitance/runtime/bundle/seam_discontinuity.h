@@ -4,7 +4,7 @@
 #pragma once
 #include <vector>
 
-#include "exitance/bake/seams/seam_samples.h"
+#include "exitance/runtime/bundle/seam_samples.h"
 #include "exitance/formats/lightmap_exr.h"
 
 namespace exitance {
