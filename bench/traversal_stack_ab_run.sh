@@ -2,6 +2,7 @@
 # On the GPU machine: A/B/C of three runtime folders (rtA, rtB, rtC in .replay/ab.txz, each from
 # `cmake --install BUILD --component runtime --prefix rtX` of one variant, with building.bake and
 # city.bake packed as bench/open_city_gpu_pack.sh packs the city), alternated, 256 spp.
+set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
 export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
 mkdir -p /tmp/w && tar -C /tmp/w -xJf .replay/ab.txz
