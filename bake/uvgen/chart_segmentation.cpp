@@ -5,6 +5,8 @@
 #include <deque>
 #include <numbers>
 
+#include <Eigen/Dense>
+
 namespace exitance::uvgen {
 namespace {
 
@@ -200,8 +202,35 @@ bool chart_is_disk(const WeldedMesh& mesh, const std::vector<uint32_t>& triangle
   return steps == boundary.size();
 }
 
+std::vector<uint32_t> principal_seed_faces(const WeldedMesh& mesh) {
+  Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    if (mesh.degenerate[t]) continue;
+    const Eigen::Vector3d n(mesh.normals[t][0], mesh.normals[t][1], mesh.normals[t][2]);
+    spread += mesh.areas[t] * n * n.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(spread);  // eigenvalues ascending
+  std::vector<uint32_t> seeds;
+  for (int axis = 2; axis >= 0; --axis) {
+    const Eigen::Vector3d e = solver.eigenvectors().col(axis);
+    const Point3 direction{e[0], e[1], e[2]};
+    int64_t lowest = -1, highest = -1;
+    double low = 2, high = -2;
+    for (uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+      if (mesh.degenerate[t]) continue;
+      const double d = dot(mesh.normals[t], direction);
+      if (d > high) high = d, highest = t;
+      if (d < low) low = d, lowest = t;
+    }
+    for (int64_t t : {highest, lowest})
+      if (t >= 0 && std::find(seeds.begin(), seeds.end(), uint32_t(t)) == seeds.end()) seeds.push_back(uint32_t(t));
+  }
+  return seeds;
+}
+
 std::vector<Chart> segment_into_charts(const WeldedMesh& mesh, const std::vector<int32_t>& neighbour,
-                                       const SegmentationSettings& settings, ChartSplitter& splitter) {
+                                       const SegmentationSettings& settings, ChartSplitter& splitter,
+                                       int64_t first_seed) {
   const double cos_cone = cos_degrees(settings.cone_degrees);
   std::vector<uint8_t> assigned(mesh.triangle_count(), 0);
   std::vector<Chart> charts;
@@ -224,6 +253,7 @@ std::vector<Chart> segment_into_charts(const WeldedMesh& mesh, const std::vector
         ++next_in_order;
       if (next_in_order < mesh.triangle_count()) seed = next_in_order;
     }
+    if (grown == 0 && first_seed >= 0) seed = first_seed;
     if (seed < 0) break;
     Chart chart;
     chart.normal = mesh.normals[size_t(seed)];

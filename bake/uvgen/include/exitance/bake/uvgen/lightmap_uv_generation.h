@@ -32,6 +32,13 @@ struct UvGenerationSettings {
                                      // 2 charts on a UV sphere, 5 on a torus; 66 gave 7 and 16)
   double sharp_edge_degrees = 75;    // faces meeting at a larger dihedral angle are never one chart
   size_t max_chart_triangles = 20000;  // larger charts are split (bounds LSCM's solve)
+  // Meshes up to this many triangles search for a tighter layout (up to 9 packings): charts also
+  // grown from the faces at either end of the normals' principal axes, then up to split_charts
+  // times the largest chart filling less than split_below_fill of its bounding box halved across
+  // its long axis; the layout whose charts fill most of the packed rectangle is kept.
+  size_t layout_search_max_triangles = 50000;
+  int split_charts = 2;
+  double split_below_fill = 0.6;
   double stretch_bound = 2;          // a chart whose mean area or angle distortion exceeds it is "stretched"
   std::function<void(double)> progress;  // fraction done, called from the calling thread
 };
