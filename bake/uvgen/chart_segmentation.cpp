@@ -5,8 +5,6 @@
 #include <deque>
 #include <numbers>
 
-#include <Eigen/Dense>
-
 namespace exitance::uvgen {
 namespace {
 
@@ -202,23 +200,14 @@ bool chart_is_disk(const WeldedMesh& mesh, const std::vector<uint32_t>& triangle
   return steps == boundary.size();
 }
 
-std::vector<uint32_t> principal_seed_faces(const WeldedMesh& mesh) {
-  Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
-  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
-    if (mesh.degenerate[t]) continue;
-    const Eigen::Vector3d n(mesh.normals[t][0], mesh.normals[t][1], mesh.normals[t][2]);
-    spread += mesh.areas[t] * n * n.transpose();
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(spread);  // eigenvalues ascending
+std::vector<uint32_t> axis_seed_faces(const WeldedMesh& mesh) {
   std::vector<uint32_t> seeds;
-  for (int axis = 2; axis >= 0; --axis) {
-    const Eigen::Vector3d e = solver.eigenvectors().col(axis);
-    const Point3 direction{e[0], e[1], e[2]};
+  for (size_t axis = 0; axis < 3; ++axis) {
     int64_t lowest = -1, highest = -1;
     double low = 2, high = -2;
     for (uint32_t t = 0; t < mesh.triangle_count(); ++t) {
       if (mesh.degenerate[t]) continue;
-      const double d = dot(mesh.normals[t], direction);
+      const double d = mesh.normals[t][axis];
       if (d > high) high = d, highest = t;
       if (d < low) low = d, lowest = t;
     }

@@ -52,11 +52,12 @@ std::vector<Chart> segment_into_charts(const WeldedMesh& mesh, const std::vector
                                        const SegmentationSettings& settings, ChartSplitter& splitter,
                                        int64_t first_seed = -1);
 
-// First seeds worth trying: the faces whose normals lie farthest along either direction of each
-// principal axis of the mesh's area-weighted normals (n n^T summed), the dominant axis first;
-// distinct, non-degenerate. Where the first cone boundaries fall decides whether a ring's charts
-// are its top and bottom halves or arches across it.
-std::vector<uint32_t> principal_seed_faces(const WeldedMesh& mesh);
+// First seeds worth trying: the faces whose normals point farthest along +x, -x, +y, -y, +z, -z
+// (distinct, non-degenerate). Where the first cone boundaries fall decides whether a ring's charts
+// are its top and bottom halves or arches across it. World axes rather than the normals' principal
+// axes: on a sphere or a cube those are degenerate, and which basis an eigensolver returns there
+// would change with round-off.
+std::vector<uint32_t> axis_seed_faces(const WeldedMesh& mesh);
 
 // True when the chart's faces, sharing the welded vertices, form a topological disk: every edge used
 // once or twice with opposite orientations, V - E + F = 1 and exactly one boundary loop through

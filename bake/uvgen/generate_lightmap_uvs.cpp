@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 
 #include "chart_halving.h"
@@ -16,6 +17,8 @@ namespace {
 
 using uvgen::Point2;
 using uvgen::Point3;
+
+const double kCurvedChartCos = std::cos(10 * std::numbers::pi / 180);
 
 double uv_area(const std::array<Point2, 3>& uv) {
   return 0.5 * std::fabs((uv[1][0] - uv[0][0]) * (uv[2][1] - uv[0][1]) - (uv[1][1] - uv[0][1]) * (uv[2][0] - uv[0][0]));
@@ -142,15 +145,23 @@ GeneratedUvs generate_lightmap_uvs(std::span<const Vec3> positions, std::span<co
   // Two searches on small meshes (bench/results/uvgen.md), each layout kept only when its charts
   // fill more of the packed rectangle. First, where the first chart's cone boundaries fall decides
   // the charts' shapes: on a torus, arches across the tube or the tube's top and bottom halves; the
-  // charts are also grown from the faces at either end of the normals' principal axes.
+  // charts are also grown from the faces whose normals point farthest along each axis.
   auto fills_more = [](const uvgen::PackedCharts& a, const uvgen::PackedCharts& b) {
     if (a.fits != b.fits) return a.fits;
     return a.texels_per_unit * a.texels_per_unit / (double(a.width) * a.height) >
            b.texels_per_unit * b.texels_per_unit / (double(b.width) * b.height);
   };
-  const bool search = triangle_count <= settings.layout_search_max_triangles;
+  // Planar charts (a building's boxes) flatten as they are, whichever face seeds them: only meshes
+  // with a curved chart (a face over 10 degrees from its seed's normal) search.
+  bool curved = false;
+  for (const uvgen::Chart& chart : best.charts)
+    for (uint32_t t : chart.triangles) {
+      const uvgen::Point3& n = mesh.normals[t];
+      curved = curved || n[0] * chart.normal[0] + n[1] * chart.normal[1] + n[2] * chart.normal[2] < kCurvedChartCos;
+    }
+  const bool search = curved && triangle_count <= settings.layout_search_max_triangles;
   if (search)
-    for (uint32_t seed : uvgen::principal_seed_faces(mesh)) {
+    for (uint32_t seed : uvgen::axis_seed_faces(mesh)) {
       Layout trial = lay_out(int64_t(seed), false);
       if (fills_more(trial.packed, best.packed)) best = std::move(trial);
     }

@@ -33,7 +33,7 @@ struct UvGenerationSettings {
   double sharp_edge_degrees = 75;    // faces meeting at a larger dihedral angle are never one chart
   size_t max_chart_triangles = 20000;  // larger charts are split (bounds LSCM's solve)
   // Meshes up to this many triangles search for a tighter layout (up to 9 packings): charts also
-  // grown from the faces at either end of the normals' principal axes, then up to split_charts
+  // grown from the faces whose normals point farthest along +-x, +-y, +-z, then up to split_charts
   // times the largest chart filling less than split_below_fill of its bounding box halved across
   // its long axis; the layout whose charts fill most of the packed rectangle is kept.
   size_t layout_search_max_triangles = 50000;
