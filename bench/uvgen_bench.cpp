@@ -1,6 +1,6 @@
 // Lightmap UV generation time (bake/uvgen) on a synthetic torus of about N triangles, welded or with
 // every triangle's vertices split as some exporters write them (bench/results/uvgen.md).
-//   bench_uvgen [--triangles N] [--split] [--density T] [--dump UVS.txt]
+//   bench_uvgen [--triangles N] [--split] [--density T] [--search-max-triangles N] [--dump UVS.txt]
 #include <CLI/CLI.hpp>
 
 #include <chrono>
@@ -19,6 +19,9 @@ int main(int argc, char** argv) {
   app.add_option("--triangles", triangles, "about this many triangles");
   app.add_flag("--split", split, "every triangle with vertices of its own");
   app.add_option("--density", density, "texels per unit (the torus is 2.7 units wide)");
+  exitance::UvGenerationSettings settings;
+  app.add_option("--search-max-triangles", settings.layout_search_max_triangles,
+                 "meshes up to this many triangles search for a tighter layout (UvGenerationSettings)");
   std::string dump;
   app.add_option("--dump", dump, "write the generated UVs (chart u0 v0 u1 v1 u2 v2 per triangle) to this file");
   CLI11_PARSE(app, argc, argv);
@@ -43,7 +46,6 @@ int main(int argc, char** argv) {
       index = uint32_t(positions.size() - 1);
     }
   }
-  exitance::UvGenerationSettings settings;
   settings.texels_per_unit = density;
   const auto start = std::chrono::steady_clock::now();
   const exitance::GeneratedUvs uvs = exitance::generate_lightmap_uvs(positions, indices, settings);

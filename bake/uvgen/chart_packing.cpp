@@ -383,6 +383,17 @@ Point2 PackedCharts::uv(size_t chart, Point2 point) const {
           std::clamp((c.origin[1] + turned_point[1]) / side, 0.0, 1.0)};
 }
 
+double bounding_box_fill(const ChartOutline& chart) {
+  double area = 0;
+  for (size_t i = 0; i + 2 < chart.points.size(); i += 3) {
+    const Point2 &a = chart.points[i], &b = chart.points[i + 1], &c = chart.points[i + 2];
+    area += 0.5 * std::fabs((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
+  }
+  const Orientation o = minimal_area_orientation(chart);
+  const double box = o.extent[0] * o.extent[1];
+  return box > 0 ? area / box : 1;
+}
+
 PackedCharts pack_charts(const std::vector<ChartOutline>& charts, const PackingSettings& settings) {
   PackedCharts packed;
   packed.placements.resize(charts.size());

@@ -46,6 +46,10 @@ struct PackedCharts {
   Point2 uv(size_t chart, Point2 point) const;
 };
 
+// The chart's area over the area of its minimal-area bounding box (1 for a rectangle, low for an
+// arch).
+double bounding_box_fill(const ChartOutline& chart);
+
 PackedCharts pack_charts(const std::vector<ChartOutline>& charts, const PackingSettings& settings);
 
 }  // namespace exitance::uvgen

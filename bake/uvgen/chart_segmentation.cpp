@@ -200,8 +200,26 @@ bool chart_is_disk(const WeldedMesh& mesh, const std::vector<uint32_t>& triangle
   return steps == boundary.size();
 }
 
+std::vector<uint32_t> axis_seed_faces(const WeldedMesh& mesh) {
+  std::vector<uint32_t> seeds;
+  for (size_t axis = 0; axis < 3; ++axis) {
+    int64_t lowest = -1, highest = -1;
+    double low = 2, high = -2;
+    for (uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+      if (mesh.degenerate[t]) continue;
+      const double d = mesh.normals[t][axis];
+      if (d > high) high = d, highest = t;
+      if (d < low) low = d, lowest = t;
+    }
+    for (int64_t t : {highest, lowest})
+      if (t >= 0 && std::find(seeds.begin(), seeds.end(), uint32_t(t)) == seeds.end()) seeds.push_back(uint32_t(t));
+  }
+  return seeds;
+}
+
 std::vector<Chart> segment_into_charts(const WeldedMesh& mesh, const std::vector<int32_t>& neighbour,
-                                       const SegmentationSettings& settings, ChartSplitter& splitter) {
+                                       const SegmentationSettings& settings, ChartSplitter& splitter,
+                                       int64_t first_seed) {
   const double cos_cone = cos_degrees(settings.cone_degrees);
   std::vector<uint8_t> assigned(mesh.triangle_count(), 0);
   std::vector<Chart> charts;
@@ -224,6 +242,7 @@ std::vector<Chart> segment_into_charts(const WeldedMesh& mesh, const std::vector
         ++next_in_order;
       if (next_in_order < mesh.triangle_count()) seed = next_in_order;
     }
+    if (grown == 0 && first_seed >= 0) seed = first_seed;
     if (seed < 0) break;
     Chart chart;
     chart.normal = mesh.normals[size_t(seed)];

@@ -45,9 +45,19 @@ class ChartSplitter {
   uint32_t stamp_ = 0, walk_ = 0;
 };
 
-// Every non-degenerate triangle lands in exactly one chart; degenerate triangles in none.
+// Every non-degenerate triangle lands in exactly one chart; degenerate triangles in none. The first
+// chart grows from `first_seed` (a non-degenerate face), or from the first face when it is -1; each
+// later one from the free face whose normal is farthest from every seed so far.
 std::vector<Chart> segment_into_charts(const WeldedMesh& mesh, const std::vector<int32_t>& neighbour,
-                                       const SegmentationSettings& settings, ChartSplitter& splitter);
+                                       const SegmentationSettings& settings, ChartSplitter& splitter,
+                                       int64_t first_seed = -1);
+
+// First seeds worth trying: the faces whose normals point farthest along +x, -x, +y, -y, +z, -z
+// (distinct, non-degenerate). Where the first cone boundaries fall decides whether a ring's charts
+// are its top and bottom halves or arches across it. World axes rather than the normals' principal
+// axes: on a sphere or a cube those are degenerate, and which basis an eigensolver returns there
+// would change with round-off.
+std::vector<uint32_t> axis_seed_faces(const WeldedMesh& mesh);
 
 // True when the chart's faces, sharing the welded vertices, form a topological disk: every edge used
 // once or twice with opposite orientations, V - E + F = 1 and exactly one boundary loop through

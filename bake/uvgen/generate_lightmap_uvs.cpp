@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 
+#include "chart_halving.h"
 #include "chart_packing.h"
 #include "chart_parameterization.h"
 #include "chart_segmentation.h"
@@ -15,6 +17,8 @@ namespace {
 
 using uvgen::Point2;
 using uvgen::Point3;
+
+const double kCurvedChartCos = std::cos(10 * std::numbers::pi / 180);
 
 double uv_area(const std::array<Point2, 3>& uv) {
   return 0.5 * std::fabs((uv[1][0] - uv[0][0]) * (uv[2][1] - uv[0][1]) - (uv[1][1] - uv[0][1]) * (uv[2][0] - uv[0][0]));
@@ -51,73 +55,163 @@ GeneratedUvs generate_lightmap_uvs(std::span<const Vec3> positions, std::span<co
   segmentation.max_chart_triangles = settings.max_chart_triangles;
   const std::vector<int32_t> neighbour = uvgen::face_neighbours(mesh, segmentation.sharp_edge_degrees);
   uvgen::ChartSplitter splitter(mesh, neighbour, segmentation.max_chart_triangles);
-  std::vector<uvgen::Chart> grown = uvgen::segment_into_charts(mesh, neighbour, segmentation, splitter);
-  progress.at(0.05);
 
   GeneratedUvs out;
   UvGenerationStats& stats = out.stats;
   stats.triangles = triangle_count;
 
-  // Flatten every chart, then scale it so its UV area equals its 3-D area (uniform texel density).
-  // (Splitting charts that fill their bounding box badly, arches like a torus's, was measured: 10
-  // charts instead of 5 on the test torus for 0.522 utilization instead of 0.515; not kept.)
-  const std::vector<uvgen::Chart> charts = std::move(grown);
-  std::vector<uvgen::FlatChart> flat(charts.size());
-  size_t flattened = 0;
-  for (size_t c = 0; c < charts.size(); ++c) {
-    flat[c] = uvgen::flatten_chart(mesh, charts[c]);
-    (flat[c].lscm ? stats.lscm_charts : stats.planar_charts)++;
+  // Flatten a chart, then scale it so its UV area equals its 3-D area (uniform texel density).
+  auto flatten_scaled = [&](const uvgen::Chart& chart) {
+    uvgen::FlatChart flat = uvgen::flatten_chart(mesh, chart);
     double area_3d = 0, area_uv = 0;
-    for (size_t i = 0; i < charts[c].triangles.size(); ++i) {
-      area_3d += mesh.areas[charts[c].triangles[i]];
-      area_uv += uv_area(flat[c].corner_uv[i]);
+    for (size_t i = 0; i < chart.triangles.size(); ++i) {
+      area_3d += mesh.areas[chart.triangles[i]];
+      area_uv += uv_area(flat.corner_uv[i]);
     }
     const double scale = area_uv > 0 && area_3d > 0 ? std::sqrt(area_3d / area_uv) : 0;
-    for (auto& corners : flat[c].corner_uv)
+    for (auto& corners : flat.corner_uv)
       for (Point2& q : corners) q = {q[0] * scale, q[1] * scale};
-    flattened += charts[c].triangles.size();
-    progress.at(0.05 + 0.85 * double(flattened) / double(std::max<size_t>(triangle_count, 1)));
-  }
+    return flat;
+  };
 
-  // Degenerate faces: collapsed onto a chart's copy of one of their vertices (no area, so they
-  // cover nothing of their own), or, when no chart has any of their vertices, a point chart each.
-  std::vector<int32_t> vertex_chart(mesh.positions.size(), -1);
-  std::vector<Point2> vertex_uv(mesh.positions.size());
-  for (size_t c = 0; c < charts.size(); ++c)
-    for (size_t i = 0; i < charts[c].triangles.size(); ++i)
-      for (size_t k = 0; k < 3; ++k) {
-        const uint32_t w = mesh.triangles[charts[c].triangles[i]][k];
-        if (vertex_chart[w] < 0) vertex_chart[w] = int32_t(c), vertex_uv[w] = flat[c].corner_uv[i][k];
+  // The charts' outlines for the packer. Degenerate faces: collapsed onto a chart's copy of one of
+  // their vertices (no area, so they cover nothing of their own), or, when no chart has any of their
+  // vertices, a point chart each (after the real charts).
+  struct Outlines {
+    std::vector<uvgen::ChartOutline> charts;
+    std::vector<std::pair<int32_t, Point2>> collapsed;  // per degenerate triangle: chart, point
+  };
+  auto outline = [&](const std::vector<uvgen::Chart>& charts, const std::vector<uvgen::FlatChart>& flat) {
+    Outlines o;
+    std::vector<int32_t> vertex_chart(mesh.positions.size(), -1);
+    std::vector<Point2> vertex_uv(mesh.positions.size());
+    for (size_t c = 0; c < charts.size(); ++c)
+      for (size_t i = 0; i < charts[c].triangles.size(); ++i)
+        for (size_t k = 0; k < 3; ++k) {
+          const uint32_t w = mesh.triangles[charts[c].triangles[i]][k];
+          if (vertex_chart[w] < 0) vertex_chart[w] = int32_t(c), vertex_uv[w] = flat[c].corner_uv[i][k];
+        }
+    o.collapsed.assign(triangle_count, {-1, Point2{}});
+    o.charts.resize(charts.size());
+    for (uint32_t t = 0; t < triangle_count; ++t) {
+      if (!mesh.degenerate[t]) continue;
+      for (uint32_t w : mesh.triangles[t])
+        if (vertex_chart[w] >= 0) {
+          o.collapsed[t] = {vertex_chart[w], vertex_uv[w]};
+          break;
+        }
+      if (o.collapsed[t].first < 0) {
+        o.collapsed[t] = {int32_t(o.charts.size()), Point2{0, 0}};
+        o.charts.push_back({{Point2{0, 0}, Point2{0, 0}, Point2{0, 0}}});
       }
-  out.triangle_chart.assign(triangle_count, 0);
-  std::vector<std::pair<int32_t, Point2>> collapsed(triangle_count, {-1, Point2{}});
-  const size_t real_charts = charts.size();
-  std::vector<uvgen::ChartOutline> outlines(real_charts);
-  for (uint32_t t = 0; t < triangle_count; ++t) {
-    if (!mesh.degenerate[t]) continue;
-    ++stats.degenerate_triangles;
-    for (uint32_t w : mesh.triangles[t])
-      if (vertex_chart[w] >= 0) {
-        collapsed[t] = {vertex_chart[w], vertex_uv[w]};
-        break;
-      }
-    if (collapsed[t].first < 0) {
-      collapsed[t] = {int32_t(outlines.size()), Point2{0, 0}};
-      outlines.push_back({{Point2{0, 0}, Point2{0, 0}, Point2{0, 0}}});
     }
-  }
-  for (size_t c = 0; c < real_charts; ++c) {
-    std::vector<Point2>& points = outlines[c].points;
-    for (const auto& corners : flat[c].corner_uv) points.insert(points.end(), corners.begin(), corners.end());
-  }
+    for (size_t c = 0; c < charts.size(); ++c) {
+      std::vector<Point2>& points = o.charts[c].points;
+      for (const auto& corners : flat[c].corner_uv) points.insert(points.end(), corners.begin(), corners.end());
+    }
+    return o;
+  };
 
   uvgen::PackingSettings packing;
   packing.texels_per_unit = settings.texels_per_unit;
   packing.max_side_texels = settings.max_side_texels;
   packing.gutter_texels = settings.gutter_texels;
-  const uvgen::PackedCharts packed = uvgen::pack_charts(outlines, packing);
-  progress.at(0.95);
+  struct Layout {
+    std::vector<uvgen::Chart> charts;
+    std::vector<uvgen::FlatChart> flat;
+    Outlines outlines;
+    uvgen::PackedCharts packed;
+  };
+  // Charts grown from `first_seed` (-1: the first face), flattened and packed; `report`: progress
+  // over the flattening, which takes most of the time.
+  auto lay_out = [&](int64_t first_seed, bool report) {
+    Layout l;
+    l.charts = uvgen::segment_into_charts(mesh, neighbour, segmentation, splitter, first_seed);
+    if (report) progress.at(0.05);
+    l.flat.resize(l.charts.size());
+    size_t flattened = 0;
+    for (size_t c = 0; c < l.charts.size(); ++c) {
+      l.flat[c] = flatten_scaled(l.charts[c]);
+      flattened += l.charts[c].triangles.size();
+      if (report) progress.at(0.05 + 0.8 * double(flattened) / double(std::max<size_t>(triangle_count, 1)));
+    }
+    l.outlines = outline(l.charts, l.flat);
+    l.packed = uvgen::pack_charts(l.outlines.charts, packing);
+    if (report) progress.at(0.9);
+    return l;
+  };
+  Layout best = lay_out(-1, true);
 
+  // Two searches on small meshes (bench/results/uvgen.md), each layout kept only when its charts
+  // fill more of the packed rectangle. First, where the first chart's cone boundaries fall decides
+  // the charts' shapes: on a torus, arches across the tube or the tube's top and bottom halves; the
+  // charts are also grown from the faces whose normals point farthest along each axis.
+  auto fills_more = [](const uvgen::PackedCharts& a, const uvgen::PackedCharts& b) {
+    if (a.fits != b.fits) return a.fits;
+    return a.texels_per_unit * a.texels_per_unit / (double(a.width) * a.height) >
+           b.texels_per_unit * b.texels_per_unit / (double(b.width) * b.height);
+  };
+  // Planar charts (a building's boxes) flatten as they are, whichever face seeds them: only meshes
+  // with a curved chart (a face over 10 degrees from its seed's normal) search.
+  bool curved = false;
+  for (const uvgen::Chart& chart : best.charts)
+    for (uint32_t t : chart.triangles) {
+      const uvgen::Point3& n = mesh.normals[t];
+      curved = curved || n[0] * chart.normal[0] + n[1] * chart.normal[1] + n[2] * chart.normal[2] < kCurvedChartCos;
+    }
+  const bool search = curved && triangle_count <= settings.layout_search_max_triangles;
+  if (search)
+    for (uint32_t seed : uvgen::axis_seed_faces(mesh)) {
+      Layout trial = lay_out(int64_t(seed), false);
+      if (fills_more(trial.packed, best.packed)) best = std::move(trial);
+    }
+  // Then arches (a torus's halves flatten to ~200-degree arches) fill little of their bounding box
+  // and stack badly: the largest chart filling less than split_below_fill of its box is halved
+  // across its long axis, up to split_charts times in a row; halving one arch of two does not pay,
+  // halving both does (the halves stack), so the best layout of the sequence is kept.
+  if (search) {
+    Layout current = best;
+    for (int split = 0; split < settings.split_charts; ++split) {
+      int64_t pick = -1;
+      double pick_area = 0;
+      for (size_t c = 0; c < current.charts.size(); ++c) {
+        if (current.charts[c].triangles.size() < 4) continue;
+        double area = 0;
+        for (uint32_t t : current.charts[c].triangles) area += mesh.areas[t];
+        if (area > pick_area && uvgen::bounding_box_fill(current.outlines.charts[c]) < settings.split_below_fill)
+          pick = int64_t(c), pick_area = area;
+      }
+      if (pick < 0) break;
+      std::vector<uvgen::Chart> halves = uvgen::halve_chart(current.charts[size_t(pick)], current.flat[size_t(pick)], splitter);
+      if (halves.size() < 2) break;
+      Layout next;
+      for (size_t c = 0; c < current.charts.size(); ++c) {
+        if (c != size_t(pick)) {
+          next.charts.push_back(std::move(current.charts[c])), next.flat.push_back(std::move(current.flat[c]));
+          continue;
+        }
+        for (uvgen::Chart& half : halves) {
+          next.flat.push_back(flatten_scaled(half));
+          next.charts.push_back(std::move(half));
+        }
+      }
+      next.outlines = outline(next.charts, next.flat);
+      next.packed = uvgen::pack_charts(next.outlines.charts, packing);
+      current = std::move(next);
+      if (fills_more(current.packed, best.packed)) best = current;
+    }
+  }
+  std::vector<uvgen::Chart>& charts = best.charts;
+  std::vector<uvgen::FlatChart>& flat = best.flat;
+  const Outlines& outlines = best.outlines;
+  const uvgen::PackedCharts& packed = best.packed;
+  progress.at(0.95);
+  for (const uvgen::FlatChart& f : flat) (f.lscm ? stats.lscm_charts : stats.planar_charts)++;
+  const size_t real_charts = charts.size();
+  const auto& collapsed = outlines.collapsed;
+  stats.degenerate_triangles = size_t(std::count(mesh.degenerate.begin(), mesh.degenerate.end(), uint8_t(1)));
+
+  out.triangle_chart.assign(triangle_count, 0);
   out.corner_uv.assign(3 * triangle_count, Vec2{});
   auto store = [&](uint32_t t, size_t k, Point2 uv) {
     const float u = float(uv[0]), v = float(uv[1]);
@@ -136,7 +230,7 @@ GeneratedUvs generate_lightmap_uvs(std::span<const Vec3> positions, std::span<co
     }
 
   // Statistics on the UVs as stored (floats), normalized so UV area equals 3-D area over the mesh.
-  stats.charts = outlines.size();
+  stats.charts = outlines.charts.size();
   stats.packed_width = packed.width;
   stats.packed_height = packed.height;
   stats.texels_per_unit = packed.texels_per_unit;

@@ -249,15 +249,15 @@ struct Shape {
 };
 
 TEST(LightmapUvGeneration, ClosedPrimitivesGiveFewChartsAndNoOverlap) {
-  // At 32 texels per unit the 3.1-texel gaps cost much of a small chart; a torus's charts are arches
-  // with little that fits inside them (bench/results/uvgen.md): the bounds are what the bottom-left
-  // packer achieves here (cube 0.848, sphere 0.648, cylinder 0.776, torus 0.548) less about three
-  // texel rows of the packed rectangle (~0.02), for LSCM round-off moving a mask texel on another
-  // machine, not 60 % everywhere.
-  const Shape shapes[] = {{"cube", cube(), 6, 0.8, 1.01},
-                          {"uv sphere", uv_sphere(), 4, 0.6, 1.3},
-                          {"cylinder", cylinder(), 6, 0.75, 1.01},
-                          {"torus", torus(), 6, 0.525, 1.35}};
+  // At 32 texels per unit the 3.1-texel gaps cost much of a small chart, and a torus's halves are
+  // ~200-degree arches (bench/results/uvgen.md): the bounds are what the layout search achieves here
+  // (cube 0.848, sphere 0.689, cylinder 0.829, torus 0.619) less about three texel rows of the
+  // packed rectangle (~0.02), for LSCM round-off moving a mask texel on another machine; the torus
+  // at the 60 % issue 13 asks for.
+  const Shape shapes[] = {{"cube", cube(), 6, 0.83, 1.01},
+                          {"uv sphere", uv_sphere(), 4, 0.67, 1.3},
+                          {"cylinder", cylinder(), 6, 0.81, 1.01},
+                          {"torus", torus(), 6, 0.60, 1.15}};
   for (const Shape& shape : shapes) {
     SCOPED_TRACE(shape.name);
     const GeneratedUvs uvs = generate(shape.mesh);
@@ -270,10 +270,29 @@ TEST(LightmapUvGeneration, ClosedPrimitivesGiveFewChartsAndNoOverlap) {
   }
 }
 
+// The layout search (other first seeds, halved arches) keeps a layout only when it fills more of
+// the packed rectangle: never below the first layout, and above it on the torus.
+TEST(LightmapUvGeneration, LayoutSearchNeverFillsLess) {
+  const std::pair<const char*, Mesh> meshes[] = {{"uv sphere", uv_sphere()}, {"cylinder", cylinder()}, {"torus", torus()}};
+  for (const auto& [name, mesh] : meshes) {
+    SCOPED_TRACE(name);
+    UvGenerationSettings settings;
+    settings.texels_per_unit = kDensity;
+    settings.max_side_texels = kMaxPage - 2 * kPadding;
+    const GeneratedUvs searched = generate_lightmap_uvs(mesh.positions, mesh.indices, settings);
+    settings.layout_search_max_triangles = 0;
+    const GeneratedUvs first = generate_lightmap_uvs(mesh.positions, mesh.indices, settings);
+    EXPECT_GE(searched.stats.utilization, first.stats.utilization);
+    if (std::string(name) == "torus") {
+      EXPECT_GT(searched.stats.utilization, first.stats.utilization + 0.03);
+    }
+  }
+}
+
 TEST(LightmapUvGeneration, HostileMeshesGiveValidSeparatedCharts) {
   const Shape shapes[] = {{"non-manifold", non_manifold_fin(), 5, 0, 2},
                           {"degenerate", with_degenerate_triangles(), 5, 0, 2},
-                          {"two cubes", two_cubes(), 12, 0.6, 1.01}};
+                          {"two cubes", two_cubes(), 12, 0.81, 1.01}};
   for (const Shape& shape : shapes) {
     SCOPED_TRACE(shape.name);
     const GeneratedUvs uvs = generate(shape.mesh);

@@ -1,6 +1,7 @@
 // Lightmap UVs for a mesh that has none (issue 13): charts grown by normal cone on the position-welded
 // mesh, each flattened by LSCM (CGAL) or, when that fails, projected onto its plane, scaled to a
-// uniform texel density and packed into the unit square with a gutter measured in texels.
+// uniform texel density and packed into the unit square with a gutter measured in texels. Small
+// curved meshes try a few other layouts (other first seeds, arches halved) and keep the tightest.
 //
 // Why the texel density is an input: a gutter is only meaningful at a resolution. The atlas layout
 // (bake/layout/atlas_layout.cpp) gives an instance texels_per_uv = density * sqrt(world area / UV
@@ -29,9 +30,16 @@ struct UvGenerationSettings {
   // rasterized charts; the extra 0.1 absorbs float rounding of the UVs and of the layout's area sums.
   double gutter_texels = 3.1;
   double chart_cone_degrees = 90;    // a chart's faces stay within this angle of its seed's normal (measured:
-                                     // 2 charts on a UV sphere, 5 on a torus; 66 gave 7 and 16)
+                                     // 2 charts on a UV sphere, 5 on a torus before the layout search; 66 gave 7 and 16)
   double sharp_edge_degrees = 75;    // faces meeting at a larger dihedral angle are never one chart
   size_t max_chart_triangles = 20000;  // larger charts are split (bounds LSCM's solve)
+  // Meshes up to this many triangles search for a tighter layout (up to 9 packings): charts also
+  // grown from the faces whose normals point farthest along +-x, +-y, +-z, then up to split_charts
+  // times the largest chart filling less than split_below_fill of its bounding box halved across
+  // its long axis; the layout whose charts fill most of the packed rectangle is kept.
+  size_t layout_search_max_triangles = 50000;
+  int split_charts = 2;
+  double split_below_fill = 0.6;
   double stretch_bound = 2;          // a chart whose mean area or angle distortion exceeds it is "stretched"
   std::function<void(double)> progress;  // fraction done, called from the calling thread
 };
