@@ -21,7 +21,7 @@
 namespace exitance::formats {
 
 inline constexpr char kSceneMagic[8] = {'E', 'X', 'S', 'C', 'E', 'N', 'E', '\0'};
-constexpr uint32_t kSceneFormatVersion = 2;        // what writers write
+constexpr uint32_t kSceneFormatVersion = 3;        // what writers write
 constexpr uint32_t kOldestSceneFormatVersion = 1;  // readers accept 1 .. kSceneFormatVersion
 constexpr uint32_t kSceneHeaderSize = 160;
 // Fixed record sizes (bytes) of the payload's arrays; scene_format.md has the layouts.
@@ -94,6 +94,10 @@ struct MaterialRecord {
   AlphaMode alpha_mode = AlphaMode::Opaque;
   float alpha_cutoff = 0.5f;
   float base_alpha = 1.0f;  // baseColorFactor[3]
+  // Version 3 (older files read back as none): glTF normalTexture, linear RGB (no sRGB decode), and
+  // its scale (tangent-space x, y multiplied by it).
+  TextureBindingRecord normal_texture;
+  float normal_scale = 1.0f;
 };
 
 struct InstanceRecord {
@@ -208,6 +212,10 @@ struct SceneFile {
   // COLOR_0 per corner (3 per triangle), or both empty: no vertex colours (version 2).
   std::vector<Float3> vertex_color;
   std::vector<float> vertex_alpha;
+  // Per corner (3 per triangle), or both empty: world-space tangent (unit, or zero on corners no
+  // normal map reads) and its handedness w = +1 or -1, bitangent = w * cross(normal, tangent) (version 3).
+  std::vector<Float3> tangents;
+  std::vector<float> tangent_signs;
   float texel_density = 0;     // lightmap texels per scene unit
   TexelGBufferRecords texels;  // includes the atlas page sizes
   // Probe positions and states only (SH coefficients are not stored: they read back as zero).
