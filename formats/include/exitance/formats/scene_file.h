@@ -190,8 +190,8 @@ struct BvhNodeRecord {
 };
 static_assert(sizeof(BvhNodeRecord) == kSceneBvhNodeSize, "scene.bin BVH node record is 112 bytes");
 
-// One level over the world-space triangles (a two-level layout, per mesh plus instances, will be
-// format version 2). Nodes depth-first, nodes[0] the root; leaf slots hold scene triangle indices.
+// One level over the world-space triangles (a two-level layout, per mesh plus instances, will be a
+// later format version). Nodes depth-first, nodes[0] the root; leaf slots hold scene triangle indices.
 struct SceneBvh {
   std::vector<BvhNodeRecord> nodes;
   std::vector<uint32_t> leaf_triangles;
@@ -248,7 +248,7 @@ inline uint32_t texel_morton_code(uint32_t x, uint32_t y) {
 void validate_scene_file(const SceneFile& scene, const std::string& name_for_errors);
 
 // The exact bytes of scene.bin; throws FormatError if the scene is invalid. format_version 1
-// writes the old layout (tests, fixtures) and refuses a scene with anything only version 2 holds.
+// (or 2) writes the old layout (tests, fixtures) and refuses a scene with anything only a later version holds.
 std::vector<uint8_t> encode_scene(const SceneFile& scene, uint32_t format_version = kSceneFormatVersion);
 void write_scene_file(const std::string& path, const SceneFile& scene);
 
