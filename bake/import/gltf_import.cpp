@@ -522,8 +522,8 @@ class SceneFlattener {
   const std::string& file_;
   const ImportOptions& options_;
   Scene& scene_;
-  bool vertex_colors_ = false;
-  bool tangents_ = false;  // some primitive so far has a normal-mapped material: every corner gets a frame  // some primitive so far has COLOR_0: every corner gets a colour
+  bool vertex_colors_ = false;  // some primitive so far has COLOR_0: every corner gets a colour
+  bool tangents_ = false;  // some primitive so far has a normal-mapped material: every corner gets a frame
   Diagnostics& diagnostics_;
   uint32_t default_material_;
   std::vector<uint8_t> node_state_;  // 0 unvisited, 1 on the current path, 2 done

@@ -33,6 +33,8 @@
 #include "exitance/bake/command/bake_pipeline.h"
 #include "exitance/formats/lightmap_exr.h"
 #include "exitance/formats/scene_file.h"
+#include "exitance/runtime/cpu_reference_integrator.h"
+#include "exitance/runtime/view/path_traced_view.h"
 #include "exitance/runtime/view/view_render.h"
 #include "exitance/runtime/view/view_scene.h"
 #include "scene_builder.h"
@@ -275,6 +277,35 @@ TEST_F(ViewDirectionalSh1, UnderAQuadrantSkyPixelsFollowTheL1ReconstructionAndAW
               flipped.outside, flipped.worst_z, reversed.outside, reversed.worst_z);
   EXPECT_GT(flipped.outside, 0);
   EXPECT_GT(reversed.outside, 0);
+}
+
+// The path-traced view lights the normal-mapped normal (the true E(n)/pi the layers approximate):
+// under the uniform sky the mean over its pixels is albedo x L (1 + n . n0) / 2, a z-test of the
+// mean residual within 4 standard errors (pixels are independent estimates; their variances from
+// PathTracedView::variance). E(n0)/pi = L is 1 - n . n0 = 17 % away, far outside.
+TEST_F(ViewDirectionalSh1, ThePathTracedViewLightsTheMappedNormal) {
+  const view::ViewScene scene = view::open_view_scene((*dir_ / "uniform.bake").string());
+  const CpuReferenceIntegrator reference(*view::lighting_scene_of(scene)->source);
+  IntegratorSettings settings;
+  settings.spp = 256;
+  settings.seed = 5;
+  settings.recorded_bounces = 1;
+  const int side = 16;
+  const view::PathTracedView traced = view::render_path_traced_view(
+      scene, view::look_at_camera({0, 1, 0}, {0, 0, 0}, {0, 0, -1}, 1.0), side, side, reference, settings);
+  ASSERT_EQ(traced.estimate.texels.size(), size_t(side * side));
+  const double cos_tilt = world_mapped_normal().y, pixels = double(side * side);
+  for (int c = 0; c < 3; ++c) {
+    double residual = 0, variance = 0;
+    const double exact = kAlbedo[c] * kUniformSky[c] * (1 + cos_tilt) / 2;
+    for (size_t p = 0; p < size_t(side * side); ++p) {
+      residual += (traced.image.rgb[p * 3 + size_t(c)] - exact) / pixels;
+      variance += traced.variance[p * 3 + size_t(c)] / (pixels * pixels);
+    }
+    std::printf("[view sh1] path traced, channel %d: exact %.5f, mean residual %+.2e, SE %.2e\n", c, exact, residual,
+                std::sqrt(variance));
+    EXPECT_LE(std::fabs(residual), 4 * std::sqrt(variance) + 1e-6 * exact) << "channel " << c;
+  }
 }
 
 // Without sh1 layers (or with them ignored) the view reads the RGB layer as before: exactly
