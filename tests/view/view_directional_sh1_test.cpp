@@ -282,7 +282,7 @@ TEST_F(ViewDirectionalSh1, UnderAQuadrantSkyPixelsFollowTheL1ReconstructionAndAW
 // The path-traced view lights the normal-mapped normal (the true E(n)/pi the layers approximate):
 // under the uniform sky the mean over its pixels is albedo x L (1 + n . n0) / 2, a z-test of the
 // mean residual within 4 standard errors (pixels are independent estimates; their variances from
-// PathTracedView::variance). E(n0)/pi = L is 1 - n . n0 = 17 % away, far outside.
+// PathTracedView::variance). E(n0)/pi = L would be 9.6 % higher, about 80 standard errors away.
 TEST_F(ViewDirectionalSh1, ThePathTracedViewLightsTheMappedNormal) {
   const view::ViewScene scene = view::open_view_scene((*dir_ / "uniform.bake").string());
   const CpuReferenceIntegrator reference(*view::lighting_scene_of(scene)->source);
