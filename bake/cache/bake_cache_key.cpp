@@ -16,7 +16,7 @@ static_assert(sizeof(AtlasSettings) == 24, "AtlasSettings changed: hash the new 
 // write_gltf (where results go does not change them), progress.
 static_assert(sizeof(BakeOptions) == 456, "BakeOptions changed: hash the new field in bake_cache_key (or say why not)");
 static_assert(sizeof(ImportOptions) == 8, "ImportOptions changed: hash the new field in bake_cache_key");
-static_assert(sizeof(Material) == 136, "Material changed: hash the new field in bake_cache_key");
+static_assert(sizeof(Material) == 168, "Material changed: hash the new field in bake_cache_key");
 static_assert(sizeof(PunctualLight) == 88, "PunctualLight changed: hash the new field in bake_cache_key");
 
 using scene_hashing::binding;
@@ -24,7 +24,7 @@ using scene_hashing::vec3;
 
 void hash_scene(Sha256Stream& h, const Scene& scene) {
   h.array(scene.positions), h.array(scene.normals), h.array(scene.uv0), h.array(scene.lightmap_uv);
-  h.array(scene.vertex_color), h.array(scene.vertex_alpha);
+  h.array(scene.vertex_color), h.array(scene.vertex_alpha), h.array(scene.tangents), h.array(scene.tangent_signs);
   h.array(scene.triangle_material), h.array(scene.triangle_instance);
   h.value(uint64_t(scene.materials.size()));
   for (const Material& m : scene.materials) {
@@ -32,6 +32,7 @@ void hash_scene(Sha256Stream& h, const Scene& scene) {
     vec3(h, m.base_color), binding(h, m.base_color_texture), h.value(m.metallic);
     vec3(h, m.emission), binding(h, m.emissive_texture), h.value(m.double_sided);
     h.value(m.alpha_mode), h.value(m.alpha_cutoff), h.value(m.base_alpha);
+    binding(h, m.normal_texture), h.value(m.normal_scale);
   }
   h.value(uint64_t(scene.textures.size()));
   for (const Texture& t : scene.textures) scene_hashing::texture(h, t);

@@ -7,7 +7,9 @@ namespace exitance {
 namespace {
 
 // A new field in one of these must be sorted into the keys below (or said to be lighting-only).
-static_assert(sizeof(Material) == 136, "Material changed: hash the new field in stage_cache_keys where a stage reads it");
+// normal_texture / normal_scale (and Scene::tangents): no offline stage reads them; only scene.bin
+// and exitance-view do, and the bundle cache key hashes them.
+static_assert(sizeof(Material) == 168, "Material changed: hash the new field in stage_cache_keys where a stage reads it");
 static_assert(sizeof(PunctualLight) == 88, "PunctualLight changed: hash the new field in stage_cache_keys if a stage reads it");
 static_assert(sizeof(AtlasSettings) == 24, "AtlasSettings changed: hash the new field in the layout key");
 

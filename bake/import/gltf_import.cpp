@@ -9,7 +9,9 @@
 #include "exitance/bake/import/gltf_materials.h"
 #include "exitance/bake/import/gltf_triangle_corners.h"
 #include "exitance/bake/input_error.h"
+#include "exitance/common/texture_sampling.h"
 #include "exitance/runtime/node_transform.h"
+#include "exitance/runtime/tangent_frames.h"
 
 namespace exitance {
 namespace {
@@ -113,6 +115,7 @@ struct RepairCounts {
   size_t recomputed_normals = 0;
   size_t non_finite_normals = 0;
   size_t renormalized_normals = 0;
+  size_t zero_tangents = 0;
 };
 
 class SceneFlattener {
@@ -171,6 +174,9 @@ class SceneFlattener {
                         " NaN or infinite vertex normals replaced by face normals");
     if (repairs_.renormalized_normals)
       diagnostics_.warn(file_ + ": " + std::to_string(repairs_.renormalized_normals) + " vertex normals renormalized");
+    if (repairs_.zero_tangents)
+      diagnostics_.warn(file_ + ": " + std::to_string(repairs_.zero_tangents) +
+                        " zero TANGENT vectors: the normal map is not applied at those vertices");
   }
 
  private:
@@ -304,6 +310,12 @@ class SceneFlattener {
       material = uint32_t(primitive.material);
     }
     const std::vector<uint32_t> corners = triangle_corners(mode, indices);
+    const TangentFrames frames = tangent_frames(primitive, scene_.materials[material], positions, normals, corners, read_optional);
+    if (frames.normal_mapped && !tangents_) {  // corners before this primitive have no frame
+      tangents_ = true;
+      scene_.tangents.assign(scene_.positions.size(), Vec3(0));
+      scene_.tangent_signs.assign(scene_.positions.size(), 1.0f);
+    }
     const uint32_t first_local_triangle = generated.local_triangles;
     generated.local_triangles += uint32_t(corners.size() / 3);
     if (generated.request && generated.first_instance) {
@@ -329,6 +341,14 @@ class SceneFlattener {
         const uint32_t vi = v[size_t(k)];
         scene_.positions.push_back(p[size_t(k)]);
         scene_.normals.push_back(shading_normal(normals, vi, world, face_normal, flip_winding));
+        if (tangents_) {
+          const TangentFrame frame =
+              frames.normal_mapped
+                  ? transform_tangent_frame(world, frames.local[vi], frames.local_normals[vi], scene_.normals.back())
+                  : TangentFrame{};
+          scene_.tangents.push_back(frame.tangent);
+          scene_.tangent_signs.push_back(frame.sign);
+        }
         scene_.uv0.push_back(uv0.empty() ? Vec2{} : to_vec2(uv0, vi));
         scene_.lightmap_uv.push_back(generated.request ? Vec2{} : to_vec2(lightmap_uv, vi));
         if (generated.request)
@@ -343,6 +363,50 @@ class SceneFlattener {
       scene_.triangle_material.push_back(material);
       scene_.triangle_instance.push_back(instance_index);
     }
+  }
+
+  // A primitive's tangent frames in its local space (tangent_frames.h), for materials with a normal
+  // map: the TANGENT attribute when present, else generated from the UVs the normal map reads
+  // (after its KHR_texture_transform, so the tangent follows the texture's own u axis).
+  struct TangentFrames {
+    bool normal_mapped = false;
+    std::vector<TangentFrame> local;  // per vertex
+    std::vector<Vec3> local_normals;  // per vertex, the normals the frames were built against
+  };
+  template <class ReadOptional>
+  TangentFrames tangent_frames(const tinygltf::Primitive& primitive, const Material& material,
+                               const std::vector<float>& positions, const std::vector<float>& normals,
+                               const std::vector<uint32_t>& corners, ReadOptional& read_optional) {
+    TangentFrames out;
+    if (material.normal_texture.texture < 0) return out;
+    out.normal_mapped = true;
+    const size_t vertex_count = positions.size() / 3;
+    std::vector<Vec3> local_positions(vertex_count), given_normals;
+    for (size_t i = 0; i < vertex_count; ++i) local_positions[i] = to_vec3(positions, i);
+    if (!normals.empty())
+      for (size_t i = 0; i < vertex_count; ++i) given_normals.push_back(to_vec3(normals, i));
+    out.local_normals = tangent_space_normals(local_positions, given_normals, corners);
+    if (const std::vector<float> tangents = read_optional("TANGENT", 4, NonFinite::Reject); !tangents.empty()) {
+      out.local.resize(vertex_count);
+      for (size_t i = 0; i < vertex_count; ++i) {
+        const Vec3 t{tangents[4 * i], tangents[4 * i + 1], tangents[4 * i + 2]};
+        const float t_length = length(t);
+        if (!(t_length > 1e-6f)) {
+          ++repairs_.zero_tangents;
+          continue;
+        }
+        out.local[i] = {t / t_length, tangents[4 * i + 3] < 0.0f ? -1.0f : 1.0f};
+      }
+      return out;
+    }
+    const TextureTransform& transform = material.normal_texture.transform;
+    const std::vector<float> uv_values = read_optional("TEXCOORD_" + std::to_string(transform.tex_coord), 2, NonFinite::Reject);
+    std::vector<Vec2> uvs(vertex_count, Vec2{0, 0});
+    if (!uv_values.empty())
+      for (size_t i = 0; i < vertex_count; ++i)
+        uvs[i] = transform_texture_coordinate(to_vec2(uv_values, i), transform.offset, transform.scale, transform.rotation);
+    out.local = generate_vertex_tangents(local_positions, out.local_normals, uvs, corners);
+    return out;
   }
 
   Vec3 shading_normal(const std::vector<float>& normals, uint32_t vi, const Mat4& world, Vec3 face_normal,
@@ -459,6 +523,7 @@ class SceneFlattener {
   const ImportOptions& options_;
   Scene& scene_;
   bool vertex_colors_ = false;  // some primitive so far has COLOR_0: every corner gets a colour
+  bool tangents_ = false;  // some primitive so far has a normal-mapped material: every corner gets a frame
   Diagnostics& diagnostics_;
   uint32_t default_material_;
   std::vector<uint8_t> node_state_;  // 0 unvisited, 1 on the current path, 2 done

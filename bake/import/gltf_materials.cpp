@@ -49,13 +49,21 @@ class TextureImporter {
   TextureImporter(const tinygltf::Model& model, const std::string& file, Scene& scene)
       : model_(model), file_(file), scene_(scene) {}
 
+  // Colour textures (base colour, emissive) are sRGB-encoded; data textures (normal maps) are not.
+  enum class Encoding { Srgb, Data };
+
   TextureBinding bind(const tinygltf::TextureInfo& info, const std::string& element) {
+    return bind(info.index, info.texCoord, info.extensions, element, Encoding::Srgb);
+  }
+
+  TextureBinding bind(int index, int tex_coord, const tinygltf::ExtensionMap& extensions, const std::string& element,
+                      Encoding encoding) {
     TextureBinding binding;
-    if (info.index < 0) return binding;
-    if (size_t(info.index) >= model_.textures.size())
-      throw InputError(file_, element, "texture " + std::to_string(info.index) + " does not exist");
-    const tinygltf::Texture& texture = model_.textures[size_t(info.index)];
-    const std::string texture_element = "texture " + std::to_string(info.index);
+    if (index < 0) return binding;
+    if (size_t(index) >= model_.textures.size())
+      throw InputError(file_, element, "texture " + std::to_string(index) + " does not exist");
+    const tinygltf::Texture& texture = model_.textures[size_t(index)];
+    const std::string texture_element = "texture " + std::to_string(index);
     if (texture.source < 0 || size_t(texture.source) >= model_.images.size())
       throw InputError(file_, texture_element, "image " + std::to_string(texture.source) + " does not exist");
     int sampler_wrap_s = TINYGLTF_TEXTURE_WRAP_REPEAT, sampler_wrap_t = TINYGLTF_TEXTURE_WRAP_REPEAT;
@@ -65,7 +73,7 @@ class TextureImporter {
       sampler_wrap_s = model_.samplers[size_t(texture.sampler)].wrapS;
       sampler_wrap_t = model_.samplers[size_t(texture.sampler)].wrapT;
     }
-    const auto key = std::make_tuple(texture.source, sampler_wrap_s, sampler_wrap_t);
+    const auto key = std::make_tuple(texture.source, sampler_wrap_s, sampler_wrap_t, encoding == Encoding::Data);
     auto found = cache_.find(key);
     if (found == cache_.end()) {
       const tinygltf::Image& image = model_.images[size_t(texture.source)];
@@ -73,16 +81,18 @@ class TextureImporter {
       if (image.image.empty())
         throw InputError(file_, image_element,
                          image.uri.empty() ? "has no data" : "file '" + image.uri + "' is missing or unreadable");
-      Texture decoded = decode_srgb_image(image.image, image_name_hint(image), file_, image_element);
+      Texture decoded = encoding == Encoding::Srgb
+                            ? decode_srgb_image(image.image, image_name_hint(image), file_, image_element)
+                            : decode_data_image(image.image, image_name_hint(image), file_, image_element);
       decoded.wrap_s = wrap_mode(sampler_wrap_s);
       decoded.wrap_t = wrap_mode(sampler_wrap_t);
       scene_.textures.push_back(std::move(decoded));
       found = cache_.emplace(key, int(scene_.textures.size() - 1)).first;
     }
     binding.texture = found->second;
-    binding.transform.tex_coord = info.texCoord;
-    auto ext = info.extensions.find("KHR_texture_transform");
-    if (ext != info.extensions.end()) {
+    binding.transform.tex_coord = tex_coord;
+    auto ext = extensions.find("KHR_texture_transform");
+    if (ext != extensions.end()) {
       const tinygltf::Value& t = ext->second;
       const std::string ext_element = element + " KHR_texture_transform";
       const tinygltf::Value& offset = member(t, "offset");
@@ -106,7 +116,7 @@ class TextureImporter {
   const tinygltf::Model& model_;
   const std::string& file_;
   Scene& scene_;
-  std::map<std::tuple<int, int, int>, int> cache_;
+  std::map<std::tuple<int, int, int, bool>, int> cache_;
 };
 
 }  // namespace
@@ -134,6 +144,12 @@ uint32_t import_gltf_materials(const tinygltf::Model& model, const std::string& 
     material.emission = rgb_factor(source.emissiveFactor, {0, 0, 0}, file, element + " emissiveFactor") * strength;
     material.emissive_texture = textures.bind(source.emissiveTexture, element + " emissiveTexture");
     material.double_sided = source.doubleSided;
+    const tinygltf::NormalTextureInfo& normal = source.normalTexture;
+    material.normal_texture = textures.bind(normal.index, normal.texCoord, normal.extensions,
+                                            element + " normalTexture", TextureImporter::Encoding::Data);
+    material.normal_scale = float(normal.scale);
+    if (!std::isfinite(material.normal_scale))
+      throw InputError(file, element + " normalTexture", "scale is not finite");
     if (pbr.baseColorFactor.size() == 4) {
       material.base_alpha = float(pbr.baseColorFactor[3]);
       if (!std::isfinite(material.base_alpha) || material.base_alpha < 0 || material.base_alpha > 1)

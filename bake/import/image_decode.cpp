@@ -110,8 +110,10 @@ Texture read_all(OIIO::ImageInput& input, const std::string& file, const std::st
 
 }  // namespace
 
-Texture decode_srgb_image(const std::vector<unsigned char>& bytes, const std::string& name_hint,
-                          const std::string& file, const std::string& element) {
+namespace {
+
+Texture decode_image(const std::vector<unsigned char>& bytes, const std::string& name_hint, const std::string& file,
+                     const std::string& element, bool srgb) {
   if (bytes.empty()) throw InputError(file, element, "image has no data");
   if (const std::string problem = png_structure_problem(bytes); !problem.empty())
     throw InputError(file, element, problem);
@@ -121,9 +123,21 @@ Texture decode_srgb_image(const std::vector<unsigned char>& bytes, const std::st
   if (!input) throw InputError(file, element, "image data does not decode (" + one_line(OIIO::geterror()) + ")");
   const bool is_float = input->spec().format.is_floating_point();
   Texture texture = read_all(*input, file, element);
-  if (!is_float)
+  if (srgb && !is_float)
     for (float& v : texture.rgb) v = srgb_to_linear(std::clamp(v, 0.0f, 1.0f));
   return texture;
+}
+
+}  // namespace
+
+Texture decode_srgb_image(const std::vector<unsigned char>& bytes, const std::string& name_hint,
+                          const std::string& file, const std::string& element) {
+  return decode_image(bytes, name_hint, file, element, true);
+}
+
+Texture decode_data_image(const std::vector<unsigned char>& bytes, const std::string& name_hint,
+                          const std::string& file, const std::string& element) {
+  return decode_image(bytes, name_hint, file, element, false);
 }
 
 Texture read_linear_image_file(const std::string& path, const std::string& element) {

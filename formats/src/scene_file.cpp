@@ -24,6 +24,9 @@ constexpr uint64_t kMinMaterialBytes = 4 + 12 + 4 + 12 + 4 + 4 + 4;
 constexpr uint64_t kMaterialVersion2Bytes = 2 * (4 + 8 + 4 + 8) + 4 + 4 + 4;
 constexpr uint64_t kTextureHeaderBytes = 5 * 4;   // width, height, wrap_s, wrap_t, has_alpha
 constexpr uint64_t kVertexColorBytes = 4 * 4;     // per corner: f32[3] colour, f32 alpha
+// Version 3 appends to each material: the normal texture's index and binding, and its scale.
+constexpr uint64_t kMaterialVersion3Bytes = 4 + (4 + 8 + 4 + 8) + 4;
+constexpr uint64_t kTangentBytes = 4 * 4;  // per corner: f32[3] tangent, f32 sign
 constexpr uint64_t kMinInstanceBytes = 4 + 4 + 4 + 4 + 4 + 128 + 4 + 16 + 16;
 constexpr uint64_t kMinNodeBytes = 4 + 4 * 5 + 24 + 32 + 24 + 128;
 constexpr uint64_t kMinCameraBytes = 4 + 4 + 4 + 6 * 4;
@@ -116,6 +119,8 @@ void validate_materials(const SceneFile& s, const std::string& name) {
       throw FormatError(at(name, "material", i) + "emission must be finite and >= 0");
     validate_binding(m.base_color_texture, s.textures.size(), at(name, "material", i) + "base colour texture: ");
     validate_binding(m.emissive_texture, s.textures.size(), at(name, "material", i) + "emissive texture: ");
+    validate_binding(m.normal_texture, s.textures.size(), at(name, "material", i) + "normal texture: ");
+    if (!finite(m.normal_scale)) throw FormatError(at(name, "material", i) + "normal scale is not finite");
     if (uint32_t(m.alpha_mode) > uint32_t(AlphaMode::Blend))
       throw FormatError(at(name, "material", i) + "alpha mode " + std::to_string(uint32_t(m.alpha_mode)) +
                         " is not OPAQUE (0), MASK (1) or BLEND (2)");
@@ -160,6 +165,29 @@ void validate_vertex_colors(const SceneFile& s, const std::string& name) {
   for (size_t c = 0; c < corners; ++c)
     if (!finite(s.vertex_color[c]) || !finite(s.vertex_alpha[c]))
       throw FormatError(at(name, "triangle", c / 3) + "vertex colour is not finite");
+}
+
+void validate_tangents(const SceneFile& s, const std::string& name) {
+  if (s.tangents.empty() && s.tangent_signs.empty()) return;
+  const size_t corners = 3 * s.triangles.count();
+  if (s.tangents.size() != corners || s.tangent_signs.size() != corners)
+    throw FormatError(name + ": tangents: " + std::to_string(s.tangents.size()) + " tangents and " +
+                      std::to_string(s.tangent_signs.size()) + " signs for " + std::to_string(corners) + " corners");
+  for (size_t c = 0; c < corners; ++c) {
+    if (!finite(s.tangents[c])) throw FormatError(at(name, "triangle", c / 3) + "tangent is not finite");
+    if (s.tangent_signs[c] != 1.0f && s.tangent_signs[c] != -1.0f)
+      throw FormatError(at(name, "triangle", c / 3) + "tangent sign is not +1 or -1");
+  }
+}
+
+// What version 2 cannot hold, for encode_scene(scene, 2).
+void refuse_version3_content(const SceneFile& s, const std::string& name, uint32_t version) {
+  const std::string why = " is not stored by scene.bin version " + std::to_string(version);
+  if (!s.tangents.empty()) throw FormatError(name + ": tangents:" + why);
+  const MaterialRecord defaults;
+  for (size_t i = 0; i < s.materials.size(); ++i)
+    if (s.materials[i].normal_texture.texture != -1 || s.materials[i].normal_scale != defaults.normal_scale)
+      throw FormatError(at(name, "material", i) + "normal textures are" + why.substr(3));
 }
 
 // What version 1 cannot hold, for encode_scene(scene, 1).
@@ -625,6 +653,7 @@ void validate_scene_file(const SceneFile& s, const std::string& name) {
   validate_textures(s, name);
   validate_materials(s, name);
   validate_vertex_colors(s, name);
+  validate_tangents(s, name);
   validate_pages(s, name);
   validate_nodes(s, name);
   validate_triangles(s, name);
@@ -641,9 +670,11 @@ std::vector<uint8_t> encode_scene(const SceneFile& s, uint32_t version) {
   if (version < kOldestSceneFormatVersion || version > kSceneFormatVersion)
     throw FormatError(writing + ": format version " + std::to_string(version) + " is not one this writer writes");
   validate_scene_file(s, writing);
+  if (version <= 2) refuse_version3_content(s, writing, version);
   if (version == 1) refuse_version2_content(s, writing);
   const bool has_environment = s.sky_environment.width != 0;
   const bool has_vertex_colors = !s.vertex_color.empty();
+  const bool has_tangents = !s.tangents.empty();
   const SceneTriangles& t = s.triangles;
   std::vector<uint8_t> header;
   binary_io::LittleEndianWriter h(header);
@@ -670,7 +701,7 @@ std::vector<uint8_t> encode_scene(const SceneFile& s, uint32_t version) {
   for (uint32_t c : s.probes.counts) h.u32(c);
   h.u32(uint32_t(s.textures.size()));    // texture_count (version 2; reserved 0 in version 1)
   h.u32(has_vertex_colors ? 1 : 0);       // vertex_colors (version 2; reserved 0 in version 1)
-  h.u32(0);                               // reserved
+  h.u32(has_tangents ? 1 : 0);            // tangents (version 3; reserved 0 before)
 
   const uint64_t fixed = fixed_payload_bytes(
       t.count(), s.bvh.nodes.size(), s.bvh.leaf_triangles.size(), s.texels.pages.size(), s.texels.texels.size(),
@@ -728,6 +759,15 @@ std::vector<uint8_t> encode_scene(const SceneFile& s, uint32_t version) {
       p.f32(m.alpha_cutoff);
       p.f32(m.base_alpha);
     }
+    if (version >= 3) {
+      const TextureBindingRecord& b = m.normal_texture;
+      p.u32(uint32_t(b.texture));
+      p.u32(b.tex_coord);
+      put(p, b.offset);
+      p.f32(b.rotation);
+      put(p, b.scale);
+      p.f32(m.normal_scale);
+    }
   }
   for (const InstanceRecord& r : s.instances) {
     put_name(p, r.name);
@@ -773,6 +813,9 @@ std::vector<uint8_t> encode_scene(const SceneFile& s, uint32_t version) {
   for (float a : s.vertex_alpha) p.f32(a);
   for (const TextureRecord& texture : s.textures) put_texture(p, texture);
   if (has_environment) put_texture(p, s.sky_environment);
+  // Version 3's section after them.
+  for (const Float3& v : s.tangents) put(p, v);
+  for (float w : s.tangent_signs) p.f32(w);
   const framing::FileKind kind{kSceneMagic, version, kSceneHeaderSize, version};
   return framing::build_frame(kind, header, payload);
 }
@@ -800,9 +843,10 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
   for (uint32_t& c : s.probes.counts) c = h.u32();
   const uint32_t texture_count = h.u32(), vertex_colors = h.u32();
   const uint32_t version = frame.version;
-  // Version 1 reserves offsets 132..143; version 2 uses the first two of them.
-  const uint32_t reserved[3] = {texture_count, vertex_colors, h.u32()};
-  for (int k = version >= 2 ? 2 : 0; k < 3; ++k)
+  const uint32_t tangents = h.u32();
+  // Version 1 reserves offsets 132..143; version 2 uses the first two of them, version 3 all three.
+  const uint32_t reserved[3] = {texture_count, vertex_colors, tangents};
+  for (int k = version >= 3 ? 3 : version >= 2 ? 2 : 0; k < 3; ++k)
     if (reserved[k] != 0)
       throw FormatError(name + ": header: reserved field at offset " + std::to_string(132 + 4 * k) + " is " +
                         std::to_string(reserved[k]) + ", not 0");
@@ -817,6 +861,9 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
   // writes 0 there, so accepting 1 would read a file that does not re-encode to itself).
   if (vertex_colors == 1 && triangle_count == 0)
     throw FormatError(name + ": header: vertex_colors is 1 but the scene has no triangles");
+  if (tangents > 1) throw FormatError(name + ": header: tangents " + std::to_string(tangents) + " is not 0 or 1");
+  if (tangents == 1 && triangle_count == 0)
+    throw FormatError(name + ": header: tangents is 1 but the scene has no triangles");
   if (triangle_count > kMaxSceneTriangles)
     throw FormatError(name + ": header: " + std::to_string(triangle_count) + " triangles exceed the limit of " +
                       std::to_string(kMaxSceneTriangles));
@@ -831,9 +878,11 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
                       std::to_string(s.probes.counts[2]));
   const uint64_t fixed = fixed_payload_bytes(triangle_count, bvh_node_count, leaf_count, page_count, texel_count,
                                              partial_count, moved_count, probe_count);
-  const uint64_t material_bytes = kMinMaterialBytes + (version >= 2 ? kMaterialVersion2Bytes : 0);
+  const uint64_t material_bytes =
+      kMinMaterialBytes + (version >= 2 ? kMaterialVersion2Bytes : 0) + (version >= 3 ? kMaterialVersion3Bytes : 0);
   const uint64_t version2_bytes = uint64_t(vertex_colors) * triangle_count * 3 * kVertexColorBytes +
-                                  (uint64_t(texture_count) + environment) * kTextureHeaderBytes;
+                                  (uint64_t(texture_count) + environment) * kTextureHeaderBytes +
+                                  uint64_t(tangents) * triangle_count * 3 * kTangentBytes;
   const uint64_t minimum = fixed + material_count * material_bytes + instance_count * kMinInstanceBytes +
                            node_count * kMinNodeBytes + camera_count * kMinCameraBytes + light_count * kMinLightBytes +
                            version2_bytes;
@@ -914,6 +963,15 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
       m.alpha_mode = AlphaMode(p.u32());
       m.alpha_cutoff = p.f32();
       m.base_alpha = p.f32();
+      if (version >= 3) {
+        TextureBindingRecord& b = m.normal_texture;
+        b.texture = int32_t(p.u32());
+        b.tex_coord = p.u32();
+        get(p, b.offset);
+        b.rotation = p.f32();
+        get(p, b.scale);
+        m.normal_scale = p.f32();
+      }
     } else if (m.base_color_texture.texture != -1 || m.emissive_texture.texture != -1) {
       throw FormatError(where + "texture indices must be -1 in version 1 (textures are not stored by version 1)");
     }
@@ -980,6 +1038,12 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
   s.textures.reserve(texture_count);  // bounded by the payload size check above
   for (uint32_t i = 0; i < texture_count; ++i) s.textures.push_back(get_texture(p, at(name, "texture", i)));
   if (environment) s.sky_environment = get_texture(p, name + ": sky environment: ");
+  if (tangents) {  // bounded by the payload size check above
+    s.tangents.resize(size_t(triangle_count) * 3);
+    s.tangent_signs.resize(size_t(triangle_count) * 3);
+    for (Float3& v : s.tangents) get(p, v);
+    for (float& w : s.tangent_signs) w = p.f32();
+  }
   if (p.remaining() != 0)
     throw FormatError(name + ": payload: " + std::to_string(p.remaining()) + " bytes after the last " +
                       (version >= 2 ? "section" : "light"));

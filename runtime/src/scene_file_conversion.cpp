@@ -99,6 +99,11 @@ formats::SceneFile make_scene_file(const Scene& scene, const TexelGBuffer& gbuff
   file.vertex_color.reserve(scene.vertex_color.size());
   for (const Vec3& c : scene.vertex_color) file.vertex_color.push_back(to_record(c));
   file.vertex_alpha = scene.vertex_alpha;
+  if (scene.tangents.size() != scene.tangent_signs.size() || (!scene.tangents.empty() && scene.tangents.size() != corners))
+    throw FormatError("scene.bin (writing): tangents and their signs do not hold one entry per corner");
+  file.tangents.reserve(scene.tangents.size());
+  for (const Vec3& v : scene.tangents) file.tangents.push_back(to_record(v));
+  file.tangent_signs = scene.tangent_signs;
   for (size_t i = 0; i < scene.textures.size(); ++i)
     file.textures.push_back(to_record(scene.textures[i], "texture " + std::to_string(i)));
   for (const Material& m : scene.materials) {
@@ -113,6 +118,8 @@ formats::SceneFile make_scene_file(const Scene& scene, const TexelGBuffer& gbuff
     r.alpha_mode = formats::AlphaMode(uint32_t(m.alpha_mode));
     r.alpha_cutoff = m.alpha_cutoff;
     r.base_alpha = m.base_alpha;
+    r.normal_texture = to_record(m.normal_texture);
+    r.normal_scale = m.normal_scale;
     file.materials.push_back(std::move(r));
   }
 
@@ -232,12 +239,17 @@ PersistedScene restore_scene(const formats::SceneFile& file) {
     m.alpha_mode = Material::AlphaMode(uint32_t(r.alpha_mode));
     m.alpha_cutoff = r.alpha_cutoff;
     m.base_alpha = r.base_alpha;
+    m.normal_texture = from_record(r.normal_texture);
+    m.normal_scale = r.normal_scale;
     scene.materials.push_back(std::move(m));
   }
   for (const formats::TextureRecord& r : file.textures) scene.textures.push_back(from_record(r));
   scene.vertex_color.reserve(file.vertex_color.size());
   for (const formats::Float3& c : file.vertex_color) scene.vertex_color.push_back(from_record(c));
   scene.vertex_alpha = file.vertex_alpha;
+  scene.tangents.reserve(file.tangents.size());
+  for (const formats::Float3& v : file.tangents) scene.tangents.push_back(from_record(v));
+  scene.tangent_signs = file.tangent_signs;
   out.atlas.texel_density = file.texel_density;
   for (const formats::TexelPageRecord& p : file.texels.pages)
     out.atlas.page_sizes.emplace_back(int(p.width), int(p.height));

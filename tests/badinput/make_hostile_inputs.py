@@ -177,6 +177,17 @@ def png(width, height, rgb=(200, 200, 200), idat=None):
             + chunk(b"IDAT", data) + chunk(b"IEND", b""))
 
 
+def with_normal_map(s, index=0, tangents=None, tangent_type="VEC4"):
+    """normalTexture (a flat 1x1 PNG read through TEXCOORD_1); with `tangents`, a TANGENT attribute of
+    those rows (FLOAT, `tangent_type`)."""
+    s.j["images"] = [{"uri": "data:image/png;base64," + base64.b64encode(png(1, 1, (128, 128, 255))).decode()}]
+    s.j["textures"] = [{"source": 0}]
+    s.j["materials"][0]["normalTexture"] = {"index": index, "texCoord": 1}
+    if tangents is not None:
+        s.j["meshes"][0]["primitives"][0]["attributes"]["TANGENT"] = s.accessor(tangents, FLOAT, tangent_type, ARRAY_BUFFER)
+    return s
+
+
 def with_texture(s, image):
     s.j["images"] = [image]
     s.j["textures"] = [{"source": 0}]
@@ -249,6 +260,10 @@ def build():
     gltf_case("valid_texture.gltf", with_texture(cube(), {
         "uri": "data:image/png;base64," + base64.b64encode(png(4, 4)).decode()}), 0, "-",
         note="base colour texture read through TEXCOORD_1")
+    gltf_case("valid_normal_map.gltf", with_normal_map(cube()), 0, "-",
+              note="normalTexture without TANGENT: tangents generated from TEXCOORD_1")
+    gltf_case("valid_normal_map_tangents.gltf", with_normal_map(cube(), tangents=[(1.0, 0.0, 0.0, 1.0)] * 24), 0, "-",
+              note="normalTexture with a TANGENT attribute")
 
     s = cube()
     p0 = cube_geometry()[0][0]
@@ -476,6 +491,14 @@ def build():
     # --- materials, textures, images ----------------------------------------------------
     gltf_case("texture_index_oob.gltf", mutate(lambda j: j["materials"][0]["pbrMetallicRoughness"].update(
         baseColorTexture={"index": 9, "texCoord": 1})), 2, "material 0|texture 9")
+    gltf_case("normal_texture_index_oob.gltf", with_normal_map(cube(), index=3), 2, "material 0",
+              note="normalTexture points at a texture that does not exist")
+    gltf_case("tangent_vec3.gltf", with_normal_map(cube(), tangents=[(1.0, 0.0, 0.0)] * 24, tangent_type="VEC3"), 2,
+              "mesh 0 primitive 0|accessor 5", note="TANGENT must be VEC4 FLOAT")
+    gltf_case("tangent_short_count.gltf", with_normal_map(cube(), tangents=[(1.0, 0.0, 0.0, 1.0)] * 23), 2,
+              "mesh 0 primitive 0|accessor 5", note="23 tangents for 24 vertices")
+    gltf_case("tangent_nan.gltf", with_normal_map(cube(), tangents=[(float("nan"), 0.0, 0.0, 1.0)] + [(1.0, 0.0, 0.0, 1.0)] * 23),
+              2, "accessor 5", note="a NaN tangent")
     s = with_texture(cube(), {"uri": "data:image/png;base64," + base64.b64encode(png(4, 4)).decode()})
     s.j["textures"][0]["source"] = 4
     gltf_case("image_index_oob.gltf", s, 2, "texture 0|image 4")

@@ -190,4 +190,18 @@ inline formats::SceneFile make_textured_sample_scene_file() {
   return s;
 }
 
+// The textured sample plus what only format version 3 stores: a normal texture binding (with a
+// transform and scale) and per-corner tangent frames (both handedness signs, a zero tangent).
+inline formats::SceneFile make_normal_mapped_sample_scene_file() {
+  formats::SceneFile s = make_textured_sample_scene_file();
+  s.materials[0].normal_texture = {0, 1, {0.5f, -0.25f}, 0.375f, {1.0f, 2.0f}};
+  s.materials[0].normal_scale = 0.625f;
+  s.materials[2].normal_texture = {1, 0, {0, 0}, 0, {1, 1}};
+  for (size_t c = 0; c < s.triangles.positions.size(); ++c) {
+    s.tangents.push_back(c == 5 ? formats::Float3{0, 0, 0} : formats::Float3{c % 2 ? 1.0f : 0.0f, c % 2 ? 0.0f : 0.6f, c % 2 ? 0.0f : 0.8f});
+    s.tangent_signs.push_back(c % 3 == 1 ? -1.0f : 1.0f);
+  }
+  return s;
+}
+
 }  // namespace exitance::test

@@ -123,12 +123,18 @@ void expect_bitwise_equal(const SceneFile& a, const SceneFile& b) {
       EXPECT_EQ(std::bit_cast<uint32_t>(u->rotation), std::bit_cast<uint32_t>(v->rotation));
     }
     EXPECT_EQ(std::tie(x.alpha_mode, x.alpha_cutoff, x.base_alpha), std::tie(y.alpha_mode, y.alpha_cutoff, y.base_alpha));
+    const TextureBindingRecord &u = x.normal_texture, &v = y.normal_texture;
+    EXPECT_EQ(std::tie(u.texture, u.tex_coord, u.offset, u.scale), std::tie(v.texture, v.tex_coord, v.offset, v.scale));
+    EXPECT_EQ(std::bit_cast<uint32_t>(u.rotation), std::bit_cast<uint32_t>(v.rotation));
+    EXPECT_EQ(std::bit_cast<uint32_t>(x.normal_scale), std::bit_cast<uint32_t>(y.normal_scale));
   }
   ASSERT_EQ(a.textures.size(), b.textures.size());
   for (size_t i = 0; i < a.textures.size(); ++i) expect_same_texture(a.textures[i], b.textures[i], "texture");
   expect_same_texture(a.sky_environment, b.sky_environment, "sky environment");
   expect_same_bytes(a.vertex_color, b.vertex_color, "vertex colours");
   expect_same_bytes(a.vertex_alpha, b.vertex_alpha, "vertex alphas");
+  expect_same_bytes(a.tangents, b.tangents, "tangents");
+  expect_same_bytes(a.tangent_signs, b.tangent_signs, "tangent signs");
   ASSERT_EQ(a.instances.size(), b.instances.size());
   for (size_t i = 0; i < a.instances.size(); ++i) {
     const InstanceRecord &x = a.instances[i], &y = b.instances[i];
@@ -241,7 +247,7 @@ TEST(SceneFile, TexturedSceneRoundTripsBitwiseExact) {
   // The documented layout of what version 2 adds.
   auto u32 = [&](size_t offset) { return test::get_u32(bytes, offset); };
   auto f32 = [&](size_t offset) { return std::bit_cast<float>(u32(offset)); };
-  EXPECT_EQ(u32(8), 2u);
+  EXPECT_EQ(u32(8), 3u);
   EXPECT_EQ(u32(88), 1u);   // environment stored
   EXPECT_EQ(u32(132), 2u);  // texture count
   EXPECT_EQ(u32(136), 1u);  // vertex colours
@@ -281,13 +287,95 @@ TEST(SceneFile, EveryTruncationAndByteCorruptionOfTheVersion2SectionsIsRefused) 
   }
 }
 
+// Version 3: the normal texture binding and scale after each material's version 2 fields, the
+// tangent frames after the environment, flagged at header offset 140; bit for bit both ways.
+TEST(SceneFile, NormalMappedSceneRoundTripsBitwiseExact) {
+  const SceneFile mapped = test::make_normal_mapped_sample_scene_file();
+  const std::vector<uint8_t> bytes = encode_scene(mapped);
+  const SceneFile back = read(bytes);
+  expect_bitwise_equal(mapped, back);
+  EXPECT_EQ(encode_scene(back), bytes);
+  auto u32 = [&](size_t offset) { return test::get_u32(bytes, offset); };
+  auto f32 = [&](size_t offset) { return std::bit_cast<float>(u32(offset)); };
+  EXPECT_EQ(u32(8), 3u);
+  EXPECT_EQ(u32(140), 1u);  // tangents stored
+  const size_t m = sample_offsets().materials + 9;  // material 0 after its name "White"
+  EXPECT_EQ(u32(m + 100), 0u);      // normal texture 0
+  EXPECT_EQ(u32(m + 104), 1u);      // TEXCOORD_1
+  EXPECT_EQ(f32(m + 108), 0.5f);    // offset[0]
+  EXPECT_EQ(f32(m + 116), 0.375f);  // rotation
+  EXPECT_EQ(f32(m + 124), 2.0f);    // scale[1]
+  EXPECT_EQ(f32(m + 128), 0.625f);  // normal scale
+  // The last section: 12 tangents (f32[3]) then their 12 signs.
+  const size_t corners = 3 * mapped.triangles.count(), tangents = bytes.size() - 16 * corners;
+  EXPECT_EQ(f32(tangents + 12 * 1), 1.0f);         // corner 1: (1, 0, 0)
+  EXPECT_EQ(f32(tangents + 12 * 2 + 8), 0.8f);     // corner 2: (0, 0.6, 0.8)
+  EXPECT_EQ(f32(tangents + 12 * corners + 4), -1.0f);  // corner 1's sign
+  // The textured sample has no normal map: version 3 without the tangent section.
+  EXPECT_EQ(test::get_u32(textured_bytes(), 140), 0u);
+  // Every truncation and every byte corruption of the tangent section is refused.
+  for (size_t length = tangents; length < bytes.size(); ++length)
+    EXPECT_THROW(read_scene(bytes.data(), length, "scene.bin"), FormatError) << "length " << length;
+  for (size_t position = tangents; position < bytes.size(); ++position) {
+    std::vector<uint8_t> corrupt = bytes;
+    corrupt[position] ^= 0x10;
+    EXPECT_THROW(read(corrupt), FormatError) << "byte " << position;
+  }
+  // Field checks, through the reader (checksums refreshed) and the writer alike.
+  struct Case {
+    void (*edit)(SceneFile&);
+    const char* expected;
+  };
+  const Case cases[] = {
+      {[](SceneFile& s) { s.tangents[4][1] = NAN; }, "triangle 1: tangent is not finite"},
+      {[](SceneFile& s) { s.tangent_signs[7] = 0.5f; }, "triangle 2: tangent sign is not +1 or -1"},
+      {[](SceneFile& s) { s.tangent_signs.pop_back(); }, "tangents: 12 tangents and 11 signs for 12 corners"},
+      {[](SceneFile& s) { s.materials[1].normal_texture.texture = 2; },
+       "material 1: normal texture: texture 2 does not exist (2 textures)"},
+      {[](SceneFile& s) { s.materials[1].normal_texture.tex_coord = 2; }, "material 1: normal texture: tex_coord 2"},
+      {[](SceneFile& s) { s.materials[1].normal_scale = INFINITY; }, "material 1: normal scale is not finite"},
+  };
+  for (const Case& c : cases) {
+    SceneFile bad = mapped;
+    c.edit(bad);
+    expect_format_error([&] { encode_scene(bad); }, c.expected);
+  }
+  std::vector<uint8_t> bad_sign = bytes;
+  put_f32(bad_sign, tangents + 12 * corners + 8, 2.0f);
+  refresh_checksums(bad_sign, kHeader);
+  expect_format_error([&] { read(bad_sign); }, "scene.bin: triangle 0: tangent sign is not +1 or -1");
+}
+
+// Version 2 files (no normal textures, no tangents) are still read, and the version 2 writer
+// refuses what only version 3 holds.
+TEST(SceneFile, Version2FilesAreStillRead) {
+  const std::vector<uint8_t> bytes = encode_scene(textured(), 2);
+  EXPECT_EQ(test::get_u32(bytes, 8), 2u);
+  EXPECT_EQ(textured_bytes().size() - bytes.size(), 32 * textured().materials.size());
+  const SceneFile back = read(bytes);
+  expect_bitwise_equal(textured(), back);
+  EXPECT_EQ(encode_scene(back, 2), bytes);
+  EXPECT_EQ(encode_scene(back), textured_bytes());  // upgraded on rewrite
+  std::vector<uint8_t> tangents_v2 = bytes;
+  put_u32(tangents_v2, 140, 1);
+  refresh_checksums(tangents_v2, kHeader);
+  expect_format_error([&] { read(tangents_v2); }, "header: reserved field at offset 140 is 1, not 0");
+  const SceneFile mapped = test::make_normal_mapped_sample_scene_file();
+  expect_format_error([&] { encode_scene(mapped, 2); }, "tangents: is not stored by scene.bin version 2");
+  SceneFile normal_only = textured();
+  normal_only.materials[1].normal_texture.texture = 0;
+  expect_format_error([&] { encode_scene(normal_only, 2); },
+                      "material 1: normal textures are not stored by scene.bin version 2");
+}
+
 // Version 1 files (no textures, bindings, alpha modes, vertex colours or environment) are still
 // read; the version 1 writer refuses what only version 2 holds.
 TEST(SceneFile, Version1FilesAreStillRead) {
   const std::vector<uint8_t> bytes = encode_scene(sample(), 1);
   EXPECT_EQ(test::get_u32(bytes, 8), 1u);
-  // Version 1's material record ends after the two texture indices: 60 bytes less per material.
-  EXPECT_EQ(sample_bytes().size() - bytes.size(), 60 * sample().materials.size());
+  // Version 1's material record ends after the two texture indices: 92 bytes less per material
+  // (60 of version 2's bindings and alpha fields, 32 of version 3's normal texture).
+  EXPECT_EQ(sample_bytes().size() - bytes.size(), 92 * sample().materials.size());
   const SceneFile back = read(bytes);
   expect_bitwise_equal(sample(), back);
   EXPECT_EQ(encode_scene(back, 1), bytes);
@@ -311,7 +399,7 @@ TEST(SceneFile, Version1FilesAreStillRead) {
   masked.materials[2].alpha_mode = AlphaMode::Mask;
   expect_format_error([&] { encode_scene(masked, 1); },
                       "material 2: textures and alpha modes are not stored by scene.bin version 1");
-  expect_format_error([&] { encode_scene(sample(), 3); }, "format version 3 is not one this writer writes");
+  expect_format_error([&] { encode_scene(sample(), 4); }, "format version 4 is not one this writer writes");
 }
 
 TEST(SceneFile, SceneWithoutProbesOrTrianglesRoundTrips) {
@@ -332,7 +420,7 @@ TEST(SceneFile, HeaderAndPayloadHaveTheDocumentedLayout) {
   auto f32 = [&](size_t offset) { return std::bit_cast<float>(test::get_u32(b, offset)); };
   auto u32 = [&](size_t offset) { return test::get_u32(b, offset); };
   EXPECT_EQ(std::memcmp(b.data(), "EXSCENE\0", 8), 0);
-  EXPECT_EQ(u32(8), 2u);
+  EXPECT_EQ(u32(8), 3u);
   EXPECT_EQ(u32(12), 160u);
   const uint32_t counts[15] = {4, 3, 2, 5, 2, 3, 2, 5, 3, 1, 4, 2, 4, 4, 2};
   for (int i = 0; i < 15; ++i) EXPECT_EQ(u32(16 + 4 * size_t(i)), counts[i]) << "header field at " << 16 + 4 * i;
@@ -345,7 +433,7 @@ TEST(SceneFile, HeaderAndPayloadHaveTheDocumentedLayout) {
   EXPECT_EQ(u32(120), 2u);    // probe counts
   EXPECT_EQ(u32(124), 1u);
   EXPECT_EQ(u32(128), 2u);
-  EXPECT_EQ(u32(132) | u32(136) | u32(140), 0u);  // no textures, no vertex colours, reserved
+  EXPECT_EQ(u32(132) | u32(136) | u32(140), 0u);  // no textures, no vertex colours, no tangents
   EXPECT_EQ(test::get_u64(b, 144), b.size() - kHeader);
   EXPECT_EQ(u32(152), crc32(b.data() + kHeader, b.size() - kHeader));
   EXPECT_EQ(u32(156), crc32(b.data(), 156));
@@ -406,13 +494,13 @@ TEST(SceneFile, EverySingleByteCorruptionIsRefused) {
 
 TEST(SceneFile, OtherVersionsAreRefusedByName) {
   std::vector<uint8_t> bytes = sample_bytes();
-  put_u32(bytes, 8, 3);
+  put_u32(bytes, 8, 4);
   refresh_checksums(bytes, kHeader);
   try {
     read(bytes);
-    FAIL() << "version 3 accepted";
+    FAIL() << "version 4 accepted";
   } catch (const FormatError& e) {
-    EXPECT_STREQ(e.what(), "scene.bin: format version 3 is newer than this loader (2)");
+    EXPECT_STREQ(e.what(), "scene.bin: format version 4 is newer than this loader (3)");
   }
   put_u32(bytes, 8, 0);
   refresh_checksums(bytes, kHeader);
@@ -511,7 +599,8 @@ const StructuralCase kStructuralCases[] = {
     {"huge texture count", [](auto& b, auto&) { put_u32(b, 132, 0xFFFFFFFFu); }, "the header's counts need at least"},
     {"negative sky", [](auto& b, auto&) { put_f32(b, 80, -0.5f); }, "sky radiance must be finite and >= 0"},
     {"texel density", [](auto& b, auto&) { put_f32(b, 92, std::nanf("")); }, "texel density nan"},
-    {"reserved", [](auto& b, auto&) { put_u32(b, 140, 1); }, "header: reserved field at offset 140 is 1, not 0"},
+    {"tangents flag", [](auto& b, auto&) { put_u32(b, 140, 2); }, "header: tangents 2 is not 0 or 1"},
+    {"tangents missing", [](auto& b, auto&) { put_u32(b, 140, 1); }, "the header's counts need at least"},
     {"too many triangles", [](auto& b, auto&) { put_u32(b, 16, 1u << 29); }, "triangles exceed the limit"},
     {"counts beyond the payload", [](auto& b, auto&) { put_u32(b, 44, 0x40000000u); },
      "the header's counts need at least"},

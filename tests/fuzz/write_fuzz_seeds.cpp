@@ -104,6 +104,11 @@ int main(int argc, char** argv) {
   // Version 2's sections (textures, bindings, alpha modes, vertex colours, environment sky), and the
   // same sample in the version 1 layout.
   write_scene_file((dir / "scene" / "textured.bin").string(), exitance::test::make_textured_sample_scene_file());
+  // Version 3's normal texture bindings and tangent frames.
+  write_scene_file((dir / "scene" / "normal-mapped.bin").string(), exitance::test::make_normal_mapped_sample_scene_file());
+  const std::vector<uint8_t> version2 = encode_scene(exitance::test::make_textured_sample_scene_file(), 2);
+  std::ofstream((dir / "scene" / "version2.bin").string(), std::ios::binary)
+      .write(reinterpret_cast<const char*>(version2.data()), std::streamsize(version2.size()));
   const std::vector<uint8_t> version1 = encode_scene(exitance::test::make_sample_scene_file(), 1);
   std::ofstream((dir / "scene" / "version1.bin").string(), std::ios::binary)
       .write(reinterpret_cast<const char*>(version1.data()), std::streamsize(version1.size()));

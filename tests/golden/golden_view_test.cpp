@@ -199,5 +199,74 @@ TEST_F(GoldenCourtyard, AMirroredScaleOffsetFails) {
   EXPECT_GT(g.rel_mse, kBrokenMargin * g.tolerance);
 }
 
+// A 4 m room lit only by punctual lights (KHR_lights_punctual): a warm point light low in the back
+// right corner, whose light the box shadows on the floor and the left wall, and a spot light (cone
+// 0.15 to 0.3 rad) tilted onto the floor left of the box, a soft-edged pool; white walls but a red
+// left one.
+void build_lamp_room(samples::SceneBuilder& scene) {
+  const samples::MaterialId white = scene.addMaterial({.name = "White", .baseColor = {0.73f, 0.73f, 0.73f}});
+  const samples::MaterialId red = scene.addMaterial({.name = "Red", .baseColor = {0.63f, 0.065f, 0.05f}});
+  const float r = 2.0f, top = 4.0f;
+  auto wall = [&](const char* name, samples::Quad quad, samples::MaterialId material) {
+    samples::MeshBuilder mesh;
+    mesh.addQuad(quad, material);
+    scene.addMeshNode(name, mesh);
+  };
+  wall("Floor", samples::Quad::axisAligned({-r, 0, -r}, {r, 0, r}, {0, 1, 0}), white);
+  wall("Ceiling", samples::Quad::axisAligned({-r, top, -r}, {r, top, r}, {0, -1, 0}), white);
+  wall("BackWall", samples::Quad::axisAligned({-r, 0, -r}, {r, top, -r}, {0, 0, 1}), white);
+  wall("FrontWall", samples::Quad::axisAligned({-r, 0, r}, {r, top, r}, {0, 0, -1}), white);
+  wall("LeftWall", samples::Quad::axisAligned({-r, 0, -r}, {-r, top, r}, {1, 0, 0}), red);
+  wall("RightWall", samples::Quad::axisAligned({r, 0, -r}, {r, top, r}, {-1, 0, 0}), white);
+  samples::MeshBuilder box;
+  box.addBox({.center = {0, 0.5f, 0}, .size = {1.0f, 1.0f, 1.0f}, .yawRadians = 0.4f}, white,
+             samples::FaceDirection::Outward, samples::BoxFace::AllButBottom);
+  scene.addMeshNode("Box", box, {0.2f, 0.0f, -0.6f});
+  scene.addPointLight({.name = "Bulb", .position = {1.3f, 2.2f, -1.0f}, .color = {1.0f, 0.9f, 0.8f}, .intensity = 2.0f});
+  scene.addSpotLight({.name = "Spot",
+                      .position = {-0.2f, 3.8f, 0.8f},
+                      .direction = {-1.0f, -3.8f, -2.3f},
+                      .color = {0.8f, 0.9f, 1.0f},
+                      .intensity = 40.0f,
+                      .innerConeAngle = 0.15f,
+                      .outerConeAngle = 0.3f});
+}
+
+// The lamp room at 8 texels per metre and 128 samples per texel, seen from inside the front wall.
+class GoldenLampRoom : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    scene_ = new GoldenScene(bake_and_trace("lamp_room", build_lamp_room, 8, 128, "",
+                                            view::look_at_camera({0, 2, 1.9f}, {0, 1.0f, -2}, {0, 1, 0}, 1.1)));
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(scene_->dir);
+    delete scene_;
+  }
+  static GoldenScene* scene_;
+};
+GoldenScene* GoldenLampRoom::scene_ = nullptr;
+
+TEST_F(GoldenLampRoom, BakedViewMatchesThePathTracedReference) {
+  EXPECT_EQ(scene_->traced.estimate.nonfinite_samples, 0u);
+  const GoldenComparison g = golden(*scene_, scene_->bundle);
+  testing::print_golden("lamp_room", g);
+  EXPECT_GT(g.pixels, size_t(kImageSide * kImageSide * 9 / 10));
+  EXPECT_LT(g.rel_mse, g.tolerance);
+}
+
+// The back wall drawn with its lightmap mirrored in u (along x): the bulb's bright patch moves across.
+TEST_F(GoldenLampRoom, AMirroredScaleOffsetFails) {
+  const fs::path broken = broken_copy(*scene_, "mirrored.bake", [](nlohmann::json& manifest) {
+    nlohmann::json& so = instance_named(manifest, "BackWall")["scale_offset"];
+    const double sx = so[0].get<double>(), ox = so[2].get<double>();
+    so[0] = -sx;
+    so[2] = ox + sx;
+  });
+  const GoldenComparison g = golden(*scene_, broken);
+  testing::print_golden("lamp_room, BackWall mirrored in u", g);
+  EXPECT_GT(g.rel_mse, kBrokenMargin * g.tolerance);
+}
+
 }  // namespace
 }  // namespace exitance

@@ -115,7 +115,7 @@ TEST(TexturedSceneBin, CpuRelightFromSceneBinReproducesTheBake) {
   const fs::path bundle = dir / "textured.bake";
   ASSERT_TRUE(fs::exists(bundle / "scene.bin"));
   const nlohmann::json manifest = nlohmann::json::parse(read_text(bundle / "manifest.json"));
-  EXPECT_EQ(manifest["scene"]["format_version"], 2);
+  EXPECT_EQ(manifest["scene"]["format_version"], formats::kSceneFormatVersion);
   const formats::SceneFile file = formats::read_scene_file((bundle / "scene.bin").string());
   EXPECT_EQ(file.textures.size(), 1u);
   EXPECT_FALSE(file.vertex_color.empty());

@@ -439,6 +439,43 @@ TEST(SceneEditsApply, ScaleKeepsTexelsAndMirrorsLikeTheImporter) {
   }
 }
 
+// With a normal map on Box's material (tangents generated from TEXCOORD_1), moving Box turns its
+// tangent frames as importing the moved node does: a rotation turns the tangents, a mirroring scale
+// also flips their handedness (tangent_frames.h). Tangents are unit vectors from the same kind of
+// float products as the normals: the normals' tolerance, times the condition number of the edit's
+// linear part (4 for the scale 1, 2, 0.5), which amplifies the stored tangents' rounding.
+TEST(SceneEditsApply, MovedNormalMapFramesEqualImportingTheMovedNode) {
+  json d = scene_document();
+  d["images"] = json::array({{{"uri", "data:image/png;base64,"
+                                      "iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAIAAACQd1PeAAAADElEQVR42mNoaPgPAAODAgA+WCglAAAAAElFTkSuQmCC"}}});
+  d["textures"] = json::array({{{"source", 0}}});
+  d["materials"][0]["normalTexture"] = {{"index", 0}, {"texCoord", 1}};
+  const PersistedScene mapped = persisted_from(d);
+  ASSERT_EQ(mapped.scene.tangents.size(), mapped.scene.positions.size());
+  const std::array<double, 4> turn{0.3, -0.4, 0.2, std::sqrt(1 - 0.09 - 0.16 - 0.04)};
+  for (const auto& [scale, rotation] : {std::pair{std::array<double, 3>{-1, 1, 1}, std::array<double, 4>{0, 0, 0, 1}},
+                                        std::pair{std::array<double, 3>{1, 2, 0.5}, turn}}) {
+    SCOPED_TRACE("scale x " + std::to_string(scale[0]));
+    PersistedScene p = mapped;
+    apply_scene_edits(p, {node_edit("Box", std::nullopt, rotation, scale)});
+    json moved = d;
+    moved["nodes"][1]["scale"] = scale;
+    moved["nodes"][1]["rotation"] = rotation;
+    const Scene r = import_document(moved);
+    ASSERT_EQ(p.scene.tangents.size(), r.tangents.size());
+    const double tolerance = 16 * kHalfUlp * 4;
+    size_t flipped = 0;
+    for (size_t c = 0; c < r.tangents.size(); ++c) {
+      for (int k = 0; k < 3; ++k) ASSERT_NEAR(p.scene.tangents[c][k], r.tangents[c][k], tolerance) << "corner " << c;
+      ASSERT_EQ(p.scene.tangent_signs[c], r.tangent_signs[c]) << "corner " << c;
+      flipped += p.scene.tangent_signs[c] != mapped.scene.tangent_signs[c];
+    }
+    // Box's 6 corners flip with the mirror (Twin's, the same mesh, do not); none with the turn.
+    EXPECT_EQ(flipped, scale[0] < 0 ? 6u : 0u);
+    EXPECT_NO_THROW(bytes_of(p));
+  }
+}
+
 // A texel the unocclude step pushed off its surface point keeps the push, moved rigidly.
 TEST(SceneEditsApply, PushedTexelsMoveRigidly) {
   PersistedScene p = baked();

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 
 #include <OpenImageIO/imageio.h>
 #include <unistd.h>
@@ -418,6 +419,100 @@ TEST(GltfImport, VertexColoursMultiplyTheBaseColour) {
   EXPECT_EQ(albedo.z, 0.0f);
   const Vec3 red = diffuse_albedo(scene, 0, 0, 0);
   EXPECT_EQ(red.x, 0.5f);
+}
+
+// The triangle of triangle_document with a one-texel PNG of (128, 64, 255) as `normalTexture`
+// (and as base colour texture), and optionally a TANGENT attribute (1, 0, 0, w) at every vertex.
+json normal_mapped_document(const std::filesystem::path& dir, std::optional<float> tangent_w, const json& normal_texture) {
+  const std::string png = (dir / "normal.png").string();
+  const unsigned char pixel[3] = {128, 64, 255};
+  auto out = OIIO::ImageOutput::create(png);
+  EXPECT_TRUE(out && out->open(png, OIIO::ImageSpec(1, 1, 3, OIIO::TypeDesc::UINT8)));
+  EXPECT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixel));
+  out->close();
+  json d = triangle_document();
+  d["images"] = json::array({{{"uri", "normal.png"}}});
+  d["textures"] = json::array({{{"source", 0}}});
+  d["materials"] = json::array(
+      {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}, {"metallicFactor", 0}}}, {"normalTexture", normal_texture}}});
+  d["meshes"][0]["primitives"][0]["material"] = 0;
+  if (tangent_w) {
+    std::vector<unsigned char> data;
+    for (int v = 0; v < 3; ++v) append_floats(data, {1, 0, 0, *tangent_w});
+    d["buffers"].push_back({{"byteLength", 48}, {"uri", "data:application/octet-stream;base64," + base64(data)}});
+    d["bufferViews"].push_back({{"buffer", 1}, {"byteLength", 48}});
+    d["accessors"].push_back({{"bufferView", 2}, {"componentType", 5126}, {"count", 3}, {"type", "VEC4"}});
+    d["meshes"][0]["primitives"][0]["attributes"]["TANGENT"] = 3;
+  }
+  return d;
+}
+
+Scene import_document(const std::filesystem::path& dir, const json& d) {
+  const std::string path = (dir / "normal_mapped.gltf").string();
+  std::ofstream(path) << d.dump();
+  Diagnostics diagnostics;
+  return import_gltf(path, ImportOptions{}, diagnostics);
+}
+
+void expect_frames(const Scene& scene, Vec3 tangent, float sign) {
+  ASSERT_EQ(scene.tangents.size(), 3u);
+  ASSERT_EQ(scene.tangent_signs.size(), 3u);
+  for (size_t c = 0; c < 3; ++c) {
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(scene.tangents[c][k], tangent[k], 1e-6f) << "corner " << c << " component " << k;
+    EXPECT_EQ(scene.tangent_signs[c], sign) << "corner " << c;
+  }
+}
+
+// normalTexture reaches the material (texture, texCoord, scale, KHR_texture_transform), decoded as
+// data (no sRGB curve, unlike the same image as base colour); TANGENT turns with its node, and a
+// mirroring node flips its handedness (the bitangent w cross(n, t) must stay the mirrored one).
+TEST(GltfImport, NormalTextureAndTangentsReachTheScene) {
+  const auto dir = std::filesystem::temp_directory_path() / ("gltf_normal_map_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const json normal_texture = json::parse(
+      R"({"index": 0, "texCoord": 1, "scale": 0.5, "extensions": {"KHR_texture_transform": {"offset": [0.25, 0]}}})");
+  json d = normal_mapped_document(dir, 1.0f, normal_texture);
+  d["nodes"][0]["rotation"] = {0, 0, std::sqrt(0.5), std::sqrt(0.5)};  // 90 degrees about +Z
+  const Scene turned = import_document(dir, d);
+  ASSERT_EQ(turned.triangle_count(), 1u);
+  const Material& m = turned.materials[0];
+  ASSERT_GE(m.normal_texture.texture, 0);
+  EXPECT_EQ(m.normal_texture.transform.tex_coord, 1);
+  EXPECT_EQ(m.normal_texture.transform.offset.x, 0.25f);
+  EXPECT_EQ(m.normal_scale, 0.5f);
+  ASSERT_EQ(turned.textures.size(), 2u);  // the image as sRGB colour and as data
+  const Texture& normal_map = turned.textures[size_t(m.normal_texture.texture)];
+  EXPECT_NEAR(normal_map.rgb[0], 128.0f / 255.0f, 1e-6f);
+  EXPECT_NEAR(normal_map.rgb[1], 64.0f / 255.0f, 1e-6f);
+  EXPECT_NEAR(turned.textures[size_t(m.base_color_texture.texture)].rgb[0], 0.2158605f, 1e-5f);  // sRGB 128
+  expect_frames(turned, {0, 1, 0}, 1.0f);
+
+  d = normal_mapped_document(dir, 1.0f, normal_texture);
+  d["nodes"][0]["scale"] = {-1, 1, 1};
+  const Scene mirrored = import_document(dir, d);
+  for (const Vec3& n : mirrored.normals) EXPECT_EQ(n.z, 1.0f);
+  expect_frames(mirrored, {-1, 0, 0}, -1.0f);
+
+  // No normal map: no frames at all.
+  const Scene plain = import_document(dir, triangle_document());
+  EXPECT_TRUE(plain.tangents.empty());
+  EXPECT_TRUE(plain.tangent_signs.empty());
+  std::filesystem::remove_all(dir);
+}
+
+// Without TANGENT the frames follow the UVs the normal map reads, after its transform: on the
+// triangle (0,0,0), (1,0,0), (0,1,0) with TEXCOORD_1 (0,0), (1,0), (0,1), u runs along +x and v
+// along +y, so t = +x and the bitangent (towards decreasing v) is -y = -cross(n, t): w = -1. Rotated
+// by pi/2 (uv' = (v, -u)), u' runs along +y: t = +y, and w = -1 again.
+TEST(GltfImport, MissingTangentsAreGeneratedFromTheNormalMapUvs) {
+  const auto dir = std::filesystem::temp_directory_path() / ("gltf_generated_tangent_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  expect_frames(import_document(dir, normal_mapped_document(dir, std::nullopt, json::parse(R"({"index": 0, "texCoord": 1})"))),
+                {1, 0, 0}, -1.0f);
+  const json rotated = json::parse(
+      R"({"index": 0, "texCoord": 1, "extensions": {"KHR_texture_transform": {"rotation": 1.5707963267948966}}})");
+  expect_frames(import_document(dir, normal_mapped_document(dir, std::nullopt, rotated)), {0, 1, 0}, -1.0f);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include "edit_checks.h"
 #include "exitance/runtime/node_transform.h"
+#include "exitance/runtime/tangent_frames.h"
 #include "exitance/runtime/texel_surface.h"
 
 namespace exitance::refresh {
@@ -51,6 +52,10 @@ void move_triangles(Scene& next, const Instance& instance, const Matrix4d& delta
         std::swap(next.vertex_color[size_t(t) * 3 + 1], next.vertex_color[size_t(t) * 3 + 2]);
         std::swap(next.vertex_alpha[size_t(t) * 3 + 1], next.vertex_alpha[size_t(t) * 3 + 2]);
       }
+      if (next.tangents.size() == next.positions.size()) {
+        std::swap(next.tangents[size_t(t) * 3 + 1], next.tangents[size_t(t) * 3 + 2]);
+        std::swap(next.tangent_signs[size_t(t) * 3 + 1], next.tangent_signs[size_t(t) * 3 + 2]);
+      }
     }
     const Vec3 face = cross(p[1] - p[0], p[2] - p[0]);
     const float face_length = length(face);
@@ -61,7 +66,15 @@ void move_triangles(Scene& next, const Instance& instance, const Matrix4d& delta
       // Cofactor = det * inverse-transpose: its sign undone so the normal keeps its side.
       const Vec3 m = transform_normal(delta, n[k]) * (mirrors ? -1.0f : 1.0f);
       const float m_length = length(m);
-      n[k] = m_length > 0.0f && std::isfinite(m_length) ? m / m_length : face / face_length;
+      const Vec3 moved_normal = m_length > 0.0f && std::isfinite(m_length) ? m / m_length : face / face_length;
+      if (next.tangents.size() == next.positions.size()) {  // normal-map frames move with the surface
+        const size_t c = size_t(t) * 3 + size_t(k);
+        const TangentFrame frame =
+            transform_tangent_frame(delta, {next.tangents[c], next.tangent_signs[c]}, n[k], moved_normal);
+        next.tangents[c] = frame.tangent;
+        next.tangent_signs[c] = frame.sign;
+      }
+      n[k] = moved_normal;
     }
   }
 }

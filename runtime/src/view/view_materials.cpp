@@ -4,6 +4,7 @@
 #include "exitance/common/material.h"
 #include "exitance/common/surface_alpha.h"
 #include "exitance/common/texture_sampling.h"
+#include "exitance/runtime/tangent_frames.h"
 
 namespace exitance::view {
 namespace {
@@ -97,6 +98,17 @@ float surface_opacity(const formats::SceneFile& scene, uint32_t t, float b1, flo
     case formats::AlphaMode::Blend: return coverage(scene, t, b1, b2);
   }
   return 1.0f;
+}
+
+Vec3 surface_normal(const formats::SceneFile& scene, uint32_t t, float b1, float b2, Vec3 n) {
+  const formats::MaterialRecord& m = material_of(scene, t);
+  if (m.normal_texture.texture < 0 || scene.tangents.empty()) return n;
+  TangentFrame frame;
+  const size_t c = size_t(t) * 3;
+  frame.tangent = to_vec3(scene.tangents[c]) * (1.0f - b1 - b2) + to_vec3(scene.tangents[c + 1]) * b1 +
+                  to_vec3(scene.tangents[c + 2]) * b2;
+  frame.sign = corner_mix(scene.tangent_signs, t, b1, b2) < 0.0f ? -1.0f : 1.0f;
+  return perturbed_normal(n, frame, binding_rgb(scene, m.normal_texture, t, b1, b2), m.normal_scale);
 }
 
 Vec3 sky_radiance(const formats::SceneFile& scene, Vec3 direction) {

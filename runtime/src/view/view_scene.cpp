@@ -50,6 +50,8 @@ ViewScene open_view_scene(const std::string& bundle_directory) {
       throw ViewInputError(bundle_directory + ": instance " + std::to_string(i) + ": scene.bin places node " +
                            std::to_string(node) + ", manifest.json node " + std::to_string(manifest_instances[i].node));
   }
+  view.has_sh1_layers = true;
+  for (const char* channel : kSh1Channels) view.has_sh1_layers = view.has_sh1_layers && view.bundle.has_lightmap_channel(channel);
   // scene.bin's per-triangle texel size is 0 exactly for triangles without a live texel.
   view.instance_has_texels.assign(scene_instances.size(), 0);
   const auto& texel_size = view.scene.texels.triangle_texel_size;

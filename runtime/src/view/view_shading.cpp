@@ -29,7 +29,9 @@ SurfaceAtHit surface_at(const ViewScene& view, const Bvh4WalkHit& hit, Vec3 dire
   const formats::MaterialRecord& m = view.scene.materials[tris.material[t]];
   const bool front = dot(direction, s.geometric_normal) < 0;
   s.back_face_absorbs = !front && !m.double_sided;
-  s.shading_normal = front || !m.double_sided ? n : -n;
+  s.interpolated_normal = n;
+  s.mapped_normal = surface_normal(view.scene, uint32_t(t), b1, b2, n);
+  s.shading_normal = front || !m.double_sided ? s.mapped_normal : -s.mapped_normal;
   s.instance = tris.instance[t];
   s.triangle = uint32_t(t);
   s.albedo = surface_albedo(view.scene, s.triangle, b1, b2);
@@ -47,9 +49,19 @@ Vec3 probes_irradiance_over_pi(const ViewScene& view, const SurfaceAtHit& s) {
   return {e.irradiance_over_pi[0], e.irradiance_over_pi[1], e.irradiance_over_pi[2]};
 }
 
+// The lightmap's E/pi; with L1 SH layers, at the mapped normal n rather than the normal n0 the texels
+// were baked for (docs/bundle.md, "Directional layers"): E(n)/pi = RGB + L1 . (n - n0), clamped at 0.
+// n0 between texel centres is the interpolated normal, as each texel's n0 is it at its centre; the
+// lightmap holds the front side's irradiance, so both are taken on the front.
 Vec3 lightmap_irradiance_over_pi(const ViewScene& view, const SurfaceAtHit& s) {
   const loader::Rgb e = view.bundle.lightmap(s.instance, s.lightmap_uv);
-  return {e[0], e[1], e[2]};
+  const Vec3 rgb{e[0], e[1], e[2]};
+  const Vec3 d = s.mapped_normal - s.interpolated_normal;
+  if (!view.has_sh1_layers || (d.x == 0.0f && d.y == 0.0f && d.z == 0.0f)) return rgb;
+  float l1[9];
+  for (int k = 0; k < 9; ++k) l1[k] = view.bundle.lightmap_channel(s.instance, kSh1Channels[k], s.lightmap_uv);
+  const auto channel = [&](int c, float base) { return std::max(0.0f, base + l1[c] * d.x + l1[3 + c] * d.y + l1[6 + c] * d.z); };
+  return {channel(0, rgb.x), channel(1, rgb.y), channel(2, rgb.z)};
 }
 
 }  // namespace

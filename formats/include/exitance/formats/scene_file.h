@@ -21,7 +21,7 @@
 namespace exitance::formats {
 
 inline constexpr char kSceneMagic[8] = {'E', 'X', 'S', 'C', 'E', 'N', 'E', '\0'};
-constexpr uint32_t kSceneFormatVersion = 2;        // what writers write
+constexpr uint32_t kSceneFormatVersion = 3;        // what writers write
 constexpr uint32_t kOldestSceneFormatVersion = 1;  // readers accept 1 .. kSceneFormatVersion
 constexpr uint32_t kSceneHeaderSize = 160;
 // Fixed record sizes (bytes) of the payload's arrays; scene_format.md has the layouts.
@@ -94,6 +94,10 @@ struct MaterialRecord {
   AlphaMode alpha_mode = AlphaMode::Opaque;
   float alpha_cutoff = 0.5f;
   float base_alpha = 1.0f;  // baseColorFactor[3]
+  // Version 3 (older files read back as none): glTF normalTexture, linear RGB (no sRGB decode), and
+  // its scale (tangent-space x, y multiplied by it).
+  TextureBindingRecord normal_texture;
+  float normal_scale = 1.0f;
 };
 
 struct InstanceRecord {
@@ -186,8 +190,8 @@ struct BvhNodeRecord {
 };
 static_assert(sizeof(BvhNodeRecord) == kSceneBvhNodeSize, "scene.bin BVH node record is 112 bytes");
 
-// One level over the world-space triangles (a two-level layout, per mesh plus instances, will be
-// format version 2). Nodes depth-first, nodes[0] the root; leaf slots hold scene triangle indices.
+// One level over the world-space triangles (a two-level layout, per mesh plus instances, will be a
+// later format version). Nodes depth-first, nodes[0] the root; leaf slots hold scene triangle indices.
 struct SceneBvh {
   std::vector<BvhNodeRecord> nodes;
   std::vector<uint32_t> leaf_triangles;
@@ -208,6 +212,10 @@ struct SceneFile {
   // COLOR_0 per corner (3 per triangle), or both empty: no vertex colours (version 2).
   std::vector<Float3> vertex_color;
   std::vector<float> vertex_alpha;
+  // Per corner (3 per triangle), or both empty: world-space tangent (unit, or zero on corners no
+  // normal map reads) and its handedness w = +1 or -1, bitangent = w * cross(normal, tangent) (version 3).
+  std::vector<Float3> tangents;
+  std::vector<float> tangent_signs;
   float texel_density = 0;     // lightmap texels per scene unit
   TexelGBufferRecords texels;  // includes the atlas page sizes
   // Probe positions and states only (SH coefficients are not stored: they read back as zero).
@@ -240,7 +248,7 @@ inline uint32_t texel_morton_code(uint32_t x, uint32_t y) {
 void validate_scene_file(const SceneFile& scene, const std::string& name_for_errors);
 
 // The exact bytes of scene.bin; throws FormatError if the scene is invalid. format_version 1
-// writes the old layout (tests, fixtures) and refuses a scene with anything only version 2 holds.
+// (or 2) writes the old layout (tests, fixtures) and refuses a scene with anything only a later version holds.
 std::vector<uint8_t> encode_scene(const SceneFile& scene, uint32_t format_version = kSceneFormatVersion);
 void write_scene_file(const std::string& path, const SceneFile& scene);
 

@@ -52,6 +52,11 @@ struct Material {
   AlphaMode alpha_mode = AlphaMode::Opaque;
   float alpha_cutoff = 0.5f;
   float base_alpha = 1.0f;  // baseColorFactor[3]
+  // glTF normalTexture (linear RGB, tangent space: n = normalize((2 rgb - 1) * (scale, scale, 1))).
+  // Not used by the lighting stage, which lights the interpolated normal as engines do with
+  // directional lightmaps; exitance-view evaluates the L1 SH layers at the mapped normal.
+  TextureBinding normal_texture;
+  float normal_scale = 1.0f;
 };
 
 struct PunctualLight {
@@ -121,6 +126,12 @@ struct Scene {
   // when no primitive has COLOR_0 (corners of primitives without it are white, alpha 1).
   std::vector<Vec3> vertex_color;
   std::vector<float> vertex_alpha;
+  // Tangent frames for normal maps: per corner, or both empty when no material has a normal map.
+  // World-space unit tangent (the glTF TANGENT attribute, else generated from the normal map's UV
+  // derivatives: tangent_frames.h; zero on corners of primitives whose material has no normal map)
+  // and handedness w = +1 or -1: bitangent = w * cross(normal, tangent).
+  std::vector<Vec3> tangents;
+  std::vector<float> tangent_signs;
   std::vector<uint32_t> triangle_material;
   std::vector<uint32_t> triangle_instance;
   std::vector<Material> materials;

@@ -25,6 +25,13 @@ Vec3 surface_emission(const formats::SceneFile& scene, uint32_t t, float b1, flo
 // behind, as an engine's alpha blending does.
 float surface_opacity(const formats::SceneFile& scene, uint32_t t, float b1, float b2);
 
+// The front side's shading normal with the material's normal map applied (tangent_frames.h,
+// perturbed_normal): `n` is the interpolated normal at (b1, b2) of t, the normal texture is read
+// bilinearly through its binding (linear RGB, its scale), in the frame of the corner tangents
+// interpolated (handedness: the sign of the interpolated w). `n` itself where the material has no
+// normal map or scene.bin stores no tangents (version 2 and older).
+Vec3 surface_normal(const formats::SceneFile& scene, uint32_t t, float b1, float b2, Vec3 n);
+
 // Sky radiance seen along unit `direction`: the image sky's nearest texel, or the constant sky.
 Vec3 sky_radiance(const formats::SceneFile& scene, Vec3 direction);
 

@@ -35,7 +35,9 @@ struct RayScratch {
 struct SurfaceAtHit {
   Vec3 position;
   Vec3 geometric_normal;   // front side (counter-clockwise winding)
-  Vec3 shading_normal;     // interpolated, facing the viewer on a double-sided surface's back
+  Vec3 shading_normal;     // interpolated and normal-mapped, facing the viewer on a double-sided surface's back
+  Vec3 interpolated_normal;  // front side, without the normal map: the n0 a lightmap texel was baked for
+  Vec3 mapped_normal;        // front side, with the material's normal map (= interpolated_normal without one)
   bool back_face_absorbs;  // the back of a single-sided surface: the bake treats it as black
   uint32_t instance;
   uint32_t triangle;

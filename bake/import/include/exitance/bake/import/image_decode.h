@@ -13,6 +13,10 @@ namespace exitance {
 Texture decode_srgb_image(const std::vector<unsigned char>& bytes, const std::string& name_hint,
                           const std::string& file, const std::string& element);
 
+// The same for data images (glTF normalTexture): 8/16-bit values mapped to [0, 1], no sRGB decode.
+Texture decode_data_image(const std::vector<unsigned char>& bytes, const std::string& name_hint,
+                          const std::string& file, const std::string& element);
+
 // Reads an equirectangular float image (EXR/HDR) from disk for the sky: linear, no conversion.
 Texture read_linear_image_file(const std::string& path, const std::string& element);
 
