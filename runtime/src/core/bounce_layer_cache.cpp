@@ -1,4 +1,4 @@
-#include "bounce_layer_cache.h"
+#include "exitance/runtime/core/bounce_layer_cache.h"
 
 #include <cmath>
 
