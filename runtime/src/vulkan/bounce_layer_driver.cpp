@@ -90,7 +90,8 @@ void BounceLayerDriver::prepare() {
   prepared_ = true;
 }
 
-// Layers [0, layers) on the device as the host's caches are now. The whole buffer again when it
+// Layers [0, layers) on the device as the host's caches are now. The whole buffer on this bake's
+// first upload (the buffer may hold an earlier bake's caches or a probe bake's SH sums) and when it
 // had to grow (a new buffer), else only the layers rebuilt since.
 void BounceLayerDriver::upload_caches(size_t layers, const std::vector<BounceLayerCache>& caches,
                                       const std::vector<uint64_t>& versions) {
@@ -102,20 +103,22 @@ void BounceLayerDriver::upload_caches(size_t layers, const std::vector<BounceLay
                              " layer caches pass the device's largest storage buffer");
   if (cache_words_.size() < words) cache_words_.resize(words, 0.0f);
   uploaded_versions_.resize(std::max(uploaded_versions_.size(), layers), 0);
-  const bool grown = buffers.probes.sh_sums.size() < words * 4;
-  if (grown) {
+  bool whole = buffers.probes.sh_sums.size() < words * 4;
+  if (whole) {
     buffers.probes.reserve_bytes(context, words * 4);
     runner_.bind_buffers();
   }
+  whole = whole || !tables_uploaded_;
+  tables_uploaded_ = true;
   for (size_t k = 0; k < layers; ++k) {
-    if (uploaded_versions_[k] == versions[k] && !grown) continue;
+    if (uploaded_versions_[k] == versions[k] && !whole) continue;
     caches[k].interleave(cache_words_, first_layer_word_ + k * layer_words_);
-    if (!grown && layer_words_ > 0)
+    if (!whole && layer_words_ > 0)
       context.upload(buffers.probes.sh_sums, &cache_words_[first_layer_word_ + k * layer_words_], layer_words_ * 4,
                      (first_layer_word_ + k * layer_words_) * 4);
     uploaded_versions_[k] = versions[k];
   }
-  if (grown) context.upload(buffers.probes.sh_sums, cache_words_.data(), words * 4);
+  if (whole) context.upload(buffers.probes.sh_sums, cache_words_.data(), words * 4);
 }
 
 void BounceLayerDriver::estimate(const BounceLayerPass& pass, const std::vector<BounceLayerCache>& caches,

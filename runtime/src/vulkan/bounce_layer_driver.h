@@ -35,6 +35,7 @@ class BounceLayerDriver final : public BounceLayerEstimator {
   const TexelGBuffer& gbuffer_;
   const IntegratorSettings& settings_;
   bool prepared_ = false;
+  bool tables_uploaded_ = false;  // header and tables on the device (the first upload writes everything)
   size_t max_work_ = 0;
   GpuParams params_{};
   BatchTotals totals_;
