@@ -115,11 +115,6 @@ std::shared_ptr<const Integrator> backend_stage(const SceneForLighting& scene, c
                                                 Diagnostics& diagnostics) {
   options.announce_stage("backend");
   BackendRequest request = options.backend;
-  if (options.lighting.integrator == IntegratorMode::Bounces && request.name == "auto") {
-    // The per-bounce mode exists on the CPU backend only for now (the Vulkan backend refuses it).
-    request.name = "cpu";
-    diagnostics.warn("--integrator bounces: using the CPU reference (Embree), the only backend with per-bounce passes yet");
-  }
   if (options.adaptive_request == AdaptiveRequest::On && request.name == "auto") {
     // Adaptive sampling exists on the CPU backend only for now (the Vulkan backend refuses it).
     request.name = "cpu";

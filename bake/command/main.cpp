@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
   app.add_option("--integrator", integrator,
                  "auto (default: bounces on the CPU backend unless --directional, --guiding or --adaptive on needs path "
                  "tracing; path on the Vulkan backend) | path (unbiased path tracing) | bounces (per-bounce gather "
-                 "passes; CPU backend only, biased by the lightmap resolution: bench/results/per-bounce-traced.md)")
+                 "passes, both backends; biased by the lightmap resolution: bench/results/per-bounce-traced.md)")
       ->check(CLI::IsMember({"auto", "path", "bounces"}));
   app.add_option("--sky", options.sky, "sky radiance: R,G,B or an equirectangular image (EXR/HDR)");
   app.add_option("--seed", options.lighting.seed, "random seed; results are deterministic per seed and backend");

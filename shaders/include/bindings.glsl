@@ -40,6 +40,8 @@ layout(std430, set = 0, binding = kBindingTexelSums) buffer AccumulatorBuffer { 
 layout(std430, set = 0, binding = kBindingBounceSums) buffer BounceAccumulatorBuffer { double acc_bounce[]; };  // [k][texel][rgb]
 layout(std430, set = 0, binding = kBindingTexelSamples) buffer SampleCountBuffer { uint acc_samples[]; };
 layout(std430, set = 0, binding = kBindingProbeShSums) buffer ProbeShBuffer { double acc_probe_sh[]; };  // [probe][coefficient][rgb]
+// Per-bounce layer passes: the layers' atlas caches, in the probe SH sums' binding (gpu_layout.h kBindingBounceCache).
+layout(std430, set = 0, binding = kBindingBounceCache) readonly buffer BounceCacheBuffer { float bounce_cache[]; };
 layout(std430, set = 0, binding = kBindingProbeCounts) buffer ProbeCountBuffer { uint acc_probe_counts[]; };  // [probe][samples, back faces]
 
 layout(push_constant) uniform Push {
@@ -66,6 +68,10 @@ uint queue_append(uint counter_slot) {
 // probe ray (sky or emission), slot 1 the path estimate of E/pi at its hit, then after all the
 // batch's slots, per work item, the hit's albedo (x < 0: back face) and the ray direction.
 uint result_index(uint work, uint slot) { return (work * (params.recorded + 1u) + slot) * 3u; }
+
+// Per-bounce layer passes (one result slot, recorded = 0): per work item a flag, 1 when the texel's
+// continuation ray met a single-sided back face (layer 0), after the batch's slots.
+uint bounce_back_face_index(uint work) { return params.batch_work_total * 3u + work; }
 
 uint probe_extra_index(uint work) { return params.batch_work_total * 6u + work * 6u; }
 

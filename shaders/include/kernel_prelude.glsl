@@ -33,6 +33,8 @@ bool dispatch_vertex_result(uint p, uint r) {
   return false;
 }
 
+#include "bounce_pass.glsl"
+
 // A probe work item (probe, sample) starts with a ray from the probe (path.h probe_ray_direction).
 // Depth 0 marks the probe ray (shade: shade_probe_hit; the hit then starts a texel path, its depth
 // counted from 1). The direction is kept for the projection (reduce_probes).
@@ -78,6 +80,15 @@ void regenerate(uint p) {
     x.shading_normal = start_points[texel].shading_normal.xyz;
     path_work[p] = w;
     path_depth[p] = 0u;
+    if ((params.bounce_flags & kBouncePass) != 0u) {
+      // Per-bounce layer passes (bounce_pass.glsl): a gather ray, or at layer 0 the direct-light
+      // sample below (the same random stream as a path's first vertex).
+      if (params.bounce_layer > 0u) {
+        if (start_bounce_gather(p, texel, sample_index, x, seed)) return;
+        continue;
+      }
+      path_depth[p] = kBounceDirectRay | kBounceFromTexel;
+    }
     uint r = sample_vertex(p, x, vec3(1.0), rng);
     path_rng[p] = uvec4(rng.item_hash, rng.index, rng.dimension, rng.mode);
     if (dispatch_vertex_result(p, r)) return;

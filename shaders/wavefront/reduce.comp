@@ -2,7 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // Stage "accumulate": per texel of the batch, adds each sample's total (sum of its bounce slots),
 // its square, its bounce layers and (directional batches) its L1 to double-precision sums, in sample
-// order (one writer per texel).
+// order (one writer per texel). A per-bounce layer pass also counts its back-face flags.
 layout(local_size_x = 64) in;
 #include "../include/kernel_prelude.glsl"
 
@@ -12,9 +12,10 @@ void main() {
   if (j >= n) return;
   uint texel = batch_items[params.batch_item_offset + j];
   uint K = params.recorded;
-  uint nonfinite = 0u, samples = 0u;
+  uint nonfinite = 0u, samples = 0u, back_faces = 0u;
   for (uint s = 0u; s < params.batch_sample_count; ++s) {
     uint w = s * n + j;
+    if ((params.bounce_flags & kBouncePass) != 0u && results[bounce_back_face_index(w)] > 0.0) ++back_faces;
     vec3 total = vec3(0.0);
     for (uint k = 0u; k <= K; ++k) {
       uint r = result_index(w, k);
@@ -37,5 +38,7 @@ void main() {
     ++samples;
   }
   acc_samples[texel] += samples;
+  // Per-bounce layer passes record no bounce layers: the first slot counts back faces instead.
+  if ((params.bounce_flags & kBouncePass) != 0u) acc_bounce[texel * 3u] += double(back_faces);
   if (nonfinite > 0u) atomicAdd(counters[kCounterNonfinite], nonfinite);
 }

@@ -6,6 +6,7 @@
 // Probe batches (the kProbeMode variant): depth 0 is the ray from the probe, shaded by
 // shade_probe_hit, with the hit's albedo kept apart (the reference multiplies the hit's whole E/pi
 // estimate by it); the path from the hit is the texel estimator with its depth counted from 1.
+// Per-bounce layer passes (params.bounce_flags) shade with bounce_pass.glsl instead.
 layout(local_size_x = 64) in;
 #include "../include/kernel_prelude.glsl"
 
@@ -28,7 +29,18 @@ void main() {
   bool continues = false;
   vec3 throughput = tp.xyz;
   SurfacePoint x;
-  if (kProbeMode && depth == 0u) {
+  uint next_depth = depth + 1u;
+  if (!kProbeMode && (params.bounce_flags & kBouncePass) != 0u) {
+    BounceHit b = shade_bounce_hit(p, work, depth, hit, wi, tp, rng);
+    if (b.queued) {
+      path_rng[p] = uvec4(rng.item_hash, rng.index, rng.dimension, rng.mode);
+      return;
+    }
+    continues = b.direct_sample;  // one direct-light sample at the hit, through the same sample_vertex
+    x = b.next;
+    throughput = b.throughput;
+    next_depth = kBounceDirectRay;
+  } else if (kProbeMode && depth == 0u) {
     vec3 albedo = vec3(0.0);
     if (tri == kInvalid) {
       add_result(work, 0u, scene_sky_radiance(wi));
@@ -55,7 +67,7 @@ void main() {
     x = h.next;
   }
   if (continues) {
-    path_depth[p] = depth + 1u;
+    path_depth[p] = next_depth;
     uint r = sample_vertex(p, x, throughput, rng);
     path_rng[p] = uvec4(rng.item_hash, rng.index, rng.dimension, rng.mode);
     if (dispatch_vertex_result(p, r)) return;

@@ -344,8 +344,8 @@ TEST(PerBounce, CornellRoomAgainstThePathTracer) {
   ::testing::Test::RecordProperty("rel_mse_vs_path", std::to_string(rel_mse / values));
 }
 
-// bake --integrator bounces --bounce-layers: with --backend auto the CPU reference is chosen (the
-// only backend with the mode), and the page holds every bounce layer, which sum to R,G,B.
+// bake --integrator bounces --bounce-layers on the CPU reference: the page holds every bounce
+// layer, which sum to R,G,B.
 TEST(PerBounce, BakeWritesEveryBounceLayer) {
   namespace fs = std::filesystem;
   const fs::path out = fs::temp_directory_path() / ("exitance-test-per-bounce-" + std::to_string(::getpid()));
@@ -359,11 +359,9 @@ TEST(PerBounce, BakeWritesEveryBounceLayer) {
   options.bounce_layers = true;
   options.probes_enabled = false;
   options.svo_enabled = false;
+  options.backend.name = "cpu";
   Diagnostics diagnostics;
   run_bake(options, diagnostics);
-  bool told = false;
-  for (const std::string& w : diagnostics.warnings) told = told || w.find("--integrator bounces") != std::string::npos;
-  EXPECT_TRUE(told) << "--backend auto with bounces names the CPU reference it uses";
   std::ifstream manifest_file(out / "manifest.json");
   const nlohmann::json manifest = nlohmann::json::parse(manifest_file);
   const formats::LightmapImage page =
@@ -382,14 +380,18 @@ TEST(PerBounce, BakeWritesEveryBounceLayer) {
   fs::remove_all(out);
 }
 
-// The Vulkan backend has no per-bounce mode yet: it says so instead of path tracing silently.
-TEST(PerBounce, VulkanBackendRefusesTheMode) {
+// Both backends refuse --directional sh1 with the mode (it estimates no L1 layers) instead of
+// leaving them empty. (The Vulkan mode itself: tests/crosscheck/vulkan_bounce_crosscheck_test.cpp.)
+TEST(PerBounce, BothBackendsRefuseDirectionalLayers) {
+  const testing::AtlasScene box = furnace_box(0.5f, {1, 1, 1}, 4);
+  IntegratorSettings settings = bounce_settings(4, 1);
+  settings.directional = DirectionalMode::Sh1;
+  EXPECT_THROW(CpuReferenceIntegrator(box.scene).bake(box.gbuffer, settings), std::invalid_argument);
   const std::vector<VulkanDeviceInfo> devices = enumerate_vulkan_devices();
   if (std::none_of(devices.begin(), devices.end(), [](const VulkanDeviceInfo& d) { return d.usable; }))
     GTEST_SKIP() << "no usable Vulkan device";
-  const testing::AtlasScene box = furnace_box(0.5f, {1, 1, 1}, 4);
   const std::unique_ptr<VulkanIntegrator> vulkan = VulkanIntegrator::create(make_lighting_scene(box.scene));
-  EXPECT_THROW(vulkan->bake(box.gbuffer, bounce_settings(4, 1)), std::runtime_error);
+  EXPECT_THROW(vulkan->bake(box.gbuffer, settings), std::invalid_argument);
 }
 
 // bounce_gather.h as C++ (the same text compiles as GLSL: shaders/checks/bounce_gather_check.comp).

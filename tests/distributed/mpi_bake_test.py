@@ -46,7 +46,7 @@ def main():
     parser.add_argument("--bake", required=True)
     parser.add_argument("--scene", required=True)
     parser.add_argument("--backend", default="cpu",
-                        help="vulkan: the identity check alone, path tracing (each rank's device runs its texel range)")
+                        help="vulkan: the identity check alone, path tracing and the per-bounce mode (each rank's device runs its texel range)")
     args = parser.parse_args()
     mpirun = shutil.which("mpirun")
     if not mpirun:
@@ -56,7 +56,7 @@ def main():
     common = [args.scene, "--backend", args.backend, "--no-cache", "--texel-density", "6", "--spp", "8",
               "--probe-spp", "16", "--seed", "7", "--bounce-layers"]
     try:
-        for integrator in (["path", "bounces"] if args.backend == "cpu" else ["path"]):
+        for integrator in ["path", "bounces"]:
             one, two = os.path.join(work, integrator + "_1"), os.path.join(work, integrator + "_2")
             options = common + ["--integrator", integrator]
             single = run([args.bake] + options + ["-o", one])

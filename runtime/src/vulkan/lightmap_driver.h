@@ -29,6 +29,8 @@ class LightmapDriver {
   uint64_t add_samples_to(const std::vector<uint32_t>& texels, uint32_t first_sample, uint32_t samples);
   LightmapEstimate read();
   bool started() const { return progressive_.has_value(); }
+  // Another bake takes the texel buffers (the per-bounce mode): the progressive accumulation ends.
+  void end_progressive() { progressive_.reset(); }
   uint32_t samples_done() const { return progressive_ ? progressive_->next_sample : 0; }
 
  private:

@@ -1,10 +1,13 @@
 // The Vulkan backend as an Integrator: owns the device context, the scene on the device, the
 // wavefront's kernels and buffers, and one driver per integrator (lightmap texels, probes), which
-// run batches through the shared wavefront-batch runner (wavefront_batch.h).
+// run batches through the shared wavefront-batch runner (wavefront_batch.h). The per-bounce mode is
+// the core's host loop (core/per_bounce_bake.h) over this backend's layer estimator (bounce_layer_driver.h).
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 
 #include <stdexcept>
 
+#include "bounce_layer_driver.h"
+#include "exitance/runtime/core/per_bounce_bake.h"
 #include "gpu_scene.h"
 #include "kernel_launches.h"
 #include "lightmap_driver.h"
@@ -30,6 +33,9 @@ struct VulkanIntegrator::Impl {
   WavefrontBatchRunner runner;
   LightmapDriver lightmap;
   ProbeDriver probes;
+  // The per-bounce gather reads each triangle's instance and lightmap UVs from here (shared, not a
+  // reference to the caller's scene); update_geometry keeps it current.
+  std::shared_ptr<const Scene> source;
 
   Impl(const LightingScene& lighting, const VulkanDeviceOptions& options)
       : context(options),
@@ -39,7 +45,8 @@ struct VulkanIntegrator::Impl {
         buffers(context, sizes.paths),
         runner(context, scene, kernels, buffers, statistics, sizes, options.collect_stage_statistics),
         lightmap(runner),
-        probes(runner) {
+        probes(runner),
+        source(lighting.source) {
     runner.bind_buffers();
   }
 };
@@ -55,11 +62,18 @@ VulkanIntegrator::VulkanIntegrator(std::unique_ptr<Impl> impl) : impl_(std::move
 VulkanIntegrator::~VulkanIntegrator() = default;
 
 LightmapEstimate VulkanIntegrator::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const {
-  if (settings.integrator == IntegratorMode::Bounces) throw std::runtime_error("Vulkan backend: --integrator bounces is implemented on the CPU backend only (use --backend cpu)");
   if (settings.guiding != GuidingMode::Off) throw std::runtime_error("Vulkan backend: --guiding grid is implemented on the CPU backend only (use --backend cpu)");
   if (settings.adaptive) throw std::runtime_error("Vulkan backend: --adaptive on is implemented on the CPU backend only (use --backend cpu)");
   if (settings.spp == 0 && !(settings.time_budget_seconds > 0) && !(settings.target_relative_error > 0))
     throw std::invalid_argument("Vulkan backend: spp 0 needs a time budget or a target error");
+  if (settings.integrator == IntegratorMode::Bounces) {
+    if (settings.directional != DirectionalMode::Off)
+      throw std::invalid_argument("Vulkan backend: --directional sh1 applies to path tracing, not to --integrator bounces");
+    impl_->lightmap.end_progressive();  // the texel buffers are this bake's now
+    impl_->runner.statistics().clear();
+    vulkan::BounceLayerDriver layers(impl_->runner, impl_->source, gbuffer, settings);
+    return bake_per_bounce(gbuffer, settings, layers);
+  }
   return impl_->lightmap.bake(gbuffer, settings);
 }
 
@@ -82,7 +96,10 @@ uint32_t VulkanIntegrator::progressive_samples() const { return impl_->lightmap.
 
 void VulkanIntegrator::update_materials(const LightingScene& edited) { impl_->scene.update_materials(edited); }
 void VulkanIntegrator::update_lights(const LightingScene& edited) { impl_->scene.update_lights(edited); }
-void VulkanIntegrator::update_geometry(const LightingScene& edited) { impl_->scene.update_geometry(edited); }
+void VulkanIntegrator::update_geometry(const LightingScene& edited) {
+  impl_->scene.update_geometry(edited);
+  impl_->source = edited.source;
+}
 
 const VulkanDeviceInfo& VulkanIntegrator::device() const { return impl_->context.info(); }
 std::string VulkanIntegrator::device_description() const {

@@ -100,6 +100,8 @@ void ProbeAccumulators::reserve(Context& context, size_t probes) {
   grow(context, counts, probes * 2 * 4);
 }
 
+void ProbeAccumulators::reserve_bytes(Context& context, VkDeviceSize sh_sum_bytes) { grow(context, sh_sums, sh_sum_bytes); }
+
 void ProbeAccumulators::clear(VkCommandBuffer cmd) const {
   for (const Buffer* b : {&sh_sums, &counts}) vkCmdFillBuffer(cmd, b->handle(), 0, VK_WHOLE_SIZE, 0);
 }

@@ -120,6 +120,8 @@ struct ProbeAccumulators {
 
   explicit ProbeAccumulators(Context& context);
   void reserve(Context& context, size_t probes);
+  // Per-bounce lightmap bakes keep their layer caches in sh_sums (gpu_layout.h kBindingBounceCache).
+  void reserve_bytes(Context& context, VkDeviceSize sh_sum_bytes);
   void clear(VkCommandBuffer cmd) const;
   void bind(DescriptorWrites& writes) const;
 };

@@ -1,5 +1,5 @@
 // The per-bounce mode's shared math (issue 10, seed 003 ch. 3-4), for the CPU backend
-// (runtime/src/cpu/cpu_bounce_integrator.cpp) and a later Vulkan kernel: where a gather ray's hit
+// (runtime/src/cpu/cpu_bounce_integrator.cpp) and the Vulkan kernels (shaders/include/bounce_pass.glsl): where a gather ray's hit
 // reads a bounce layer in the atlas, and the geometric extrapolation of the bounces not run.
 //
 // B_k(x) = E_k(x)/pi, the irradiance over pi from light that bounced k times. With cosine-sampled
@@ -44,6 +44,12 @@ EXITANCE_FN BilinearFootprint bilinear_footprint(vec2 page_uv, int width, int he
   f.fy = py - fy0;
   return f;
 }
+
+// A footprint texel is on the hit's surface when its normal is within ~37 degrees of the hit's and
+// it lies near the hit's tangent plane (within ~14 degrees seen from the hit): thresholds loose
+// enough for curved surfaces at coarse texels, tight enough to drop the next face of a box.
+const float kSameSurfaceCosine = 0.8f;
+const float kPlaneSlope = 0.25f;
 
 // Weight of corner (dx, dy) in {0, 1}^2 of a footprint.
 EXITANCE_FN float bilinear_weight(BilinearFootprint f, int dx, int dy) {

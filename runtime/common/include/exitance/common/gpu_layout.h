@@ -112,8 +112,8 @@ struct GpuParams {
   uint environment_height;
   uint shadow_slots;       // shadow rays kept per path slot: 3 with an environment map, else 2
   uint directional;        // texel batches: 1 = also estimate the L1 SH layers (DirectionalMode::Sh1)
-  uint params_pad0;
-  uint params_pad1;
+  uint bounce_flags;       // texel batches: 0 = path tracing; else a per-bounce layer pass (kBouncePass | ...)
+  uint bounce_layer;       // per-bounce layer pass: k, the layer B_k estimated (0 = direct light)
   uint params_pad2;
 };
 
@@ -164,6 +164,26 @@ const uint kBindingEnvironment = 30u;
 // the first continuation's sh1_direction_factor (xyz) at path_throughput[path_capacity + p], per texel
 // the 9 L1 sums [texel][axis][rgb] after the texel sums (acc_total from item_count_total * 6), and
 // per sample the L1 results after the batch's bounce slots (bindings.glsl sh1_result_index).
+// The per-bounce mode's layer passes (GpuParams::bounce_flags, shaders/include/bounce_pass.glsl)
+// read the layers' dilated atlas caches from the probe SH sums' binding, which a lightmap bake
+// leaves unused, as floats: kBounceCacheHeaderWords words of header (uint bits, kBounceCache* below),
+// then per scene triangle its instance (uint bits) and lightmap UVs (3 x xy), per instance its page
+// (int bits, -1: none) and scale_offset, per page width, height and first page texel (uint bits),
+// then per layer kBounceCacheTexelWords per page texel (BounceLayerCache's channels interleaved:
+// rgb, lit, position, geometric normal). Per work item a back-face flag follows the batch's result
+// slots (bounce_back_face_index).
+const uint kBindingBounceCache = kBindingProbeShSums;
+const uint kBounceCacheTriangles = 0u;      // header word: first word of the triangle table; +1 its count
+const uint kBounceCacheInstances = 2u;      // first word of the instance table; +1 its count
+const uint kBounceCachePages = 4u;          // first word of the page table; +1 its count
+const uint kBounceCacheLayers = 6u;         // first word of layer 0; +1 words per layer
+const uint kBounceCacheHeaderWords = 8u;
+const uint kBounceCacheTriangleWords = 7u;
+const uint kBounceCacheInstanceWords = 5u;
+const uint kBounceCachePageWords = 3u;
+const uint kBounceCacheTexelWords = 10u;
+const uint kBouncePass = 1u;                // bounce_flags: this batch estimates layer bounce_layer
+const uint kBounceTraceFirst = 2u;          // at layer 0 a gather hit takes a direct-light sample, not the cache
 const uint kBindingCount = 31u;
 
 // Counter slots (uint each; statistics are 64-bit lo/hi pairs).
@@ -174,6 +194,9 @@ const uint kCounterNonfinite = 4u;
 const uint kCounterRaysPrimary = 5u;
 const uint kCounterRaysBounce = 6u;
 const uint kCounterRaysShadow = 7u;
+const uint kCounterBounceGathers = 8u;     // per-bounce passes: gather rays that hit a surface,
+const uint kCounterBounceTexelless = 9u;   // of those estimated on the fly (no lit texel there),
+const uint kCounterBounceBackFaces = 10u;  // of those single-sided back faces
 const uint kCounterStatExtendActive = 16u;  // lanes active inside traversal loops / lanes launched there
 const uint kCounterStatExtendLaunched = 18u;
 const uint kCounterStatConnectActive = 20u;

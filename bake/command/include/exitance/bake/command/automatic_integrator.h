@@ -9,7 +9,8 @@
 
 namespace exitance {
 
-// Path tracing on the Vulkan backend (no per-bounce passes there yet) and for what only it
+// Path tracing on the Vulkan backend (its per-bounce passes exist but are not measured against its
+// path tracer on GPUs yet: docs/lighting-core.md) and for what only it
 // estimates: --directional sh1, --guiding grid, --adaptive on; else the per-bounce mode.
 IntegratorMode automatic_integrator(const BakeOptions& options, const Integrator& backend);
 

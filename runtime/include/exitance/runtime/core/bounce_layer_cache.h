@@ -29,6 +29,9 @@ class BounceLayerCache {
   // (bounce_gather.h), renormalised over them; false when there is none, or the G-buffer has no
   // rectangle for the instance.
   bool lookup(const TexelGBuffer& gbuffer, uint32_t instance, Vec2 uv, Vec3 position, Vec3 normal, Vec3& out) const;
+  // The pages' texels one after another (row 0 first), kBounceCacheTexelWords floats each, from
+  // out[offset] (gpu_layout.h; the Vulkan backend's copy). `out` must have room.
+  void interleave(std::vector<float>& out, size_t offset) const;
 
  private:
   struct Page {

@@ -1,20 +1,16 @@
-#include "bounce_layer_cache.h"
+#include "exitance/runtime/core/bounce_layer_cache.h"
 
 #include <cmath>
 
 #include "exitance/common/bounce_gather.h"
+#include "exitance/common/gpu_layout.h"
 #include "exitance/runtime/bundle/lightmap_assembly.h"
 
 namespace exitance {
 namespace {
 
 enum Channel { kR, kG, kB, kLit, kPx, kPy, kPz, kNx, kNy, kNz, kChannels };
-
-// A footprint texel is on the hit's surface when its normal is within ~37 degrees of the hit's and
-// it lies near the hit's tangent plane (within ~14 degrees seen from the hit): thresholds loose
-// enough for curved surfaces at coarse texels, tight enough to drop the next face of a box.
-constexpr float kSameSurfaceCosine = 0.8f;
-constexpr float kPlaneSlope = 0.25f;
+static_assert(kChannels == int(kBounceCacheTexelWords));
 
 }  // namespace
 
@@ -75,6 +71,19 @@ bool BounceLayerCache::lookup(const TexelGBuffer& gbuffer, uint32_t instance, Ve
   if (!(weight > 1e-3)) return false;
   out = {float(sum[0] / weight), float(sum[1] / weight), float(sum[2] / weight)};
   return true;
+}
+
+}  // namespace exitance
+
+namespace exitance {
+
+void BounceLayerCache::interleave(std::vector<float>& out, size_t offset) const {
+  for (const Page& page : pages_) {
+    const size_t texels = size_t(page.width) * size_t(page.height);
+    for (size_t t = 0; t < texels; ++t)
+      for (int c = 0; c < kChannels; ++c) out[offset + t * kChannels + size_t(c)] = page.channel[c][t];
+    offset += texels * kChannels;
+  }
 }
 
 }  // namespace exitance

@@ -1,0 +1,180 @@
+#include "bounce_layer_driver.h"
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace exitance::vulkan {
+namespace {
+
+// Per work item: result slot 0 (RGB) and the back-face flag (bindings.glsl bounce_back_face_index).
+constexpr size_t kResultBytes = 16;
+
+float word_bits(uint32_t u) {
+  float f;
+  std::memcpy(&f, &u, 4);
+  return f;
+}
+
+}  // namespace
+
+BounceLayerDriver::BounceLayerDriver(WavefrontBatchRunner& runner, std::shared_ptr<const Scene> source,
+                                     const TexelGBuffer& gbuffer, const IntegratorSettings& settings)
+    : runner_(runner), source_(std::move(source)), gbuffer_(gbuffer), settings_(settings) {
+  // The tables the lookup reads (bounce_pass.glsl bounce_cache_lookup), as BounceLayerCache::lookup
+  // reads them on the CPU: each triangle's instance and lightmap UVs, each instance's rectangle.
+  const size_t triangles = source_ && source_->triangle_instance.size() * 3 <= source_->lightmap_uv.size()
+                               ? source_->triangle_instance.size() : 0;
+  const size_t instances = gbuffer_.instance_rects.size(), pages = gbuffer_.pages.size();
+  const size_t triangle_table = kBounceCacheHeaderWords;
+  const size_t instance_table = triangle_table + triangles * kBounceCacheTriangleWords;
+  const size_t page_table = instance_table + instances * kBounceCacheInstanceWords;
+  first_layer_word_ = page_table + pages * kBounceCachePageWords;
+  size_t page_texels = 0;
+  for (const AtlasPage& page : gbuffer_.pages) page_texels += size_t(page.width) * size_t(page.height);
+  layer_words_ = page_texels * kBounceCacheTexelWords;
+  if (first_layer_word_ + layer_words_ >= (size_t(1) << 32))
+    throw std::runtime_error("Vulkan backend: --integrator bounces: the atlas is too large for the layer cache");
+  cache_words_.assign(first_layer_word_, 0.0f);
+  const uint32_t header[kBounceCacheHeaderWords] = {uint32_t(triangle_table), uint32_t(triangles),
+                                                    uint32_t(instance_table), uint32_t(instances),
+                                                    uint32_t(page_table),     uint32_t(pages),
+                                                    uint32_t(first_layer_word_), uint32_t(layer_words_)};
+  for (uint32_t i = 0; i < kBounceCacheHeaderWords; ++i) cache_words_[i] = word_bits(header[i]);
+  for (size_t t = 0; t < triangles; ++t) {
+    float* w = &cache_words_[triangle_table + t * kBounceCacheTriangleWords];
+    w[0] = word_bits(source_->triangle_instance[t]);
+    for (int k = 0; k < 3; ++k) w[1 + 2 * k] = source_->lightmap_uv[t * 3 + size_t(k)].x, w[2 + 2 * k] = source_->lightmap_uv[t * 3 + size_t(k)].y;
+  }
+  for (size_t i = 0; i < instances; ++i) {
+    const InstanceRect& rect = gbuffer_.instance_rects[i];
+    float* w = &cache_words_[instance_table + i * kBounceCacheInstanceWords];
+    w[0] = word_bits(uint32_t(rect.page));
+    for (int k = 0; k < 4; ++k) w[1 + k] = rect.scale_offset[k];
+  }
+  size_t first_texel = 0;
+  for (size_t p = 0; p < pages; ++p) {
+    float* w = &cache_words_[page_table + p * kBounceCachePageWords];
+    w[0] = word_bits(uint32_t(gbuffer_.pages[p].width));
+    w[1] = word_bits(uint32_t(gbuffer_.pages[p].height));
+    w[2] = word_bits(uint32_t(first_texel));
+    first_texel += size_t(gbuffer_.pages[p].width) * size_t(gbuffer_.pages[p].height);
+  }
+}
+
+// Buffers sized and bound, the texels' start points uploaded (as LightmapDriver::prepare).
+void BounceLayerDriver::prepare() {
+  const size_t texels = gbuffer_.texels.size();
+  if (texels >= (1ull << 31)) throw std::runtime_error("Vulkan backend: too many texels");
+  Context& context = runner_.context();
+  WavefrontBuffers& buffers = runner_.buffers();
+  max_work_ = runner_.work_items_per_batch(kResultBytes);
+  std::vector<GpuSurfacePoint> start_points(texels);
+  for (size_t i = 0; i < texels; ++i) {
+    const LiveTexel& t = gbuffer_.texels[i];
+    start_points[i] = {Vec4(t.position, 0.0f), Vec4(t.geometric_normal, 0.0f), Vec4(t.shading_normal, 0.0f)};
+  }
+  buffers.items.reserve(context, texels);
+  buffers.texels.reserve(context, texels, 1);
+  buffers.results.reserve(context, max_work_ * kResultBytes);
+  runner_.bind_buffers();
+  context.upload(buffers.items.start_points, start_points.data(), start_points.size() * sizeof(GpuSurfacePoint));
+  buffers.items.owner = WorkItems::Owner::Texels;
+  // One result slot (recorded 0): every contribution of a layer sample adds to it.
+  params_ = runner_.bake_params(settings_, 0, uint32_t(texels));
+  params_.directional = 0;
+  params_.max_bounces = 0;
+  params_.bounce_flags = kBouncePass | (settings_.trace_first_bounce ? kBounceTraceFirst : 0u);
+  prepared_ = true;
+}
+
+// Layers [0, layers) on the device as the host's caches are now. The whole buffer on this bake's
+// first upload (the buffer may hold an earlier bake's caches or a probe bake's SH sums) and when it
+// had to grow (a new buffer), else only the layers rebuilt since.
+void BounceLayerDriver::upload_caches(size_t layers, const std::vector<BounceLayerCache>& caches,
+                                      const std::vector<uint64_t>& versions) {
+  Context& context = runner_.context();
+  WavefrontBuffers& buffers = runner_.buffers();
+  const size_t words = first_layer_word_ + std::max<size_t>(layers, 1) * layer_words_;
+  if (words * 4 > size_t(context.properties().limits.maxStorageBufferRange))
+    throw std::runtime_error("Vulkan backend: --integrator bounces: " + std::to_string(layers) +
+                             " layer caches pass the device's largest storage buffer");
+  if (cache_words_.size() < words) cache_words_.resize(words, 0.0f);
+  uploaded_versions_.resize(std::max(uploaded_versions_.size(), layers), 0);
+  bool whole = buffers.probes.sh_sums.size() < words * 4;
+  if (whole) {
+    buffers.probes.reserve_bytes(context, words * 4);
+    runner_.bind_buffers();
+  }
+  whole = whole || !tables_uploaded_;
+  tables_uploaded_ = true;
+  for (size_t k = 0; k < layers; ++k) {
+    if (uploaded_versions_[k] == versions[k] && !whole) continue;
+    caches[k].interleave(cache_words_, first_layer_word_ + k * layer_words_);
+    if (!whole && layer_words_ > 0)
+      context.upload(buffers.probes.sh_sums, &cache_words_[first_layer_word_ + k * layer_words_], layer_words_ * 4,
+                     (first_layer_word_ + k * layer_words_) * 4);
+    uploaded_versions_[k] = versions[k];
+  }
+  if (whole) context.upload(buffers.probes.sh_sums, cache_words_.data(), words * 4);
+}
+
+void BounceLayerDriver::estimate(const BounceLayerPass& pass, const std::vector<BounceLayerCache>& caches,
+                                 const std::vector<uint64_t>& cache_versions) {
+  if (pass.samples == 0 || pass.end <= pass.begin) return;
+  if (!prepared_) prepare();
+  Context& context = runner_.context();
+  WavefrontBuffers& buffers = runner_.buffers();
+  upload_caches(size_t(pass.layer), caches, cache_versions);
+  if (uint64_t(pass.first_sample) + pass.samples > std::numeric_limits<uint32_t>::max())
+    throw std::invalid_argument("Vulkan backend: more than 2^32 - 1 samples per texel");
+  const size_t texels = gbuffer_.texels.size();
+  work_list_.resize(pass.end - pass.begin);
+  for (size_t i = pass.begin; i < pass.end; ++i) work_list_[i - pass.begin] = uint32_t(i);
+  context.upload(buffers.items.batch_items, work_list_.data(), work_list_.size() * 4);
+  VkCommandBuffer cmd = context.begin();
+  buffers.texels.clear(cmd);
+  context.submit_and_wait(cmd);
+
+  params_.bounce_layer = uint32_t(pass.layer);
+  const size_t chunk = std::min(work_list_.size(), max_work_);
+  const uint32_t largest = uint32_t(std::max<size_t>(1, max_work_ / chunk));
+  for (uint32_t done = 0; done < pass.samples;) {
+    const uint32_t samples = std::min(pass.samples - done, largest);
+    for (size_t offset = 0; offset < work_list_.size(); offset += chunk) {
+      const uint32_t n = uint32_t(std::min(chunk, work_list_.size() - offset));
+      BatchTotals batch;
+      runner_.run(params_, {uint32_t(offset), n, pass.first_sample + done, samples}, kResultBytes, kTexelBatch, batch);
+      totals_.add(batch);
+    }
+    done += samples;
+  }
+  runner_.record_statistics(totals_, kTexelBatch);
+
+  // The pass's sums (texel order, doubles) onto the layer's; the back-face counts in the first bounce slot.
+  std::vector<double> sums(texels * 6), back_faces(texels * 3);
+  context.download(buffers.texels.sums, sums.data(), sums.size() * 8);
+  context.download(buffers.texels.bounce_sums, back_faces.data(), back_faces.size() * 8);
+  for (size_t i = pass.begin; i < pass.end; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      pass.sum[i * 3 + size_t(c)] += sums[i * 6 + size_t(c)];
+      pass.sum_squared[i * 3 + size_t(c)] += sums[i * 6 + 3 + size_t(c)];
+    }
+    if (pass.back_faces) pass.back_faces[i] += uint32_t(back_faces[i * 3]);
+    if (pass.texel_rays) pass.texel_rays[i] = 0;  // not counted per texel on the device: an even split
+  }
+}
+
+BounceGatherCounts BounceLayerDriver::counts() const {
+  BounceGatherCounts c;
+  c.rays = totals_.rays();
+  c.gathers = totals_.bounce_gathers;
+  c.texelless = totals_.bounce_texelless;
+  c.back_faces = totals_.bounce_back_faces;
+  c.nonfinite = totals_.nonfinite;
+  return c;
+}
+
+}  // namespace exitance::vulkan
