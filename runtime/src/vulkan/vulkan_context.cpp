@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "device_requirements.h"
+#include "driver_allocation_scope.h"
 
 namespace exitance::vulkan {
 
@@ -89,7 +90,11 @@ VkInstance create_instance(bool validation, VkDebugUtilsMessengerCreateInfoEXT* 
     info.pNext = messenger;
   }
   VkInstance instance = VK_NULL_HANDLE;
-  const VkResult r = vkCreateInstance(&info, nullptr, &instance);
+  VkResult r;
+  {
+    const DriverAllocationScope driver;
+    r = vkCreateInstance(&info, nullptr, &instance);
+  }
   if (r != VK_SUCCESS)
     throw std::runtime_error("no Vulkan device: cannot create a Vulkan instance (" + result_name(r) +
                              "; is a Vulkan driver such as mesa-vulkan-drivers installed?)");
@@ -119,9 +124,13 @@ void Context::create_own_device(const VulkanDeviceOptions& options) {
     if (create) check(create(instance_, &messenger, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
   }
   uint32_t count = 0;
-  vkEnumeratePhysicalDevices(instance_, &count, nullptr);
-  std::vector<VkPhysicalDevice> devices(count);
-  vkEnumeratePhysicalDevices(instance_, &count, devices.data());
+  std::vector<VkPhysicalDevice> devices;
+  {
+    const DriverAllocationScope driver;
+    vkEnumeratePhysicalDevices(instance_, &count, nullptr);
+    devices.resize(count);
+    vkEnumeratePhysicalDevices(instance_, &count, devices.data());
+  }
   if (count == 0) throw std::runtime_error("no Vulkan device: the Vulkan loader found no physical device");
   int chosen = -1;
   std::string reasons;
@@ -154,7 +163,10 @@ void Context::create_own_device(const VulkanDeviceOptions& options) {
   device_info.queueCreateInfoCount = 1;
   device_info.pQueueCreateInfos = &queue_info;
   device_info.pEnabledFeatures = &features;
-  check(vkCreateDevice(physical_, &device_info, nullptr, &device_), "vkCreateDevice");
+  {
+    const DriverAllocationScope driver;
+    check(vkCreateDevice(physical_, &device_info, nullptr, &device_), "vkCreateDevice");
+  }
   vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
 }
 
@@ -170,9 +182,13 @@ void Context::adopt(const VulkanExternalDevice& external) {
   queue_ = external.queue;
   queue_family_ = external.queue_family;
   uint32_t count = 0;
-  vkEnumeratePhysicalDevices(instance_, &count, nullptr);
-  std::vector<VkPhysicalDevice> devices(count);
-  vkEnumeratePhysicalDevices(instance_, &count, devices.data());
+  std::vector<VkPhysicalDevice> devices;
+  {
+    const DriverAllocationScope driver;
+    vkEnumeratePhysicalDevices(instance_, &count, nullptr);
+    devices.resize(count);
+    vkEnumeratePhysicalDevices(instance_, &count, devices.data());
+  }
   const auto position = std::find(devices.begin(), devices.end(), physical_);
   info_ = describe_device(physical_, uint32_t(position - devices.begin()));  // its index on the engine's instance
 }
@@ -365,9 +381,13 @@ std::vector<VulkanDeviceInfo> enumerate_vulkan_devices() {
     return result;
   }
   uint32_t count = 0;
-  vkEnumeratePhysicalDevices(instance, &count, nullptr);
-  std::vector<VkPhysicalDevice> devices(count);
-  vkEnumeratePhysicalDevices(instance, &count, devices.data());
+  std::vector<VkPhysicalDevice> devices;
+  {
+    const vulkan::DriverAllocationScope driver;
+    vkEnumeratePhysicalDevices(instance, &count, nullptr);
+    devices.resize(count);
+    vkEnumeratePhysicalDevices(instance, &count, devices.data());
+  }
   for (uint32_t i = 0; i < count; ++i) result.push_back(vulkan::describe_device(devices[i], i));
   vkDestroyInstance(instance, nullptr);
   return result;
