@@ -200,8 +200,13 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
           cache_versions.push_back(0);
         }
       }
-      if (settings.progress && !passes.timed())
-        settings.progress(forced ? double(k + 1) / double(layer_cap) : double(k + 1) / double(k + 2), counters().rays);
+      // After every layer pass: the fraction of the budget spent under --time (a pass holds every
+      // layer, and on a large scene one pass can take most of the budget), else of the layers.
+      if (settings.progress)
+        settings.progress(passes.timed() ? std::min(1.0, passes.elapsed_seconds() / settings.time_budget_seconds)
+                          : forced       ? double(k + 1) / double(layer_cap)
+                                         : double(k + 1) / double(k + 2),
+                          counters().rays);
       bool out_of_time = passes.timed() && passes.elapsed_seconds() >= settings.time_budget_seconds;
       if (share && passes.timed()) out_of_time = agreed(*share, out_of_time);
       if (out_of_time) break;
