@@ -39,6 +39,10 @@ int main(int argc, char** argv) {
   bool no_frame_errors = false;
   app.add_flag("--no-frame-errors", no_frame_errors,
                "with --frames: no per-frame error (it reads the lightmap back between frames, which idles the GPU)");
+  app.add_option("--integrator", options.integrator,
+                 "path (default: progressive path tracing, frames) | bounces (the per-bounce mode, the whole lightmap "
+                 "in one run; not with --frames or --budget-ms)")
+      ->check(CLI::IsMember({"path", "bounces"}));
   app.add_option("--seed", seed, "random seed (default: the bake's); results are deterministic per seed and device");
   app.add_option("--device", options.device_index, "Vulkan device index (see --list-devices)")->check(CLI::NonNegativeNumber);
   app.add_flag("--list-devices", list_devices, "print the Vulkan devices and exit");

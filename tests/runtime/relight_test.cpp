@@ -153,6 +153,56 @@ TEST(Relight, ReproducesADirectionalBakeBitForBit) {
   fs::remove_all(dir);
 }
 
+// The per-bounce mode (--integrator bounces): a bundle baked with it on the Vulkan backend is relit
+// with it from scene.bin, bit for bit (the same core loop, per-texel streams and seed); the manifest
+// records the integrator; --frames is refused with it, and a directional bundle cannot use it.
+TEST(Relight, ReproducesAVulkanPerBounceBakeBitForBit) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const fs::path dir = fs::temp_directory_path() / ("exitance-relight-bounces-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path baked = dir / "bounces.bake", output = dir / "bounces-relit.bake";
+  BakeOptions bake;
+  bake.input = std::string(EXITANCE_SAMPLE_DIR) + "/cornell_room.gltf";
+  bake.output = baked.string();
+  bake.backend.name = "vulkan";
+  bake.lighting.integrator = IntegratorMode::Bounces;
+  bake.integrator_auto = false;
+  bake.atlas.texel_density = 4;
+  bake.lighting.spp = 4;
+  bake.lighting.seed = 9;
+  bake.probes_enabled = false;
+  bake.svo_enabled = false;
+  bake.skip_sealed_texels = false;
+  Diagnostics diagnostics;
+  run_bake(bake, diagnostics);
+  RelightOptions options;
+  options.bundle = baked.string();
+  options.output = output.string();
+  options.seed = 9;
+  options.spp = 4;
+  options.integrator = "bounces";
+  const nlohmann::json report = relight_bundle(options);
+  EXPECT_EQ(report["integrator"], "bounces");
+  EXPECT_GT(report["rays"].get<uint64_t>(), 0u);
+  const nlohmann::json manifest = nlohmann::json::parse(file_bytes(output / "manifest.json"));
+  EXPECT_EQ(manifest["settings"]["integrator"], "bounces");
+  size_t pages = 0;
+  for (const auto& entry : fs::directory_iterator(baked)) {
+    if (entry.path().extension() != ".exr") continue;
+    EXPECT_TRUE(file_bytes(entry.path()) == file_bytes(output / entry.path().filename()))
+        << entry.path().filename() << " differs from the per-bounce bake's";
+    ++pages;
+  }
+  EXPECT_GE(pages, 1u);
+  // Not progressive: frames need path tracing.
+  options.frames = 2;
+  options.output = (dir / "refused.bake").string();
+  EXPECT_THROW(relight_bundle(options), RelightInputError);
+  EXPECT_FALSE(fs::exists(dir / "refused.bake"));
+  fs::remove_all(dir);
+}
+
 // A scene with smooth lightmap UV seams (a sphere with generated UVs over a floor): the bake stitches
 // them, and so does the relight, from scene.bin's scene and atlas, bit for bit as the bake did; a bake
 // written with --seams off is relit unstitched (the mode follows the bundle's stats.seams.mode).

@@ -62,6 +62,8 @@ struct RefreshSession::State {
   uint32_t near_samples = 0, far_samples = 0, all_samples = 0;
   // What texels show until they have samples again after an edit (published_lightmap).
   std::optional<LightmapEstimate> previous;
+  // A bake_per_bounce() result: lightmap() until the next restart, edit or refresh.
+  std::optional<LightmapEstimate> per_bounce;
 };
 
 namespace {
@@ -163,6 +165,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
 
 void RefreshSession::restart() {
   State& s = *state_;
+  s.per_bounce.reset();
   s.integrator->start_progressive(s.persisted.gbuffer, s.settings);
   s.near_texels.clear();
   s.far_texels.clear();
@@ -173,6 +176,7 @@ const std::vector<uint32_t>& RefreshSession::texels_near_last_edit() const { ret
 
 uint32_t RefreshSession::samples_per_texel() const {
   const State& s = *state_;
+  if (s.per_bounce) return s.per_bounce->texels.empty() ? 0 : s.per_bounce->texels.front().samples;
   if (!s.near_texels.empty()) return s.far_samples;  // the far texels lag
   return s.all_samples;
 }
@@ -185,6 +189,7 @@ RefreshReport RefreshSession::refresh(const RefreshBudget& budget) {
   if (budget.milliseconds == 0 && budget.max_samples_per_texel == 0 && budget.texel_samples == 0)
     throw std::invalid_argument("RefreshSession::refresh: a budget needs milliseconds, a sample cap or texel-samples");
   State& s = *state_;
+  if (s.per_bounce) restart();  // the progressive accumulation again, from sample 0
   VulkanIntegrator& integrator = *s.integrator;
   const uint32_t cap = budget.max_samples_per_texel ? budget.max_samples_per_texel : std::numeric_limits<uint32_t>::max();
   RefreshReport report;
@@ -252,7 +257,27 @@ RefreshReport RefreshSession::refresh(const RefreshBudget& budget) {
   return report;
 }
 
-LightmapEstimate RefreshSession::lightmap() const { return state_->integrator->progressive_estimate(); }
+LightmapEstimate RefreshSession::lightmap() const {
+  return state_->per_bounce ? *state_->per_bounce : state_->integrator->progressive_estimate();
+}
+
+LightmapEstimate RefreshSession::bake_per_bounce(uint32_t spp, double time_budget_seconds) {
+  State& s = *state_;
+  if (s.settings.directional != DirectionalMode::Off)
+    throw std::invalid_argument("the per-bounce mode estimates no directional (sh1) layers: relight this bundle with path tracing");
+  if (spp == 0 && !(time_budget_seconds > 0))
+    throw std::invalid_argument("the per-bounce mode needs samples per texel or a time budget");
+  IntegratorSettings settings = s.settings;
+  settings.integrator = IntegratorMode::Bounces;
+  settings.spp = spp;
+  settings.time_budget_seconds = time_budget_seconds;
+  const formats::BakeSettings baked = s.manifest.settings.value_or(formats::BakeSettings{});
+  settings.trace_first_bounce = baked.first_bounce != "cached";
+  s.per_bounce = s.integrator->bake(s.persisted.gbuffer, settings);
+  return *s.per_bounce;
+}
+
+bool RefreshSession::per_bounce() const { return state_->per_bounce.has_value(); }
 
 LightmapEstimate RefreshSession::published_lightmap() const {
   LightmapEstimate estimate = lightmap();

@@ -96,7 +96,7 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   manifest.generator = "exitance-relight 0.1.0";
   formats::BakeSettings& settings = manifest.settings.emplace(baked);
   settings.backend = "vulkan";
-  settings.integrator = "path";  // the Vulkan backend's only integrator so far
+  settings.integrator = session.per_bounce() ? "bounces" : "path";
   settings.spp = session.samples_per_texel();
   settings.seed = session.settings().seed;
   settings.time_budget_seconds = report.value("time_budget_seconds", 0.0);

@@ -28,6 +28,11 @@ json relight_bundle(const RelightOptions& options) {
   };
   if (!(options.time_budget_seconds >= 0) || !(options.frame_budget_ms >= 0))
     throw RelightInputError("--time and --budget-ms must not be negative");
+  const bool per_bounce = options.integrator == "bounces";
+  if (!per_bounce && options.integrator != "path")
+    throw RelightInputError("--integrator " + options.integrator + ": expected path or bounces");
+  if (per_bounce && (options.frames > 0 || options.frame_budget_ms > 0))
+    throw RelightInputError("--integrator bounces runs the whole lightmap at once: --frames and --budget-ms need --integrator path");
 
   const fs::path bundle(options.bundle);
   const fs::path out = options.output.empty() ? bundle : fs::path(options.output);
@@ -76,7 +81,16 @@ json relight_bundle(const RelightOptions& options) {
   const auto lighting_start = Clock::now();
   json frames = json::array();
   uint64_t rays = 0;
-  for (uint32_t frame = 0; options.frames == 0 || frame < options.frames; ++frame) {
+  if (per_bounce) {
+    report("lighting", 0, 0);
+    try {
+      rays = session->bake_per_bounce(spp, options.time_budget_seconds).rays;
+    } catch (const std::invalid_argument& e) {
+      throw RelightInputError(options.bundle + ": " + e.what());
+    }
+    report("lighting", 1, rays);
+  }
+  for (uint32_t frame = 0; !per_bounce && (options.frames == 0 || frame < options.frames); ++frame) {
     RefreshBudget budget;
     budget.max_samples_per_texel = spp;
     budget.milliseconds = options.frame_budget_ms;
@@ -123,6 +137,7 @@ json relight_bundle(const RelightOptions& options) {
                         {"lane_efficiency", s.lane_efficiency}});
 
   json run;
+  run["integrator"] = per_bounce ? "bounces" : "path";
   run["spp"] = session->samples_per_texel();
   run["time_budget_seconds"] = options.time_budget_seconds;
   if (options.frame_budget_ms > 0) run["frame_budget_ms"] = options.frame_budget_ms;

@@ -84,6 +84,15 @@ class RefreshSession {
   // Drops every accumulated sample; the next refresh starts at sample 0.
   void restart();
   RefreshReport refresh(const RefreshBudget& budget);
+  // The whole lightmap in the per-bounce mode (seed 003; core/per_bounce_bake.h) on the session's
+  // device, at `spp` samples per texel per bounce (0: until the budget) within `time_budget_seconds`
+  // (0: none), with the bake's --first-bounce; not progressive: it replaces what lightmap() returns
+  // until the next restart, edit or refresh() call (which starts the progressive accumulation
+  // again). Throws std::invalid_argument for a bundle with directional layers (per-bounce passes
+  // estimate no L1) or without a bound.
+  LightmapEstimate bake_per_bounce(uint32_t spp, double time_budget_seconds);
+  // Whether lightmap() holds a bake_per_bounce() result.
+  bool per_bounce() const;
 
   // The lightmap accumulated since the last edit or restart (a read-back: it waits for the device).
   LightmapEstimate lightmap() const;

@@ -32,6 +32,9 @@ struct RelightOptions {
   bool validation = false;         // Vulkan validation layers; any message fails the relight
   bool stage_statistics = false;   // GPU time, rays and lane efficiency per wavefront stage (slower; benchmarks)
   uint32_t traversal_rays = 0;     // > 0: also time this many incoherent closest-hit rays alone (benchmarks)
+  // "path" (progressive path tracing, frames) or "bounces" (the per-bounce mode in one run: no
+  // --frames or --budget-ms; RefreshSession::bake_per_bounce).
+  std::string integrator = "path";
   // Stage reporting: (stage, fraction done, rays so far).
   std::function<void(const std::string&, double, uint64_t)> progress;
 };
