@@ -1,0 +1,35 @@
+#!/bin/bash
+# On the GPU machine (carry .gl and .replay; .replay/pb.txz holds a runtime folder `rt` from
+# `cmake --install BUILD --component runtime`, with build/bench/bench_bundle_rel_mse copied into rt/bin,
+# and cornell.bake, building.bake, city.bake: manifest, probes.bin, scene.bin, svo.bin of CPU bakes).
+# Per scene: a two-seed 4096-spp path-traced reference, then path at 64/256/1024 spp and the
+# per-bounce mode at 16/64/256 spp, timed, and each one's relMSE against the reference.
+#   bash .replay/per_bounce_gpu_run.sh
+set -e
+for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
+export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+mkdir -p /tmp/w && tar -C /tmp/w -xJf .replay/pb.txz
+nvidia-smi --query-gpu=name,driver_version --format=csv,noheader
+R=/tmp/w/rt/bin/exitance-relight
+field() { grep -o "\"$1\": *[0-9.e+-]*" $2 | head -1 | sed 's/.*: *//'; }
+for scene in ${SCENES:-cornell building city}; do
+  B=/tmp/w/$scene.bake
+  $R $B -o /tmp/w/warm.bake --spp 4 --seed 1 --json > /dev/null
+  $R $B -o /tmp/w/warm.bake --spp 4 --seed 1 --integrator bounces --json > /dev/null
+  $R $B -o /tmp/w/$scene-refA.bake --spp 4096 --seed 101 --json > /tmp/w/refA.json
+  $R $B -o /tmp/w/$scene-refB.bake --spp 4096 --seed 202 --json > /tmp/w/refB.json
+  tests=""
+  for spp in 64 256 1024; do
+    $R $B -o /tmp/w/$scene-path$spp.bake --spp $spp --seed 1 --json > /tmp/w/r.json
+    echo "$scene path $spp spp: lighting $(field lighting_seconds /tmp/w/r.json) s, rays $(field rays /tmp/w/r.json)"
+    tests="$tests /tmp/w/$scene-path$spp.bake"
+  done
+  for spp in 16 64 256; do
+    $R $B -o /tmp/w/$scene-bounces$spp.bake --spp $spp --seed 1 --integrator bounces --json > /tmp/w/r.json
+    echo "$scene bounces $spp spp: lighting $(field lighting_seconds /tmp/w/r.json) s, rays $(field rays /tmp/w/r.json)"
+    tests="$tests /tmp/w/$scene-bounces$spp.bake"
+  done
+  echo "$scene reference: $(field lighting_seconds /tmp/w/refA.json) s per 4096-spp run"
+  LD_LIBRARY_PATH=/tmp/w/rt/lib /tmp/w/rt/bin/bench_bundle_rel_mse /tmp/w/$scene-refA.bake /tmp/w/$scene-refB.bake $tests | sed "s#/tmp/w/##"
+  rm -rf /tmp/w/$scene-*.bake
+done
