@@ -1,5 +1,7 @@
 #include "exitance/bake/command/bake_stages.h"
 
+#include <chrono>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -197,11 +199,23 @@ LightmapEstimate lighting_stage(const Integrator& backend, const TexelGBuffer& g
   // The backends light the texel list they are given: hand them the texels light can reach and
   // put the estimate back on the full list (sealed texels with no samples).
   LightmapEstimate estimate;
+  const auto start = std::chrono::steady_clock::now();
   if (skip && skip->texels > 0) {
     const LightmapEstimate traced = backend.bake(gbuffer_without_skipped(gbuffer, skip->sealed), settings);
     estimate = expand_lightmap_estimate(traced, skip->sealed);
   } else {
     estimate = backend.bake(gbuffer, settings);
+  }
+  // A budget is cut into passes of whole samples; when even the first pass (one sample per texel,
+  // one per bounce in the per-bounce mode) does not fit, the bake keeps it and says so.
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (settings.time_budget_seconds > 0 && seconds > 1.02 * settings.time_budget_seconds) {
+    char line[320];
+    std::snprintf(line, sizeof line,
+                  "--time: the lighting took %.3g s, %.3gx the %.3g s the budget left it: one pass of the "
+                  "fewest samples the integrator takes did not fit (lower --texel-density or raise --time)",
+                  seconds, seconds / settings.time_budget_seconds, settings.time_budget_seconds);
+    diagnostics.warn(line);
   }
   warn_about_nonfinite_samples(estimate.nonfinite_samples, "path", options, diagnostics);
   return estimate;

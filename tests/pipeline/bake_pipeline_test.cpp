@@ -171,6 +171,31 @@ TEST(BakePipeline, SameSeedSameResult) {
   fs::remove_all(dir);
 }
 
+// A --time budget shorter than the lighting's first pass (one sample of every texel, and of every
+// bounce layer in the per-bounce mode): the bake keeps that pass, writes the bundle, and warns with
+// the time it took against the budget. The budget here (1 ms, the least the lighting gets) is far
+// below what one pass over 16 k texels takes on any machine (tens of milliseconds).
+TEST(BakePipeline, ABudgetBelowOnePassWarnsAndStillWrites) {
+  const fs::path dir = testing::fresh_temp_dir("budget");
+  BakeOptions options;
+  options.input = write_two_plane_scene(dir).string();
+  options.output = (dir / "out.bake").string();
+  options.sky = "1,1,1";
+  options.atlas.texel_density = 32;
+  options.lighting.spp = 0;
+  options.lighting.time_budget_seconds = 1e-3;
+  options.probes_enabled = false;
+  options.backend.name = "cpu";
+  Diagnostics diagnostics;
+  const nlohmann::json report = run_bake(options, diagnostics);
+  EXPECT_GT(report["live_texels"].get<size_t>(), 16000u);
+  bool warned = false;
+  for (const std::string& w : diagnostics.warnings) warned = warned || w.rfind("--time: the lighting took", 0) == 0;
+  EXPECT_TRUE(warned);
+  EXPECT_TRUE(fs::exists(dir / "out.bake" / "lightmap-0.exr"));
+  fs::remove_all(dir);
+}
+
 // A box standing on a floor under the sky: the floor under it is sealed. The bake skips it
 // (stats.skipped, valid = 0, A kept, filled from lit neighbours, never NaN); --no-skip traces it,
 // and what it gets there is exactly black (the skip changes nothing but the fill).
