@@ -48,15 +48,13 @@ bool bounce_cache_lookup(uint layer, uint tri, float b1, float b2, vec3 position
       uint at = layer_words + (first_texel + uint(y) * uint(width) + uint(x)) * kBounceCacheTexelWords;
       if (!(bounce_cache[at + 3u] > 0.0)) continue;
       vec3 n = vec3(bounce_cache[at + 7u], bounce_cache[at + 8u], bounce_cache[at + 9u]);
-      vec3 d = vec3(bounce_cache[at + 4u], bounce_cache[at + 5u], bounce_cache[at + 6u]) - position;
-      if (dot(n, normal) < kSameSurfaceCosine * length(n)) continue;
-      if (abs(dot(d, normal)) > kPlaneSlope * length(d)) continue;
+      vec3 p = vec3(bounce_cache[at + 4u], bounce_cache[at + 5u], bounce_cache[at + 6u]);
+      if (!texel_on_hit_surface(p, n, position, normal)) continue;
       float w = bilinear_weight(f, dx, dy);
       weight += w;
       sum += w * vec3(bounce_cache[at], bounce_cache[at + 1u], bounce_cache[at + 2u]);
     }
-  // A footprint whose usable texels carry almost no weight would amplify one texel's noise: none.
-  if (!(weight > 1e-3)) return false;
+  if (!(weight > kLeastFootprintWeight)) return false;
   value = sum / weight;
   return true;
 }

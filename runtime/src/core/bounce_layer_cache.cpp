@@ -60,15 +60,13 @@ bool BounceLayerCache::lookup(const TexelGBuffer& gbuffer, uint32_t instance, Ve
       const size_t at = size_t(y) * size_t(page.width) + size_t(x);
       if (!(page.channel[kLit][at] > 0)) continue;
       const Vec3 n{page.channel[kNx][at], page.channel[kNy][at], page.channel[kNz][at]};
-      const Vec3 d = Vec3{page.channel[kPx][at], page.channel[kPy][at], page.channel[kPz][at]} - position;
-      if (dot(n, normal) < kSameSurfaceCosine * length(n)) continue;
-      if (std::fabs(dot(d, normal)) > kPlaneSlope * length(d)) continue;
+      const Vec3 p{page.channel[kPx][at], page.channel[kPy][at], page.channel[kPz][at]};
+      if (!texel_on_hit_surface(p, n, position, normal)) continue;
       const double w = bilinear_weight(f, dx, dy);
       weight += w;
       for (int c = 0; c < 3; ++c) sum[c] += w * page.channel[c][at];
     }
-  // A footprint whose usable texels carry almost no weight would amplify one texel's noise: none.
-  if (!(weight > 1e-3)) return false;
+  if (!(weight > kLeastFootprintWeight)) return false;
   out = {float(sum[0] / weight), float(sum[1] / weight), float(sum[2] / weight)};
   return true;
 }

@@ -51,6 +51,18 @@ EXITANCE_FN BilinearFootprint bilinear_footprint(vec2 page_uv, int width, int he
 const float kSameSurfaceCosine = 0.8f;
 const float kPlaneSlope = 0.25f;
 
+// Whether a footprint texel (centre `texel_position`, normal `texel_normal`, any length) is on the
+// surface hit at `position` with unit normal `normal`, by the two thresholds above.
+EXITANCE_FN bool texel_on_hit_surface(vec3 texel_position, vec3 texel_normal, vec3 position, vec3 normal) {
+  vec3 d = texel_position - position;
+  return !(dot(texel_normal, normal) < kSameSurfaceCosine * length(texel_normal)) &&
+         !(abs(dot(d, normal)) > kPlaneSlope * length(d));
+}
+
+// A footprint whose usable texels carry no more bilinear weight than this gives no value: the
+// renormalisation would amplify one texel's noise.
+const float kLeastFootprintWeight = 1e-3f;
+
 // Weight of corner (dx, dy) in {0, 1}^2 of a footprint.
 EXITANCE_FN float bilinear_weight(BilinearFootprint f, int dx, int dy) {
   float wx = dx == 0 ? 1.0f - f.fx : f.fx;
