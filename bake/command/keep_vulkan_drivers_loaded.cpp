@@ -2,14 +2,8 @@
 // loader has already dlclose()d as "<unknown module>", which no suppression can match. Pinning
 // the loader and Mesa's lavapipe for the life of the process lets their driver-internal leaks be
 // attributed, and suppressed by name in tests/lsan.supp, while our own leaks still fail the run.
-// GCC defines __SANITIZE_ADDRESS__ under -fsanitize=address; clang (14) only answers __has_feature.
-#if defined(__SANITIZE_ADDRESS__)
-#define EXITANCE_ADDRESS_SANITIZER 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define EXITANCE_ADDRESS_SANITIZER 1
-#endif
-#endif
+#include "exitance/runtime/address_sanitizer.h"
+
 #if defined(EXITANCE_ADDRESS_SANITIZER)
 #include <dlfcn.h>
 

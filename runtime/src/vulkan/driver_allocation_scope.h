@@ -5,14 +5,7 @@
 // allocates nothing inside these calls; everywhere else leaks still fail the sanitizer run.
 #pragma once
 
-// GCC defines __SANITIZE_ADDRESS__ under -fsanitize=address; clang (14) only answers __has_feature.
-#if defined(__SANITIZE_ADDRESS__)
-#define EXITANCE_ADDRESS_SANITIZER 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define EXITANCE_ADDRESS_SANITIZER 1
-#endif
-#endif
+#include "exitance/runtime/address_sanitizer.h"
 
 #if defined(EXITANCE_ADDRESS_SANITIZER)
 #include <sanitizer/lsan_interface.h>
