@@ -21,17 +21,14 @@
 #include "exitance/formats/lightmap_exr.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "support/sphere_over_floor_gltf.h"
+#include "support/vulkan_device_available.h"
 
 namespace exitance {
 namespace {
 
 namespace fs = std::filesystem;
 
-bool has_vulkan_device() {
-  for (const VulkanDeviceInfo& d : enumerate_vulkan_devices())
-    if (d.usable) return true;
-  return false;
-}
+using testing::has_vulkan_device;
 
 // A 6 m textured floor, a back wall, and a 2 x 1 m fence of four vertical slats (a MASK texture of
 // alternating opaque and clear columns) standing on the floor; TEXCOORD_0 only.

@@ -27,6 +27,7 @@
 #include "exitance/runtime/refresh/refresh_session.h"
 #include "exitance/runtime/scene_file_conversion.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
+#include "support/vulkan_device_available.h"
 
 namespace exitance {
 namespace {
@@ -34,11 +35,7 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
-bool has_vulkan_device() {
-  for (const VulkanDeviceInfo& d : enumerate_vulkan_devices())
-    if (d.usable) return true;
-  return false;
-}
+using testing::has_vulkan_device;
 
 fs::path test_dir() {
   static const fs::path dir = [] {

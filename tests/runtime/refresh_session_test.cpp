@@ -18,17 +18,14 @@
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "exitance/runtime/world_box.h"
 #include "support/engine_vulkan_device.h"
+#include "support/vulkan_device_available.h"
 
 namespace exitance {
 namespace {
 
 namespace fs = std::filesystem;
 
-bool has_vulkan_device() {
-  for (const VulkanDeviceInfo& d : enumerate_vulkan_devices())
-    if (d.usable) return true;
-  return false;
-}
+using testing::has_vulkan_device;
 
 // The Cornell room baked once (CPU backend: the session must not depend on how it was baked).
 const fs::path& baked_bundle() {

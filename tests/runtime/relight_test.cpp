@@ -23,17 +23,14 @@
 #include "exitance/runtime/scene_file_conversion.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "support/sphere_over_floor_gltf.h"
+#include "support/vulkan_device_available.h"
 
 namespace exitance {
 namespace {
 
 namespace fs = std::filesystem;
 
-bool has_vulkan_device() {
-  for (const VulkanDeviceInfo& d : enumerate_vulkan_devices())
-    if (d.usable) return true;
-  return false;
-}
+using testing::has_vulkan_device;
 
 std::string file_bytes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
