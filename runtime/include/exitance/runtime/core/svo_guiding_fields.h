@@ -66,8 +66,8 @@ struct SvoGuidingConfig {
 // The octree level whose voxel edge (size / 2^level) is the diameter of the footprint at distance
 // r of a cone of solid angle `solid_angle`: the cone's plane half-angle theta solves
 // solid_angle = 2 pi (1 - cos theta), footprint radius R = r tan(theta), level =
-// floor(log2(size / (2 R))) clamped to [0, depth] (the coarsest voxel no larger than the footprint
-// is the finest one that still averages over it). Seed 000's public code passes the solid angle
+// floor(log2(size / (2 R))) clamped to [0, depth]: the finest voxel whose edge is at least the
+// footprint's diameter, so the read averages over the whole footprint (as a cone march would). Seed 000's public code passes the solid angle
 // 4 pi / N^2 where this plane angle belongs (R = 4 r / N); for a hemisphere bin of 2 pi / N^2,
 // theta ~ sqrt(2) / N, about a third of that.
 double svo_guide_cone_half_angle(double solid_angle);
