@@ -104,6 +104,8 @@ int main(int argc, char** argv) {
                  "atlases would otherwise get a few leaves per axis)");
   double svo_c_ray = 512;
   app.add_option("--svo-c-ray", svo_c_ray, "svo runs: PARTITION-S c_ray (vertices per sample per texel per bin)");
+  uint32_t svo_rays_per_bin = 1;
+  app.add_option("--svo-rays-per-bin", svo_rays_per_bin, "svo runs: rays per hemisphere bin of a field (k x k)");
   app.add_option("--name", scene_name, "scene name in the CSV (default: file stem)");
   app.add_option("--max-seconds", max_seconds, "stop the ladder after a run longer than this");
   app.add_option("--sky", sky);
@@ -252,6 +254,7 @@ int main(int argc, char** argv) {
         settings.guiding_mix = guiding_mix;
         settings.guiding_octree = &octree;
         settings.guiding_svo_c_ray = svo_c_ray;
+        settings.guiding_svo_rays_per_bin = svo_rays_per_bin;
         uint32_t svo_records = 0, svo_bins = 0;
         size_t svo_memory = 0;
         settings.inspect_svo_guiding = [&](const SvoGuidingFields& fields) {

@@ -240,11 +240,17 @@ void SvoGuidingFields::build_field(uint32_t record, uint64_t seed) {
   const Vec3 origin = offset_ray_origin(record_origin_[record], ng, scene_.extent);
   float* field = &field_[size_t(record) * kGuideBins];
   const uint64_t stream = splitmix64(seed ^ splitmix64((uint64_t(rebuilds_) << 32) ^ record ^ 0xF1E1Dull));
+  const uint32_t k = std::max(1u, uint32_t(std::sqrt(double(std::max(1u, config_.rays_per_bin)) + 1e-9)));
   for (uint32_t b = 0; b < kGuideBins; ++b) {
-    const uint64_t h = splitmix64(stream + b);
-    const Vec3 d = guide_from_class_local(normal_class, guide_bin_point(b, unit_float(h), unit_float(splitmix64(h))));
-    // Directions under the capture texel's surface carry nothing it can receive.
-    field[b] = dot(d, ng) > 0 ? radiance_along(origin, d) : 0.0f;
+    double sum = 0;
+    for (uint32_t s = 0; s < k * k; ++s) {
+      const uint64_t h = splitmix64(stream + uint64_t(b) * k * k + s);
+      const float fx = (float(s % k) + unit_float(h)) / float(k), fy = (float(s / k) + unit_float(splitmix64(h))) / float(k);
+      const Vec3 d = guide_from_class_local(normal_class, guide_bin_point(b, std::min(fx, 0.99999994f), std::min(fy, 0.99999994f)));
+      // Directions under the capture texel's surface carry nothing it can receive.
+      if (dot(d, ng) > 0) sum += radiance_along(origin, d);
+    }
+    field[b] = float(sum / double(k * k));
   }
   // [1 2 1] x [1 2 1] / 16 on the square, weights renormalised at its edges.
   constexpr int n = int(kGuideBinsPerSide);

@@ -132,9 +132,10 @@ struct CpuReferenceIntegrator::Impl {
   // SVO guiding: vertices sample their bin's field and are counted for the next rebuild's bins.
   struct SvoGuide {
     SvoGuidingFields& fields;
+    bool counting;
     uint32_t site(const SurfacePoint& x) const {
       const uint32_t node = fields.node_of(x.position);
-      fields.count(node, x.shading_normal);
+      if (counting) fields.count(node, x.shading_normal);
       return fields.record_of(node, x.shading_normal);
     }
     GuideVertex vertex(uint32_t record) const { return fields.vertex(record); }
@@ -258,13 +259,15 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   // SVO guiding: fields rebuilt after the passes that reach 1, 2, 4, ... samples per texel (the first
   // pass unguided unless the octree already holds exitance), their rays traced by Embree.
   std::unique_ptr<SvoGuidingFields> svo_guide;
-  uint32_t svo_counted_from = 0, svo_next_rebuild = 1;
+  uint32_t svo_next_rebuild = 1;
+  bool svo_counting = false;  // this pass counts vertices per node: the pass that ends at a rebuild
   if (settings.guiding == GuidingMode::Svo) {
     if (!settings.guiding_octree)
       throw std::invalid_argument("CPU backend: --guiding svo needs the bake's sparse voxel octree (not --voxel-resolution none)");
     SvoGuidingConfig config;
     config.mix = settings.guiding_mix;
     config.c_ray = settings.guiding_svo_c_ray;
+    config.rays_per_bin = settings.guiding_svo_rays_per_bin;
     std::shared_ptr<const EmbreeScene> embree = impl_->embree;
     svo_guide = std::make_unique<SvoGuidingFields>(*impl_->lighting, *settings.guiding_octree, gbuffer, config,
                                                    [embree](Vec3 origin, Vec3 direction) {
@@ -298,7 +301,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     contributions.directional = directional;
     const uint64_t rays_before = rays;
     if (svo_guide)
-      impl_->trace(point, settings, rng, contributions, rays, Impl::SvoGuide{*svo_guide}, &guided_per_thread.local());
+      impl_->trace(point, settings, rng, contributions, rays, Impl::SvoGuide{*svo_guide, svo_counting},
+                   &guided_per_thread.local());
     else if (guide)
       impl_->trace(point, settings, rng, contributions, rays, Impl::GridGuide{*impl_, *guide, learning},
                    &guided_per_thread.local());
@@ -346,6 +350,9 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   double fraction = 1;
   while (passes.next_pass(first, count, &fraction)) {
     const bool learning = guide && first < kGuidingLearningSamples;
+    // SVO bins come from the vertices of the pass that reaches the next rebuild (counting every
+    // pass cost integer atomics at every vertex for counts the doubling schedule mostly discards).
+    svo_counting = svo_guide && first + count >= svo_next_rebuild;
     if (planning) {
       const double progress = double(first) - progress_after_pilot + double(count) * fraction;
       tbb::parallel_for(tbb::blocked_range<size_t>(0, texel_count, 16), [&](const tbb::blocked_range<size_t>& range) {
@@ -377,10 +384,9 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       }
     }
     if (learning) guide->swap();  // this pass's learning becomes the next pass's frozen table
-    if (svo_guide && passes.samples_done() >= svo_next_rebuild) {
-      svo_guide->rebuild(&estimate, double(passes.samples_done() - svo_counted_from), settings.seed);
-      svo_counted_from = passes.samples_done();
-      svo_next_rebuild = 2 * passes.samples_done();
+    if (svo_guide && svo_counting) {  // this pass reached the next rebuild and counted its vertices
+      svo_guide->rebuild(&estimate, double(count) * fraction, settings.seed);
+      svo_next_rebuild = 2 * (first + count);
     }
     passes.finish_pass(rays_per_thread.combine(std::plus<uint64_t>()));
     if (adaptive && !planning && passes.samples_done() == pilot && fraction == 1) {

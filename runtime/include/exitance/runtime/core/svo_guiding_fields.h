@@ -14,8 +14,8 @@
 //    thesis's c_ray counts one 1-spp frame, so the threshold scales with the samples counted) or it
 //    is at level l_min. A vertex's bin is its first marked ancestor (or itself); none: cosine only.
 //  - Fields: per (bin, normal class) with counted vertices and a texel of that class in the bin, a
-//    capture origin = one of those texels (hashed pick, re-picked per rebuild); one ray per
-//    hemisphere bin of guided_direction.h (jittered per rebuild); at hit distance r the octree is
+//    capture origin = one of those texels (hashed pick, re-picked per rebuild); rays_per_bin rays
+//    per hemisphere bin of guided_direction.h (stratified, jittered per rebuild), averaged; at hit distance r the octree is
 //    read at the level whose voxel edge matches the footprint diameter 2 r tan(theta) of the cone
 //    of the bin's mean solid angle (svo_guide_cone_level), on the side facing the ray; the hit
 //    triangle's own emission is kept when larger (emitters without texels); misses read the sky.
@@ -61,6 +61,9 @@ struct SvoGuidingConfig {
   float mix = 0.5f;         // guided component's probability at a guided vertex
   double c_ray = 512;       // vertices per sample per texel that make a node a bin
   int l_min_below_depth = 3;  // l_min = max(0, depth - this)
+  // Rays per hemisphere bin of a field (a stratified k x k grid in the bin's square, k = floor(sqrt)):
+  // the thesis's 1 aliases small openings (a 5 cm gap is a fifth of a bin 3 m away).
+  uint32_t rays_per_bin = 1;
 };
 
 // The octree level whose voxel edge (size / 2^level) is the diameter of the footprint at distance
