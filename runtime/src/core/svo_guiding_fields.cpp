@@ -129,7 +129,8 @@ void SvoGuidingFields::fill_exitance(const LightmapEstimate& estimate) {
     if (i >= estimate.texels.size() || estimate.texels[i].samples == 0) continue;
     float b1, b2;
     barycentrics_on_triangle(scene_, t.triangle, t.position, b1, b2);
-    const Vec3 outgoing = scene_emission(scene_, t.triangle, b1, b2) + t.albedo * estimate.mean_total(i);
+    const Vec3 reflected = t.albedo * estimate.mean_total(i);
+    const Vec3 outgoing = config_.emitted ? scene_emission(scene_, t.triangle, b1, b2) + reflected : reflected;
     exitance_->deposit({t.position, t.geometric_normal, outgoing * kPi, t.world_texel_size * t.world_texel_size});
   }
   exitance_->publish(1.0f);  // replacement: the running estimate already averages every sample
@@ -226,6 +227,7 @@ float SvoGuidingFields::radiance_along(Vec3 origin, Vec3 direction) const {
   }
   // Emitters may have no texels (then the octree never saw them): their own emission counts too.
   const Vec3 ng = triangle_geometric_normal(scene_, hit.triangle);
+  if (!config_.emitted) return std::isfinite(radiance) ? std::max(radiance, 0.0f) : 0.0f;
   if (dot(direction, ng) < 0 || material_double_sided(scene_material(scene_, scene_triangle_material(scene_, hit.triangle)))) {
     float b1, b2;
     barycentrics_on_triangle(scene_, hit.triangle, p, b1, b2);

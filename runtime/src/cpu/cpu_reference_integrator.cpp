@@ -268,6 +268,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     config.mix = settings.guiding_mix;
     config.c_ray = settings.guiding_svo_c_ray;
     config.rays_per_bin = settings.guiding_svo_rays_per_bin;
+    config.emitted = settings.guiding_svo_emitted;
     std::shared_ptr<const EmbreeScene> embree = impl_->embree;
     svo_guide = std::make_unique<SvoGuidingFields>(*impl_->lighting, *settings.guiding_octree, gbuffer, config,
                                                    [embree](Vec3 origin, Vec3 direction) {

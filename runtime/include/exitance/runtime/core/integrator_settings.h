@@ -65,6 +65,7 @@ struct IntegratorSettings {
   const formats::SparseVoxelOctree* guiding_octree = nullptr;
   double guiding_svo_c_ray = 512;
   uint32_t guiding_svo_rays_per_bin = 1;  // rays per hemisphere bin of an SVO field (k x k stratified)
+  bool guiding_svo_emitted = true;        // SVO fields include emitted radiance (false: reflected only)
   std::function<void(double fraction_done, uint64_t rays)> progress;  // called between passes
   // Called once at the end of a guided bake with its cache (plots of the learned fields, tests).
   std::function<void(const GridGuidingCache&)> inspect_guiding;

@@ -64,6 +64,9 @@ struct SvoGuidingConfig {
   // Rays per hemisphere bin of a field (a stratified k x k grid in the bin's square, k = floor(sqrt)):
   // the thesis's 1 aliases small openings (a 5 cm gap is a fifth of a bin 3 m away).
   uint32_t rays_per_bin = 1;
+  // Whether fields hold emitted radiance too (the thesis) or only reflected radiance: next-event
+  // estimation already samples emitters, and guided rays spent on them only split its MIS weight.
+  bool emitted = true;
 };
 
 // The octree level whose voxel edge (size / 2^level) is the diameter of the footprint at distance
