@@ -3,7 +3,8 @@
 // unguided path tracer per region (instance) on a box lit by a small bright emitter (NEE + MIS
 // against the mixture pdf), the Cornell room, the courtyard (sky) and ajar_room; no NaN/Inf; a
 // one-emitter scene's field peaks toward the emitter; PARTITION-S's bins follow c_ray and l_min;
-// results bit-identical per seed and across thread counts.
+// an octree holding exitance guides the first pass; results bit-identical per seed and across
+// thread counts.
 //
 // Statistics as guided_path_test.cpp: standard errors from kSeeds independent seeds, kZLimit = 5
 // (two-sided p ~ 1.3e-4 under Student's t with 15 dof per region), and each test checks its power:
@@ -20,6 +21,7 @@
 
 #include "exitance/bake/command/prepared_scene.h"
 #include "exitance/bake/voxelize/svo_build.h"
+#include "exitance/runtime/bundle/texel_exitance.h"
 #include "exitance/runtime/core/svo_guiding_fields.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "support/atlas_box.h"
@@ -263,6 +265,26 @@ TEST(SvoGuiding, BitIdenticalPerSeedAndThreadCount) {
   }
   const LightmapEstimate other = integrator.bake(p.gbuffer, settings(24, 8, GuidingMode::Svo, &octree));
   EXPECT_FALSE(identical(a, other)) << "the seed must matter";
+}
+
+// An octree that already holds exitance (an earlier bake's svo.bin) seeds the guide: its fields are
+// built before the first pass, so even a 1-spp bake samples guided; a fresh octree's first pass is
+// unguided.
+TEST(SvoGuiding, OctreeWithExitanceGuidesTheFirstPass) {
+  const Vec3 le{1, 1, 1};
+  const Vec3 emission[6] = {le, le, le, le, le, le};
+  const testing::AtlasScene box = testing::atlas_box(0.5f, emission, 8);
+  formats::SparseVoxelOctree octree = octree_of(box.scene, 8);
+  const CpuReferenceIntegrator integrator(box.scene);
+  EXPECT_EQ(integrator.bake(box.gbuffer, settings(1, 1, GuidingMode::Svo, &octree)).guided_vertices, 0u);
+  fill_svo_exitance(octree, box.scene, box.gbuffer, integrator.bake(box.gbuffer, settings(4, 2, GuidingMode::Off, nullptr)));
+  uint32_t seeded_rebuilds = 0;
+  IntegratorSettings s = settings(1, 1, GuidingMode::Svo, &octree);
+  s.inspect_svo_guiding = [&](const SvoGuidingFields& fields) { seeded_rebuilds = fields.rebuilds(); };
+  const LightmapEstimate e = integrator.bake(box.gbuffer, s);
+  EXPECT_GT(e.guided_vertices, 0u);
+  EXPECT_EQ(seeded_rebuilds, 2u);  // before the first pass, and after it
+  EXPECT_EQ(e.nonfinite_samples, 0u);
 }
 
 TEST(SvoGuiding, RefusedWithoutOctreeOrInBouncesMode) {
