@@ -13,7 +13,7 @@ measured in the same run. References are cached by content hash in ~/.cache/exit
 (bench/results/per-bounce.md) come from --backends cpu --integrators path,bounces --report per-bounce;
 grid guiding's (bench/results/guiding.md) from --backends cpu --integrators path,guided --report guiding_time_vs_error;
 SVO guiding's (bench/results/guiding-svo.md) from --integrators path,guided,svo (--tool-args passes
-e.g. "--svo-depth 7 --svo-c-ray 256" on to bench_time_to_error).
+e.g. --tool-args="--svo-depth 7 --svo-c-ray 256" on to bench_time_to_error; write it with =).
 --ladder-scale multiplies every scene's largest spp (longer ladders, e.g. to reach 20 s).
 The table's last column: relMSE of the CPU path tracer divided by this row's, both interpolated
 (log-log) at the same time, the longest both reached: > 1 = better than the CPU path tracer.

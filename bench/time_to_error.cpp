@@ -108,6 +108,8 @@ int main(int argc, char** argv) {
   app.add_option("--svo-rays-per-bin", svo_rays_per_bin, "svo runs: rays per hemisphere bin of a field (k x k)");
   bool svo_reflected_only = false;
   app.add_flag("--svo-reflected-only", svo_reflected_only, "svo runs: fields without emitted radiance");
+  bool svo_skip_texels = false;
+  app.add_flag("--svo-skip-texels", svo_skip_texels, "svo runs: texel vertices sample cosine (guiding from bounce 1)");
   app.add_option("--name", scene_name, "scene name in the CSV (default: file stem)");
   app.add_option("--max-seconds", max_seconds, "stop the ladder after a run longer than this");
   app.add_option("--sky", sky);
@@ -258,6 +260,7 @@ int main(int argc, char** argv) {
         settings.guiding_svo_c_ray = svo_c_ray;
         settings.guiding_svo_rays_per_bin = svo_rays_per_bin;
         settings.guiding_svo_emitted = !svo_reflected_only;
+        settings.guiding_svo_texels = !svo_skip_texels;
         uint32_t svo_records = 0, svo_bins = 0;
         size_t svo_memory = 0;
         settings.inspect_svo_guiding = [&](const SvoGuidingFields& fields) {

@@ -76,6 +76,7 @@ void hash_options(Sha256Stream& h, const BakeOptions& o) {
   h.value(l.directional);
   h.value(l.guiding_grid_cells), h.value(l.adaptive), h.value(o.adaptive_request);
   h.value(l.guiding_svo_c_ray), h.value(l.guiding_svo_rays_per_bin), h.value(l.guiding_svo_emitted);
+  h.value(l.guiding_svo_texels);
   h.value(o.bounce_layers), h.value(o.probes_enabled), h.value(o.probe_spacing), h.value(o.probe_spp);
   h.value(o.probe_sh_window), h.value(o.svo_enabled), h.value(o.voxel_resolution);
   h.value(o.skip_sealed_texels), h.value(o.stitch_seams);

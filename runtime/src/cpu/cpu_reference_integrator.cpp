@@ -112,7 +112,7 @@ struct CpuReferenceIntegrator::Impl {
   // What trace() asks of a guide: the record of a vertex (site), its strategy (vertex), and what a
   // continuation ray teaches it (observe). No guide: cosine sampling, exactly as before guiding.
   struct NoGuide {
-    uint32_t site(const SurfacePoint&) const { return 0; }
+    uint32_t site(const SurfacePoint&, int) const { return 0; }
     GuideVertex vertex(uint32_t) const { return guide_vertex_cosine(); }
     void observe(uint32_t, const GuideVertex&, Vec3, const Hit&) const {}
   };
@@ -121,7 +121,7 @@ struct CpuReferenceIntegrator::Impl {
     const Impl& impl;
     GridGuidingCache& cache;
     bool learn;
-    uint32_t site(const SurfacePoint& x) const { return cache.record_of(x.position, x.shading_normal); }
+    uint32_t site(const SurfacePoint& x, int) const { return cache.record_of(x.position, x.shading_normal); }
     GuideVertex vertex(uint32_t record) const { return cache.vertex(record); }
     void observe(uint32_t record, const GuideVertex& g, Vec3 direction, const Hit& hit) const {
       if (!learn || record == GridGuidingCache::kNoRecord) return;
@@ -129,14 +129,16 @@ struct CpuReferenceIntegrator::Impl {
       if (local.z > 0) cache.learn(record, guide_bin_of_local(local), impl.learning_target(cache, hit, direction));
     }
   };
-  // SVO guiding: vertices sample their bin's field and are counted for the next rebuild's bins.
+  // SVO guiding: vertices sample their bin's field and are counted for the next rebuild's bins;
+  // without `texels`, the texel's own vertex samples cosine (its Sobol pair stays stratified).
   struct SvoGuide {
     SvoGuidingFields& fields;
     bool counting;
-    uint32_t site(const SurfacePoint& x) const {
+    bool texels;
+    uint32_t site(const SurfacePoint& x, int bounce) const {
       const uint32_t node = fields.node_of(x.position);
       if (counting) fields.count(node, x.shading_normal);
-      return fields.record_of(node, x.shading_normal);
+      return bounce == 0 && !texels ? SvoGuidingFields::kNoRecord : fields.record_of(node, x.shading_normal);
     }
     GuideVertex vertex(uint32_t record) const { return fields.vertex(record); }
     void observe(uint32_t, const GuideVertex&, Vec3, const Hit&) const {}
@@ -151,7 +153,7 @@ struct CpuReferenceIntegrator::Impl {
     Vec3 throughput{1, 1, 1};
     for (int bounce = 0;; ++bounce) {
       const Vec3 origin = offset_ray_origin(x.position, x.geometric_normal, s.extent);
-      const uint32_t record = guide.site(x);
+      const uint32_t record = guide.site(x, bounce);
       GuideVertex g = guide.vertex(record);
       if (guided_vertices && g.guided_probability > 0) ++*guided_vertices;
       const bool directional_texel = out.directional && bounce == 0;
@@ -302,7 +304,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     contributions.directional = directional;
     const uint64_t rays_before = rays;
     if (svo_guide)
-      impl_->trace(point, settings, rng, contributions, rays, Impl::SvoGuide{*svo_guide, svo_counting},
+      impl_->trace(point, settings, rng, contributions, rays, Impl::SvoGuide{*svo_guide, svo_counting, settings.guiding_svo_texels},
                    &guided_per_thread.local());
     else if (guide)
       impl_->trace(point, settings, rng, contributions, rays, Impl::GridGuide{*impl_, *guide, learning},

@@ -66,6 +66,9 @@ struct IntegratorSettings {
   double guiding_svo_c_ray = 512;
   uint32_t guiding_svo_rays_per_bin = 1;  // rays per hemisphere bin of an SVO field (k x k stratified)
   bool guiding_svo_emitted = true;        // SVO fields include emitted radiance (false: reflected only)
+  // Whether texels' own vertices (bounce 0) sample the SVO mixture; false: cosine there, so the
+  // first continuation keeps its stratified Sobol pair (bench/results/guiding-svo.md).
+  bool guiding_svo_texels = true;
   std::function<void(double fraction_done, uint64_t rays)> progress;  // called between passes
   // Called once at the end of a guided bake with its cache (plots of the learned fields, tests).
   std::function<void(const GridGuidingCache&)> inspect_guiding;
