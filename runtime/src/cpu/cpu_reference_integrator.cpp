@@ -304,8 +304,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     contributions.directional = directional;
     const uint64_t rays_before = rays;
     if (svo_guide)
-      impl_->trace(point, settings, rng, contributions, rays, Impl::SvoGuide{*svo_guide, svo_counting, settings.guiding_svo_texels},
-                   &guided_per_thread.local());
+      impl_->trace(point, settings, rng, contributions, rays,
+                   Impl::SvoGuide{*svo_guide, svo_counting, settings.guiding_svo_texels}, &guided_per_thread.local());
     else if (guide)
       impl_->trace(point, settings, rng, contributions, rays, Impl::GridGuide{*impl_, *guide, learning},
                    &guided_per_thread.local());
@@ -353,8 +353,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   double fraction = 1;
   while (passes.next_pass(first, count, &fraction)) {
     const bool learning = guide && first < kGuidingLearningSamples;
-    // SVO bins come from the vertices of the pass that reaches the next rebuild (counting every
-    // pass cost integer atomics at every vertex for counts the doubling schedule mostly discards).
+    // SVO bins come from the vertices of the pass that reaches the next rebuild (the thesis's
+    // previous frame): counts of earlier passes would describe older fields' paths.
     svo_counting = svo_guide && first + count >= svo_next_rebuild;
     if (planning) {
       const double progress = double(first) - progress_after_pilot + double(count) * fraction;
