@@ -1,5 +1,7 @@
 #!/usr/bin/python3
-"""Images of learned grid guiding tables (issue 11): the CSV of bench_time_to_error --guiding-fields.
+"""Images of learned grid guiding tables or SVO guiding fields (issue 11): the CSV of
+bench_time_to_error --guiding-fields (grid runs: one row per grid cell x class; svo runs: one row per
+(bin, class) record with its bin's octree level and capture origin).
 
   /usr/bin/python3 bench/plot_guiding_fields.py FIELDS.csv OUT.png [--title NAME] [--count 8]
 
@@ -48,13 +50,15 @@ def main():
         grid = [[max(values[j * side + i], 1e-6) for i in range(side)] for j in range(side)]
         image = ax.imshow(grid, origin="lower", norm=LogNorm(vmin=max(min(min(g) for g in grid), max(values) * 1e-4),
                                                              vmax=max(values)), cmap="magma")
-        ax.set_title(f"cell ({r['cell_x']},{r['cell_y']},{r['cell_z']}) {CLASSES[int(r['normal_class'])]}\nmax/mean {peak:.1f}",
-                     fontsize=8)
+        where = (f"cell ({r['cell_x']},{r['cell_y']},{r['cell_z']})" if "cell_x" in r else
+                 f"level {r['level']} at ({float(r['x']):.2f},{float(r['y']):.2f},{float(r['z']):.2f})")
+        ax.set_title(f"{where} {CLASSES[int(r['normal_class'])]}\nmax/mean {peak:.1f}", fontsize=8)
         ax.axis("on")
         ax.set_xticks([])
         ax.set_yticks([])
         fig.colorbar(image, ax=ax, fraction=0.046, pad=0.04)
-    fig.suptitle(args.title + f" (cell {float(rows[0]['cell_size']):.3g} units, {len(rows)} records)", fontsize=9)
+    size = f"cell {float(rows[0]['cell_size']):.3g} units" if "cell_size" in rows[0] else "SVO fields"
+    fig.suptitle(args.title + f" ({size}, {len(rows)} records)", fontsize=9)
     fig.tight_layout()
     fig.savefig(args.out, dpi=100)
 
