@@ -144,8 +144,8 @@ TEST(GuidedDirection, GuidedAndMixturePdfsIntegrateToOne) {
   }
 }
 
-// Sampled directions against the pdf on a grid 4x finer than the bins (so the jitter inside a bin is
-// tested too): expected counts from the pdf integrated over each grid cell.
+// Sampled directions against the pdf on a grid 4x finer than the bins (so the point inside a bin, from
+// the bin number's remainder and the second number, is tested too): expected counts from the pdf integrated over each grid cell.
 TEST(GuidedDirection, SampledDirectionsFollowTheGuidedPdf) {
   const std::vector<float> cdf = make_cdf(5, true);
   const GuideVertex g = guided(cdf, 2, 1.0f);
@@ -154,8 +154,8 @@ TEST(GuidedDirection, SampledDirectionsFollowTheGuidedPdf) {
   std::vector<double> count(kFine * kFine, 0);
   Pcg32 rng = pcg_init(9, 2, 0);
   for (int k = 0; k < n; ++k) {
-    const float u1 = pcg_uniform(rng), u2 = pcg_uniform(rng), u3 = pcg_uniform(rng);
-    const Vec3 w = guided_component_sample(g, u1, u2, u3);
+    const float u1 = pcg_uniform(rng), u2 = pcg_uniform(rng);
+    const Vec3 w = guided_component_sample(g, u1, u2);
     ASSERT_GT(guided_component_pdf(g, w), 0.0f);
     const Vec2 st = hemisphere_to_concentric_square(guide_to_class_local(g.normal_class, w));
     count[std::min(int(st.y * kFine), kFine - 1) * kFine + std::min(int(st.x * kFine), kFine - 1)] += 1;
@@ -247,7 +247,7 @@ TEST(GuidedDirection, DegenerateInputsGiveNoNaN) {
   const GuideVertex g = guided(cdf, 1, 0.5f);
   for (float u : {0.0f, 0.5f, 0.99999994f}) EXPECT_EQ(guide_sample_bin(cdf.data(), u), 99u);
   for (float u : {0.0f, 0.99999994f}) {
-    const Vec3 w = guided_component_sample(g, 0.3f, u, u);
+    const Vec3 w = guided_component_sample(g, u, u);
     EXPECT_TRUE(std::isfinite(w.x) && std::isfinite(w.y) && std::isfinite(w.z));
     EXPECT_NEAR(length(w), 1.0f, 1e-5f);
   }

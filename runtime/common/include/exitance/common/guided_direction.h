@@ -110,10 +110,23 @@ EXITANCE_FN float guided_component_pdf(GuideVertex g, vec3 wi) {
   return guide_bin_probability(g.cdf, guide_bin_of_local(local)) * float(kGuideBins) * local.z * kInvPi;
 }
 
-// A world direction from the guided component: u_bin picks the bin, (u_x, u_y) place it in the bin.
-EXITANCE_FN vec3 guided_component_sample(GuideVertex g, float u_bin, float u_x, float u_y) {
+// A world direction from the guided component, from two numbers: u_bin picks the bin by CDF
+// inversion and its remainder inside the bin's CDF interval (uniform in [0, 1) given the bin) places
+// the point along the bin's square cell, u_y across it. One 2-D sample in, so the sampler's 2-D
+// stratification carries through the warp. Both coordinates are kept kGuideEdgeMargin inside the
+// cell: a point exactly on its edge (u_bin equal to a CDF value, u_y = 0: both happen with dyadic
+// samples) can round into the neighbouring bin on the way through the concentric map and back, whose
+// probability may be 0. The margin moves 2^-20 of a bin's mass by at most 2^-20 of its width, below
+// the CDF's own float rounding.
+const float kGuideEdgeMargin = 9.5367431640625e-7f;  // 2^-20
+EXITANCE_FN float guide_inside_cell(float f) {
+  return kGuideEdgeMargin + min(max(f, 0.0f), 1.0f) * (1.0f - 2.0f * kGuideEdgeMargin);
+}
+EXITANCE_FN vec3 guided_component_sample(GuideVertex g, float u_bin, float u_y) {
   uint bin = guide_sample_bin(g.cdf, u_bin);
-  return guide_from_class_local(g.normal_class, guide_bin_point(bin, u_x, u_y));
+  float probability = guide_bin_probability(g.cdf, bin);
+  float fx = probability > 0.0f ? (u_bin - guide_cdf_at(g.cdf, bin)) / probability : 0.5f;
+  return guide_from_class_local(g.normal_class, guide_bin_point(bin, guide_inside_cell(fx), guide_inside_cell(u_y)));
 }
 
 EXITANCE_NAMESPACE_END

@@ -107,27 +107,33 @@ EXITANCE_FN DirectionSample sample_continuation(uint strategy, SurfacePoint x, I
   return s;
 }
 
-// Cosine vertices: as above. Guided (or defensive) vertices draw the component choice, a 2-D sample
-// (u1, u2) and a third number u3 that only the guided component uses (bin, then the point in it); u3
-// is drawn either way so the later dimensions of the path line up across its samples. The defensive
-// choice reuses the component number: u_choose < uniform_probability takes the uniform component,
-// the rest, rescaled to [0, 1), chooses between guided and cosine. A direction under the surface
-// (shading or geometric) ends the path: the integrand is 0 there.
+// Cosine vertices: as above. Guided (or defensive) vertices spend the same 2-D sample (u1, u2) as
+// cosine ones, so a guided texel keeps the Sobol sampler's 2-D stratification of its first bounce
+// (drawing the component choice and the in-bin point from extra dimensions cost guided texels up to
+// 1.6x the relMSE per sample: bench/results/guiding-svo.md). u1 picks the component: below
+// uniform_probability the defensive uniform component, then the guided one with probability
+// guided_probability, else cosine; u1 rescaled into the chosen interval is that component's first
+// number (guided: the bin by CDF inversion, then its remainder inside the bin's CDF interval places
+// the point across the bin), u2 its second. A direction under the surface (shading or geometric)
+// ends the path: the integrand is 0 there.
+EXITANCE_FN float rescaled_unit(float u, float lo, float width) {
+  return min(max((u - lo) / width, 0.0f), 0.99999994f);
+}
+
 EXITANCE_FN DirectionSample sample_continuation(GuideVertex g, SurfacePoint x, INOUT(PathSampler) rng) {
   if (!(g.guided_probability > 0.0f) && !(g.uniform_probability > 0.0f))
     return sample_continuation(kStrategyCosine, x, rng);
-  float u_choose = sample_1d(rng);
   vec2 u = sample_2d(rng);
-  float u3 = sample_1d(rng);
   DirectionSample s;
-  if (u_choose < g.uniform_probability) {
-    s.direction = to_world(sample_uniform_hemisphere(u.x, u.y), x.shading_normal);
+  if (u.x < g.uniform_probability) {
+    s.direction = to_world(sample_uniform_hemisphere(rescaled_unit(u.x, 0.0f, g.uniform_probability), u.y), x.shading_normal);
   } else {
-    float u_strategy = (u_choose - g.uniform_probability) / (1.0f - g.uniform_probability);
+    float u_strategy = rescaled_unit(u.x, g.uniform_probability, 1.0f - g.uniform_probability);
     if (u_strategy < g.guided_probability) {
-      s.direction = guided_component_sample(g, u.x, u.y, u3);
+      s.direction = guided_component_sample(g, rescaled_unit(u_strategy, 0.0f, g.guided_probability), u.y);
     } else {
-      s.direction = to_world(sample_cosine_hemisphere(u.x, u.y), x.shading_normal);
+      float u_cosine = rescaled_unit(u_strategy, g.guided_probability, 1.0f - g.guided_probability);
+      s.direction = to_world(sample_cosine_hemisphere(u_cosine, u.y), x.shading_normal);
     }
   }
   s.pdf = continuation_pdf(g, x, s.direction);
