@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   std::string integrator = "auto";
   app.add_option("--integrator", integrator,
-                 "auto (default: bounces on the CPU backend unless --directional, --guiding or --adaptive on needs path "
+                 "auto (default: bounces on the CPU backend unless --directional, --guiding grid or --adaptive on needs path "
                  "tracing; path on the Vulkan backend) | path (unbiased path tracing) | bounces (per-bounce gather "
                  "passes, both backends; biased by the lightmap resolution: bench/results/per-bounce-traced.md)")
       ->check(CLI::IsMember({"auto", "path", "bounces"}));
@@ -132,8 +132,9 @@ int main(int argc, char** argv) {
   app.add_option("--directional", directional,
                  "sh1: also write L1 SH directional layers sh1.x.R .. sh1.z.B (docs/bundle.md; path tracing)");
   app.add_option("--guiding", guiding,
-                 "auto (= off for now) | off | svo (not implemented yet) | grid (regular-grid SARSA cache, seed 002; "
-                 "CPU backend only)")
+                 "auto (default: path tracing on the CPU backend measures guided against unguided samples during a "
+                 "pilot and keeps guiding per region where it pays; off elsewhere) | off | svo (not implemented yet) | "
+                 "grid (regular-grid SARSA cache, seed 002; CPU backend only)")
       ->check(CLI::IsMember({"auto", "off", "svo", "grid"}));
   app.add_option("--guiding-mix", options.lighting.guiding_mix,
                  "probability of the guided direction in the one-sample mixture with cosine sampling (default 0.5)")
@@ -279,6 +280,8 @@ int main(int argc, char** argv) {
     }
     options.lighting.guiding = exitance::GuidingMode::Grid;
   }
+  // Resolved once the backend and integrator are known (automatic_integrator.h).
+  if (guiding == "auto") options.lighting.guiding = exitance::GuidingMode::Auto;
 
   if (no_cache && !cache_directory.empty()) {
     std::cerr << "bake: error: --cache " << cache_directory << ": contradicts --no-cache\n";

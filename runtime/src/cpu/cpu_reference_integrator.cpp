@@ -15,6 +15,7 @@
 #include "cpu_bounce_integrator.h"
 #include "exitance/runtime/core/adaptive_sampling_plan.h"
 #include "exitance/runtime/core/grid_guiding_cache.h"
+#include "exitance/runtime/core/guiding_choice.h"
 #include "exitance/runtime/core/pass_scheduler.h"
 #include "exitance/runtime/core/scene_access.h"
 #include "exitance/runtime/core/work_share.h"
@@ -28,6 +29,12 @@ constexpr int kMaxRecordedBounces = 16;
 // small scenes the learning (a target per ray, atomic adds) costs as much as the ray itself, and by
 // then the table has stopped improving (bench/results/guiding.md).
 constexpr uint32_t kGuidingLearningSamples = 64;
+// --guiding auto: the pilot (guided and unguided samples on every texel, the guide learning) lasts
+// the grid's learning samples; a bake of fewer --spp gives it a quarter of them (at least 4).
+uint32_t guiding_auto_pilot(uint32_t spp) {
+  if (spp == 0 || spp >= 4 * kGuidingLearningSamples) return kGuidingLearningSamples;
+  return std::max(4u, spp / 4 / 4 * 4);  // a multiple of 4: a boundary of the ramp's passes
+}
 // A target error plans at most this many samples for a texel without --spp (documented).
 constexpr uint32_t kMostSamplesForTarget = 1u << 17;
 
@@ -220,11 +227,27 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
 
   // Built inside the timed bake: guided results are measured with the cost of their guiding data.
   std::unique_ptr<GridGuidingCache> guide;
-  if (settings.guiding == GuidingMode::Grid) {
+  const GuidingMode guided_kind = settings.guiding == GuidingMode::Auto ? settings.guiding_auto_candidate : settings.guiding;
+  if (guided_kind == GuidingMode::Grid) {
     GridGuidingConfig config;
     config.mix = settings.guiding_mix;
     config.cells_on_longest_axis = settings.guiding_grid_cells;
     guide = std::make_unique<GridGuidingCache>(*impl_->lighting, gbuffer, config);
+  }
+  // --guiding auto (guiding_choice.h): regions are the guide's records (grid cell x normal class of
+  // the texel), the unit whose learned table decides how well its texels' first vertices are guided,
+  // with at least 16 texels each, so a region's variance sums are not one texel's noise. Texels
+  // without a record share one more region.
+  std::unique_ptr<GuidingChoice> choice;
+  if (settings.guiding == GuidingMode::Auto) {
+    if (!guide) throw std::invalid_argument("CPU backend: --guiding auto has no guided kind to measure (candidate not built)");
+    const uint32_t pilot = guiding_auto_pilot(settings.spp);
+    std::vector<uint32_t> region(texel_count);
+    for (size_t i = 0; i < texel_count; ++i) {
+      const uint32_t r = guide->record_of(gbuffer.texels[i].position, gbuffer.texels[i].shading_normal);
+      region[i] = r == GridGuidingCache::kNoRecord ? guide->record_count() : r;
+    }
+    choice = std::make_unique<GuidingChoice>(std::move(region), guide->record_count() + 1, pilot, pilot / 4, settings.seed);
   }
 
   // Adaptive sampling (adaptive_sampling_plan.h): a uniform pilot, then per-texel rates from the
@@ -242,6 +265,11 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   // One sample `s` of texel `i`.
   auto take_sample = [&](size_t i, uint32_t s, bool learning, PathContributions& contributions) {
     uint64_t& rays = rays_per_thread.local();
+    uint64_t& guided_vertices = guided_per_thread.local();
+    // Auto: this sample's strategy (the pilot's coin, then its region's choice); unguided samples
+    // trace without the guide, so regions that chose cosine pay nothing for it.
+    const bool guided_sample = !choice || choice->sample_guided(i, s);
+    GridGuidingCache* sample_guide = guided_sample ? guide.get() : nullptr;
     const LiveTexel& texel = gbuffer.texels[i];
     const SurfacePoint point{texel.position, texel.geometric_normal, texel.shading_normal};
     TexelAccumulator& acc = estimate.texels[i];
@@ -249,8 +277,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     contributions = PathContributions{};
     contributions.recorded = estimate.recorded_bounces;
     contributions.directional = directional;
-    const uint64_t rays_before = rays;
-    impl_->trace(point, settings, rng, contributions, rays, guide.get(), learning, &guided_per_thread.local());
+    const uint64_t rays_before = rays, guided_before = guided_vertices;
+    impl_->trace(point, settings, rng, contributions, rays, sample_guide, learning && sample_guide, &guided_vertices);
     const Vec3 total = contributions.total();
     Vec3 l1[3];
     bool l1_finite = true;
@@ -272,6 +300,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       for (int axis = 0; axis < 3; ++axis)
         for (int c = 0; c < 3; ++c) estimate.sh1[(i * 3 + size_t(axis)) * 3 + size_t(c)] += l1[axis][c];
     ++acc.samples;
+    if (choice && !choice->decided())
+      choice->record(i, s, guided_sample, luminance(total), rays - rays_before, guided_vertices - guided_before);
     if (share) texel_rays[i] += rays - rays_before, ++shared_samples_per_thread.local();
     if (adaptive && !planning) {
       TexelSampleSums& p = pilot_sums[i];
@@ -292,7 +322,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   uint32_t first = 0, count = 0;
   double fraction = 1;
   while (passes.next_pass(first, count, &fraction)) {
-    const bool learning = guide && first < kGuidingLearningSamples;
+    const bool learning = guide && first < (choice ? choice->pilot() : kGuidingLearningSamples) &&
+                          (!choice || !choice->decided());
     if (planning) {
       const double progress = double(first) - progress_after_pilot + double(count) * fraction;
       tbb::parallel_for(tbb::blocked_range<size_t>(0, texel_count, 16), [&](const tbb::blocked_range<size_t>& range) {
@@ -325,6 +356,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     }
     if (learning) guide->swap();  // this pass's learning becomes the next pass's frozen table
     passes.finish_pass(rays_per_thread.combine(std::plus<uint64_t>()));
+    // Auto: the pilot is complete on every texel; each region keeps its cheaper strategy from here.
+    if (choice && !choice->decided() && passes.samples_done() >= choice->pilot() && fraction == 1) choice->decide();
     if (adaptive && !planning && passes.samples_done() == pilot && fraction == 1) {
       // The pilot is complete: every texel's rate from its neighbours' pilot samples.
       plan = plan_adaptive_rates(gbuffer, pilot_sums);
@@ -362,6 +395,11 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     estimate.nonfinite_samples = share->sum(estimate.nonfinite_samples);
   }
   estimate.guided_vertices = guided_per_thread.combine(std::plus<uint64_t>());
+  if (choice) {
+    estimate.guiding_auto = true;
+    estimate.guiding_auto_pilot = choice->pilot();
+    if (choice->decided()) estimate.guiding_regions = choice->regions(), estimate.guiding_scene = choice->scene();
+  }
   if (guide && settings.inspect_guiding) settings.inspect_guiding(*guide);
   estimate.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (settings.work_share && !share) settings.work_share->work.seconds += estimate.seconds;

@@ -1,0 +1,139 @@
+// `--guiding auto` (issue 11): keep guiding only where it pays, decided from the bake's own samples.
+//
+// During a pilot every texel takes guided and unguided samples (a hashed coin per sample), and for
+// each strategy sums the luminance of its samples, their squares and their counted cost. After the
+// pilot each region (a group of texels, given by the caller) compares
+//   relative variance per sample x cost per sample
+// of the two strategies on its texels and keeps the cheaper one for the rest of the bake.
+//
+// Variance estimates from a pilot are noisy (path samples are heavy-tailed: a region of 16 texels x
+// 24 samples per strategy misjudges a white furnace's equal variances by +-30 %), so a region keeps
+// guiding on its own evidence only when the difference D = V_u C_u - V_g C_g is significant:
+// |D| > kChoiceZ standard errors, from each texel's fourth moment (the variance of its sample
+// variance). Where a region's evidence is weak it follows the whole scene's verdict (all texels'
+// sums, the same test), and where that is weak too it stays unguided: the cheaper code path, and
+// the one that can never be more than the pilot's cost worse than unguided.
+//
+// Why mixing strategies in one texel's mean stays unbiased: a texel's estimate is the mean of N
+// samples with N fixed in advance (by --spp or the pass schedule, never by the sample values).
+// Sample s uses a strategy chosen from samples before s only (the pilot's coin, or the region's
+// choice made from pilot samples), and its own random numbers are drawn afresh for s; guided and
+// unguided samples are both unbiased estimators of the same E/pi whatever the guide table is, so
+// E[Y_s | strategy] = E/pi for either strategy and E[mean] = E/pi. The choice changes only the
+// variance. (A rule that changed N from the values, like stopping when a texel looks converged,
+// would be biased; this one does not.)
+//
+// Why a hashed coin and not the sample index's parity: the Sobol sampler (path_sampler.h) shuffles
+// indices with a permutation whose low output bit depends only on the index's low bit, so the even
+// samples of a texel would all fall in one half of the first dimension: each strategy's pilot
+// statistics would see half the domain. A coin hashed from (seed, texel, sample) is independent of
+// the points, so each strategy sees a random subset of uniform points.
+//
+// Cost is counted, not timed, so the choice (and with it the image) is deterministic per seed and
+// independent of the thread count and the machine's load: rays traced, plus a fixed price per guided
+// vertex for the work a guided vertex does besides its rays (table lookup, CDF inversion, the
+// mixture's pdf in next-event estimation's MIS weight), calibrated once on the CPU backend
+// (kGuidedVertexCostInRays, bench/results/guiding-auto.md).
+//
+// Another guided kind (an SVO guide, say) plugs in as the candidate unchanged: the integrator only
+// needs to say, per sample, which strategy ran and what it cost.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace exitance {
+
+// The extra cost of a guided vertex in units of one traced ray (CPU backend, grid guiding), measured
+// from per-sample times and counts: bench/results/guiding-auto.md, "Cost model".
+constexpr double kGuidedVertexCostInRays = 0.5;
+// Standard errors a difference of efficiency must exceed to count (one-sided 1.3e-3 under a normal).
+constexpr double kChoiceZ = 3.0;
+
+// One strategy's pilot sums on one texel.
+struct StrategySums {
+  uint32_t samples = 0;
+  double sum = 0;          // luminance of E/pi
+  double sum_squared = 0;
+  double sum_cubed = 0;   // with the fourth power: the variance of the sample variance
+  double sum_fourth = 0;
+  uint64_t rays = 0;
+  uint64_t guided_vertices = 0;
+};
+
+// Relative variances and costs of the two strategies over some texels, and the verdict they give.
+struct EfficiencyEvidence {
+  uint32_t texels_measured = 0;          // with >= 2 samples of each strategy and some signal
+  double relative_variance[2] = {0, 0};  // [unguided, guided]: sum over texels of s^2 / (mean + eps)^2
+  double variance_of_variance[2] = {0, 0};  // of those sums (fourth moments)
+  double samples[2] = {0, 0};
+  double cost[2] = {0, 0};               // in rays (guided vertices priced by kGuidedVertexCostInRays)
+  double cost_per_sample(int k) const { return samples[k] > 0 ? cost[k] / samples[k] : 0.0; }
+  // (V x C) unguided / (V x C) guided: > 1 guiding pays; 0 when nothing was measured.
+  double efficiency_ratio() const;
+  // D / SE(D), D = V_u C_u - V_g C_g: > kChoiceZ guiding pays, < -kChoiceZ it does not.
+  double z() const;
+};
+
+// Where a region's strategy came from.
+enum class ChoiceBasis : uint8_t { Region, Scene, Default };
+
+// What a region measured and chose (for the manifest's stats and tests).
+struct RegionChoice {
+  uint32_t texels = 0;
+  uint32_t texels_measured = 0;   // with >= 2 samples of each strategy and some signal
+  double relative_variance[2] = {0, 0};  // [unguided, guided]: sum over texels of s^2 / (mean + eps)^2
+  double cost_per_sample[2] = {0, 0};    // in rays (guided vertices priced by kGuidedVertexCostInRays)
+  // (V x C) unguided / (V x C) guided: > 1 guiding pays; 0 when nothing was measured.
+  double efficiency_ratio = 0;
+  double z = 0;  // EfficiencyEvidence::z
+  bool guided = false;
+  ChoiceBasis basis = ChoiceBasis::Default;
+};
+
+class GuidingChoice {
+ public:
+  // `texel_region`: the region of every texel, in [0, region_count). `pilot`: samples per texel before
+  // the choice; statistics come from samples [statistics_from, pilot) (earlier ones see a guide that
+  // has barely learned, which would understate guiding).
+  GuidingChoice(std::vector<uint32_t> texel_region, uint32_t region_count, uint32_t pilot, uint32_t statistics_from,
+                uint64_t seed);
+
+  uint32_t pilot() const { return pilot_; }
+  bool decided() const { return decided_; }
+  // Whether sample `sample` of `texel` is guided: the pilot's coin before the choice, the region's
+  // choice after it.
+  bool sample_guided(size_t texel, uint32_t sample) const;
+  // Adds one finished pilot sample (ignored outside [statistics_from, pilot) or after the choice).
+  // Texels are independent: concurrent calls for different texels are safe.
+  void record(size_t texel, uint32_t sample, bool guided, double luminance, uint64_t rays, uint64_t guided_vertices);
+  // Every region picks its strategy from the sums (deterministic given them). `floor`: the epsilon of
+  // the relative variance, in luminance of E/pi (kErrorFloorFraction x the mean, as the EXR's error layer).
+  void decide(double floor);
+  // decide() with the floor computed from the pilot's own sums.
+  void decide();
+
+  const std::vector<RegionChoice>& regions() const { return regions_; }
+  // The whole scene's evidence (every measured texel), which regions without their own follow.
+  const EfficiencyEvidence& scene() const { return scene_; }
+  size_t texels_guided() const;
+  size_t regions_guided() const;
+  bool any_guided() const { return regions_guided() > 0; }
+  const StrategySums& sums(size_t texel, bool guided) const { return sums_[texel * 2 + (guided ? 1 : 0)]; }
+
+ private:
+  std::vector<uint32_t> texel_region_;
+  std::vector<StrategySums> sums_;  // [texel][unguided, guided]
+  std::vector<RegionChoice> regions_;
+  EfficiencyEvidence scene_;
+  uint32_t pilot_;
+  uint32_t statistics_from_;
+  uint64_t seed_;
+  bool decided_ = false;
+};
+
+// The decision rule alone: a region whose own evidence is significant follows it; else the scene's,
+// when that is significant; else unguided (the cheaper code path, nothing to look up).
+void choose(RegionChoice& region, const EfficiencyEvidence& own, const EfficiencyEvidence& scene);
+
+}  // namespace exitance

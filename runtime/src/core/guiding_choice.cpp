@@ -1,0 +1,144 @@
+#include "exitance/runtime/core/guiding_choice.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "exitance/common/rng.h"
+#include "exitance/runtime/core/estimates.h"
+
+namespace exitance {
+
+GuidingChoice::GuidingChoice(std::vector<uint32_t> texel_region, uint32_t region_count, uint32_t pilot,
+                             uint32_t statistics_from, uint64_t seed)
+    : texel_region_(std::move(texel_region)),
+      sums_(texel_region_.size() * 2),
+      regions_(region_count),
+      pilot_(pilot),
+      statistics_from_(std::min(statistics_from, pilot)),
+      seed_(seed) {
+  for (uint32_t r : texel_region_) {
+    if (r >= region_count) throw std::invalid_argument("GuidingChoice: a texel's region is out of range");
+    ++regions_[r].texels;
+  }
+}
+
+bool GuidingChoice::sample_guided(size_t texel, uint32_t sample) const {
+  if (decided_) return regions_[texel_region_[texel]].guided;
+  // Independent of the sampler's points (see the header): a hash with its own salt.
+  return (splitmix64(seed_ ^ 0x6A1D1C401CE5A17Bull ^ (uint64_t(texel) << 24) ^ uint64_t(sample)) >> 63) != 0;
+}
+
+void GuidingChoice::record(size_t texel, uint32_t sample, bool guided, double luminance, uint64_t rays,
+                           uint64_t guided_vertices) {
+  if (decided_ || sample < statistics_from_ || sample >= pilot_) return;
+  StrategySums& s = sums_[texel * 2 + (guided ? 1 : 0)];
+  const double y2 = luminance * luminance;
+  ++s.samples;
+  s.sum += luminance;
+  s.sum_squared += y2;
+  s.sum_cubed += y2 * luminance;
+  s.sum_fourth += y2 * y2;
+  s.rays += rays;
+  s.guided_vertices += guided_vertices;
+}
+
+void GuidingChoice::decide() {
+  double sum = 0;
+  uint64_t samples = 0;
+  for (const StrategySums& s : sums_) sum += s.sum, samples += s.samples;
+  decide(samples > 0 ? kErrorFloorFraction * sum / double(samples) : 0.0);
+}
+
+namespace {
+
+constexpr double kUnboundedRatio = 1e30;  // finite, so the manifest's JSON can hold it
+
+// A texel's sample variance and the variance of that estimate (iid samples: mu4 / n - sigma^4 (n - 3)
+// / (n (n - 1)), with the central moments from the raw sums).
+void sample_variance(const StrategySums& s, double& variance, double& variance_of_variance) {
+  const double n = s.samples, m = s.sum / n;
+  const double m2 = std::max(0.0, s.sum_squared / n - m * m);
+  const double m4 = std::max(0.0, (s.sum_fourth - 4 * m * s.sum_cubed + 6 * m * m * s.sum_squared) / n - 3 * m * m * m * m);
+  variance = m2 * n / (n - 1);
+  variance_of_variance = std::max(0.0, m4 / n - variance * variance * (n - 3) / (n * (n - 1)));
+}
+
+}  // namespace
+
+double EfficiencyEvidence::efficiency_ratio() const {
+  if (texels_measured == 0) return 0.0;
+  const double unguided = relative_variance[0] * cost_per_sample(0), guided = relative_variance[1] * cost_per_sample(1);
+  // Guided without any variance against an unguided one with some: guiding pays without bound.
+  return guided > 0 ? unguided / guided : unguided > 0 ? kUnboundedRatio : 0.0;
+}
+
+double EfficiencyEvidence::z() const {
+  if (texels_measured == 0) return 0.0;
+  const double cu = cost_per_sample(0), cg = cost_per_sample(1);
+  const double d = relative_variance[0] * cu - relative_variance[1] * cg;
+  const double se = std::sqrt(cu * cu * variance_of_variance[0] + cg * cg * variance_of_variance[1]);
+  return se > 0 ? d / se : d > 0 ? kUnboundedRatio : d < 0 ? -kUnboundedRatio : 0.0;
+}
+
+void choose(RegionChoice& region, const EfficiencyEvidence& own, const EfficiencyEvidence& scene) {
+  region.texels_measured = own.texels_measured;
+  for (int k = 0; k < 2; ++k) region.relative_variance[k] = own.relative_variance[k], region.cost_per_sample[k] = own.cost_per_sample(k);
+  region.efficiency_ratio = own.efficiency_ratio();
+  region.z = own.z();
+  if (std::fabs(region.z) > kChoiceZ) {
+    region.basis = ChoiceBasis::Region;
+    region.guided = region.z > 0;
+  } else if (std::fabs(scene.z()) > kChoiceZ) {
+    region.basis = ChoiceBasis::Scene;
+    region.guided = scene.z() > 0;
+  } else {
+    region.basis = ChoiceBasis::Default;
+    region.guided = false;
+  }
+}
+
+void GuidingChoice::decide(double floor) {
+  // Serial, in texel order: the same sums give the same doubles on every run and thread count.
+  std::vector<EfficiencyEvidence> evidence(regions_.size());
+  scene_ = {};
+  for (size_t i = 0; i < texel_region_.size(); ++i) {
+    EfficiencyEvidence& region = evidence[texel_region_[i]];
+    const StrategySums* s = &sums_[i * 2];
+    for (int k = 0; k < 2; ++k) {
+      const double cost = double(s[k].rays) + kGuidedVertexCostInRays * double(s[k].guided_vertices);
+      region.samples[k] += s[k].samples, region.cost[k] += cost;
+      scene_.samples[k] += s[k].samples, scene_.cost[k] += cost;
+    }
+    if (s[0].samples < 2 || s[1].samples < 2) continue;
+    // Both strategies' variances are weighted by the same (pooled mean + floor)^2, so the comparison
+    // is the one relMSE makes, and bright texels do not outvote dim ones.
+    const double mean = (s[0].sum + s[1].sum) / double(s[0].samples + s[1].samples);
+    const double scale = (mean + floor) * (mean + floor);
+    if (!(scale > 0)) continue;
+    ++region.texels_measured, ++scene_.texels_measured;
+    for (int k = 0; k < 2; ++k) {
+      double variance = 0, variance_of_variance = 0;
+      sample_variance(s[k], variance, variance_of_variance);
+      region.relative_variance[k] += variance / scale, scene_.relative_variance[k] += variance / scale;
+      region.variance_of_variance[k] += variance_of_variance / (scale * scale);
+      scene_.variance_of_variance[k] += variance_of_variance / (scale * scale);
+    }
+  }
+  for (size_t r = 0; r < regions_.size(); ++r) choose(regions_[r], evidence[r], scene_);
+  decided_ = true;
+}
+
+size_t GuidingChoice::texels_guided() const {
+  size_t n = 0;
+  for (const RegionChoice& r : regions_) n += r.guided ? r.texels : 0;
+  return n;
+}
+
+size_t GuidingChoice::regions_guided() const {
+  size_t n = 0;
+  for (const RegionChoice& r : regions_) n += r.guided ? 1 : 0;
+  return n;
+}
+
+}  // namespace exitance
