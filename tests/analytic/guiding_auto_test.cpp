@@ -109,8 +109,8 @@ TEST(GuidingAuto, ChoiceAndResultBitIdenticalPerSeedAndThreadCount) {
   const PreparedScene p = sample_scene("ajar_room", 4);
   const CpuReferenceIntegrator integrator(p.scene);
   const LightmapEstimate a = integrator.bake(p.gbuffer, settings(96, 7, GuidingMode::Auto));
-  ASSERT_FALSE(a.guiding_regions.empty()) << "96 spp: the pilot (24) ends within the bake";
-  EXPECT_EQ(a.guiding_auto_pilot, 24u);
+  ASSERT_FALSE(a.guiding_regions.empty()) << "96 spp: the pilot (16) ends within the bake";
+  EXPECT_EQ(a.guiding_auto_pilot, 16u);
   const LightmapEstimate b = integrator.bake(p.gbuffer, settings(96, 7, GuidingMode::Auto));
   EXPECT_TRUE(identical(a, b)) << "two runs with one seed differ";
   {

@@ -1,6 +1,6 @@
 // --guiding auto's decision (core/guiding_choice.h) on synthetic pilot samples of known variance and
 // cost: it keeps the strategy with the lower variance x counted cost, deterministically, and its
-// pilot coin is fair and independent of the sample index's parity.
+// pilot gives every texel one guided and one unguided half, guided first for about half the texels.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,10 +13,11 @@ namespace {
 
 constexpr uint32_t kPilot = 64, kFrom = 16;
 constexpr size_t kTexels = 64;
+constexpr double kGuidedCost = 10 + 8 * kGuidedVertexCostInRays;
 
 // Pilot samples for `regions` regions of kTexels / regions texels each: every sample drawn with mean
-// 1 and the deviation of its strategy; guided samples cost 10 rays and 8 guided vertices (14 rays at
-// kGuidedVertexCostInRays = 0.5), unguided ones 10 rays.
+// 1 and the deviation of its strategy; guided samples cost 10 rays and 8 guided vertices (kGuidedCost
+// in rays: 15.2 at kGuidedVertexCostInRays = 0.65), unguided ones 10 rays.
 GuidingChoice pilot(const std::vector<double>& guided_deviation, double unguided_deviation, uint64_t seed) {
   const uint32_t regions = uint32_t(guided_deviation.size());
   std::vector<uint32_t> region(kTexels);
@@ -34,8 +35,8 @@ GuidingChoice pilot(const std::vector<double>& guided_deviation, double unguided
   return choice;
 }
 
-// Guided at 1/4 the variance for 1.4x the cost pays (ratio ~2.9), at 4x or 1/25 the variance the
-// evidence is overwhelming too (z far beyond kChoiceZ); at 0.9x the variance (ratio ~0.79, z ~ -2)
+// Guided at 1/4 the variance for 1.5x the cost pays (ratio ~2.6), at 4x or 1/25 the variance the
+// evidence is overwhelming too (z far beyond kChoiceZ); at 0.9x the variance (ratio ~0.73, z ~ -3)
 // the region's own evidence is weak and it follows the scene, where guiding does not pay. Each region has 16 texels x ~24 samples per strategy: a variance estimate's
 // relative error is ~7 %, the ratio's ~10 %, far from the margins.
 TEST(GuidingChoice, KeepsTheStrategyWithLowerVarianceTimesCost) {
@@ -55,11 +56,11 @@ TEST(GuidingChoice, KeepsTheStrategyWithLowerVarianceTimesCost) {
   for (const RegionChoice& r : c.regions()) {
     EXPECT_EQ(r.texels_measured, 16u);
     EXPECT_NEAR(r.cost_per_sample[0], 10.0, 1e-9);
-    EXPECT_NEAR(r.cost_per_sample[1], 10.0 + 8 * kGuidedVertexCostInRays, 1e-9);
+    EXPECT_NEAR(r.cost_per_sample[1], kGuidedCost, 1e-9);
   }
   // A ratio of two variance estimates of ~16 x 23 degrees of freedom each: relative SE sqrt(2/368 + 2/368).
   const double relative_se = std::sqrt(4.0 / 368.0);
-  const double expected0 = 4.0 * 10 / 14, expected1 = 1.0 / 0.9025 * 10 / 14;
+  const double expected0 = 4.0 * 10 / kGuidedCost, expected1 = 1.0 / 0.9025 * 10 / kGuidedCost;
   EXPECT_NEAR(c.regions()[0].efficiency_ratio, expected0, 5 * relative_se * expected0);
   EXPECT_NEAR(c.regions()[1].efficiency_ratio, expected1, 5 * relative_se * expected1);
   // After the choice every sample of a texel follows its region.
@@ -72,7 +73,7 @@ TEST(GuidingChoice, KeepsTheStrategyWithLowerVarianceTimesCost) {
 // Seven regions where guiding clearly pays and one where it is even (ratio ~0.99): the even one has
 // no evidence of its own and follows the scene's verdict.
 TEST(GuidingChoice, RegionsWithoutEvidenceFollowTheScene) {
-  const GuidingChoice c = pilot({0.05, 0.05, 0.05, 0.05, 0.05, 0.05, 0.05, 0.1 * std::sqrt(10.0 / 14)}, 0.1, 7);
+  const GuidingChoice c = pilot({0.05, 0.05, 0.05, 0.05, 0.05, 0.05, 0.05, 0.1 * std::sqrt(10.0 / kGuidedCost)}, 0.1, 7);
   EXPECT_GT(c.scene().z(), kChoiceZ);
   for (size_t r = 0; r < 7; ++r) EXPECT_EQ(c.regions()[r].basis, ChoiceBasis::Region) << r;
   EXPECT_LT(std::fabs(c.regions()[7].z), kChoiceZ);
@@ -88,23 +89,27 @@ TEST(GuidingChoice, DeterministicGivenTheSums) {
   }
 }
 
-// The pilot coin: about half the samples guided, also among even and among odd sample indices
-// (binomial, 5 standard deviations), and it depends on the seed.
-TEST(GuidingChoice, PilotCoinIsFairAndIndependentOfParity) {
-  GuidingChoice c(std::vector<uint32_t>(1000, 0), 1, kPilot, kFrom, 5);
-  GuidingChoice other(std::vector<uint32_t>(1000, 0), 1, kPilot, kFrom, 6);
-  uint64_t guided[2] = {0, 0}, total[2] = {0, 0}, differ = 0;
-  for (size_t i = 0; i < 1000; ++i)
+// Every texel's pilot: one aligned half guided, the other not (stratified Sobol blocks); the guided
+// half first for about half the texels (binomial, 5 standard deviations), depending on the seed.
+TEST(GuidingChoice, PilotHalvesPerTexel) {
+  constexpr size_t kMany = 1000;
+  GuidingChoice c(std::vector<uint32_t>(kMany, 0), 1, kPilot, kFrom, 5);
+  GuidingChoice other(std::vector<uint32_t>(kMany, 0), 1, kPilot, kFrom, 6);
+  size_t guided_first = 0, differ = 0;
+  for (size_t i = 0; i < kMany; ++i) {
+    uint32_t guided = 0;
     for (uint32_t s = 0; s < kPilot; ++s) {
-      guided[s & 1] += c.sample_guided(i, s), ++total[s & 1];
-      differ += c.sample_guided(i, s) != other.sample_guided(i, s);
+      guided += c.sample_guided(i, s);
+      EXPECT_EQ(c.sample_guided(i, s), c.sample_guided(i, s < kPilot / 2 ? 0 : kPilot / 2)) << i << " " << s;
     }
-  for (int p = 0; p < 2; ++p) {
-    const double n = double(total[p]);
-    EXPECT_NEAR(double(guided[p]), n / 2, 5 * std::sqrt(n / 4)) << "parity " << p;
+    EXPECT_EQ(guided, kPilot / 2);
+    guided_first += c.sample_guided(i, 0);
+    differ += c.sample_guided(i, 0) != other.sample_guided(i, 0);
   }
-  const double n = double(total[0] + total[1]);
+  const double n = kMany;
+  EXPECT_NEAR(double(guided_first), n / 2, 5 * std::sqrt(n / 4));
   EXPECT_NEAR(double(differ), n / 2, 5 * std::sqrt(n / 4));
+  EXPECT_THROW(GuidingChoice({0}, 1, 24, 6, 1), std::invalid_argument);  // not a power of two
 }
 
 // Samples outside [statistics_from, pilot) are not counted; a region with nothing measured, or

@@ -17,6 +17,7 @@ GuidingChoice::GuidingChoice(std::vector<uint32_t> texel_region, uint32_t region
       pilot_(pilot),
       statistics_from_(std::min(statistics_from, pilot)),
       seed_(seed) {
+  if (pilot_ < 2 || (pilot_ & (pilot_ - 1)) != 0) throw std::invalid_argument("GuidingChoice: the pilot must be a power of two >= 2");
   for (uint32_t r : texel_region_) {
     if (r >= region_count) throw std::invalid_argument("GuidingChoice: a texel's region is out of range");
     ++regions_[r].texels;
@@ -25,8 +26,9 @@ GuidingChoice::GuidingChoice(std::vector<uint32_t> texel_region, uint32_t region
 
 bool GuidingChoice::sample_guided(size_t texel, uint32_t sample) const {
   if (decided_) return regions_[texel_region_[texel]].guided;
-  // Independent of the sampler's points (see the header): a hash with its own salt.
-  return (splitmix64(seed_ ^ 0x6A1D1C401CE5A17Bull ^ (uint64_t(texel) << 24) ^ uint64_t(sample)) >> 63) != 0;
+  // Which half of the pilot is guided: a hash of (seed, texel) with its own salt (see the header).
+  const bool guided_first = (splitmix64(seed_ ^ 0x6A1D1C401CE5A17Bull ^ uint64_t(texel)) >> 63) != 0;
+  return (sample < pilot_ / 2) == guided_first;
 }
 
 void GuidingChoice::record(size_t texel, uint32_t sample, bool guided, double luminance, uint64_t rays,

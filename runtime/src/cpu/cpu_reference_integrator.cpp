@@ -30,10 +30,13 @@ constexpr int kMaxRecordedBounces = 16;
 // then the table has stopped improving (bench/results/guiding.md).
 constexpr uint32_t kGuidingLearningSamples = 64;
 // --guiding auto: the pilot (guided and unguided samples on every texel, the guide learning) lasts
-// the grid's learning samples; a bake of fewer --spp gives it a quarter of them (at least 4).
+// the grid's learning samples; a bake of fewer --spp gives it the largest power of two up to a
+// quarter of them, at least 4 (powers of two from 4 on are boundaries of the ramp's passes).
 uint32_t guiding_auto_pilot(uint32_t spp) {
   if (spp == 0 || spp >= 4 * kGuidingLearningSamples) return kGuidingLearningSamples;
-  return std::max(4u, spp / 4 / 4 * 4);  // a multiple of 4: a boundary of the ramp's passes
+  uint32_t pilot = 4;
+  while (pilot * 2 <= spp / 4) pilot *= 2;
+  return pilot;
 }
 // A target error plans at most this many samples for a texel without --spp (documented).
 constexpr uint32_t kMostSamplesForTarget = 1u << 17;
@@ -266,7 +269,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   auto take_sample = [&](size_t i, uint32_t s, bool learning, PathContributions& contributions) {
     uint64_t& rays = rays_per_thread.local();
     uint64_t& guided_vertices = guided_per_thread.local();
-    // Auto: this sample's strategy (the pilot's coin, then its region's choice); unguided samples
+    // Auto: this sample's strategy (the pilot's halves, then its region's choice); unguided samples
     // trace without the guide, so regions that chose cosine pay nothing for it.
     const bool guided_sample = !choice || choice->sample_guided(i, s);
     GridGuidingCache* sample_guide = guided_sample ? guide.get() : nullptr;
