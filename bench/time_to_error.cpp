@@ -263,7 +263,7 @@ int main(int argc, char** argv) {
         }
         if (estimate.guiding_auto) {  // what --guiding auto kept (stderr: the CSV stays one row per run)
           size_t texels = 0, guided = 0, regions = 0;
-          for (const RegionChoice& r : estimate.guiding_regions) texels += r.texels, guided += r.guided ? r.texels : 0, regions += r.guided;
+          for (const RegionChoice& r : estimate.guiding_regions) texels += r.texels, guided += r.texels_guided, regions += r.guided;
           std::cerr << scene_name << " " << spp << " spp auto: " << (estimate.guiding_regions.empty() ? "undecided" : "decided")
                     << ", regions guided " << regions << "/" << estimate.guiding_regions.size() << ", texels guided "
                     << guided << "/" << texels << "\n";

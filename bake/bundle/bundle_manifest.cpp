@@ -134,7 +134,8 @@ json guiding_auto_json(const LightmapEstimate& estimate) {
   std::vector<double> ratios;
   for (const RegionChoice& r : regions) {
     texels += r.texels;
-    if (r.guided) texels_guided += r.texels, ++regions_guided;
+    texels_guided += r.texels_guided;
+    if (r.guided) ++regions_guided;
     ++by_basis[int(r.basis)];
     if (r.texels_measured == 0) continue;
     ++measured;

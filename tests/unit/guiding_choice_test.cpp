@@ -22,7 +22,7 @@ GuidingChoice pilot(const std::vector<double>& guided_deviation, double unguided
   const uint32_t regions = uint32_t(guided_deviation.size());
   std::vector<uint32_t> region(kTexels);
   for (size_t i = 0; i < kTexels; ++i) region[i] = uint32_t(i * regions / kTexels);
-  GuidingChoice choice(region, regions, kPilot, kFrom, seed);
+  GuidingChoice choice(region, regions, kPilot, kFrom, seed, 1.0);  // every texel measures
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   for (size_t i = 0; i < kTexels; ++i)
@@ -93,8 +93,8 @@ TEST(GuidingChoice, DeterministicGivenTheSums) {
 // half first for about half the texels (binomial, 5 standard deviations), depending on the seed.
 TEST(GuidingChoice, PilotHalvesPerTexel) {
   constexpr size_t kMany = 1000;
-  GuidingChoice c(std::vector<uint32_t>(kMany, 0), 1, kPilot, kFrom, 5);
-  GuidingChoice other(std::vector<uint32_t>(kMany, 0), 1, kPilot, kFrom, 6);
+  GuidingChoice c(std::vector<uint32_t>(kMany, 0), 1, kPilot, kFrom, 5, 1.0);
+  GuidingChoice other(std::vector<uint32_t>(kMany, 0), 1, kPilot, kFrom, 6, 1.0);
   size_t guided_first = 0, differ = 0;
   for (size_t i = 0; i < kMany; ++i) {
     uint32_t guided = 0;
@@ -112,10 +112,33 @@ TEST(GuidingChoice, PilotHalvesPerTexel) {
   EXPECT_THROW(GuidingChoice({0}, 1, 24, 6, 1), std::invalid_argument);  // not a power of two
 }
 
+// With the default share, about a quarter of the texels measure (binomial, 5 standard deviations);
+// the others take no guided sample in the pilot, and each strategy's samples are numbered from 0 on
+// its own sequence without gaps.
+TEST(GuidingChoice, AQuarterOfTheTexelsMeasure) {
+  constexpr size_t kMany = 4000;
+  GuidingChoice c(std::vector<uint32_t>(kMany, 0), 1, kPilot, kFrom, 9);
+  size_t measuring = 0;
+  for (size_t i = 0; i < kMany; ++i) {
+    measuring += c.measuring(i);
+    uint32_t next[2] = {0, 0};
+    for (uint32_t s = 0; s < kPilot; ++s) {
+      const bool g = c.sample_guided(i, s);
+      if (!c.measuring(i)) EXPECT_FALSE(g);
+      EXPECT_EQ(c.strategy_sample_index(i, s, g), next[g]++) << i << " " << s;
+    }
+    // After the pilot either strategy continues where its sequence stopped.
+    EXPECT_EQ(c.strategy_sample_index(i, kPilot, false), next[0]);
+    EXPECT_EQ(c.strategy_sample_index(i, kPilot, true), next[1]);
+  }
+  const double n = kMany, p = kPilotMeasuringShare;
+  EXPECT_NEAR(double(measuring), n * p, 5 * std::sqrt(n * p * (1 - p)));
+}
+
 // Samples outside [statistics_from, pilot) are not counted; a region with nothing measured, or
 // with equal efficiency, stays unguided.
 TEST(GuidingChoice, CountsOnlyThePilotWindowAndDefaultsToUnguided) {
-  GuidingChoice c({0, 0, 1}, 2, 8, 2, 1);
+  GuidingChoice c({0, 0, 1}, 2, 8, 2, 1, 1.0);
   for (uint32_t s = 0; s < 12; ++s) {
     c.record(0, s, false, double(s % 3), 4, 0);
     c.record(0, s, true, double(s % 3), 4, 0);

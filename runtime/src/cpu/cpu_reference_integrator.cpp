@@ -276,7 +276,10 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     const LiveTexel& texel = gbuffer.texels[i];
     const SurfacePoint point{texel.position, texel.geometric_normal, texel.shading_normal};
     TexelAccumulator& acc = estimate.texels[i];
-    PathSampler rng = path_sampler(settings.seed, i, s, settings.sampler);
+    // Auto: each strategy on its own sequence, by its own count (guiding_choice.h says why).
+    PathSampler rng = choice ? path_sampler(settings.seed, guided_sample ? GuidingChoice::guided_stream(i) : i,
+                                            choice->strategy_sample_index(i, s, guided_sample), settings.sampler)
+                             : path_sampler(settings.seed, i, s, settings.sampler);
     contributions = PathContributions{};
     contributions.recorded = estimate.recorded_bounces;
     contributions.directional = directional;

@@ -1,7 +1,7 @@
 // `--guiding auto` (issue 11): keep guiding only where it pays, decided from the bake's own samples.
 //
-// During a pilot every texel takes as many guided as unguided samples (one half of the pilot each,
-// in an order hashed per texel), and for
+// During a pilot a hashed share of the texels (kPilotMeasuringShare) takes as many guided as
+// unguided samples (one half of the pilot each, in an order hashed per texel), and for
 // each strategy sums the luminance of its samples, their squares and their counted cost. After the
 // pilot each region (a group of texels, given by the caller) compares
 //   relative variance per sample x cost per sample
@@ -17,12 +17,17 @@
 //
 // Why mixing strategies in one texel's mean stays unbiased: a texel's estimate is the mean of N
 // samples with N fixed in advance (by --spp or the pass schedule, never by the sample values).
-// Sample s uses a strategy chosen from samples before s only (the pilot's coin, or the region's
-// choice made from pilot samples), and its own random numbers are drawn afresh for s; guided and
-// unguided samples are both unbiased estimators of the same E/pi whatever the guide table is, so
-// E[Y_s | strategy] = E/pi for either strategy and E[mean] = E/pi. The choice changes only the
-// variance. (A rule that changed N from the values, like stopping when a texel looks converged,
-// would be biased; this one does not.)
+// Guided and unguided samples are both unbiased estimators of the same E/pi whatever the guide table
+// is. In the pilot a texel's strategies follow a hash of (seed, texel), not any sample value. After
+// it, a texel's strategy is chosen from the OTHER texels' pilot samples only (leave-one-out, as
+// adaptive_sampling_plan.h does): its region's and the scene's sums less its own. Its own samples
+// are scrambled Sobol points (path_sampler.h), dependent on each other (that is their
+// stratification), so a choice made from its own pilot values could correlate with its later
+// samples' errors; other texels' scrambles are independent hashes, so given the choice each of its
+// later samples is still uniform: E[Y_s | strategy] = E/pi, and E[mean] = E/pi. The choice changes
+// only the variance. (The floor epsilon comes from every texel's mean, a 1/texels coupling, as in the
+// adaptive plan; a rule that changed N from the values, like stopping when a texel looks converged,
+// would be biased.)
 //
 // Why halves and not alternate samples: a texel's Sobol samples (path_sampler.h) are stratified over
 // aligned blocks of 2^k sample indices, dimension by dimension, and the two strategies draw their
@@ -31,7 +36,15 @@
 // equal samples on the sunlit courtyard up to 256 spp, though unbiased. With the pilot a power of two
 // and each strategy on one aligned half, every block of samples a texel takes is a stratified set.
 // (By the sample's parity would be worse still: the sampler's index shuffle keeps the low bit, so one
-// strategy would see one half of the first dimension only.)
+// strategy would see one half of the first dimension only.) Beyond that, each strategy draws its
+// samples from its own sequence, indexed by its own count (strategy_sample_index; guided samples on
+// a stream of their own, guided_stream): a texel's unguided samples are then a prefix of the Sobol
+// sequence an unguided bake uses, not that sequence with holes where the guided half went (a hole of
+// 16 in 128 samples is a 16-sample block whose error counts like the 112 others': measured 1.1-1.2x
+// the relMSE at equal spp on the courtyard at 16-256 spp, still). That remaining cost is QMC's: a
+// texel whose samples are split into two separately stratified sets converges more slowly than one
+// set (on the sunlit courtyard, 2 guided samples of 16 raise the relMSE 1.2x), so only a quarter of
+// the texels measure; the others stay unguided through the pilot.
 //
 // Cost is counted, not timed, so the choice (and with it the image) is deterministic per seed and
 // independent of the thread count and the machine's load: rays traced, plus a fixed price per guided
@@ -53,6 +66,10 @@ namespace exitance {
 constexpr double kGuidedVertexCostInRays = 0.65;
 // Standard errors a difference of efficiency must exceed to count (one-sided 1.3e-3 under a normal).
 constexpr double kChoiceZ = 3.0;
+// The share of texels that measure both strategies in the pilot (the rest take unguided samples):
+// the pilot's cost on QMC-friendly scenes scales with it; a region of 16 texels keeps ~4 measuring
+// ones, so regions mostly follow the scene's evidence.
+constexpr double kPilotMeasuringShare = 0.25;
 
 // One strategy's pilot sums on one texel.
 struct StrategySums {
@@ -91,8 +108,11 @@ struct RegionChoice {
   // (V x C) unguided / (V x C) guided: > 1 guiding pays; 0 when nothing was measured.
   double efficiency_ratio = 0;
   double z = 0;  // EfficiencyEvidence::z
+  // The verdict of all its texels' evidence (what the manifest reports). Each texel follows the
+  // verdict without its own samples (leave-one-out), which agrees but for texels near the threshold.
   bool guided = false;
   ChoiceBasis basis = ChoiceBasis::Default;
+  uint32_t texels_guided = 0;  // texels whose own (leave-one-out) choice is guiding
 };
 
 class GuidingChoice {
@@ -101,13 +121,21 @@ class GuidingChoice {
   // the choice, a power of two (so its halves are stratified blocks); statistics come from samples [statistics_from, pilot) (earlier ones see a guide that
   // has barely learned, which would understate guiding).
   GuidingChoice(std::vector<uint32_t> texel_region, uint32_t region_count, uint32_t pilot, uint32_t statistics_from,
-                uint64_t seed);
+                uint64_t seed, double measuring_share = kPilotMeasuringShare);
 
   uint32_t pilot() const { return pilot_; }
   bool decided() const { return decided_; }
   // Whether sample `sample` of `texel` is guided: in the pilot, the half of it the texel's hashed
-  // coin gave guiding; after it, the region's choice.
+  // coin gave guiding; after it, the texel's leave-one-out choice.
   bool sample_guided(size_t texel, uint32_t sample) const;
+  // Whether `texel` measures both strategies in the pilot (a hash of seed and texel).
+  bool measuring(size_t texel) const;
+  // The index of texel sample `sample` (of strategy `guided`) within its strategy's own sequence:
+  // `sample` less the samples of the other strategy before it.
+  uint32_t strategy_sample_index(size_t texel, uint32_t sample, bool guided) const;
+  // The random stream of a texel's guided samples (unguided ones use the texel's usual stream): a salt
+  // far from the texel, probe and bounce-pass stream ranges.
+  static uint64_t guided_stream(size_t texel) { return uint64_t(texel) ^ 0xA5E1D6C3B2F40000ull; }
   // Adds one finished pilot sample (ignored outside [statistics_from, pilot) or after the choice).
   // Texels are independent: concurrent calls for different texels are safe.
   void record(size_t texel, uint32_t sample, bool guided, double luminance, uint64_t rays, uint64_t guided_vertices);
@@ -129,15 +157,17 @@ class GuidingChoice {
   std::vector<uint32_t> texel_region_;
   std::vector<StrategySums> sums_;  // [texel][unguided, guided]
   std::vector<RegionChoice> regions_;
+  std::vector<uint8_t> texel_guided_;  // after decide()
   EfficiencyEvidence scene_;
   uint32_t pilot_;
   uint32_t statistics_from_;
   uint64_t seed_;
+  uint64_t measuring_below_;  // hash threshold: measuring_share x 2^64
   bool decided_ = false;
 };
 
-// The decision rule alone: a region whose own evidence is significant follows it; else the scene's,
+// The decision rule alone: evidence of the region that is significant decides; else the scene's,
 // when that is significant; else unguided (the cheaper code path, nothing to look up).
-void choose(RegionChoice& region, const EfficiencyEvidence& own, const EfficiencyEvidence& scene);
+ChoiceBasis choose(const EfficiencyEvidence& region, const EfficiencyEvidence& scene, bool& guided);
 
 }  // namespace exitance
