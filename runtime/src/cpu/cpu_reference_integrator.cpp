@@ -29,7 +29,7 @@ constexpr int kMaxRecordedBounces = 16;
 // small scenes the learning (a target per ray, atomic adds) costs as much as the ray itself, and by
 // then the table has stopped improving (bench/results/guiding.md).
 constexpr uint32_t kGuidingLearningSamples = 64;
-// --guiding auto: the pilot (guided and unguided samples on every texel, the guide learning) lasts
+// --guiding auto: the pilot (guided and unguided samples on a quarter of the texels, the guide learning) lasts
 // the grid's learning samples; a bake of fewer --spp gives it the largest power of two up to a
 // quarter of them, at least 4 (powers of two from 4 on are boundaries of the ramp's passes).
 uint32_t guiding_auto_pilot(uint32_t spp) {
@@ -269,7 +269,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   auto take_sample = [&](size_t i, uint32_t s, bool learning, PathContributions& contributions) {
     uint64_t& rays = rays_per_thread.local();
     uint64_t& guided_vertices = guided_per_thread.local();
-    // Auto: this sample's strategy (the pilot's halves, then its region's choice); unguided samples
+    // Auto: this sample's strategy (the pilot's halves on measuring texels, then the texel's
+    // leave-one-out choice from its region's and the scene's evidence); unguided samples
     // trace without the guide, so regions that chose cosine pay nothing for it.
     const bool guided_sample = !choice || choice->sample_guided(i, s);
     GridGuidingCache* sample_guide = guided_sample ? guide.get() : nullptr;
@@ -362,7 +363,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     }
     if (learning) guide->swap();  // this pass's learning becomes the next pass's frozen table
     passes.finish_pass(rays_per_thread.combine(std::plus<uint64_t>()));
-    // Auto: the pilot is complete on every texel; each region keeps its cheaper strategy from here.
+    // Auto: the pilot is complete on every texel; each texel takes its region's cheaper strategy from here.
     if (choice && !choice->decided() && passes.samples_done() >= choice->pilot() && fraction == 1) choice->decide();
     if (adaptive && !planning && passes.samples_done() == pilot && fraction == 1) {
       // The pilot is complete: every texel's rate from its neighbours' pilot samples.
