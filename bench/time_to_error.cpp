@@ -2,7 +2,7 @@
 // content hash outside the repository) is the reference; runs at doubling spp record seconds,
 // relMSE, MAE, worst-texel error and rays/s as CSV, and the time to reach a target relMSE.
 //
-//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,adaptive,bounces,guided,svo] [--guiding-mix M] [--name NAME]
+//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,adaptive,bounces,guided,svo,guided_auto] [--guiding-mix M] [--name NAME]
 //                       [--sky R,G,B] [--texel-density T] [--reference-spp N] [--max-spp N]
 //                       [--max-seconds S] [--target 0.01] [--bounces N] [--min-spp N] [--cache DIR] [--csv FILE]
 //                       [--texel-csv FILE] [--guiding-fields FILE] [--samplers sobol,independent]
@@ -91,7 +91,8 @@ int main(int argc, char** argv) {
   app.add_option("--backends", backends, "comma-separated: cpu, vulkan (the reference is always cpu)");
   app.add_option("--integrators", integrators,
                  "comma-separated: path, adaptive (path with adaptive sampling; spp = mean), bounces, bounces_cached "
-                 "(bounces with --first-bounce cached), guided (path with --guiding grid), svo (path with --guiding svo)");
+                 "(bounces with --first-bounce cached), guided (path with --guiding grid), svo (path with --guiding svo), "
+                 "guided_auto (path with --guiding auto)");
   float guiding_mix = 0.5f;
   app.add_option("--guiding-mix", guiding_mix, "guided component's probability (guided runs)");
   std::string guiding_fields;
@@ -206,6 +207,7 @@ int main(int argc, char** argv) {
   if (listed("path")) modes.push_back({IntegratorMode::Path, GuidingMode::Off, "path_tracing"});
   if (listed("adaptive")) modes.push_back({IntegratorMode::Path, GuidingMode::Off, "path_adaptive", true});
   if (listed("guided")) modes.push_back({IntegratorMode::Path, GuidingMode::Grid, "path_guided_grid"});
+  if (listed("guided_auto")) modes.push_back({IntegratorMode::Path, GuidingMode::Auto, "path_guided_auto"});
   if (listed("svo")) modes.push_back({IntegratorMode::Path, GuidingMode::Svo, "path_guided_svo"});
   // The octree of svo runs: built once, as the bake's voxelize stage does before lighting (not timed:
   // every bake builds it, guided or not).
@@ -304,6 +306,21 @@ int main(int argc, char** argv) {
         if (m.guiding == GuidingMode::Svo)
           std::cerr << mode_name << " " << spp << " spp: " << svo_bins << " bins, " << svo_records << " records, "
                     << svo_memory << " bytes\n";
+        if (mode == IntegratorMode::Path) {  // counts behind --guiding auto's cost model (bench/results/guiding-auto.md)
+          uint64_t samples = 0;
+          for (const TexelAccumulator& t : estimate.texels) samples += t.samples;
+          std::cerr << scene_name << " " << mode_name << " " << spp << " spp: rays/sample "
+                    << double(estimate.rays) / double(std::max<uint64_t>(samples, 1)) << ", guided vertices/sample "
+                    << double(estimate.guided_vertices) / double(std::max<uint64_t>(samples, 1)) << ", seconds "
+                    << estimate.seconds << "\n";
+        }
+        if (estimate.guiding_auto) {  // what --guiding auto kept (stderr: the CSV stays one row per run)
+          size_t texels = 0, guided = 0, regions = 0;
+          for (const RegionChoice& r : estimate.guiding_regions) texels += r.texels, guided += r.texels_guided, regions += r.guided;
+          std::cerr << scene_name << " " << spp << " spp auto: " << (estimate.guiding_regions.empty() ? "undecided" : "decided")
+                    << ", regions guided " << regions << "/" << estimate.guiding_regions.size() << ", texels guided "
+                    << guided << "/" << texels << "\n";
+        }
         std::vector<float> result = flatten(estimate);
         result.resize(values);
         ErrorFigures e = compare(result, reference_mean);

@@ -121,6 +121,52 @@ json error_distribution_json(const LightmapEstimate& estimate) {
           {"max", errors.empty() ? 0.0 : double(errors.back())}};
 }
 
+// stats.guiding (--guiding auto): what the measured choice kept, and why (core/guiding_choice.h).
+json guiding_auto_json(const LightmapEstimate& estimate) {
+  json out = {{"mode", "auto"}, {"candidate", "grid"}, {"pilot_samples_per_texel", estimate.guiding_auto_pilot},
+              {"guided_vertices", estimate.guided_vertices}};
+  const std::vector<RegionChoice>& regions = estimate.guiding_regions;
+  if (regions.empty()) {
+    out["decided"] = false;  // the bake ended within the pilot: every sample tossed the pilot's coin
+    return out;
+  }
+  size_t texels = 0, texels_guided = 0, regions_guided = 0, measured = 0, by_basis[3] = {0, 0, 0};
+  std::vector<double> ratios;
+  for (const RegionChoice& r : regions) {
+    texels += r.texels;
+    texels_guided += r.texels_guided;
+    if (r.guided) ++regions_guided;
+    ++by_basis[int(r.basis)];
+    if (r.texels_measured == 0) continue;
+    ++measured;
+    ratios.push_back(r.efficiency_ratio);
+  }
+  std::sort(ratios.begin(), ratios.end());
+  auto quantile = [&](double q) { return ratios.empty() ? 0.0 : ratios[std::min(ratios.size() - 1, size_t(q * double(ratios.size())))]; };
+  const EfficiencyEvidence& scene = estimate.guiding_scene;
+  out["decided"] = true;
+  out["chose"] = regions_guided == 0 ? "off" : regions_guided == regions.size() ? "guided" : "per region";
+  out["regions"] = regions.size();
+  out["regions_measured"] = measured;
+  out["regions_guided"] = regions_guided;
+  // Where each region's strategy came from: its own significant evidence, the scene's, or neither (unguided).
+  out["regions_by_basis"] = {{"region", by_basis[int(ChoiceBasis::Region)]},
+                             {"scene", by_basis[int(ChoiceBasis::Scene)]},
+                             {"default", by_basis[int(ChoiceBasis::Default)]}};
+  out["texels_guided_fraction"] = texels > 0 ? double(texels_guided) / double(texels) : 0.0;
+  // Relative variance x counted cost, unguided over guided: > 1 guiding pays. z: its difference in
+  // standard errors (kChoiceZ decides).
+  out["efficiency_ratio"] = {{"scene", scene.efficiency_ratio()},
+                             {"scene_z", scene.z()},
+                             {"regions_min", ratios.empty() ? 0.0 : ratios.front()},
+                             {"regions_p50", quantile(0.5)},
+                             {"regions_max", ratios.empty() ? 0.0 : ratios.back()}};
+  out["cost_per_sample_rays"] = {{"unguided", scene.cost_per_sample(0)}, {"guided", scene.cost_per_sample(1)}};
+  out["guided_vertex_cost_rays"] = kGuidedVertexCostInRays;
+  out["choice_z"] = kChoiceZ;
+  return out;
+}
+
 // "stats": what each stage did and how long it took.
 json stats_json(const BakeResults& results, const json& seconds, size_t warnings, const BakeOptions& options) {
   const TexelGBuffer& gbuffer = results.gbuffer;
@@ -157,6 +203,7 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
   stats["coplanar_texels"] = results.geometry.coplanar_texels;
   stats["enclosed_lights"] = results.geometry.enclosed_lights;
   stats["nonfinite_samples"] = estimate.nonfinite_samples;
+  if (estimate.guiding_auto) stats["guiding"] = guiding_auto_json(estimate);
   if (results.stage_cache) stats["cache"]["stages"] = *results.stage_cache;
   if (results.distribution)
     for (const auto& [key, value] : results.distribution->items()) stats[key] = value;

@@ -1,18 +1,28 @@
 #include "exitance/bake/command/automatic_integrator.h"
 
+#include "exitance/runtime/core/work_share.h"
+
 namespace exitance {
 
 IntegratorMode automatic_integrator(const BakeOptions& options, const Integrator& backend) {
   if (backend.backend_name() != "cpu") return IntegratorMode::Path;
   if (options.lighting.directional != DirectionalMode::Off) return IntegratorMode::Path;
-  if (options.lighting.guiding != GuidingMode::Off) return IntegratorMode::Path;
+  if (options.lighting.guiding == GuidingMode::Grid) return IntegratorMode::Path;  // auto does not ask for it
   if (options.adaptive_request == AdaptiveRequest::On) return IntegratorMode::Path;
   return IntegratorMode::Bounces;
+}
+
+GuidingMode automatic_guiding(const BakeOptions& options, const Integrator& backend) {
+  if (options.lighting.guiding != GuidingMode::Auto) return options.lighting.guiding;
+  const bool measured_choice = backend.backend_name() == "cpu" && options.lighting.integrator == IntegratorMode::Path &&
+                               !distributed(options.lighting.work_share);
+  return measured_choice ? GuidingMode::Auto : GuidingMode::Off;
 }
 
 BakeOptions with_integrator_decided(const BakeOptions& options, const Integrator& backend) {
   BakeOptions decided = options;
   if (options.integrator_auto) decided.lighting.integrator = automatic_integrator(options, backend);
+  decided.lighting.guiding = automatic_guiding(decided, backend);
   return decided;
 }
 

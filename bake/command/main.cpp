@@ -107,7 +107,7 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   std::string integrator = "auto";
   app.add_option("--integrator", integrator,
-                 "auto (default: bounces on the CPU backend unless --directional, --guiding or --adaptive on needs path "
+                 "auto (default: bounces on the CPU backend unless --directional, --guiding grid or --adaptive on needs path "
                  "tracing; path on the Vulkan backend) | path (unbiased path tracing) | bounces (per-bounce gather "
                  "passes, both backends; biased by the lightmap resolution: bench/results/per-bounce-traced.md)")
       ->check(CLI::IsMember({"auto", "path", "bounces"}));
@@ -133,8 +133,10 @@ int main(int argc, char** argv) {
   app.add_option("--directional", directional,
                  "sh1: also write L1 SH directional layers sh1.x.R .. sh1.z.B (docs/bundle.md; path tracing)");
   app.add_option("--guiding", guiding,
-                 "auto (= off for now) | off | svo (fields from exitance in the bake's voxel octree, seed 000) | grid "
-                 "(regular-grid SARSA cache, seed 002); both CPU backend only")
+                 "auto (default: path tracing on the CPU backend measures guided (grid) against unguided samples "
+                 "during a pilot and keeps guiding per region where it pays; off on Vulkan, per-bounce and under mpirun) "
+                 "| off | svo (fields from exitance in the bake's voxel octree, seed 000) | grid (regular-grid SARSA "
+                 "cache, seed 002)")
       ->check(CLI::IsMember({"auto", "off", "svo", "grid"}));
   app.add_option("--guiding-mix", options.lighting.guiding_mix,
                  "probability of the guided direction in the one-sample mixture with cosine sampling (default 0.5)")
@@ -280,10 +282,8 @@ int main(int argc, char** argv) {
     std::cerr << "bake: error: --guiding svo builds its fields from the voxel octree: it contradicts --voxel-resolution none\n";
     return 2;
   }
-  if (guiding == "svo" && options.backend.name == "vulkan") {
-    std::cerr << "bake: error: --guiding svo is implemented on the CPU backend only (use --backend cpu)\n";
-    return 2;
-  }
+  // Resolved once the backend and integrator are known (automatic_integrator.h).
+  if (guiding == "auto") options.lighting.guiding = exitance::GuidingMode::Auto;
 
   if (no_cache && !cache_directory.empty()) {
     std::cerr << "bake: error: --cache " << cache_directory << ": contradicts --no-cache\n";

@@ -15,6 +15,7 @@
 #include "cpu_bounce_integrator.h"
 #include "exitance/runtime/core/adaptive_sampling_plan.h"
 #include "exitance/runtime/core/grid_guiding_cache.h"
+#include "exitance/runtime/core/guiding_choice.h"
 #include "exitance/runtime/core/pass_scheduler.h"
 #include "exitance/runtime/core/svo_guiding_fields.h"
 #include "exitance/runtime/core/scene_access.h"
@@ -29,6 +30,15 @@ constexpr int kMaxRecordedBounces = 16;
 // small scenes the learning (a target per ray, atomic adds) costs as much as the ray itself, and by
 // then the table has stopped improving (bench/results/guiding.md).
 constexpr uint32_t kGuidingLearningSamples = 64;
+// --guiding auto: the pilot (guided and unguided samples on a quarter of the texels, the guide learning) lasts
+// the grid's learning samples; a bake of fewer --spp gives it the largest power of two up to a
+// quarter of them, at least 4 (powers of two from 4 on are boundaries of the ramp's passes).
+uint32_t guiding_auto_pilot(uint32_t spp) {
+  if (spp == 0 || spp >= 4 * kGuidingLearningSamples) return kGuidingLearningSamples;
+  uint32_t pilot = 4;
+  while (pilot * 2 <= spp / 4) pilot *= 2;
+  return pilot;
+}
 // A target error plans at most this many samples for a texel without --spp (documented).
 constexpr uint32_t kMostSamplesForTarget = 1u << 17;
 
@@ -252,7 +262,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
 
   // Built inside the timed bake: guided results are measured with the cost of their guiding data.
   std::unique_ptr<GridGuidingCache> guide;
-  if (settings.guiding == GuidingMode::Grid) {
+  const GuidingMode guided_kind = settings.guiding == GuidingMode::Auto ? settings.guiding_auto_candidate : settings.guiding;
+  if (guided_kind == GuidingMode::Grid) {
     GridGuidingConfig config;
     config.mix = settings.guiding_mix;
     config.cells_on_longest_axis = settings.guiding_grid_cells;
@@ -279,6 +290,21 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
                                                    });
     if (svo_guide->seeded()) svo_guide->rebuild(nullptr, 0, settings.seed);
   }
+  // --guiding auto (guiding_choice.h): regions are the guide's records (grid cell x normal class of
+  // the texel), the unit whose learned table decides how well its texels' first vertices are guided,
+  // with at least 16 texels each, so a region's variance sums are not one texel's noise. Texels
+  // without a record share one more region.
+  std::unique_ptr<GuidingChoice> choice;
+  if (settings.guiding == GuidingMode::Auto) {
+    if (!guide) throw std::invalid_argument("CPU backend: --guiding auto has no guided kind to measure (candidate not built)");
+    const uint32_t pilot = guiding_auto_pilot(settings.spp);
+    std::vector<uint32_t> region(texel_count);
+    for (size_t i = 0; i < texel_count; ++i) {
+      const uint32_t r = guide->record_of(gbuffer.texels[i].position, gbuffer.texels[i].shading_normal);
+      region[i] = r == GridGuidingCache::kNoRecord ? guide->record_count() : r;
+    }
+    choice = std::make_unique<GuidingChoice>(std::move(region), guide->record_count() + 1, pilot, pilot / 4, settings.seed);
+  }
 
   // Adaptive sampling (adaptive_sampling_plan.h): a uniform pilot, then per-texel rates from the
   // neighbours' pilot samples. A target error always plans: a rule that stopped a texel on its own
@@ -295,22 +321,31 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   // One sample `s` of texel `i`.
   auto take_sample = [&](size_t i, uint32_t s, bool learning, PathContributions& contributions) {
     uint64_t& rays = rays_per_thread.local();
+    uint64_t& guided_vertices = guided_per_thread.local();
+    // Auto: this sample's strategy (the pilot's halves on measuring texels, then the texel's
+    // leave-one-out choice from its region's and the scene's evidence); unguided samples
+    // trace without the guide, so regions that chose cosine pay nothing for it.
+    const bool guided_sample = !choice || choice->sample_guided(i, s);
+    GridGuidingCache* sample_guide = guided_sample ? guide.get() : nullptr;
     const LiveTexel& texel = gbuffer.texels[i];
     const SurfacePoint point{texel.position, texel.geometric_normal, texel.shading_normal};
     TexelAccumulator& acc = estimate.texels[i];
-    PathSampler rng = path_sampler(settings.seed, i, s, settings.sampler);
+    // Auto: each strategy on its own sequence, by its own count (guiding_choice.h says why).
+    PathSampler rng = choice ? path_sampler(settings.seed, guided_sample ? GuidingChoice::guided_stream(i) : i,
+                                            choice->strategy_sample_index(i, s, guided_sample), settings.sampler)
+                             : path_sampler(settings.seed, i, s, settings.sampler);
     contributions = PathContributions{};
     contributions.recorded = estimate.recorded_bounces;
     contributions.directional = directional;
-    const uint64_t rays_before = rays;
+    const uint64_t rays_before = rays, guided_before = guided_vertices;
     if (svo_guide)
       impl_->trace(point, settings, rng, contributions, rays,
-                   Impl::SvoGuide{*svo_guide, svo_counting, settings.guiding_svo_texels}, &guided_per_thread.local());
-    else if (guide)
-      impl_->trace(point, settings, rng, contributions, rays, Impl::GridGuide{*impl_, *guide, learning},
-                   &guided_per_thread.local());
+                   Impl::SvoGuide{*svo_guide, svo_counting, settings.guiding_svo_texels}, &guided_vertices);
+    else if (sample_guide)
+      impl_->trace(point, settings, rng, contributions, rays, Impl::GridGuide{*impl_, *sample_guide, learning},
+                   &guided_vertices);
     else
-      impl_->trace(point, settings, rng, contributions, rays, Impl::NoGuide{}, &guided_per_thread.local());
+      impl_->trace(point, settings, rng, contributions, rays, Impl::NoGuide{}, &guided_vertices);
     const Vec3 total = contributions.total();
     Vec3 l1[3];
     bool l1_finite = true;
@@ -332,6 +367,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       for (int axis = 0; axis < 3; ++axis)
         for (int c = 0; c < 3; ++c) estimate.sh1[(i * 3 + size_t(axis)) * 3 + size_t(c)] += l1[axis][c];
     ++acc.samples;
+    if (choice && !choice->decided())
+      choice->record(i, s, guided_sample, luminance(total), rays - rays_before, guided_vertices - guided_before);
     if (share) texel_rays[i] += rays - rays_before, ++shared_samples_per_thread.local();
     if (adaptive && !planning) {
       TexelSampleSums& p = pilot_sums[i];
@@ -352,7 +389,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   uint32_t first = 0, count = 0;
   double fraction = 1;
   while (passes.next_pass(first, count, &fraction)) {
-    const bool learning = guide && first < kGuidingLearningSamples;
+    const bool learning = guide && first < (choice ? choice->pilot() : kGuidingLearningSamples) &&
+                          (!choice || !choice->decided());
     // SVO bins come from the vertices of the pass that reaches the next rebuild (the thesis's
     // previous frame): counts of earlier passes would describe older fields' paths.
     svo_counting = svo_guide && first + count >= svo_next_rebuild;
@@ -392,6 +430,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       svo_next_rebuild = 2 * (first + count);
     }
     passes.finish_pass(rays_per_thread.combine(std::plus<uint64_t>()));
+    // Auto: the pilot is complete on every texel; each texel takes its region's cheaper strategy from here.
+    if (choice && !choice->decided() && passes.samples_done() >= choice->pilot() && fraction == 1) choice->decide();
     if (adaptive && !planning && passes.samples_done() == pilot && fraction == 1) {
       // The pilot is complete: every texel's rate from its neighbours' pilot samples.
       plan = plan_adaptive_rates(gbuffer, pilot_sums);
@@ -429,6 +469,11 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     estimate.nonfinite_samples = share->sum(estimate.nonfinite_samples);
   }
   estimate.guided_vertices = guided_per_thread.combine(std::plus<uint64_t>());
+  if (choice) {
+    estimate.guiding_auto = true;
+    estimate.guiding_auto_pilot = choice->pilot();
+    if (choice->decided()) estimate.guiding_regions = choice->regions(), estimate.guiding_scene = choice->scene();
+  }
   if (guide && settings.inspect_guiding) settings.inspect_guiding(*guide);
   if (svo_guide && settings.inspect_svo_guiding) settings.inspect_svo_guiding(*svo_guide);
   estimate.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "exitance/common/gpu_layout.h"
+#include "exitance/runtime/core/guiding_choice.h"
 #include "exitance/runtime/spherical_harmonics.h"
 #include "exitance/runtime/vec_math.h"
 
@@ -47,6 +48,12 @@ struct LightmapEstimate {
   uint64_t nonfinite_samples = 0;  // samples discarded because they were NaN/Inf (should stay 0)
   BounceGatherStatistics bounce_statistics;
   uint64_t guided_vertices = 0;  // path vertices that sampled a guided mixture (--guiding); 0 unguided
+  // GuidingMode::Auto: what the choice measured and kept per region (core/guiding_choice.h); empty
+  // otherwise or when the bake ended before the pilot did (then every sample tossed its coin).
+  bool guiding_auto = false;
+  uint32_t guiding_auto_pilot = 0;  // samples per texel before the choice
+  std::vector<RegionChoice> guiding_regions;
+  EfficiencyEvidence guiding_scene;  // the whole scene's evidence, which regions without their own follow
   bool adaptive = false;         // samples were planned per texel (core/adaptive_sampling_plan.h)
   uint32_t adaptive_pilot = 0;   // samples per texel of the pilot before the plan (0: no plan made)
   // DirectionalMode::Sh1: per texel the sums of the L1 estimates (path.h sh1_direction_factor),

@@ -22,8 +22,10 @@ enum class IntegratorMode { Path, Bounces };
 // Path guiding of the continuation directions (bake --guiding, issue 11). Grid: the regular-grid
 // SARSA cache of seed 002 (core/grid_guiding_cache.h), one-sample MIS with cosine sampling. Svo:
 // fields built from exitance in the bake's octree (seed 000, core/svo_guiding_fields.h; needs
-// guiding_octree). The choice of `auto` is made by the caller (bake), which hands Off or a mode here.
-enum class GuidingMode { Off, Grid, Svo };
+// guiding_octree). Auto: the integrator measures, during a pilot, the variance per counted cost of
+// guided (the `guiding_auto_candidate` kind) and unguided samples per region and keeps guiding where
+// it pays (core/guiding_choice.h); CPU backend, which alone has it so far (bake hands Off to the others).
+enum class GuidingMode { Off, Grid, Svo, Auto };
 
 // Directional lightmaps (bake --directional, issue 14). Sh1: per texel also the world-space L1 SH
 // coefficients of cosine-convolved irradiance in units of E/pi (LightmapEstimate::sh1,
@@ -58,6 +60,7 @@ struct IntegratorSettings {
   uint32_t sampler = 0;            // random numbers: kSamplerSobol (0) or kSamplerIndependent (path_sampler.h)
   GuidingMode guiding = GuidingMode::Off;  // Path mode only; backends refuse modes they lack
   DirectionalMode directional = DirectionalMode::Off;  // Path mode only
+  GuidingMode guiding_auto_candidate = GuidingMode::Grid;  // the guided kind Auto measures against unguided
   float guiding_mix = 0.5f;         // probability of the guided component at a guided vertex (0..1)
   int guiding_grid_cells = 16;      // grid cells along the scene's longest axis (cubic cells)
   // GuidingMode::Svo: the bake's octree (its structure; exitance it holds seeds the guide), and

@@ -13,9 +13,17 @@ namespace exitance {
 // tracing reaches a given relMSE 1-9x sooner there, its per-bounce passes being bound by the host's
 // cache builds between layers) and for what only it
 // estimates: --directional sh1, --guiding grid, --adaptive on; else the per-bounce mode.
+// (--guiding auto does not ask for path tracing: it guides path tracing when that runs.)
 IntegratorMode automatic_integrator(const BakeOptions& options, const Integrator& backend);
 
-// `options` with lighting.integrator decided by automatic_integrator when options.integrator_auto.
+// `--guiding auto` once the backend and integrator are known: Auto (the measured per-region choice,
+// core/guiding_choice.h) when the CPU backend path traces in one process; Off elsewhere: the Vulkan
+// backend has no guiding yet, per-bounce passes are not guided, guiding is not split over ranks.
+// Other modes pass through.
+GuidingMode automatic_guiding(const BakeOptions& options, const Integrator& backend);
+
+// `options` with lighting.integrator decided by automatic_integrator when options.integrator_auto,
+// and lighting.guiding by automatic_guiding.
 BakeOptions with_integrator_decided(const BakeOptions& options, const Integrator& backend);
 
 }  // namespace exitance
