@@ -7,8 +7,9 @@
 //
 // Standard errors come from independent seeds (kSeeds per estimator): guided samples of one texel
 // depend on the table learned from all texels, so per-texel tracked variances are not used.
-// kZLimit = 5: two 12-seed means (Welch, ~22 degrees of freedom) differ by 5 SE with two-sided
-// p ~ 5e-5 per region; with up to ~25 regions per test a false alarm stays below ~0.2 %.
+// kZLimit = 5: two 8-seed means (Welch, ~14 degrees of freedom) differ by 5 SE with two-sided
+// p ~ 2e-4 per region; with up to ~25 regions per test a false alarm stays below ~0.5 %; the
+// furnace tests one 8-seed mean against the closed form (t with 7 dof): p ~ 2e-3 per channel.
 // Each region test also checks its power: a 10 % bias in the median region must exceed kZLimit SEs.
 #include <gtest/gtest.h>
 
@@ -33,7 +34,7 @@ namespace exitance {
 namespace {
 
 constexpr double kZLimit = 5.0;
-constexpr int kSeeds = 12;
+constexpr int kSeeds = 8;
 constexpr double kDetectableBias = 0.10;
 
 IntegratorSettings settings(uint32_t spp, uint64_t seed, GuidingMode guiding, float mix = 0.5f) {
@@ -111,9 +112,10 @@ TEST(VulkanGridGuiding, FurnaceReachesLeOverOneMinusAlbedo) {
   });
 }
 
-// guided_path_test.cpp's small bright emitter (20 cm, radiance 200, guided share 0.75): the MIS
-// weights of NEE against the mixture pdf decide the result (weighing against the cosine pdf
-// instead measured z +5.2 there on the CPU).
+// guided_path_test.cpp's small bright emitter (20 cm, radiance 200, guided share 0.75), where the
+// MIS weights of NEE against the mixture pdf matter. Measured mutation (NEE weighed against the
+// cosine pdf in path.glsl): the walls moved by 0.1-0.25 % (z up to +2.5 at a wall SE of 0.1-0.2 %),
+// which this test does not resolve; it checks unbiasedness at that resolution.
 TEST(VulkanGridGuiding, SmallBrightEmitterAgreesWithUnguided) {
   const Vec3 black{0, 0, 0};
   const Vec3 emission[6] = {black, black, black, black, black, black};
@@ -134,7 +136,30 @@ TEST(VulkanGridGuiding, AjarRoomAgreesWithUnguided) {
   atlas.texel_density = 4;
   Diagnostics diagnostics;
   const PreparedScene p = prepare_scene_for_lighting(EXITANCE_SAMPLE_DIR "/ajar_room.gltf", "", atlas, diagnostics);
-  expect_guided_agrees("ajar_room", p.scene, p.gbuffer, 64, 0.5f, false);
+  expect_guided_agrees("ajar_room", p.scene, p.gbuffer, 32, 0.5f, false);
+}
+
+// The courtyard under a blue sky (bake --sky 0.25,0.5,1) and its low sun: escaping continuations
+// learn the sky's radiance. (The sun alone teaches nothing: continuation rays never meet a
+// punctual light, so the table of a sun-only scene stays cosine.)
+struct SkyCourtyard {
+  Scene scene;
+  TexelGBuffer gbuffer;
+};
+
+SkyCourtyard courtyard_under_sky() {
+  AtlasSettings atlas;
+  atlas.texel_density = 1;
+  Diagnostics diagnostics;
+  const PreparedScene p = prepare_scene_for_lighting(EXITANCE_SAMPLE_DIR "/courtyard.gltf", "", atlas, diagnostics);
+  SkyCourtyard c{p.scene, p.gbuffer};
+  c.scene.sky.constant = {0.25f, 0.5f, 1.0f};
+  return c;
+}
+
+TEST(VulkanGridGuiding, CourtyardUnderSkyAgreesWithUnguided) {
+  const SkyCourtyard c = courtyard_under_sky();
+  expect_guided_agrees("courtyard", c.scene, c.gbuffer, 16, 0.5f, false);
 }
 
 // The learned table of a whole bake, copied out by inspect_guiding.
@@ -151,7 +176,7 @@ LearnedTable learned_table(const GridGuidingCache& cache) {
   return t;
 }
 
-// A furnace of albedo 0: every continuation ray from a texel hits an emitting wall, so every target
+// The exact case: a furnace of albedo 0, where every continuation ray from a texel hits an emitting wall, so every target
 // is L_e exactly (Lbar never enters), and a bin's learned value is the fixed-point mean of equal
 // targets: exactly the same number on both backends for every bin both saw, whatever their counts.
 // The backends draw the same random numbers, so they see the same bins up to directions within
@@ -190,6 +215,66 @@ TEST(VulkanGridGuiding, DeviceLearnsTheCpuTable) {
   EXPECT_EQ(g.guided_vertices, c.guided_vertices);
 }
 
+// Mean over records of the L1 distance between two tables' bin probabilities (their CDFs' steps).
+double table_distance(const std::vector<std::vector<float>>& a, const std::vector<std::vector<float>>& b) {
+  double sum = 0;
+  for (size_t r = 0; r < a.size(); ++r)
+    for (uint32_t k = 0; k < kGuideBins; ++k) sum += std::fabs((a[r][k + 1] - a[r][k]) - (b[r][k + 1] - b[r][k]));
+  return a.empty() ? 0.0 : sum / double(a.size());
+}
+
+std::vector<std::vector<float>> cdfs(const GridGuidingCache& cache) {
+  std::vector<std::vector<float>> out;
+  for (uint32_t r = 0; r < cache.record_count(); ++r) {
+    const GuideVertex g = cache.vertex(r);
+    out.emplace_back(g.cdf, g.cdf + kGuideBins + 1);
+  }
+  return out;
+}
+
+// The device learns the CPU's table from the same samples: with one seed both backends draw the same
+// random numbers, learn the same targets in the same fixed-point units and fold them with the same
+// code, so their tables differ only where rounding sends a path elsewhere (a direction on a bin
+// edge, a hit on a triangle edge). The tolerance is relative to the table's own noise, the distance
+// between the CPU's tables of two seeds: a device that learned elsewhere, or other targets, would be
+// about as far as that (measured: 0 in the box, i.e. bit-identical tables; see the printout).
+void expect_tables_match_the_cpu(const std::string& label, const Scene& scene, const TexelGBuffer& gbuffer,
+                                 uint32_t spp, float mix) {
+  CREATE_VULKAN_OR_SKIP(vk, scene);
+  const CpuReferenceIntegrator cpu(scene);
+  std::vector<std::vector<float>> device, host, other_seed;
+  IntegratorSettings s = settings(spp, 5, GuidingMode::Grid, mix);
+  s.inspect_guiding = [&](const GridGuidingCache& t) { device = cdfs(t); };
+  vk->bake(gbuffer, s);
+  s.inspect_guiding = [&](const GridGuidingCache& t) { host = cdfs(t); };
+  cpu.bake(gbuffer, s);
+  s.seed = 6;
+  s.inspect_guiding = [&](const GridGuidingCache& t) { other_seed = cdfs(t); };
+  cpu.bake(gbuffer, s);
+  ASSERT_EQ(device.size(), host.size());
+  ASSERT_GT(device.size(), 0u);
+  const double same = table_distance(device, host), noise = table_distance(host, other_seed);
+  std::printf("[vulkan guided] %s tables: device vs CPU, one seed %.3g; CPU vs CPU, two seeds %.3g\n", label.c_str(),
+              same, noise);
+  EXPECT_GT(noise, 0.0);
+  EXPECT_LE(same, 0.05 * noise) << label;
+}
+
+TEST(VulkanGridGuiding, SmallEmitterDeviceLearnsTheCpuTable) {
+  const Vec3 black{0, 0, 0};
+  const Vec3 emission[6] = {black, black, black, black, black, black};
+  const testing::AtlasScene box = testing::atlas_box(0.6f, emission, 8, 0.2f, {200, 200, 200});
+  expect_tables_match_the_cpu("small emitter", box.scene, box.gbuffer, 64, 0.75f);
+}
+
+TEST(VulkanGridGuiding, CornellRoomDeviceLearnsTheCpuTable) {
+  AtlasSettings atlas;
+  atlas.texel_density = 2;
+  Diagnostics diagnostics;
+  const PreparedScene p = prepare_scene_for_lighting(EXITANCE_SAMPLE_DIR "/cornell_room.gltf", "", atlas, diagnostics);
+  expect_tables_match_the_cpu("cornell_room", p.scene, p.gbuffer, 64, 0.5f);
+}
+
 bool identical(const LightmapEstimate& a, const LightmapEstimate& b) {
   if (a.texels.size() != b.texels.size() || a.bounces != b.bounces) return false;
   for (size_t i = 0; i < a.texels.size(); ++i)
@@ -198,6 +283,11 @@ bool identical(const LightmapEstimate& a, const LightmapEstimate& b) {
 }
 
 // Integer sums on the device and in the fold: the same seed gives the same table and lightmap.
+TEST(VulkanGridGuiding, CourtyardUnderSkyDeviceLearnsTheCpuTable) {
+  const SkyCourtyard c = courtyard_under_sky();
+  expect_tables_match_the_cpu("courtyard", c.scene, c.gbuffer, 64, 0.5f);
+}
+
 TEST(VulkanGridGuiding, BitIdenticalPerSeed) {
   AtlasSettings atlas;
   atlas.texel_density = 2;
