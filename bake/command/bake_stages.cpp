@@ -122,11 +122,6 @@ std::shared_ptr<const Integrator> backend_stage(const SceneForLighting& scene, c
     request.name = "cpu";
     diagnostics.warn("--adaptive on: using the CPU reference (Embree), the only backend with adaptive sampling yet");
   }
-  if (options.lighting.guiding != GuidingMode::Off && request.name == "auto") {
-    // Grid guiding exists on the CPU backend only for now (the Vulkan backend refuses it).
-    request.name = "cpu";
-    diagnostics.warn("--guiding grid: using the CPU reference (Embree), the only backend with guiding yet");
-  }
   return choose_lighting_backend(scene.lighting, scene.embree, request, diagnostics);
 }
 

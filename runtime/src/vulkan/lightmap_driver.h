@@ -16,9 +16,17 @@
 
 namespace exitance::vulkan {
 
+// What grid guiding reads of the scene (GridGuidingCache's bounds and radiance scale); the
+// integrator keeps it current through scene edits.
+struct GuidingScene {
+  Vec3 bounds_lo{0, 0, 0}, bounds_hi{0, 0, 0};
+  float reference_radiance = 1;
+};
+
 class LightmapDriver {
  public:
   explicit LightmapDriver(WavefrontBatchRunner& runner) : runner_(runner) {}
+  void set_guiding_scene(const GuidingScene& scene) { guiding_scene_ = scene; }
   LightmapEstimate bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings);
 
   void start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings);
@@ -57,6 +65,7 @@ class LightmapDriver {
   std::vector<uint32_t> unconverged(const std::vector<uint32_t>& work_list, size_t texel_count, double target);
 
   WavefrontBatchRunner& runner_;
+  GuidingScene guiding_scene_;
   std::optional<Accumulation> progressive_;
 };
 
