@@ -11,7 +11,9 @@ measured in the same run. References are cached by content hash in ~/.cache/exit
 
 --report names the CSV, plot and table (default time_vs_error); the per-bounce mode's figures
 (bench/results/per-bounce.md) come from --backends cpu --integrators path,bounces --report per-bounce;
-grid guiding's (bench/results/guiding.md) from --backends cpu --integrators path,guided --report guiding_time_vs_error.
+grid guiding's (bench/results/guiding.md) from --backends cpu --integrators path,guided --report guiding_time_vs_error;
+SVO guiding's (bench/results/guiding-svo.md) from --integrators path,guided,svo (--tool-args passes
+e.g. "--svo-depth 7 --svo-c-ray 256" on to bench_time_to_error).
 --ladder-scale multiplies every scene's largest spp (longer ladders, e.g. to reach 20 s).
 The table's last column: relMSE of the CPU path tracer divided by this row's, both interpolated
 (log-log) at the same time, the longest both reached: > 1 = better than the CPU path tracer.
@@ -36,13 +38,14 @@ SCENES = [
 ]
 
 
-def run_scene(build, backends, integrators, name, sky, density, reference_spp, max_spp, max_seconds, target):
+def run_scene(build, backends, integrators, name, sky, density, reference_spp, max_spp, max_seconds, target, tool_args=""):
     tool = os.path.join(build, "bench", "bench_time_to_error")
     scene = os.path.join(build, "samples", name + ".gltf")
     command = [tool, scene, "--backends", backends, "--integrators", integrators, "--name", name, "--texel-density", str(density), "--reference-spp", str(reference_spp),
                "--max-spp", str(max_spp), "--max-seconds", str(max_seconds), "--target", str(target)]
     if sky:
         command += ["--sky", sky]
+    command += tool_args.split()
     print("+", " ".join(command), file=sys.stderr, flush=True)
     result = subprocess.run(command, check=True, capture_output=True, text=True)
     sys.stderr.write(result.stderr)
@@ -88,6 +91,7 @@ def main():
     parser.add_argument("--report", default="time_vs_error")
     parser.add_argument("--quick", action="store_true", help="4x fewer reference and ladder samples")
     parser.add_argument("--ladder-scale", type=int, default=1, help="multiply every scene's largest spp")
+    parser.add_argument("--tool-args", default="", help="extra arguments for bench_time_to_error")
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
 
@@ -98,7 +102,7 @@ def main():
         max_spp *= args.ladder_scale
         if args.quick:
             reference_spp, max_spp = max(64, reference_spp // 4), max(16, max_spp // 4)
-        rows, command = run_scene(args.build, args.backends, args.integrators, name, sky, density, reference_spp, max_spp, args.max_seconds, args.target)
+        rows, command = run_scene(args.build, args.backends, args.integrators, name, sky, density, reference_spp, max_spp, args.max_seconds, args.target, args.tool_args)
         all_rows += rows
         commands.append(" ".join(command))
 

@@ -2,7 +2,7 @@
 // content hash outside the repository) is the reference; runs at doubling spp record seconds,
 // relMSE, MAE, worst-texel error and rays/s as CSV, and the time to reach a target relMSE.
 //
-//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,adaptive,bounces,guided] [--guiding-mix M] [--name NAME]
+//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,adaptive,bounces,guided,svo] [--guiding-mix M] [--name NAME]
 //                       [--sky R,G,B] [--texel-density T] [--reference-spp N] [--max-spp N]
 //                       [--max-seconds S] [--target 0.01] [--bounces N] [--min-spp N] [--cache DIR] [--csv FILE]
 //                       [--texel-csv FILE] [--guiding-fields FILE] [--samplers sobol,independent]
@@ -36,6 +36,8 @@
 #include "exitance/runtime/embree_scene.h"
 #include "rel_mse_weight.h"
 #include "exitance/runtime/core/grid_guiding_cache.h"
+#include "exitance/runtime/core/svo_guiding_fields.h"
+#include "exitance/bake/voxelize/svo_build.h"
 #include "exitance/common/path_sampler.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/bake/command/backend_choice.h"
@@ -89,12 +91,21 @@ int main(int argc, char** argv) {
   app.add_option("--backends", backends, "comma-separated: cpu, vulkan (the reference is always cpu)");
   app.add_option("--integrators", integrators,
                  "comma-separated: path, adaptive (path with adaptive sampling; spp = mean), bounces, bounces_cached "
-                 "(bounces with --first-bounce cached), guided (path with --guiding grid)");
+                 "(bounces with --first-bounce cached), guided (path with --guiding grid), svo (path with --guiding svo)");
   float guiding_mix = 0.5f;
   app.add_option("--guiding-mix", guiding_mix, "guided component's probability (guided runs)");
   std::string guiding_fields;
   app.add_option("--guiding-fields", guiding_fields,
-                 "CSV of the learned grid guiding tables of the last guided run (record, cell, class, bins)");
+                 "CSV of the learned grid guiding tables of the last guided run (record, cell, class, bins); svo "
+                 "runs: their last run's fields (record, bin node level, class, capture origin, bins)");
+  uint32_t svo_depth = 0;
+  app.add_option("--svo-depth", svo_depth,
+                 "svo runs: octree depth (default: the bake's for --texel-density, at least 6: the bench's coarse "
+                 "atlases would otherwise get a few leaves per axis)");
+  double svo_c_ray = 512;
+  app.add_option("--svo-c-ray", svo_c_ray, "svo runs: PARTITION-S c_ray (vertices per sample per texel per bin)");
+  uint32_t svo_rays_per_bin = 1;
+  app.add_option("--svo-rays-per-bin", svo_rays_per_bin, "svo runs: rays per hemisphere bin of a field (k x k)");
   app.add_option("--name", scene_name, "scene name in the CSV (default: file stem)");
   app.add_option("--max-seconds", max_seconds, "stop the ladder after a run longer than this");
   app.add_option("--sky", sky);
@@ -191,6 +202,16 @@ int main(int argc, char** argv) {
   if (listed("path")) modes.push_back({IntegratorMode::Path, GuidingMode::Off, "path_tracing"});
   if (listed("adaptive")) modes.push_back({IntegratorMode::Path, GuidingMode::Off, "path_adaptive", true});
   if (listed("guided")) modes.push_back({IntegratorMode::Path, GuidingMode::Grid, "path_guided_grid"});
+  if (listed("svo")) modes.push_back({IntegratorMode::Path, GuidingMode::Svo, "path_guided_svo"});
+  // The octree of svo runs: built once, as the bake's voxelize stage does before lighting (not timed:
+  // every bake builds it, guided or not).
+  formats::SparseVoxelOctree octree;
+  if (listed("svo")) {
+    SvoBuildSettings build;
+    build.depth = svo_depth ? svo_depth : std::max(6u, default_svo_depth(scene, density));
+    octree = build_sparse_voxel_octree(scene, build);
+    std::cerr << "svo guiding octree: depth " << build.depth << ", " << octree.nodes.size() << " nodes\n";
+  }
   if (listed("bounces")) modes.push_back({IntegratorMode::Bounces, GuidingMode::Off, "per_bounce"});
   if (listed("bounces_cached"))
     modes.push_back({IntegratorMode::Bounces, GuidingMode::Off, "per_bounce_cached", false, kSamplerSobol, false});
@@ -213,6 +234,7 @@ int main(int argc, char** argv) {
         warm_up.spp = 1;
         warm_up.integrator = mode;
         warm_up.guiding = m.guiding;
+        warm_up.guiding_octree = &octree;
         try {
           backend->bake(gbuffer, warm_up);
         } catch (const std::exception& e) {
@@ -230,6 +252,27 @@ int main(int argc, char** argv) {
         settings.max_bounces = bounces;
         settings.guiding = m.guiding;
         settings.guiding_mix = guiding_mix;
+        settings.guiding_octree = &octree;
+        settings.guiding_svo_c_ray = svo_c_ray;
+        settings.guiding_svo_rays_per_bin = svo_rays_per_bin;
+        uint32_t svo_records = 0, svo_bins = 0;
+        size_t svo_memory = 0;
+        settings.inspect_svo_guiding = [&](const SvoGuidingFields& fields) {
+          svo_records = fields.record_count(), svo_bins = fields.bin_count(), svo_memory = fields.memory_bytes();
+          if (guiding_fields.empty()) return;
+          std::ofstream out(guiding_fields);
+          out << "record,level,normal_class,x,y,z,bytes_per_record,memory_bytes";
+          for (uint b = 0; b < kGuideBins; ++b) out << ",bin" << b;
+          out << "\n";
+          for (uint32_t r = 0; r < fields.record_count(); ++r) {
+            const Vec3 o = fields.capture_origin(r);
+            out << r << "," << int(octree.nodes[fields.bin_node(fields.record_bin(r))].level) << ","
+                << fields.record_class(r) << "," << o.x << "," << o.y << "," << o.z << ","
+                << SvoGuidingFields::bytes_per_record() << "," << fields.memory_bytes();
+            for (uint b = 0; b < kGuideBins; ++b) out << "," << fields.field(r)[b];
+            out << "\n";
+          }
+        };
         settings.adaptive = m.adaptive;  // spp is then the mean samples per texel
         settings.sampler = m.sampler;
         settings.trace_first_bounce = m.trace_first_bounce;
@@ -252,6 +295,9 @@ int main(int argc, char** argv) {
                   }
           };
         const LightmapEstimate estimate = backend->bake(gbuffer, settings);
+        if (m.guiding == GuidingMode::Svo)
+          std::cerr << mode_name << " " << spp << " spp: " << svo_bins << " bins, " << svo_records << " records, "
+                    << svo_memory << " bytes\n";
         std::vector<float> result = flatten(estimate);
         result.resize(values);
         ErrorFigures e = compare(result, reference_mean);

@@ -200,6 +200,8 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   // --probe-spp), the texels get what the probes left.
   std::optional<ProbeEstimate> probe_lighting;
   BakeOptions lighting_options = decided;
+  // SVO guiding builds its fields over the octree voxelized above (main refuses it without one).
+  if (voxels) lighting_options.lighting.guiding_octree = &voxels->svo;
   const double budget = options.lighting.time_budget_seconds;
   if (probes) {
     const double probe_budget = budget > 0 ? kProbeShareOfTimeBudget * budget : 0.0;

@@ -49,7 +49,8 @@ void quiet_unless_rank_zero(const exitance::MpiWorkShare* share) {
 std::string refused_under_mpirun(const exitance::BakeOptions& options, const std::string& adaptive,
                                  const std::string& guiding, const std::string& integrator) {
   if (adaptive == "on") return "--adaptive on: adaptive sampling runs in one process only, not under mpirun";
-  if (guiding == "grid") return "--guiding grid: guiding runs in one process only, not under mpirun";
+  if (guiding == "grid" || guiding == "svo")
+    return "--guiding " + guiding + ": guiding runs in one process only, not under mpirun";
   if (integrator == "path" && options.lighting.target_relative_error > 0 && options.backend.name == "cpu")
     return "--target-error: on the CPU backend with --integrator path it plans each texel's samples in one process; "
            "under mpirun use --integrator bounces";
@@ -132,8 +133,8 @@ int main(int argc, char** argv) {
   app.add_option("--directional", directional,
                  "sh1: also write L1 SH directional layers sh1.x.R .. sh1.z.B (docs/bundle.md; path tracing)");
   app.add_option("--guiding", guiding,
-                 "auto (= off for now) | off | svo (not implemented yet) | grid (regular-grid SARSA cache, seed 002; "
-                 "CPU backend only)")
+                 "auto (= off for now) | off | svo (fields from exitance in the bake's voxel octree, seed 000) | grid "
+                 "(regular-grid SARSA cache, seed 002); both CPU backend only")
       ->check(CLI::IsMember({"auto", "off", "svo", "grid"}));
   app.add_option("--guiding-mix", options.lighting.guiding_mix,
                  "probability of the guided direction in the one-sample mixture with cosine sampling (default 0.5)")
@@ -268,16 +269,20 @@ int main(int argc, char** argv) {
     }
     options.lighting.directional = exitance::DirectionalMode::Sh1;
   }
-  if (guiding == "svo") {
-    std::cerr << "bake: error: --guiding svo is not implemented yet (use grid or off)\n";
-    return 1;
-  }
-  if (guiding == "grid") {
+  if (guiding == "grid" || guiding == "svo") {
     if (integrator == "bounces") {
-      std::cerr << "bake: error: --guiding grid guides path tracing: it needs --integrator path\n";
+      std::cerr << "bake: error: --guiding " << guiding << " guides path tracing: it needs --integrator path\n";
       return 2;
     }
-    options.lighting.guiding = exitance::GuidingMode::Grid;
+    options.lighting.guiding = guiding == "grid" ? exitance::GuidingMode::Grid : exitance::GuidingMode::Svo;
+  }
+  if (guiding == "svo" && voxels == "none") {
+    std::cerr << "bake: error: --guiding svo builds its fields from the voxel octree: it contradicts --voxel-resolution none\n";
+    return 2;
+  }
+  if (guiding == "svo" && options.backend.name == "vulkan") {
+    std::cerr << "bake: error: --guiding svo is implemented on the CPU backend only (use --backend cpu)\n";
+    return 2;
   }
 
   if (no_cache && !cache_directory.empty()) {

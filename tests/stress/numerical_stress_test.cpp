@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "exitance/bake/voxelize/svo_build.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "support/test_scenes.h"
@@ -56,8 +57,8 @@ Room make_room(float scale, Vec3 offset) {
   return room;
 }
 
-// Every stress test runs on each backend: the CPU reference, the CPU reference with grid guiding
-// forced on, and the Vulkan compute backend (lavapipe in CI, validation layers on; any validation
+// Every stress test runs on each backend: the CPU reference, the CPU reference with grid or SVO
+// guiding forced on, and the Vulkan compute backend (lavapipe in CI, validation layers on; any validation
 // message fails the test).
 class Stress : public ::testing::TestWithParam<std::string> {
  protected:
@@ -73,6 +74,15 @@ class Stress : public ::testing::TestWithParam<std::string> {
     if (GetParam() == "cpu_guided") {  // grid guiding forced on (issue 11): same checks, same tolerances
       IntegratorSettings guided = settings;
       guided.guiding = GuidingMode::Grid;
+      return CpuReferenceIntegrator(scene).bake(texels, guided);
+    }
+    if (GetParam() == "cpu_svo_guided") {  // SVO guiding forced on, over a 64^3 octree of the scene
+      SvoBuildSettings build;
+      build.depth = 6;
+      const formats::SparseVoxelOctree octree = build_sparse_voxel_octree(scene, build);
+      IntegratorSettings guided = settings;
+      guided.guiding = GuidingMode::Svo;
+      guided.guiding_octree = &octree;
       return CpuReferenceIntegrator(scene).bake(texels, guided);
     }
     std::vector<std::string> messages;
@@ -251,7 +261,7 @@ TEST_P(Stress, ThinWallDoesNotLeak) {
   EXPECT_EQ(leak, 0.0);
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, Stress, ::testing::Values("cpu", "cpu_guided", "vulkan"),
+INSTANTIATE_TEST_SUITE_P(Backends, Stress, ::testing::Values("cpu", "cpu_guided", "cpu_svo_guided", "vulkan"),
                          [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
 
 }  // namespace

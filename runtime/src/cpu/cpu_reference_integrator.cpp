@@ -16,6 +16,7 @@
 #include "exitance/runtime/core/adaptive_sampling_plan.h"
 #include "exitance/runtime/core/grid_guiding_cache.h"
 #include "exitance/runtime/core/pass_scheduler.h"
+#include "exitance/runtime/core/svo_guiding_fields.h"
 #include "exitance/runtime/core/scene_access.h"
 #include "exitance/common/guide_learning.h"  // after scene_access.h: path.h reads its accessors
 #include "exitance/runtime/core/work_share.h"
@@ -104,18 +105,50 @@ struct CpuReferenceIntegrator::Impl {
     return guide_learning_target(h, expected);
   }
 
-  // One path sample of E/pi at x; `first_bounce` is the bounce x stands for (0 at a texel). With a
-  // guiding cache, vertices sample its frozen table's mixture and every ray teaches its back table.
+  // What trace() asks of a guide: the record of a vertex (site), its strategy (vertex), and what a
+  // continuation ray teaches it (observe). No guide: cosine sampling, exactly as before guiding.
+  struct NoGuide {
+    uint32_t site(const SurfacePoint&) const { return 0; }
+    GuideVertex vertex(uint32_t) const { return guide_vertex_cosine(); }
+    void observe(uint32_t, const GuideVertex&, Vec3, const Hit&) const {}
+  };
+  // Grid guiding: vertices sample the frozen table's mixture; while learning, every ray teaches the back table.
+  struct GridGuide {
+    const Impl& impl;
+    GridGuidingCache& cache;
+    bool learn;
+    uint32_t site(const SurfacePoint& x) const { return cache.record_of(x.position, x.shading_normal); }
+    GuideVertex vertex(uint32_t record) const { return cache.vertex(record); }
+    void observe(uint32_t record, const GuideVertex& g, Vec3 direction, const Hit& hit) const {
+      if (!learn || record == GridGuidingCache::kNoRecord) return;
+      const Vec3 local = guide_to_class_local(g.normal_class, direction);
+      if (local.z > 0) cache.learn(record, guide_bin_of_local(local), impl.learning_target(cache, hit, direction));
+    }
+  };
+  // SVO guiding: vertices sample their bin's field and are counted for the next rebuild's bins.
+  struct SvoGuide {
+    SvoGuidingFields& fields;
+    bool counting;
+    uint32_t site(const SurfacePoint& x) const {
+      const uint32_t node = fields.node_of(x.position);
+      if (counting) fields.count(node, x.shading_normal);
+      return fields.record_of(node, x.shading_normal);
+    }
+    GuideVertex vertex(uint32_t record) const { return fields.vertex(record); }
+    void observe(uint32_t, const GuideVertex&, Vec3, const Hit&) const {}
+  };
+
+  // One path sample of E/pi at x; `first_bounce` is the bounce x stands for (0 at a texel).
+  template <class Guide>
   void trace(SurfacePoint x, const IntegratorSettings& settings, PathSampler& rng, PathContributions& out,
-             uint64_t& rays, GridGuidingCache* guide = nullptr, bool learn = false,
-             uint64_t* guided_vertices = nullptr) const {
+             uint64_t& rays, const Guide& guide, uint64_t* guided_vertices = nullptr) const {
     const LightingScene& s = scene();
     const PathLimits limits{settings.max_bounces, settings.russian_roulette_start, settings.safety_bounce_cap};
     Vec3 throughput{1, 1, 1};
     for (int bounce = 0;; ++bounce) {
       const Vec3 origin = offset_ray_origin(x.position, x.geometric_normal, s.extent);
-      const uint32_t record = guide ? guide->record_of(x.position, x.shading_normal) : GridGuidingCache::kNoRecord;
-      GuideVertex g = guide ? guide->vertex(record) : guide_vertex_cosine();
+      const uint32_t record = guide.site(x);
+      GuideVertex g = guide.vertex(record);
       if (guided_vertices && g.guided_probability > 0) ++*guided_vertices;
       const bool directional_texel = out.directional && bounce == 0;
       if (directional_texel) g = with_uniform_component(g, kDirectionalUniformProbability);
@@ -130,10 +163,7 @@ struct CpuReferenceIntegrator::Impl {
       const Vec3 ray_throughput = throughput * continuation_weight(g, x, d);
       ++rays;
       const Hit hit = embree->intersect(origin, d.direction, INFINITY);
-      if (learn && record != GridGuidingCache::kNoRecord) {
-        const Vec3 local = guide_to_class_local(g.normal_class, d.direction);
-        if (local.z > 0) guide->learn(record, guide_bin_of_local(local), learning_target(*guide, hit, d.direction));
-      }
+      guide.observe(record, g, d.direction, hit);
       if (!hit.found) {
         out.add(bounce, ray_throughput * escaped_radiance(s, d.direction, d.pdf));
         return;
@@ -159,7 +189,7 @@ struct CpuReferenceIntegrator::Impl {
     if (!h.continues) return h.radiance;
     PathContributions contributions;
     contributions.recorded = 0;
-    trace(h.next, settings, rng, contributions, rays);
+    trace(h.next, settings, rng, contributions, rays, NoGuide{});
     return h.radiance + h.albedo * contributions.total();
   }
 };
@@ -222,6 +252,26 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     config.cells_on_longest_axis = settings.guiding_grid_cells;
     guide = std::make_unique<GridGuidingCache>(*impl_->lighting, gbuffer, config);
   }
+  // SVO guiding: fields rebuilt after the passes that reach 1, 2, 4, ... samples per texel (the first
+  // pass unguided unless the octree already holds exitance), their rays traced by Embree.
+  std::unique_ptr<SvoGuidingFields> svo_guide;
+  uint32_t svo_next_rebuild = 1;
+  bool svo_counting = false;  // this pass counts vertices per node: the pass that ends at a rebuild
+  if (settings.guiding == GuidingMode::Svo) {
+    if (!settings.guiding_octree)
+      throw std::invalid_argument("CPU backend: --guiding svo needs the bake's sparse voxel octree (not --voxel-resolution none)");
+    SvoGuidingConfig config;
+    config.mix = settings.guiding_mix;
+    config.c_ray = settings.guiding_svo_c_ray;
+    config.rays_per_bin = settings.guiding_svo_rays_per_bin;
+    std::shared_ptr<const EmbreeScene> embree = impl_->embree;
+    svo_guide = std::make_unique<SvoGuidingFields>(*impl_->lighting, *settings.guiding_octree, gbuffer, config,
+                                                   [embree](Vec3 origin, Vec3 direction) {
+                                                     const Hit h = embree->intersect(origin, direction, INFINITY);
+                                                     return GuideRayHit{h.found, h.distance, h.triangle};
+                                                   });
+    if (svo_guide->seeded()) svo_guide->rebuild(nullptr, 0, settings.seed);
+  }
 
   // Adaptive sampling (adaptive_sampling_plan.h): a uniform pilot, then per-texel rates from the
   // neighbours' pilot samples. A target error always plans: a rule that stopped a texel on its own
@@ -246,7 +296,14 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     contributions.recorded = estimate.recorded_bounces;
     contributions.directional = directional;
     const uint64_t rays_before = rays;
-    impl_->trace(point, settings, rng, contributions, rays, guide.get(), learning, &guided_per_thread.local());
+    if (svo_guide)
+      impl_->trace(point, settings, rng, contributions, rays, Impl::SvoGuide{*svo_guide, svo_counting},
+                   &guided_per_thread.local());
+    else if (guide)
+      impl_->trace(point, settings, rng, contributions, rays, Impl::GridGuide{*impl_, *guide, learning},
+                   &guided_per_thread.local());
+    else
+      impl_->trace(point, settings, rng, contributions, rays, Impl::NoGuide{}, &guided_per_thread.local());
     const Vec3 total = contributions.total();
     Vec3 l1[3];
     bool l1_finite = true;
@@ -289,6 +346,9 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   double fraction = 1;
   while (passes.next_pass(first, count, &fraction)) {
     const bool learning = guide && first < kGuidingLearningSamples;
+    // SVO bins come from the vertices of the pass that reaches the next rebuild (counting every
+    // pass cost integer atomics at every vertex for counts the doubling schedule mostly discards).
+    svo_counting = svo_guide && first + count >= svo_next_rebuild;
     if (planning) {
       const double progress = double(first) - progress_after_pilot + double(count) * fraction;
       tbb::parallel_for(tbb::blocked_range<size_t>(0, texel_count, 16), [&](const tbb::blocked_range<size_t>& range) {
@@ -320,6 +380,10 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       }
     }
     if (learning) guide->swap();  // this pass's learning becomes the next pass's frozen table
+    if (svo_guide && svo_counting) {  // this pass reached the next rebuild and counted its vertices
+      svo_guide->rebuild(&estimate, double(count) * fraction, settings.seed);
+      svo_next_rebuild = 2 * (first + count);
+    }
     passes.finish_pass(rays_per_thread.combine(std::plus<uint64_t>()));
     if (adaptive && !planning && passes.samples_done() == pilot && fraction == 1) {
       // The pilot is complete: every texel's rate from its neighbours' pilot samples.
@@ -359,6 +423,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   }
   estimate.guided_vertices = guided_per_thread.combine(std::plus<uint64_t>());
   if (guide && settings.inspect_guiding) settings.inspect_guiding(*guide);
+  if (svo_guide && settings.inspect_svo_guiding) settings.inspect_svo_guiding(*svo_guide);
   estimate.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (settings.work_share && !share) settings.work_share->work.seconds += estimate.seconds;
   return estimate;

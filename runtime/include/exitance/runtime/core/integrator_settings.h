@@ -4,8 +4,12 @@
 #include <functional>
 
 namespace exitance {
+namespace formats {
+struct SparseVoxelOctree;
+}
 
 class GridGuidingCache;
+class SvoGuidingFields;
 class WorkShare;
 
 // How texels are lit (bake --integrator). Path: the unbiased path tracer of path.h, one path per
@@ -16,9 +20,10 @@ class WorkShare;
 enum class IntegratorMode { Path, Bounces };
 
 // Path guiding of the continuation directions (bake --guiding, issue 11). Grid: the regular-grid
-// SARSA cache of seed 002 (core/grid_guiding_cache.h), one-sample MIS with cosine sampling. The
-// choice of `auto` is made by the caller (bake), which hands Off or a mode here.
-enum class GuidingMode { Off, Grid };
+// SARSA cache of seed 002 (core/grid_guiding_cache.h), one-sample MIS with cosine sampling. Svo:
+// fields built from exitance in the bake's octree (seed 000, core/svo_guiding_fields.h; needs
+// guiding_octree). The choice of `auto` is made by the caller (bake), which hands Off or a mode here.
+enum class GuidingMode { Off, Grid, Svo };
 
 // Directional lightmaps (bake --directional, issue 14). Sh1: per texel also the world-space L1 SH
 // coefficients of cosine-convolved irradiance in units of E/pi (LightmapEstimate::sh1,
@@ -55,9 +60,15 @@ struct IntegratorSettings {
   DirectionalMode directional = DirectionalMode::Off;  // Path mode only
   float guiding_mix = 0.5f;         // probability of the guided component at a guided vertex (0..1)
   int guiding_grid_cells = 16;      // grid cells along the scene's longest axis (cubic cells)
+  // GuidingMode::Svo: the bake's octree (its structure; exitance it holds seeds the guide), and
+  // PARTITION-S's c_ray (vertices per sample per texel that make a node a bin).
+  const formats::SparseVoxelOctree* guiding_octree = nullptr;
+  double guiding_svo_c_ray = 512;
+  uint32_t guiding_svo_rays_per_bin = 1;  // rays per hemisphere bin of an SVO field (k x k stratified)
   std::function<void(double fraction_done, uint64_t rays)> progress;  // called between passes
   // Called once at the end of a guided bake with its cache (plots of the learned fields, tests).
   std::function<void(const GridGuidingCache&)> inspect_guiding;
+  std::function<void(const SvoGuidingFields&)> inspect_svo_guiding;  // the same for GuidingMode::Svo
   // This process's share of a bake split over processes (core/work_share.h; bake under mpirun); null:
   // the whole bake. Backends without it refuse more than one rank before lighting (bake does).
   WorkShare* work_share = nullptr;
