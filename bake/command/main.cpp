@@ -280,10 +280,6 @@ int main(int argc, char** argv) {
     std::cerr << "bake: error: --guiding svo builds its fields from the voxel octree: it contradicts --voxel-resolution none\n";
     return 2;
   }
-  if (guiding == "svo" && options.backend.name == "vulkan") {
-    std::cerr << "bake: error: --guiding svo is implemented on the CPU backend only (use --backend cpu)\n";
-    return 2;
-  }
 
   if (no_cache && !cache_directory.empty()) {
     std::cerr << "bake: error: --cache " << cache_directory << ": contradicts --no-cache\n";

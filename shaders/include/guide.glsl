@@ -1,5 +1,5 @@
-// Grid guiding on the wavefront (issue 11; docs/lighting-core.md "Grid guiding on the Vulkan
-// backend"): the record of a vertex, its GuideVertex from the front table, and the learning of its
+// Guiding on the wavefront (issue 11; docs/lighting-core.md "Grid guiding on the Vulkan backend",
+// "SVO guiding"): the record of a vertex (grid cell or octree bin), its GuideVertex from the front table, and the learning of its
 // continuation ray into the back table, over the guide buffer's sections (gpu_layout.h
 // kBindingGuide). The estimator and the learning target are the CPU reference's (path.h,
 // common/guide_learning.h); GridGuidingCache on the host folds the back sums between passes.
@@ -22,11 +22,42 @@ uint guide_grid_record(vec3 position, vec3 shading_normal) {
   return guide_words[base + kGuideGridWords + cell_index * kGuideNormalClasses + guide_normal_class(shading_normal)];
 }
 
+// kGuideLocatorSvo: SvoGuidingFields::node_of (formats::svo_find_node's descent: the deepest node
+// whose cube holds the point) and record_of; in counting passes the vertex adds 1 to its (node,
+// class) count in the back section, for the next rebuild's PARTITION-S bins.
+uint guide_svo_record(vec3 position, vec3 shading_normal) {
+  uint base = guide_words[kGuideLocatorOffset];
+  vec3 origin = vec3(guide_float(base), guide_float(base + 1u), guide_float(base + 2u));
+  float size = guide_float(base + 3u);
+  uint depth = guide_words[base + 4u];
+  uint nodes = guide_words[base + 5u];
+  vec3 local = (position - origin) / size;
+  // Outside the cube (NaN included): no node, cosine sampling.
+  if (!(all(greaterThanEqual(local, vec3(0.0))) && all(lessThanEqual(local, vec3(1.0))))) return kGuideNoRecord;
+  uint links = base + kGuideSvoWords;
+  uint node = 0u;
+  for (uint level = 0u; level < depth; ++level) {
+    uint cells = 2u << level;  // per axis at level + 1
+    uvec3 cell = min(uvec3(local * float(cells)), uvec3(cells - 1u));
+    uint octant = (cell.x & 1u) | ((cell.y & 1u) << 1u) | ((cell.z & 1u) << 2u);
+    uint mask = guide_words[links + 2u * node + 1u] & 0xFFu;
+    if ((mask & (1u << octant)) == 0u) break;
+    node = guide_words[links + 2u * node] + uint(bitCount(mask & ((1u << octant) - 1u)));
+  }
+  uint normal_class = guide_normal_class(shading_normal);
+  if ((params.guiding & kGuidingCount) != 0u)
+    atomicAdd(guide_words[guide_words[kGuideBackOffset] + node * kGuideNormalClasses + normal_class], 1u);
+  uint bin = guide_words[links + 2u * nodes + node];
+  if (bin == kGuideNoRecord) return kGuideNoRecord;
+  return guide_words[links + 3u * nodes + bin * kGuideNormalClasses + normal_class];
+}
+
 // The record of a surface point, or kGuideNoRecord (cosine sampling, nothing learned): one locator
 // per kind, the rest of the buffer shared by all kinds.
 uint guide_record(vec3 position, vec3 shading_normal) {
   uint kind = guide_words[kGuideLocatorKind];
   if (kind == kGuideLocatorGrid) return guide_grid_record(position, shading_normal);
+  if (kind == kGuideLocatorSvo) return guide_svo_record(position, shading_normal);
   return kGuideNoRecord;
 }
 

@@ -7,10 +7,12 @@
 // read() downloads the sums. bake() and the probe driver reuse the buffers, so bake() ends a
 // progressive accumulation, and start points a probe bake overwrote are uploaded again.
 #pragma once
+#include <memory>
 #include <optional>
 
 #include "exitance/runtime/core/estimates.h"
 #include "exitance/runtime/core/integrator_settings.h"
+#include "exitance/runtime/core/lighting_scene.h"
 #include "exitance/runtime/texel_gbuffer.h"
 #include "wavefront_batch.h"
 
@@ -21,6 +23,9 @@ namespace exitance::vulkan {
 struct GuidingScene {
   Vec3 bounds_lo{0, 0, 0}, bounds_hi{0, 0, 0};
   float reference_radiance = 1;
+  // SVO guiding's fields trace their capture rays here (core BVH) and read emission and sky: the
+  // scene the integrator was created on.
+  std::shared_ptr<const LightingScene> lighting;
 };
 
 class LightmapDriver {

@@ -24,8 +24,9 @@ namespace exitance {
 using namespace exitance::vulkan;
 namespace {
 
-vulkan::GuidingScene guiding_scene(const LightingScene& scene) {
+vulkan::GuidingScene guiding_scene(const LightingScene& scene, std::shared_ptr<const LightingScene> created) {
   vulkan::GuidingScene g;
+  g.lighting = std::move(created);
   g.bounds_lo = scene.bounds_lo;
   g.bounds_hi = scene.bounds_hi;
   g.reference_radiance = GridGuidingCache::reference_radiance(scene);
@@ -48,8 +49,11 @@ struct VulkanIntegrator::Impl {
   // The per-bounce gather reads each triangle's instance and lightmap UVs from here (shared, not a
   // reference to the caller's scene); update_geometry keeps it current.
   std::shared_ptr<const Scene> source;
+  std::shared_ptr<const LightingScene> created_on;  // SVO guiding's capture rays
 
-  Impl(const LightingScene& lighting, const VulkanDeviceOptions& options)
+  Impl(std::shared_ptr<const LightingScene> lighting_ptr, const VulkanDeviceOptions& options)
+      : Impl(*lighting_ptr, options, lighting_ptr) {}
+  Impl(const LightingScene& lighting, const VulkanDeviceOptions& options, std::shared_ptr<const LightingScene> lighting_ptr)
       : context(options),
         sizes(choose_wavefront_sizes(context, options)),
         scene(context, lighting, sizes.quantized_nodes),
@@ -58,9 +62,10 @@ struct VulkanIntegrator::Impl {
         runner(context, scene, kernels, buffers, statistics, sizes, options.collect_stage_statistics),
         lightmap(runner),
         probes(runner),
-        source(lighting.source) {
+        source(lighting.source),
+        created_on(std::move(lighting_ptr)) {
     runner.bind_buffers();
-    lightmap.set_guiding_scene(guiding_scene(lighting));
+    lightmap.set_guiding_scene(guiding_scene(lighting, created_on));
   }
 };
 
@@ -68,7 +73,7 @@ std::unique_ptr<VulkanIntegrator> VulkanIntegrator::create(std::shared_ptr<const
                                                            const VulkanDeviceOptions& options) {
   if (!scene) throw std::invalid_argument("Vulkan backend: no scene");
   check_supported_by_vulkan(*scene);
-  return std::unique_ptr<VulkanIntegrator>(new VulkanIntegrator(std::make_unique<Impl>(*scene, options)));
+  return std::unique_ptr<VulkanIntegrator>(new VulkanIntegrator(std::make_unique<Impl>(scene, options)));
 }
 
 VulkanIntegrator::VulkanIntegrator(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -113,15 +118,15 @@ uint32_t VulkanIntegrator::progressive_samples() const { return impl_->lightmap.
 
 void VulkanIntegrator::update_materials(const LightingScene& edited) {
   impl_->scene.update_materials(edited);
-  impl_->lightmap.set_guiding_scene(guiding_scene(edited));
+  impl_->lightmap.set_guiding_scene(guiding_scene(edited, impl_->created_on));
 }
 void VulkanIntegrator::update_lights(const LightingScene& edited) {
   impl_->scene.update_lights(edited);
-  impl_->lightmap.set_guiding_scene(guiding_scene(edited));
+  impl_->lightmap.set_guiding_scene(guiding_scene(edited, impl_->created_on));
 }
 void VulkanIntegrator::update_geometry(const LightingScene& edited) {
   impl_->scene.update_geometry(edited);
-  impl_->lightmap.set_guiding_scene(guiding_scene(edited));
+  impl_->lightmap.set_guiding_scene(guiding_scene(edited, impl_->created_on));
   impl_->source = edited.source;
 }
 

@@ -214,11 +214,20 @@ const uint kGuideHeaderWords = 16u;
 const uint kGuideLocatorNone = 0u;      // every vertex samples cosine
 const uint kGuideLocatorGrid = 1u;
 const uint kGuideGridWords = 8u;        // origin xyz, cell size, cells x y z, 0
+// kGuideLocatorSvo (--guiding svo; core/svo_guiding_fields.h's device contract): kGuideSvoWords words
+// (octree origin xyz, size as floats; depth, node count, bin count, 0), then per node 2 words
+// (first child, child mask | level << 8), per node its bin (or kGuideNoRecord), per bin and normal
+// class its record (or kGuideNoRecord). Its back section holds no learning sums but per node and
+// class a vertex count (integer atomics in passes with kGuidingCount), read back for the next
+// rebuild's bins (SvoGuidingFields::import_counts). Front: probability, 0, class, 0.
+const uint kGuideLocatorSvo = 2u;
+const uint kGuideSvoWords = 8u;
 const uint kGuideFrontWords = 4u;
 const uint kGuideBackWords = 3u;
 const uint kGuideNoRecord = 0xFFFFFFFFu;
 const uint kGuidingSample = 1u;         // GpuParams::guiding: vertices sample the front table's mixture
 const uint kGuidingLearn = 2u;          // and their continuation rays add to the back table
+const uint kGuidingCount = 4u;          // SVO locator: vertices count themselves per (node, class)
 const uint kBindingCount = 31u;
 
 // Counter slots (uint each; statistics are 64-bit lo/hi pairs).
