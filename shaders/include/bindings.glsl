@@ -42,6 +42,9 @@ layout(std430, set = 0, binding = kBindingTexelSamples) buffer SampleCountBuffer
 layout(std430, set = 0, binding = kBindingProbeShSums) buffer ProbeShBuffer { double acc_probe_sh[]; };  // [probe][coefficient][rgb]
 // Per-bounce layer passes: the layers' atlas caches, in the probe SH sums' binding (gpu_layout.h kBindingBounceCache).
 layout(std430, set = 0, binding = kBindingBounceCache) readonly buffer BounceCacheBuffer { float bounce_cache[]; };
+// Path guiding: its header, locator, front, CDF and back sections, in the same binding (gpu_layout.h
+// kBindingGuide); shaders/include/guide.glsl reads and learns into them.
+layout(std430, set = 0, binding = kBindingGuide) buffer GuideBuffer { uint guide_words[]; };
 layout(std430, set = 0, binding = kBindingProbeCounts) buffer ProbeCountBuffer { uint acc_probe_counts[]; };  // [probe][samples, back faces]
 
 layout(push_constant) uniform Push {

@@ -2,6 +2,7 @@
 // next-event estimation, continuation sampling and hit shading as the CPU reference, with the rays
 // they ask for queued to the connect and extend stages instead of traced at once.
 #include "exitance/common/path.h"
+#include "guide.glsl"
 
 PathLimits path_limits() {
   PathLimits limits;
@@ -48,9 +49,17 @@ uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rn
   vec3 origin = offset_ray_origin(x.position, x.geometric_normal, params.scene_extent);
   path_ray_o[p] = vec4(origin, 0.0);
   ShadowRay area, punctual_light, environment;  // the environment ray exists only with an image sky (3 slots)
-  // A directional texel's own vertex samples the defensive mixture (path.h); every other vertex cosine.
+  // Guided batches: the vertex's record samples the front table's mixture (guide.glsl); probes stay
+  // unguided. A directional texel's own vertex adds the defensive uniform component (path.h).
   bool directional_texel = !kProbeMode && params.directional != 0u && path_depth[p] == 0u;
   GuideVertex guide = guide_vertex_cosine();
+  uint record = kGuideNoRecord;
+  if (!kProbeMode && (params.guiding & kGuidingSample) != 0u) {
+    record = guide_record(x.position, x.shading_normal);
+    guide = guide_vertex_of(record);
+    uint guided = subgroupBallotBitCount(subgroupBallot(guide.guided_probability > 0.0));
+    if (subgroupElect() && guided > 0u) add_stat64(kCounterGuidedVertices, guided);
+  }
   if (directional_texel) guide = with_uniform_component(guide, kDirectionalUniformProbability);
   next_event_estimation(x, origin, throughput, guide, rng, area, punctual_light, environment);
   uint first = p * params.shadow_slots;
@@ -65,7 +74,9 @@ uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rn
   uint pending = shadows ? 2u : 0u;
   if (directional_texel) path_throughput[sh1_factor_index(p)] = vec4(d.pdf > 0.0 ? sh1_direction_factor(x, d.direction) : vec3(0.0), 0.0);
   if (!(d.pdf > 0.0)) return pending;
-  path_ray_d[p] = vec4(d.direction, 0.0);
+  // w: the learning key of the ray's bin (guide.glsl), read back when its hit is shaded.
+  uint key = (params.guiding & kGuidingLearn) != 0u ? guide_learning_key(record, guide, d.direction) : kInvalid;
+  path_ray_d[p] = vec4(d.direction, uintBitsToFloat(key));
   path_throughput[p] = vec4(throughput * continuation_weight(guide, x, d), d.pdf);  // weight 1 for cosine vertices
   return pending | 1u;
 }

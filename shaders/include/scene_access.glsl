@@ -175,6 +175,6 @@ vec3 scene_sample_environment(float u1, float u2, out float pdf) {
   return direction;
 }
 
-// Guiding tables are not on the device yet (issue 11: the Vulkan backend refuses --guiding grid),
-// so no guided vertex exists here; path.h's guided code still needs the accessor to compile.
-float guide_cdf_at(uint cdf, uint i) { return 0.0; }
+// Grid guiding's CDFs (guided_direction.h) live in the guide buffer (gpu_layout.h kBindingGuide): a
+// handle is the word offset of its record's CDF (guide.glsl guide_vertex_of).
+float guide_cdf_at(uint cdf, uint i) { return uintBitsToFloat(guide_words[cdf + i]); }

@@ -26,6 +26,9 @@ void main() {
   rng.dimension = rs.z;
   rng.mode = rs.w;
 
+  // Guided learning passes: the ray teaches its vertex's bin what it met (guide.glsl).
+  if (!kProbeMode && (params.guiding & kGuidingLearn) != 0u) guide_learn_from_hit(floatBitsToUint(path_ray_d[p].w), tri, hit, wi);
+
   bool continues = false;
   vec3 throughput = tp.xyz;
   SurfacePoint x;

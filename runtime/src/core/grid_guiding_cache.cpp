@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "exitance/runtime/core/scene_access.h"
+#include "exitance/common/guide_learning.h"  // after scene_access.h: path.h reads its accessors
+
 namespace exitance {
 namespace {
 
@@ -34,12 +37,23 @@ Grid make_grid(Vec3 extent, int n) {
 
 }  // namespace
 
+float GridGuidingCache::reference_radiance(const LightingScene& scene) {
+  float reference = luminance(scene.sky);
+  for (const GpuMaterial& m : scene.materials)
+    reference = std::max(reference, luminance(Vec3(m.emission.x, m.emission.y, m.emission.z)));
+  return reference;
+}
+
 GridGuidingCache::GridGuidingCache(const LightingScene& scene, const TexelGBuffer& gbuffer,
+                                   const GridGuidingConfig& config)
+    : GridGuidingCache(scene.bounds_lo, scene.bounds_hi, reference_radiance(scene), gbuffer, config) {}
+
+GridGuidingCache::GridGuidingCache(Vec3 bounds_lo, Vec3 bounds_hi, float reference, const TexelGBuffer& gbuffer,
                                    const GridGuidingConfig& config)
     : config_(config) {
   config_.mix = std::clamp(config_.mix, 0.0f, 1.0f);
-  lo_ = scene.bounds_lo;
-  const Vec3 extent = scene.bounds_hi - scene.bounds_lo;
+  lo_ = bounds_lo;
+  const Vec3 extent = bounds_hi - bounds_lo;
   // The finest grid whose records average kMinTexelsPerRecord texels.
   for (int n = std::max(1, config_.cells_on_longest_axis);; --n) {
     const Grid g = make_grid(extent, n);
@@ -61,9 +75,6 @@ GridGuidingCache::GridGuidingCache(const LightingScene& scene, const TexelGBuffe
   }
 
   // The radiance scale: the brightest emission or sky (luminance); a scene without either learns 0.
-  float reference = luminance(scene.sky);
-  for (const GpuMaterial& m : scene.materials)
-    reference = std::max(reference, luminance(Vec3(m.emission.x, m.emission.y, m.emission.z)));
   if (!(reference > 0) || !std::isfinite(reference)) reference = 1.0f;
   fixed_scale_ = kFixedUnitsPerReference / double(reference);
   target_cap_ = reference * kCapInReferences;
@@ -114,10 +125,16 @@ float GridGuidingCache::expected_cosine_radiance(uint32_t record) const {
 
 void GridGuidingCache::learn(uint32_t record, uint32_t bin, float target) {
   if (record == kNoRecord || bin >= kGuideBins || !(target >= 0)) return;  // NaN never enters
-  const double fixed = double(std::min(target, target_cap_)) * fixed_scale_ + 0.5;
   BinAccumulator& a = back_[size_t(record) * kGuideBins + bin];
-  a.sum.fetch_add(uint64_t(fixed), std::memory_order_relaxed);
+  a.sum.fetch_add(guide_fixed_point(target, target_cap_, fixed_scale_), std::memory_order_relaxed);
   a.count.fetch_add(1, std::memory_order_relaxed);
+}
+
+void GridGuidingCache::import_learned(uint32_t record, uint32_t bin, uint64_t fixed_sum, uint32_t count) {
+  if (record >= front_.size() || bin >= kGuideBins || count == 0) return;
+  BinAccumulator& a = back_[size_t(record) * kGuideBins + bin];
+  a.sum.fetch_add(fixed_sum, std::memory_order_relaxed);
+  a.count.fetch_add(count, std::memory_order_relaxed);
 }
 
 void GridGuidingCache::swap() {

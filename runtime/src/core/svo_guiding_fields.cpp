@@ -114,6 +114,12 @@ void SvoGuidingFields::count(uint32_t node, Vec3 shading_normal) {
   counts_[size_t(node) * kGuideNormalClasses + guide_normal_class(shading_normal)].fetch_add(1, std::memory_order_relaxed);
 }
 
+void SvoGuidingFields::import_counts(const uint32_t* counts, size_t words) {
+  const size_t n = std::min(words, octree_.nodes.size() * kGuideNormalClasses);
+  for (size_t i = 0; i < n; ++i)
+    if (counts[i]) counts_[i].fetch_add(counts[i], std::memory_order_relaxed);
+}
+
 void SvoGuidingFields::rebuild(const LightmapEstimate* estimate, double samples_counted, uint64_t seed) {
   if (octree_.nodes.empty()) return;
   if (estimate) fill_exitance(*estimate);

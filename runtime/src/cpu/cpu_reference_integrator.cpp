@@ -19,6 +19,7 @@
 #include "exitance/runtime/core/pass_scheduler.h"
 #include "exitance/runtime/core/svo_guiding_fields.h"
 #include "exitance/runtime/core/scene_access.h"
+#include "exitance/common/guide_learning.h"  // after scene_access.h: path.h reads its accessors
 #include "exitance/runtime/core/work_share.h"
 #include "exitance/runtime/embree_scene.h"
 
@@ -28,8 +29,8 @@ namespace {
 constexpr int kMaxRecordedBounces = 16;
 // Grid guiding learns during the first samples per texel and then samples its frozen table: on
 // small scenes the learning (a target per ray, atomic adds) costs as much as the ray itself, and by
-// then the table has stopped improving (bench/results/guiding.md).
-constexpr uint32_t kGuidingLearningSamples = 64;
+// then the table has stopped improving (bench/results/guiding.md). Shared with the Vulkan backend.
+constexpr uint32_t kGuidingLearningSamples = GridGuidingCache::kLearningSamples;
 // --guiding auto: the pilot (guided and unguided samples on a quarter of the texels, the guide learning) lasts
 // the grid's learning samples; a bake of fewer --spp gives it the largest power of two up to a
 // quarter of them, at least 4 (powers of two from 4 on are boundaries of the ramp's passes).
@@ -106,17 +107,14 @@ struct CpuReferenceIntegrator::Impl {
   }
 
   // What a guided vertex's continuation ray saw, as the learning target of its bin (luminance of
-  // incident radiance): the emission and albedo x the frozen table's cosine-weighted mean at the hit.
+  // incident radiance): the emission and albedo x the frozen table's cosine-weighted mean at the hit
+  // (common/guide_learning.h, shared with the Vulkan wavefront).
   float learning_target(const GridGuidingCache& guide, const Hit& hit, Vec3 wi) const {
     const LightingScene& s = scene();
-    if (!hit.found) return luminance(scene_sky_radiance(s, wi));
-    const Vec3 ng = triangle_geometric_normal(s, hit.triangle);
-    const bool front = dot(wi, ng) < 0;
-    if (!front && !material_double_sided(scene_material(s, scene_triangle_material(s, hit.triangle)))) return 0.0f;
-    const SurfacePoint y = surface_point_on_triangle(s, hit.triangle, ng, hit.b1, hit.b2, front);
-    return luminance(scene_emission(s, hit.triangle, hit.b1, hit.b2)) +
-           luminance(scene_albedo(s, hit.triangle, hit.b1, hit.b2)) *
-               guide.expected_cosine_radiance(guide.record_of(y.position, y.shading_normal));
+    if (!hit.found) return guide_learning_target(guide_learning_escape(s, wi), 0.0f);
+    const GuideLearningHit h = guide_learning_hit(s, hit.triangle, hit.b1, hit.b2, wi);
+    const float expected = h.reads_expectation ? guide.expected_cosine_radiance(guide.record_of(h.y.position, h.y.shading_normal)) : 0.0f;
+    return guide_learning_target(h, expected);
   }
 
   // What trace() asks of a guide: the record of a vertex (site), its strategy (vertex), and what a

@@ -3,10 +3,16 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <memory>
+#include <optional>
 #include <stdexcept>
 
+#include "exitance/runtime/core/grid_guiding_cache.h"
 #include "exitance/runtime/core/pass_scheduler.h"
 #include "exitance/runtime/core/work_share.h"
+#include "exitance/runtime/core/svo_guiding_fields.h"
+#include "guide_buffer.h"
+#include "svo_guide_buffer.h"
 
 namespace exitance::vulkan {
 namespace {
@@ -96,6 +102,7 @@ LightmapEstimate LightmapDriver::download(const Accumulation& a) {
   }
   estimate.rays = a.totals.rays();
   estimate.nonfinite_samples = a.totals.nonfinite;
+  estimate.guided_vertices = a.totals.guided_vertices;
   estimate.seconds = a.seconds;
   return estimate;
 }
@@ -127,15 +134,51 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   if (a.texel_count == 0) return download(a);
 
   const uint32_t spp_limit = settings.spp == 0 ? std::numeric_limits<uint32_t>::max() : settings.spp;
-  PassPolicy policy;
-  // Untimed: as many samples per batch as fill the work items; a budget or target error: ramped passes.
-  policy.largest_pass = uint32_t(std::max<size_t>(1, a.max_work / std::min(a.texel_count, a.max_work)));
-  policy.ramp = settings.time_budget_seconds > 0 || settings.target_relative_error > 0;
-  PassScheduler passes(settings, policy);
   // Split over processes (core/work_share.h): this rank's device runs its contiguous range of the
   // texels through the work list (global indices, so the same random streams); the sums are
   // gathered once at the end. Every rank follows every pass (rank 0 decides them), work or not.
   WorkShare* share = distributed(settings.work_share);
+  // Grid guiding (guide_buffer.h): the CPU reference's cache and its passes. Built inside the timed
+  // bake, as on the CPU: guided results are measured with the cost of their guiding data.
+  std::unique_ptr<GridGuidingCache> guide;
+  std::optional<GuideBuffer> guide_buffer;
+  if (settings.guiding == GuidingMode::Grid) {
+    if (share) throw std::invalid_argument("Vulkan backend: guiding runs in one process only, not under mpirun with several ranks");
+    GridGuidingConfig config;
+    config.mix = settings.guiding_mix;
+    config.cells_on_longest_axis = settings.guiding_grid_cells;
+    guide = std::make_unique<GridGuidingCache>(guiding_scene_.bounds_lo, guiding_scene_.bounds_hi,
+                                               guiding_scene_.reference_radiance, gbuffer, config);
+    guide_buffer.emplace(*guide);
+    guide_buffer->upload(runner_);
+  }
+  // SVO guiding (svo_guide_buffer.h): the CPU reference's fields and schedule. The first pass is
+  // unguided (no bins yet) unless the octree holds exitance; the passes that reach 1, 2, 4, ...
+  // samples per texel count their vertices on the device, then the host rebuilds the fields from the
+  // running lightmap and those counts and uploads them.
+  std::unique_ptr<SvoGuidingFields> svo_guide;
+  std::optional<SvoGuideBuffer> svo_buffer;
+  uint32_t svo_next_rebuild = 1;
+  if (settings.guiding == GuidingMode::Svo) {
+    if (share) throw std::invalid_argument("Vulkan backend: guiding runs in one process only, not under mpirun with several ranks");
+    if (!settings.guiding_octree)
+      throw std::invalid_argument("Vulkan backend: --guiding svo needs the bake's sparse voxel octree (not --voxel-resolution none)");
+    if (!guiding_scene_.lighting) throw std::logic_error("Vulkan backend: SVO guiding without the integrator's scene");
+    SvoGuidingConfig config;
+    config.mix = settings.guiding_mix;
+    config.c_ray = settings.guiding_svo_c_ray;
+    config.rays_per_bin = settings.guiding_svo_rays_per_bin;
+    svo_guide = std::make_unique<SvoGuidingFields>(*guiding_scene_.lighting, *settings.guiding_octree, gbuffer, config);
+    if (svo_guide->seeded()) svo_guide->rebuild(nullptr, 0, settings.seed);
+    svo_buffer.emplace(*svo_guide);
+    svo_buffer->upload(runner_);
+  }
+  PassPolicy policy;
+  // Untimed: as many samples per batch as fill the work items; a budget or target error: ramped passes.
+  // Guided: ramped too, so the table swaps after the same samples as the CPU's (1, 2, 3, 4, 8, ... 64).
+  policy.largest_pass = uint32_t(std::max<size_t>(1, a.max_work / std::min(a.texel_count, a.max_work)));
+  policy.ramp = settings.time_budget_seconds > 0 || settings.target_relative_error > 0 || guide || svo_guide;
+  PassScheduler passes(settings, policy);
   std::vector<size_t> bounds;
   if (share) {
     bounds = split_by_cost(a.texel_count, {}, share->ranks());
@@ -148,11 +191,22 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   uint32_t first = 0, pass = 0;
   while ((share || !a.work_list.empty()) && passes.next_pass(first, pass)) {
     const auto pass_start = Clock::now();
+    const bool learning = guide && first < GridGuidingCache::kLearningSamples;
+    if (guide) a.params.guiding = kGuidingSample | (learning ? kGuidingLearn : 0u);
     if (!a.work_list.empty()) {
       const size_t chunk = std::min(a.work_list.size(), a.max_work);
       pass = std::min<uint32_t>(pass, uint32_t(std::max<size_t>(1, a.max_work / chunk)));
+      if (svo_guide) a.params.guiding = kGuidingSample | (first + pass >= svo_next_rebuild ? kGuidingCount : 0u);
       run_pass(a, first, pass);
       if (share) share->work.texel_samples += uint64_t(a.work_list.size()) * pass;
+    }
+    if (learning) guide_buffer->fold_learning(runner_, *guide);  // this pass's learning is the next pass's table
+    if (svo_guide && (a.params.guiding & kGuidingCount) != 0u) {  // this pass counted: rebuild the fields
+      svo_buffer->import_counts(runner_, *svo_guide);
+      const LightmapEstimate running = download(a);
+      svo_guide->rebuild(&running, double(pass), settings.seed);
+      svo_buffer->repack(runner_, *svo_guide);
+      svo_next_rebuild = 2 * (first + pass);
     }
     const uint32_t done = first + pass;
     if (settings.target_relative_error > 0 && done >= 16 && done < spp_limit) {
@@ -173,6 +227,8 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   a.seconds = std::chrono::duration<double>(Clock::now() - start_time).count();
   runner_.record_statistics(a.totals, kTexelBatch);
   LightmapEstimate estimate = download(a);
+  if (guide && settings.inspect_guiding) settings.inspect_guiding(*guide);
+  if (svo_guide && settings.inspect_svo_guiding) settings.inspect_svo_guiding(*svo_guide);
   if (settings.work_share) settings.work_share->work.rays += estimate.rays;
   if (share) {
     allgather_items(*share, estimate.texels.data(), 1, bounds);

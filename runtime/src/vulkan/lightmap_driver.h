@@ -7,18 +7,31 @@
 // read() downloads the sums. bake() and the probe driver reuse the buffers, so bake() ends a
 // progressive accumulation, and start points a probe bake overwrote are uploaded again.
 #pragma once
+#include <memory>
 #include <optional>
 
 #include "exitance/runtime/core/estimates.h"
 #include "exitance/runtime/core/integrator_settings.h"
+#include "exitance/runtime/core/lighting_scene.h"
 #include "exitance/runtime/texel_gbuffer.h"
 #include "wavefront_batch.h"
 
 namespace exitance::vulkan {
 
+// What grid guiding reads of the scene (GridGuidingCache's bounds and radiance scale); the
+// integrator keeps it current through scene edits.
+struct GuidingScene {
+  Vec3 bounds_lo{0, 0, 0}, bounds_hi{0, 0, 0};
+  float reference_radiance = 1;
+  // SVO guiding's fields trace their capture rays here (core BVH) and read emission and sky: the
+  // scene the integrator was created on.
+  std::shared_ptr<const LightingScene> lighting;
+};
+
 class LightmapDriver {
  public:
   explicit LightmapDriver(WavefrontBatchRunner& runner) : runner_(runner) {}
+  void set_guiding_scene(const GuidingScene& scene) { guiding_scene_ = scene; }
   LightmapEstimate bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings);
 
   void start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings);
@@ -57,6 +70,7 @@ class LightmapDriver {
   std::vector<uint32_t> unconverged(const std::vector<uint32_t>& work_list, size_t texel_count, double target);
 
   WavefrontBatchRunner& runner_;
+  GuidingScene guiding_scene_;
   std::optional<Accumulation> progressive_;
 };
 

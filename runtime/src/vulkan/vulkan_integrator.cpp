@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "bounce_layer_driver.h"
+#include "exitance/runtime/core/grid_guiding_cache.h"
 #include "exitance/runtime/core/per_bounce_bake.h"
 #include "gpu_scene.h"
 #include "kernel_launches.h"
@@ -21,6 +22,18 @@
 
 namespace exitance {
 using namespace exitance::vulkan;
+namespace {
+
+vulkan::GuidingScene guiding_scene(const LightingScene& scene, std::shared_ptr<const LightingScene> created) {
+  vulkan::GuidingScene g;
+  g.lighting = std::move(created);
+  g.bounds_lo = scene.bounds_lo;
+  g.bounds_hi = scene.bounds_hi;
+  g.reference_radiance = GridGuidingCache::reference_radiance(scene);
+  return g;
+}
+
+}  // namespace
 
 // Members in construction order: each uses those above it, and goes before them.
 struct VulkanIntegrator::Impl {
@@ -36,8 +49,11 @@ struct VulkanIntegrator::Impl {
   // The per-bounce gather reads each triangle's instance and lightmap UVs from here (shared, not a
   // reference to the caller's scene); update_geometry keeps it current.
   std::shared_ptr<const Scene> source;
+  std::shared_ptr<const LightingScene> created_on;  // SVO guiding's capture rays
 
-  Impl(const LightingScene& lighting, const VulkanDeviceOptions& options)
+  Impl(std::shared_ptr<const LightingScene> lighting_ptr, const VulkanDeviceOptions& options)
+      : Impl(*lighting_ptr, options, lighting_ptr) {}
+  Impl(const LightingScene& lighting, const VulkanDeviceOptions& options, std::shared_ptr<const LightingScene> lighting_ptr)
       : context(options),
         sizes(choose_wavefront_sizes(context, options)),
         scene(context, lighting, sizes.quantized_nodes),
@@ -46,8 +62,10 @@ struct VulkanIntegrator::Impl {
         runner(context, scene, kernels, buffers, statistics, sizes, options.collect_stage_statistics),
         lightmap(runner),
         probes(runner),
-        source(lighting.source) {
+        source(lighting.source),
+        created_on(std::move(lighting_ptr)) {
     runner.bind_buffers();
+    lightmap.set_guiding_scene(guiding_scene(lighting, created_on));
   }
 };
 
@@ -55,20 +73,21 @@ std::unique_ptr<VulkanIntegrator> VulkanIntegrator::create(std::shared_ptr<const
                                                            const VulkanDeviceOptions& options) {
   if (!scene) throw std::invalid_argument("Vulkan backend: no scene");
   check_supported_by_vulkan(*scene);
-  return std::unique_ptr<VulkanIntegrator>(new VulkanIntegrator(std::make_unique<Impl>(*scene, options)));
+  return std::unique_ptr<VulkanIntegrator>(new VulkanIntegrator(std::make_unique<Impl>(scene, options)));
 }
 
 VulkanIntegrator::VulkanIntegrator(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 VulkanIntegrator::~VulkanIntegrator() = default;
 
 LightmapEstimate VulkanIntegrator::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const {
-  if (settings.guiding != GuidingMode::Off) throw std::runtime_error("Vulkan backend: --guiding grid is implemented on the CPU backend only (use --backend cpu)");
   if (settings.adaptive) throw std::runtime_error("Vulkan backend: --adaptive on is implemented on the CPU backend only (use --backend cpu)");
   if (settings.spp == 0 && !(settings.time_budget_seconds > 0) && !(settings.target_relative_error > 0))
     throw std::invalid_argument("Vulkan backend: spp 0 needs a time budget or a target error");
   if (settings.integrator == IntegratorMode::Bounces) {
     if (settings.directional != DirectionalMode::Off)
       throw std::invalid_argument("Vulkan backend: --directional sh1 applies to path tracing, not to --integrator bounces");
+    if (settings.guiding != GuidingMode::Off)
+      throw std::invalid_argument("Vulkan backend: guiding applies to path tracing, not to --integrator bounces");
     impl_->lightmap.end_progressive();  // the texel buffers are this bake's now
     impl_->runner.statistics().clear();
     vulkan::BounceLayerDriver layers(impl_->runner, impl_->source, gbuffer, settings);
@@ -84,7 +103,10 @@ ProbeEstimate VulkanIntegrator::bake_probes(const std::vector<Vec3>& positions, 
 }
 
 void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) {
-  if (settings.guiding != GuidingMode::Off) throw std::runtime_error("Vulkan backend: --guiding grid is implemented on the CPU backend only (use --backend cpu)");
+  // The progressive accumulation (exitance-relight) adds samples in calls the caller sizes, with no
+  // pass where a learned table could swap: guiding runs in bake() only.
+  if (settings.guiding != GuidingMode::Off)
+    throw std::runtime_error("Vulkan backend: guiding runs in whole bakes only, not in progressive accumulation (relight)");
   impl_->lightmap.start(gbuffer, settings);
 }
 uint64_t VulkanIntegrator::add_samples(uint32_t samples) { return impl_->lightmap.add_samples(samples); }
@@ -94,10 +116,17 @@ uint64_t VulkanIntegrator::add_samples_to(const std::vector<uint32_t>& texels, u
 LightmapEstimate VulkanIntegrator::progressive_estimate() const { return impl_->lightmap.read(); }
 uint32_t VulkanIntegrator::progressive_samples() const { return impl_->lightmap.samples_done(); }
 
-void VulkanIntegrator::update_materials(const LightingScene& edited) { impl_->scene.update_materials(edited); }
-void VulkanIntegrator::update_lights(const LightingScene& edited) { impl_->scene.update_lights(edited); }
+void VulkanIntegrator::update_materials(const LightingScene& edited) {
+  impl_->scene.update_materials(edited);
+  impl_->lightmap.set_guiding_scene(guiding_scene(edited, impl_->created_on));
+}
+void VulkanIntegrator::update_lights(const LightingScene& edited) {
+  impl_->scene.update_lights(edited);
+  impl_->lightmap.set_guiding_scene(guiding_scene(edited, impl_->created_on));
+}
 void VulkanIntegrator::update_geometry(const LightingScene& edited) {
   impl_->scene.update_geometry(edited);
+  impl_->lightmap.set_guiding_scene(guiding_scene(edited, impl_->created_on));
   impl_->source = edited.source;
 }
 

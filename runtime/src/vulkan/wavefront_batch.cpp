@@ -19,6 +19,7 @@ void BatchTotals::add(const uint32_t* c) {
   nonfinite += c[kCounterNonfinite];
   bounce_gathers += c[kCounterBounceGathers], bounce_texelless += c[kCounterBounceTexelless];
   bounce_back_faces += c[kCounterBounceBackFaces];
+  guided_vertices += stat64(c, kCounterGuidedVertices);
   extend_busy += stat64(c, kCounterStatExtendActive), extend_launched += stat64(c, kCounterStatExtendLaunched);
   connect_busy += stat64(c, kCounterStatConnectActive), connect_launched += stat64(c, kCounterStatConnectLaunched);
   shade_items += stat64(c, kCounterStatShadeItems), shade_lanes += stat64(c, kCounterStatShadeLanes);
@@ -27,6 +28,7 @@ void BatchTotals::add(const uint32_t* c) {
 void BatchTotals::add(const BatchTotals& o) {
   rays_primary += o.rays_primary, rays_bounce += o.rays_bounce, rays_shadow += o.rays_shadow, nonfinite += o.nonfinite;
   bounce_gathers += o.bounce_gathers, bounce_texelless += o.bounce_texelless, bounce_back_faces += o.bounce_back_faces;
+  guided_vertices += o.guided_vertices;
   extend_busy += o.extend_busy, extend_launched += o.extend_launched, connect_busy += o.connect_busy;
   connect_launched += o.connect_launched, shade_items += o.shade_items, shade_lanes += o.shade_lanes;
 }

@@ -57,6 +57,7 @@ struct BatchRange {
 struct BatchTotals {
   uint64_t rays_primary = 0, rays_bounce = 0, rays_shadow = 0, nonfinite = 0;
   uint64_t bounce_gathers = 0, bounce_texelless = 0, bounce_back_faces = 0;  // per-bounce layer passes
+  uint64_t guided_vertices = 0;  // guided batches: vertices that sampled a learned table
   uint64_t extend_busy = 0, extend_launched = 0, connect_busy = 0, connect_launched = 0, shade_items = 0, shade_lanes = 0;
   uint64_t rays() const { return rays_primary + rays_bounce + rays_shadow; }
   void add(const uint32_t* counters);

@@ -114,7 +114,7 @@ struct GpuParams {
   uint directional;        // texel batches: 1 = also estimate the L1 SH layers (DirectionalMode::Sh1)
   uint bounce_flags;       // texel batches: 0 = path tracing; else a per-bounce layer pass (kBouncePass | ...)
   uint bounce_layer;       // per-bounce layer pass: k, the layer B_k estimated (0 = direct light)
-  uint params_pad2;
+  uint guiding;            // texel path batches: kGuiding* bits (the guide buffer, kBindingGuide); 0 = cosine
 };
 
 // Descriptor bindings of the wavefront (one set).
@@ -184,6 +184,50 @@ const uint kBounceCachePageWords = 3u;
 const uint kBounceCacheTexelWords = 10u;
 const uint kBouncePass = 1u;                // bounce_flags: this batch estimates layer bounce_layer
 const uint kBounceTraceFirst = 2u;          // at layer 0 a gather hit takes a direct-light sample, not the cache
+// Path guiding (--guiding grid, issue 11; docs/lighting-core.md "Grid guiding on the Vulkan
+// backend") keeps ALL its data in the same binding, as uints (a lightmap path-tracing bake uses
+// neither probe sums nor layer caches): a header of kGuideHeaderWords, then sections at the word
+// offsets the header gives:
+//   locator  how a surface point (position, shading normal) finds its record; its layout depends on
+//            the header's locator kind. kGuideLocatorGrid: kGuideGridWords words (origin xyz, cell
+//            size as floats; cells along x, y, z), then per (cell, normal class) the record or
+//            kGuideNoRecord, cell (z * ny + y) * nx + x, class guided_direction.h guide_normal_class.
+//            Another kind (a tree descent to a bin) adds its own locator section and reuses the rest.
+//   front    per record kGuideFrontWords: guided probability (float), Lbar (float), normal class, 0
+//   cdf      per record kGuideBins + 1 floats (guided_direction.h's CDF; a GuideVertex's cdf handle
+//            is the word offset of its record's CDF)
+//   back     per record and bin kGuideBackWords: fixed-point sum (lo, hi words) and count, added to
+//            with integer atomics during learning passes; the host reads, folds (GridGuidingCache
+//            import_learned + swap) and clears them between passes, then rewrites front and cdf.
+// The header also holds the fixed-point scale (a double as lo, hi words) and the target cap (float)
+// of common/guide_learning.h guide_fixed_point.
+const uint kBindingGuide = kBindingProbeShSums;
+const uint kGuideLocatorKind = 0u;      // header word: kGuideLocator*
+const uint kGuideRecordCount = 1u;
+const uint kGuideLocatorOffset = 2u;    // header words: first word of each section
+const uint kGuideFrontOffset = 3u;
+const uint kGuideCdfOffset = 4u;
+const uint kGuideBackOffset = 5u;
+const uint kGuideFixedUnits = 6u;       // + 7: the double's lo, hi words
+const uint kGuideFixedCap = 8u;
+const uint kGuideHeaderWords = 16u;
+const uint kGuideLocatorNone = 0u;      // every vertex samples cosine
+const uint kGuideLocatorGrid = 1u;
+const uint kGuideGridWords = 8u;        // origin xyz, cell size, cells x y z, 0
+// kGuideLocatorSvo (--guiding svo; core/svo_guiding_fields.h's device contract): kGuideSvoWords words
+// (octree origin xyz, size as floats; depth, node count, bin count, 0), then per node 2 words
+// (first child, child mask | level << 8), per node its bin (or kGuideNoRecord), per bin and normal
+// class its record (or kGuideNoRecord). Its back section holds no learning sums but per node and
+// class a vertex count (integer atomics in passes with kGuidingCount), read back for the next
+// rebuild's bins (SvoGuidingFields::import_counts). Front: probability, 0, class, 0.
+const uint kGuideLocatorSvo = 2u;
+const uint kGuideSvoWords = 8u;
+const uint kGuideFrontWords = 4u;
+const uint kGuideBackWords = 3u;
+const uint kGuideNoRecord = 0xFFFFFFFFu;
+const uint kGuidingSample = 1u;         // GpuParams::guiding: vertices sample the front table's mixture
+const uint kGuidingLearn = 2u;          // and their continuation rays add to the back table
+const uint kGuidingCount = 4u;          // SVO locator: vertices count themselves per (node, class)
 const uint kBindingCount = 31u;
 
 // Counter slots (uint each; statistics are 64-bit lo/hi pairs).
@@ -197,6 +241,7 @@ const uint kCounterRaysShadow = 7u;
 const uint kCounterBounceGathers = 8u;     // per-bounce passes: gather rays that hit a surface,
 const uint kCounterBounceTexelless = 9u;   // of those estimated on the fly (no lit texel there),
 const uint kCounterBounceBackFaces = 10u;  // of those single-sided back faces
+const uint kCounterGuidedVertices = 12u;   // guided batches: vertices with a learned record (lo, hi)
 const uint kCounterStatExtendActive = 16u;  // lanes active inside traversal loops / lanes launched there
 const uint kCounterStatExtendLaunched = 18u;
 const uint kCounterStatConnectActive = 20u;

@@ -47,10 +47,20 @@ class GridGuidingCache {
   static constexpr uint32_t kNoRecord = 0xFFFFFFFFu;
   static constexpr float kUniformFloor = 0.02f;
   static constexpr double kMinTexelsPerRecord = 16;
+  // Backends learn during the passes of the first samples per texel, then sample the frozen table:
+  // on small scenes learning (a target per ray, atomic adds) costs as much as the ray itself, and by
+  // then the table has stopped improving (bench/results/guiding.md).
+  static constexpr uint32_t kLearningSamples = 64;
 
   // Records for the (cell, class) pairs of `gbuffer`'s texels. `scene` gives the bounds and the
   // radiance scale of the fixed-point sums (the brightest emitter or sky).
   GridGuidingCache(const LightingScene& scene, const TexelGBuffer& gbuffer, const GridGuidingConfig& config);
+  // The same from what the cache reads of the scene: its bounds and reference_radiance(scene) (a
+  // backend that keeps only these, the Vulkan one, builds the same cache).
+  GridGuidingCache(Vec3 bounds_lo, Vec3 bounds_hi, float reference_radiance, const TexelGBuffer& gbuffer,
+                   const GridGuidingConfig& config);
+  // The radiance scale of the fixed-point sums: the brightest emitter or sky (luminance), else 1.
+  static float reference_radiance(const LightingScene& scene);
 
   // The record of a surface point, kNoRecord when its (cell, class) has no texels.
   uint32_t record_of(Vec3 position, Vec3 shading_normal) const;
@@ -61,6 +71,10 @@ class GridGuidingCache {
   // Adds one learning target (luminance of radiance) for `bin` of `record` to the back table.
   // Thread-safe; the sums are integers, so their result does not depend on the order of calls.
   void learn(uint32_t record, uint32_t bin, float target);
+  // Adds sums learned elsewhere (the Vulkan wavefront's back table, in the same fixed-point units:
+  // common/guide_learning.h guide_fixed_point with fixed_cap() and fixed_units()) to the back table
+  // of `bin` of `record`, so swap() folds them exactly as it folds learn()'s.
+  void import_learned(uint32_t record, uint32_t bin, uint64_t fixed_sum, uint32_t count);
   // Between passes: folds the back table into the front one, rebuilds the CDFs, clears the back.
   void swap();
 
@@ -72,6 +86,13 @@ class GridGuidingCache {
   // The front table's learned radiance of a record (kGuideBins values), for plots and tests.
   const float* radiance(uint32_t record) const { return &radiance_[size_t(record) * kGuideBins]; }
   uint32_t record_of_cell(int x, int y, int z, uint normal_class) const;
+
+  // The locator and the front table as a device copies them (runtime/src/vulkan/guide_buffer.cpp).
+  Vec3 grid_origin() const { return lo_; }
+  // Per (cell, class), cell (z * cells(1) + y) * cells(0) + x: its record or kNoRecord.
+  const std::vector<uint32_t>& record_index() const { return record_index_; }
+  double fixed_units() const { return fixed_scale_; }  // fixed-point units per unit of radiance
+  float fixed_cap() const { return target_cap_; }      // targets are clamped here before conversion
 
  private:
   // What a vertex reads (small and together: the hot data of every path vertex).

@@ -109,6 +109,8 @@ class SvoGuidingFields {
   GuideVertex vertex(uint32_t record) const;
   // Counts one path vertex at `node` for the next rebuild's bins. Thread-safe, integer.
   void count(uint32_t node, Vec3 shading_normal);
+  // Adds counts made elsewhere (a device's integer atomics): kGuideNormalClasses per node, as count().
+  void import_counts(const uint32_t* counts, size_t words);
   // Whether the octree's exitance was given (an earlier bake or refresh): fields can be built
   // before the first pass, with bins from the texels' positions.
   bool seeded() const { return seeded_; }

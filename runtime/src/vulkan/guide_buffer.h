@@ -1,0 +1,37 @@
+// Grid guiding's data on the device (gpu_layout.h kBindingGuide, in the probe SH sums' binding):
+// the GridGuidingCache's locator and front table packed as the guide buffer's sections, and its
+// back table's integer sums, learned by the kernels (shaders/include/guide.glsl), read back and
+// imported into the cache between learning passes. The fold and the CDFs are the cache's own
+// (GridGuidingCache::import_learned, swap), so both backends build the same tables from the same sums.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "exitance/runtime/core/grid_guiding_cache.h"
+#include "wavefront_batch.h"
+
+namespace exitance::vulkan {
+
+class GuideBuffer {
+ public:
+  // Lays out and packs the sections of `cache` (its front table as it is now).
+  explicit GuideBuffer(const GridGuidingCache& cache);
+
+  // The whole buffer onto the device (growing and rebinding the binding), back sums at 0.
+  void upload(WavefrontBatchRunner& runner) const;
+  // After a learning pass: the device's back sums into `cache` (import_learned), the cache's swap,
+  // the back sums cleared on the device and the new front table uploaded.
+  void fold_learning(WavefrontBatchRunner& runner, GridGuidingCache& cache);
+
+  size_t bytes() const { return words_.size() * 4; }
+
+ private:
+  void pack_front(const GridGuidingCache& cache);
+
+  std::vector<uint32_t> words_;
+  size_t front_ = 0, cdf_ = 0, back_ = 0;  // first words of the sections
+  uint32_t records_ = 0;
+};
+
+}  // namespace exitance::vulkan
