@@ -33,6 +33,11 @@ json relight_bundle(const RelightOptions& options) {
     throw RelightInputError("--integrator " + options.integrator + ": expected path or bounces");
   if (per_bounce && (options.frames > 0 || options.frame_budget_ms > 0))
     throw RelightInputError("--integrator bounces runs the whole lightmap at once: --frames and --budget-ms need --integrator path");
+  const bool guided = options.guiding == "grid";
+  if (!guided && options.guiding != "off") throw RelightInputError("--guiding " + options.guiding + ": expected off or grid");
+  if (guided && per_bounce) throw RelightInputError("--guiding grid guides path tracing: it needs --integrator path");
+  if (guided && (options.frames > 0 || options.frame_budget_ms > 0))
+    throw RelightInputError("--guiding grid runs the whole lightmap at once: --frames and --budget-ms need --guiding off");
 
   const fs::path bundle(options.bundle);
   const fs::path out = options.output.empty() ? bundle : fs::path(options.output);
@@ -90,7 +95,12 @@ json relight_bundle(const RelightOptions& options) {
     }
     report("lighting", 1, rays);
   }
-  for (uint32_t frame = 0; !per_bounce && (options.frames == 0 || frame < options.frames); ++frame) {
+  if (guided) {
+    report("lighting", 0, 0);
+    rays = session->bake_guided(spp, options.time_budget_seconds).rays;
+    report("lighting", 1, rays);
+  }
+  for (uint32_t frame = 0; !per_bounce && !guided && (options.frames == 0 || frame < options.frames); ++frame) {
     RefreshBudget budget;
     budget.max_samples_per_texel = spp;
     budget.milliseconds = options.frame_budget_ms;
@@ -138,6 +148,7 @@ json relight_bundle(const RelightOptions& options) {
 
   json run;
   run["integrator"] = per_bounce ? "bounces" : "path";
+  if (guided) run["guiding"] = "grid";
   run["spp"] = session->samples_per_texel();
   run["time_budget_seconds"] = options.time_budget_seconds;
   if (options.frame_budget_ms > 0) run["frame_budget_ms"] = options.frame_budget_ms;

@@ -35,6 +35,9 @@ struct RelightOptions {
   // "path" (progressive path tracing, frames) or "bounces" (the per-bounce mode in one run: no
   // --frames or --budget-ms; RefreshSession::bake_per_bounce).
   std::string integrator = "path";
+  // "off" or "grid" (grid-guided path tracing of the whole lightmap in one run, as bake --guiding
+  // grid on the Vulkan backend: no --frames or --budget-ms; RefreshSession::bake_guided).
+  std::string guiding = "off";
   // Stage reporting: (stage, fraction done, rays so far).
   std::function<void(const std::string&, double, uint64_t)> progress;
 };
