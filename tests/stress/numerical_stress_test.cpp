@@ -58,11 +58,11 @@ Room make_room(float scale, Vec3 offset) {
 
 // Every stress test runs on each backend: the CPU reference, the CPU reference with grid guiding
 // forced on, and the Vulkan compute backend (lavapipe in CI, validation layers on; any validation
-// message fails the test).
+// message fails the test), unguided and with grid guiding forced on.
 class Stress : public ::testing::TestWithParam<std::string> {
  protected:
   void SetUp() override {
-    if (GetParam() != "vulkan") return;
+    if (GetParam() != "vulkan" && GetParam() != "vulkan_guided") return;
     bool usable = false;
     for (const VulkanDeviceInfo& d : enumerate_vulkan_devices()) usable = usable || d.usable;
     if (!usable) GTEST_SKIP() << "no usable Vulkan device";
@@ -75,6 +75,8 @@ class Stress : public ::testing::TestWithParam<std::string> {
       guided.guiding = GuidingMode::Grid;
       return CpuReferenceIntegrator(scene).bake(texels, guided);
     }
+    IntegratorSettings vulkan_settings = settings;
+    if (GetParam() == "vulkan_guided") vulkan_settings.guiding = GuidingMode::Grid;  // same checks, same tolerances
     std::vector<std::string> messages;
     VulkanDeviceOptions options;
     options.validation = true;
@@ -82,7 +84,7 @@ class Stress : public ::testing::TestWithParam<std::string> {
     LightmapEstimate estimate;
     {
       const auto integrator = VulkanIntegrator::create(make_lighting_scene(scene), options);
-      estimate = integrator->bake(texels, settings);
+      estimate = integrator->bake(texels, vulkan_settings);
     }
     EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: " << messages.front();
     return estimate;
@@ -251,7 +253,7 @@ TEST_P(Stress, ThinWallDoesNotLeak) {
   EXPECT_EQ(leak, 0.0);
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, Stress, ::testing::Values("cpu", "cpu_guided", "vulkan"),
+INSTANTIATE_TEST_SUITE_P(Backends, Stress, ::testing::Values("cpu", "cpu_guided", "vulkan", "vulkan_guided"),
                          [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
 
 }  // namespace
