@@ -1,4 +1,4 @@
-// exitance-relight BUNDLE [-o OUT] [--edits EDITS.json] [--spp N] [--time S] [--budget-ms N] [--frames N] [--seed N] [--device N] [--json]
+// exitance-relight BUNDLE [-o OUT] [--edits EDITS.json] [--spp N] [--time S] [--budget-ms N] [--frames N] [--guiding off|grid|svo] [--seed N] [--device N] [--json]
 // Re-lights a baked bundle from its scene.bin on the GPU (runtime/src/relight). Links the runtime
 // library and nothing of the offline stage; runs where only a Vulkan driver exists.
 #include <CLI/CLI.hpp>
@@ -43,6 +43,10 @@ int main(int argc, char** argv) {
                  "path (default: progressive path tracing, frames) | bounces (the per-bounce mode, the whole lightmap "
                  "in one run; not with --frames or --budget-ms)")
       ->check(CLI::IsMember({"path", "bounces"}));
+  app.add_option("--guiding", options.guiding,
+                 "off (default) | grid | svo (guided path tracing, as bake --guiding grid|svo; svo reads the bundle's "
+                 "svo.bin: the whole lightmap in one run; not with --frames, --budget-ms or --integrator bounces)")
+      ->check(CLI::IsMember({"off", "grid", "svo"}));
   app.add_option("--seed", seed, "random seed (default: the bake's); results are deterministic per seed and device");
   app.add_option("--device", options.device_index, "Vulkan device index (see --list-devices)")->check(CLI::NonNegativeNumber);
   app.add_flag("--list-devices", list_devices, "print the Vulkan devices and exit");

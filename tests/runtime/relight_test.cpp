@@ -200,6 +200,58 @@ TEST(Relight, ReproducesAVulkanPerBounceBakeBitForBit) {
   fs::remove_all(dir);
 }
 
+// Grid guiding (--guiding grid): a bundle baked guided on the Vulkan backend is relit guided from
+// scene.bin bit for bit (the same texels, grid, learning passes and seed); the report says so; it
+// is refused with --frames (not progressive) and with --integrator bounces.
+TEST(Relight, ReproducesAVulkanGuidedBakeBitForBit) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const fs::path dir = fs::temp_directory_path() / ("exitance-relight-guided-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path baked = dir / "guided.bake", output = dir / "guided-relit.bake";
+  BakeOptions bake;
+  bake.input = std::string(EXITANCE_SAMPLE_DIR) + "/cornell_room.gltf";
+  bake.output = baked.string();
+  bake.backend.name = "vulkan";
+  bake.lighting.integrator = IntegratorMode::Path;
+  bake.lighting.guiding = GuidingMode::Grid;
+  bake.integrator_auto = false;
+  bake.atlas.texel_density = 4;
+  bake.lighting.spp = 12;
+  bake.lighting.seed = 9;
+  bake.probes_enabled = false;
+  bake.svo_enabled = false;
+  bake.skip_sealed_texels = false;
+  Diagnostics diagnostics;
+  run_bake(bake, diagnostics);
+  RelightOptions options;
+  options.bundle = baked.string();
+  options.output = output.string();
+  options.seed = 9;
+  options.spp = 12;
+  options.guiding = "grid";
+  const nlohmann::json report = relight_bundle(options);
+  EXPECT_EQ(report["integrator"], "path");
+  EXPECT_EQ(report["guiding"], "grid");
+  EXPECT_GT(report["rays"].get<uint64_t>(), 0u);
+  size_t pages = 0;
+  for (const auto& entry : fs::directory_iterator(baked)) {
+    if (entry.path().extension() != ".exr") continue;
+    EXPECT_TRUE(file_bytes(entry.path()) == file_bytes(output / entry.path().filename()))
+        << entry.path().filename() << " differs from the guided bake's";
+    ++pages;
+  }
+  EXPECT_GE(pages, 1u);
+  options.output = (dir / "refused.bake").string();
+  options.frames = 2;
+  EXPECT_THROW(relight_bundle(options), RelightInputError);
+  options.frames = 0;
+  options.integrator = "bounces";
+  EXPECT_THROW(relight_bundle(options), RelightInputError);
+  EXPECT_FALSE(fs::exists(dir / "refused.bake"));
+  fs::remove_all(dir);
+}
+
 // A scene with smooth lightmap UV seams (a sphere with generated UVs over a floor): the bake stitches
 // them, and so does the relight, from scene.bin's scene and atlas, bit for bit as the bake did; a bake
 // written with --seams off is relit unstitched (the mode follows the bundle's stats.seams.mode).

@@ -59,11 +59,11 @@ Room make_room(float scale, Vec3 offset) {
 
 // Every stress test runs on each backend: the CPU reference, the CPU reference with grid or SVO
 // guiding forced on, and the Vulkan compute backend (lavapipe in CI, validation layers on; any validation
-// message fails the test).
+// message fails the test), unguided and with grid or SVO guiding forced on.
 class Stress : public ::testing::TestWithParam<std::string> {
  protected:
   void SetUp() override {
-    if (GetParam() != "vulkan") return;
+    if (GetParam().rfind("vulkan", 0) != 0) return;
     bool usable = false;
     for (const VulkanDeviceInfo& d : enumerate_vulkan_devices()) usable = usable || d.usable;
     if (!usable) GTEST_SKIP() << "no usable Vulkan device";
@@ -76,15 +76,22 @@ class Stress : public ::testing::TestWithParam<std::string> {
       guided.guiding = GuidingMode::Grid;
       return CpuReferenceIntegrator(scene).bake(texels, guided);
     }
-    if (GetParam() == "cpu_svo_guided") {  // SVO guiding forced on, over a 64^3 octree of the scene
+    // SVO guiding forced on, over a 64^3 octree of the scene (the octree outlives the bake below).
+    formats::SparseVoxelOctree octree;
+    if (GetParam() == "cpu_svo_guided" || GetParam() == "vulkan_svo_guided") {
       SvoBuildSettings build;
       build.depth = 6;
-      const formats::SparseVoxelOctree octree = build_sparse_voxel_octree(scene, build);
+      octree = build_sparse_voxel_octree(scene, build);
+    }
+    if (GetParam() == "cpu_svo_guided") {
       IntegratorSettings guided = settings;
       guided.guiding = GuidingMode::Svo;
       guided.guiding_octree = &octree;
       return CpuReferenceIntegrator(scene).bake(texels, guided);
     }
+    IntegratorSettings vulkan_settings = settings;
+    if (GetParam() == "vulkan_guided") vulkan_settings.guiding = GuidingMode::Grid;  // same checks, same tolerances
+    if (GetParam() == "vulkan_svo_guided") vulkan_settings.guiding = GuidingMode::Svo, vulkan_settings.guiding_octree = &octree;
     std::vector<std::string> messages;
     VulkanDeviceOptions options;
     options.validation = true;
@@ -92,7 +99,7 @@ class Stress : public ::testing::TestWithParam<std::string> {
     LightmapEstimate estimate;
     {
       const auto integrator = VulkanIntegrator::create(make_lighting_scene(scene), options);
-      estimate = integrator->bake(texels, settings);
+      estimate = integrator->bake(texels, vulkan_settings);
     }
     EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: " << messages.front();
     return estimate;
@@ -261,7 +268,8 @@ TEST_P(Stress, ThinWallDoesNotLeak) {
   EXPECT_EQ(leak, 0.0);
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, Stress, ::testing::Values("cpu", "cpu_guided", "cpu_svo_guided", "vulkan"),
+INSTANTIATE_TEST_SUITE_P(Backends, Stress, ::testing::Values("cpu", "cpu_guided", "cpu_svo_guided", "vulkan", "vulkan_guided",
+                                           "vulkan_svo_guided"),
                          [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
 
 }  // namespace

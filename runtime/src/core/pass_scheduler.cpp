@@ -40,7 +40,10 @@ bool PassScheduler::next_pass_here(uint32_t& begin, uint32_t& count, double* fra
   pending_fraction_ = 1;
   if (stopped_ || done_ >= limit_) return false;
   uint32_t pass = std::min(limit_ - done_, policy_.largest_pass);
-  if (policy_.ramp) pass = std::min(pass, done_ < 4 ? 1u : (done_ < 64 ? 4u : 16u));
+  if (policy_.ramp && done_ < policy_.ramp_below) {
+    pass = std::min(pass, done_ < 4 ? 1u : (done_ < 64 ? 4u : 16u));
+    pass = std::min(pass, policy_.ramp_below - done_);  // the ramp's last pass ends where it stops
+  }
   if (policy_.stratified_set > 0 && timed())
     pass = std::min(pass, policy_.stratified_set - done_ % policy_.stratified_set);
   pass_start_seconds_ = elapsed_seconds();

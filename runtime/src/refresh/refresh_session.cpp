@@ -62,8 +62,9 @@ struct RefreshSession::State {
   uint32_t near_samples = 0, far_samples = 0, all_samples = 0;
   // What texels show until they have samples again after an edit (published_lightmap).
   std::optional<LightmapEstimate> previous;
-  // A bake_per_bounce() result: lightmap() until the next restart, edit or refresh.
+  // A bake_per_bounce() or bake_guided() result: lightmap() until the next restart, edit or refresh.
   std::optional<LightmapEstimate> per_bounce;
+  bool whole_run_guided = false;  // per_bounce holds a bake_guided() result
 };
 
 namespace {
@@ -166,6 +167,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
 void RefreshSession::restart() {
   State& s = *state_;
   s.per_bounce.reset();
+  s.whole_run_guided = false;
   s.integrator->start_progressive(s.persisted.gbuffer, s.settings);
   s.near_texels.clear();
   s.far_texels.clear();
@@ -274,10 +276,34 @@ LightmapEstimate RefreshSession::bake_per_bounce(uint32_t spp, double time_budge
   const formats::BakeSettings baked = s.manifest.settings.value_or(formats::BakeSettings{});
   settings.trace_first_bounce = baked.first_bounce != "cached";
   s.per_bounce = s.integrator->bake(s.persisted.gbuffer, settings);
+  s.whole_run_guided = false;
   return *s.per_bounce;
 }
 
-bool RefreshSession::per_bounce() const { return state_->per_bounce.has_value(); }
+bool RefreshSession::per_bounce() const { return state_->per_bounce.has_value() && !state_->whole_run_guided; }
+
+LightmapEstimate RefreshSession::bake_guided(uint32_t spp, double time_budget_seconds, float guiding_mix, GuidingMode mode) {
+  State& s = *state_;
+  if (spp == 0 && !(time_budget_seconds > 0))
+    throw std::invalid_argument("guided path tracing needs samples per texel or a time budget");
+  if (mode != GuidingMode::Grid && mode != GuidingMode::Svo) throw std::invalid_argument("bake_guided: the mode must be grid or svo");
+  IntegratorSettings settings = s.settings;
+  settings.integrator = IntegratorMode::Path;
+  settings.guiding = mode;
+  if (mode == GuidingMode::Svo) {
+    // The bundle's octree: its published exitance (the bake's light) seeds the guide's first fields.
+    if (!s.svo) throw std::invalid_argument("--guiding svo: the bundle has no svo.bin (baked with --voxel-resolution none)");
+    settings.guiding_octree = &*s.svo;
+  }
+  settings.guiding_mix = guiding_mix;
+  settings.spp = spp;
+  settings.time_budget_seconds = time_budget_seconds;
+  s.per_bounce = s.integrator->bake(s.persisted.gbuffer, settings);
+  s.whole_run_guided = true;
+  return *s.per_bounce;
+}
+
+bool RefreshSession::guided() const { return state_->per_bounce.has_value() && state_->whole_run_guided; }
 
 LightmapEstimate RefreshSession::published_lightmap() const {
   LightmapEstimate estimate = lightmap();

@@ -33,6 +33,11 @@ json relight_bundle(const RelightOptions& options) {
     throw RelightInputError("--integrator " + options.integrator + ": expected path or bounces");
   if (per_bounce && (options.frames > 0 || options.frame_budget_ms > 0))
     throw RelightInputError("--integrator bounces runs the whole lightmap at once: --frames and --budget-ms need --integrator path");
+  const bool guided = options.guiding == "grid" || options.guiding == "svo";
+  if (!guided && options.guiding != "off") throw RelightInputError("--guiding " + options.guiding + ": expected off, grid or svo");
+  if (guided && per_bounce) throw RelightInputError("--guiding " + options.guiding + " guides path tracing: it needs --integrator path");
+  if (guided && (options.frames > 0 || options.frame_budget_ms > 0))
+    throw RelightInputError("--guiding " + options.guiding + " runs the whole lightmap at once: --frames and --budget-ms need --guiding off");
 
   const fs::path bundle(options.bundle);
   const fs::path out = options.output.empty() ? bundle : fs::path(options.output);
@@ -90,7 +95,13 @@ json relight_bundle(const RelightOptions& options) {
     }
     report("lighting", 1, rays);
   }
-  for (uint32_t frame = 0; !per_bounce && (options.frames == 0 || frame < options.frames); ++frame) {
+  if (guided) {
+    report("lighting", 0, 0);
+    rays = session->bake_guided(spp, options.time_budget_seconds, 0.5f,
+                                options.guiding == "svo" ? GuidingMode::Svo : GuidingMode::Grid).rays;
+    report("lighting", 1, rays);
+  }
+  for (uint32_t frame = 0; !per_bounce && !guided && (options.frames == 0 || frame < options.frames); ++frame) {
     RefreshBudget budget;
     budget.max_samples_per_texel = spp;
     budget.milliseconds = options.frame_budget_ms;
@@ -138,6 +149,7 @@ json relight_bundle(const RelightOptions& options) {
 
   json run;
   run["integrator"] = per_bounce ? "bounces" : "path";
+  if (guided) run["guiding"] = options.guiding;
   run["spp"] = session->samples_per_texel();
   run["time_budget_seconds"] = options.time_budget_seconds;
   if (options.frame_budget_ms > 0) run["frame_budget_ms"] = options.frame_budget_ms;

@@ -175,9 +175,13 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   }
   PassPolicy policy;
   // Untimed: as many samples per batch as fill the work items; a budget or target error: ramped passes.
-  // Guided: ramped too, so the table swaps after the same samples as the CPU's (1, 2, 3, 4, 8, ... 64).
+  // Guided: ramped while learning, so the table swaps after the same samples as the CPU's (1, 2, 3,
+  // 4, 8, ... 64); then, untimed, the largest passes (the frozen table makes pass sizes irrelevant).
   policy.largest_pass = uint32_t(std::max<size_t>(1, a.max_work / std::min(a.texel_count, a.max_work)));
-  policy.ramp = settings.time_budget_seconds > 0 || settings.target_relative_error > 0 || guide || svo_guide;
+  policy.ramp = settings.time_budget_seconds > 0 || settings.target_relative_error > 0;
+  if (guide && !policy.ramp) policy.ramp = true, policy.ramp_below = GridGuidingCache::kLearningSamples;
+  // SVO: ramped throughout, as on the CPU, so its rebuilds (1, 2, 4, ... spp) end passes of the same sizes.
+  if (svo_guide) policy.ramp = true, policy.ramp_below = PassPolicy{}.ramp_below;
   PassScheduler passes(settings, policy);
   std::vector<size_t> bounds;
   if (share) {

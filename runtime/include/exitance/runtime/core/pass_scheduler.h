@@ -14,6 +14,9 @@ struct PassPolicy {
   // Passes of 1 sample, then 4 (from 4 samples), then 16 (from 64): early progress, and a time
   // budget or target error honoured at fine grain.
   bool ramp = false;
+  // The ramp applies while fewer samples than this are done (a backend that needs the small passes
+  // only early, e.g. Vulkan grid guiding's learning passes, then runs its largest).
+  uint32_t ramp_below = 0xFFFFFFFFu;
   // > 0: when a budget may stop the run, passes end on multiples of this and the budget is checked
   // only there (probes: a stopped run never leaves a stratified set's strata out).
   uint32_t stratified_set = 0;

@@ -93,6 +93,14 @@ class RefreshSession {
   LightmapEstimate bake_per_bounce(uint32_t spp, double time_budget_seconds);
   // Whether lightmap() holds a bake_per_bounce() result.
   bool per_bounce() const;
+  // The whole lightmap by grid-guided path tracing (--guiding grid, issue 11) on the session's
+  // device: one bake, whose learned table swaps between its passes, so not progressive; otherwise
+  // as bake_per_bounce (it replaces what lightmap() returns until the next restart, edit or refresh).
+  // `mode`: Grid or Svo (the bundle's svo.bin is the octree; its exitance seeds the first fields).
+  LightmapEstimate bake_guided(uint32_t spp, double time_budget_seconds, float guiding_mix = 0.5f,
+                               GuidingMode mode = GuidingMode::Grid);
+  // Whether lightmap() holds a bake_guided() result.
+  bool guided() const;
 
   // The lightmap accumulated since the last edit or restart (a read-back: it waits for the device).
   LightmapEstimate lightmap() const;

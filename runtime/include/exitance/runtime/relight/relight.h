@@ -35,6 +35,10 @@ struct RelightOptions {
   // "path" (progressive path tracing, frames) or "bounces" (the per-bounce mode in one run: no
   // --frames or --budget-ms; RefreshSession::bake_per_bounce).
   std::string integrator = "path";
+  // "off", "grid" or "svo" (guided path tracing of the whole lightmap in one run, as bake --guiding
+  // grid|svo on the Vulkan backend; svo's octree is the bundle's svo.bin: no --frames or --budget-ms;
+  // RefreshSession::bake_guided).
+  std::string guiding = "off";
   // Stage reporting: (stage, fraction done, rays so far).
   std::function<void(const std::string&, double, uint64_t)> progress;
 };
