@@ -1,13 +1,13 @@
 #!/bin/bash
-# Grid guiding against unguided path tracing on the GPU machine (issue 11), through exitance-relight
-# (--guiding grid: one guided bake of the whole lightmap, bit-identical to bake --backend vulkan).
+# Guided (grid and SVO) against unguided path tracing on the GPU machine (issue 11), through
+# exitance-relight (--guiding grid|svo: one guided bake of the whole lightmap, as bake --backend vulkan).
 # Carry .gl and .replay; .replay/gd.txz holds a runtime folder `rt` from
 # `cmake --install BUILD --component runtime`, with build/bench/bench_bundle_rel_mse copied into rt/bin,
 # and ajar.bake, cornell.bake, courtyard.bake (manifest.json, scene.bin, probes.bin, svo.bin of CPU
-# bakes; commands in bench/results/guiding-gpu.md). Per scene: a two-seed 4096-spp unguided
-# reference, then unguided and guided runs at equal lighting time (--time, TIMES seconds) and at
-# equal samples (SPPS), each timed (lighting seconds, with the guided bake's table building and
-# learning) and compared with the reference (relMSE, the reference's own noise subtracted).
+# bakes; bench/guiding_gpu_pack.sh makes it). Per scene: a two-seed 4096-spp unguided reference, then
+# unguided, grid- and SVO-guided runs at equal lighting time (--time, TIMES seconds) and at equal
+# samples (SPPS), each timed (lighting seconds, with the guides' building and learning) and compared
+# with the reference (relMSE, the reference's own noise subtracted).
 #   bash .replay/guiding_gpu_run.sh            (SCENES, TIMES, SPPS override the lists)
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
@@ -30,13 +30,15 @@ for scene in ${SCENES:-ajar cornell courtyard}; do
   $R $B -o /tmp/w/$scene-refB.bake --spp 4096 --seed 202 --json > /tmp/w/refB.json
   echo "$scene reference: $(field lighting_seconds /tmp/w/refA.json) s per 4096-spp run"
   tests=""
-  for t in ${TIMES:-0.25 0.5 1 2}; do
+  for t in ${TIMES:-0.25 1}; do
     run path-${t}s --spp 0 --time $t
-    run guided-${t}s --spp 0 --time $t --guiding grid
+    run grid-${t}s --spp 0 --time $t --guiding grid
+    run svo-${t}s --spp 0 --time $t --guiding svo
   done
-  for spp in ${SPPS:-64 256 1024}; do
+  for spp in ${SPPS:-256}; do
     run path-${spp}spp --spp $spp
-    run guided-${spp}spp --spp $spp --guiding grid
+    run grid-${spp}spp --spp $spp --guiding grid
+    run svo-${spp}spp --spp $spp --guiding svo
   done
   LD_LIBRARY_PATH=/tmp/w/rt/lib /tmp/w/rt/bin/bench_bundle_rel_mse /tmp/w/$scene-refA.bake /tmp/w/$scene-refB.bake $tests | sed "s#/tmp/w/##"
   rm -rf /tmp/w/$scene-*.bake
