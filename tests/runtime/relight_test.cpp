@@ -393,6 +393,22 @@ TEST(Relight, BadScenesAreOneLineAndExitTwo) {
   EXPECT_EQ(run_relight((f.dir / "no-such.bake").string(), errors), 2);
   EXPECT_NE(errors.find("manifest.json"), std::string::npos) << errors;
   EXPECT_EQ(run_relight(f.baked.string() + " --spp -3", errors), 2);
+  // SVO guiding: a whole run, and it needs the bundle's octree.
+  const fs::path guided_out = f.dir / "svo-out.bake";
+  EXPECT_EQ(run_relight(f.baked.string() + " -o " + guided_out.string() + " --guiding svo --frames 2", errors), 2);
+  EXPECT_EQ(std::count(errors.begin(), errors.end(), '\n'), 1) << errors;
+  EXPECT_NE(errors.find("--guiding svo"), std::string::npos) << errors;
+  const fs::path no_octree = f.dir / "no-octree.bake";
+  fs::remove_all(no_octree);
+  fs::copy(f.baked, no_octree, fs::copy_options::recursive);
+  fs::remove(no_octree / "svo.bin");
+  nlohmann::json manifest = nlohmann::json::parse(file_bytes(no_octree / "manifest.json"));
+  manifest.erase("svo");
+  std::ofstream(no_octree / "manifest.json", std::ios::trunc) << manifest.dump(2);
+  EXPECT_EQ(run_relight(no_octree.string() + " -o " + guided_out.string() + " --guiding svo --spp 1", errors), 2);
+  EXPECT_EQ(std::count(errors.begin(), errors.end(), '\n'), 1) << errors;
+  EXPECT_NE(errors.find("svo.bin"), std::string::npos) << errors;
+  EXPECT_FALSE(fs::exists(guided_out)) << "partial output";
 }
 
 }  // namespace

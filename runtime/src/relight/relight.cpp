@@ -50,6 +50,8 @@ json relight_bundle(const RelightOptions& options) {
   auto validation = std::make_shared<ValidationMessages>();
   if (options.validation) session_options.device.on_validation_message = ValidationMessages::collector(validation);
   const std::unique_ptr<RefreshSession> session = RefreshSession::open(options.bundle, session_options);
+  if (options.guiding == "svo" && !session->svo())
+    throw RelightInputError(options.bundle + ": --guiding svo reads the bundle's svo.bin, which it has none of (baked with --voxel-resolution none)");
   const formats::BakeSettings baked = session->manifest().settings.value_or(formats::BakeSettings{});
   seconds["load"] = clock.lap();
 
