@@ -1,0 +1,57 @@
+// bake's guiding options that contradict the rest of the command line (docs/cli.md, --guiding): one
+// line naming the option and the conflict, exit 2, and no bundle written. They are refused before
+// any stage runs, so the sample scene costs nothing here.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "support/fresh_temp_dir.h"
+
+namespace exitance {
+namespace {
+
+namespace fs = std::filesystem;
+
+int run(const std::string& command) {
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+TEST(BakeGuidingOptions, ContradictionsAreOneLineAndExit2) {
+  const fs::path dir = testing::fresh_temp_dir("guiding-options");
+  const struct {
+    const char* options;
+    const char* expected;  // in the one error line
+  } cases[] = {
+      {"--guiding svo --voxel-resolution none", "--guiding svo builds its fields from the voxel octree"},
+      {"--guiding svo --integrator bounces", "--guiding svo guides path tracing"},
+      {"--guiding grid --integrator bounces", "--guiding grid guides path tracing"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.options);
+    const fs::path out = dir / "out.bake", err = dir / "stderr.txt";
+    EXPECT_EQ(run(std::string(EXITANCE_BAKE) + " " + EXITANCE_SAMPLE_DIR "/cornell_room.gltf --no-cache --spp 1 " +
+                  c.options + " -o " + out.string() + " 2>" + err.string() + " >/dev/null"),
+              2);
+    const std::string message = read_text(err);
+    EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
+    EXPECT_EQ(message.rfind("bake: error: ", 0), 0u) << message;
+    EXPECT_NE(message.find(c.expected), std::string::npos) << message;
+    EXPECT_FALSE(fs::exists(out));
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace exitance
