@@ -5,15 +5,27 @@
 #include <string>
 
 namespace exitance::vulkan {
-namespace {
 
-uint32_t float_bits(float f) {
+uint32_t guide_float_bits(float f) {
   uint32_t u;
   std::memcpy(&u, &f, 4);
   return u;
 }
 
-}  // namespace
+void upload_guide_words(WavefrontBatchRunner& runner, const std::vector<uint32_t>& words, const char* mode,
+                        const char* remedy) {
+  Context& context = runner.context();
+  WavefrontBuffers& buffers = runner.buffers();
+  const size_t bytes = words.size() * 4;
+  if (uint64_t(bytes) > context.properties().limits.maxStorageBufferRange)
+    throw std::runtime_error(std::string("Vulkan backend: --guiding ") + mode + ": the guide buffer (" +
+                             std::to_string(bytes) + " bytes) passes the device's largest storage buffer (" + remedy + ")");
+  if (buffers.probes.sh_sums.size() < bytes) {
+    buffers.probes.reserve_bytes(context, bytes);
+    runner.bind_buffers();
+  }
+  context.upload(buffers.probes.sh_sums, words.data(), bytes);
+}
 
 GuideBuffer::GuideBuffer(const GridGuidingCache& cache) : records_(cache.record_count()) {
   const std::vector<uint32_t>& index = cache.record_index();
@@ -38,13 +50,13 @@ GuideBuffer::GuideBuffer(const GridGuidingCache& cache) : records_(cache.record_
   std::memcpy(&units_bits, &units, 8);
   words_[kGuideFixedUnits] = uint32_t(units_bits);
   words_[kGuideFixedUnits + 1] = uint32_t(units_bits >> 32);
-  words_[kGuideFixedCap] = float_bits(cache.fixed_cap());
+  words_[kGuideFixedCap] = guide_float_bits(cache.fixed_cap());
   const Vec3 origin = cache.grid_origin();
   for (int a = 0; a < 3; ++a) {
-    words_[locator + size_t(a)] = float_bits(origin[a]);
+    words_[locator + size_t(a)] = guide_float_bits(origin[a]);
     words_[locator + 4 + size_t(a)] = uint32_t(cache.cells(a));
   }
-  words_[locator + 3] = float_bits(cache.cell_size());
+  words_[locator + 3] = guide_float_bits(cache.cell_size());
   std::memcpy(&words_[locator + kGuideGridWords], index.data(), index.size() * 4);
   pack_front(cache);
 }
@@ -53,8 +65,8 @@ void GuideBuffer::pack_front(const GridGuidingCache& cache) {
   for (uint32_t r = 0; r < records_; ++r) {
     const GuideVertex g = cache.vertex(r);
     uint32_t* f = &words_[front_ + size_t(r) * kGuideFrontWords];
-    f[0] = float_bits(g.guided_probability);
-    f[1] = float_bits(cache.expected_cosine_radiance(r));
+    f[0] = guide_float_bits(g.guided_probability);
+    f[1] = guide_float_bits(cache.expected_cosine_radiance(r));
     f[2] = g.normal_class;
     f[3] = 0;
     std::memcpy(&words_[cdf_ + size_t(r) * (kGuideBins + 1)], g.cdf, (kGuideBins + 1) * 4);
@@ -62,16 +74,7 @@ void GuideBuffer::pack_front(const GridGuidingCache& cache) {
 }
 
 void GuideBuffer::upload(WavefrontBatchRunner& runner) const {
-  Context& context = runner.context();
-  WavefrontBuffers& buffers = runner.buffers();
-  if (uint64_t(bytes()) > context.properties().limits.maxStorageBufferRange)
-    throw std::runtime_error("Vulkan backend: --guiding grid: the guide buffer (" + std::to_string(bytes()) +
-                             " bytes) passes the device's largest storage buffer (use fewer --guiding-grid-cells)");
-  if (buffers.probes.sh_sums.size() < bytes()) {
-    buffers.probes.reserve_bytes(context, bytes());
-    runner.bind_buffers();
-  }
-  context.upload(buffers.probes.sh_sums, words_.data(), bytes());
+  upload_guide_words(runner, words_, "grid", "use fewer --guiding-grid-cells");
 }
 
 void GuideBuffer::fold_learning(WavefrontBatchRunner& runner, GridGuidingCache& cache) {

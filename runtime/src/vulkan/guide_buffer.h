@@ -13,6 +13,14 @@
 
 namespace exitance::vulkan {
 
+// A float's bits as one guide-buffer word.
+uint32_t guide_float_bits(float f);
+// Every guide layout's words onto the device, in the guide binding (the probe SH sums' buffer, grown
+// and rebound when too small). `mode` and `remedy` complete the error when the device's largest
+// storage buffer is too small.
+void upload_guide_words(WavefrontBatchRunner& runner, const std::vector<uint32_t>& words, const char* mode,
+                        const char* remedy);
+
 class GuideBuffer {
  public:
   // Lays out and packs the sections of `cache` (its front table as it is now).

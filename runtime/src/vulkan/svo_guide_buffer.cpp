@@ -1,5 +1,7 @@
 #include "svo_guide_buffer.h"
 
+#include "guide_buffer.h"
+
 #include <algorithm>
 #include <array>
 #include <cstring>
@@ -7,15 +9,6 @@
 #include <string>
 
 namespace exitance::vulkan {
-namespace {
-
-uint32_t float_bits(float f) {
-  uint32_t u;
-  std::memcpy(&u, &f, 4);
-  return u;
-}
-
-}  // namespace
 
 SvoGuideBuffer::SvoGuideBuffer(const SvoGuidingFields& fields) { pack(fields); }
 
@@ -43,8 +36,8 @@ void SvoGuideBuffer::pack(const SvoGuidingFields& fields) {
   words_[kGuideCdfOffset] = uint32_t(cdf);
   words_[kGuideBackOffset] = uint32_t(counts_);
   const std::array<float, 3> origin = fields.origin();
-  for (int a = 0; a < 3; ++a) words_[locator + size_t(a)] = float_bits(origin[size_t(a)]);
-  words_[locator + 3] = float_bits(fields.size());
+  for (int a = 0; a < 3; ++a) words_[locator + size_t(a)] = guide_float_bits(origin[size_t(a)]);
+  words_[locator + 3] = guide_float_bits(fields.size());
   words_[locator + 4] = fields.depth();
   words_[locator + 5] = uint32_t(nodes);
   words_[locator + 6] = fields.bin_count();
@@ -57,23 +50,14 @@ void SvoGuideBuffer::pack(const SvoGuidingFields& fields) {
   for (uint32_t r = 0; r < records; ++r) {
     const GuideVertex g = fields.vertex(r);
     uint32_t* f = &words_[front + size_t(r) * kGuideFrontWords];
-    f[0] = float_bits(g.guided_probability);
+    f[0] = guide_float_bits(g.guided_probability);
     f[2] = g.normal_class;
     std::memcpy(&words_[cdf + size_t(r) * (kGuideBins + 1)], g.cdf, (kGuideBins + 1) * 4);
   }
 }
 
 void SvoGuideBuffer::upload(WavefrontBatchRunner& runner) const {
-  Context& context = runner.context();
-  WavefrontBuffers& buffers = runner.buffers();
-  if (uint64_t(bytes()) > context.properties().limits.maxStorageBufferRange)
-    throw std::runtime_error("Vulkan backend: --guiding svo: the guide buffer (" + std::to_string(bytes()) +
-                             " bytes) passes the device's largest storage buffer (use a coarser --voxel-resolution)");
-  if (buffers.probes.sh_sums.size() < bytes()) {
-    buffers.probes.reserve_bytes(context, bytes());
-    runner.bind_buffers();
-  }
-  context.upload(buffers.probes.sh_sums, words_.data(), bytes());
+  upload_guide_words(runner, words_, "svo", "use a coarser --voxel-resolution");
 }
 
 void SvoGuideBuffer::import_counts(WavefrontBatchRunner& runner, SvoGuidingFields& fields) {
