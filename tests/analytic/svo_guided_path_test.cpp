@@ -26,6 +26,7 @@
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "support/atlas_box.h"
 #include "support/independent_estimates.h"
+#include "support/guiding_octree.h"
 #include "support/region_and_furnace_checks.h"
 
 namespace exitance {
@@ -35,14 +36,6 @@ constexpr double kZLimit = 5.0;
 constexpr int kSeeds = 16;
 constexpr double kDetectableBias = 0.10;
 constexpr double kPi = 3.141592653589793;
-
-// The bake's octree for `texel_density`, at least 64 leaves per axis: the test atlases are coarse
-// (2-8 texels per unit), where the bake's default (leaves ~4 texels wide) would leave 2-8 leaves.
-formats::SparseVoxelOctree octree_of(const Scene& scene, float texel_density) {
-  SvoBuildSettings build;
-  build.depth = std::max(6u, default_svo_depth(scene, texel_density));
-  return build_sparse_voxel_octree(scene, build);
-}
 
 IntegratorSettings settings(uint32_t spp, uint64_t seed, GuidingMode guiding, const formats::SparseVoxelOctree* octree,
                             float mix = 0.5f) {
@@ -60,7 +53,7 @@ IntegratorSettings settings(uint32_t spp, uint64_t seed, GuidingMode guiding, co
 double expect_regions_agree(const std::string& label, const Scene& scene, const TexelGBuffer& gbuffer, float density,
                             uint32_t spp, float mix = 0.5f, bool texels = true) {
   const CpuReferenceIntegrator integrator(scene);
-  const formats::SparseVoxelOctree octree = octree_of(scene, density);
+  const formats::SparseVoxelOctree octree = testing::guiding_octree(scene, density);
   std::map<uint32_t, std::vector<double>> guided, unguided;
   uint64_t guided_vertices = 0, vertices_possible = 0;
   for (int seed = 0; seed < kSeeds; ++seed) {
@@ -128,7 +121,7 @@ TEST(SvoGuiding, FurnaceReachesLeOverOneMinusAlbedo) {
   const float rho = 0.5f;
   const Vec3 emission[6] = {le, le, le, le, le, le};
   const testing::AtlasScene box = testing::atlas_box(rho, emission, 8);
-  const formats::SparseVoxelOctree octree = octree_of(box.scene, 8);
+  const formats::SparseVoxelOctree octree = testing::guiding_octree(box.scene, 8);
   const CpuReferenceIntegrator integrator(box.scene);
   testing::expect_furnace_closed_form("svo guided", le, rho, kSeeds, kZLimit, [&](uint64_t seed) {
     LightmapEstimate e = integrator.bake(box.gbuffer, settings(16, seed, GuidingMode::Svo, &octree));
@@ -181,7 +174,7 @@ TEST(SvoGuiding, BrightestBinPointsAtTheEmitter) {
   const Vec3 black{0, 0, 0};
   const Vec3 emission[6] = {black, black, black, black, black, black};
   const testing::AtlasScene box = testing::atlas_box(0.05f, emission, 8, 0.2f, {200, 200, 200});
-  const formats::SparseVoxelOctree octree = octree_of(box.scene, 8);
+  const formats::SparseVoxelOctree octree = testing::guiding_octree(box.scene, 8);
   IntegratorSettings s = settings(8, 3, GuidingMode::Svo, &octree);
   int floor_records = 0;
   s.inspect_svo_guiding = [&](const SvoGuidingFields& fields) {
@@ -214,7 +207,7 @@ TEST(SvoGuiding, BinsFollowCRayAndLMin) {
   atlas.texel_density = 2;
   Diagnostics diagnostics;
   const PreparedScene p = prepare_scene_for_lighting(EXITANCE_SAMPLE_DIR "/cornell_room.gltf", "", atlas, diagnostics);
-  const formats::SparseVoxelOctree octree = octree_of(p.scene, 2);
+  const formats::SparseVoxelOctree octree = testing::guiding_octree(p.scene, 2);
   ASSERT_GE(octree.depth, 4u);
   const uint32_t l_min = octree.depth - 3;
   auto levels = [&](double c_ray) {
@@ -261,7 +254,7 @@ TEST(SvoGuiding, BitIdenticalPerSeedAndThreadCount) {
   atlas.texel_density = 4;
   Diagnostics diagnostics;
   const PreparedScene p = prepare_scene_for_lighting(EXITANCE_SAMPLE_DIR "/ajar_room.gltf", "", atlas, diagnostics);
-  const formats::SparseVoxelOctree octree = octree_of(p.scene, 4);
+  const formats::SparseVoxelOctree octree = testing::guiding_octree(p.scene, 4);
   const CpuReferenceIntegrator integrator(p.scene);
   const LightmapEstimate a = integrator.bake(p.gbuffer, settings(24, 7, GuidingMode::Svo, &octree));
   const LightmapEstimate b = integrator.bake(p.gbuffer, settings(24, 7, GuidingMode::Svo, &octree));
@@ -283,7 +276,7 @@ TEST(SvoGuiding, OctreeWithExitanceGuidesTheFirstPass) {
   const Vec3 le{1, 1, 1};
   const Vec3 emission[6] = {le, le, le, le, le, le};
   const testing::AtlasScene box = testing::atlas_box(0.5f, emission, 8);
-  formats::SparseVoxelOctree octree = octree_of(box.scene, 8);
+  formats::SparseVoxelOctree octree = testing::guiding_octree(box.scene, 8);
   const CpuReferenceIntegrator integrator(box.scene);
   EXPECT_EQ(integrator.bake(box.gbuffer, settings(1, 1, GuidingMode::Svo, &octree)).guided_vertices, 0u);
   fill_svo_exitance(octree, box.scene, box.gbuffer, integrator.bake(box.gbuffer, settings(4, 2, GuidingMode::Off, nullptr)));
@@ -300,7 +293,7 @@ TEST(SvoGuiding, RefusedWithoutOctreeOrInBouncesMode) {
   const Vec3 le{1, 1, 1};
   const Vec3 emission[6] = {le, le, le, le, le, le};
   const testing::AtlasScene box = testing::atlas_box(0.5f, emission, 4);
-  const formats::SparseVoxelOctree octree = octree_of(box.scene, 4);
+  const formats::SparseVoxelOctree octree = testing::guiding_octree(box.scene, 4);
   const CpuReferenceIntegrator integrator(box.scene);
   EXPECT_THROW(integrator.bake(box.gbuffer, settings(4, 1, GuidingMode::Svo, nullptr)), std::invalid_argument);
   IntegratorSettings bounces = settings(4, 1, GuidingMode::Svo, &octree);

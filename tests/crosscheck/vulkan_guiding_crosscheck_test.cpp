@@ -28,6 +28,7 @@
 #include "support/atlas_box.h"
 #include "support/independent_estimates.h"
 #include "support/region_and_furnace_checks.h"
+#include "support/region_runs.h"
 #include "support/validated_vulkan_backend.h"
 
 namespace exitance {
@@ -46,35 +47,11 @@ IntegratorSettings settings(uint32_t spp, uint64_t seed, GuidingMode guiding, fl
   return s;
 }
 
-using RegionRuns = std::map<uint32_t, std::vector<double>>;
-
-void add_regions(const TexelGBuffer& gbuffer, const LightmapEstimate& e, RegionRuns& runs) {
-  for (const auto& entry : testing::region_means(gbuffer, testing::luminance_means(e))) runs[entry.first].push_back(entry.second);
-}
-
-// Per region, the means of two sets of independent runs agree within kZLimit. Returns the median
-// over regions of the relative standard error of the difference.
-double expect_regions_agree(const std::string& label, const RegionRuns& reference, const RegionRuns& tested) {
-  std::vector<double> relative_se;
-  for (const auto& entry : reference) {
-    const testing::MeanAndError r = testing::mean_and_standard_error(entry.second);
-    const testing::MeanAndError t = testing::mean_and_standard_error(tested.at(entry.first));
-    const double se = std::hypot(r.standard_error, t.standard_error);
-    const double z = se > 0 ? (t.mean - r.mean) / se : (t.mean == r.mean ? 0.0 : INFINITY);
-    std::printf("[vulkan guided] %s region %u: reference %.5g tested %.5g (SE %.2g) z %+.2f\n", label.c_str(),
-                entry.first, r.mean, t.mean, se, z);
-    EXPECT_LE(std::fabs(z), kZLimit) << label << " region " << entry.first;
-    relative_se.push_back(r.mean > 0 ? se / r.mean : INFINITY);
-  }
-  std::sort(relative_se.begin(), relative_se.end());
-  return relative_se[relative_se.size() / 2];
-}
-
 // Vulkan guided against Vulkan unguided (and, with `cpu_too`, against the CPU's guided estimate).
 void expect_guided_agrees(const std::string& label, const Scene& scene, const TexelGBuffer& gbuffer, uint32_t spp,
                           float mix, bool cpu_too) {
   CREATE_VULKAN_OR_SKIP(vk, scene);
-  RegionRuns guided, unguided, cpu_guided;
+  testing::RegionRuns guided, unguided, cpu_guided;
   uint64_t guided_vertices = 0, texel_samples = 0;
   for (int seed = 0; seed < kSeeds; ++seed) {
     const LightmapEstimate g = vk->bake(gbuffer, settings(spp, uint64_t(seed), GuidingMode::Grid, mix));
@@ -84,18 +61,18 @@ void expect_guided_agrees(const std::string& label, const Scene& scene, const Te
     EXPECT_EQ(u.guided_vertices, 0u);
     guided_vertices += g.guided_vertices;
     texel_samples += uint64_t(gbuffer.texels.size()) * spp;
-    add_regions(gbuffer, g, guided);
-    add_regions(gbuffer, u, unguided);
+    testing::add_regions(gbuffer, g, guided);
+    testing::add_regions(gbuffer, u, unguided);
     if (cpu_too) {
       const CpuReferenceIntegrator cpu(scene);
-      add_regions(gbuffer, cpu.bake(gbuffer, settings(spp, uint64_t(seed) + 2000, GuidingMode::Grid, mix)), cpu_guided);
+      testing::add_regions(gbuffer, cpu.bake(gbuffer, settings(spp, uint64_t(seed) + 2000, GuidingMode::Grid, mix)), cpu_guided);
     }
   }
   // Guiding must really be on: after the first passes most texel vertices sample the mixture.
   EXPECT_GT(double(guided_vertices), 0.5 * double(texel_samples)) << label;
-  const double se = expect_regions_agree(label + " vs unguided", unguided, guided);
+  const double se = testing::expect_regions_agree("vulkan guided", label + " vs unguided", unguided, guided, kZLimit);
   EXPECT_LT(kZLimit * se, kDetectableBias) << "the test could not see a 10 % bias";
-  if (cpu_too) expect_regions_agree(label + " vs CPU guided", cpu_guided, guided);
+  if (cpu_too) testing::expect_regions_agree("vulkan guided", label + " vs CPU guided", cpu_guided, guided, kZLimit);
 }
 
 TEST(VulkanGridGuiding, FurnaceReachesLeOverOneMinusAlbedo) {

@@ -22,13 +22,14 @@
 #include <vector>
 
 #include "exitance/bake/command/prepared_scene.h"
-#include "exitance/bake/voxelize/svo_build.h"
 #include "exitance/runtime/core/svo_guiding_fields.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "support/atlas_box.h"
 #include "support/independent_estimates.h"
+#include "support/guiding_octree.h"
 #include "support/region_and_furnace_checks.h"
+#include "support/region_runs.h"
 #include "support/validated_vulkan_backend.h"
 
 namespace exitance {
@@ -37,13 +38,6 @@ namespace {
 constexpr double kZLimit = 5.0;
 constexpr int kSeeds = 8;
 constexpr double kDetectableBias = 0.10;
-
-// The bake's octree, at least 64 leaves per axis (the test atlases are coarse), as the CPU tests build it.
-formats::SparseVoxelOctree octree_of(const Scene& scene, float texel_density) {
-  SvoBuildSettings build;
-  build.depth = std::max(6u, default_svo_depth(scene, texel_density));
-  return build_sparse_voxel_octree(scene, build);
-}
 
 IntegratorSettings settings(uint32_t spp, uint64_t seed, GuidingMode guiding, const formats::SparseVoxelOctree* octree,
                             float mix = 0.5f) {
@@ -56,34 +50,12 @@ IntegratorSettings settings(uint32_t spp, uint64_t seed, GuidingMode guiding, co
   return s;
 }
 
-using RegionRuns = std::map<uint32_t, std::vector<double>>;
-
-void add_regions(const TexelGBuffer& gbuffer, const LightmapEstimate& e, RegionRuns& runs) {
-  for (const auto& entry : testing::region_means(gbuffer, testing::luminance_means(e))) runs[entry.first].push_back(entry.second);
-}
-
-double expect_regions_agree(const std::string& label, const RegionRuns& reference, const RegionRuns& tested) {
-  std::vector<double> relative_se;
-  for (const auto& entry : reference) {
-    const testing::MeanAndError r = testing::mean_and_standard_error(entry.second);
-    const testing::MeanAndError t = testing::mean_and_standard_error(tested.at(entry.first));
-    const double se = std::hypot(r.standard_error, t.standard_error);
-    const double z = se > 0 ? (t.mean - r.mean) / se : (t.mean == r.mean ? 0.0 : INFINITY);
-    std::printf("[vulkan svo] %s region %u: reference %.5g tested %.5g (SE %.2g) z %+.2f\n", label.c_str(), entry.first,
-                r.mean, t.mean, se, z);
-    EXPECT_LE(std::fabs(z), kZLimit) << label << " region " << entry.first;
-    relative_se.push_back(r.mean > 0 ? se / r.mean : INFINITY);
-  }
-  std::sort(relative_se.begin(), relative_se.end());
-  return relative_se[relative_se.size() / 2];
-}
-
 // Vulkan SVO-guided against Vulkan unguided (and, with `cpu_too`, against the CPU's SVO-guided estimate).
 void expect_guided_agrees(const std::string& label, const Scene& scene, const TexelGBuffer& gbuffer, float density,
                           uint32_t spp, float mix, bool cpu_too) {
   CREATE_VULKAN_OR_SKIP(vk, scene);
-  const formats::SparseVoxelOctree octree = octree_of(scene, density);
-  RegionRuns guided, unguided, cpu_guided;
+  const formats::SparseVoxelOctree octree = testing::guiding_octree(scene, density);
+  testing::RegionRuns guided, unguided, cpu_guided;
   uint64_t guided_vertices = 0, texel_samples = 0;
   for (int seed = 0; seed < kSeeds; ++seed) {
     const LightmapEstimate g = vk->bake(gbuffer, settings(spp, uint64_t(seed), GuidingMode::Svo, &octree, mix));
@@ -93,11 +65,11 @@ void expect_guided_agrees(const std::string& label, const Scene& scene, const Te
     EXPECT_EQ(u.guided_vertices, 0u);
     guided_vertices += g.guided_vertices;
     texel_samples += uint64_t(gbuffer.texels.size()) * spp;
-    add_regions(gbuffer, g, guided);
-    add_regions(gbuffer, u, unguided);
+    testing::add_regions(gbuffer, g, guided);
+    testing::add_regions(gbuffer, u, unguided);
     if (cpu_too) {
       const CpuReferenceIntegrator cpu(scene);
-      add_regions(gbuffer, cpu.bake(gbuffer, settings(spp, uint64_t(seed) + 2000, GuidingMode::Svo, &octree, mix)),
+      testing::add_regions(gbuffer, cpu.bake(gbuffer, settings(spp, uint64_t(seed) + 2000, GuidingMode::Svo, &octree, mix)),
                   cpu_guided);
     }
   }
@@ -105,9 +77,9 @@ void expect_guided_agrees(const std::string& label, const Scene& scene, const Te
   std::printf("[vulkan svo] %s: %.3f guided vertices per texel sample\n", label.c_str(),
               double(guided_vertices) / double(texel_samples));
   EXPECT_GT(double(guided_vertices), 0.5 * double(texel_samples)) << label;
-  const double se = expect_regions_agree(label + " vs unguided", unguided, guided);
+  const double se = testing::expect_regions_agree("vulkan svo", label + " vs unguided", unguided, guided, kZLimit);
   EXPECT_LT(kZLimit * se, kDetectableBias) << "the test could not see a 10 % bias";
-  if (cpu_too) expect_regions_agree(label + " vs CPU svo", cpu_guided, guided);
+  if (cpu_too) testing::expect_regions_agree("vulkan svo", label + " vs CPU svo", cpu_guided, guided, kZLimit);
 }
 
 TEST(VulkanSvoGuiding, FurnaceReachesLeOverOneMinusAlbedo) {
@@ -116,7 +88,7 @@ TEST(VulkanSvoGuiding, FurnaceReachesLeOverOneMinusAlbedo) {
   const Vec3 emission[6] = {le, le, le, le, le, le};
   const testing::AtlasScene box = testing::atlas_box(rho, emission, 8);
   CREATE_VULKAN_OR_SKIP(vk, box.scene);
-  const formats::SparseVoxelOctree octree = octree_of(box.scene, 8);
+  const formats::SparseVoxelOctree octree = testing::guiding_octree(box.scene, 8);
   testing::expect_furnace_closed_form("vulkan svo", le, rho, kSeeds, kZLimit, [&](uint64_t seed) {
     LightmapEstimate e = vk->bake(box.gbuffer, settings(16, seed, GuidingMode::Svo, &octree));
     EXPECT_EQ(e.nonfinite_samples, 0u);
@@ -164,7 +136,7 @@ TEST(VulkanSvoGuiding, BitIdenticalPerSeed) {
   Diagnostics diagnostics;
   const PreparedScene p = prepare_scene_for_lighting(EXITANCE_SAMPLE_DIR "/ajar_room.gltf", "", atlas, diagnostics);
   CREATE_VULKAN_OR_SKIP(vk, p.scene);
-  const formats::SparseVoxelOctree octree = octree_of(p.scene, 2);
+  const formats::SparseVoxelOctree octree = testing::guiding_octree(p.scene, 2);
   std::vector<std::vector<float>> cdfs;
   std::vector<uint32_t> bins;
   IntegratorSettings s = settings(24, 7, GuidingMode::Svo, &octree);
