@@ -86,6 +86,15 @@ SvoGuidingFields::SvoGuidingFields(const LightingScene& scene, const formats::Sp
   for (size_t i = 0; i < gbuffer.texels.size(); ++i) texel_node_[i] = node_of(gbuffer.texels[i].position);
 }
 
+SvoGuidingConfig svo_guiding_config(const IntegratorSettings& settings) {
+  SvoGuidingConfig config;
+  config.mix = settings.guiding_mix;
+  config.c_ray = settings.guiding_svo_c_ray;
+  config.rays_per_bin = settings.guiding_svo_rays_per_bin;
+  config.emitted = settings.guiding_svo_emitted;
+  return config;
+}
+
 SvoGuidingFields::~SvoGuidingFields() = default;
 
 uint32_t SvoGuidingFields::node_of(Vec3 p) const {

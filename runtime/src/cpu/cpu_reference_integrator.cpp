@@ -275,13 +275,9 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   if (settings.guiding == GuidingMode::Svo) {
     if (!settings.guiding_octree)
       throw std::invalid_argument("CPU backend: --guiding svo needs the bake's sparse voxel octree (not --voxel-resolution none)");
-    SvoGuidingConfig config;
-    config.mix = settings.guiding_mix;
-    config.c_ray = settings.guiding_svo_c_ray;
-    config.rays_per_bin = settings.guiding_svo_rays_per_bin;
-    config.emitted = settings.guiding_svo_emitted;
     std::shared_ptr<const EmbreeScene> embree = impl_->embree;
-    svo_guide = std::make_unique<SvoGuidingFields>(*impl_->lighting, *settings.guiding_octree, gbuffer, config,
+    svo_guide = std::make_unique<SvoGuidingFields>(*impl_->lighting, *settings.guiding_octree, gbuffer,
+                                                   svo_guiding_config(settings),
                                                    [embree](Vec3 origin, Vec3 direction) {
                                                      const Hit h = embree->intersect(origin, direction, INFINITY);
                                                      return GuideRayHit{h.found, h.distance, h.triangle};

@@ -164,11 +164,8 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     if (!settings.guiding_octree)
       throw std::invalid_argument("Vulkan backend: --guiding svo needs the bake's sparse voxel octree (not --voxel-resolution none)");
     if (!guiding_scene_.lighting) throw std::logic_error("Vulkan backend: SVO guiding without the integrator's scene");
-    SvoGuidingConfig config;
-    config.mix = settings.guiding_mix;
-    config.c_ray = settings.guiding_svo_c_ray;
-    config.rays_per_bin = settings.guiding_svo_rays_per_bin;
-    svo_guide = std::make_unique<SvoGuidingFields>(*guiding_scene_.lighting, *settings.guiding_octree, gbuffer, config);
+    svo_guide = std::make_unique<SvoGuidingFields>(*guiding_scene_.lighting, *settings.guiding_octree, gbuffer,
+                                                   svo_guiding_config(settings));
     if (svo_guide->seeded()) svo_guide->rebuild(nullptr, 0, settings.seed);
     svo_buffer.emplace(*svo_guide);
     svo_buffer->upload(runner_);

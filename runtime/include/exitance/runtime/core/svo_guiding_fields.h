@@ -50,6 +50,7 @@
 #include "exitance/common/guided_direction.h"
 #include "exitance/formats/sparse_voxel_octree.h"
 #include "exitance/runtime/core/estimates.h"
+#include "exitance/runtime/core/integrator_settings.h"
 #include "exitance/runtime/core/lighting_scene.h"
 #include "exitance/runtime/texel_gbuffer.h"
 
@@ -68,6 +69,8 @@ struct SvoGuidingConfig {
   // estimation already samples emitters, and guided rays spent on them only split its MIS weight.
   bool emitted = true;
 };
+// The configuration an integrator's settings ask for (guiding_mix, guiding_svo_*), for every backend.
+SvoGuidingConfig svo_guiding_config(const IntegratorSettings& settings);
 
 // The octree level whose voxel edge (size / 2^level) is the diameter of the footprint at distance
 // r of a cone of solid angle `solid_angle`: the cone's plane half-angle theta solves
