@@ -2,7 +2,7 @@
 // content hash outside the repository) is the reference; runs at doubling spp record seconds,
 // relMSE, MAE, worst-texel error and rays/s as CSV, and the time to reach a target relMSE.
 //
-//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,adaptive,bounces,guided,svo,guided_auto] [--guiding-mix M] [--name NAME]
+//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,adaptive,bounces,guided,svo,guided_auto,nee,guided_nee,svo_nee] [--guiding-mix M] [--name NAME]
 //                       [--sky R,G,B] [--texel-density T] [--reference-spp N] [--max-spp N]
 //                       [--max-seconds S] [--target 0.01] [--bounces N] [--min-spp N] [--cache DIR] [--csv FILE]
 //                       [--texel-csv FILE] [--guiding-fields FILE] [--samplers sobol,independent]
@@ -92,9 +92,14 @@ int main(int argc, char** argv) {
   app.add_option("--integrators", integrators,
                  "comma-separated: path, adaptive (path with adaptive sampling; spp = mean), bounces, bounces_cached "
                  "(bounces with --first-bounce cached), guided (path with --guiding grid), svo (path with --guiding svo), "
-                 "guided_auto (path with --guiding auto)");
+                 "guided_auto (path with --guiding auto), nee / guided_nee / svo_nee (path, guided and svo with "
+                 "--emitter-guiding on)");
   float guiding_mix = 0.5f;
   app.add_option("--guiding-mix", guiding_mix, "guided component's probability (guided runs)");
+  float emitter_guiding_mix = 0.5f;
+  uint32_t emitter_guiding_patches = 512;
+  app.add_option("--emitter-guiding-mix", emitter_guiding_mix, "learned next-event component's probability (*nee runs)");
+  app.add_option("--emitter-guiding-patches", emitter_guiding_patches, "about this many emitter patches (*nee runs)");
   std::string guiding_fields;
   app.add_option("--guiding-fields", guiding_fields,
                  "CSV of the learned grid guiding tables of the last guided run (record, cell, class, bins); svo "
@@ -199,6 +204,7 @@ int main(int argc, char** argv) {
     bool adaptive = false;
     uint32_t sampler = kSamplerSobol;
     bool trace_first_bounce = true;  // bounces: B_1 traced (true) or read from the B_0 lightmap
+    bool emitter_guiding = false;
   };
   std::vector<Mode> modes;
   auto listed = [&](const std::string& name) {
@@ -209,10 +215,16 @@ int main(int argc, char** argv) {
   if (listed("guided")) modes.push_back({IntegratorMode::Path, GuidingMode::Grid, "path_guided_grid"});
   if (listed("guided_auto")) modes.push_back({IntegratorMode::Path, GuidingMode::Auto, "path_guided_auto"});
   if (listed("svo")) modes.push_back({IntegratorMode::Path, GuidingMode::Svo, "path_guided_svo"});
+  // Emitter guiding (--emitter-guiding on) with unguided, grid and SVO continuations.
+  if (listed("nee")) modes.push_back({IntegratorMode::Path, GuidingMode::Off, "path_nee", false, kSamplerSobol, true, true});
+  if (listed("guided_nee"))
+    modes.push_back({IntegratorMode::Path, GuidingMode::Grid, "path_guided_grid_nee", false, kSamplerSobol, true, true});
+  if (listed("svo_nee"))
+    modes.push_back({IntegratorMode::Path, GuidingMode::Svo, "path_guided_svo_nee", false, kSamplerSobol, true, true});
   // The octree of svo runs: built once, as the bake's voxelize stage does before lighting (not timed:
   // every bake builds it, guided or not).
   formats::SparseVoxelOctree octree;
-  if (listed("svo")) {
+  if (listed("svo") || listed("svo_nee")) {
     SvoBuildSettings build;
     build.depth = svo_depth ? svo_depth : std::max(6u, default_svo_depth(scene, density));
     octree = build_sparse_voxel_octree(scene, build);
@@ -258,6 +270,9 @@ int main(int argc, char** argv) {
         settings.max_bounces = bounces;
         settings.guiding = m.guiding;
         settings.guiding_mix = guiding_mix;
+        settings.emitter_guiding = m.emitter_guiding;
+        settings.emitter_guiding_mix = emitter_guiding_mix;
+        settings.emitter_guiding_patches = emitter_guiding_patches;
         settings.guiding_octree = &octree;
         settings.guiding_svo_c_ray = svo_c_ray;
         settings.guiding_svo_rays_per_bin = svo_rays_per_bin;

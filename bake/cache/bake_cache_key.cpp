@@ -11,11 +11,11 @@ namespace {
 // A new field in one of these must be added to the key below; the sizes catch most additions.
 // Not hashed: work_share (how many processes lit a bake does not change its bits: issue 15),
 // guiding_octree (the bake's own octree, from the hashed voxel options) and the inspect callbacks.
-static_assert(sizeof(IntegratorSettings) == 208, "IntegratorSettings changed: hash the new field in bake_cache_key");
+static_assert(sizeof(IntegratorSettings) == 248, "IntegratorSettings changed: hash the new field in bake_cache_key");
 static_assert(sizeof(AtlasSettings) == 24, "AtlasSettings changed: hash the new field in bake_cache_key");
 // Not hashed: input and output paths (the input's name and bytes are), cache_directory and
 // write_gltf (where results go does not change them), progress.
-static_assert(sizeof(BakeOptions) == 512, "BakeOptions changed: hash the new field in bake_cache_key (or say why not)");
+static_assert(sizeof(BakeOptions) == 552, "BakeOptions changed: hash the new field in bake_cache_key (or say why not)");
 static_assert(sizeof(ImportOptions) == 8, "ImportOptions changed: hash the new field in bake_cache_key");
 static_assert(sizeof(Material) == 168, "Material changed: hash the new field in bake_cache_key");
 static_assert(sizeof(PunctualLight) == 88, "PunctualLight changed: hash the new field in bake_cache_key");
@@ -77,6 +77,7 @@ void hash_options(Sha256Stream& h, const BakeOptions& o) {
   h.value(l.guiding_grid_cells), h.value(l.adaptive), h.value(o.adaptive_request);
   h.value(l.guiding_svo_c_ray), h.value(l.guiding_svo_rays_per_bin), h.value(l.guiding_svo_emitted);
   h.value(l.guiding_svo_texels);
+  h.value(l.emitter_guiding), h.value(l.emitter_guiding_mix), h.value(l.emitter_guiding_patches);
   h.value(o.bounce_layers), h.value(o.probes_enabled), h.value(o.probe_spacing), h.value(o.probe_spp);
   h.value(o.probe_sh_window), h.value(o.svo_enabled), h.value(o.voxel_resolution);
   h.value(o.skip_sealed_texels), h.value(o.stitch_seams);

@@ -9,6 +9,7 @@ IntegratorMode automatic_integrator(const BakeOptions& options, const Integrator
   if (options.lighting.directional != DirectionalMode::Off) return IntegratorMode::Path;
   if (options.lighting.guiding == GuidingMode::Grid) return IntegratorMode::Path;  // auto does not ask for it
   if (options.adaptive_request == AdaptiveRequest::On) return IntegratorMode::Path;
+  if (options.lighting.emitter_guiding) return IntegratorMode::Path;
   return IntegratorMode::Bounces;
 }
 

@@ -51,6 +51,7 @@ std::string refused_under_mpirun(const exitance::BakeOptions& options, const std
   if (adaptive == "on") return "--adaptive on: adaptive sampling runs in one process only, not under mpirun";
   if (guiding == "grid" || guiding == "svo")
     return "--guiding " + guiding + ": guiding runs in one process only, not under mpirun";
+  if (options.lighting.emitter_guiding) return "--emitter-guiding on: guiding runs in one process only, not under mpirun";
   if (integrator == "path" && options.lighting.target_relative_error > 0 && options.backend.name == "cpu")
     return "--target-error: on the CPU backend with --integrator path it plans each texel's samples in one process; "
            "under mpirun use --integrator bounces";
@@ -140,6 +141,15 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"auto", "off", "svo", "grid"}));
   app.add_option("--guiding-mix", options.lighting.guiding_mix,
                  "probability of the guided direction in the one-sample mixture with cosine sampling (default 0.5)")
+      ->check(CLI::Range(0.0f, 1.0f));
+  std::string emitter_guiding = "off";
+  app.add_option("--emitter-guiding", emitter_guiding,
+                 "off (default) | on: next-event estimation samples emitter patches from a distribution learned per "
+                 "grid region, mixed with the default sampling (docs/lighting-core.md \"Emitter guiding\"; path "
+                 "tracing, CPU backend, one process)")
+      ->check(CLI::IsMember({"off", "on"}));
+  app.add_option("--emitter-guiding-mix", options.lighting.emitter_guiding_mix,
+                 "probability of the learned emitter distribution in the mixture with the default (default 0.5)")
       ->check(CLI::Range(0.0f, 1.0f));
   std::string sampler = "sobol";
   app.add_option("--sampler", sampler,
@@ -284,6 +294,17 @@ int main(int argc, char** argv) {
   }
   // Resolved once the backend and integrator are known (automatic_integrator.h).
   if (guiding == "auto") options.lighting.guiding = exitance::GuidingMode::Auto;
+  if (emitter_guiding == "on") {
+    if (integrator == "bounces") {
+      std::cerr << "bake: error: --emitter-guiding on guides path tracing's next-event estimation: it needs --integrator path\n";
+      return 2;
+    }
+    if (options.backend.name == "vulkan") {
+      std::cerr << "bake: error: --emitter-guiding on: implemented on the CPU backend only (use --backend cpu)\n";
+      return 2;
+    }
+    options.lighting.emitter_guiding = true;
+  }
 
   if (no_cache && !cache_directory.empty()) {
     std::cerr << "bake: error: --cache " << cache_directory << ": contradicts --no-cache\n";

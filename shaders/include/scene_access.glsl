@@ -178,3 +178,5 @@ vec3 scene_sample_environment(float u1, float u2, out float pdf) {
 // Grid guiding's CDFs (guided_direction.h) live in the guide buffer (gpu_layout.h kBindingGuide): a
 // handle is the word offset of its record's CDF (guide.glsl guide_vertex_of).
 float guide_cdf_at(uint cdf, uint i) { return uintBitsToFloat(guide_words[cdf + i]); }
+// Emitter guiding's tables (guided_emitters.h) live there too: a handle is a word offset.
+uint emitter_guide_word(uint table, uint i) { return guide_words[table + i]; }

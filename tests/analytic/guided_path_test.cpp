@@ -22,6 +22,7 @@
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "support/atlas_box.h"
+#include "support/identical_estimates.h"
 #include "support/independent_estimates.h"
 #include "support/region_and_furnace_checks.h"
 
@@ -121,12 +122,7 @@ TEST(GridGuiding, AjarRoomAgreesWithUnguided) {
   EXPECT_LT(kZLimit * se, kDetectableBias) << "the test could not see a 10 % bias";
 }
 
-bool identical(const LightmapEstimate& a, const LightmapEstimate& b) {
-  if (a.texels.size() != b.texels.size() || a.bounces != b.bounces) return false;
-  for (size_t i = 0; i < a.texels.size(); ++i)
-    if (std::memcmp(&a.texels[i], &b.texels[i], sizeof(TexelAccumulator)) != 0) return false;
-  return true;
-}
+bool identical(const LightmapEstimate& a, const LightmapEstimate& b) { return testing::identical_texel_sums(a, b); }
 
 TEST(GridGuiding, BitIdenticalPerSeedAndThreadCount) {
   AtlasSettings atlas;

@@ -21,6 +21,7 @@
 #include "exitance/bake/command/prepared_scene.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "support/atlas_box.h"
+#include "support/identical_estimates.h"
 #include "support/independent_estimates.h"
 #include "support/region_and_furnace_checks.h"
 
@@ -94,9 +95,7 @@ TEST(GuidingAuto, AjarRoomAgreesWithUnguided) {
 }
 
 bool identical(const LightmapEstimate& a, const LightmapEstimate& b) {
-  if (a.texels.size() != b.texels.size() || a.bounces != b.bounces) return false;
-  for (size_t i = 0; i < a.texels.size(); ++i)
-    if (std::memcmp(&a.texels[i], &b.texels[i], sizeof(TexelAccumulator)) != 0) return false;
+  if (!testing::identical_texel_sums(a, b)) return false;
   if (a.guiding_regions.size() != b.guiding_regions.size()) return false;
   for (size_t r = 0; r < a.guiding_regions.size(); ++r)
     if (a.guiding_regions[r].guided != b.guiding_regions[r].guided ||

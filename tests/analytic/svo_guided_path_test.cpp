@@ -25,6 +25,7 @@
 #include "exitance/runtime/core/svo_guiding_fields.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "support/atlas_box.h"
+#include "support/identical_estimates.h"
 #include "support/independent_estimates.h"
 #include "support/guiding_octree.h"
 #include "support/region_and_furnace_checks.h"
@@ -242,12 +243,7 @@ TEST(SvoGuiding, BinsFollowCRayAndLMin) {
   EXPECT_GT(deeper, coarse_total);
 }
 
-bool identical(const LightmapEstimate& a, const LightmapEstimate& b) {
-  if (a.texels.size() != b.texels.size() || a.bounces != b.bounces) return false;
-  for (size_t i = 0; i < a.texels.size(); ++i)
-    if (std::memcmp(&a.texels[i], &b.texels[i], sizeof(TexelAccumulator)) != 0) return false;
-  return true;
-}
+bool identical(const LightmapEstimate& a, const LightmapEstimate& b) { return testing::identical_texel_sums(a, b); }
 
 TEST(SvoGuiding, BitIdenticalPerSeedAndThreadCount) {
   AtlasSettings atlas;

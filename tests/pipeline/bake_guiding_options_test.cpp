@@ -1,6 +1,6 @@
-// bake's guiding options that contradict the rest of the command line (docs/cli.md, --guiding): one
-// line naming the option and the conflict, exit 2, and no bundle written. They are refused before
-// any stage runs, so the sample scene costs nothing here.
+// bake's guiding options that contradict the rest of the command line (docs/cli.md, --guiding,
+// --emitter-guiding): one line naming the option and the conflict, exit 2, and no bundle written.
+// They are refused before any stage runs, so the sample scene costs nothing here.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -37,6 +37,8 @@ TEST(BakeGuidingOptions, ContradictionsAreOneLineAndExit2) {
       {"--guiding svo --voxel-resolution none", "--guiding svo builds its fields from the voxel octree"},
       {"--guiding svo --integrator bounces", "--guiding svo guides path tracing"},
       {"--guiding grid --integrator bounces", "--guiding grid guides path tracing"},
+      {"--emitter-guiding on --integrator bounces", "--emitter-guiding on guides path tracing"},
+      {"--emitter-guiding on --backend vulkan", "--emitter-guiding on: implemented on the CPU backend only"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.options);

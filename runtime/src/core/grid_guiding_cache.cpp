@@ -50,29 +50,10 @@ GridGuidingCache::GridGuidingCache(const LightingScene& scene, const TexelGBuffe
 
 GridGuidingCache::GridGuidingCache(Vec3 bounds_lo, Vec3 bounds_hi, float reference, const TexelGBuffer& gbuffer,
                                    const GridGuidingConfig& config)
-    : config_(config) {
+    : config_(config), locator_(bounds_lo, bounds_hi, gbuffer, config.cells_on_longest_axis, kMinTexelsPerRecord) {
   config_.mix = std::clamp(config_.mix, 0.0f, 1.0f);
-  lo_ = bounds_lo;
-  const Vec3 extent = bounds_hi - bounds_lo;
-  // The finest grid whose records average kMinTexelsPerRecord texels.
-  for (int n = std::max(1, config_.cells_on_longest_axis);; --n) {
-    const Grid g = make_grid(extent, n);
-    cell_size_ = g.cell;
-    for (int a = 0; a < 3; ++a) dims_[a] = g.dims[a];
-    const size_t cells = size_t(dims_[0]) * size_t(dims_[1]) * size_t(dims_[2]);
-    record_index_.assign(cells * kGuideNormalClasses, kNoRecord);
-    front_.clear();
-    for (const LiveTexel& t : gbuffer.texels) {
-      const uint normal_class = guide_normal_class(t.shading_normal);
-      const size_t key = size_t(cell_index(t.position)) * kGuideNormalClasses + normal_class;
-      if (record_index_[key] != kNoRecord) continue;
-      record_index_[key] = uint32_t(front_.size());
-      Front f;
-      f.normal_class = normal_class;
-      front_.push_back(f);
-    }
-    if (n == 1 || double(gbuffer.texels.size()) >= kMinTexelsPerRecord * double(front_.size())) break;
-  }
+  front_.resize(locator_.record_count());
+  for (uint32_t r = 0; r < front_.size(); ++r) front_[r].normal_class = locator_.normal_class(r);
 
   // The radiance scale: the brightest emission or sky (luminance); a scene without either learns 0.
   if (!(reference > 0) || !std::isfinite(reference)) reference = 1.0f;
@@ -85,24 +66,6 @@ GridGuidingCache::GridGuidingCache(Vec3 bounds_lo, Vec3 bounds_hi, float referen
   weight_.assign(records * kGuideBins, 0.0f);
   back_.reset(new BinAccumulator[records * kGuideBins]);
   for (uint32_t r = 0; r < records; ++r) rebuild(r);
-}
-
-uint32_t GridGuidingCache::cell_index(Vec3 p) const {
-  int c[3];
-  for (int a = 0; a < 3; ++a) {
-    const float f = (p[a] - lo_[a]) / cell_size_;
-    c[a] = f >= 0 ? std::min(int(std::min(f, 1e9f)), dims_[a] - 1) : 0;  // NaN and below: cell 0
-  }
-  return uint32_t((c[2] * dims_[1] + c[1]) * dims_[0] + c[0]);
-}
-
-uint32_t GridGuidingCache::record_of(Vec3 position, Vec3 shading_normal) const {
-  return record_index_[size_t(cell_index(position)) * kGuideNormalClasses + guide_normal_class(shading_normal)];
-}
-
-uint32_t GridGuidingCache::record_of_cell(int x, int y, int z, uint normal_class) const {
-  if (x < 0 || y < 0 || z < 0 || x >= dims_[0] || y >= dims_[1] || z >= dims_[2]) return kNoRecord;
-  return record_index_[size_t((z * dims_[1] + y) * dims_[0] + x) * kGuideNormalClasses + normal_class];
 }
 
 GuideVertex GridGuidingCache::vertex(uint32_t record) const {
@@ -195,7 +158,7 @@ size_t GridGuidingCache::bytes_per_record() {
 }
 
 size_t GridGuidingCache::memory_bytes() const {
-  return bytes_per_record() * front_.size() + record_index_.size() * sizeof(uint32_t);
+  return bytes_per_record() * front_.size() + locator_.memory_bytes();
 }
 
 }  // namespace exitance

@@ -14,6 +14,7 @@
 
 #include "cpu_bounce_integrator.h"
 #include "exitance/runtime/core/adaptive_sampling_plan.h"
+#include "exitance/runtime/core/emitter_guiding_cache.h"
 #include "exitance/runtime/core/grid_guiding_cache.h"
 #include "exitance/runtime/core/guiding_choice.h"
 #include "exitance/runtime/core/pass_scheduler.h"
@@ -85,9 +86,11 @@ struct CpuReferenceIntegrator::Impl {
 
   // Traces the shadow rays of one vertex; returns what the unoccluded ones carry. With `sh1` (a
   // directional texel's own vertex), also adds their L1 estimates there.
+  // `arrived`: whether each ray arrived (unoccluded).
   Vec3 connect(const ShadowRay (&rays)[3], Vec3 origin, uint64_t& traced, const SurfacePoint& x,
-               Vec3* sh1 = nullptr) const {
+               Vec3* sh1 = nullptr, bool (*arrived)[3] = nullptr) const {
     Vec3 sum{0, 0, 0};
+    if (arrived) (*arrived)[0] = (*arrived)[1] = (*arrived)[2] = false;
     for (const ShadowRay& r : rays) {
       const float state = r.contribution_state.w;
       if (state == kShadowNone) continue;
@@ -96,6 +99,7 @@ struct CpuReferenceIntegrator::Impl {
       const Vec3 d{r.direction_length.x, r.direction_length.y, r.direction_length.z};
       if (!embree->occluded(origin, d, r.direction_length.w)) {
         const Vec3 c{r.contribution_state.x, r.contribution_state.y, r.contribution_state.z};
+        if (arrived) (*arrived)[&r - rays] = true;
         sum += c;
         if (sh1) {
           const Vec3 f = sh1_direction_factor(x, d);
@@ -152,10 +156,18 @@ struct CpuReferenceIntegrator::Impl {
     void observe(uint32_t, const GuideVertex&, Vec3, const Hit&) const {}
   };
 
+  // Emitter guiding at the path's vertices (null: the default next-event sampling); `learn`: its
+  // next-event samples teach the back tables.
+  struct EmitterGuiding {
+    EmitterGuidingCache* cache = nullptr;
+    bool learn = false;
+  };
+
   // One path sample of E/pi at x; `first_bounce` is the bounce x stands for (0 at a texel).
   template <class Guide>
   void trace(SurfacePoint x, const IntegratorSettings& settings, PathSampler& rng, PathContributions& out,
-             uint64_t& rays, const Guide& guide, uint64_t* guided_vertices = nullptr) const {
+             uint64_t& rays, const Guide& guide, uint64_t* guided_vertices = nullptr,
+             EmitterGuiding emitter_guiding = {}) const {
     const LightingScene& s = scene();
     const PathLimits limits{settings.max_bounces, settings.russian_roulette_start, settings.safety_bounce_cap};
     Vec3 throughput{1, 1, 1};
@@ -167,8 +179,19 @@ struct CpuReferenceIntegrator::Impl {
       const bool directional_texel = out.directional && bounce == 0;
       if (directional_texel) g = with_uniform_component(g, kDirectionalUniformProbability);
       ShadowRay shadow[kShadowRaysPerVertex];
-      next_event_estimation(s, x, origin, throughput, g, rng, shadow[0], shadow[1], shadow[2]);
-      const Vec3 direct = connect(shadow, origin, rays, x, directional_texel ? out.texel_nee_sh1 : nullptr);
+      const uint32_t emitter_record = emitter_guiding.cache ? emitter_guiding.cache->record_of(x.position, x.shading_normal)
+                                                            : EmitterGuidingCache::kNoRecord;
+      const EmitterGuide eg = emitter_guiding.cache ? emitter_guiding.cache->vertex(emitter_record) : emitter_guide_none();
+      EmitterLearning learning;
+      next_event_estimation(s, x, origin, throughput, g, eg, rng, shadow[0], shadow[1], shadow[2], learning);
+      bool arrived[3];
+      const Vec3 direct = connect(shadow, origin, rays, x, directional_texel ? out.texel_nee_sh1 : nullptr, &arrived);
+      if (emitter_guiding.learn) {
+        if (arrived[0] && learning.patch_index != kEmitterPatchNone)
+          emitter_guiding.cache->learn(emitter_record, learning.patch_index, learning.value);
+        if (arrived[1] && learning.punctual_light != kEmitterPatchNone)
+          emitter_guiding.cache->learn_punctual(emitter_record, learning.punctual_light, learning.punctual_value);
+      }
       out.add(bounce, direct);
       if (directional_texel) out.texel_nee = direct;
       const DirectionSample d = sample_continuation(g, x, rng);
@@ -183,7 +206,7 @@ struct CpuReferenceIntegrator::Impl {
         return;
       }
       const HitResult h = shade_continuation_hit(s, hit.triangle, hit.distance, hit.b1, hit.b2, d.direction, d.pdf,
-                                                 ray_throughput, bounce, limits, rng);
+                                                 ray_throughput, bounce, limits, eg, rng);
       out.add(bounce, h.radiance);
       if (!h.continues) return;
       throughput = h.throughput;
@@ -228,7 +251,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   if (settings.integrator == IntegratorMode::Bounces) {
     if (settings.directional != DirectionalMode::Off)
       throw std::invalid_argument("CPU backend: --directional sh1 applies to path tracing, not to --integrator bounces");
-    if (settings.guiding != GuidingMode::Off)
+    if (settings.guiding != GuidingMode::Off || settings.emitter_guiding)
       throw std::invalid_argument("CPU backend: guiding applies to path tracing, not to --integrator bounces");
     if (settings.adaptive)
       throw std::invalid_argument("CPU backend: adaptive sampling applies to path tracing, not to --integrator bounces");
@@ -284,6 +307,16 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
                                                    });
     if (svo_guide->seeded()) svo_guide->rebuild(nullptr, 0, settings.seed);
   }
+  // Emitter guiding: learned from every pass's next-event samples, folded after each pass.
+  std::unique_ptr<EmitterGuidingCache> emitter_guide;
+  if (settings.emitter_guiding && (impl_->lighting->emitter_count() > 0 || impl_->lighting->punctual_count() >= 2)) {
+    if (share) throw std::invalid_argument("CPU backend: --emitter-guiding runs in one process only, not under mpirun with several ranks");
+    EmitterGuidingConfig config;
+    config.mix = settings.emitter_guiding_mix;
+    config.cells_on_longest_axis = settings.guiding_grid_cells;
+    config.patch_target = settings.emitter_guiding_patches;
+    emitter_guide = std::make_unique<EmitterGuidingCache>(*impl_->lighting, gbuffer, config);
+  }
   // --guiding auto (guiding_choice.h): regions are the guide's records (grid cell x normal class of
   // the texel), the unit whose learned table decides how well its texels' first vertices are guided,
   // with at least 16 texels each, so a region's variance sums are not one texel's noise. Texels
@@ -332,14 +365,16 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     contributions.recorded = estimate.recorded_bounces;
     contributions.directional = directional;
     const uint64_t rays_before = rays, guided_before = guided_vertices;
+    const Impl::EmitterGuiding emitter_guiding{emitter_guide.get(), emitter_guide != nullptr};
     if (svo_guide)
       impl_->trace(point, settings, rng, contributions, rays,
-                   Impl::SvoGuide{*svo_guide, svo_counting, settings.guiding_svo_texels}, &guided_vertices);
+                   Impl::SvoGuide{*svo_guide, svo_counting, settings.guiding_svo_texels}, &guided_vertices,
+                   emitter_guiding);
     else if (sample_guide)
       impl_->trace(point, settings, rng, contributions, rays, Impl::GridGuide{*impl_, *sample_guide, learning},
-                   &guided_vertices);
+                   &guided_vertices, emitter_guiding);
     else
-      impl_->trace(point, settings, rng, contributions, rays, Impl::NoGuide{}, &guided_vertices);
+      impl_->trace(point, settings, rng, contributions, rays, Impl::NoGuide{}, &guided_vertices, emitter_guiding);
     const Vec3 total = contributions.total();
     Vec3 l1[3];
     bool l1_finite = true;
@@ -419,6 +454,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       }
     }
     if (learning) guide->swap();  // this pass's learning becomes the next pass's frozen table
+    if (emitter_guide) emitter_guide->swap();
     if (svo_guide && svo_counting) {  // this pass reached the next rebuild and counted its vertices
       svo_guide->rebuild(&estimate, double(count) * fraction, settings.seed);
       svo_next_rebuild = 2 * (first + count);
@@ -470,6 +506,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   }
   if (guide && settings.inspect_guiding) settings.inspect_guiding(*guide);
   if (svo_guide && settings.inspect_svo_guiding) settings.inspect_svo_guiding(*svo_guide);
+  if (emitter_guide && settings.inspect_emitter_guiding) settings.inspect_emitter_guiding(*emitter_guide);
   estimate.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (settings.work_share && !share) settings.work_share->work.seconds += estimate.seconds;
   return estimate;

@@ -27,6 +27,7 @@
 #include "exitance/common/distribution.h"
 #include "exitance/common/gpu_layout.h"
 #include "exitance/common/guided_direction.h"
+#include "exitance/common/guided_emitters.h"
 #include "exitance/common/punctual_light.h"
 #include "exitance/common/ray_offset.h"
 #include "exitance/common/path_sampler.h"
@@ -116,10 +117,6 @@ EXITANCE_FN DirectionSample sample_continuation(uint strategy, SurfacePoint x, I
 // number (guided: the bin by CDF inversion, then its remainder inside the bin's CDF interval places
 // the point across the bin), u2 its second. A direction under the surface (shading or geometric)
 // ends the path: the integrand is 0 there.
-EXITANCE_FN float rescaled_unit(float u, float lo, float width) {
-  return min(max((u - lo) / width, 0.0f), 0.99999994f);
-}
-
 EXITANCE_FN DirectionSample sample_continuation(GuideVertex g, SurfacePoint x, INOUT(PathSampler) rng) {
   if (!(g.guided_probability > 0.0f) && !(g.uniform_probability > 0.0f))
     return sample_continuation(kStrategyCosine, x, rng);
@@ -182,25 +179,44 @@ EXITANCE_FN bool material_double_sided(GpuMaterial m) { return m.albedo_double_s
 // each only when the scene has lights of that kind.
 // Three named outputs (area light, punctual light, environment) rather than an array.
 // `guide`: the vertex's continuation strategy, whose pdf weighs the area and environment samples.
+// `emitter_guide` (guided_emitters.h): the vertex's learned area-light strategy; with tables but
+// guided_probability 0 it samples by default and still reports the patch, for learning.
+// `learning`: the area sample's patch (kEmitterPatchNone: no tables or no sample) and its value
+// luminance(L_e) cos / (pi p), unweighted by MIS and throughput, which counts when the ray is unoccluded.
+struct EmitterLearning {
+  uint patch_index;
+  float value;
+  uint punctual_light;  // kEmitterPatchNone: no punctual tables or no sample
+  float punctual_value; // luminance(I falloff cos / pi) / probability
+};
+
 EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, vec3 throughput, GuideVertex guide,
-                                       INOUT(PathSampler) rng, OUT(ShadowRay) area_ray, OUT(ShadowRay) punctual_ray,
-                                       OUT(ShadowRay) environment_ray) {
+                                       EmitterGuide emitter_guide, INOUT(PathSampler) rng, OUT(ShadowRay) area_ray,
+                                       OUT(ShadowRay) punctual_ray, OUT(ShadowRay) environment_ray,
+                                       OUT(EmitterLearning) learning) {
   area_ray = no_shadow_ray();
   punctual_ray = no_shadow_ray();
   environment_ray = no_shadow_ray();
+  learning.patch_index = kEmitterPatchNone;
+  learning.value = 0.0f;
+  learning.punctual_light = kEmitterPatchNone;
+  learning.punctual_value = 0.0f;
   uint emitters = scene_emitter_count(SCENE_ALONE_ARG);
   if (emitters > 0u) {
     float u_choose = sample_1d(rng);
     vec2 u = sample_2d(rng);
-    float pmf;
-    uint tri = scene_emitter_triangle(SCENE_ARG sample_cdf(scene_emitter_cdf(SCENE_ALONE_ARG), emitters, u_choose, pmf));
-    vec2 bary = sample_triangle_barycentrics(u.x, u.y);
+    EmitterPoint point = emitter_mixture_sample(scene_emitter_cdf(SCENE_ALONE_ARG), emitters, emitter_guide, u_choose, u.x, u.y);
+    vec2 bary = point.barycentrics;
+    uint patch_index = point.patch_index;
+    uint tri = scene_emitter_triangle(SCENE_ARG point.emitter);
     vec3 p0 = scene_triangle_vertex(SCENE_ARG tri, 0u);
     vec3 p1 = scene_triangle_vertex(SCENE_ARG tri, 1u);
     vec3 p2 = scene_triangle_vertex(SCENE_ARG tri, 2u);
     vec3 light_position = p0 * (1.0f - bary.x - bary.y) + p1 * bary.x + p2 * bary.y;
     vec3 light_normal = normalize(cross(p1 - p0, p2 - p0));
     float pdf_area = scene_triangle_area_pdf(SCENE_ARG tri);
+    if (patch_index != kEmitterPatchNone)
+      pdf_area *= emitter_guide_ratio(scene_emitter_cdf(SCENE_ALONE_ARG), emitter_guide, patch_index);
     vec3 to_light = light_position - x.position;
     float distance2 = dot(to_light, to_light);
     float distance = sqrt(distance2);
@@ -220,6 +236,8 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
           vec3 le = scene_emission(SCENE_ARG tri, bary.x, bary.y);
           area_ray.direction_length = vec4(span / span_length, span_length);
           area_ray.contribution_state = vec4(throughput * (le * (cos_x * kInvPi * weight / pdf_light)), kShadowTrace);
+          learning.patch_index = patch_index;
+          learning.value = luminance(le) * cos_x * kInvPi / pdf_light;
         } else {
           area_ray.contribution_state = vec4(0.0f, 0.0f, 0.0f, kShadowCountOnly);
         }
@@ -230,7 +248,8 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
   if (punctual > 0u) {
     float u_choose = sample_1d(rng);
     float probability;
-    GpuPunctualLight light = scene_punctual_light(SCENE_ARG sample_cdf(scene_punctual_cdf(SCENE_ALONE_ARG), punctual, u_choose, probability));
+    uint light_index = punctual_mixture_sample(scene_punctual_cdf(SCENE_ALONE_ARG), punctual, emitter_guide, u_choose, probability);
+    GpuPunctualLight light = scene_punctual_light(SCENE_ARG light_index);
     uint type = floatBitsToUint(light.position_type.w);
     vec3 direction = vec3(light.direction_cos_inner.x, light.direction_cos_inner.y, light.direction_cos_inner.z);
     vec3 wi;
@@ -251,6 +270,10 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
       vec3 intensity = vec3(light.intensity_cos_outer.x, light.intensity_cos_outer.y, light.intensity_cos_outer.z);
       punctual_ray.direction_length = vec4(wi, distance);
       punctual_ray.contribution_state = vec4(throughput * (intensity * (falloff * cos_x * kInvPi / probability)), kShadowTrace);
+      if (emitter_guide.punctual_count > 0u) {
+        learning.punctual_light = light_index;
+        learning.punctual_value = luminance(intensity) * falloff * cos_x * kInvPi / probability;
+      }
     }
   }
   if (scene_has_environment(SCENE_ALONE_ARG)) {
@@ -265,6 +288,14 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
           vec4(throughput * (scene_sky_radiance(SCENE_ARG wi) * (cos_x * kInvPi * weight / pdf_env)), kShadowTrace);
     }
   }
+}
+
+EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, vec3 throughput, GuideVertex guide,
+                                       INOUT(PathSampler) rng, OUT(ShadowRay) area_ray, OUT(ShadowRay) punctual_ray,
+                                       OUT(ShadowRay) environment_ray) {
+  EmitterLearning learning;
+  next_event_estimation(SCENE_ARG x, origin, throughput, guide, emitter_guide_none(), rng, area_ray, punctual_ray,
+                        environment_ray, learning);
 }
 
 EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, vec3 throughput, uint strategy,
@@ -309,10 +340,11 @@ struct HitResult {
 };
 
 // `bounce`: the bounce of the vertex the ray left (0 = the texel). Draws one random number when
-// Russian roulette is played.
+// Russian roulette is played. `emitter_guide`: the area-light strategy of the vertex the ray left,
+// whose density weighs an emitter hit.
 EXITANCE_FN HitResult shade_continuation_hit(SCENE_PARAM uint tri, float t_hit, float b1, float b2, vec3 wi,
                                              float pdf_continuation, vec3 throughput, int bounce, PathLimits limits,
-                                             INOUT(PathSampler) rng) {
+                                             EmitterGuide emitter_guide, INOUT(PathSampler) rng) {
   HitResult h;
   h.radiance = vec3(0.0f);
   h.continues = false;
@@ -326,6 +358,7 @@ EXITANCE_FN HitResult shade_continuation_hit(SCENE_PARAM uint tri, float t_hit, 
     if (max_component(le) > 0.0f) {
       float cos_l = abs(dot(wi, ng));
       float pdf_light = scene_triangle_area_pdf(SCENE_ARG tri) * t_hit * t_hit / cos_l;
+      pdf_light *= emitter_guide_ratio_at_triangle(scene_emitter_cdf(SCENE_ALONE_ARG), emitter_guide, tri, b1, b2);
       h.radiance = throughput * le * power_heuristic(pdf_continuation, pdf_light);
     }
   }
@@ -346,6 +379,13 @@ EXITANCE_FN HitResult shade_continuation_hit(SCENE_PARAM uint tri, float t_hit, 
   h.continues = true;
   h.next = surface_point_on_triangle(SCENE_ARG tri, ng, b1, b2, front);
   return h;
+}
+
+EXITANCE_FN HitResult shade_continuation_hit(SCENE_PARAM uint tri, float t_hit, float b1, float b2, vec3 wi,
+                                             float pdf_continuation, vec3 throughput, int bounce, PathLimits limits,
+                                             INOUT(PathSampler) rng) {
+  return shade_continuation_hit(SCENE_ARG tri, t_hit, b1, b2, wi, pdf_continuation, throughput, bounce, limits,
+                                emitter_guide_none(), rng);
 }
 
 // ---- Light probes ----

@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "exitance/common/guided_direction.h"
+#include "exitance/runtime/core/guide_grid_locator.h"
 #include "exitance/runtime/core/lighting_scene.h"
 #include "exitance/runtime/texel_gbuffer.h"
 
@@ -44,7 +45,7 @@ struct GridGuidingConfig {
 
 class GridGuidingCache {
  public:
-  static constexpr uint32_t kNoRecord = 0xFFFFFFFFu;
+  static constexpr uint32_t kNoRecord = GuideGridLocator::kNoRecord;
   static constexpr float kUniformFloor = 0.02f;
   static constexpr double kMinTexelsPerRecord = 16;
   // Backends learn during the passes of the first samples per texel, then sample the frozen table:
@@ -63,7 +64,7 @@ class GridGuidingCache {
   static float reference_radiance(const LightingScene& scene);
 
   // The record of a surface point, kNoRecord when its (cell, class) has no texels.
-  uint32_t record_of(Vec3 position, Vec3 shading_normal) const;
+  uint32_t record_of(Vec3 position, Vec3 shading_normal) const { return locator_.record_of(position, shading_normal); }
   // The strategy at a vertex of record `record` from the front table (cosine only for kNoRecord).
   GuideVertex vertex(uint32_t record) const;
   // (1/pi) * integral of the front L_i * cos over the record's class hemisphere (0 for kNoRecord).
@@ -79,18 +80,20 @@ class GridGuidingCache {
   void swap();
 
   uint32_t record_count() const { return uint32_t(front_.size()); }
-  int cells(int axis) const { return dims_[axis]; }
-  float cell_size() const { return cell_size_; }
+  int cells(int axis) const { return locator_.cells(axis); }
+  float cell_size() const { return locator_.cell_size(); }
   static size_t bytes_per_record();
   size_t memory_bytes() const;
   // The front table's learned radiance of a record (kGuideBins values), for plots and tests.
   const float* radiance(uint32_t record) const { return &radiance_[size_t(record) * kGuideBins]; }
-  uint32_t record_of_cell(int x, int y, int z, uint normal_class) const;
+  uint32_t record_of_cell(int x, int y, int z, uint normal_class) const {
+    return locator_.record_of_cell(x, y, z, normal_class);
+  }
 
   // The locator and the front table as a device copies them (runtime/src/vulkan/guide_buffer.cpp).
-  Vec3 grid_origin() const { return lo_; }
+  Vec3 grid_origin() const { return locator_.origin(); }
   // Per (cell, class), cell (z * cells(1) + y) * cells(0) + x: its record or kNoRecord.
-  const std::vector<uint32_t>& record_index() const { return record_index_; }
+  const std::vector<uint32_t>& record_index() const { return locator_.record_index(); }
   double fixed_units() const { return fixed_scale_; }  // fixed-point units per unit of radiance
   float fixed_cap() const { return target_cap_; }      // targets are clamped here before conversion
 
@@ -106,16 +109,12 @@ class GridGuidingCache {
     std::atomic<uint64_t> sum{0};   // fixed-point
     std::atomic<uint32_t> count{0};
   };
-  uint32_t cell_index(Vec3 position) const;
   void rebuild(uint32_t record);
 
   GridGuidingConfig config_;
-  Vec3 lo_;
-  float cell_size_ = 1;
-  int dims_[3] = {1, 1, 1};
+  GuideGridLocator locator_;
   double fixed_scale_ = 1;  // fixed-point units per unit of radiance
   float target_cap_ = 0;    // targets are clamped here (guiding only: no estimator bias)
-  std::vector<uint32_t> record_index_;  // per (cell, class)
   std::vector<Front> front_;
   std::vector<float> cdf_;       // kGuideBins + 1 per record
   std::vector<float> radiance_;  // kGuideBins per record: learned L_i

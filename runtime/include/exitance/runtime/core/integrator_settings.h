@@ -8,6 +8,7 @@ namespace formats {
 struct SparseVoxelOctree;
 }
 
+class EmitterGuidingCache;
 class GridGuidingCache;
 class SvoGuidingFields;
 class WorkShare;
@@ -72,10 +73,17 @@ struct IntegratorSettings {
   // Whether texels' own vertices (bounce 0) sample the SVO mixture; false: cosine there, so the
   // first continuation keeps its stratified Sobol pair (bench/results/guiding-svo.md).
   bool guiding_svo_texels = true;
+  // Emitter guiding (bake --emitter-guiding, core/emitter_guiding_cache.h): next-event estimation
+  // samples emitter patches from a distribution learned per grid record, as one component of a
+  // one-sample mixture with the default (probability emitter_guiding_mix); Path mode, CPU backend.
+  bool emitter_guiding = false;
+  float emitter_guiding_mix = 0.5f;
+  uint32_t emitter_guiding_patches = 512;  // about this many emitter patches (guided_emitters.h)
   std::function<void(double fraction_done, uint64_t rays)> progress;  // called between passes
   // Called once at the end of a guided bake with its cache (plots of the learned fields, tests).
   std::function<void(const GridGuidingCache&)> inspect_guiding;
   std::function<void(const SvoGuidingFields&)> inspect_svo_guiding;  // the same for GuidingMode::Svo
+  std::function<void(const EmitterGuidingCache&)> inspect_emitter_guiding;  // the same for emitter_guiding
   // This process's share of a bake split over processes (core/work_share.h; bake under mpirun); null:
   // the whole bake. Backends without it refuse more than one rank before lighting (bake does).
   WorkShare* work_share = nullptr;

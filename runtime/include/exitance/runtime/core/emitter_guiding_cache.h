@@ -1,0 +1,115 @@
+// Emitter guiding: guided next-event estimation (issue 11; docs/lighting-core.md "Emitter guiding").
+// The scene's emitter triangles are cut into patches (guided_emitters.h), and per record of the
+// guiding grid (GuideGridLocator: grid cell x normal class, where texels are) a distribution over
+// the patches is learned from the next-event samples themselves and sampled as one component of a
+// one-sample mixture with the default next-event sampling.
+//
+// Learning: a next-event sample at a vertex of record r that lands on patch k with value
+// v = luminance(L_e) cos / (pi p) (0 when occluded) is an unbiased estimate of the patch's
+// integral of unoccluded direct light over r's vertices, so the sums of v per patch over all
+// passes, normalised, are the record's distribution (cumulative, as every pass estimates the same
+// integrals). A patch's sum is noisy until several samples have reached it, and a distribution
+// that follows a few lucky patches of a visible light samples the rest of that light rarely (the
+// building's direct light measured 1.8x the default's variance so). So the sums are pooled per
+// cluster of patches (about a light), and inside a cluster the learned shares count with weight
+// n / (n + kPseudoSamplesPerPatch x patches), n the cluster's unoccluded samples, the rest spread as
+// the default sampling spreads; kFloor of the whole distribution stays the default's. Sums and
+// counts are integers added atomically, so they do not depend on thread count or order; swap()
+// between passes folds them into the front table that the next pass samples (double buffering, as
+// the grid cache).
+#pragma once
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "exitance/common/guided_emitters.h"
+#include "exitance/runtime/core/guide_grid_locator.h"
+#include "exitance/runtime/core/lighting_scene.h"
+#include "exitance/runtime/texel_gbuffer.h"
+
+namespace exitance {
+
+struct EmitterGuidingConfig {
+  float mix = 0.5f;                 // the learned component's probability at a record that learned something
+  int cells_on_longest_axis = 16;   // the guiding grid (GuideGridLocator)
+  uint32_t patch_target = 512;      // about this many patches (fewer when the tables would pass kMemoryBudget)
+  uint32_t cluster_target = 64;     // about this many clusters (EmitterPatches::cluster_first)
+};
+
+// The patch tables of an emitter list (guided_emitters.h): built from its power CDF alone.
+struct EmitterPatches {
+  std::vector<uint32_t> emitter_patch;   // per emitter: first patch << 3 | level
+  std::vector<uint32_t> patch_emitters;  // per patch: first emitter, one past its last
+  std::vector<float> default_probability;  // per patch: P0
+  // Clusters: runs of whole emitters' patches of at most 1 / cluster_target of the power (or one
+  // emitter's sub-triangles): patch range [cluster_first[c], cluster_first[c + 1]).
+  std::vector<uint32_t> cluster_first;
+  uint32_t count() const { return uint32_t(default_probability.size()); }
+  uint32_t cluster_count() const { return cluster_first.empty() ? 0u : uint32_t(cluster_first.size() - 1); }
+};
+EmitterPatches build_emitter_patches(const std::vector<double>& emitter_cdf, uint32_t patch_target,
+                                     uint32_t cluster_target);
+
+class EmitterGuidingCache {
+ public:
+  static constexpr uint32_t kNoRecord = GuideGridLocator::kNoRecord;
+  static constexpr float kFloor = 0.1f;  // of each record's distribution, spread as the default sampling
+  static constexpr double kPseudoSamplesPerPatch = 4;
+  // Punctual lights are guided when the scene has 2 to this many (one table entry per light per record).
+  static constexpr uint32_t kMostGuidedPunctualLights = 1024;
+  static constexpr size_t kMemoryBudget = size_t(256) << 20;  // tables of all records together
+
+  EmitterGuidingCache(const LightingScene& scene, const TexelGBuffer& gbuffer, const EmitterGuidingConfig& config);
+
+  uint32_t record_of(Vec3 position, Vec3 shading_normal) const;
+  // The strategy at a vertex of `record`: learned tables (guided_probability 0 until the record has
+  // learned something), emitter_guide_none() for kNoRecord.
+  EmitterGuide vertex(uint32_t record) const;
+  // Adds one next-event sample's value to `patch` of `record` (thread-safe, order-independent).
+  void learn(uint32_t record, uint32_t patch, float value);
+  // The same for punctual light `light`.
+  void learn_punctual(uint32_t record, uint32_t light, float value);
+  // Between passes: folds the sums learned since the last swap into the front tables.
+  void swap();
+
+  uint32_t record_count() const { return locator_.record_count(); }
+  uint32_t patch_count() const { return patches_.count(); }
+  uint32_t punctual_count() const { return punctual_count_; }  // guided punctual lights (0: none)
+  const EmitterPatches& patches() const { return patches_; }
+  const GuideGridLocator& locator() const { return locator_; }
+  // The front distribution's probability of `patch` at `record` (0 while nothing is learned).
+  float probability(uint32_t record, uint32_t patch) const;
+  float punctual_probability(uint32_t record, uint32_t light) const;  // the same for punctual lights
+  size_t memory_bytes() const;
+
+ private:
+  void rebuild(uint32_t record);
+
+  EmitterGuidingConfig config_;
+  GuideGridLocator locator_;
+  EmitterPatches patches_;
+  std::vector<uint32_t> triangle_emitter_;  // per scene triangle
+  double fixed_scale_ = 1;                  // fixed-point units per unit of value
+  float value_cap_ = 0;
+  std::vector<float> guided_probability_;   // per record
+  std::vector<float> cdf_;                  // patch_count + 1 per record
+  std::vector<double> learned_;             // patch_count per record: cumulative sums of values
+  std::vector<uint32_t> samples_;           // patch_count per record: cumulative unoccluded samples
+  struct Accumulator {
+    std::atomic<uint64_t> sum{0};  // fixed point
+    std::atomic<uint32_t> count{0};
+  };
+  static_assert(sizeof(Accumulator) == 16, "kBytesPerRecordPatch counts 16 bytes per accumulator");
+  std::unique_ptr<Accumulator[]> back_;  // patch_count per record
+  // Punctual lights: the same per record, without clusters (each light is one).
+  uint32_t punctual_count_ = 0;
+  std::vector<float> punctual_default_;      // per light: probability by power
+  std::vector<float> punctual_guided_probability_;
+  std::vector<float> punctual_cdf_;          // punctual_count + 1 per record
+  std::vector<double> punctual_learned_;
+  std::unique_ptr<std::atomic<uint64_t>[]> punctual_back_;
+};
+
+}  // namespace exitance

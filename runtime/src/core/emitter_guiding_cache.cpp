@@ -1,0 +1,243 @@
+// Emitter guiding: see emitter_guiding_cache.h for the choices.
+#include "exitance/runtime/core/emitter_guiding_cache.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "exitance/runtime/core/grid_guiding_cache.h"
+#include "exitance/runtime/core/scene_access.h"
+#include "exitance/common/guide_learning.h"  // after scene_access.h: path.h reads its accessors
+
+namespace exitance {
+namespace {
+
+// Fixed point as the grid cache's: 2^24 units per reference radiance, values capped at 2^16
+// references (the cap shapes the guide only; the estimator is unbiased whatever it learns).
+constexpr double kFixedUnitsPerReference = 16777216.0;
+constexpr float kCapInReferences = 65536.0f;
+// Back sum and count (one 16-byte accumulator), cumulative samples, cumulative sum, CDF entry.
+constexpr size_t kBytesPerRecordPatch = 16 + sizeof(uint32_t) + sizeof(double) + sizeof(float);
+
+}  // namespace
+
+EmitterPatches build_emitter_patches(const std::vector<double>& cdf, uint32_t target, uint32_t cluster_target) {
+  EmitterPatches p;
+  const size_t emitters = cdf.size() > 0 ? cdf.size() - 1 : 0;
+  p.emitter_patch.resize(emitters);
+  const double t = std::max<uint32_t>(target, 1);
+  for (size_t e = 0; e < emitters;) {
+    const double share = cdf[e + 1] - cdf[e];
+    const uint32_t first = p.count();
+    if (share * t >= 1) {  // its own 4^L sub-triangles, 4^L <= share * target
+      uint32_t level = 0;
+      while (level < kEmitterPatchMaxLevel && double(1u << (2 * (level + 1))) <= share * t) ++level;
+      p.emitter_patch[e] = first << 3 | level;
+      const uint32_t subs = 1u << (2 * level);
+      for (uint32_t s = 0; s < subs; ++s) {
+        p.patch_emitters.push_back(uint32_t(e));
+        p.patch_emitters.push_back(uint32_t(e + 1));
+        p.default_probability.push_back(float(share / subs));
+      }
+      ++e;
+      continue;
+    }
+    // A run of dimmer emitters sharing at most 1 / target of the power.
+    const size_t begin = e;
+    double sum = 0;
+    while (e < emitters) {
+      const double s = cdf[e + 1] - cdf[e];
+      if (e > begin && (s * t >= 1 || (sum + s) * t > 1)) break;
+      sum += s;
+      p.emitter_patch[e] = first << 3;
+      ++e;
+    }
+    p.patch_emitters.push_back(uint32_t(begin));
+    p.patch_emitters.push_back(uint32_t(e));
+    p.default_probability.push_back(float(sum));
+  }
+  // Clusters: runs of units (an emitter's sub-triangles, or one shared patch) up to 1 / cluster_target.
+  const double ct = std::max<uint32_t>(cluster_target, 1);
+  double cluster_share = 0;
+  for (uint32_t k = 0; k < p.count();) {
+    const uint32_t first_emitter = p.patch_emitters[2 * k];
+    const uint32_t unit = p.emitter_patch[first_emitter] & 7 ? 1u << (2 * (p.emitter_patch[first_emitter] & 7)) : 1u;
+    double unit_share = 0;
+    for (uint32_t j = k; j < k + unit; ++j) unit_share += p.default_probability[j];
+    if (p.cluster_first.empty() || (cluster_share + unit_share) * ct > 1) {
+      p.cluster_first.push_back(k);
+      cluster_share = 0;
+    }
+    cluster_share += unit_share;
+    k += unit;
+  }
+  p.cluster_first.push_back(p.count());
+  return p;
+}
+
+EmitterGuidingCache::EmitterGuidingCache(const LightingScene& scene, const TexelGBuffer& gbuffer,
+                                         const EmitterGuidingConfig& config)
+    : config_(config),
+      locator_(scene.bounds_lo, scene.bounds_hi, gbuffer, config.cells_on_longest_axis,
+               GridGuidingCache::kMinTexelsPerRecord) {
+  config_.mix = std::clamp(config_.mix, 0.0f, 1.0f);
+  const size_t records = locator_.record_count();
+  // Patches at most twice the target, so the budget bounds the target.
+  uint32_t target = std::max<uint32_t>(config_.patch_target, 1);
+  if (records > 0)
+    target = uint32_t(std::clamp<size_t>(kMemoryBudget / (2 * kBytesPerRecordPatch * records), 1, target));
+  if (scene.emitter_count() > 0) patches_ = build_emitter_patches(scene.emitter_cdf, target, config_.cluster_target);
+  triangle_emitter_.assign(scene.triangles.size(), kEmitterPatchNone);
+  for (uint32_t e = 0; e < scene.emitter_count(); ++e) triangle_emitter_[scene.emitter_triangles[e]] = e;
+
+  float reference = GridGuidingCache::reference_radiance(scene);
+  if (!(reference > 0) || !std::isfinite(reference)) reference = 1.0f;
+  fixed_scale_ = kFixedUnitsPerReference / double(reference);
+  value_cap_ = reference * kCapInReferences;
+
+  const size_t patches = patch_count();
+  guided_probability_.assign(records, 0.0f);
+  cdf_.assign(records * (patches + 1), 0.0f);
+  learned_.assign(records * patches, 0.0);
+  samples_.assign(records * patches, 0);
+  back_.reset(new Accumulator[records * patches]);
+  if (scene.punctual_count() >= 2 && scene.punctual_count() <= kMostGuidedPunctualLights) {
+    punctual_count_ = scene.punctual_count();
+    for (uint32_t i = 0; i < punctual_count_; ++i)
+      punctual_default_.push_back(float(scene.punctual_cdf[i + 1] - scene.punctual_cdf[i]));
+    punctual_guided_probability_.assign(records, 0.0f);
+    punctual_cdf_.assign(records * (punctual_count_ + 1), 0.0f);
+    punctual_learned_.assign(records * punctual_count_, 0.0);
+    punctual_back_.reset(new std::atomic<uint64_t>[records * punctual_count_]);
+    for (size_t i = 0; i < records * punctual_count_; ++i) punctual_back_[i].store(0, std::memory_order_relaxed);
+  }
+  for (uint32_t r = 0; r < records; ++r) rebuild(r);
+}
+
+uint32_t EmitterGuidingCache::record_of(Vec3 position, Vec3 shading_normal) const {
+  return patch_count() > 0 || punctual_count_ > 0 ? locator_.record_of(position, shading_normal) : kNoRecord;
+}
+
+EmitterGuide EmitterGuidingCache::vertex(uint32_t record) const {
+  EmitterGuide g = emitter_guide_none();
+  if (record == kNoRecord) return g;
+  if (patch_count() > 0) {
+    g.guided_probability = guided_probability_[record];
+    g.cdf = &cdf_[size_t(record) * (patch_count() + 1)];
+    g.patch_count = patch_count();
+    g.emitter_patch = patches_.emitter_patch.data();
+    g.patch_emitters = patches_.patch_emitters.data();
+    g.triangle_emitter = triangle_emitter_.data();
+  }
+  if (punctual_count_ > 0) {
+    g.punctual_guided_probability = punctual_guided_probability_[record];
+    g.punctual_cdf = &punctual_cdf_[size_t(record) * (punctual_count_ + 1)];
+    g.punctual_count = punctual_count_;
+  }
+  return g;
+}
+
+void EmitterGuidingCache::learn(uint32_t record, uint32_t patch, float value) {
+  if (record == kNoRecord || patch >= patch_count() || !(value > 0)) return;  // NaN never enters
+  Accumulator& a = back_[size_t(record) * patch_count() + patch];
+  a.sum.fetch_add(guide_fixed_point(value, value_cap_, fixed_scale_), std::memory_order_relaxed);
+  a.count.fetch_add(1, std::memory_order_relaxed);
+}
+
+void EmitterGuidingCache::learn_punctual(uint32_t record, uint32_t light, float value) {
+  if (record == kNoRecord || light >= punctual_count_ || !(value > 0)) return;
+  punctual_back_[size_t(record) * punctual_count_ + light].fetch_add(guide_fixed_point(value, value_cap_, fixed_scale_),
+                                                                     std::memory_order_relaxed);
+}
+
+void EmitterGuidingCache::swap() {
+  const size_t patches = patch_count();
+  for (uint32_t r = 0; r < record_count(); ++r) {
+    bool changed = false;
+    for (size_t k = 0; k < patches; ++k) {
+      Accumulator& a = back_[size_t(r) * patches + k];
+      const uint32_t count = a.count.load(std::memory_order_relaxed);
+      if (count == 0) continue;
+      const uint64_t units = a.sum.load(std::memory_order_relaxed);
+      a.sum.store(0, std::memory_order_relaxed);
+      a.count.store(0, std::memory_order_relaxed);
+      learned_[size_t(r) * patches + k] += double(units) / fixed_scale_;
+      samples_[size_t(r) * patches + k] += count;
+      changed = true;
+    }
+    for (size_t i = 0; i < punctual_count_; ++i) {
+      std::atomic<uint64_t>& sum = punctual_back_[size_t(r) * punctual_count_ + i];
+      const uint64_t units = sum.load(std::memory_order_relaxed);
+      if (units == 0) continue;
+      sum.store(0, std::memory_order_relaxed);
+      punctual_learned_[size_t(r) * punctual_count_ + i] += double(units) / fixed_scale_;
+      changed = true;
+    }
+    if (changed) rebuild(r);
+  }
+}
+
+void EmitterGuidingCache::rebuild(uint32_t record) {
+  if (punctual_count_ > 0) {
+    const double* learned = &punctual_learned_[size_t(record) * punctual_count_];
+    float* cdf = &punctual_cdf_[size_t(record) * (punctual_count_ + 1)];
+    double total = 0;
+    for (size_t i = 0; i < punctual_count_; ++i) total += learned[i];
+    const bool any = total > 0 && std::isfinite(total);
+    punctual_guided_probability_[record] = any ? config_.mix : 0.0f;
+    double run = 0;
+    cdf[0] = 0;
+    for (size_t i = 0; i < punctual_count_; ++i) {
+      run += any ? (1.0 - kFloor) * learned[i] / total + kFloor * punctual_default_[i] : punctual_default_[i];
+      cdf[i + 1] = float(std::min(run, 1.0));
+    }
+    cdf[punctual_count_] = 1.0f;
+  }
+  const size_t patches = patch_count();
+  if (patches == 0) return;
+  const double* learned = &learned_[size_t(record) * patches];
+  const uint32_t* samples = &samples_[size_t(record) * patches];
+  float* cdf = &cdf_[size_t(record) * (patches + 1)];
+  double total = 0;
+  for (size_t k = 0; k < patches; ++k) total += learned[k];
+  const bool any = total > 0 && std::isfinite(total);
+  guided_probability_[record] = any ? config_.mix : 0.0f;
+  double run = 0;
+  cdf[0] = 0;
+  for (uint32_t c = 0; c < patches_.cluster_count(); ++c) {
+    const uint32_t first = patches_.cluster_first[c], end = patches_.cluster_first[c + 1];
+    double cluster_sum = 0, cluster_default = 0, cluster_samples = 0;
+    for (uint32_t k = first; k < end; ++k)
+      cluster_sum += learned[k], cluster_default += patches_.default_probability[k], cluster_samples += samples[k];
+    const double trust = cluster_samples / (cluster_samples + kPseudoSamplesPerPatch * double(end - first));
+    for (uint32_t k = first; k < end; ++k) {
+      const double p0 = patches_.default_probability[k];
+      double learned_share = 0;
+      if (any && cluster_sum > 0)
+        learned_share = (trust * learned[k] + (1 - trust) * cluster_sum * (cluster_default > 0 ? p0 / cluster_default : 0)) / total;
+      run += any ? (1.0 - kFloor) * learned_share + kFloor * p0 : p0;
+      cdf[k + 1] = float(std::min(run, 1.0));
+    }
+  }
+  cdf[patches] = 1.0f;
+}
+
+float EmitterGuidingCache::probability(uint32_t record, uint32_t patch) const {
+  if (record >= record_count() || patch >= patch_count() || !(guided_probability_[record] > 0)) return 0.0f;
+  const float* cdf = &cdf_[size_t(record) * (patch_count() + 1)];
+  return std::max(cdf[patch + 1] - cdf[patch], 0.0f);
+}
+
+float EmitterGuidingCache::punctual_probability(uint32_t record, uint32_t light) const {
+  if (record >= record_count() || light >= punctual_count_ || !(punctual_guided_probability_[record] > 0)) return 0.0f;
+  const float* cdf = &punctual_cdf_[size_t(record) * (punctual_count_ + 1)];
+  return std::max(cdf[light + 1] - cdf[light], 0.0f);
+}
+
+size_t EmitterGuidingCache::memory_bytes() const {
+  return size_t(record_count()) * (patch_count() * kBytesPerRecordPatch + sizeof(float) * 2) + locator_.memory_bytes() +
+         (patches_.emitter_patch.size() + patches_.patch_emitters.size() + triangle_emitter_.size()) * sizeof(uint32_t) +
+         patches_.default_probability.size() * sizeof(float) + patches_.cluster_first.size() * sizeof(uint32_t) +
+         size_t(record_count()) * punctual_count_ * (sizeof(uint64_t) + sizeof(double) + sizeof(float));
+}
+
+}  // namespace exitance
