@@ -15,6 +15,7 @@ grid guiding's (bench/results/guiding.md) from --backends cpu --integrators path
 SVO guiding's (bench/results/guiding-svo.md) from --integrators path,guided,svo (--tool-args passes
 e.g. --tool-args="--svo-depth 7 --svo-c-ray 256" on to bench_time_to_error; write it with =).
 --guiding auto's (bench/results/guiding-auto.md) from --backends cpu --integrators path,guided_auto --report guiding_auto_time_vs_error.
+Emitter guiding's (bench/results/emitter-guiding.md) from --backends cpu --integrators path,nee --report emitter_guiding_time_vs_error.
 --ladder-scale multiplies every scene's largest spp (longer ladders, e.g. to reach 20 s).
 The table's last column: relMSE of the CPU path tracer divided by this row's, both interpolated
 (log-log) at the same time, the longest both reached: > 1 = better than the CPU path tracer.

@@ -204,6 +204,15 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
   stats["enclosed_lights"] = results.geometry.enclosed_lights;
   stats["nonfinite_samples"] = estimate.nonfinite_samples;
   if (estimate.guiding_auto) stats["guiding"] = guiding_auto_json(estimate);
+  if (estimate.emitter_guiding.records > 0) {
+    const LightmapEstimate::EmitterGuidingReport& e = estimate.emitter_guiding;
+    stats["emitter_guiding"] = {{"records", e.records},
+                                {"records_sampling_learned", e.records_sampling_learned},
+                                {"patches", e.patches},
+                                {"punctual_lights", e.punctual_lights},
+                                {"memory_bytes", e.memory_bytes},
+                                {"dropped_after_learning", e.dropped}};
+  }
   if (results.stage_cache) stats["cache"]["stages"] = *results.stage_cache;
   if (results.distribution)
     for (const auto& [key, value] : results.distribution->items()) stats[key] = value;

@@ -20,10 +20,16 @@ GuidingMode automatic_guiding(const BakeOptions& options, const Integrator& back
   return measured_choice ? GuidingMode::Auto : GuidingMode::Off;
 }
 
+bool automatic_emitter_guiding(const BakeOptions& options, const Integrator& backend) {
+  return backend.backend_name() == "cpu" && options.lighting.integrator == IntegratorMode::Path &&
+         !distributed(options.lighting.work_share);
+}
+
 BakeOptions with_integrator_decided(const BakeOptions& options, const Integrator& backend) {
   BakeOptions decided = options;
   if (options.integrator_auto) decided.lighting.integrator = automatic_integrator(options, backend);
   decided.lighting.guiding = automatic_guiding(decided, backend);
+  if (options.emitter_guiding_auto) decided.lighting.emitter_guiding = automatic_emitter_guiding(decided, backend);
   return decided;
 }
 

@@ -142,12 +142,12 @@ int main(int argc, char** argv) {
   app.add_option("--guiding-mix", options.lighting.guiding_mix,
                  "probability of the guided direction in the one-sample mixture with cosine sampling (default 0.5)")
       ->check(CLI::Range(0.0f, 1.0f));
-  std::string emitter_guiding = "off";
+  std::string emitter_guiding = "auto";
   app.add_option("--emitter-guiding", emitter_guiding,
-                 "off (default) | on: next-event estimation samples emitter patches from a distribution learned per "
-                 "grid region, mixed with the default sampling (docs/lighting-core.md \"Emitter guiding\"; path "
-                 "tracing, CPU backend, one process)")
-      ->check(CLI::IsMember({"off", "on"}));
+                 "auto (default: on where the CPU backend path traces in one process) | on | off: next-event "
+                 "estimation samples emitter patches and punctual lights from distributions learned per grid region, "
+                 "mixed with the default choice by power (docs/lighting-core.md \"Emitter guiding\")")
+      ->check(CLI::IsMember({"auto", "off", "on"}));
   app.add_option("--emitter-guiding-mix", options.lighting.emitter_guiding_mix,
                  "probability of the learned emitter distribution in the mixture with the default (default 0.5)")
       ->check(CLI::Range(0.0f, 1.0f));
@@ -305,6 +305,7 @@ int main(int argc, char** argv) {
     }
     options.lighting.emitter_guiding = true;
   }
+  options.emitter_guiding_auto = emitter_guiding == "auto";
 
   if (no_cache && !cache_directory.empty()) {
     std::cerr << "bake: error: --cache " << cache_directory << ": contradicts --no-cache\n";

@@ -18,6 +18,19 @@ constexpr float kCapInReferences = 65536.0f;
 // Back sum and count (one 16-byte accumulator), cumulative samples, cumulative sum, CDF entry.
 constexpr size_t kBytesPerRecordPatch = 16 + sizeof(uint32_t) + sizeof(double) + sizeof(float);
 
+// The direct light's second moment under the default over that under the mixture, if the learned
+// distribution (cdf) is the light's: how much the mixture can lower next-event variance.
+double second_moment_gain(const float* cdf, const float* default_probability, size_t cells, float mix) {
+  double under_default = 0, under_mixture = 0;
+  for (size_t k = 0; k < cells; ++k) {
+    const double q = double(cdf[k + 1]) - double(cdf[k]), p0 = default_probability[k];
+    const double mixture = mix * q + (1 - mix) * p0;
+    if (p0 > 0) under_default += q * q / p0;
+    if (mixture > 0) under_mixture += q * q / mixture;
+  }
+  return under_mixture > 0 ? under_default / under_mixture : 1.0;
+}
+
 }  // namespace
 
 EmitterPatches build_emitter_patches(const std::vector<double>& cdf, uint32_t target, uint32_t cluster_target) {
@@ -191,6 +204,8 @@ void EmitterGuidingCache::rebuild(uint32_t record) {
       cdf[i + 1] = float(std::min(run, 1.0));
     }
     cdf[punctual_count_] = 1.0f;
+    if (any && second_moment_gain(cdf, punctual_default_.data(), punctual_count_, config_.mix) < kMinSecondMomentGain)
+      punctual_guided_probability_[record] = 0.0f;
   }
   const size_t patches = patch_count();
   if (patches == 0) return;
@@ -219,6 +234,15 @@ void EmitterGuidingCache::rebuild(uint32_t record) {
     }
   }
   cdf[patches] = 1.0f;
+  if (any && second_moment_gain(cdf, patches_.default_probability.data(), patches, config_.mix) < kMinSecondMomentGain)
+    guided_probability_[record] = 0.0f;
+}
+
+uint32_t EmitterGuidingCache::records_sampling_learned() const {
+  uint32_t records = 0;
+  for (uint32_t r = 0; r < record_count(); ++r)
+    records += guided_probability_[r] > 0 || (punctual_count_ > 0 && punctual_guided_probability_[r] > 0);
+  return records;
 }
 
 float EmitterGuidingCache::probability(uint32_t record, uint32_t patch) const {

@@ -156,11 +156,11 @@ struct CpuReferenceIntegrator::Impl {
     void observe(uint32_t, const GuideVertex&, Vec3, const Hit&) const {}
   };
 
-  // Emitter guiding at the path's vertices (null: the default next-event sampling); `learn`: its
-  // next-event samples teach the back tables.
+  // Emitter guiding at the path's vertices (null: the default next-event sampling); which of its
+  // next-event samples teach the back tables (EmitterGuidingCache::learning).
   struct EmitterGuiding {
     EmitterGuidingCache* cache = nullptr;
-    bool learn = false;
+    EmitterGuidingCache::Learning learning = EmitterGuidingCache::Learning::None;
   };
 
   // One path sample of E/pi at x; `first_bounce` is the bounce x stands for (0 at a texel).
@@ -181,12 +181,17 @@ struct CpuReferenceIntegrator::Impl {
       ShadowRay shadow[kShadowRaysPerVertex];
       const uint32_t emitter_record = emitter_guiding.cache ? emitter_guiding.cache->record_of(x.position, x.shading_normal)
                                                             : EmitterGuidingCache::kNoRecord;
-      const EmitterGuide eg = emitter_guiding.cache ? emitter_guiding.cache->vertex(emitter_record) : emitter_guide_none();
+      EmitterGuide eg = emitter_guiding.cache ? emitter_guiding.cache->vertex(emitter_record) : emitter_guide_none();
+      const bool sampling_learned = eg.guided_probability > 0 || eg.punctual_guided_probability > 0;
+      const bool learns = emitter_guiding.learning == EmitterGuidingCache::Learning::Everywhere ||
+                          (emitter_guiding.learning == EmitterGuidingCache::Learning::WhereSampled && sampling_learned);
+      // A vertex that neither learns nor samples a learned distribution takes the default's code path.
+      if (!learns && !sampling_learned) eg = emitter_guide_none();
       EmitterLearning learning;
       next_event_estimation(s, x, origin, throughput, g, eg, rng, shadow[0], shadow[1], shadow[2], learning);
       bool arrived[3];
       const Vec3 direct = connect(shadow, origin, rays, x, directional_texel ? out.texel_nee_sh1 : nullptr, &arrived);
-      if (emitter_guiding.learn) {
+      if (learns) {
         if (arrived[0] && learning.patch_index != kEmitterPatchNone)
           emitter_guiding.cache->learn(emitter_record, learning.patch_index, learning.value);
         if (arrived[1] && learning.punctual_light != kEmitterPatchNone)
@@ -317,6 +322,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     config.patch_target = settings.emitter_guiding_patches;
     emitter_guide = std::make_unique<EmitterGuidingCache>(*impl_->lighting, gbuffer, config);
   }
+  bool emitter_guiding_active = emitter_guide != nullptr;
   // --guiding auto (guiding_choice.h): regions are the guide's records (grid cell x normal class of
   // the texel), the unit whose learned table decides how well its texels' first vertices are guided,
   // with at least 16 texels each, so a region's variance sums are not one texel's noise. Texels
@@ -365,7 +371,9 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     contributions.recorded = estimate.recorded_bounces;
     contributions.directional = directional;
     const uint64_t rays_before = rays, guided_before = guided_vertices;
-    const Impl::EmitterGuiding emitter_guiding{emitter_guide.get(), emitter_guide != nullptr};
+    EmitterGuidingCache* emitter_cache = emitter_guiding_active ? emitter_guide.get() : nullptr;
+    const Impl::EmitterGuiding emitter_guiding{emitter_cache, emitter_cache ? EmitterGuidingCache::learning(s)
+                                                                           : EmitterGuidingCache::Learning::None};
     if (svo_guide)
       impl_->trace(point, settings, rng, contributions, rays,
                    Impl::SvoGuide{*svo_guide, svo_counting, settings.guiding_svo_texels}, &guided_vertices,
@@ -454,7 +462,13 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       }
     }
     if (learning) guide->swap();  // this pass's learning becomes the next pass's frozen table
-    if (emitter_guide) emitter_guide->swap();
+    if (emitter_guide && emitter_guiding_active) {
+      emitter_guide->swap();
+      // Past the samples every vertex learns from, a scene where no record samples its learned
+      // distribution (every light seen whole, as in the Cornell room) drops the cache altogether.
+      if (first + count >= EmitterGuidingCache::kEveryLearningSamples && !emitter_guide->samples_anywhere())
+        emitter_guiding_active = false;
+    }
     if (svo_guide && svo_counting) {  // this pass reached the next rebuild and counted its vertices
       svo_guide->rebuild(&estimate, double(count) * fraction, settings.seed);
       svo_next_rebuild = 2 * (first + count);
@@ -506,7 +520,16 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   }
   if (guide && settings.inspect_guiding) settings.inspect_guiding(*guide);
   if (svo_guide && settings.inspect_svo_guiding) settings.inspect_svo_guiding(*svo_guide);
-  if (emitter_guide && settings.inspect_emitter_guiding) settings.inspect_emitter_guiding(*emitter_guide);
+  if (emitter_guide) {
+    LightmapEstimate::EmitterGuidingReport& report = estimate.emitter_guiding;
+    report.records = emitter_guide->record_count();
+    report.records_sampling_learned = emitter_guiding_active ? emitter_guide->records_sampling_learned() : 0;
+    report.patches = emitter_guide->patch_count();
+    report.punctual_lights = emitter_guide->punctual_count();
+    report.memory_bytes = emitter_guide->memory_bytes();
+    report.dropped = !emitter_guiding_active;
+    if (settings.inspect_emitter_guiding) settings.inspect_emitter_guiding(*emitter_guide);
+  }
   estimate.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (settings.work_share && !share) settings.work_share->work.seconds += estimate.seconds;
   return estimate;

@@ -34,6 +34,9 @@ struct BakeOptions {
   // --integrator auto (the bake command's default): lighting.integrator is decided once the backend is
   // chosen (bake/command/automatic_integrator.h); false: lighting.integrator as given.
   bool integrator_auto = false;
+  // --emitter-guiding auto (the bake command's default): lighting.emitter_guiding is decided with the
+  // integrator (on where the CPU backend path traces in one process); false: as given.
+  bool emitter_guiding_auto = false;
   bool bounce_layers = false;
   // Sealed texels (bake/raster/sealed_texels.h) are found either way; true: the lighting stage
   // does not trace them (they are dilated from lit neighbours). --no-skip: false.

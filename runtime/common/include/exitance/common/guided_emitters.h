@@ -80,26 +80,24 @@ EXITANCE_FN EmitterGuide emitter_guide_none() {
 // A triangle with corners (A, B, C) has children 0: (A, AB, AC), 1: (AB, B, BC), 2: (AC, BC, C) and
 // 3: (BC, AC, AB) (the middle one, turned), where XY is the midpoint; sub-triangle s of level L is
 // the path of L base-4 digits, most significant first. Corners are (b1, b2) barycentrics.
+// Branch-free (selects): the child of each level depends on the point, which branches mispredict.
 EXITANCE_FN uint emitter_sub_triangle_of(uint level, float b1, float b2) {
   float l0 = 1.0f - b1 - b2;
   float l1 = b1;
   float l2 = b2;
   uint index = 0u;
   for (uint k = 0u; k < level; ++k) {
-    uint child;
-    if (l0 > 0.5f) {
-      child = 0u;
-      l0 = 2.0f * l0 - 1.0f, l1 = 2.0f * l1, l2 = 2.0f * l2;
-    } else if (l1 > 0.5f) {
-      child = 1u;
-      l0 = 2.0f * l0, l1 = 2.0f * l1 - 1.0f, l2 = 2.0f * l2;
-    } else if (l2 > 0.5f) {
-      child = 2u;
-      l0 = 2.0f * l0, l1 = 2.0f * l1, l2 = 2.0f * l2 - 1.0f;
-    } else {
-      child = 3u;
-      l0 = 1.0f - 2.0f * l0, l1 = 1.0f - 2.0f * l1, l2 = 1.0f - 2.0f * l2;
-    }
+    bool corner0 = l0 > 0.5f;
+    bool corner1 = !corner0 && l1 > 0.5f;
+    bool corner2 = !corner0 && !corner1 && l2 > 0.5f;
+    bool middle = !corner0 && !corner1 && !corner2;
+    uint child = corner0 ? 0u : (corner1 ? 1u : (corner2 ? 2u : 3u));
+    // Corner child c: l' = 2 l - e_c; the middle one (turned): l' = 1 - 2 l.
+    float scale = middle ? -2.0f : 2.0f;
+    float offset = middle ? 1.0f : 0.0f;
+    l0 = scale * l0 + offset - (corner0 ? 1.0f : 0.0f);
+    l1 = scale * l1 + offset - (corner1 ? 1.0f : 0.0f);
+    l2 = scale * l2 + offset - (corner2 ? 1.0f : 0.0f);
     index = index * 4u + child;
   }
   return index;
@@ -162,17 +160,18 @@ EXITANCE_FN float emitter_guide_ratio_at_triangle(CDF_REF, EmitterGuide g, uint 
 }
 
 // CDF inversion over `count` cells (as guide_sample_bin, for any count): the cell k with
-// cdf[k] <= u < cdf[k + 1], then back over cells of probability 0.
+// cdf[k] <= u < cdf[k + 1], then back over cells of probability 0. A fixed number of steps with a
+// select each (the branchy search mispredicted on every step).
 EXITANCE_FN uint emitter_guide_sample_cell(GUIDE_CDF_REF cdf, uint count, float u) {
-  uint lo = 0u;
-  uint hi = count;  // answer in [lo, hi)
-  while (hi - lo > 1u) {
-    uint mid = (lo + hi) / 2u;
-    if (guide_cdf_at(cdf, mid) <= u) lo = mid;
-    else hi = mid;
+  uint step = 1u;
+  while (step * 2u <= count) step *= 2u;
+  uint cell = 0u;  // largest k < count with cdf[k] <= u
+  for (; step > 0u; step /= 2u) {
+    uint candidate = cell + step;
+    cell = candidate < count && guide_cdf_at(cdf, min(candidate, count)) <= u ? candidate : cell;
   }
-  while (lo > 0u && !(guide_bin_probability(cdf, lo) > 0.0f)) --lo;
-  return lo;
+  while (cell > 0u && !(guide_bin_probability(cdf, cell) > 0.0f)) --cell;
+  return cell;
 }
 EXITANCE_FN uint emitter_guide_sample_patch(EmitterGuide g, float u) { return emitter_guide_sample_cell(g.cdf, g.patch_count, u); }
 

@@ -54,6 +54,16 @@ struct LightmapEstimate {
   uint32_t guiding_auto_pilot = 0;  // samples per texel before the choice
   std::vector<RegionChoice> guiding_regions;
   EfficiencyEvidence guiding_scene;  // the whole scene's evidence, which regions without their own follow
+  // Emitter guiding (core/emitter_guiding_cache.h): what the cache held at the end of the bake;
+  // records = 0 when it was off or the scene has fewer than two lights of either kind.
+  struct EmitterGuidingReport {
+    uint32_t records = 0;
+    uint32_t records_sampling_learned = 0;  // sampling a learned distribution (area or punctual)
+    uint32_t patches = 0;
+    uint32_t punctual_lights = 0;
+    uint64_t memory_bytes = 0;
+    bool dropped = false;  // no record gained enough after the learning samples: the default from there on
+  } emitter_guiding;
   bool adaptive = false;         // samples were planned per texel (core/adaptive_sampling_plan.h)
   uint32_t adaptive_pilot = 0;   // samples per texel of the pilot before the plan (0: no plan made)
   // DirectionalMode::Sh1: per texel the sums of the L1 estimates (path.h sh1_direction_factor),

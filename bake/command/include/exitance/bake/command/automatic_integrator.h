@@ -22,8 +22,14 @@ IntegratorMode automatic_integrator(const BakeOptions& options, const Integrator
 // Other modes pass through.
 GuidingMode automatic_guiding(const BakeOptions& options, const Integrator& backend);
 
+// `--emitter-guiding auto`: on where the CPU backend path traces in one process (the only place it
+// is implemented; records that gain little sample by default: core/emitter_guiding_cache.h), off
+// elsewhere.
+bool automatic_emitter_guiding(const BakeOptions& options, const Integrator& backend);
+
 // `options` with lighting.integrator decided by automatic_integrator when options.integrator_auto,
-// and lighting.guiding by automatic_guiding.
+// lighting.guiding by automatic_guiding, and lighting.emitter_guiding by automatic_emitter_guiding
+// when options.emitter_guiding_auto.
 BakeOptions with_integrator_decided(const BakeOptions& options, const Integrator& backend);
 
 }  // namespace exitance
