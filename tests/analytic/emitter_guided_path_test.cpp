@@ -295,18 +295,7 @@ double expect_regions_agree(const std::string& label, const Scene& scene, const 
     for (auto& [region, m] : testing::region_means(gbuffer, testing::luminance_means(g))) guided[region].push_back(m);
     for (auto& [region, m] : testing::region_means(gbuffer, testing::luminance_means(u))) unguided[region].push_back(m);
   }
-  std::vector<double> relative_se;
-  for (auto& [region, values] : unguided) {
-    const testing::MeanAndError su = testing::mean_and_standard_error(values), sg = testing::mean_and_standard_error(guided[region]);
-    const double se = std::hypot(su.standard_error, sg.standard_error);
-    const double z = se > 0 ? (sg.mean - su.mean) / se : (sg.mean == su.mean ? 0.0 : INFINITY);
-    std::printf("[emitter guided] %s region %u: unguided %.5g guided %.5g (SE %.2g) z %+.2f\n", label.c_str(), region,
-                su.mean, sg.mean, se, z);
-    EXPECT_LE(std::fabs(z), kZLimit) << label << " region " << region;
-    if (su.mean > 0) relative_se.push_back(se / su.mean);
-  }
-  std::sort(relative_se.begin(), relative_se.end());
-  return relative_se.empty() ? INFINITY : relative_se[relative_se.size() / 2];
+  return testing::expect_region_means_agree("emitter guided", label, guided, unguided, kZLimit);
 }
 
 double sample_scene_agrees(const char* name, float density, uint32_t spp) {

@@ -62,18 +62,7 @@ double expect_regions_agree(const std::string& label, const Scene& scene, const 
   }
   // Guiding must really be on: after the first passes most texel vertices sample the mixture.
   EXPECT_GT(double(guided_vertices), 0.5 * double(vertices_possible)) << label;
-  std::vector<double> relative_se;
-  for (auto& [region, values] : unguided) {
-    const testing::MeanAndError su = testing::mean_and_standard_error(values), sg = testing::mean_and_standard_error(guided[region]);
-    const double se = std::hypot(su.standard_error, sg.standard_error);
-    const double z = se > 0 ? (sg.mean - su.mean) / se : (sg.mean == su.mean ? 0.0 : INFINITY);
-    std::printf("[guided] %s region %u: unguided %.5g guided %.5g (SE %.2g) z %+.2f\n", label.c_str(), region, su.mean,
-                sg.mean, se, z);
-    EXPECT_LE(std::fabs(z), kZLimit) << label << " region " << region;
-    relative_se.push_back(su.mean > 0 ? se / su.mean : INFINITY);
-  }
-  std::sort(relative_se.begin(), relative_se.end());
-  return relative_se[relative_se.size() / 2];
+  return testing::expect_region_means_agree("guided", label, guided, unguided, kZLimit);
 }
 
 TEST(GridGuiding, FurnaceReachesLeOverOneMinusAlbedo) {

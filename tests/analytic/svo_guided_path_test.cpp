@@ -73,18 +73,7 @@ double expect_regions_agree(const std::string& label, const Scene& scene, const 
   // texels, some later vertices do).
   if (texels) EXPECT_GT(double(guided_vertices), 0.5 * double(vertices_possible)) << label;
   else EXPECT_GT(guided_vertices, 0u) << label;
-  std::vector<double> relative_se;
-  for (auto& [region, values] : unguided) {
-    const testing::MeanAndError su = testing::mean_and_standard_error(values), sg = testing::mean_and_standard_error(guided[region]);
-    const double se = std::hypot(su.standard_error, sg.standard_error);
-    const double z = se > 0 ? (sg.mean - su.mean) / se : (sg.mean == su.mean ? 0.0 : INFINITY);
-    std::printf("[svo guided] %s region %u: unguided %.5g guided %.5g (SE %.2g) z %+.2f\n", label.c_str(), region,
-                su.mean, sg.mean, se, z);
-    EXPECT_LE(std::fabs(z), kZLimit) << label << " region " << region;
-    relative_se.push_back(su.mean > 0 ? se / su.mean : INFINITY);
-  }
-  std::sort(relative_se.begin(), relative_se.end());
-  return relative_se[relative_se.size() / 2];
+  return testing::expect_region_means_agree("svo guided", label, guided, unguided, kZLimit);
 }
 
 // The cone's half-angle solves Omega = 2 pi (1 - cos theta); the level's voxel edge size / 2^level
@@ -235,7 +224,9 @@ TEST(SvoGuiding, BinsFollowCRayAndLMin) {
   const std::vector<uint32_t> coarse = levels(1e12), fine = levels(1e-6);
   uint32_t coarse_total = 0, deeper = 0;
   for (uint32_t l = 0; l <= octree.depth; ++l) {
-    if (l != l_min) EXPECT_EQ(coarse[l], 0u) << l;
+    if (l != l_min) {
+      EXPECT_EQ(coarse[l], 0u) << l;
+    }
     coarse_total += coarse[l];
     if (l > l_min) deeper += fine[l];
   }

@@ -3,11 +3,13 @@
 #pragma once
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <functional>
 #include <map>
+#include <string>
 #include <vector>
 
 #include "exitance/runtime/core/estimates.h"
@@ -29,6 +31,29 @@ inline std::map<uint32_t, double> region_means(const TexelGBuffer& gbuffer, cons
   for (size_t i = 0; i < texel.size(); ++i) sum[gbuffer.texels[i].instance] += texel[i], count[gbuffer.texels[i].instance] += 1;
   for (auto& [region, s] : sum) s /= count[region];
   return sum;
+}
+
+// Per region, the means of `guided` and `unguided` runs (independent seeds each) agree within
+// z_limit standard errors of their difference. Returns the median over regions of that standard
+// error relative to the unguided mean (infinite for a region whose mean is 0): the caller checks
+// the test's power with it.
+inline double expect_region_means_agree(const char* tag, const std::string& label,
+                                        const std::map<uint32_t, std::vector<double>>& guided,
+                                        const std::map<uint32_t, std::vector<double>>& unguided, double z_limit) {
+  std::vector<double> relative_se;
+  for (const auto& entry : unguided) {
+    const uint32_t region = entry.first;
+    const MeanAndError su = mean_and_standard_error(entry.second), sg = mean_and_standard_error(guided.at(region));
+    const double se = std::hypot(su.standard_error, sg.standard_error);
+    const double z = se > 0 ? (sg.mean - su.mean) / se : (sg.mean == su.mean ? 0.0 : INFINITY);
+    std::printf("[%s] %s region %u: unguided %.5g guided %.5g (SE %.2g) z %+.2f\n", tag, label.c_str(), region, su.mean,
+                sg.mean, se, z);
+    EXPECT_LE(std::fabs(z), z_limit) << label << " region " << region;
+    relative_se.push_back(su.mean > 0 ? se / su.mean : INFINITY);
+  }
+  if (relative_se.empty()) return INFINITY;
+  std::sort(relative_se.begin(), relative_se.end());
+  return relative_se[relative_se.size() / 2];
 }
 
 // The mean over texels of each channel, over `seeds` runs of `bake(seed)`, equals le / (1 - rho)

@@ -190,52 +190,54 @@ void EmitterGuidingCache::swap() {
 }
 
 void EmitterGuidingCache::rebuild(uint32_t record) {
+  std::vector<double> shares;  // learned shares of the cells; empty while nothing is learned
   if (punctual_count_ > 0) {
     const double* learned = &punctual_learned_[size_t(record) * punctual_count_];
-    float* cdf = &punctual_cdf_[size_t(record) * (punctual_count_ + 1)];
     double total = 0;
     for (size_t i = 0; i < punctual_count_; ++i) total += learned[i];
-    const bool any = total > 0 && std::isfinite(total);
-    punctual_guided_probability_[record] = any ? config_.mix : 0.0f;
-    double run = 0;
-    cdf[0] = 0;
-    for (size_t i = 0; i < punctual_count_; ++i) {
-      run += any ? (1.0 - kFloor) * learned[i] / total + kFloor * punctual_default_[i] : punctual_default_[i];
-      cdf[i + 1] = float(std::min(run, 1.0));
-    }
-    cdf[punctual_count_] = 1.0f;
-    if (any && second_moment_gain(cdf, punctual_default_.data(), punctual_count_, config_.mix) < kMinSecondMomentGain)
-      punctual_guided_probability_[record] = 0.0f;
+    shares.clear();
+    if (total > 0 && std::isfinite(total))
+      for (size_t i = 0; i < punctual_count_; ++i) shares.push_back(learned[i] / total);
+    punctual_guided_probability_[record] = fill_cdf(shares, punctual_default_.data(), punctual_count_,
+                                                    &punctual_cdf_[size_t(record) * (punctual_count_ + 1)]);
   }
   const size_t patches = patch_count();
   if (patches == 0) return;
   const double* learned = &learned_[size_t(record) * patches];
   const uint32_t* samples = &samples_[size_t(record) * patches];
-  float* cdf = &cdf_[size_t(record) * (patches + 1)];
   double total = 0;
   for (size_t k = 0; k < patches; ++k) total += learned[k];
-  const bool any = total > 0 && std::isfinite(total);
-  guided_probability_[record] = any ? config_.mix : 0.0f;
-  double run = 0;
-  cdf[0] = 0;
-  for (uint32_t c = 0; c < patches_.cluster_count(); ++c) {
-    const uint32_t first = patches_.cluster_first[c], end = patches_.cluster_first[c + 1];
-    double cluster_sum = 0, cluster_default = 0, cluster_samples = 0;
-    for (uint32_t k = first; k < end; ++k)
-      cluster_sum += learned[k], cluster_default += patches_.default_probability[k], cluster_samples += samples[k];
-    const double trust = cluster_samples / (cluster_samples + kPseudoSamplesPerPatch * double(end - first));
-    for (uint32_t k = first; k < end; ++k) {
-      const double p0 = patches_.default_probability[k];
-      double learned_share = 0;
-      if (any && cluster_sum > 0)
-        learned_share = (trust * learned[k] + (1 - trust) * cluster_sum * (cluster_default > 0 ? p0 / cluster_default : 0)) / total;
-      run += any ? (1.0 - kFloor) * learned_share + kFloor * p0 : p0;
-      cdf[k + 1] = float(std::min(run, 1.0));
+  shares.clear();
+  if (total > 0 && std::isfinite(total)) {
+    shares.resize(patches, 0.0);
+    for (uint32_t c = 0; c < patches_.cluster_count(); ++c) {
+      const uint32_t first = patches_.cluster_first[c], end = patches_.cluster_first[c + 1];
+      double cluster_sum = 0, cluster_default = 0, cluster_samples = 0;
+      for (uint32_t k = first; k < end; ++k)
+        cluster_sum += learned[k], cluster_default += patches_.default_probability[k], cluster_samples += samples[k];
+      if (!(cluster_sum > 0)) continue;
+      const double trust = cluster_samples / (cluster_samples + kPseudoSamplesPerPatch * double(end - first));
+      for (uint32_t k = first; k < end; ++k) {
+        const double spread = cluster_default > 0 ? patches_.default_probability[k] / cluster_default : 0.0;
+        shares[k] = (trust * learned[k] + (1 - trust) * cluster_sum * spread) / total;
+      }
     }
   }
-  cdf[patches] = 1.0f;
-  if (any && second_moment_gain(cdf, patches_.default_probability.data(), patches, config_.mix) < kMinSecondMomentGain)
-    guided_probability_[record] = 0.0f;
+  guided_probability_[record] =
+      fill_cdf(shares, patches_.default_probability.data(), patches, &cdf_[size_t(record) * (patches + 1)]);
+}
+
+float EmitterGuidingCache::fill_cdf(const std::vector<double>& shares, const float* default_probability, size_t cells,
+                                    float* cdf) const {
+  double run = 0;
+  cdf[0] = 0;
+  for (size_t k = 0; k < cells; ++k) {
+    run += shares.empty() ? default_probability[k] : (1.0 - kFloor) * shares[k] + kFloor * default_probability[k];
+    cdf[k + 1] = float(std::min(run, 1.0));
+  }
+  cdf[cells] = 1.0f;
+  if (shares.empty() || second_moment_gain(cdf, default_probability, cells, config_.mix) < kMinSecondMomentGain) return 0.0f;
+  return config_.mix;
 }
 
 uint32_t EmitterGuidingCache::records_sampling_learned() const {

@@ -107,6 +107,10 @@ class EmitterGuidingCache {
 
  private:
   void rebuild(uint32_t record);
+  // Fills cdf (cells + 1 values) with (1 - kFloor) x shares + kFloor x the default (the default alone
+  // while `shares` is empty); returns the guided probability: config mix where that gains
+  // kMinSecondMomentGain, else 0.
+  float fill_cdf(const std::vector<double>& shares, const float* default_probability, size_t cells, float* cdf) const;
 
   EmitterGuidingConfig config_;
   GuideGridLocator locator_;
