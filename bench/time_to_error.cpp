@@ -2,7 +2,7 @@
 // content hash outside the repository) is the reference; runs at doubling spp record seconds,
 // relMSE, MAE, worst-texel error and rays/s as CSV, and the time to reach a target relMSE.
 //
-//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,adaptive,bounces,guided,svo,guided_auto,nee,guided_nee,svo_nee] [--guiding-mix M] [--name NAME]
+//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,adaptive,bounces,guided,svo,guided_auto,nee,guided_nee,svo_nee,bounces_nee] [--guiding-mix M] [--name NAME]
 //                       [--sky R,G,B] [--texel-density T] [--reference-spp N] [--max-spp N]
 //                       [--max-seconds S] [--target 0.01] [--bounces N] [--min-spp N] [--cache DIR] [--csv FILE]
 //                       [--texel-csv FILE] [--guiding-fields FILE] [--samplers sobol,independent]
@@ -92,8 +92,8 @@ int main(int argc, char** argv) {
   app.add_option("--integrators", integrators,
                  "comma-separated: path, adaptive (path with adaptive sampling; spp = mean), bounces, bounces_cached "
                  "(bounces with --first-bounce cached), guided (path with --guiding grid), svo (path with --guiding svo), "
-                 "guided_auto (path with --guiding auto), nee / guided_nee / svo_nee (path, guided and svo with "
-                 "--emitter-guiding on)");
+                 "guided_auto (path with --guiding auto), nee / guided_nee / svo_nee / bounces_nee (path, guided, "
+                 "svo and bounces with --emitter-guiding on)");
   float guiding_mix = 0.5f;
   app.add_option("--guiding-mix", guiding_mix, "guided component's probability (guided runs)");
   float emitter_guiding_mix = 0.5f;
@@ -231,6 +231,8 @@ int main(int argc, char** argv) {
     std::cerr << "svo guiding octree: depth " << build.depth << ", " << octree.nodes.size() << " nodes\n";
   }
   if (listed("bounces")) modes.push_back({IntegratorMode::Bounces, GuidingMode::Off, "per_bounce"});
+  if (listed("bounces_nee"))
+    modes.push_back({IntegratorMode::Bounces, GuidingMode::Off, "per_bounce_nee", false, kSamplerSobol, true, true});
   if (listed("bounces_cached"))
     modes.push_back({IntegratorMode::Bounces, GuidingMode::Off, "per_bounce_cached", false, kSamplerSobol, false});
   if (("," + samplers + ",").find(",independent,") != std::string::npos) {

@@ -9,7 +9,6 @@ IntegratorMode automatic_integrator(const BakeOptions& options, const Integrator
   if (options.lighting.directional != DirectionalMode::Off) return IntegratorMode::Path;
   if (options.lighting.guiding == GuidingMode::Grid) return IntegratorMode::Path;  // auto does not ask for it
   if (options.adaptive_request == AdaptiveRequest::On) return IntegratorMode::Path;
-  if (options.lighting.emitter_guiding) return IntegratorMode::Path;
   return IntegratorMode::Bounces;
 }
 
@@ -21,8 +20,7 @@ GuidingMode automatic_guiding(const BakeOptions& options, const Integrator& back
 }
 
 bool automatic_emitter_guiding(const BakeOptions& options, const Integrator& backend) {
-  return backend.backend_name() == "cpu" && options.lighting.integrator == IntegratorMode::Path &&
-         !distributed(options.lighting.work_share);
+  return backend.backend_name() == "cpu" && !distributed(options.lighting.work_share);
 }
 
 BakeOptions with_integrator_decided(const BakeOptions& options, const Integrator& backend) {

@@ -144,7 +144,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0f, 1.0f));
   std::string emitter_guiding = "auto";
   app.add_option("--emitter-guiding", emitter_guiding,
-                 "auto (default: on where the CPU backend path traces in one process) | on | off: next-event "
+                 "auto (default: on where the CPU backend bakes in one process) | on | off: next-event "
                  "estimation samples emitter patches and punctual lights from distributions learned per grid region, "
                  "mixed with the default choice by power (docs/lighting-core.md \"Emitter guiding\")")
       ->check(CLI::IsMember({"auto", "off", "on"}));
@@ -295,10 +295,6 @@ int main(int argc, char** argv) {
   // Resolved once the backend and integrator are known (automatic_integrator.h).
   if (guiding == "auto") options.lighting.guiding = exitance::GuidingMode::Auto;
   if (emitter_guiding == "on") {
-    if (integrator == "bounces") {
-      std::cerr << "bake: error: --emitter-guiding on guides path tracing's next-event estimation: it needs --integrator path\n";
-      return 2;
-    }
     if (options.backend.name == "vulkan") {
       std::cerr << "bake: error: --emitter-guiding on: implemented on the CPU backend only (use --backend cpu)\n";
       return 2;

@@ -7,8 +7,9 @@
 //    emitter and point light outside, every record's learned distributions put most of their mass on
 //    the lights inside (the default sampling by power gives them < 1 %).
 //  - Forced on, the guided estimator converges to the unguided one per region (instance) on that box,
-//    the Cornell room, ajar_room and the building (many emitters, point and spot lights); no NaN/Inf;
-//    bit-identical per seed and thread count.
+//    the Cornell room, ajar_room and the building (many emitters, point and spot lights), and the
+//    per-bounce mode's guided direct layers to its unguided ones; no NaN/Inf; bit-identical per seed
+//    and thread count.
 // Statistics as svo_guided_path_test.cpp: kSeeds independent seeds, kZLimit = 5 standard errors, and
 // each comparison checks its power (a 10 % bias in the median region must exceed kZLimit SE).
 // Chi-square limits: the Wilson-Hilferty quantile at z = 4.75 (upper tail ~1e-6).
@@ -340,12 +341,48 @@ TEST(EmitterGuiding, BitIdenticalPerSeedAndThreadCount) {
   EXPECT_FALSE(testing::identical_texel_sums(a, unguided)) << "emitter guiding must change the samples";
 }
 
-TEST(EmitterGuiding, RefusedInBouncesMode) {
+// The per-bounce mode (--integrator bounces) guides its direct-light samples: B_0's at texels and
+// B_1's traced ones at gather hits. Both layers are linear in those samples, so per region their
+// means agree with the unguided per-bounce mode's (two bounces, so no data-dependent tail length).
+TEST(EmitterGuiding, PerBounceLayersAgreeWithUnguided) {
   const testing::AtlasScene box = box_with_lights_outside();
   const CpuReferenceIntegrator integrator(box.scene);
-  IntegratorSettings s = settings(4, 1, true);
+  std::map<uint32_t, std::vector<double>> guided[2], unguided[2];
+  for (int seed = 0; seed < kSeeds; ++seed) {
+    for (bool on : {true, false}) {
+      IntegratorSettings s = settings(256, uint64_t(seed) + (on ? 0 : 1000), on);
+      s.integrator = IntegratorMode::Bounces;
+      s.max_bounces = 2;
+      const LightmapEstimate e = integrator.bake(box.gbuffer, s);
+      EXPECT_EQ(e.nonfinite_samples, 0u);
+      if (on) {
+        EXPECT_GT(e.emitter_guiding.records_sampling_learned, 0u);
+      }
+      for (int layer = 0; layer < 2; ++layer) {
+        std::vector<double> texel(box.gbuffer.texels.size());
+        for (size_t i = 0; i < texel.size(); ++i) texel[i] = luminance(e.mean_bounce(layer, i));
+        for (auto& [region, m] : testing::region_means(box.gbuffer, texel)) (on ? guided : unguided)[layer][region].push_back(m);
+      }
+    }
+  }
+  for (int layer = 0; layer < 2; ++layer) {
+    const double se = testing::expect_region_means_agree("emitter guided", "per-bounce layer " + std::to_string(layer),
+                                                         guided[layer], unguided[layer], kZLimit);
+    EXPECT_LT(kZLimit * se, kDetectableBias) << "layer " << layer << ": the test could not see a 10 % bias";
+  }
+}
+
+TEST(EmitterGuiding, PerBounceBitIdenticalPerSeedAndThreadCount) {
+  const testing::AtlasScene box = box_with_lights_outside();
+  const CpuReferenceIntegrator integrator(box.scene);
+  IntegratorSettings s = settings(24, 7, true);
   s.integrator = IntegratorMode::Bounces;
-  EXPECT_THROW(integrator.bake(box.gbuffer, s), std::invalid_argument);
+  const LightmapEstimate a = integrator.bake(box.gbuffer, s);
+  const LightmapEstimate b = integrator.bake(box.gbuffer, s);
+  EXPECT_TRUE(testing::identical_texel_sums(a, b)) << "two runs with one seed differ";
+  tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+  const LightmapEstimate c = integrator.bake(box.gbuffer, s);
+  EXPECT_TRUE(testing::identical_texel_sums(a, c)) << "one thread and all threads differ";
 }
 
 }  // namespace

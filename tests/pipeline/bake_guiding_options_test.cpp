@@ -37,7 +37,6 @@ TEST(BakeGuidingOptions, ContradictionsAreOneLineAndExit2) {
       {"--guiding svo --voxel-resolution none", "--guiding svo builds its fields from the voxel octree"},
       {"--guiding svo --integrator bounces", "--guiding svo guides path tracing"},
       {"--guiding grid --integrator bounces", "--guiding grid guides path tracing"},
-      {"--emitter-guiding on --integrator bounces", "--emitter-guiding on guides path tracing"},
       {"--emitter-guiding on --backend vulkan", "--emitter-guiding on: implemented on the CPU backend only"},
   };
   for (const auto& c : cases) {

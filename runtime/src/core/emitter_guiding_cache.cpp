@@ -149,6 +149,27 @@ EmitterGuide EmitterGuidingCache::vertex(uint32_t record) const {
   return g;
 }
 
+EmitterGuidingCache::Site EmitterGuidingCache::site(EmitterGuidingCache* cache, Vec3 position, Vec3 shading_normal,
+                                                    Learning learning) {
+  Site s;
+  s.guide = emitter_guide_none();
+  if (!cache) return s;
+  s.record = cache->record_of(position, shading_normal);
+  const EmitterGuide guide = cache->vertex(s.record);
+  const bool sampling_learned = guide.guided_probability > 0 || guide.punctual_guided_probability > 0;
+  s.learns = s.record != kNoRecord &&
+             (learning == Learning::Everywhere || (learning == Learning::WhereSampled && sampling_learned));
+  if (s.learns || sampling_learned) s.guide = guide;
+  return s;
+}
+
+void EmitterGuidingCache::learn_arrived(const Site& site, uint32_t patch, float value, bool area_arrived,
+                                        uint32_t punctual_light, float punctual_value, bool punctual_arrived) {
+  if (!site.learns) return;
+  if (area_arrived && patch != kEmitterPatchNone) learn(site.record, patch, value);
+  if (punctual_arrived && punctual_light != kEmitterPatchNone) learn_punctual(site.record, punctual_light, punctual_value);
+}
+
 void EmitterGuidingCache::learn(uint32_t record, uint32_t patch, float value) {
   if (record == kNoRecord || patch >= patch_count() || !(value > 0)) return;  // NaN never enters
   Accumulator& a = back_[size_t(record) * patch_count() + patch];

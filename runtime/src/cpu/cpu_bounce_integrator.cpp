@@ -21,9 +21,12 @@
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <limits>
+#include <memory>
 
 #include "exitance/common/bounce_gather.h"
+#include "exitance/runtime/core/emitter_guiding_cache.h"
 #include "exitance/runtime/core/per_bounce_bake.h"
 #include "exitance/runtime/core/scene_access.h"
 #include "exitance/runtime/embree_scene.h"
@@ -35,20 +38,31 @@ using Counters = BounceGatherCounts;
 
 class BounceGather {
  public:
+  // `emitter_guide`: emitter guiding's cache (null: the default next-event sampling) and which
+  // samples learn (EmitterGuidingCache::learning of the sample's index).
   BounceGather(const LightingScene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer,
-               const std::vector<BounceLayerCache>& caches, const IntegratorSettings& settings)
-      : scene_(scene), embree_(embree), gbuffer_(gbuffer), caches_(caches), settings_(settings) {}
+               const std::vector<BounceLayerCache>& caches, const IntegratorSettings& settings,
+               EmitterGuidingCache* emitter_guide)
+      : scene_(scene), embree_(embree), gbuffer_(gbuffer), caches_(caches), settings_(settings),
+        emitter_guide_(emitter_guide) {}
 
   // One sample of B_0 at x: path.h's estimator stopped after the direct light. `back_face`: its
   // continuation ray met the back of a single-sided surface (x is inside or under geometry).
-  Vec3 direct(SurfacePoint x, PathSampler& rng, Counters& c, bool& back_face) const {
+  Vec3 direct(SurfacePoint x, PathSampler& rng, Counters& c, bool& back_face,
+              EmitterGuidingCache::Learning learning) const {
     back_face = false;
     const LightingScene& scene = scene_;
     const Vec3 origin = offset_ray_origin(x.position, x.geometric_normal, scene.extent);
     ShadowRay shadow[kShadowRaysPerVertex];
-    next_event_estimation(scene, x, origin, Vec3(1.0f), settings_.sampling_strategy, rng, shadow[0], shadow[1],
-                          shadow[2]);
-    Vec3 sum = connect(shadow, origin, c);
+    const EmitterGuidingCache::Site site = EmitterGuidingCache::site(emitter_guide_, x.position, x.shading_normal, learning);
+    EmitterLearning learned;
+    next_event_estimation(scene, x, origin, Vec3(1.0f), guide_vertex_cosine(), site.guide, rng, shadow[0], shadow[1],
+                          shadow[2], learned);
+    bool arrived[kShadowRaysPerVertex];
+    Vec3 sum = connect(shadow, origin, c, arrived);
+    if (site.learns)
+      emitter_guide_->learn_arrived(site, learned.patch_index, learned.value, arrived[0], learned.punctual_light,
+                                    learned.punctual_value, arrived[1]);
     const DirectionSample d = sample_continuation(settings_.sampling_strategy, x, rng);
     if (!(d.pdf > 0)) return sum;
     ++c.rays;
@@ -58,12 +72,12 @@ class BounceGather {
                 !material_double_sided(scene_material(scene, scene_triangle_material(scene, hit.triangle)));
     const PathLimits direct_only{0, settings_.russian_roulette_start, settings_.safety_bounce_cap};
     const HitResult h = shade_continuation_hit(scene, hit.triangle, hit.distance, hit.b1, hit.b2, d.direction, d.pdf,
-                                               Vec3(1.0f), 0, direct_only, rng);
+                                               Vec3(1.0f), 0, direct_only, site.guide, rng);
     return sum + h.radiance;
   }
 
   // One sample of B_{layer+1} at x: a continuation ray, the hit's albedo times B_layer there.
-  Vec3 gather(SurfacePoint x, int layer, PathSampler& rng, Counters& c) const {
+  Vec3 gather(SurfacePoint x, int layer, PathSampler& rng, Counters& c, EmitterGuidingCache::Learning learning) const {
     const LightingScene& scene = scene_;
     const DirectionSample d = sample_continuation(settings_.sampling_strategy, x, rng);
     if (!(d.pdf > 0)) return {0, 0, 0};
@@ -86,32 +100,38 @@ class BounceGather {
     Vec3 b;
     const SurfacePoint y = surface_point_on_triangle(scene, tri, ng, hit.b1, hit.b2, front);
     if (layer == 0 && settings_.trace_first_bounce) {
-      b = on_the_fly(y, layer, rng, c);
+      b = on_the_fly(y, layer, rng, c, learning);
     } else if (!front || !caches_[size_t(layer)].lookup(gbuffer_, instance_of(tri), lightmap_uv(tri, hit.b1, hit.b2),
                                                         y.position, ng, b)) {
       ++c.texelless;
-      b = on_the_fly(y, layer, rng, c);
+      b = on_the_fly(y, layer, rng, c, learning);
     }
     return albedo * b * weight;
   }
 
  private:
   // B_layer at a surface point that has no texels: one sample, from the layer below.
-  Vec3 on_the_fly(SurfacePoint y, int layer, PathSampler& rng, Counters& c) const {
+  Vec3 on_the_fly(SurfacePoint y, int layer, PathSampler& rng, Counters& c, EmitterGuidingCache::Learning learning) const {
     bool back_face = false;
-    return layer == 0 ? direct(y, rng, c, back_face) : gather(y, layer - 1, rng, c);
+    return layer == 0 ? direct(y, rng, c, back_face, learning) : gather(y, layer - 1, rng, c, learning);
   }
 
-  Vec3 connect(const ShadowRay (&rays)[kShadowRaysPerVertex], Vec3 origin, Counters& c) const {
+  // `arrived`: whether each ray arrived (unoccluded).
+  Vec3 connect(const ShadowRay (&rays)[kShadowRaysPerVertex], Vec3 origin, Counters& c,
+               bool (&arrived)[kShadowRaysPerVertex]) const {
     Vec3 sum{0, 0, 0};
-    for (const ShadowRay& r : rays) {
+    for (uint k = 0; k < kShadowRaysPerVertex; ++k) {
+      const ShadowRay& r = rays[k];
+      arrived[k] = false;
       const float state = r.contribution_state.w;
       if (state == kShadowNone) continue;
       ++c.rays;
       if (state != kShadowTrace) continue;
       const Vec3 d{r.direction_length.x, r.direction_length.y, r.direction_length.z};
-      if (!embree_.occluded(origin, d, r.direction_length.w))
+      if (!embree_.occluded(origin, d, r.direction_length.w)) {
         sum += Vec3{r.contribution_state.x, r.contribution_state.y, r.contribution_state.z};
+        arrived[k] = true;
+      }
     }
     return sum;
   }
@@ -133,18 +153,38 @@ class BounceGather {
   const TexelGBuffer& gbuffer_;
   const std::vector<BounceLayerCache>& caches_;
   const IntegratorSettings& settings_;
+  EmitterGuidingCache* emitter_guide_;
 };
 
 // Layer passes over texels in parallel (TBB), each texel's samples in order: deterministic sums.
+// Emitter guiding (settings.emitter_guiding): one cache through all layers' passes, learning from
+// the direct-light samples (B_0's, and B_1's traced ones at gather hits), folded before each pass;
+// dropped, as in path mode, when after 64 samples of a layer no record gains enough.
 class CpuBounceLayerEstimator final : public BounceLayerEstimator {
  public:
   CpuBounceLayerEstimator(const LightingScene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer,
                           const IntegratorSettings& settings)
-      : scene_(scene), embree_(embree), gbuffer_(gbuffer), settings_(settings) {}
+      : scene_(scene), embree_(embree), gbuffer_(gbuffer), settings_(settings) {
+    if (settings.emitter_guiding && (scene.emitter_count() > 0 || scene.punctual_count() >= 2)) {
+      EmitterGuidingConfig config;
+      config.mix = settings.emitter_guiding_mix;
+      config.cells_on_longest_axis = settings.guiding_grid_cells;
+      config.patch_target = settings.emitter_guiding_patches;
+      emitter_guide_ = std::make_unique<EmitterGuidingCache>(scene, gbuffer, config);
+      built_ = true;
+    }
+  }
 
   void estimate(const BounceLayerPass& pass, const std::vector<BounceLayerCache>& caches,
                 const std::vector<uint64_t>&) override {
-    const BounceGather gather(scene_, embree_, gbuffer_, caches, settings_);
+    if (emitter_guide_) {
+      // The previous pass's learning becomes this pass's front table.
+      if (learned_samples_ > 0) emitter_guide_->swap();
+      if (learned_samples_ >= EmitterGuidingCache::kEveryLearningSamples && !emitter_guide_->samples_anywhere())
+        emitter_guide_.reset();
+    }
+    if (emitter_guide_) learned_samples_ = std::max(learned_samples_, pass.first_sample + pass.samples);
+    const BounceGather gather(scene_, embree_, gbuffer_, caches, settings_, emitter_guide_.get());
     const size_t k = size_t(pass.layer);
     tbb::parallel_for(tbb::blocked_range<size_t>(pass.begin, pass.end, 64), [&](const tbb::blocked_range<size_t>& range) {
       Counters& c = counters_per_thread_.local();
@@ -156,7 +196,10 @@ class CpuBounceLayerEstimator final : public BounceLayerEstimator {
           PathSampler rng = k == 0 ? path_sampler(settings_.seed, i, s, settings_.sampler)
                                    : path_sampler(settings_.seed, kBounceRngStreamBase * k + i, s, settings_.sampler);
           bool back_face = false;
-          const Vec3 value = k == 0 ? gather.direct(x, rng, c, back_face) : gather.gather(x, int(k) - 1, rng, c);
+          const EmitterGuidingCache::Learning learning =
+              emitter_guide_ ? EmitterGuidingCache::learning(s) : EmitterGuidingCache::Learning::None;
+          const Vec3 value =
+              k == 0 ? gather.direct(x, rng, c, back_face, learning) : gather.gather(x, int(k) - 1, rng, c, learning);
           if (back_face) ++pass.back_faces[i];
           if (!is_finite(value)) {
             ++c.nonfinite;  // counted and reported; counts as 0 (an unbiased estimator never produces these)
@@ -170,6 +213,18 @@ class CpuBounceLayerEstimator final : public BounceLayerEstimator {
         if (pass.texel_rays) pass.texel_rays[i] = c.rays - rays_before;
       }
     });
+  }
+
+  // What emitter guiding's cache held at the end (nothing when it was off).
+  void report(LightmapEstimate::EmitterGuidingReport& out) const {
+    if (!built_) return;
+    out.dropped = !emitter_guide_;
+    if (!emitter_guide_) return;
+    out.records = emitter_guide_->record_count();
+    out.records_sampling_learned = emitter_guide_->records_sampling_learned();
+    out.patches = emitter_guide_->patch_count();
+    out.punctual_lights = emitter_guide_->punctual_count();
+    out.memory_bytes = emitter_guide_->memory_bytes();
   }
 
   BounceGatherCounts counts() const override {
@@ -187,6 +242,9 @@ class CpuBounceLayerEstimator final : public BounceLayerEstimator {
   const TexelGBuffer& gbuffer_;
   const IntegratorSettings& settings_;
   mutable tbb::combinable<Counters> counters_per_thread_;
+  std::unique_ptr<EmitterGuidingCache> emitter_guide_;
+  uint32_t learned_samples_ = 0;  // the most samples per texel any layer's passes have taken so far
+  bool built_ = false;            // emitter guiding was on (emitter_guide_ is null once dropped)
 };
 
 }  // namespace
@@ -194,7 +252,9 @@ class CpuBounceLayerEstimator final : public BounceLayerEstimator {
 LightmapEstimate bake_per_bounce(const LightingScene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer,
                                  const IntegratorSettings& settings) {
   CpuBounceLayerEstimator estimator(scene, embree, gbuffer, settings);
-  return bake_per_bounce(gbuffer, settings, estimator);
+  LightmapEstimate estimate = bake_per_bounce(gbuffer, settings, estimator);
+  estimator.report(estimate.emitter_guiding);
+  return estimate;
 }
 
 }  // namespace exitance

@@ -179,24 +179,16 @@ struct CpuReferenceIntegrator::Impl {
       const bool directional_texel = out.directional && bounce == 0;
       if (directional_texel) g = with_uniform_component(g, kDirectionalUniformProbability);
       ShadowRay shadow[kShadowRaysPerVertex];
-      const uint32_t emitter_record = emitter_guiding.cache ? emitter_guiding.cache->record_of(x.position, x.shading_normal)
-                                                            : EmitterGuidingCache::kNoRecord;
-      EmitterGuide eg = emitter_guiding.cache ? emitter_guiding.cache->vertex(emitter_record) : emitter_guide_none();
-      const bool sampling_learned = eg.guided_probability > 0 || eg.punctual_guided_probability > 0;
-      const bool learns = emitter_guiding.learning == EmitterGuidingCache::Learning::Everywhere ||
-                          (emitter_guiding.learning == EmitterGuidingCache::Learning::WhereSampled && sampling_learned);
-      // A vertex that neither learns nor samples a learned distribution takes the default's code path.
-      if (!learns && !sampling_learned) eg = emitter_guide_none();
+      const EmitterGuidingCache::Site site =
+          EmitterGuidingCache::site(emitter_guiding.cache, x.position, x.shading_normal, emitter_guiding.learning);
+      const EmitterGuide& eg = site.guide;
       EmitterLearning learning;
       next_event_estimation(s, x, origin, throughput, g, eg, rng, shadow[0], shadow[1], shadow[2], learning);
       bool arrived[3];
       const Vec3 direct = connect(shadow, origin, rays, x, directional_texel ? out.texel_nee_sh1 : nullptr, &arrived);
-      if (learns) {
-        if (arrived[0] && learning.patch_index != kEmitterPatchNone)
-          emitter_guiding.cache->learn(emitter_record, learning.patch_index, learning.value);
-        if (arrived[1] && learning.punctual_light != kEmitterPatchNone)
-          emitter_guiding.cache->learn_punctual(emitter_record, learning.punctual_light, learning.punctual_value);
-      }
+      if (site.learns)
+        emitter_guiding.cache->learn_arrived(site, learning.patch_index, learning.value, arrived[0], learning.punctual_light,
+                                             learning.punctual_value, arrived[1]);
       out.add(bounce, direct);
       if (directional_texel) out.texel_nee = direct;
       const DirectionSample d = sample_continuation(g, x, rng);
@@ -256,8 +248,10 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   if (settings.integrator == IntegratorMode::Bounces) {
     if (settings.directional != DirectionalMode::Off)
       throw std::invalid_argument("CPU backend: --directional sh1 applies to path tracing, not to --integrator bounces");
-    if (settings.guiding != GuidingMode::Off || settings.emitter_guiding)
+    if (settings.guiding != GuidingMode::Off)
       throw std::invalid_argument("CPU backend: guiding applies to path tracing, not to --integrator bounces");
+    if (settings.emitter_guiding && distributed(settings.work_share))
+      throw std::invalid_argument("CPU backend: --emitter-guiding runs in one process only, not under mpirun with several ranks");
     if (settings.adaptive)
       throw std::invalid_argument("CPU backend: adaptive sampling applies to path tracing, not to --integrator bounces");
     return bake_per_bounce(*impl_->lighting, *impl_->embree, gbuffer, settings);

@@ -81,7 +81,22 @@ class EmitterGuidingCache {
     return sample % kLaterLearningStride == 0 ? Learning::WhereSampled : Learning::None;
   }
 
+
   uint32_t record_of(Vec3 position, Vec3 shading_normal) const;
+
+  // The strategy at one path vertex and whether its next-event samples learn (both CPU estimators):
+  // a vertex that neither learns nor samples a learned distribution gets emitter_guide_none(), the
+  // default's code path. A null cache: the default, learning nothing.
+  struct Site {
+    uint32_t record = kNoRecord;
+    EmitterGuide guide;
+    bool learns = false;
+  };
+  static Site site(EmitterGuidingCache* cache, Vec3 position, Vec3 shading_normal, Learning learning);
+  // After the site's shadow rays: the samples that arrived (path.h EmitterLearning's patch and
+  // light, kEmitterPatchNone for none) teach the back tables.
+  void learn_arrived(const Site& site, uint32_t patch, float value, bool area_arrived, uint32_t punctual_light,
+                     float punctual_value, bool punctual_arrived);
   // The strategy at a vertex of `record`: learned tables (guided_probability 0 until the record has
   // learned something, or while it would gain too little), emitter_guide_none() for kNoRecord.
   EmitterGuide vertex(uint32_t record) const;

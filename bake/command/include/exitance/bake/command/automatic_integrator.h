@@ -22,9 +22,9 @@ IntegratorMode automatic_integrator(const BakeOptions& options, const Integrator
 // Other modes pass through.
 GuidingMode automatic_guiding(const BakeOptions& options, const Integrator& backend);
 
-// `--emitter-guiding auto`: on where the CPU backend path traces in one process (the only place it
-// is implemented; records that gain little sample by default: core/emitter_guiding_cache.h), off
-// elsewhere.
+// `--emitter-guiding auto`: on where the CPU backend bakes in one process, path tracing or per-bounce
+// (the only places it is implemented; records that gain little sample by default:
+// core/emitter_guiding_cache.h), off elsewhere.
 bool automatic_emitter_guiding(const BakeOptions& options, const Integrator& backend);
 
 // `options` with lighting.integrator decided by automatic_integrator when options.integrator_auto,
