@@ -34,6 +34,9 @@ struct BakeOptions {
   // --integrator auto (the bake command's default): lighting.integrator is decided once the backend is
   // chosen (bake/command/automatic_integrator.h); false: lighting.integrator as given.
   bool integrator_auto = false;
+  // --guiding auto given on the command line (not the default): the Vulkan backend then runs the
+  // measured choice too; by default it stays unguided (bake/command/automatic_integrator.h).
+  bool guiding_auto_given = false;
   bool bounce_layers = false;
   // Sealed texels (bake/raster/sealed_texels.h) are found either way; true: the lighting stage
   // does not trace them (they are dilated from lit neighbours). --no-skip: false.
