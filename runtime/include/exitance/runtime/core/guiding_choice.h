@@ -66,7 +66,7 @@ namespace exitance {
 constexpr double kGuidedVertexCostInRays = 0.65;
 // The same price on the Vulkan backend (docs/lighting-core.md, "`--guiding auto` on the Vulkan
 // backend", says why this value): a constant, not a clock, so the choice stays deterministic per seed.
-constexpr double kGuidedVertexCostInRaysVulkan = 2.0;
+constexpr double kGuidedVertexCostInRaysVulkan = 1.0;
 // Standard errors a difference of efficiency must exceed to count (one-sided 1.3e-3 under a normal).
 constexpr double kChoiceZ = 3.0;
 // The share of texels that measure both strategies in the pilot (the rest take unguided samples):
