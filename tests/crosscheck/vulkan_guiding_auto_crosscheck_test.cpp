@@ -10,8 +10,13 @@
 // 2e-4 per region; with ~10 regions a false alarm stays below ~0.2 %. Power: a 10 % bias in the
 // median region must exceed kZLimit SEs.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -22,6 +27,7 @@
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "support/atlas_box.h"
+#include "support/fresh_temp_dir.h"
 #include "support/region_runs.h"
 #include "support/validated_vulkan_backend.h"
 
@@ -166,6 +172,36 @@ TEST(VulkanGuidingAuto, BitIdenticalPerSeedAndReported) {
   EXPECT_TRUE(identical(a, b)) << "two runs with one seed differ";
   const LightmapEstimate other = vk->bake(p.gbuffer, settings(96, 8, GuidingMode::Auto));
   EXPECT_FALSE(identical(a, other)) << "the seed must matter";
+}
+
+// bake --backend vulkan: `--guiding auto` given runs the measured choice and reports it (stats.guiding,
+// with Vulkan's guided-vertex price); by default a Vulkan bake stays unguided (no pilot, no report).
+TEST(VulkanGuidingAuto, BakeRunsItOnlyWhenGiven) {
+  const PreparedScene p = cornell_room();
+  {
+    CREATE_VULKAN_OR_SKIP(vk, p.scene);  // a device for bake too, or skip
+  }
+  const std::filesystem::path dir = testing::fresh_temp_dir("vulkan-guiding-auto");
+  auto bake = [&](const std::string& options) {
+    const std::filesystem::path out = dir / "out.bake";
+    std::filesystem::remove_all(out);
+    const std::string command = std::string(EXITANCE_BAKE) + " " EXITANCE_SAMPLE_DIR "/cornell_room.gltf --backend vulkan " +
+                                "--no-cache --spp 16 --texel-density 1 --probes none --voxel-resolution none " + options +
+                                " -o " + out.string() + " >/dev/null 2>&1";
+    const int status = std::system(command.c_str());
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << command;
+    std::ifstream in(out / "manifest.json");
+    return nlohmann::json::parse(in);
+  };
+  const nlohmann::json given = bake("--guiding auto");
+  ASSERT_TRUE(given["stats"].contains("guiding"));
+  EXPECT_EQ(given["stats"]["guiding"]["mode"], "auto");
+  EXPECT_EQ(given["stats"]["guiding"]["decided"], true);
+  EXPECT_EQ(given["stats"]["guiding"]["pilot_samples_per_texel"], 4) << "16 spp: a pilot of 4";
+  EXPECT_EQ(given["stats"]["guiding"]["guided_vertex_cost_rays"].get<double>(), kGuidedVertexCostInRaysVulkan);
+  const nlohmann::json by_default = bake("");
+  EXPECT_FALSE(by_default["stats"].contains("guiding")) << "a default Vulkan bake pays no pilot";
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
