@@ -243,12 +243,13 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   while ((share || !a.work_list.empty()) && passes.next_pass(first, pass)) {
     const auto pass_start = Clock::now();
     // Auto: the guide learns during the pilot only; the pilot's passes record the strategy sums; after
-    // the choice only its guided texels' samples look the guide up (none at all: no guiding).
+    // the choice only its guided texels' samples look the guide up (none at all: no guide lookup,
+    // but the strategy words still index each texel's unguided sequence where its pilot left it).
     const bool learning = guide && first < (choice ? choice->pilot() : GridGuidingCache::kLearningSamples) &&
                           (!choice || !choice->decided());
     if (guide) a.params.guiding = kGuidingSample | (learning ? kGuidingLearn : 0u);
     if (choice) a.params.guiding |= kGuidingAuto | (choice->decided() ? 0u : kGuidingAutoRecord);
-    if (choice && choice->decided() && choice->texels_guided() == 0) a.params.guiding = 0;
+    if (choice && choice->decided() && choice->texels_guided() == 0) a.params.guiding = kGuidingAuto;
     if (!a.work_list.empty()) {
       const size_t chunk = std::min(a.work_list.size(), a.max_work);
       pass = std::min<uint32_t>(pass, uint32_t(std::max<size_t>(1, a.max_work / chunk)));
