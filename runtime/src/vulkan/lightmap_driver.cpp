@@ -226,7 +226,8 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   // 4, 8, ... 64); then, untimed, the largest passes (the frozen table makes pass sizes irrelevant).
   policy.largest_pass = uint32_t(std::max<size_t>(1, a.max_work / std::min(a.texel_count, a.max_work)));
   policy.ramp = settings.time_budget_seconds > 0 || settings.target_relative_error > 0;
-  if (guide && !policy.ramp) policy.ramp = true, policy.ramp_below = GridGuidingCache::kLearningSamples;
+  // Auto: ramped through its pilot only (the table freezes there; its last pass ends at the pilot).
+  if (guide && !policy.ramp) policy.ramp = true, policy.ramp_below = choice ? choice->pilot() : GridGuidingCache::kLearningSamples;
   // SVO: ramped throughout, as on the CPU, so its rebuilds (1, 2, 4, ... spp) end passes of the same sizes.
   if (svo_guide) policy.ramp = true, policy.ramp_below = PassPolicy{}.ramp_below;
   PassScheduler passes(settings, policy);
