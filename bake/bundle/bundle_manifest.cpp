@@ -122,7 +122,7 @@ json error_distribution_json(const LightmapEstimate& estimate) {
 }
 
 // stats.guiding (--guiding auto): what the measured choice kept, and why (core/guiding_choice.h).
-json guiding_auto_json(const LightmapEstimate& estimate) {
+json guiding_auto_json(const LightmapEstimate& estimate, const std::string& backend) {
   json out = {{"mode", "auto"}, {"candidate", "grid"}, {"pilot_samples_per_texel", estimate.guiding_auto_pilot},
               {"guided_vertices", estimate.guided_vertices}};
   const std::vector<RegionChoice>& regions = estimate.guiding_regions;
@@ -162,7 +162,8 @@ json guiding_auto_json(const LightmapEstimate& estimate) {
                              {"regions_p50", quantile(0.5)},
                              {"regions_max", ratios.empty() ? 0.0 : ratios.back()}};
   out["cost_per_sample_rays"] = {{"unguided", scene.cost_per_sample(0)}, {"guided", scene.cost_per_sample(1)}};
-  out["guided_vertex_cost_rays"] = kGuidedVertexCostInRays;
+  // Each backend's price of a guided vertex (core/guiding_choice.h).
+  out["guided_vertex_cost_rays"] = backend == "vulkan" ? kGuidedVertexCostInRaysVulkan : kGuidedVertexCostInRays;
   out["choice_z"] = kChoiceZ;
   return out;
 }
@@ -203,7 +204,7 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
   stats["coplanar_texels"] = results.geometry.coplanar_texels;
   stats["enclosed_lights"] = results.geometry.enclosed_lights;
   stats["nonfinite_samples"] = estimate.nonfinite_samples;
-  if (estimate.guiding_auto) stats["guiding"] = guiding_auto_json(estimate);
+  if (estimate.guiding_auto) stats["guiding"] = guiding_auto_json(estimate, results.backend.backend_name());
   if (estimate.emitter_guiding.records > 0) {
     const LightmapEstimate::EmitterGuidingReport& e = estimate.emitter_guiding;
     stats["emitter_guiding"] = {{"records", e.records},

@@ -72,7 +72,7 @@ void hash_options(Sha256Stream& h, const BakeOptions& o) {
   h.value(l.max_bounces), h.value(l.seed), h.value(l.recorded_bounces), h.value(l.russian_roulette_start);
   h.value(l.safety_bounce_cap), h.value(l.sampling_strategy), h.value(l.sampler), h.value(l.guiding), h.value(l.guiding_mix);
   h.value(l.trace_first_bounce);
-  h.value(o.integrator_auto), h.value(o.emitter_guiding_auto);
+  h.value(o.integrator_auto), h.value(o.emitter_guiding_auto), h.value(o.guiding_auto_given);
   h.value(l.directional);
   h.value(l.guiding_grid_cells), h.value(l.adaptive), h.value(o.adaptive_request);
   h.value(l.guiding_svo_c_ray), h.value(l.guiding_svo_rays_per_bin), h.value(l.guiding_svo_emitted);

@@ -135,7 +135,8 @@ int main(int argc, char** argv) {
                  "sh1: also write L1 SH directional layers sh1.x.R .. sh1.z.B (docs/bundle.md; path tracing)");
   app.add_option("--guiding", guiding,
                  "auto (default: path tracing on the CPU backend measures guided (grid) against unguided samples "
-                 "during a pilot and keeps guiding per region where it pays; off on Vulkan, per-bounce and under mpirun) "
+                 "during a pilot and keeps guiding per region where it pays; on Vulkan only when given (its pilot "
+                 "costs); off per-bounce and under mpirun) "
                  "| off | svo (fields from exitance in the bake's voxel octree, seed 000) | grid (regular-grid SARSA "
                  "cache, seed 002)")
       ->check(CLI::IsMember({"auto", "off", "svo", "grid"}));
@@ -302,6 +303,7 @@ int main(int argc, char** argv) {
     options.lighting.emitter_guiding = true;
   }
   options.emitter_guiding_auto = emitter_guiding == "auto";
+  options.guiding_auto_given = guiding == "auto" && app.get_option("--guiding")->count() > 0;
 
   if (no_cache && !cache_directory.empty()) {
     std::cerr << "bake: error: --cache " << cache_directory << ": contradicts --no-cache\n";

@@ -45,8 +45,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"path", "bounces"}));
   app.add_option("--guiding", options.guiding,
                  "off (default) | grid | svo (guided path tracing, as bake --guiding grid|svo; svo reads the bundle's "
-                 "svo.bin: the whole lightmap in one run; not with --frames, --budget-ms or --integrator bounces)")
-      ->check(CLI::IsMember({"off", "grid", "svo"}));
+                 "svo.bin: the whole lightmap in one run; not with --frames, --budget-ms or --integrator bounces; auto is "
+                 "refused: the measured choice runs in bake only)")
+      ->check(CLI::IsMember({"off", "grid", "svo", "auto"}));
   app.add_option("--seed", seed, "random seed (default: the bake's); results are deterministic per seed and device");
   app.add_option("--device", options.device_index, "Vulkan device index (see --list-devices)")->check(CLI::NonNegativeNumber);
   app.add_flag("--list-devices", list_devices, "print the Vulkan devices and exit");

@@ -102,6 +102,17 @@ void add_sh1_result(uint work, vec3 value, vec3 factor) {
   }
 }
 
+// --guiding auto's pilot passes (GpuParams::guiding & kGuidingAutoRecord): per work item its rays
+// and guided vertices, as floats after the batch's bounce slots and L1 (gpu_layout.h kAutoCostWords).
+// One writer at a time: a work item is one path, and every stage ends with a barrier.
+uint auto_cost_index(uint work) {
+  return params.batch_work_total * ((params.recorded + 1u) * 3u + (params.directional != 0u ? 9u : 0u)) + work * kAutoCostWords;
+}
+
+void add_auto_cost(uint work, uint slot, uint count) {
+  if ((params.guiding & kGuidingAutoRecord) != 0u && count > 0u) results[auto_cost_index(work) + slot] += float(count);
+}
+
 // A contribution of path p: its E/pi slot, and on a directional texel batch its L1 through the
 // path's first continuation (path.h sh1_direction_factor).
 void add_path_result(uint p, uint work, uint depth, vec3 value) {

@@ -4,6 +4,7 @@
 // kBindingGuide). The estimator and the learning target are the CPU reference's (path.h,
 // common/guide_learning.h); GridGuidingCache on the host folds the back sums between passes.
 #include "exitance/common/guide_learning.h"
+#include "exitance/common/guiding_auto_strategy.h"
 
 float guide_float(uint word) { return uintBitsToFloat(guide_words[word]); }
 
@@ -108,4 +109,14 @@ void guide_learn_from_hit(uint key, uint tri, vec4 hit, vec3 wi) {
   GuideLearningHit h = tri == kInvalid ? guide_learning_escape(wi) : guide_learning_hit(tri, hit.z, hit.w, wi);
   float expected = h.reads_expectation ? guide_expected_cosine(guide_record(h.y.position, h.y.shading_normal)) : 0.0;
   guide_learn(key, guide_learning_target(h, expected));
+}
+
+// --guiding auto (gpu_layout.h kGuidingAuto): a texel's strategy word, and whether work item w (a
+// texel sample of this batch) is guided.
+uint auto_texel_word(uint texel) { return guide_words[guide_words[kGuideAutoTexels] + texel]; }
+
+bool auto_work_guided(uint w) {
+  uint n = params.batch_item_count;
+  uint texel = batch_items[params.batch_item_offset + w % n];
+  return auto_sample_guided(auto_texel_word(texel), params.batch_sample_begin + w / n, guide_words[kGuideAutoPilot]);
 }

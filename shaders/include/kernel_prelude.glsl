@@ -73,7 +73,16 @@ void regenerate(uint p) {
     uint n = params.batch_item_count;
     uint texel = batch_items[params.batch_item_offset + w % n];
     uint sample_index = params.batch_sample_begin + w / n;
-    PathSampler rng = path_sampler(seed, uint64_t(texel), sample_index, params.sampler_mode);
+    // --guiding auto: each strategy on its own sequence, by its own count (guiding_auto_strategy.h).
+    uint64_t stream = uint64_t(texel);
+    uint strategy_index = sample_index;
+    if ((params.guiding & kGuidingAuto) != 0u) {
+      uint word = auto_texel_word(texel);
+      bool guided = auto_sample_guided(word, sample_index, guide_words[kGuideAutoPilot]);
+      stream = auto_sample_stream(texel, guided);
+      strategy_index = auto_strategy_sample_index(word, sample_index, guide_words[kGuideAutoPilot], guided);
+    }
+    PathSampler rng = path_sampler(seed, stream, strategy_index, params.sampler_mode);
     SurfacePoint x;
     x.position = start_points[texel].position.xyz;
     x.geometric_normal = start_points[texel].geometric_normal.xyz;

@@ -39,6 +39,7 @@ uint connect_shadow_rays(uint p, inout uint steps) {
       add_sh1_result(work, contribution.xyz, factor);
     }
   }
+  add_auto_cost(work, 0u, rays);
   return rays;
 }
 
@@ -54,11 +55,15 @@ uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rn
   bool directional_texel = !kProbeMode && params.directional != 0u && path_depth[p] == 0u;
   GuideVertex guide = guide_vertex_cosine();
   uint record = kGuideNoRecord;
-  if (!kProbeMode && (params.guiding & kGuidingSample) != 0u) {
+  // --guiding auto: only the texel samples of the guided strategy look the guide up.
+  bool guided_path = !kProbeMode && (params.guiding & kGuidingSample) != 0u;
+  if (guided_path && (params.guiding & kGuidingAuto) != 0u) guided_path = auto_work_guided(path_work[p]);
+  if (guided_path) {
     record = guide_record(x.position, x.shading_normal);
     guide = guide_vertex_of(record);
     uint guided = subgroupBallotBitCount(subgroupBallot(guide.guided_probability > 0.0));
     if (subgroupElect() && guided > 0u) add_stat64(kCounterGuidedVertices, guided);
+    if (guide.guided_probability > 0.0) add_auto_cost(path_work[p], 1u, 1u);
   }
   if (directional_texel) guide = with_uniform_component(guide, kDirectionalUniformProbability);
   next_event_estimation(x, origin, throughput, guide, rng, area, punctual_light, environment);

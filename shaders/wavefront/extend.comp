@@ -11,6 +11,7 @@ void main() {
   uint p = ray_queue[q * params.path_capacity + i];
   uint steps = 0u;
   path_hit[p] = trace_closest(path_ray_o[p].xyz, path_ray_d[p].xyz, kInfinity, steps);
+  if (!kProbeMode) add_auto_cost(path_work[p], 0u, 1u);
   bool primary = path_depth[p] == 0u;
   uint n_primary = subgroupBallotBitCount(subgroupBallot(primary));
   uint n_all = subgroupBallotBitCount(subgroupBallot(true));

@@ -2,9 +2,28 @@
 #extension GL_GOOGLE_include_directive : require
 // Stage "accumulate": per texel of the batch, adds each sample's total (sum of its bounce slots),
 // its square, its bounce layers and (directional batches) its L1 to double-precision sums, in sample
-// order (one writer per texel). A per-bounce layer pass also counts its back-face flags.
+// order (one writer per texel). A per-bounce layer pass also counts its back-face flags; a --guiding
+// auto pilot pass adds each sample's luminance moments and costs to its strategy's sums (gpu_layout.h).
 layout(local_size_x = 64) in;
 #include "../include/kernel_prelude.glsl"
+
+// GuidingChoice::record on the device: texel sample `sample_index` (of strategy `guided`) with total E/pi
+// `total`, counted at work item w, into the texel's strategy sums in the guide buffer's auto section.
+void record_auto_sample(uint texel, uint sample_index, uint w, vec3 total) {
+  uint pilot = guide_words[kGuideAutoPilot];
+  if (sample_index < guide_words[kGuideAutoStatisticsFrom] || sample_index >= pilot) return;
+  bool guided = auto_sample_guided(auto_texel_word(texel), sample_index, pilot);
+  uint s = guide_words[kGuideAutoSums] / 2u + (texel * 2u + (guided ? 1u : 0u)) * kAutoSumDoubles;
+  double y = double(luminance(total)), y2 = y * y;
+  uint c = auto_cost_index(w);
+  acc_probe_sh[s] += 1.0lf;
+  acc_probe_sh[s + 1u] += y;
+  acc_probe_sh[s + 2u] += y2;
+  acc_probe_sh[s + 3u] += y2 * y;
+  acc_probe_sh[s + 4u] += y2 * y2;
+  acc_probe_sh[s + 5u] += double(results[c]);
+  acc_probe_sh[s + 6u] += double(results[c + 1u]);
+}
 
 void main() {
   uint j = gl_GlobalInvocationID.x;
@@ -27,6 +46,7 @@ void main() {
     if (!finite) { ++nonfinite; continue; }
     if (params.directional != 0u)
       for (uint k = 0u; k < 9u; ++k) acc_total[sh1_sum_index(texel) + k] += double(results[sh1_result_index(w) + k]);
+    if ((params.guiding & kGuidingAutoRecord) != 0u) record_auto_sample(texel, params.batch_sample_begin + s, w, total);
     for (uint c = 0u; c < 3u; ++c) {
       acc_total[texel * 6u + c] += double(total[c]);
       acc_total[texel * 6u + 3u + c] += double(total[c]) * double(total[c]);

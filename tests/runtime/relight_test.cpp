@@ -393,8 +393,13 @@ TEST(Relight, BadScenesAreOneLineAndExitTwo) {
   EXPECT_EQ(run_relight((f.dir / "no-such.bake").string(), errors), 2);
   EXPECT_NE(errors.find("manifest.json"), std::string::npos) << errors;
   EXPECT_EQ(run_relight(f.baked.string() + " --spp -3", errors), 2);
-  // SVO guiding: a whole run, and it needs the bundle's octree.
+  // --guiding auto: bake's measured choice, refused here in one line.
   const fs::path guided_out = f.dir / "svo-out.bake";
+  EXPECT_EQ(run_relight(f.baked.string() + " -o " + guided_out.string() + " --guiding auto --spp 1", errors), 2);
+  EXPECT_EQ(std::count(errors.begin(), errors.end(), '\n'), 1) << errors;
+  EXPECT_NE(errors.find("--guiding auto"), std::string::npos) << errors;
+  EXPECT_FALSE(fs::exists(guided_out)) << "partial output";
+  // SVO guiding: a whole run, and it needs the bundle's octree.
   EXPECT_EQ(run_relight(f.baked.string() + " -o " + guided_out.string() + " --guiding svo --frames 2", errors), 2);
   EXPECT_EQ(std::count(errors.begin(), errors.end(), '\n'), 1) << errors;
   EXPECT_NE(errors.find("--guiding svo"), std::string::npos) << errors;

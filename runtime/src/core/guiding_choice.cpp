@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "exitance/common/guiding_auto_strategy.h"
 #include "exitance/common/rng.h"
 #include "exitance/runtime/core/estimates.h"
 
@@ -42,6 +43,14 @@ bool GuidingChoice::sample_guided(size_t texel, uint32_t sample) const {
   return (sample < pilot_ / 2) == guided_first;
 }
 
+uint32_t GuidingChoice::strategy_word(size_t texel) const {
+  uint32_t word = measuring(texel) ? kAutoMeasuring : 0u;
+  // Before the choice a measuring texel's sample 0 is guided exactly when its coin put the guided half first.
+  if (!decided_ && sample_guided(texel, 0)) word |= kAutoGuidedFirst;
+  if (decided_) word |= kAutoDecided | (texel_guided_[texel] != 0 ? kAutoGuided : 0u);
+  return word;
+}
+
 void GuidingChoice::record(size_t texel, uint32_t sample, bool guided, double luminance, uint64_t rays,
                            uint64_t guided_vertices) {
   if (decided_ || sample < statistics_from_ || sample >= pilot_) return;
@@ -54,6 +63,25 @@ void GuidingChoice::record(size_t texel, uint32_t sample, bool guided, double lu
   s.sum_fourth += y2 * y2;
   s.rays += rays;
   s.guided_vertices += guided_vertices;
+}
+
+void GuidingChoice::add_sums(size_t texel, bool guided, const StrategySums& add) {
+  if (decided_) return;
+  StrategySums& s = sums_[texel * 2 + (guided ? 1 : 0)];
+  s.samples += add.samples;
+  s.sum += add.sum;
+  s.sum_squared += add.sum_squared;
+  s.sum_cubed += add.sum_cubed;
+  s.sum_fourth += add.sum_fourth;
+  s.rays += add.rays;
+  s.guided_vertices += add.guided_vertices;
+}
+
+uint32_t GuidingChoice::pilot_for(uint32_t spp, uint32_t learning_samples) {
+  if (spp == 0 || spp >= 4 * learning_samples) return learning_samples;
+  uint32_t pilot = 4;
+  while (pilot * 2 <= spp / 4) pilot *= 2;
+  return pilot;
 }
 
 void GuidingChoice::decide() {
@@ -126,7 +154,7 @@ void GuidingChoice::decide(double floor) {
     const StrategySums* s = &sums_[i * 2];
     for (int k = 0; k < 2; ++k) {
       t.samples[k] = s[k].samples;
-      t.cost[k] = double(s[k].rays) + kGuidedVertexCostInRays * double(s[k].guided_vertices);
+      t.cost[k] = double(s[k].rays) + guided_vertex_cost_ * double(s[k].guided_vertices);
     }
     // Both strategies' variances are weighted by the same (pooled mean + floor)^2, so the comparison
     // is the one relMSE makes, and bright texels do not outvote dim ones.

@@ -33,6 +33,9 @@ json relight_bundle(const RelightOptions& options) {
     throw RelightInputError("--integrator " + options.integrator + ": expected path or bounces");
   if (per_bounce && (options.frames > 0 || options.frame_budget_ms > 0))
     throw RelightInputError("--integrator bounces runs the whole lightmap at once: --frames and --budget-ms need --integrator path");
+  if (options.guiding == "auto")
+    throw RelightInputError("--guiding auto: the measured choice runs in bake only (bake --backend vulkan --guiding auto); "
+                            "relight with --guiding off, grid or svo");
   const bool guided = options.guiding == "grid" || options.guiding == "svo";
   if (!guided && options.guiding != "off") throw RelightInputError("--guiding " + options.guiding + ": expected off, grid or svo");
   if (guided && per_bounce) throw RelightInputError("--guiding " + options.guiding + " guides path tracing: it needs --integrator path");

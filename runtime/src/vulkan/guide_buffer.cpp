@@ -1,5 +1,6 @@
 #include "guide_buffer.h"
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -39,6 +40,7 @@ GuideBuffer::GuideBuffer(const GridGuidingCache& cache) : records_(cache.record_
     throw std::runtime_error("Vulkan backend: --guiding grid: " + std::to_string(records_) +
                              " guiding records do not fit the guide buffer (use fewer --guiding-grid-cells)");
   words_.assign(words, 0u);
+  back_end_ = words;
   words_[kGuideLocatorKind] = kGuideLocatorGrid;
   words_[kGuideRecordCount] = records_;
   words_[kGuideLocatorOffset] = uint32_t(locator);
@@ -80,7 +82,7 @@ void GuideBuffer::upload(WavefrontBatchRunner& runner) const {
 void GuideBuffer::fold_learning(WavefrontBatchRunner& runner, GridGuidingCache& cache) {
   Context& context = runner.context();
   const Buffer& buffer = runner.buffers().probes.sh_sums;
-  const size_t back_words = words_.size() - back_;
+  const size_t back_words = back_end_ - back_;
   if (back_words == 0) return;
   context.download(buffer, &words_[back_], back_words * 4, back_ * 4);
   for (uint32_t r = 0; r < records_; ++r)
@@ -88,11 +90,40 @@ void GuideBuffer::fold_learning(WavefrontBatchRunner& runner, GridGuidingCache& 
       const uint32_t* w = &words_[back_ + (size_t(r) * kGuideBins + b) * kGuideBackWords];
       if (w[2] != 0) cache.import_learned(r, b, uint64_t(w[0]) | (uint64_t(w[1]) << 32), w[2]);
     }
-  std::fill(words_.begin() + std::ptrdiff_t(back_), words_.end(), 0u);
+  std::fill(words_.begin() + std::ptrdiff_t(back_), words_.begin() + std::ptrdiff_t(back_end_), 0u);
   cache.swap();
   pack_front(cache);
   // Front and CDFs (adjacent) with the new table, the back sums at 0 for the next pass.
-  context.upload(buffer, &words_[front_], (words_.size() - front_) * 4, front_ * 4);
+  context.upload(buffer, &words_[front_], (back_end_ - front_) * 4, front_ * 4);
+}
+
+void GuideBuffer::add_auto_sections(const std::vector<uint32_t>& texel_words, uint32_t pilot, uint32_t statistics_from) {
+  auto_texel_count_ = texel_words.size();
+  auto_texels_ = words_.size();
+  auto_sums_ = (auto_texels_ + texel_words.size() + 1) & ~size_t(1);  // doubles: an even word
+  const size_t words = auto_sums_ + auto_texel_count_ * 2 * kAutoSumDoubles * 2;
+  if (words >= (size_t(1) << 32))
+    throw std::runtime_error("Vulkan backend: --guiding auto: " + std::to_string(auto_texel_count_) +
+                             " texels' strategy sums do not fit the guide buffer (use a lower --texel-density)");
+  words_.resize(words, 0u);
+  std::copy(texel_words.begin(), texel_words.end(), words_.begin() + std::ptrdiff_t(auto_texels_));
+  words_[kGuideAutoTexels] = uint32_t(auto_texels_);
+  words_[kGuideAutoSums] = uint32_t(auto_sums_);
+  words_[kGuideAutoPilot] = pilot;
+  words_[kGuideAutoStatisticsFrom] = statistics_from;
+}
+
+void GuideBuffer::upload_auto_words(WavefrontBatchRunner& runner, const std::vector<uint32_t>& texel_words) {
+  if (texel_words.size() != auto_texel_count_) throw std::logic_error("GuideBuffer: strategy words of another atlas");
+  std::copy(texel_words.begin(), texel_words.end(), words_.begin() + std::ptrdiff_t(auto_texels_));
+  runner.context().upload(runner.buffers().probes.sh_sums, texel_words.data(), texel_words.size() * 4, auto_texels_ * 4);
+}
+
+std::vector<double> GuideBuffer::download_auto_sums(WavefrontBatchRunner& runner) const {
+  std::vector<double> sums(auto_texel_count_ * 2 * kAutoSumDoubles);
+  if (!sums.empty())
+    runner.context().download(runner.buffers().probes.sh_sums, sums.data(), sums.size() * 8, auto_sums_ * 4);
+  return sums;
 }
 
 }  // namespace exitance::vulkan

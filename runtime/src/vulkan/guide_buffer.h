@@ -34,11 +34,21 @@ class GuideBuffer {
 
   size_t bytes() const { return words_.size() * 4; }
 
+  // --guiding auto (gpu_layout.h kGuidingAuto): appends the per-texel strategy words and the zeroed
+  // strategy sums (kAutoSumDoubles x 2 per texel) after the grid's sections. Before upload().
+  void add_auto_sections(const std::vector<uint32_t>& texel_words, uint32_t pilot, uint32_t statistics_from);
+  // The strategy words onto the device again (after the choice).
+  void upload_auto_words(WavefrontBatchRunner& runner, const std::vector<uint32_t>& texel_words);
+  // The device's strategy sums, [texel][unguided, guided][kAutoSumDoubles].
+  std::vector<double> download_auto_sums(WavefrontBatchRunner& runner) const;
+
  private:
   void pack_front(const GridGuidingCache& cache);
 
   std::vector<uint32_t> words_;
   size_t front_ = 0, cdf_ = 0, back_ = 0;  // first words of the sections
+  size_t back_end_ = 0;                    // the grid's last section ends here; auto's follow
+  size_t auto_texels_ = 0, auto_sums_ = 0, auto_texel_count_ = 0;
   uint32_t records_ = 0;
 };
 

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "exitance/runtime/core/grid_guiding_cache.h"
+#include "exitance/runtime/core/guiding_choice.h"
 #include "exitance/runtime/core/pass_scheduler.h"
 #include "exitance/runtime/core/work_share.h"
 #include "exitance/runtime/core/svo_guiding_fields.h"
@@ -20,6 +21,32 @@ namespace {
 constexpr int kMaxRecordedBounces = 16;
 using Clock = std::chrono::steady_clock;
 
+// --guiding auto: every texel's strategy word (common/guiding_auto_strategy.h) from the choice.
+std::vector<uint32_t> strategy_words(const GuidingChoice& choice, size_t texel_count) {
+  std::vector<uint32_t> words(texel_count);
+  for (size_t i = 0; i < texel_count; ++i) words[i] = choice.strategy_word(i);
+  return words;
+}
+
+// The device's pilot sums (GuideBuffer::download_auto_sums) into the choice, as record() would add them.
+void import_strategy_sums(const std::vector<double>& sums, GuidingChoice& choice) {
+  const size_t texel_count = sums.size() / (2 * kAutoSumDoubles);
+  for (size_t i = 0; i < texel_count; ++i)
+    for (int k = 0; k < 2; ++k) {
+      const double* d = &sums[(i * 2 + size_t(k)) * kAutoSumDoubles];
+      if (d[0] == 0) continue;
+      StrategySums s;
+      s.samples = uint32_t(d[0]);
+      s.sum = d[1];
+      s.sum_squared = d[2];
+      s.sum_cubed = d[3];
+      s.sum_fourth = d[4];
+      s.rays = uint64_t(d[5]);
+      s.guided_vertices = uint64_t(d[6]);
+      choice.add_sums(i, k == 1, s);
+    }
+}
+
 }  // namespace
 
 // Buffers sized and bound, texels uploaded, sums cleared: an accumulation at sample 0.
@@ -31,6 +58,7 @@ void LightmapDriver::prepare(const TexelGBuffer& gbuffer, const IntegratorSettin
   // busy between drains, within the largest storage buffer.
   a.directional = settings.directional == DirectionalMode::Sh1;
   a.result_bytes = size_t(a.recorded + 1) * 12 + (a.directional ? 36 : 0);  // + 9 floats of L1 (sh1_result_index)
+  if (settings.guiding == GuidingMode::Auto) a.result_bytes += kAutoCostWords * 4;  // bindings.glsl auto_cost_index
   a.max_work = runner_.work_items_per_batch(a.result_bytes);
   a.start_points.resize(a.texel_count);
   for (size_t i = 0; i < a.texel_count; ++i) {
@@ -142,7 +170,16 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   // bake, as on the CPU: guided results are measured with the cost of their guiding data.
   std::unique_ptr<GridGuidingCache> guide;
   std::optional<GuideBuffer> guide_buffer;
-  if (settings.guiding == GuidingMode::Grid) {
+  // --guiding auto (core/guiding_choice.h, as on the CPU): the grid guide learns during a pilot in
+  // which a hashed quarter of the texels take guided and unguided halves; the device sums each
+  // strategy's samples per texel (gpu_layout.h kGuidingAuto), read back once when the pilot is
+  // complete; GuidingChoice decides per region, and the texels' verdicts go back as strategy words.
+  const bool auto_guiding = settings.guiding == GuidingMode::Auto;
+  if (auto_guiding && settings.guiding_auto_candidate != GuidingMode::Grid)
+    throw std::invalid_argument("Vulkan backend: --guiding auto measures grid guiding against unguided only");
+  std::unique_ptr<GuidingChoice> choice;
+  std::vector<uint32_t> auto_words;
+  if (settings.guiding == GuidingMode::Grid || auto_guiding) {
     if (share) throw std::invalid_argument("Vulkan backend: guiding runs in one process only, not under mpirun with several ranks");
     GridGuidingConfig config;
     config.mix = settings.guiding_mix;
@@ -150,6 +187,19 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     guide = std::make_unique<GridGuidingCache>(guiding_scene_.bounds_lo, guiding_scene_.bounds_hi,
                                                guiding_scene_.reference_radiance, gbuffer, config);
     guide_buffer.emplace(*guide);
+    if (auto_guiding) {
+      // Regions: the guide's records (grid cell x normal class), texels without one in one more (as on the CPU).
+      const uint32_t pilot = GuidingChoice::pilot_for(settings.spp, GridGuidingCache::kLearningSamples);
+      std::vector<uint32_t> region(a.texel_count);
+      for (size_t i = 0; i < a.texel_count; ++i) {
+        const uint32_t r = guide->record_of(gbuffer.texels[i].position, gbuffer.texels[i].shading_normal);
+        region[i] = r == GridGuidingCache::kNoRecord ? guide->record_count() : r;
+      }
+      choice = std::make_unique<GuidingChoice>(std::move(region), guide->record_count() + 1, pilot, pilot / 4, settings.seed);
+      choice->set_guided_vertex_cost(kGuidedVertexCostInRaysVulkan);
+      auto_words = strategy_words(*choice, a.texel_count);
+      guide_buffer->add_auto_sections(auto_words, pilot, pilot / 4);
+    }
     guide_buffer->upload(runner_);
   }
   // SVO guiding (svo_guide_buffer.h): the CPU reference's fields and schedule. The first pass is
@@ -176,7 +226,8 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   // 4, 8, ... 64); then, untimed, the largest passes (the frozen table makes pass sizes irrelevant).
   policy.largest_pass = uint32_t(std::max<size_t>(1, a.max_work / std::min(a.texel_count, a.max_work)));
   policy.ramp = settings.time_budget_seconds > 0 || settings.target_relative_error > 0;
-  if (guide && !policy.ramp) policy.ramp = true, policy.ramp_below = GridGuidingCache::kLearningSamples;
+  // Auto: ramped through its pilot only (the table freezes there; its last pass ends at the pilot).
+  if (guide && !policy.ramp) policy.ramp = true, policy.ramp_below = choice ? choice->pilot() : GridGuidingCache::kLearningSamples;
   // SVO: ramped throughout, as on the CPU, so its rebuilds (1, 2, 4, ... spp) end passes of the same sizes.
   if (svo_guide) policy.ramp = true, policy.ramp_below = PassPolicy{}.ramp_below;
   PassScheduler passes(settings, policy);
@@ -192,8 +243,14 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   uint32_t first = 0, pass = 0;
   while ((share || !a.work_list.empty()) && passes.next_pass(first, pass)) {
     const auto pass_start = Clock::now();
-    const bool learning = guide && first < GridGuidingCache::kLearningSamples;
+    // Auto: the guide learns during the pilot only; the pilot's passes record the strategy sums; after
+    // the choice only its guided texels' samples look the guide up (none at all: no guide lookup,
+    // but the strategy words still index each texel's unguided sequence where its pilot left it).
+    const bool learning = guide && first < (choice ? choice->pilot() : GridGuidingCache::kLearningSamples) &&
+                          (!choice || !choice->decided());
     if (guide) a.params.guiding = kGuidingSample | (learning ? kGuidingLearn : 0u);
+    if (choice) a.params.guiding |= kGuidingAuto | (choice->decided() ? 0u : kGuidingAutoRecord);
+    if (choice && choice->decided() && choice->texels_guided() == 0) a.params.guiding = kGuidingAuto;
     if (!a.work_list.empty()) {
       const size_t chunk = std::min(a.work_list.size(), a.max_work);
       pass = std::min<uint32_t>(pass, uint32_t(std::max<size_t>(1, a.max_work / chunk)));
@@ -202,6 +259,12 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
       if (share) share->work.texel_samples += uint64_t(a.work_list.size()) * pass;
     }
     if (learning) guide_buffer->fold_learning(runner_, *guide);  // this pass's learning is the next pass's table
+    if (choice && !choice->decided() && first + pass >= choice->pilot()) {  // the pilot is complete on every texel
+      import_strategy_sums(guide_buffer->download_auto_sums(runner_), *choice);
+      choice->decide();
+      auto_words = strategy_words(*choice, a.texel_count);
+      guide_buffer->upload_auto_words(runner_, auto_words);
+    }
     if (svo_guide && (a.params.guiding & kGuidingCount) != 0u) {  // this pass counted: rebuild the fields
       svo_buffer->import_counts(runner_, *svo_guide);
       const LightmapEstimate running = download(a);
@@ -228,6 +291,11 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   a.seconds = std::chrono::duration<double>(Clock::now() - start_time).count();
   runner_.record_statistics(a.totals, kTexelBatch);
   LightmapEstimate estimate = download(a);
+  if (choice) {
+    estimate.guiding_auto = true;
+    estimate.guiding_auto_pilot = choice->pilot();
+    if (choice->decided()) estimate.guiding_regions = choice->regions(), estimate.guiding_scene = choice->scene();
+  }
   if (guide && settings.inspect_guiding) settings.inspect_guiding(*guide);
   if (svo_guide && settings.inspect_svo_guiding) settings.inspect_svo_guiding(*svo_guide);
   if (settings.work_share) settings.work_share->work.rays += estimate.rays;

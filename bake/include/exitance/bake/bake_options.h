@@ -37,6 +37,9 @@ struct BakeOptions {
   // --emitter-guiding auto (the bake command's default): lighting.emitter_guiding is decided with the
   // integrator (on where the CPU backend path traces in one process); false: as given.
   bool emitter_guiding_auto = false;
+  // --guiding auto given on the command line (not the default): the Vulkan backend then runs the
+  // measured choice too; by default it stays unguided (bake/command/automatic_integrator.h).
+  bool guiding_auto_given = false;
   bool bounce_layers = false;
   // Sealed texels (bake/raster/sealed_texels.h) are found either way; true: the lighting stage
   // does not trace them (they are dilated from lit neighbours). --no-skip: false.

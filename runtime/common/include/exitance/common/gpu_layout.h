@@ -210,6 +210,10 @@ const uint kGuideCdfOffset = 4u;
 const uint kGuideBackOffset = 5u;
 const uint kGuideFixedUnits = 6u;       // + 7: the double's lo, hi words
 const uint kGuideFixedCap = 8u;
+const uint kGuideAutoTexels = 9u;      // --guiding auto: first word of the per-texel strategy words (0: none)
+const uint kGuideAutoSums = 10u;       // first word (even) of the per-texel strategy sums (doubles)
+const uint kGuideAutoPilot = 11u;      // pilot samples per texel (GuidingChoice::pilot)
+const uint kGuideAutoStatisticsFrom = 12u;  // first pilot sample whose values are summed
 const uint kGuideHeaderWords = 16u;
 const uint kGuideLocatorNone = 0u;      // every vertex samples cosine
 const uint kGuideLocatorGrid = 1u;
@@ -228,6 +232,19 @@ const uint kGuideNoRecord = 0xFFFFFFFFu;
 const uint kGuidingSample = 1u;         // GpuParams::guiding: vertices sample the front table's mixture
 const uint kGuidingLearn = 2u;          // and their continuation rays add to the back table
 const uint kGuidingCount = 4u;          // SVO locator: vertices count themselves per (node, class)
+// --guiding auto (core/guiding_choice.h; docs/lighting-core.md "`--guiding auto` on the Vulkan backend"):
+// two more sections of the grid's guide buffer. Per texel one strategy word (common/
+// guiding_auto_strategy.h: measuring, coin, decided, guided), which picks each texel sample's
+// strategy and sampler stream; only guided samples look up the guide. Per texel and strategy
+// [unguided, guided] kAutoSumDoubles doubles (StrategySums: samples, sum, squares, cubes, fourth
+// powers of the luminance of E/pi, rays, guided vertices), added by the accumulate stage in sample
+// order (one writer per texel, so bit-identical per seed) for samples [statistics_from, pilot), read
+// back once when the pilot is complete. While they are recorded each work item also counts its rays
+// and guided vertices, as 2 floats after the batch's result slots (bindings.glsl auto_cost_index).
+const uint kGuidingAuto = 8u;           // each texel sample's strategy from its strategy word
+const uint kGuidingAutoRecord = 16u;    // pilot passes: count work items' costs, add the strategy sums
+const uint kAutoSumDoubles = 7u;
+const uint kAutoCostWords = 2u;         // per work item: rays, guided vertices (floats)
 const uint kBindingCount = 31u;
 
 // Counter slots (uint each; statistics are 64-bit lo/hi pairs).

@@ -64,6 +64,9 @@ namespace exitance {
 // The extra cost of a guided vertex in units of one traced ray (CPU backend, grid guiding), measured
 // from per-sample times and counts: bench/results/guiding-auto.md, "Cost model".
 constexpr double kGuidedVertexCostInRays = 0.65;
+// The same price on the Vulkan backend (docs/lighting-core.md, "`--guiding auto` on the Vulkan
+// backend", says why this value): a constant, not a clock, so the choice stays deterministic per seed.
+constexpr double kGuidedVertexCostInRaysVulkan = 1.0;
 // Standard errors a difference of efficiency must exceed to count (one-sided 1.3e-3 under a normal).
 constexpr double kChoiceZ = 3.0;
 // The share of texels that measure both strategies in the pilot (the rest take unguided samples):
@@ -123,11 +126,23 @@ class GuidingChoice {
   GuidingChoice(std::vector<uint32_t> texel_region, uint32_t region_count, uint32_t pilot, uint32_t statistics_from,
                 uint64_t seed, double measuring_share = kPilotMeasuringShare);
 
+  // The pilot of a bake of `spp` samples per texel (0: unlimited) whose guide learns `learning_samples`:
+  // all of them; a bake of fewer spp gets the largest power of two up to a quarter of them, at least 4
+  // (the CPU backend's rule, cpu_reference_integrator.cpp guiding_auto_pilot).
+  static uint32_t pilot_for(uint32_t spp, uint32_t learning_samples);
+  // The price of a guided vertex in rays that decide() uses (default kGuidedVertexCostInRays, the
+  // CPU's); a backend whose guided vertices cost otherwise sets its own before decide().
+  void set_guided_vertex_cost(double rays) { guided_vertex_cost_ = rays; }
+  double guided_vertex_cost() const { return guided_vertex_cost_; }
+
   uint32_t pilot() const { return pilot_; }
   bool decided() const { return decided_; }
   // Whether sample `sample` of `texel` is guided: in the pilot, the half of it the texel's hashed
   // coin gave guiding; after it, the texel's leave-one-out choice.
   bool sample_guided(size_t texel, uint32_t sample) const;
+  // sample_guided and strategy_sample_index of `texel` as one word for the Vulkan kernels
+  // (common/guiding_auto_strategy.h: measuring, the pilot's coin, decided, the verdict).
+  uint32_t strategy_word(size_t texel) const;
   // Whether `texel` measures both strategies in the pilot (a hash of seed and texel).
   bool measuring(size_t texel) const;
   // The index of texel sample `sample` (of strategy `guided`) within its strategy's own sequence:
@@ -139,6 +154,9 @@ class GuidingChoice {
   // Adds one finished pilot sample (ignored outside [statistics_from, pilot) or after the choice).
   // Texels are independent: concurrent calls for different texels are safe.
   void record(size_t texel, uint32_t sample, bool guided, double luminance, uint64_t rays, uint64_t guided_vertices);
+  // Adds sums of samples recorded elsewhere (the Vulkan backend's device, which sums the pilot's
+  // samples [statistics_from, pilot) itself) to a texel's strategy (ignored after the choice).
+  void add_sums(size_t texel, bool guided, const StrategySums& sums);
   // Every region picks its strategy from the sums (deterministic given them). `floor`: the epsilon of
   // the relative variance, in luminance of E/pi (kErrorFloorFraction x the mean, as the EXR's error layer).
   void decide(double floor);
@@ -163,6 +181,7 @@ class GuidingChoice {
   uint32_t statistics_from_;
   uint64_t seed_;
   uint64_t measuring_below_;  // hash threshold: measuring_share x 2^64
+  double guided_vertex_cost_ = kGuidedVertexCostInRays;
   bool decided_ = false;
 };
 

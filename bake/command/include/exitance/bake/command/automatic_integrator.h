@@ -17,9 +17,10 @@ namespace exitance {
 IntegratorMode automatic_integrator(const BakeOptions& options, const Integrator& backend);
 
 // `--guiding auto` once the backend and integrator are known: Auto (the measured per-region choice,
-// core/guiding_choice.h) when the CPU backend path traces in one process; Off elsewhere: the Vulkan
-// backend has no guiding yet, per-bounce passes are not guided, guiding is not split over ranks.
-// Other modes pass through.
+// core/guiding_choice.h) when the CPU backend path traces in one process, or the Vulkan backend does
+// and --guiding auto was given (options.guiding_auto_given: by default GPU bakes pay no pilot, a
+// guided GPU bake costing 22-38x the time per spp today, bench/results/guiding-gpu.md); Off
+// elsewhere: per-bounce passes are not guided, guiding is not split over ranks. Other modes pass through.
 GuidingMode automatic_guiding(const BakeOptions& options, const Integrator& backend);
 
 // `--emitter-guiding auto`: on where the CPU backend bakes in one process, path tracing or per-bounce
