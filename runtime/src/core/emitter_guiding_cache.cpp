@@ -149,8 +149,8 @@ EmitterGuide EmitterGuidingCache::vertex(uint32_t record) const {
   return g;
 }
 
-EmitterGuidingCache::Site EmitterGuidingCache::site(EmitterGuidingCache* cache, Vec3 position, Vec3 shading_normal,
-                                                    Learning learning) {
+EmitterGuidingCache::Site EmitterGuidingCache::vertex_site(EmitterGuidingCache* cache, Vec3 position,
+                                                           Vec3 shading_normal, Learning learning) {
   Site s;
   s.guide = emitter_guide_none();
   if (!cache) return s;

@@ -54,7 +54,7 @@ class BounceGather {
     const LightingScene& scene = scene_;
     const Vec3 origin = offset_ray_origin(x.position, x.geometric_normal, scene.extent);
     ShadowRay shadow[kShadowRaysPerVertex];
-    const EmitterGuidingCache::Site site = EmitterGuidingCache::site(emitter_guide_, x.position, x.shading_normal, learning);
+    const EmitterGuidingCache::Site site = EmitterGuidingCache::vertex_site(emitter_guide_, x.position, x.shading_normal, learning);
     EmitterLearning learned;
     next_event_estimation(scene, x, origin, Vec3(1.0f), guide_vertex_cosine(), site.guide, rng, shadow[0], shadow[1],
                           shadow[2], learned);

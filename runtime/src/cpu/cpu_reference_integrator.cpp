@@ -76,6 +76,14 @@ void gather_texel_sums(WorkShare& share, LightmapEstimate& estimate, const std::
   allgather_items(share, texel_rays.data(), 1, bounds);
 }
 
+// Emitter guiding at a path's vertices (null: the default next-event sampling); which of its
+// next-event samples teach the back tables (EmitterGuidingCache::learning). Outside Impl: a default
+// argument of an Impl member cannot use a nested class's member initializers (clang).
+struct EmitterGuiding {
+  EmitterGuidingCache* cache = nullptr;
+  EmitterGuidingCache::Learning learning = EmitterGuidingCache::Learning::None;
+};
+
 }  // namespace
 
 struct CpuReferenceIntegrator::Impl {
@@ -156,13 +164,6 @@ struct CpuReferenceIntegrator::Impl {
     void observe(uint32_t, const GuideVertex&, Vec3, const Hit&) const {}
   };
 
-  // Emitter guiding at the path's vertices (null: the default next-event sampling); which of its
-  // next-event samples teach the back tables (EmitterGuidingCache::learning).
-  struct EmitterGuiding {
-    EmitterGuidingCache* cache = nullptr;
-    EmitterGuidingCache::Learning learning = EmitterGuidingCache::Learning::None;
-  };
-
   // One path sample of E/pi at x; `first_bounce` is the bounce x stands for (0 at a texel).
   template <class Guide>
   void trace(SurfacePoint x, const IntegratorSettings& settings, PathSampler& rng, PathContributions& out,
@@ -180,7 +181,7 @@ struct CpuReferenceIntegrator::Impl {
       if (directional_texel) g = with_uniform_component(g, kDirectionalUniformProbability);
       ShadowRay shadow[kShadowRaysPerVertex];
       const EmitterGuidingCache::Site site =
-          EmitterGuidingCache::site(emitter_guiding.cache, x.position, x.shading_normal, emitter_guiding.learning);
+          EmitterGuidingCache::vertex_site(emitter_guiding.cache, x.position, x.shading_normal, emitter_guiding.learning);
       const EmitterGuide& eg = site.guide;
       EmitterLearning learning;
       next_event_estimation(s, x, origin, throughput, g, eg, rng, shadow[0], shadow[1], shadow[2], learning);
@@ -366,7 +367,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     contributions.directional = directional;
     const uint64_t rays_before = rays, guided_before = guided_vertices;
     EmitterGuidingCache* emitter_cache = emitter_guiding_active ? emitter_guide.get() : nullptr;
-    const Impl::EmitterGuiding emitter_guiding{emitter_cache, emitter_cache ? EmitterGuidingCache::learning(s)
+    const EmitterGuiding emitter_guiding{emitter_cache, emitter_cache ? EmitterGuidingCache::learning(s)
                                                                            : EmitterGuidingCache::Learning::None};
     if (svo_guide)
       impl_->trace(point, settings, rng, contributions, rays,

@@ -89,10 +89,10 @@ class EmitterGuidingCache {
   // default's code path. A null cache: the default, learning nothing.
   struct Site {
     uint32_t record = kNoRecord;
-    EmitterGuide guide;
+    EmitterGuide guide = emitter_guide_none();
     bool learns = false;
   };
-  static Site site(EmitterGuidingCache* cache, Vec3 position, Vec3 shading_normal, Learning learning);
+  static Site vertex_site(EmitterGuidingCache* cache, Vec3 position, Vec3 shading_normal, Learning learning);
   // After the site's shadow rays: the samples that arrived (path.h EmitterLearning's patch and
   // light, kEmitterPatchNone for none) teach the back tables.
   void learn_arrived(const Site& site, uint32_t patch, float value, bool area_arrived, uint32_t punctual_light,
