@@ -11,10 +11,6 @@
 namespace exitance {
 namespace {
 
-// Fixed point as the grid cache's: 2^24 units per reference radiance, values capped at 2^16
-// references (the cap shapes the guide only; the estimator is unbiased whatever it learns).
-constexpr double kFixedUnitsPerReference = 16777216.0;
-constexpr float kCapInReferences = 65536.0f;
 // Back sum and count (one 16-byte accumulator), cumulative samples, cumulative sum, CDF entry.
 constexpr size_t kBytesPerRecordPatch = 16 + sizeof(uint32_t) + sizeof(double) + sizeof(float);
 
@@ -73,7 +69,7 @@ EmitterPatches build_emitter_patches(const std::vector<double>& cdf, uint32_t ta
   double cluster_share = 0;
   for (uint32_t k = 0; k < p.count();) {
     const uint32_t first_emitter = p.patch_emitters[2 * k];
-    const uint32_t unit = p.emitter_patch[first_emitter] & 7 ? 1u << (2 * (p.emitter_patch[first_emitter] & 7)) : 1u;
+    const uint32_t unit = 1u << (2 * (p.emitter_patch[first_emitter] & 7));  // 4^level patches
     double unit_share = 0;
     for (uint32_t j = k; j < k + unit; ++j) unit_share += p.default_probability[j];
     if (p.cluster_first.empty() || (cluster_share + unit_share) * ct > 1) {
@@ -102,10 +98,9 @@ EmitterGuidingCache::EmitterGuidingCache(const LightingScene& scene, const Texel
   triangle_emitter_.assign(scene.triangles.size(), kEmitterPatchNone);
   for (uint32_t e = 0; e < scene.emitter_count(); ++e) triangle_emitter_[scene.emitter_triangles[e]] = e;
 
-  float reference = GridGuidingCache::reference_radiance(scene);
-  if (!(reference > 0) || !std::isfinite(reference)) reference = 1.0f;
-  fixed_scale_ = kFixedUnitsPerReference / double(reference);
-  value_cap_ = reference * kCapInReferences;
+  const GuideFixedPoint fixed = guide_fixed_point_for(GridGuidingCache::reference_radiance(scene));
+  fixed_scale_ = fixed.units;
+  value_cap_ = fixed.cap;
 
   const size_t patches = patch_count();
   guided_probability_.assign(records, 0.0f);
@@ -124,6 +119,17 @@ EmitterGuidingCache::EmitterGuidingCache(const LightingScene& scene, const Texel
     for (size_t i = 0; i < records * punctual_count_; ++i) punctual_back_[i].store(0, std::memory_order_relaxed);
   }
   for (uint32_t r = 0; r < records; ++r) rebuild(r);
+}
+
+std::unique_ptr<EmitterGuidingCache> EmitterGuidingCache::for_bake(const LightingScene& scene,
+                                                                  const TexelGBuffer& gbuffer,
+                                                                  const IntegratorSettings& settings) {
+  if (!settings.emitter_guiding || (scene.emitter_count() == 0 && scene.punctual_count() < 2)) return nullptr;
+  EmitterGuidingConfig config;
+  config.mix = settings.emitter_guiding_mix;
+  config.cells_on_longest_axis = settings.guiding_grid_cells;
+  config.patch_target = settings.emitter_guiding_patches;
+  return std::make_unique<EmitterGuidingCache>(scene, gbuffer, config);
 }
 
 uint32_t EmitterGuidingCache::record_of(Vec3 position, Vec3 shading_normal) const {
@@ -152,7 +158,6 @@ EmitterGuide EmitterGuidingCache::vertex(uint32_t record) const {
 EmitterGuidingCache::Site EmitterGuidingCache::vertex_site(EmitterGuidingCache* cache, Vec3 position,
                                                            Vec3 shading_normal, Learning learning) {
   Site s;
-  s.guide = emitter_guide_none();
   if (!cache) return s;
   s.record = cache->record_of(position, shading_normal);
   const EmitterGuide guide = cache->vertex(s.record);
@@ -208,6 +213,21 @@ void EmitterGuidingCache::swap() {
     }
     if (changed) rebuild(r);
   }
+}
+
+void EmitterGuidingCache::end_pass(uint32_t samples) {
+  if (!active_) return;
+  swap();
+  if (samples >= kEveryLearningSamples && !samples_anywhere()) active_ = false;
+}
+
+void EmitterGuidingCache::report(LightmapEstimate::EmitterGuidingReport& out) const {
+  out.records = record_count();
+  out.records_sampling_learned = active_ ? records_sampling_learned() : 0;
+  out.patches = patch_count();
+  out.punctual_lights = punctual_count();
+  out.memory_bytes = memory_bytes();
+  out.dropped = !active_;
 }
 
 void EmitterGuidingCache::rebuild(uint32_t record) {

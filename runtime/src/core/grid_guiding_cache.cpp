@@ -10,10 +10,6 @@
 namespace exitance {
 namespace {
 
-// Fixed-point sums: 2^24 units per reference radiance, targets capped at 2^16 references, so one
-// bin overflows its 64 bits only after 2^24 capped targets in one pass.
-constexpr double kFixedUnitsPerReference = 16777216.0;
-constexpr float kCapInReferences = 65536.0f;
 // Old sample counts are kept at every swap (a cumulative mean, as the thesis accumulates): passes
 // are small (a few spp), and halving per swap left ~4 samples behind a bin (plots in
 // bench/results/guiding.md), whose noise the sampler then followed.
@@ -22,20 +18,15 @@ constexpr float kCountDecay = 1.0f;
 // few times (one lucky emitter hit) does not draw the sampler.
 constexpr double kPriorSamples = 8;
 
-struct Grid {
-  float cell = 1;
-  int dims[3] = {1, 1, 1};
-};
-
-Grid make_grid(Vec3 extent, int n) {
-  Grid g;
-  const float longest = std::max({extent.x, extent.y, extent.z});
-  g.cell = longest > 0 && std::isfinite(longest) ? longest / float(n) : 1.0f;
-  for (int a = 0; a < 3; ++a) g.dims[a] = std::clamp(int(std::ceil(extent[a] / g.cell)), 1, n);
-  return g;
-}
-
 }  // namespace
+
+GuideFixedPoint guide_fixed_point_for(float reference) {
+  // Fixed-point sums: 2^24 units per reference radiance, values capped at 2^16 references, so one
+  // sum overflows its 64 bits only after 2^24 capped values in one pass. A scene without emission
+  // or sky has reference 1 (it learns 0).
+  if (!(reference > 0) || !std::isfinite(reference)) reference = 1.0f;
+  return {16777216.0 / double(reference), reference * 65536.0f};
+}
 
 float GridGuidingCache::reference_radiance(const LightingScene& scene) {
   float reference = luminance(scene.sky);
@@ -55,10 +46,9 @@ GridGuidingCache::GridGuidingCache(Vec3 bounds_lo, Vec3 bounds_hi, float referen
   front_.resize(locator_.record_count());
   for (uint32_t r = 0; r < front_.size(); ++r) front_[r].normal_class = locator_.normal_class(r);
 
-  // The radiance scale: the brightest emission or sky (luminance); a scene without either learns 0.
-  if (!(reference > 0) || !std::isfinite(reference)) reference = 1.0f;
-  fixed_scale_ = kFixedUnitsPerReference / double(reference);
-  target_cap_ = reference * kCapInReferences;
+  const GuideFixedPoint fixed = guide_fixed_point_for(reference);
+  fixed_scale_ = fixed.units;
+  target_cap_ = fixed.cap;
 
   const size_t records = front_.size();
   cdf_.assign(records * (kGuideBins + 1), 0.0f);

@@ -31,24 +31,20 @@ bool GuidingChoice::measuring(size_t texel) const {
 }
 
 uint32_t GuidingChoice::strategy_sample_index(size_t texel, uint32_t sample, bool guided) const {
-  if (!measuring(texel)) return guided ? sample - std::min(sample, pilot_) : sample;  // the pilot was all unguided
-  return sample < pilot_ ? sample % (pilot_ / 2) : sample - pilot_ / 2;
+  return auto_strategy_sample_index(measuring(texel) ? kAutoMeasuring : 0u, sample, pilot_, guided);
 }
 
 bool GuidingChoice::sample_guided(size_t texel, uint32_t sample) const {
-  if (decided_) return texel_guided_[texel] != 0;
-  if (!measuring(texel)) return false;
-  // Which half of the pilot is guided: a hash of (seed, texel) with its own salt (see the header).
-  const bool guided_first = (splitmix64(seed_ ^ 0x6A1D1C401CE5A17Bull ^ uint64_t(texel)) >> 63) != 0;
-  return (sample < pilot_ / 2) == guided_first;
+  return auto_sample_guided(strategy_word(texel), sample, pilot_);
 }
 
 uint32_t GuidingChoice::strategy_word(size_t texel) const {
-  uint32_t word = measuring(texel) ? kAutoMeasuring : 0u;
-  // Before the choice a measuring texel's sample 0 is guided exactly when its coin put the guided half first.
-  if (!decided_ && sample_guided(texel, 0)) word |= kAutoGuidedFirst;
-  if (decided_) word |= kAutoDecided | (texel_guided_[texel] != 0 ? kAutoGuided : 0u);
-  return word;
+  // The measuring bit stays after the choice: the texel's sample indices depend on its pilot.
+  const uint32_t word = measuring(texel) ? kAutoMeasuring : 0u;
+  if (decided_) return word | kAutoDecided | (texel_guided_[texel] != 0 ? kAutoGuided : 0u);
+  // Which half of the pilot is guided: a hash of (seed, texel) with its own salt (see the header).
+  const bool guided_first = (splitmix64(seed_ ^ 0x6A1D1C401CE5A17Bull ^ uint64_t(texel)) >> 63) != 0;
+  return word != 0 && guided_first ? word | kAutoGuidedFirst : word;
 }
 
 void GuidingChoice::record(size_t texel, uint32_t sample, bool guided, double luminance, uint64_t rays,

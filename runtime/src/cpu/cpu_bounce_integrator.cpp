@@ -159,32 +159,22 @@ class BounceGather {
 // Layer passes over texels in parallel (TBB), each texel's samples in order: deterministic sums.
 // Emitter guiding (settings.emitter_guiding): one cache through all layers' passes, learning from
 // the direct-light samples (B_0's, and B_1's traced ones at gather hits), folded before each pass;
-// dropped, as in path mode, when after 64 samples of a layer no record gains enough.
+// inactive, as in path mode, when after 64 samples of a layer no record gains enough
+// (EmitterGuidingCache::end_pass).
 class CpuBounceLayerEstimator final : public BounceLayerEstimator {
  public:
   CpuBounceLayerEstimator(const LightingScene& scene, const EmbreeScene& embree, const TexelGBuffer& gbuffer,
                           const IntegratorSettings& settings)
-      : scene_(scene), embree_(embree), gbuffer_(gbuffer), settings_(settings) {
-    if (settings.emitter_guiding && (scene.emitter_count() > 0 || scene.punctual_count() >= 2)) {
-      EmitterGuidingConfig config;
-      config.mix = settings.emitter_guiding_mix;
-      config.cells_on_longest_axis = settings.guiding_grid_cells;
-      config.patch_target = settings.emitter_guiding_patches;
-      emitter_guide_ = std::make_unique<EmitterGuidingCache>(scene, gbuffer, config);
-      built_ = true;
-    }
-  }
+      : scene_(scene), embree_(embree), gbuffer_(gbuffer), settings_(settings),
+        emitter_guide_(EmitterGuidingCache::for_bake(scene, gbuffer, settings)) {}
 
   void estimate(const BounceLayerPass& pass, const std::vector<BounceLayerCache>& caches,
                 const std::vector<uint64_t>&) override {
-    if (emitter_guide_) {
-      // The previous pass's learning becomes this pass's front table.
-      if (learned_samples_ > 0) emitter_guide_->swap();
-      if (learned_samples_ >= EmitterGuidingCache::kEveryLearningSamples && !emitter_guide_->samples_anywhere())
-        emitter_guide_.reset();
-    }
-    if (emitter_guide_) learned_samples_ = std::max(learned_samples_, pass.first_sample + pass.samples);
-    const BounceGather gather(scene_, embree_, gbuffer_, caches, settings_, emitter_guide_.get());
+    // The previous pass's learning becomes this pass's front table.
+    if (emitter_guide_ && learned_samples_ > 0) emitter_guide_->end_pass(learned_samples_);
+    EmitterGuidingCache* emitter_guide = emitter_guide_ && emitter_guide_->active() ? emitter_guide_.get() : nullptr;
+    learned_samples_ = std::max(learned_samples_, pass.first_sample + pass.samples);
+    const BounceGather gather(scene_, embree_, gbuffer_, caches, settings_, emitter_guide);
     const size_t k = size_t(pass.layer);
     tbb::parallel_for(tbb::blocked_range<size_t>(pass.begin, pass.end, 64), [&](const tbb::blocked_range<size_t>& range) {
       Counters& c = counters_per_thread_.local();
@@ -197,7 +187,7 @@ class CpuBounceLayerEstimator final : public BounceLayerEstimator {
                                    : path_sampler(settings_.seed, kBounceRngStreamBase * k + i, s, settings_.sampler);
           bool back_face = false;
           const EmitterGuidingCache::Learning learning =
-              emitter_guide_ ? EmitterGuidingCache::learning(s) : EmitterGuidingCache::Learning::None;
+              emitter_guide ? EmitterGuidingCache::learning(s) : EmitterGuidingCache::Learning::None;
           const Vec3 value =
               k == 0 ? gather.direct(x, rng, c, back_face, learning) : gather.gather(x, int(k) - 1, rng, c, learning);
           if (back_face) ++pass.back_faces[i];
@@ -217,14 +207,7 @@ class CpuBounceLayerEstimator final : public BounceLayerEstimator {
 
   // What emitter guiding's cache held at the end (nothing when it was off).
   void report(LightmapEstimate::EmitterGuidingReport& out) const {
-    if (!built_) return;
-    out.dropped = !emitter_guide_;
-    if (!emitter_guide_) return;
-    out.records = emitter_guide_->record_count();
-    out.records_sampling_learned = emitter_guide_->records_sampling_learned();
-    out.patches = emitter_guide_->patch_count();
-    out.punctual_lights = emitter_guide_->punctual_count();
-    out.memory_bytes = emitter_guide_->memory_bytes();
+    if (emitter_guide_) emitter_guide_->report(out);
   }
 
   BounceGatherCounts counts() const override {
@@ -244,7 +227,6 @@ class CpuBounceLayerEstimator final : public BounceLayerEstimator {
   mutable tbb::combinable<Counters> counters_per_thread_;
   std::unique_ptr<EmitterGuidingCache> emitter_guide_;
   uint32_t learned_samples_ = 0;  // the most samples per texel any layer's passes have taken so far
-  bool built_ = false;            // emitter guiding was on (emitter_guide_ is null once dropped)
 };
 
 }  // namespace

@@ -32,15 +32,6 @@ constexpr int kMaxRecordedBounces = 16;
 // small scenes the learning (a target per ray, atomic adds) costs as much as the ray itself, and by
 // then the table has stopped improving (bench/results/guiding.md). Shared with the Vulkan backend.
 constexpr uint32_t kGuidingLearningSamples = GridGuidingCache::kLearningSamples;
-// --guiding auto: the pilot (guided and unguided samples on a quarter of the texels, the guide learning) lasts
-// the grid's learning samples; a bake of fewer --spp gives it the largest power of two up to a
-// quarter of them, at least 4 (powers of two from 4 on are boundaries of the ramp's passes).
-uint32_t guiding_auto_pilot(uint32_t spp) {
-  if (spp == 0 || spp >= 4 * kGuidingLearningSamples) return kGuidingLearningSamples;
-  uint32_t pilot = 4;
-  while (pilot * 2 <= spp / 4) pilot *= 2;
-  return pilot;
-}
 // A target error plans at most this many samples for a texel without --spp (documented).
 constexpr uint32_t kMostSamplesForTarget = 1u << 17;
 
@@ -308,16 +299,9 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     if (svo_guide->seeded()) svo_guide->rebuild(nullptr, 0, settings.seed);
   }
   // Emitter guiding: learned from every pass's next-event samples, folded after each pass.
-  std::unique_ptr<EmitterGuidingCache> emitter_guide;
-  if (settings.emitter_guiding && (impl_->lighting->emitter_count() > 0 || impl_->lighting->punctual_count() >= 2)) {
-    if (share) throw std::invalid_argument("CPU backend: --emitter-guiding runs in one process only, not under mpirun with several ranks");
-    EmitterGuidingConfig config;
-    config.mix = settings.emitter_guiding_mix;
-    config.cells_on_longest_axis = settings.guiding_grid_cells;
-    config.patch_target = settings.emitter_guiding_patches;
-    emitter_guide = std::make_unique<EmitterGuidingCache>(*impl_->lighting, gbuffer, config);
-  }
-  bool emitter_guiding_active = emitter_guide != nullptr;
+  const std::unique_ptr<EmitterGuidingCache> emitter_guide = EmitterGuidingCache::for_bake(*impl_->lighting, gbuffer, settings);
+  if (emitter_guide && share)
+    throw std::invalid_argument("CPU backend: --emitter-guiding runs in one process only, not under mpirun with several ranks");
   // --guiding auto (guiding_choice.h): regions are the guide's records (grid cell x normal class of
   // the texel), the unit whose learned table decides how well its texels' first vertices are guided,
   // with at least 16 texels each, so a region's variance sums are not one texel's noise. Texels
@@ -325,7 +309,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   std::unique_ptr<GuidingChoice> choice;
   if (settings.guiding == GuidingMode::Auto) {
     if (!guide) throw std::invalid_argument("CPU backend: --guiding auto has no guided kind to measure (candidate not built)");
-    const uint32_t pilot = guiding_auto_pilot(settings.spp);
+    const uint32_t pilot = GuidingChoice::pilot_for(settings.spp, kGuidingLearningSamples);
     std::vector<uint32_t> region(texel_count);
     for (size_t i = 0; i < texel_count; ++i) {
       const uint32_t r = guide->record_of(gbuffer.texels[i].position, gbuffer.texels[i].shading_normal);
@@ -366,7 +350,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     contributions.recorded = estimate.recorded_bounces;
     contributions.directional = directional;
     const uint64_t rays_before = rays, guided_before = guided_vertices;
-    EmitterGuidingCache* emitter_cache = emitter_guiding_active ? emitter_guide.get() : nullptr;
+    EmitterGuidingCache* emitter_cache = emitter_guide && emitter_guide->active() ? emitter_guide.get() : nullptr;
     const EmitterGuiding emitter_guiding{emitter_cache, emitter_cache ? EmitterGuidingCache::learning(s)
                                                                            : EmitterGuidingCache::Learning::None};
     if (svo_guide)
@@ -457,13 +441,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       }
     }
     if (learning) guide->swap();  // this pass's learning becomes the next pass's frozen table
-    if (emitter_guide && emitter_guiding_active) {
-      emitter_guide->swap();
-      // Past the samples every vertex learns from, a scene where no record samples its learned
-      // distribution (every light seen whole, as in the Cornell room) drops the cache altogether.
-      if (first + count >= EmitterGuidingCache::kEveryLearningSamples && !emitter_guide->samples_anywhere())
-        emitter_guiding_active = false;
-    }
+    if (emitter_guide) emitter_guide->end_pass(first + count);
     if (svo_guide && svo_counting) {  // this pass reached the next rebuild and counted its vertices
       svo_guide->rebuild(&estimate, double(count) * fraction, settings.seed);
       svo_next_rebuild = 2 * (first + count);
@@ -516,13 +494,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   if (guide && settings.inspect_guiding) settings.inspect_guiding(*guide);
   if (svo_guide && settings.inspect_svo_guiding) settings.inspect_svo_guiding(*svo_guide);
   if (emitter_guide) {
-    LightmapEstimate::EmitterGuidingReport& report = estimate.emitter_guiding;
-    report.records = emitter_guide->record_count();
-    report.records_sampling_learned = emitter_guiding_active ? emitter_guide->records_sampling_learned() : 0;
-    report.patches = emitter_guide->patch_count();
-    report.punctual_lights = emitter_guide->punctual_count();
-    report.memory_bytes = emitter_guide->memory_bytes();
-    report.dropped = !emitter_guiding_active;
+    emitter_guide->report(estimate.emitter_guiding);
     if (settings.inspect_emitter_guiding) settings.inspect_emitter_guiding(*emitter_guide);
   }
   estimate.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

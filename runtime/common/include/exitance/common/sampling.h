@@ -42,14 +42,14 @@ EXITANCE_FN vec3 to_world(vec3 local, vec3 n) {
   return t * local.x + b * local.y + n * local.z;
 }
 
-// Uniform point on a triangle (Heitz 2019, "A Low-Distortion Map Between Triangle and Square"):
-// barycentrics (b1, b2) of vertices 1 and 2.
 // u in [lo, lo + width) rescaled to [0, 1): a one-sample mixture's choice number reused as the
 // chosen component's own number, so the component keeps the sampler's stratification.
 EXITANCE_FN float rescaled_unit(float u, float lo, float width) {
   return min(max((u - lo) / width, 0.0f), 0.99999994f);
 }
 
+// Uniform point on a triangle (Heitz 2019, "A Low-Distortion Map Between Triangle and Square"):
+// barycentrics (b1, b2) of vertices 1 and 2.
 EXITANCE_FN vec2 sample_triangle_barycentrics(float u1, float u2) {
   if (u2 > u1) {
     float b1 = u1 * 0.5f;

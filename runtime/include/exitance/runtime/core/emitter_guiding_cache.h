@@ -25,7 +25,9 @@
 #include <vector>
 
 #include "exitance/common/guided_emitters.h"
+#include "exitance/runtime/core/estimates.h"
 #include "exitance/runtime/core/guide_grid_locator.h"
+#include "exitance/runtime/core/integrator_settings.h"
 #include "exitance/runtime/core/lighting_scene.h"
 #include "exitance/runtime/texel_gbuffer.h"
 
@@ -67,6 +69,10 @@ class EmitterGuidingCache {
   static constexpr size_t kMemoryBudget = size_t(256) << 20;  // tables of all records together
 
   EmitterGuidingCache(const LightingScene& scene, const TexelGBuffer& gbuffer, const EmitterGuidingConfig& config);
+  // The cache a bake's settings ask for (both CPU estimators): null when settings.emitter_guiding is
+  // off or the scene has nothing to guide (no emitter triangle and fewer than two punctual lights).
+  static std::unique_ptr<EmitterGuidingCache> for_bake(const LightingScene& scene, const TexelGBuffer& gbuffer,
+                                                       const IntegratorSettings& settings);
 
   // Which vertices of a texel's sample `sample` teach the tables: every vertex in its first
   // kEveryLearningSamples; after them, one sample in kLaterLearningStride, at vertices whose record
@@ -106,6 +112,14 @@ class EmitterGuidingCache {
   void learn_punctual(uint32_t record, uint32_t light, float value);
   // Between passes: folds the sums learned since the last swap into the front tables.
   void swap();
+  // After a pass that brought texels to `samples` samples each: swap(), and past
+  // kEveryLearningSamples, where no record samples a learned distribution (every light seen whole,
+  // as in the Cornell room), the cache stops: inactive, its vertices take the default's code path
+  // and nothing more is learned or folded.
+  void end_pass(uint32_t samples);
+  bool active() const { return active_; }
+  // What the cache held (for the manifest's stats.emitter_guiding).
+  void report(LightmapEstimate::EmitterGuidingReport& out) const;
 
   // Whether any record samples a learned distribution (area or punctual lights), and how many do.
   bool samples_anywhere() const { return records_sampling_learned() > 0; }
@@ -128,6 +142,7 @@ class EmitterGuidingCache {
   float fill_cdf(const std::vector<double>& shares, const float* default_probability, size_t cells, float* cdf) const;
 
   EmitterGuidingConfig config_;
+  bool active_ = true;
   GuideGridLocator locator_;
   EmitterPatches patches_;
   std::vector<uint32_t> triangle_emitter_;  // per scene triangle

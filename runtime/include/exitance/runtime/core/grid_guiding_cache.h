@@ -38,6 +38,16 @@
 
 namespace exitance {
 
+// The fixed-point units of learned sums (common/guide_learning.h guide_fixed_point), for the grid
+// and the emitter guiding caches: per unit of radiance (or value), and the cap values are clamped
+// to (shaping the guide only: the estimator is unbiased whatever it learns), from the scene's
+// reference radiance (GridGuidingCache::reference_radiance).
+struct GuideFixedPoint {
+  double units;
+  float cap;
+};
+GuideFixedPoint guide_fixed_point_for(float reference);
+
 struct GridGuidingConfig {
   float mix = 0.5f;               // guided component's probability at a guided vertex
   int cells_on_longest_axis = 16;

@@ -59,6 +59,8 @@
 #include <string>
 #include <vector>
 
+#include "exitance/common/guiding_auto_strategy.h"
+
 namespace exitance {
 
 // The extra cost of a guided vertex in units of one traced ray (CPU backend, grid guiding), measured
@@ -128,7 +130,7 @@ class GuidingChoice {
 
   // The pilot of a bake of `spp` samples per texel (0: unlimited) whose guide learns `learning_samples`:
   // all of them; a bake of fewer spp gets the largest power of two up to a quarter of them, at least 4
-  // (the CPU backend's rule, cpu_reference_integrator.cpp guiding_auto_pilot).
+  // (powers of two from 4 on are boundaries of the ramp's passes). Both backends.
   static uint32_t pilot_for(uint32_t spp, uint32_t learning_samples);
   // The price of a guided vertex in rays that decide() uses (default kGuidedVertexCostInRays, the
   // CPU's); a backend whose guided vertices cost otherwise sets its own before decide().
@@ -140,8 +142,9 @@ class GuidingChoice {
   // Whether sample `sample` of `texel` is guided: in the pilot, the half of it the texel's hashed
   // coin gave guiding; after it, the texel's leave-one-out choice.
   bool sample_guided(size_t texel, uint32_t sample) const;
-  // sample_guided and strategy_sample_index of `texel` as one word for the Vulkan kernels
-  // (common/guiding_auto_strategy.h: measuring, the pilot's coin, decided, the verdict).
+  // sample_guided and strategy_sample_index of `texel` as one word (common/guiding_auto_strategy.h:
+  // measuring, the pilot's coin, decided, the verdict), which both answer through that header's
+  // functions, as the Vulkan kernels do.
   uint32_t strategy_word(size_t texel) const;
   // Whether `texel` measures both strategies in the pilot (a hash of seed and texel).
   bool measuring(size_t texel) const;
@@ -150,7 +153,7 @@ class GuidingChoice {
   uint32_t strategy_sample_index(size_t texel, uint32_t sample, bool guided) const;
   // The random stream of a texel's guided samples (unguided ones use the texel's usual stream): a salt
   // far from the texel, probe and bounce-pass stream ranges.
-  static uint64_t guided_stream(size_t texel) { return uint64_t(texel) ^ 0xA5E1D6C3B2F40000ull; }
+  static uint64_t guided_stream(size_t texel) { return uint64_t(texel) ^ kAutoGuidedStreamSalt; }
   // Adds one finished pilot sample (ignored outside [statistics_from, pilot) or after the choice).
   // Texels are independent: concurrent calls for different texels are safe.
   void record(size_t texel, uint32_t sample, bool guided, double luminance, uint64_t rays, uint64_t guided_vertices);
