@@ -25,13 +25,26 @@ void record_auto_sample(uint texel, uint sample_index, uint w, vec3 total) {
   acc_probe_sh[s + 6u] += double(results[c + 1u]);
 }
 
+// The sums live in registers (local memory for the layers) through the sample loop and go back to
+// the buffers once: the compiler must assume that the result and sum buffers may alias, so a
+// `+=` on a buffer inside the loop was a global read and write per sample (the additions, and so
+// the bits, are the same in either form: each sum still adds the samples in their order).
 void main() {
   uint j = gl_GlobalInvocationID.x;
   uint n = params.batch_item_count;
   if (j >= n) return;
   uint texel = batch_items[params.batch_item_offset + j];
   uint K = params.recorded;
+  bool directional = params.directional != 0u;
   uint nonfinite = 0u, samples = 0u, back_faces = 0u;
+  dvec3 sum, square;
+  for (uint c = 0u; c < 3u; ++c) sum[c] = acc_total[texel * 6u + c], square[c] = acc_total[texel * 6u + 3u + c];
+  dvec3 layer[kMaxRecordedLayers];
+  for (uint k = 0u; k < K; ++k)
+    for (uint c = 0u; c < 3u; ++c) layer[k][c] = acc_bounce[(k * params.item_count_total + texel) * 3u + c];
+  double sh1[9];
+  if (directional)
+    for (uint k = 0u; k < 9u; ++k) sh1[k] = acc_total[sh1_sum_index(texel) + k];
   for (uint s = 0u; s < params.batch_sample_count; ++s) {
     uint w = s * n + j;
     if ((params.bounce_flags & kBouncePass) != 0u && results[bounce_back_face_index(w)] > 0.0) ++back_faces;
@@ -41,22 +54,27 @@ void main() {
       total += vec3(results[r], results[r + 1u], results[r + 2u]);
     }
     bool finite = !(any(isnan(total)) || any(isinf(total)));
-    if (params.directional != 0u)
+    if (directional)
       for (uint k = 0u; k < 9u; ++k) finite = finite && !isnan(results[sh1_result_index(w) + k]) && !isinf(results[sh1_result_index(w) + k]);
     if (!finite) { ++nonfinite; continue; }
-    if (params.directional != 0u)
-      for (uint k = 0u; k < 9u; ++k) acc_total[sh1_sum_index(texel) + k] += double(results[sh1_result_index(w) + k]);
+    if (directional)
+      for (uint k = 0u; k < 9u; ++k) sh1[k] += double(results[sh1_result_index(w) + k]);
     if ((params.guiding & kGuidingAutoRecord) != 0u) record_auto_sample(texel, params.batch_sample_begin + s, w, total);
     for (uint c = 0u; c < 3u; ++c) {
-      acc_total[texel * 6u + c] += double(total[c]);
-      acc_total[texel * 6u + 3u + c] += double(total[c]) * double(total[c]);
+      sum[c] += double(total[c]);
+      square[c] += double(total[c]) * double(total[c]);
     }
     for (uint k = 0u; k < K; ++k) {
       uint r = result_index(w, k);
-      for (uint c = 0u; c < 3u; ++c) acc_bounce[(uint(k) * params.item_count_total + texel) * 3u + c] += double(results[r + c]);
+      for (uint c = 0u; c < 3u; ++c) layer[k][c] += double(results[r + c]);
     }
     ++samples;
   }
+  for (uint c = 0u; c < 3u; ++c) acc_total[texel * 6u + c] = sum[c], acc_total[texel * 6u + 3u + c] = square[c];
+  for (uint k = 0u; k < K; ++k)
+    for (uint c = 0u; c < 3u; ++c) acc_bounce[(k * params.item_count_total + texel) * 3u + c] = layer[k][c];
+  if (directional)
+    for (uint k = 0u; k < 9u; ++k) acc_total[sh1_sum_index(texel) + k] = sh1[k];
   acc_samples[texel] += samples;
   // Per-bounce layer passes record no bounce layers: the first slot counts back faces instead.
   if ((params.bounce_flags & kBouncePass) != 0u) acc_bounce[texel * 3u] += double(back_faces);

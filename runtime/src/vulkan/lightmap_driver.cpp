@@ -18,7 +18,7 @@
 namespace exitance::vulkan {
 namespace {
 
-constexpr int kMaxRecordedBounces = 16;
+constexpr int kMaxRecordedBounces = int(kMaxRecordedLayers);
 using Clock = std::chrono::steady_clock;
 
 // --guiding auto: every texel's strategy word (common/guiding_auto_strategy.h) from the choice.

@@ -68,6 +68,8 @@ struct GpuSurfacePoint {
 // A shadow ray from the vertex's offset origin: unit direction and length, and what it adds when
 // unoccluded (path throughput included). state: kShadowNone, kShadowTrace, or kShadowCountOnly
 // (counted as a traced ray, as the reference counts it, but its segment has zero length).
+// Bounce layers a texel batch records at most (reduce.comp keeps one running sum per layer).
+const uint kMaxRecordedLayers = 16u;
 const uint kShadowRaysPerVertex = 3u;  // area light, punctual light, environment
 // The wavefront's shadow-ray buffer has room for all three per path slot, but its stride is
 // GpuParams::shadow_slots: 2 unless the sky is an image, since a third slot written per vertex cost
