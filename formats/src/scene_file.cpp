@@ -180,6 +180,14 @@ void validate_tangents(const SceneFile& s, const std::string& name) {
   }
 }
 
+// What versions 1-3 cannot hold: a triangle in several leaf slots (spatial splits, version 4).
+void refuse_version4_content(const SceneFile& s, const std::string& name, uint32_t version) {
+  if (s.bvh.leaf_triangles.size() != s.triangles.count())
+    throw FormatError(name + ": bvh: " + std::to_string(s.bvh.leaf_triangles.size()) + " leaf slots for " +
+                      std::to_string(s.triangles.count()) + " triangles: a triangle in several leaf slots is not stored by scene.bin version " +
+                      std::to_string(version));
+}
+
 // What version 2 cannot hold, for encode_scene(scene, 2).
 void refuse_version3_content(const SceneFile& s, const std::string& name, uint32_t version) {
   const std::string why = " is not stored by scene.bin version " + std::to_string(version);
@@ -470,24 +478,26 @@ void validate_bvh(const SceneFile& s, const std::string& name) {
   const size_t node_count = bvh.nodes.size();
   if (node_count == 0) throw FormatError(name + ": bvh: no root node");
   if (node_count > kMaxSceneTriangles) throw FormatError(name + ": bvh: too many nodes");
-  if (bvh.leaf_triangles.size() != triangles)
+  // Spatial splits put a large triangle's fragments in several leaves: up to two slots per triangle.
+  if (bvh.leaf_triangles.size() < triangles || bvh.leaf_triangles.size() > 2 * triangles)
     throw FormatError(name + ": bvh: " + std::to_string(bvh.leaf_triangles.size()) + " leaf slots for " +
-                      std::to_string(triangles) + " triangles (each triangle is in exactly one slot)");
+                      std::to_string(triangles) + " triangles (each triangle is in one to two slots in all)");
   std::vector<uint8_t> seen_triangle(triangles, 0);
   for (size_t i = 0; i < bvh.leaf_triangles.size(); ++i) {
     const uint32_t t = bvh.leaf_triangles[i];
     if (t >= triangles)
       throw FormatError(name + ": bvh: leaf slot " + std::to_string(i) + ": triangle " + std::to_string(t) +
                         " does not exist");
-    if (seen_triangle[t])
-      throw FormatError(name + ": bvh: triangle " + std::to_string(t) + " is in more than one leaf slot");
     seen_triangle[t] = 1;
   }
+  for (size_t t = 0; t < triangles; ++t)
+    if (!seen_triangle[t]) throw FormatError(name + ": bvh: triangle " + std::to_string(t) + " is in no leaf slot");
+  // Per triangle, the union of the boxes of the leaves that hold it: it must contain the corners.
+  std::vector<float> cover(triangles * 6);
+  for (size_t t = 0; t < triangles; ++t) {
+    for (int k = 0; k < 3; ++k) cover[t * 6 + size_t(k)] = INFINITY, cover[t * 6 + 3 + size_t(k)] = -INFINITY;
+  }
   std::vector<uint8_t> has_parent(node_count, 0), slot_used(bvh.leaf_triangles.size(), 0);
-  auto box_contains_point = [](const BvhNodeRecord& n, int c, const Float3& p) {
-    return p[0] >= n.lo_x[c] && p[0] <= n.hi_x[c] && p[1] >= n.lo_y[c] && p[1] <= n.hi_y[c] && p[2] >= n.lo_z[c] &&
-           p[2] <= n.hi_z[c];
-  };
   for (size_t i = 0; i < node_count; ++i) {
     const BvhNodeRecord& n = bvh.nodes[i];
     const std::string where = name + ": bvh node " + std::to_string(i) + ": ";
@@ -511,10 +521,11 @@ void validate_bvh(const SceneFile& s, const std::string& name) {
                               " is in more than one leaf");
           slot_used[k] = 1;
           const size_t t = bvh.leaf_triangles[k];
-          for (int v = 0; v < 3; ++v)
-            if (!box_contains_point(n, c, s.triangles.positions[3 * t + size_t(v)]))
-              throw FormatError(where + "child " + std::to_string(c) + " box does not contain triangle " +
-                                std::to_string(t));
+          const float lo[3] = {n.lo_x[c], n.lo_y[c], n.lo_z[c]}, hi[3] = {n.hi_x[c], n.hi_y[c], n.hi_z[c]};
+          for (int a = 0; a < 3; ++a) {
+            cover[t * 6 + size_t(a)] = std::min(cover[t * 6 + size_t(a)], lo[a]);
+            cover[t * 6 + 3 + size_t(a)] = std::max(cover[t * 6 + 3 + size_t(a)], hi[a]);
+          }
         }
       } else {
         if (word <= i || word >= node_count)
@@ -539,6 +550,14 @@ void validate_bvh(const SceneFile& s, const std::string& name) {
     if (!has_parent[i]) throw FormatError(name + ": bvh node " + std::to_string(i) + ": no node lists it as a child");
   for (size_t k = 0; k < slot_used.size(); ++k)
     if (!slot_used[k]) throw FormatError(name + ": bvh: leaf slot " + std::to_string(k) + " is in no leaf");
+  for (size_t t = 0; t < triangles; ++t)
+    for (int v = 0; v < 3; ++v) {
+      const Float3& p = s.triangles.positions[3 * t + size_t(v)];
+      for (int a = 0; a < 3; ++a)
+        if (!(p[a] >= cover[t * 6 + size_t(a)] && p[a] <= cover[t * 6 + 3 + size_t(a)]))
+          throw FormatError(name + ": bvh: the leaf boxes of triangle " + std::to_string(t) +
+                            " do not contain its corner " + std::to_string(v));
+    }
   // Children have higher indices than parents: one pass from the back computes, per node, the
   // traversal stack entries its subtree needs (the builder's rule: visiting a node pushes its
   // non-empty children and pops itself) and its height in inner nodes.
@@ -670,6 +689,7 @@ std::vector<uint8_t> encode_scene(const SceneFile& s, uint32_t version) {
   if (version < kOldestSceneFormatVersion || version > kSceneFormatVersion)
     throw FormatError(writing + ": format version " + std::to_string(version) + " is not one this writer writes");
   validate_scene_file(s, writing);
+  if (version <= 3) refuse_version4_content(s, writing, version);
   if (version <= 2) refuse_version3_content(s, writing, version);
   if (version == 1) refuse_version2_content(s, writing);
   const bool has_environment = s.sky_environment.width != 0;
@@ -1048,6 +1068,7 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
     throw FormatError(name + ": payload: " + std::to_string(p.remaining()) + " bytes after the last " +
                       (version >= 2 ? "section" : "light"));
   validate_scene_file(s, name);
+  if (version <= 3) refuse_version4_content(s, name, version);
   return s;
 }
 

@@ -247,7 +247,7 @@ TEST(SceneFile, TexturedSceneRoundTripsBitwiseExact) {
   // The documented layout of what version 2 adds.
   auto u32 = [&](size_t offset) { return test::get_u32(bytes, offset); };
   auto f32 = [&](size_t offset) { return std::bit_cast<float>(u32(offset)); };
-  EXPECT_EQ(u32(8), 3u);
+  EXPECT_EQ(u32(8), 4u);
   EXPECT_EQ(u32(88), 1u);   // environment stored
   EXPECT_EQ(u32(132), 2u);  // texture count
   EXPECT_EQ(u32(136), 1u);  // vertex colours
@@ -297,7 +297,7 @@ TEST(SceneFile, NormalMappedSceneRoundTripsBitwiseExact) {
   EXPECT_EQ(encode_scene(back), bytes);
   auto u32 = [&](size_t offset) { return test::get_u32(bytes, offset); };
   auto f32 = [&](size_t offset) { return std::bit_cast<float>(u32(offset)); };
-  EXPECT_EQ(u32(8), 3u);
+  EXPECT_EQ(u32(8), 4u);
   EXPECT_EQ(u32(140), 1u);  // tangents stored
   const size_t m = sample_offsets().materials + 9;  // material 0 after its name "White"
   EXPECT_EQ(u32(m + 100), 0u);      // normal texture 0
@@ -344,6 +344,43 @@ TEST(SceneFile, NormalMappedSceneRoundTripsBitwiseExact) {
   put_f32(bad_sign, tangents + 12 * corners + 8, 2.0f);
   refresh_checksums(bad_sign, kHeader);
   expect_format_error([&] { read(bad_sign); }, "scene.bin: triangle 0: tangent sign is not +1 or -1");
+}
+
+// Version 4: a triangle may sit in several leaf slots (the builder's spatial splits). Here the leaf
+// that ends at the last slot holds its first triangle twice: a valid tree that only version 4 stores.
+SceneFile with_a_split_reference() {
+  SceneFile s = sample();
+  for (BvhNodeRecord& n : s.bvh.nodes)
+    for (uint32_t& word : n.child) {
+      if (word == kSceneBvhEmptyChild || !(word & kSceneBvhLeafBit)) continue;
+      const uint32_t first = (word & ~kSceneBvhLeafBit) >> 2, count = (word & 3u) + 1;
+      if (first + count != s.bvh.leaf_triangles.size() || count == 4) continue;
+      s.bvh.leaf_triangles.push_back(s.bvh.leaf_triangles[first]);
+      ++word;
+      return s;
+    }
+  ADD_FAILURE() << "the sample has no leaf to extend";
+  return s;
+}
+
+TEST(SceneFile, Version4StoresSplitReferencesAndOlderVersionsRefuseThem) {
+  const SceneFile split = with_a_split_reference();
+  const std::vector<uint8_t> bytes = encode_scene(split);
+  EXPECT_EQ(test::get_u32(bytes, 8), 4u);
+  EXPECT_EQ(test::get_u32(bytes, 64), 5u);  // leaf slots for the 4 triangles
+  const SceneFile back = read(bytes);
+  EXPECT_EQ(back.bvh.leaf_triangles, split.bvh.leaf_triangles);
+  EXPECT_EQ(encode_scene(back), bytes);
+  expect_format_error([&] { encode_scene(split, 3); },
+                      "bvh: 5 leaf slots for 4 triangles: a triangle in several leaf slots is not stored by scene.bin version 3");
+  std::vector<uint8_t> labelled_3 = bytes;
+  put_u32(labelled_3, 8, 3);
+  refresh_checksums(labelled_3, kHeader);
+  expect_format_error([&] { read(labelled_3); }, "is not stored by scene.bin version 3");
+  // Without split references version 3 is still written, and read.
+  const std::vector<uint8_t> v3 = encode_scene(sample(), 3);
+  EXPECT_EQ(test::get_u32(v3, 8), 3u);
+  expect_bitwise_equal(sample(), read(v3));
 }
 
 // Version 2 files (no normal textures, no tangents) are still read, and the version 2 writer
@@ -399,7 +436,7 @@ TEST(SceneFile, Version1FilesAreStillRead) {
   masked.materials[2].alpha_mode = AlphaMode::Mask;
   expect_format_error([&] { encode_scene(masked, 1); },
                       "material 2: textures and alpha modes are not stored by scene.bin version 1");
-  expect_format_error([&] { encode_scene(sample(), 4); }, "format version 4 is not one this writer writes");
+  expect_format_error([&] { encode_scene(sample(), 5); }, "format version 5 is not one this writer writes");
 }
 
 TEST(SceneFile, SceneWithoutProbesOrTrianglesRoundTrips) {
@@ -420,7 +457,7 @@ TEST(SceneFile, HeaderAndPayloadHaveTheDocumentedLayout) {
   auto f32 = [&](size_t offset) { return std::bit_cast<float>(test::get_u32(b, offset)); };
   auto u32 = [&](size_t offset) { return test::get_u32(b, offset); };
   EXPECT_EQ(std::memcmp(b.data(), "EXSCENE\0", 8), 0);
-  EXPECT_EQ(u32(8), 3u);
+  EXPECT_EQ(u32(8), 4u);
   EXPECT_EQ(u32(12), 160u);
   const uint32_t counts[15] = {4, 3, 2, 5, 2, 3, 2, 5, 3, 1, 4, 2, 4, 4, 2};
   for (int i = 0; i < 15; ++i) EXPECT_EQ(u32(16 + 4 * size_t(i)), counts[i]) << "header field at " << 16 + 4 * i;
@@ -494,13 +531,13 @@ TEST(SceneFile, EverySingleByteCorruptionIsRefused) {
 
 TEST(SceneFile, OtherVersionsAreRefusedByName) {
   std::vector<uint8_t> bytes = sample_bytes();
-  put_u32(bytes, 8, 4);
+  put_u32(bytes, 8, 5);
   refresh_checksums(bytes, kHeader);
   try {
     read(bytes);
-    FAIL() << "version 4 accepted";
+    FAIL() << "version 5 accepted";
   } catch (const FormatError& e) {
-    EXPECT_STREQ(e.what(), "scene.bin: format version 4 is newer than this loader (3)");
+    EXPECT_STREQ(e.what(), "scene.bin: format version 5 is newer than this loader (4)");
   }
   put_u32(bytes, 8, 0);
   refresh_checksums(bytes, kHeader);
@@ -535,12 +572,11 @@ const StructuralCase kStructuralCases[] = {
      "leaf slot 0 is in more than one leaf"},
     {"bvh leaf slot in no leaf", [](auto& b, auto& o) { put_u32(b, bvh_child(o, 0, 1), test::leaf_word(2, 1)); },
      "bvh: leaf slot 3 is in no leaf"},
-    {"bvh triangle missing", [](auto& b, auto& o) { put_u32(b, o.bvh_leaves + 4, 2); },
-     "bvh: triangle 2 is in more than one leaf slot"},
+    {"bvh triangle missing", [](auto& b, auto& o) { put_u32(b, o.bvh_leaves + 4, 2); }, "is in no leaf slot"},
     {"bvh leaf triangle out of range", [](auto& b, auto& o) { put_u32(b, o.bvh_leaves, 4); },
      "bvh: leaf slot 0: triangle 4 does not exist"},
     {"bvh box misses its triangle", [](auto& b, auto& o) { put_f32(b, bvh_plane(o, 0, 3, 1), 1.5f); },
-     "bvh node 0: child 1 box does not contain triangle"},
+     "do not contain its corner"},
     {"bvh box misses its child's box", [](auto& b, auto& o) { put_f32(b, bvh_plane(o, 0, 1, 0), 0.5f); },
      "bvh node 0: child 0 box does not contain node 1's child"},
     {"bvh nan bound", [](auto& b, auto& o) { put_f32(b, bvh_plane(o, 1, 4, 3), std::nanf("")); },
@@ -769,7 +805,9 @@ const RecordCase kRecordCases[] = {
      },
      "no probe grid (counts 0) but origin, spacing or probes are set"},
     {"triangle arrays", [](SceneFile& s) { s.triangles.uv0.pop_back(); }, "triangle arrays disagree in length"},
-    {"leaf slot count", [](SceneFile& s) { s.bvh.leaf_triangles.push_back(0); }, "bvh: 5 leaf slots for 4 triangles"},
+    {"leaf slot count", [](SceneFile& s) { s.bvh.leaf_triangles.resize(9, 0); },
+     "bvh: 9 leaf slots for 4 triangles (each triangle is in one to two slots in all)"},
+    {"leaf slot in no leaf", [](SceneFile& s) { s.bvh.leaf_triangles.push_back(0); }, "bvh: leaf slot 4 is in no leaf"},
     {"no bvh root", [](SceneFile& s) { s.bvh.nodes.clear(); }, "bvh: no root node"},
 };
 

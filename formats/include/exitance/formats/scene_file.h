@@ -21,7 +21,7 @@
 namespace exitance::formats {
 
 inline constexpr char kSceneMagic[8] = {'E', 'X', 'S', 'C', 'E', 'N', 'E', '\0'};
-constexpr uint32_t kSceneFormatVersion = 3;        // what writers write
+constexpr uint32_t kSceneFormatVersion = 4;        // what writers write
 constexpr uint32_t kOldestSceneFormatVersion = 1;  // readers accept 1 .. kSceneFormatVersion
 constexpr uint32_t kSceneHeaderSize = 160;
 // Fixed record sizes (bytes) of the payload's arrays; scene_format.md has the layouts.

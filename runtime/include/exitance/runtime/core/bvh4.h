@@ -21,7 +21,7 @@ static_assert(sizeof(Bvh4Node) == 112);
 
 struct Bvh4 {
   std::vector<Bvh4Node> nodes;
-  std::vector<uint32_t> leaf_triangles;  // per leaf slot: the scene triangle it holds
+  std::vector<uint32_t> leaf_triangles;  // per leaf slot: the scene triangle it holds (a split triangle in several)
   uint32_t stack_entries = 1;            // traversal stack bound (shaders' kStackSize)
   uint32_t depth = 0;
 };
