@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "exitance/bake/command/backend_choice.h"
@@ -195,9 +196,13 @@ LightmapEstimate lighting_stage(const Integrator& backend, const TexelGBuffer& g
   // put the estimate back on the full list (sealed texels with no samples).
   LightmapEstimate estimate;
   const auto start = std::chrono::steady_clock::now();
+  // The budget is the stage's: its clock starts here, so the copies around the backend and the
+  // backend's own setup count against it too.
+  if (settings.time_budget_seconds > 0)
+    settings.budget_clock = [start] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   if (skip && skip->texels > 0) {
-    const LightmapEstimate traced = backend.bake(gbuffer_without_skipped(gbuffer, skip->sealed), settings);
-    estimate = expand_lightmap_estimate(traced, skip->sealed);
+    LightmapEstimate traced = backend.bake(gbuffer_without_skipped(gbuffer, skip->sealed), settings);
+    estimate = expand_lightmap_estimate(std::move(traced), skip->sealed);
   } else {
     estimate = backend.bake(gbuffer, settings);
   }

@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace exitance {
 namespace {
@@ -32,11 +33,11 @@ std::vector<T> scatter_per_texel(const std::vector<T>& traced, const std::vector
 // A new per-texel field of LightmapEstimate (estimates.h) must be added below: the copy at the top
 // carries every other field over unchanged, which for a per-texel vector would leave it indexed by
 // traced texel. The static_assert is there to make a new field fail the build here until it is.
-static_assert(sizeof(LightmapEstimate) == 344,  // guiding_*, emitter_guiding: per region and scene, not per texel
+static_assert(sizeof(LightmapEstimate) == 368,  // guiding_*, emitter_guiding: per region and scene, not per texel
               "LightmapEstimate changed: scatter its new per-texel fields in expand_lightmap_estimate, then update "
               "this size");
 
-LightmapEstimate expand_lightmap_estimate(const LightmapEstimate& traced, const std::vector<uint8_t>& skipped) {
+LightmapEstimate expand_lightmap_estimate(LightmapEstimate traced, const std::vector<uint8_t>& skipped) {
   std::vector<size_t> full_index;
   full_index.reserve(skipped.size());
   for (size_t i = 0; i < skipped.size(); ++i)
@@ -45,10 +46,14 @@ LightmapEstimate expand_lightmap_estimate(const LightmapEstimate& traced, const 
     throw std::logic_error("expand_lightmap_estimate: " + std::to_string(traced.texels.size()) +
                            " traced texels for " + std::to_string(full_index.size()) + " unskipped ones");
   const size_t all = skipped.size();
-  LightmapEstimate full = traced;  // the fields that are not per texel
-  full.texels = scatter_per_texel(traced.texels, full_index, all, 1, "texels");
-  full.bounces = scatter_per_texel(traced.bounces, full_index, all, size_t(traced.recorded_bounces), "bounces");
-  full.sh1 = scatter_per_texel(traced.sh1, full_index, all, 1, "sh1");  // [texel][axis][rgb]: 9 elements
+  std::vector<TexelAccumulator> texels = scatter_per_texel(traced.texels, full_index, all, 1, "texels");
+  std::vector<double> bounces =
+      scatter_per_texel(traced.bounces, full_index, all, size_t(traced.recorded_bounces), "bounces");
+  std::vector<double> sh1 = scatter_per_texel(traced.sh1, full_index, all, 1, "sh1");  // [texel][axis][rgb]: 9 elements
+  LightmapEstimate full = std::move(traced);  // the fields that are not per texel
+  full.texels = std::move(texels);
+  full.bounces = std::move(bounces);
+  full.sh1 = std::move(sh1);
   return full;
 }
 

@@ -198,6 +198,35 @@ TEST(PerBounce, TimeBudgetAndTargetError) {
   }
 }
 
+// Under a time budget the last layer pass may give one more sample to part of the texels
+// (core/partial_layer_pass.h): every texel's B_0 then has m or m + 1 samples, and a texel's B_0 is
+// exactly what a --spp bake of its own count gives there (B_0's random streams are per texel and
+// sample, and it reads no cache). Where the budget happened to end on a whole pass, only m is seen.
+// B_0 alone (--bounces 0), so the last pass is B_0's.
+TEST(PerBounce, TimeBudgetTexelsHoldTheirOwnSampleMeans) {
+  const testing::AtlasScene box = furnace_box(0.7f, {1, 1, 1}, 8);
+  const CpuReferenceIntegrator integrator(box.scene);
+  IntegratorSettings timed = bounce_settings(0, 9, 0);
+  timed.time_budget_seconds = 0.05;
+  const LightmapEstimate e = integrator.bake(box.gbuffer, timed);
+  const BounceGatherStatistics& b = e.bounce_statistics;
+  const uint32_t m = b.samples.front();
+  ASSERT_GE(m, 1u);
+  std::printf("[per-bounce] 0.05 s budget: B_0 %u samples, %llu texels with one more\n", m,
+              (unsigned long long)b.texels_with_one_more.front());
+  for (uint32_t count : {m, m + 1}) {
+    const LightmapEstimate fixed = integrator.bake(box.gbuffer, bounce_settings(count, 9, 0));
+    for (size_t i = 0; i < e.texels.size(); ++i) {
+      ASSERT_TRUE(e.texels[i].samples == m || e.texels[i].samples == m + 1) << "texel " << i;
+      if (e.texels[i].samples != count) continue;
+      for (int c = 0; c < 3; ++c) ASSERT_FLOAT_EQ(e.mean_bounce(0, i)[c], fixed.mean_bounce(0, i)[c]) << "texel " << i;
+    }
+  }
+  uint64_t with_one_more = 0;
+  for (const TexelAccumulator& t : e.texels) with_one_more += t.samples == m + 1 ? 1 : 0;
+  EXPECT_EQ(with_one_more, b.texels_with_one_more.front());
+}
+
 // A hand-made G-buffer has no atlas rectangles: every gather hit is estimated on the fly, which
 // makes the mode an unbiased path tracer split by bounce. Its layers are independent samples, so
 // here the tracked variance is the variance of the texel means.

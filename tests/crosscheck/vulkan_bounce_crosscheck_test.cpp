@@ -124,6 +124,36 @@ TEST(VulkanPerBounce, FurnaceWithTheTailCriterionReachesLeOverOneMinusAlbedo) {
   EXPECT_LT(s.standard_error, 0.01);
 }
 
+// Under a time budget the last layer pass may run one more sample over a hashed part of the texels
+// (the driver's work list holds just those): every texel's B_0 has m or m + 1 samples and equals, up
+// to the order its device sums were added in, a --spp bake of its own count (B_0's random streams
+// are per texel and sample; it reads no cache). Where the budget ended on a whole pass only m is seen.
+// B_0 alone (--bounces 0), so the last pass is B_0's.
+TEST(VulkanPerBounce, TimeBudgetTexelsHoldTheirOwnSampleMeans) {
+  const Vec3 one{1, 1, 1};
+  const Vec3 emission[6] = {one, one, one, one, one, one};
+  const testing::AtlasScene box = testing::atlas_box(0.7f, emission, 8);
+  CREATE_VULKAN_OR_SKIP(vk, box.scene);
+  IntegratorSettings timed = bounce_settings(0, 9, 0);
+  timed.time_budget_seconds = 0.5;
+  const LightmapEstimate e = vk->bake(box.gbuffer, timed);
+  const uint32_t m = e.bounce_statistics.samples.front();
+  ASSERT_GE(m, 1u);
+  std::printf("[vulkan per-bounce] 0.5 s budget: B_0 %u samples, %llu texels with one more\n", m,
+              (unsigned long long)e.bounce_statistics.texels_with_one_more.front());
+  for (uint32_t count : {m, m + 1}) {
+    const LightmapEstimate fixed = vk->bake(box.gbuffer, bounce_settings(count, 9, 0));
+    for (size_t i = 0; i < e.texels.size(); ++i) {
+      ASSERT_TRUE(e.texels[i].samples == m || e.texels[i].samples == m + 1) << "texel " << i;
+      if (e.texels[i].samples != count) continue;
+      for (int c = 0; c < 3; ++c) {
+        const float expected = fixed.mean_bounce(0, i)[c];
+        ASSERT_NEAR(e.mean_bounce(0, i)[c], expected, 1e-5f * std::fabs(expected)) << "texel " << i;
+      }
+    }
+  }
+}
+
 // A G-buffer without atlas rectangles: no gather hit has a texel to read, so every one goes on from
 // the hit on the device (gather rays down to a direct-light sample): an unbiased path tracer split
 // by bounce, whose per-texel errors are independent (no cache), against the furnace's closed form.

@@ -109,8 +109,11 @@ def main():
                 fail(f"--time under 2 ranks ({integrator}): exit {timed.returncode}: {timed.stderr}")
             with open(os.path.join(timed_out, "manifest.json")) as f:
                 stats = json.load(f)["stats"]
-            if stats.get("ranks") != 2 or stats["samples_per_texel"]["min"] < 1:
-                fail(f"--time under 2 ranks ({integrator}): {stats.get('ranks')} {stats['samples_per_texel']}")
+            # The budget's last pass may give part of the texels one more sample (the same texels on
+            # every rank), never more than one.
+            spp = stats["samples_per_texel"]
+            if stats.get("ranks") != 2 or spp["min"] < 1 or spp["max"] > spp["min"] + 1:
+                fail(f"--time under 2 ranks ({integrator}): {stats.get('ranks')} {spp}")
 
         # Refused before any work: one line, exit 2, nothing written.
         refused_out = os.path.join(work, "refused")

@@ -50,7 +50,8 @@ bool PassScheduler::next_pass_here(uint32_t& begin, uint32_t& count, double* fra
   if (timed() && policy_.stratified_set == 0 && seconds_per_sample_ > 0) {
     const double left = settings_.time_budget_seconds - pass_start_seconds_;
     const double samples_left = left / seconds_per_sample_;
-    if (samples_left < (fraction ? 0.02 : 0.5)) {
+    const bool spent = policy_.caller_cuts_last_pass ? !(samples_left > 0) : samples_left < (fraction ? 0.02 : 0.5);
+    if (spent) {
       stopped_ = true;
       return false;
     }
@@ -67,6 +68,7 @@ bool PassScheduler::next_pass_here(uint32_t& begin, uint32_t& count, double* fra
 }
 
 double PassScheduler::elapsed_seconds() const {
+  if (settings_.budget_clock) return settings_.budget_clock();
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 

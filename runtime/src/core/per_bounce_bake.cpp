@@ -9,7 +9,19 @@
 // the total (bounce_tail.h). spp N gives every layer N samples, in one pass; a time budget or a
 // target error ramps passes of 1, 4 then 16 samples (PassPolicy::ramp) and the layers started late
 // have fewer samples. The target error is tested on the whole lightmap (every texel's relative
-// standard error below it, and the tail below the noise), not per texel.
+// standard error below it, and the tail below the noise), not per texel. A layer's cache is built
+// when a gather is about to read it (every cache below the layer, as texelless hits recurse), so a
+// top layer's or a last pass's cache is never built for nothing; the results are those of building
+// each after its layer's pass.
+//
+// Time budget: each layer pass takes what fits of its samples at that layer's measured seconds per
+// sample, after the caches it reads are rebuilt (at their last build's time) and with the work
+// after the loop kept aside (kAfterLoopPerTail times the last tail's time). The first layer
+// pass that does not fit whole is the last of the bake: its whole samples, then one more sample for
+// the fraction of the texels the time left pays for (core/partial_layer_pass.h), so the bake ends
+// within a small part of one layer sample of the budget. When not one sample of that layer fits
+// past its caches' rebuild, the time goes to B_0, which reads no cache. Each texel's layer is the
+// mean of its own samples (counts differ by at most one), so the partial pass adds no bias.
 //
 // Noise: per layer, the variance of each texel's gather samples given the layer below; the total's
 // variance is taken as their sum. That leaves out the noise of a cache propagated upward (spread
@@ -23,6 +35,7 @@
 
 #include "exitance/common/bounce_gather.h"
 #include "exitance/runtime/core/bounce_tail.h"
+#include "exitance/runtime/core/partial_layer_pass.h"
 #include "exitance/runtime/core/pass_scheduler.h"
 #include "exitance/runtime/core/work_share.h"
 
@@ -34,6 +47,13 @@ constexpr int kMaxLayers = 257;
 constexpr size_t kLayerMemoryLimit = size_t(2) << 30;
 // Rings of gutter texels filled around charts: a bilinear footprint reaches one texel past a chart.
 constexpr int kCacheDilation = 2;
+// What a time budget keeps aside for the work after the last layer pass, in tail estimates (of as
+// many layers): the assembly reads every layer of every texel once, as the tail does, and freeing
+// the layers and the caller's copy of the result (bake's expansion onto the sealed texels) cost
+// about as much again (Cornell room, 478 k texels, 2 cores: tail 0.044-0.063 s, assembly
+// 0.03-0.05 s, frees and expansion 0.06-0.08 s; all after the last layer pass 0.11-0.14 s against
+// 0.09-0.12 s kept aside).
+constexpr double kAfterLoopPerTail = 2.0;
 // Tails of ratios above this (a nearly white closed room) are not completed: r / (1 - r) would
 // multiply the last bounce's noise by 19 or more; the stopping rule alone bounds their truncation.
 constexpr double kMaxCompletedTailRatio = 0.95;
@@ -42,17 +62,23 @@ constexpr double kMaxCompletedTailRatio = 0.95;
 struct Layer {
   std::vector<double> sum, sum_squared;
   std::vector<uint32_t> back_faces;  // B_0 only: samples whose continuation ray met a back face
-  uint32_t samples = 0;
+  uint32_t samples = 0;  // every texel's
+  // Empty, or per texel 1 where the partial last pass of a time budget gave it sample `samples` too.
+  std::vector<uint8_t> one_more;
   explicit Layer(size_t texels) : sum(texels * 3, 0.0), sum_squared(texels * 3, 0.0) {}
+  uint32_t samples_at(size_t i) const { return samples + (one_more.empty() ? 0u : uint32_t(one_more[i])); }
   Vec3 mean(size_t i) const {
-    if (samples == 0) return {0, 0, 0};
-    return {float(sum[i * 3] / samples), float(sum[i * 3 + 1] / samples), float(sum[i * 3 + 2] / samples)};
+    const uint32_t count = samples_at(i);
+    if (count == 0) return {0, 0, 0};
+    return {float(sum[i * 3] / count), float(sum[i * 3 + 1] / count), float(sum[i * 3 + 2] / count)};
   }
   double variance_of_mean(size_t i, int c) const {
-    if (samples < 2) return 0;
-    const double n = samples, m = sum[i * 3 + size_t(c)] / n;
+    const uint32_t count = samples_at(i);
+    if (count < 2) return 0;
+    const double n = count, m = sum[i * 3 + size_t(c)] / n;
     return std::max(0.0, (sum_squared[i * 3 + size_t(c)] - n * m * m) / (n - 1)) / n;
   }
+  uint64_t texels_with_one_more() const { return uint64_t(std::count(one_more.begin(), one_more.end(), uint8_t(1))); }
 };
 
 double area_of(const LiveTexel& t) {
@@ -104,22 +130,51 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
   int layer_cap = forced ? settings.max_bounces + 1 : std::min(kMaxLayers, std::max(settings.safety_bounce_cap, 1) + 1);
   layer_cap = int(std::min<size_t>(size_t(layer_cap), std::max<size_t>(2, kLayerMemoryLimit / (48 * std::max<size_t>(n, 1)))));
 
+  PassPolicy policy;
+  policy.ramp = settings.time_budget_seconds > 0 || settings.target_relative_error > 0;
+  policy.caller_cuts_last_pass = true;  // per layer, down to a part of the texels (below)
+  PassScheduler passes(settings, policy);
+
+  // The result's arrays are allocated as the layers are (their first touch costs about as much as
+  // filling them), so the assembly after the loop only writes: less of it is left past the budget.
+  LightmapEstimate estimate;
+  estimate.texels.resize(n);
   std::vector<Layer> layers;
   std::vector<BounceLayerCache> caches;
-  layers.emplace_back(n);
+  std::vector<uint64_t> cache_versions;  // bumped at each rebuild: a device copy knows when it is stale
+  std::vector<uint8_t> cache_stale;      // samples (or texel validity) changed since the cache was built
+  std::vector<double> cache_seconds;     // its last build's
+  auto add_layer = [&] {
+    layers.emplace_back(n);
+    caches.emplace_back();
+    cache_versions.push_back(0);
+    cache_stale.push_back(1);
+    cache_seconds.push_back(0.0);
+    estimate.bounces.resize(layers.size() * n * 3, 0.0);
+  };
+  add_layer();
   layers[0].back_faces.assign(n, 0);
-  caches.emplace_back();
-  std::vector<uint64_t> cache_versions(1, 0);  // bumped at each rebuild: a device copy knows when it is stale
   // Texels whose B_0 rays mostly meet back faces are inside or under geometry (as the bake's scene
   // checks say): left out of every lookup (BounceLayerCache).
   std::vector<uint8_t> valid(n, 1);
   auto counters = [&] { return estimator.counts(); };
   BounceTail tail;
   bool tail_known = false;
+  double tail_seconds = 0;  // the last tail's, over tail_layers layers: sizes the work after the loop
+  size_t tail_layers = 0;
+  auto assembly_seconds = [&] {
+    return tail_layers > 0 ? kAfterLoopPerTail * tail_seconds * double(layers.size()) / double(tail_layers) : 0.0;
+  };
+  auto build_cache = [&](size_t k) {
+    const double build_start = passes.elapsed_seconds();
+    std::vector<Vec3> means(n);
+    for (size_t i = 0; i < n; ++i) means[i] = layers[k].mean(i);
+    caches[k].build(gbuffer, means, valid, kCacheDilation);
+    ++cache_versions[k];
+    cache_stale[k] = 0;
+    cache_seconds[k] = passes.elapsed_seconds() - build_start;
+  };
 
-  PassPolicy policy;
-  policy.ramp = settings.time_budget_seconds > 0 || settings.target_relative_error > 0;
-  PassScheduler passes(settings, policy);
   // Split over processes (work_share.h): each layer pass estimates this rank's texels, then every
   // rank gathers the layer's sums, so the caches, the tail and the stop are computed from the whole
   // layer, identically everywhere. The split follows the rays each texel traced in the last pass.
@@ -127,78 +182,109 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
   std::vector<size_t> bounds = share ? split_by_cost(n, {}, share->ranks()) : std::vector<size_t>{};
   std::vector<uint64_t> texel_rays(share ? n : 0);
   uint64_t own_samples = 0;
-  std::vector<double> seconds_per_sample;  // per layer: the last pass's seconds per sample of every texel
+  std::vector<double> seconds_per_sample;  // per layer: its last whole pass's seconds per sample of every texel
+  bool budget_ends = false;                // the last layer pass of the time budget has run
   uint32_t first = 0, count = 0;
-  while (passes.next_pass(first, count)) {
+  while (!budget_ends && passes.next_pass(first, count)) {
     bool wants_more = false;
     for (size_t k = 0; k < layers.size(); ++k) {
-      Layer& layer = layers[k];
-      uint32_t add = settings.spp > 0 ? std::min(count, settings.spp - std::min(settings.spp, layer.samples)) : count;
-      // Under a time budget, a layer pass that would end past it takes the samples that fit, by this
-      // layer's measured seconds per sample (every texel still gets the same count): the budget is
-      // kept to about a pass of one sample rather than overrun by a whole ramped pass.
-      bool cut = false;
-      if (passes.timed() && k < seconds_per_sample.size() && seconds_per_sample[k] > 0) {
-        const double left = settings.time_budget_seconds - passes.elapsed_seconds();
-        add = uint32_t(std::clamp(std::floor(left / seconds_per_sample[k]), 0.0, double(add)));
-        cut = true;
+      const uint32_t wanted =
+          settings.spp > 0 ? std::min(count, settings.spp - std::min(settings.spp, layers[k].samples)) : count;
+      // What runs: `whole` samples of layer `layer` (k, or B_0 when the budget ends and not one sample
+      // of k fits past its caches' rebuild), then one more for `fraction` of the texels.
+      struct Step {
+        uint32_t layer, whole;
+        double fraction;
+        uint32_t ends;  // the budget ends with this step
+      } step{uint32_t(k), wanted, 0.0, 0u};
+      // A layer not yet measured costs about what the one below it cost (B_1 excepted: it runs in
+      // the first pass, and its traced direct light makes it dearer than B_0).
+      const double per_sample = k < seconds_per_sample.size() && seconds_per_sample[k] > 0 ? seconds_per_sample[k]
+                                : k >= 2 && k - 1 < seconds_per_sample.size()          ? seconds_per_sample[k - 1]
+                                                                                       : 0.0;
+      if (passes.timed() && per_sample > 0) {
+        double caches_first = 0;
+        for (size_t j = 0; j < k; ++j) caches_first += cache_stale[j] ? cache_seconds[j] : 0.0;
+        const double left = settings.time_budget_seconds - passes.elapsed_seconds() - assembly_seconds();
+        LayerPassCut cut = cut_layer_pass(left - caches_first, per_sample, wanted);
+        // No partial first sample: a texel without one would read the layer as 0.
+        if (layers[k].samples == 0) cut.fraction = 0;
+        if (cut.cut && cut.whole == 0 && caches_first > 0 && seconds_per_sample[0] > 0) {
+          const uint32_t room = settings.spp > 0 ? settings.spp - std::min(settings.spp, layers[0].samples)
+                                                 : 0xFFFFFFFFu - layers[0].samples;
+          cut = cut_layer_pass(left, seconds_per_sample[0], room);
+          step.layer = 0;
+        }
+        step.whole = cut.whole, step.fraction = cut.fraction, step.ends = cut.cut ? 1u : 0u;
       }
-      if (share && passes.timed()) {  // rank 0's clock decides
-        struct {
-          uint32_t add, cut;
-        } decision{add, cut ? 1u : 0u};
-        decision = agreed(*share, decision);
-        add = decision.add, cut = decision.cut != 0;
-      }
-      if (cut && add == 0) break;
-      const auto layer_start = std::chrono::steady_clock::now();
+      if (share && passes.timed()) step = agreed(*share, step);  // rank 0's clock decides
+      budget_ends = step.ends != 0;
+
+      const size_t t = step.layer;
+      Layer& layer = layers[t];
       const size_t own_begin = share ? bounds[size_t(share->rank())] : 0;
       const size_t own_end = share ? bounds[size_t(share->rank()) + 1] : n;
+      const bool runs = step.whole > 0 || step.fraction > 0;
+      if (runs)
+        for (size_t j = 0; j < t; ++j)
+          if (cache_stale[j]) build_cache(j);
       BounceLayerPass pass;
-      pass.layer = int(k);
+      pass.layer = int(t);
       pass.begin = own_begin, pass.end = own_end;
-      pass.first_sample = layer.samples, pass.samples = add;
       pass.sum = layer.sum.data(), pass.sum_squared = layer.sum_squared.data();
-      pass.back_faces = k == 0 ? layer.back_faces.data() : nullptr;
+      pass.back_faces = t == 0 ? layer.back_faces.data() : nullptr;
       pass.texel_rays = share ? texel_rays.data() : nullptr;
-      if (add > 0) estimator.estimate(pass, caches, cache_versions);
-      if (share && add > 0) {  // `add` is the same on every rank
-        share->work.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - layer_start).count();
-        own_samples += uint64_t(own_end - own_begin) * add;
+      const double layer_start = passes.elapsed_seconds();
+      if (step.whole > 0) {
+        pass.first_sample = layer.samples, pass.samples = step.whole;
+        estimator.estimate(pass, caches, cache_versions);
+        if (share) share->work.seconds += passes.elapsed_seconds() - layer_start;
+        own_samples += uint64_t(own_end - own_begin) * step.whole;
+      }
+      if (step.fraction > 0) {  // the budget's last pass: one more sample for part of the texels
+        const PartialPassTexels chosen(step.fraction, settings.seed, int(t), layer.samples + step.whole);
+        const std::vector<uint32_t> own = chosen.in_range(own_begin, own_end);
+        const double partial_start = passes.elapsed_seconds();
+        pass.first_sample = layer.samples + step.whole, pass.samples = 1, pass.texels = &own;
+        if (!own.empty()) estimator.estimate(pass, caches, cache_versions);
+        if (share) share->work.seconds += passes.elapsed_seconds() - partial_start;
+        own_samples += own.size();
+        layer.one_more.resize(n);  // every rank marks every texel: the choice is by global index
+        for (size_t i = 0; i < n; ++i) layer.one_more[i] = chosen.covers(i) ? 1 : 0;
+      }
+      if (share && runs) {  // `step` is the same on every rank
         allgather_items(*share, layer.sum.data(), 3, bounds);
         allgather_items(*share, layer.sum_squared.data(), 3, bounds);
-        if (k == 0) allgather_items(*share, layer.back_faces.data(), 1, bounds);
+        if (t == 0) allgather_items(*share, layer.back_faces.data(), 1, bounds);
         allgather_items(*share, texel_rays.data(), 1, bounds);
         bounds = split_by_cost(n, texel_rays, share->ranks());
       }
-      layer.samples += add;
-      if (seconds_per_sample.size() <= k) seconds_per_sample.resize(k + 1, 0.0);
-      if (add > 0)
-        seconds_per_sample[k] = std::chrono::duration<double>(std::chrono::steady_clock::now() - layer_start).count() / add;
-      if (k == 0)
-        for (size_t i = 0; i < n; ++i) valid[i] = 2 * layers[0].back_faces[i] <= layers[0].samples ? 1 : 0;
-      std::vector<Vec3> means(n);
-      for (size_t i = 0; i < n; ++i) means[i] = layer.mean(i);
-      caches[k].build(gbuffer, means, valid, kCacheDilation);
-      ++cache_versions[k];
+      if (step.whole > 0 && step.fraction == 0) {  // whole passes only, the exchange included
+        if (seconds_per_sample.size() <= t) seconds_per_sample.resize(t + 1, 0.0);
+        seconds_per_sample[t] = (passes.elapsed_seconds() - layer_start) / step.whole;
+      }
+      layer.samples += step.whole;
+      if (runs) cache_stale[t] = 1;
+      if (t == 0 && runs) {  // texel validity changes every cache
+        for (size_t i = 0; i < n; ++i) valid[i] = 2 * layers[0].back_faces[i] <= layers[0].samples_at(i) ? 1 : 0;
+        std::fill(cache_stale.begin(), cache_stale.end(), uint8_t(1));
+      }
 
-      if (k + 1 == layers.size()) {  // the top layer: does the light bounce on?
+      if (!budget_ends && k + 1 == layers.size()) {  // the top layer: does the light bounce on?
         // The noise needs two samples in every layer; until then no layer beyond B_1 is started.
         const bool noise_known =
             std::all_of(layers.begin(), layers.end(), [](const Layer& l) { return l.samples >= 2; });
         if (k >= 1) {
+          const double tail_start = passes.elapsed_seconds();
           tail = tail_after(layers, gbuffer);
           tail_known = true;
+          tail_seconds = passes.elapsed_seconds() - tail_start, tail_layers = layers.size();
         }
         const bool tail_above_noise = k >= 1 && (!noise_known || !tail.below_noise);
         const bool more = forced ? int(layers.size()) < layer_cap
                                  : (k == 0 || (noise_known && !tail.below_noise)) && int(layers.size()) < layer_cap;
         wants_more = wants_more || (!forced && tail_above_noise);
-        if (more) {
-          layers.emplace_back(n);
-          caches.emplace_back();
-          cache_versions.push_back(0);
-        }
+        if (more) add_layer();
       }
       // After every layer pass: the fraction of the budget spent under --time (a pass holds every
       // layer, and on a large scene one pass can take most of the budget), else of the layers.
@@ -207,6 +293,7 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
                           : forced       ? double(k + 1) / double(layer_cap)
                                          : double(k + 1) / double(k + 2),
                           counters().rays);
+      if (budget_ends) break;
       bool out_of_time = passes.timed() && passes.elapsed_seconds() >= settings.time_budget_seconds;
       if (share && passes.timed()) out_of_time = agreed(*share, out_of_time);
       if (out_of_time) break;
@@ -244,15 +331,13 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
                              tail.ratio < kMaxCompletedTailRatio;
   const double tail_factor = complete_tail ? double(geometric_tail_factor(float(tail.ratio))) : 0.0;
 
-  LightmapEstimate estimate;
   const int layer_count = int(layers.size());
   estimate.recorded_bounces = layer_count;
-  estimate.texels.resize(n);
-  estimate.bounces.assign(size_t(layer_count) * n * 3, 0.0);
-  const double n0 = layers[0].samples;
+  estimate.bounces.resize(size_t(layer_count) * n * 3);  // every entry is written below
   for (size_t i = 0; i < n; ++i) {
     TexelAccumulator& acc = estimate.texels[i];
-    acc.samples = layers[0].samples;
+    acc.samples = layers[0].samples_at(i);
+    const double n0 = acc.samples;
     double total[3] = {0, 0, 0}, variance[3] = {0, 0, 0};
     for (int k = 0; k < layer_count; ++k) {
       const Layer& layer = layers[size_t(k)];
@@ -280,7 +365,7 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
     if (share) {
       work.texel_samples += own_samples;
     } else {
-      for (const Layer& layer : layers) work.texel_samples += uint64_t(layer.samples) * n;
+      for (const Layer& layer : layers) work.texel_samples += uint64_t(layer.samples) * n + layer.texels_with_one_more();
       work.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
   }
@@ -290,7 +375,10 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
   }
   BounceGatherStatistics& stats = estimate.bounce_statistics;
   stats.bounces = layer_count - 1;
-  for (const Layer& layer : layers) stats.samples.push_back(layer.samples);
+  for (const Layer& layer : layers) {
+    stats.samples.push_back(layer.samples);
+    stats.texels_with_one_more.push_back(layer.texels_with_one_more());
+  }
   stats.gathers = c.gathers;
   stats.texelless_hits = c.texelless;
   stats.back_face_hits = c.back_faces;

@@ -176,9 +176,14 @@ class CpuBounceLayerEstimator final : public BounceLayerEstimator {
     learned_samples_ = std::max(learned_samples_, pass.first_sample + pass.samples);
     const BounceGather gather(scene_, embree_, gbuffer_, caches, settings_, emitter_guide);
     const size_t k = size_t(pass.layer);
-    tbb::parallel_for(tbb::blocked_range<size_t>(pass.begin, pass.end, 64), [&](const tbb::blocked_range<size_t>& range) {
+    // Over [begin, end), or over the listed texels (a partial pass): position j is texel texel_at(j).
+    const std::vector<uint32_t>* listed = pass.texels;
+    const size_t positions = listed ? listed->size() : pass.end - pass.begin;
+    auto texel_at = [&](size_t j) { return listed ? size_t((*listed)[j]) : pass.begin + j; };
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, positions, 64), [&](const tbb::blocked_range<size_t>& range) {
       Counters& c = counters_per_thread_.local();
-      for (size_t i = range.begin(); i != range.end(); ++i) {
+      for (size_t j = range.begin(); j != range.end(); ++j) {
+        const size_t i = texel_at(j);
         const uint64_t rays_before = c.rays;
         const LiveTexel& texel = gbuffer_.texels[i];
         const SurfacePoint x{texel.position, texel.geometric_normal, texel.shading_normal};

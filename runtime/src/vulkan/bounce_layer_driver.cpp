@@ -131,8 +131,15 @@ void BounceLayerDriver::estimate(const BounceLayerPass& pass, const std::vector<
   if (uint64_t(pass.first_sample) + pass.samples > std::numeric_limits<uint32_t>::max())
     throw std::invalid_argument("Vulkan backend: more than 2^32 - 1 samples per texel");
   const size_t texels = gbuffer_.texels.size();
-  work_list_.resize(pass.end - pass.begin);
-  for (size_t i = pass.begin; i < pass.end; ++i) work_list_[i - pass.begin] = uint32_t(i);
+  // The kernels take any list of texels (as the Vulkan path tracer's target error does): a partial
+  // pass runs the listed ones only.
+  if (pass.texels) {
+    if (pass.texels->empty()) return;
+    work_list_ = *pass.texels;
+  } else {
+    work_list_.resize(pass.end - pass.begin);
+    for (size_t i = pass.begin; i < pass.end; ++i) work_list_[i - pass.begin] = uint32_t(i);
+  }
   context.upload(buffers.items.batch_items, work_list_.data(), work_list_.size() * 4);
   VkCommandBuffer cmd = context.begin();
   buffers.texels.clear(cmd);
@@ -157,7 +164,8 @@ void BounceLayerDriver::estimate(const BounceLayerPass& pass, const std::vector<
   std::vector<double> sums(texels * 6), back_faces(texels * 3);
   context.download(buffers.texels.sums, sums.data(), sums.size() * 8);
   context.download(buffers.texels.bounce_sums, back_faces.data(), back_faces.size() * 8);
-  for (size_t i = pass.begin; i < pass.end; ++i) {
+  for (const uint32_t texel : work_list_) {
+    const size_t i = texel;
     for (int c = 0; c < 3; ++c) {
       pass.sum[i * 3 + size_t(c)] += sums[i * 6 + size_t(c)];
       pass.sum_squared[i * 3 + size_t(c)] += sums[i * 6 + 3 + size_t(c)];

@@ -28,7 +28,10 @@ struct TexelAccumulator {
 // What the per-bounce mode (IntegratorMode::Bounces) did; all zero in path mode.
 struct BounceGatherStatistics {
   int bounces = 0;                 // indirect passes run: layers B_0 .. B_bounces
-  std::vector<uint32_t> samples;   // per layer, samples per texel (a time budget can leave later layers behind)
+  std::vector<uint32_t> samples;   // per layer, samples every texel has (a time budget can leave later layers behind)
+  // Per layer, the texels with one sample more than `samples` (the partial last pass of a time
+  // budget, core/partial_layer_pass.h); 0 elsewhere.
+  std::vector<uint64_t> texels_with_one_more;
   uint64_t gathers = 0;            // gather rays that hit a surface
   uint64_t texelless_hits = 0;     // of those, hits with no lit texel to read (estimated on the fly instead)
   uint64_t back_face_hits = 0;     // of those, back faces of single-sided surfaces (0, as in path mode)

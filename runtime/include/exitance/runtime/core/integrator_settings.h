@@ -80,6 +80,10 @@ struct IntegratorSettings {
   float emitter_guiding_mix = 0.5f;
   uint32_t emitter_guiding_patches = 512;  // about this many emitter patches (guided_emitters.h)
   std::function<void(double fraction_done, uint64_t rays)> progress;  // called between passes
+  // The seconds the time budget has run (PassScheduler::elapsed_seconds); null: since the
+  // integrator's scheduler started. bake starts it with the lighting stage, so the stage's setup
+  // counts against the budget; tests drive a virtual clock (cuts that do not depend on the machine).
+  std::function<double()> budget_clock;
   // Called once at the end of a guided bake with its cache (plots of the learned fields, tests).
   std::function<void(const GridGuidingCache&)> inspect_guiding;
   std::function<void(const SvoGuidingFields&)> inspect_svo_guiding;  // the same for GuidingMode::Svo

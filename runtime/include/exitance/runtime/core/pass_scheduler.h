@@ -20,6 +20,10 @@ struct PassPolicy {
   // > 0: when a budget may stop the run, passes end on multiples of this and the budget is checked
   // only there (probes: a stopped run never leaves a stratified set's strata out).
   uint32_t stratified_set = 0;
+  // The caller cuts the last pass of a time budget itself (the per-bounce mode, layer by layer, down
+  // to a part of the texels): when less than one sample's time is left the scheduler hands out a
+  // pass of one sample instead of stopping, and stops only once the budget is spent.
+  bool caller_cuts_last_pass = false;
 };
 
 class PassScheduler {
@@ -44,6 +48,7 @@ class PassScheduler {
   void set_sample_limit(uint32_t limit) { limit_ = limit; }
 
   uint32_t samples_done() const { return done_; }
+  // On settings.budget_clock when given.
   double elapsed_seconds() const;
   bool timed() const { return settings_.time_budget_seconds > 0; }
 

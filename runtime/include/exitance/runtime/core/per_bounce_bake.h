@@ -21,6 +21,9 @@ namespace exitance {
 struct BounceLayerPass {
   int layer = 0;  // 0: direct light at the texel; k >= 1: one gather ray reading B_{k-1}
   size_t begin = 0, end = 0;
+  // Null: every texel of [begin, end). Else only these (ascending, within [begin, end)): the partial
+  // last pass of a time budget (core/partial_layer_pass.h); the others' sums are left alone.
+  const std::vector<uint32_t>* texels = nullptr;
   uint32_t first_sample = 0, samples = 0;
   double* sum = nullptr;
   double* sum_squared = nullptr;
@@ -49,8 +52,11 @@ class BounceLayerEstimator {
 
 // E/pi at every live texel as the sum of the bounce layers B_0..B_K, each kept separately
 // (LightmapEstimate::bounces, recorded_bounces = K + 1; they sum to the total), with
-// bounce_statistics filled. Uses spp, time_budget_seconds, target_relative_error, max_bounces,
-// seed, safety_bounce_cap, progress and work_share; the estimator the rest.
+// bounce_statistics filled. Under a time budget a layer's texels may hold one sample more than
+// others (the partial last pass); every layer of every texel is the mean of its own samples, and
+// TexelAccumulator::samples is the texel's B_0 count. Uses spp, time_budget_seconds, budget_clock,
+// target_relative_error, max_bounces, seed, safety_bounce_cap, progress and work_share; the
+// estimator the rest.
 LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSettings& settings,
                                  BounceLayerEstimator& estimator);
 
