@@ -1,7 +1,9 @@
 // Seconds of the offline stages that grow with the texel count (raster, unocclude, checks, sealed
 // texels, scene_file), without the lighting, and a digest of what each produced, so two builds can
 // be compared for speed and for identical results on one command (bench/results/open-city-cpu.md).
-// Each stage after raster runs --repeat times on a fresh copy of its input; the median is printed.
+// Each stage runs --repeat times on a fresh copy of its input; the medians of its wall-clock and of
+// its CPU seconds (user + system, all threads) are printed: on a shared machine the CPU seconds are
+// the steadier measure of the work done.
 //
 //   bench_offline_stages SCENE.gltf [--texel-density D] [--repeat 3]
 #include <CLI/CLI.hpp>
@@ -13,6 +15,8 @@
 #include <exception>
 #include <iostream>
 #include <vector>
+
+#include <sys/resource.h>
 
 #include "exitance/bake/command/bake_stages.h"
 
@@ -52,15 +56,27 @@ uint64_t texel_digest(const TexelGBuffer& gbuffer) {
   return d.value;
 }
 
+double cpu_seconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) + 1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
+
+struct Seconds {
+  double wall = 0, cpu = 0;
+};
+
 template <class Run>
-double median_seconds(uint32_t repeat, Run run) {
-  std::vector<double> seconds;
+Seconds median_seconds(uint32_t repeat, Run run) {
+  std::vector<double> wall, cpu;
   for (uint32_t r = 0; r < repeat; ++r) {
     const auto start = std::chrono::steady_clock::now();
+    const double cpu_start = cpu_seconds();
     run();
-    seconds.push_back(seconds_since(start));
+    wall.push_back(seconds_since(start));
+    cpu.push_back(cpu_seconds() - cpu_start);
   }
-  return median(seconds);
+  return {median(wall), median(cpu)};
 }
 
 }  // namespace
@@ -82,37 +98,38 @@ int main(int argc, char** argv) {
     uv_generation_stage(imported, without_lightmap_uvs, options, diagnostics);
     const AtlasLayout layout = layout_stage(imported, options, diagnostics);
     TexelGBuffer rasterized;
-    const double raster = median_seconds(repeat, [&] { rasterized = raster_stage(imported, layout, options, diagnostics); });
+    const Seconds raster = median_seconds(repeat, [&] { rasterized = raster_stage(imported, layout, options, diagnostics); });
     const uint64_t raster_digest = texel_digest(rasterized);
     const SceneForLighting scene = build_lighting_scene_stage(std::move(imported), options);
 
     TexelGBuffer gbuffer;
     size_t moved = 0;
-    const double unocclude = median_seconds(repeat, [&] {
+    const Seconds unocclude = median_seconds(repeat, [&] {
       gbuffer = rasterized;
       moved = unocclude_stage(scene, gbuffer, options);
     });
     GeometryCheckReport checks;
-    const double check_seconds = median_seconds(repeat, [&] { checks = scene_checks_stage(scene, gbuffer, options, diagnostics); });
+    const Seconds check_seconds = median_seconds(repeat, [&] { checks = scene_checks_stage(scene, gbuffer, options, diagnostics); });
     Digest closed;
     closed.add(checks.closed_texels.data(), checks.closed_texels.size());
     SealedTexels sealed;
-    const double sealed_seconds = median_seconds(repeat, [&] { sealed = sealed_texels_stage(scene, gbuffer, checks, options); });
+    const Seconds sealed_seconds = median_seconds(repeat, [&] { sealed = sealed_texels_stage(scene, gbuffer, checks, options); });
     PersistedSceneFile file;
-    const double scene_file =
+    const Seconds scene_file =
         median_seconds(repeat, [&] { file = scene_file_stage(scene, gbuffer, layout, nullptr, options, diagnostics); });
     Digest bytes;
     bytes.add(file.bytes.data(), file.bytes.size());
 
     std::printf("%s: %zu live texels, %zu pages, median of %u\n", options.input.c_str(), gbuffer.texels.size(),
                 gbuffer.pages.size(), repeat);
-    std::printf("raster        %8.3f s  texels %016llx\n", raster, (unsigned long long)raster_digest);
-    std::printf("unocclude     %8.3f s  moved %zu, texels %016llx\n", unocclude, moved,
+    std::printf("stage          wall s    cpu s\n");
+    std::printf("raster        %8.3f %8.3f  texels %016llx\n", raster.wall, raster.cpu, (unsigned long long)raster_digest);
+    std::printf("unocclude     %8.3f %8.3f  moved %zu, texels %016llx\n", unocclude.wall, unocclude.cpu, moved,
                 (unsigned long long)texel_digest(gbuffer));
-    std::printf("checks        %8.3f s  enclosed %zu, coplanar %zu, closed %016llx\n", check_seconds,
+    std::printf("checks        %8.3f %8.3f  enclosed %zu, coplanar %zu, closed %016llx\n", check_seconds.wall, check_seconds.cpu,
                 checks.enclosed_texels, checks.coplanar_texels, (unsigned long long)closed.value);
-    std::printf("sealed_texels %8.3f s  sealed %zu of %zu candidates\n", sealed_seconds, sealed.texels, sealed.candidates);
-    std::printf("scene_file    %8.3f s  %zu bytes %016llx\n", scene_file, file.bytes.size(), (unsigned long long)bytes.value);
+    std::printf("sealed_texels %8.3f %8.3f  sealed %zu of %zu candidates\n", sealed_seconds.wall, sealed_seconds.cpu, sealed.texels, sealed.candidates);
+    std::printf("scene_file    %8.3f %8.3f  %zu bytes %016llx\n", scene_file.wall, scene_file.cpu, file.bytes.size(), (unsigned long long)bytes.value);
   } catch (const std::exception& e) {
     std::cerr << "bench_offline_stages: " << e.what() << "\n";
     return 1;
