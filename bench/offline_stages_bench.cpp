@@ -66,10 +66,11 @@ struct Seconds {
   double wall = 0, cpu = 0;
 };
 
-template <class Run>
-Seconds median_seconds(uint32_t repeat, Run run) {
+template <class Run, class Setup>
+Seconds median_seconds(uint32_t repeat, Run run, Setup setup) {
   std::vector<double> wall, cpu;
   for (uint32_t r = 0; r < repeat; ++r) {
+    setup();  // not timed
     const auto start = std::chrono::steady_clock::now();
     const double cpu_start = cpu_seconds();
     run();
@@ -77,6 +78,11 @@ Seconds median_seconds(uint32_t repeat, Run run) {
     cpu.push_back(cpu_seconds() - cpu_start);
   }
   return {median(wall), median(cpu)};
+}
+
+template <class Run>
+Seconds median_seconds(uint32_t repeat, Run run) {
+  return median_seconds(repeat, run, [] {});
 }
 
 }  // namespace
@@ -104,10 +110,8 @@ int main(int argc, char** argv) {
 
     TexelGBuffer gbuffer;
     size_t moved = 0;
-    const Seconds unocclude = median_seconds(repeat, [&] {
-      gbuffer = rasterized;
-      moved = unocclude_stage(scene, gbuffer, options);
-    });
+    const Seconds unocclude = median_seconds(
+        repeat, [&] { moved = unocclude_stage(scene, gbuffer, options); }, [&] { gbuffer = rasterized; });
     GeometryCheckReport checks;
     const Seconds check_seconds = median_seconds(repeat, [&] { checks = scene_checks_stage(scene, gbuffer, options, diagnostics); });
     Digest closed;
