@@ -7,6 +7,7 @@
 #include <cmath>
 #include <utility>
 
+#include "exitance/bake/raster/cell_rejection.h"
 #include "exitance/formats/scene_file.h"  // texel_morton_code: the order scene.bin stores texels in
 #include "exitance/runtime/texel_surface.h"
 
@@ -83,8 +84,10 @@ TexelGBuffer rasterize_texel_gbuffer(const Scene& scene, const AtlasLayout& layo
       const int y0 = std::max(rect_y0, int(std::floor(std::min({tri[0].y, tri[1].y, tri[2].y}))));
       const int x1 = std::min(rect_x1, int(std::ceil(std::max({tri[0].x, tri[1].x, tri[2].x}))));
       const int y1 = std::min(rect_y1, int(std::ceil(std::max({tri[0].y, tri[1].y, tri[2].y}))));
+      const CellRejection outside(tri);
       for (int y = y0; y <= y1; ++y)
         for (int x = x0; x <= x1; ++x) {
+          if (outside.rejects(x, y)) continue;  // clipped_texel_coverage would give it no area
           Vec2 centroid;
           const float area = clipped_texel_coverage(tri, x, y, centroid);
           // Slivers below 0.1 % of a texel are rounding noise of the UV transform; dilation covers them.
