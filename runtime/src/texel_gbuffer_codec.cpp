@@ -19,9 +19,10 @@ bool same_bits(Vec3 a, Vec3 b) { return std::memcmp(&a, &b, sizeof(Vec3)) == 0; 
 std::string texel_where(size_t i) { return "scene.bin (writing): texel " + std::to_string(i) + ": "; }
 
 // What a texel's triangle gives at the texel, derived in parallel before the ordered pass that
-// checks and stores the texels (it throws at the first bad texel, as a serial loop would).
+// checks and stores the texels (it throws at the first bad texel, as a serial loop would). Left
+// at its defaults where the texel's page, cell, triangle or instance is invalid: that pass throws
+// before it reads them.
 struct DerivedTexel {
-  bool derived = false;  // false where the texel's page, cell, triangle or instance is invalid
   float b1 = 0, b2 = 0;
   bool geometric_normal_differs = false, shading_differs = false, moved = false;
 };
@@ -75,7 +76,6 @@ formats::TexelGBufferRecords encode_texel_gbuffer(const TexelGBuffer& gbuffer, c
       d.geometric_normal_differs = !same_bits(surface.geometric_normal, texel.geometric_normal);
       d.shading_differs = !same_bits(surface.shading_normal, texel.shading_normal) || !same_bits(surface.albedo, texel.albedo);
       d.moved = !same_bits(surface.position, texel.position);
-      d.derived = true;
     }
   });
   uint32_t previous_page = 0;
