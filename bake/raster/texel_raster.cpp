@@ -7,6 +7,7 @@
 #include <cmath>
 #include <utility>
 
+#include "exitance/bake/raster/cell_rejection.h"
 #include "exitance/formats/scene_file.h"  // texel_morton_code: the order scene.bin stores texels in
 #include "exitance/runtime/texel_surface.h"
 
@@ -16,6 +17,14 @@ namespace {
 struct TexelCandidate {
   float best_area = 0;
   float coverage = 0;
+  uint32_t triangle = 0;
+  Vec2 centroid;
+};
+
+// A cell some chart covers, with what its best triangle gave it.
+struct LiveCell {
+  uint32_t morton = 0;  // the cell's place in scene.bin's order within its page
+  uint32_t cell = 0;    // y * page width + x
   uint32_t triangle = 0;
   Vec2 centroid;
 };
@@ -32,13 +41,10 @@ TexelGBuffer rasterize_texel_gbuffer(const Scene& scene, const AtlasLayout& layo
     page.height = h;
     gbuffer.pages.push_back(std::move(page));
   }
-  // Pages are mostly empty at scale (a 10 M-texel atlas holds ~100 M cells): clearing them is a
-  // large part of the stage, so it runs in parallel too.
-  std::vector<std::vector<TexelCandidate>> candidates(gbuffer.pages.size());
+  // Pages are mostly empty at scale (a 10 M-texel atlas holds ~100 M cells): clearing their
+  // coverage is a large part of the stage, so it runs in parallel too.
   tbb::parallel_for(size_t(0), gbuffer.pages.size(), [&](size_t p) {
-    const size_t cells = size_t(gbuffer.pages[p].width) * size_t(gbuffer.pages[p].height);
-    gbuffer.pages[p].coverage.assign(cells, 0.0f);
-    candidates[p].resize(cells);
+    gbuffer.pages[p].coverage.assign(size_t(gbuffer.pages[p].width) * size_t(gbuffer.pages[p].height), 0.0f);
   });
   // Progress: rasterizing the triangles is the first half, filling in the pages' texels the second.
   auto part = [&](double start, double share) -> FractionDone {
@@ -49,14 +55,23 @@ TexelGBuffer rasterize_texel_gbuffer(const Scene& scene, const AtlasLayout& layo
   std::vector<float> triangle_texel_size(scene.triangle_count(), 0.0f);
   // Instances in parallel: each writes only the cells of its own rectangle (layout gives every
   // instance its own, 2 × padding ≥ 2 texels apart) plus a one-texel margin for rounding, so no
-  // cell is shared between tasks and each cell sees its triangles in the serial order.
+  // cell is shared between tasks and each cell sees its triangles in the serial order. Each
+  // instance rasterizes into an array of its own region only and keeps its live cells, so the
+  // pages' cells are never all held as candidates (20 bytes each, 2.3 GB at 10 M texels).
+  std::vector<std::vector<LiveCell>> instance_live(scene.instances.size());
+  std::vector<size_t> overlapping_texels(scene.instances.size(), 0);
   tbb::parallel_for(size_t(0), scene.instances.size(), [&](size_t i) {
     const Instance& instance = scene.instances[i];
     const InstanceRect& rect = layout.rects[i];
-    const AtlasPage& page = gbuffer.pages[size_t(rect.page)];
-    std::vector<TexelCandidate>& cells = candidates[size_t(rect.page)];
+    AtlasPage& page = gbuffer.pages[size_t(rect.page)];
     const int rect_x0 = std::max(0, rect.x - 1), rect_y0 = std::max(0, rect.y - 1);
     const int rect_x1 = std::min(page.width - 1, rect.x + rect.width), rect_y1 = std::min(page.height - 1, rect.y + rect.height);
+    if (rect_x1 < rect_x0 || rect_y1 < rect_y0) {
+      done.add(instance.triangle_count);
+      return;
+    }
+    const size_t region_width = size_t(rect_x1 - rect_x0 + 1);
+    std::vector<TexelCandidate> cells(region_width * size_t(rect_y1 - rect_y0 + 1));
     for (uint32_t t = instance.first_triangle; t < instance.first_triangle + instance.triangle_count; ++t) {
       Vec2 tri[3];
       chart_triangle_in_texels(scene, t, rect.scale_offset, page.width, page.height, tri);
@@ -69,13 +84,15 @@ TexelGBuffer rasterize_texel_gbuffer(const Scene& scene, const AtlasLayout& layo
       const int y0 = std::max(rect_y0, int(std::floor(std::min({tri[0].y, tri[1].y, tri[2].y}))));
       const int x1 = std::min(rect_x1, int(std::ceil(std::max({tri[0].x, tri[1].x, tri[2].x}))));
       const int y1 = std::min(rect_y1, int(std::ceil(std::max({tri[0].y, tri[1].y, tri[2].y}))));
+      const CellRejection outside(tri);
       for (int y = y0; y <= y1; ++y)
         for (int x = x0; x <= x1; ++x) {
+          if (outside.rejects(x, y)) continue;  // clipped_texel_coverage would give it no area
           Vec2 centroid;
           const float area = clipped_texel_coverage(tri, x, y, centroid);
           // Slivers below 0.1 % of a texel are rounding noise of the UV transform; dilation covers them.
           if (area <= 1e-3f) continue;
-          TexelCandidate& cell = cells[size_t(y) * size_t(page.width) + size_t(x)];
+          TexelCandidate& cell = cells[size_t(y - rect_y0) * region_width + size_t(x - rect_x0)];
           cell.coverage += area;
           if (area > cell.best_area) {
             cell.best_area = area;
@@ -84,50 +101,49 @@ TexelGBuffer rasterize_texel_gbuffer(const Scene& scene, const AtlasLayout& layo
           }
         }
     }
+    for (int y = rect_y0; y <= rect_y1; ++y)
+      for (int x = rect_x0; x <= rect_x1; ++x) {
+        const TexelCandidate& candidate = cells[size_t(y - rect_y0) * region_width + size_t(x - rect_x0)];
+        if (candidate.best_area <= 0) continue;
+        const uint32_t cell = uint32_t(y) * uint32_t(page.width) + uint32_t(x);
+        instance_live[i].push_back({formats::texel_morton_code(uint32_t(x), uint32_t(y)), cell, candidate.triangle,
+                                    candidate.centroid});
+        if (candidate.coverage > 1.05f) ++overlapping_texels[i];
+        page.coverage[cell] = std::min(1.0f, candidate.coverage);
+      }
     done.add(instance.triangle_count);
   });
   // Each page's live cells in scene.bin's order (Morton codes are distinct within a page), pages
   // in parallel; then every texel filled in, in parallel.
-  std::vector<std::vector<std::pair<uint32_t, uint32_t>>> live(gbuffer.pages.size());  // (Morton code, cell)
-  std::vector<std::vector<size_t>> page_overlaps(gbuffer.pages.size());
-  std::vector<size_t> page_skipped(gbuffer.pages.size(), 0);
+  std::vector<std::vector<size_t>> page_instances(gbuffer.pages.size());
+  for (size_t i = 0; i < scene.instances.size(); ++i) page_instances[size_t(layout.rects[i].page)].push_back(i);
+  std::vector<std::vector<LiveCell>> live(gbuffer.pages.size());
   tbb::parallel_for(size_t(0), gbuffer.pages.size(), [&](size_t p) {
-    AtlasPage& page = gbuffer.pages[p];
-    const std::vector<TexelCandidate>& page_cells = candidates[p];
-    page_overlaps[p].assign(scene.instances.size(), 0);
-    for (int y = 0; y < page.height; ++y)
-      for (int x = 0; x < page.width; ++x) {
-        const uint32_t cell = uint32_t(y) * uint32_t(page.width) + uint32_t(x);
-        const TexelCandidate& candidate = page_cells[cell];
-        if (candidate.best_area <= 0) {
-          ++page_skipped[p];
-          continue;
-        }
-        live[p].push_back({formats::texel_morton_code(uint32_t(x), uint32_t(y)), cell});
-        if (candidate.coverage > 1.05f) ++page_overlaps[p][scene.triangle_instance[candidate.triangle]];
-        page.coverage[cell] = std::min(1.0f, candidate.coverage);
-      }
-    std::sort(live[p].begin(), live[p].end());
+    size_t count = 0;
+    for (size_t i : page_instances[p]) count += instance_live[i].size();
+    live[p].reserve(count);
+    for (size_t i : page_instances[p]) {
+      live[p].insert(live[p].end(), instance_live[i].begin(), instance_live[i].end());
+      std::vector<LiveCell>().swap(instance_live[i]);
+    }
+    std::sort(live[p].begin(), live[p].end(), [](const LiveCell& a, const LiveCell& b) { return a.morton < b.morton; });
   });
-  std::vector<size_t> overlapping_texels(scene.instances.size(), 0);
   std::vector<size_t> first_live(gbuffer.pages.size(), 0);
-  size_t live_total = 0;
+  size_t live_total = 0, cells_total = 0;
   for (size_t p = 0; p < gbuffer.pages.size(); ++p) {
-    gbuffer.skipped_texels += page_skipped[p];
-    for (size_t i = 0; i < overlapping_texels.size(); ++i) overlapping_texels[i] += page_overlaps[p][i];
     first_live[p] = live_total;
     live_total += live[p].size();
+    cells_total += gbuffer.pages[p].coverage.size();
   }
+  gbuffer.skipped_texels = cells_total - live_total;
   gbuffer.texels.resize(live_total);
   ParallelProgress filled(part(0.5, 0.5), live_total);
   tbb::parallel_for(size_t(0), gbuffer.pages.size(), [&](size_t p) {
     const AtlasPage& page = gbuffer.pages[p];
-    const std::vector<TexelCandidate>& page_cells = candidates[p];
     tbb::parallel_for(tbb::blocked_range<size_t>(0, live[p].size()), [&](const tbb::blocked_range<size_t>& range) {
       for (size_t k = range.begin(); k != range.end(); ++k) {
-        const uint32_t cell_index = live[p][k].second;
-        const TexelCandidate& cell = page_cells[cell_index];
-        const uint32_t x = cell_index % uint32_t(page.width), y = cell_index / uint32_t(page.width);
+        const LiveCell& cell = live[p][k];
+        const uint32_t x = cell.cell % uint32_t(page.width), y = cell.cell / uint32_t(page.width);
         const uint32_t t = cell.triangle;
         const uint32_t instance = scene.triangle_instance[t];
         const InstanceRect& rect = layout.rects[instance];
@@ -152,7 +168,7 @@ TexelGBuffer rasterize_texel_gbuffer(const Scene& scene, const AtlasLayout& layo
       }
       filled.add(range.size());
     });
-    std::vector<TexelCandidate>().swap(candidates[p]);  // done with this page: free it early
+    std::vector<LiveCell>().swap(live[p]);  // done with this page: free it early
   });
   for (size_t i = 0; i < overlapping_texels.size(); ++i)
     if (overlapping_texels[i] > 0)

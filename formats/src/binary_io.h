@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "exitance/formats/format_error.h"
@@ -28,6 +29,22 @@ class LittleEndianWriter {
   void u64(uint64_t v) { for (int i = 0; i < 8; ++i) out_.push_back(uint8_t(v >> (8 * i))); }
   void f32(float v) { u32(std::bit_cast<uint32_t>(v)); }
   void f64(double v) { u64(std::bit_cast<uint64_t>(v)); }
+  // `count` values made of 4-byte fields (u32, f32, arrays of them), each field little-endian, as
+  // u32()/f32() one by one would write them: one copy on a little-endian host.
+  template <class T>
+  void words(const T* values, size_t count) {
+    static_assert(std::is_trivially_copyable_v<T> && sizeof(T) % 4 == 0, "whole 4-byte fields only");
+    if constexpr (std::endian::native == std::endian::little) {
+      bytes(values, count * sizeof(T));
+    } else {
+      const auto* raw = reinterpret_cast<const uint8_t*>(values);
+      for (size_t k = 0; k < count * sizeof(T) / 4; ++k) {
+        uint32_t field;
+        std::memcpy(&field, raw + 4 * k, 4);
+        u32(field);
+      }
+    }
+  }
 
  private:
   std::vector<uint8_t>& out_;

@@ -90,4 +90,29 @@ std::vector<uint8_t> build_frame(const FileKind& kind, const std::vector<uint8_t
   return bytes;
 }
 
+std::vector<uint8_t> begin_frame(const FileKind& kind, size_t payload_capacity) {
+  std::vector<uint8_t> file;
+  file.reserve(kind.header_size + payload_capacity);
+  file.resize(kind.header_size, 0);
+  return file;
+}
+
+void finish_frame(const FileKind& kind, const std::vector<uint8_t>& header_fields, std::vector<uint8_t>& file) {
+  if (16 + header_fields.size() + kTrailerSize != kind.header_size)
+    throw std::logic_error("framing: header fields do not fill the header");
+  if (file.size() < kind.header_size) throw std::logic_error("framing: the file has no room for its header");
+  std::vector<uint8_t> header;
+  header.reserve(kind.header_size);
+  binary_io::LittleEndianWriter out(header);
+  out.bytes(kind.magic, kMagicSize);
+  out.u32(kind.version);
+  out.u32(kind.header_size);
+  out.bytes(header_fields.data(), header_fields.size());
+  const size_t payload_size = file.size() - kind.header_size;
+  out.u64(payload_size);
+  out.u32(crc32(file.data() + kind.header_size, payload_size));
+  out.u32(crc32(header.data(), header.size()));
+  std::memcpy(file.data(), header.data(), header.size());
+}
+
 }  // namespace exitance::formats::framing

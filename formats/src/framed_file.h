@@ -34,4 +34,10 @@ FramedView open_frame(const uint8_t* data, size_t size, const FileKind& kind, co
 std::vector<uint8_t> build_frame(const FileKind& kind, const std::vector<uint8_t>& header_fields,
                                  const std::vector<uint8_t>& payload);
 
+// The same frame built in place, for large payloads (no copy of the payload): `file` starts as
+// begin_frame's header_size placeholder bytes, the caller appends the payload, and finish_frame
+// writes the header over the placeholder.
+std::vector<uint8_t> begin_frame(const FileKind& kind, size_t payload_capacity);
+void finish_frame(const FileKind& kind, const std::vector<uint8_t>& header_fields, std::vector<uint8_t>& file);
+
 }  // namespace exitance::formats::framing

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 #include "binary_io.h"
 #include "exitance/formats/probes_file.h"
@@ -390,26 +391,27 @@ void validate_texels(const SceneFile& s, const std::string& name) {
     uint64_t previous_code = 0;
     for (uint32_t k = 0; k < page.live_texels; ++k, ++index) {
       const TexelRecord& t = g.texels[index];
-      const std::string where = at(name, "texel", index);
+      // Built only for an error: a string per texel would cost more than the checks at 10 M texels.
+      const auto where = [&] { return at(name, "texel", index); };
       if (t.triangle >= triangles)
-        throw FormatError(where + "triangle " + std::to_string(t.triangle) + " does not exist (" +
+        throw FormatError(where() + "triangle " + std::to_string(t.triangle) + " does not exist (" +
                           std::to_string(triangles) + " triangles)");
       if (t.x >= page.width || t.y >= page.height)
-        throw FormatError(where + "(" + std::to_string(t.x) + ", " + std::to_string(t.y) + ") lies outside page " +
+        throw FormatError(where() + "(" + std::to_string(t.x) + ", " + std::to_string(t.y) + ") lies outside page " +
                           std::to_string(p) + " (" + std::to_string(page.width) + " x " + std::to_string(page.height) +
                           ")");
       const uint64_t code = uint64_t(texel_morton_code(t.x, t.y)) + 1;
       if (code <= previous_code)
-        throw FormatError(where + "(" + std::to_string(t.x) + ", " + std::to_string(t.y) +
+        throw FormatError(where() + "(" + std::to_string(t.x) + ", " + std::to_string(t.y) +
                           ") is not after the previous texel of page " + std::to_string(p) + " in Morton order");
       previous_code = code;
       const uint32_t instance = s.triangles.instance[t.triangle];
       if (s.instances[instance].page != p)
-        throw FormatError(where + "its triangle " + std::to_string(t.triangle) + " belongs to instance " +
+        throw FormatError(where() + "its triangle " + std::to_string(t.triangle) + " belongs to instance " +
                           std::to_string(instance) + " on page " + std::to_string(s.instances[instance].page) +
                           ", not page " + std::to_string(p));
       if (!(t.b1 >= 0 && t.b1 <= 1 && t.b2 >= 0 && t.b2 <= 1 && t.b1 + t.b2 <= 1.000001f))
-        throw FormatError(where + "barycentrics " + std::to_string(t.b1) + ", " + std::to_string(t.b2) +
+        throw FormatError(where() + "barycentrics " + std::to_string(t.b1) + ", " + std::to_string(t.b2) +
                           " are not on the triangle");
     }
   }
@@ -500,24 +502,24 @@ void validate_bvh(const SceneFile& s, const std::string& name) {
   std::vector<uint8_t> has_parent(node_count, 0), slot_used(bvh.leaf_triangles.size(), 0);
   for (size_t i = 0; i < node_count; ++i) {
     const BvhNodeRecord& n = bvh.nodes[i];
-    const std::string where = name + ": bvh node " + std::to_string(i) + ": ";
+    const auto where = [&] { return name + ": bvh node " + std::to_string(i) + ": "; };
     for (int c = 0; c < 4; ++c) {
       const uint32_t word = n.child[c];
       const float box[6] = {n.lo_x[c], n.hi_x[c], n.lo_y[c], n.hi_y[c], n.lo_z[c], n.hi_z[c]};
       for (float v : box)
-        if (!finite(v)) throw FormatError(where + "child " + std::to_string(c) + " bounds are not finite");
+        if (!finite(v)) throw FormatError(where() + "child " + std::to_string(c) + " bounds are not finite");
       if (word == kSceneBvhEmptyChild) continue;
       if (!(box[0] <= box[1] && box[2] <= box[3] && box[4] <= box[5]))
-        throw FormatError(where + "child " + std::to_string(c) + " box is inverted");
+        throw FormatError(where() + "child " + std::to_string(c) + " box is inverted");
       if (word & kSceneBvhLeafBit) {
         const uint64_t first = (word & ~kSceneBvhLeafBit) >> 2, count = (word & 3u) + 1;
         if (first + count > bvh.leaf_triangles.size())
-          throw FormatError(where + "child " + std::to_string(c) + " leaf slots " + std::to_string(first) + " + " +
+          throw FormatError(where() + "child " + std::to_string(c) + " leaf slots " + std::to_string(first) + " + " +
                             std::to_string(count) + " run past the " + std::to_string(bvh.leaf_triangles.size()) +
                             " leaf slots");
         for (uint64_t k = first; k < first + count; ++k) {
           if (slot_used[k])
-            throw FormatError(where + "child " + std::to_string(c) + " leaf slot " + std::to_string(k) +
+            throw FormatError(where() + "child " + std::to_string(c) + " leaf slot " + std::to_string(k) +
                               " is in more than one leaf");
           slot_used[k] = 1;
           const size_t t = bvh.leaf_triangles[k];
@@ -529,18 +531,18 @@ void validate_bvh(const SceneFile& s, const std::string& name) {
         }
       } else {
         if (word <= i || word >= node_count)
-          throw FormatError(where + "child " + std::to_string(c) + " index " + std::to_string(word) +
+          throw FormatError(where() + "child " + std::to_string(c) + " index " + std::to_string(word) +
                             (word >= node_count ? " is out of range (" + std::to_string(node_count) + " nodes)"
                                                 : " is not after its parent (depth-first order)"));
         if (has_parent[word])
-          throw FormatError(where + "child node " + std::to_string(word) + " has more than one parent");
+          throw FormatError(where() + "child node " + std::to_string(word) + " has more than one parent");
         has_parent[word] = 1;
         const BvhNodeRecord& child = bvh.nodes[word];
         for (int g = 0; g < 4; ++g) {
           if (child.child[g] == kSceneBvhEmptyChild) continue;
           if (!(child.lo_x[g] >= n.lo_x[c] && child.hi_x[g] <= n.hi_x[c] && child.lo_y[g] >= n.lo_y[c] &&
                 child.hi_y[g] <= n.hi_y[c] && child.lo_z[g] >= n.lo_z[c] && child.hi_z[g] <= n.hi_z[c]))
-            throw FormatError(where + "child " + std::to_string(c) + " box does not contain node " +
+            throw FormatError(where() + "child " + std::to_string(c) + " box does not contain node " +
                               std::to_string(word) + "'s child " + std::to_string(g));
         }
       }
@@ -684,6 +686,10 @@ void validate_scene_file(const SceneFile& s, const std::string& name) {
   validate_bvh(s, name);
 }
 
+// encode_scene writes these arrays with binary_io's words(): their bytes are their 4-byte fields in order.
+static_assert(sizeof(Float2) == 8 && sizeof(Float3) == 12);
+static_assert(sizeof(PartialCoverageRecord) == 8 && offsetof(PartialCoverageRecord, coverage) == 4);
+
 std::vector<uint8_t> encode_scene(const SceneFile& s, uint32_t version) {
   const std::string writing = "scene.bin (writing)";
   if (version < kOldestSceneFormatVersion || version > kSceneFormatVersion)
@@ -726,32 +732,39 @@ std::vector<uint8_t> encode_scene(const SceneFile& s, uint32_t version) {
   const uint64_t fixed = fixed_payload_bytes(
       t.count(), s.bvh.nodes.size(), s.bvh.leaf_triangles.size(), s.texels.pages.size(), s.texels.texels.size(),
       s.texels.partial_coverage.size(), s.texels.moved.size(), s.probes.probes.size());
-  std::vector<uint8_t> payload;
-  payload.reserve(size_t(fixed) + s.nodes.size() * kMinNodeBytes + s.instances.size() * kMinInstanceBytes);
-  binary_io::LittleEndianWriter p(payload);
-  for (const Float3& v : t.positions) put(p, v);
-  for (const Float3& v : t.normals) put(p, v);
-  for (const Float2& v : t.lightmap_uv) put(p, v);
-  for (const Float2& v : t.uv0) put(p, v);
-  for (uint32_t v : t.material) p.u32(v);
-  for (uint32_t v : t.instance) p.u32(v);
-  for (float v : s.texels.triangle_texel_size) p.f32(v);
-  for (const BvhNodeRecord& n : s.bvh.nodes) {
-    for (const float* plane : {n.lo_x, n.hi_x, n.lo_y, n.hi_y, n.lo_z, n.hi_z})
-      for (int c = 0; c < 4; ++c) p.f32(plane[c]);
-    for (uint32_t w : n.child) p.u32(w);
-  }
-  for (uint32_t v : s.bvh.leaf_triangles) p.u32(v);
+  // The payload is written straight after the header's placeholder, the large arrays in one copy
+  // each (binary_io's words(): the same bytes as field-by-field writes).
+  const framing::FileKind kind{kSceneMagic, version, kSceneHeaderSize, version};
+  std::vector<uint8_t> file = framing::begin_frame(
+      kind, size_t(fixed) + s.nodes.size() * kMinNodeBytes + s.instances.size() * kMinInstanceBytes);
+  binary_io::LittleEndianWriter p(file);
+  p.words(t.positions.data(), t.positions.size());
+  p.words(t.normals.data(), t.normals.size());
+  p.words(t.lightmap_uv.data(), t.lightmap_uv.size());
+  p.words(t.uv0.data(), t.uv0.size());
+  p.words(t.material.data(), t.material.size());
+  p.words(t.instance.data(), t.instance.size());
+  p.words(s.texels.triangle_texel_size.data(), s.texels.triangle_texel_size.size());
+  // A node's fields in the file's order are its members' order (lo_x .. hi_z, then child).
+  p.words(s.bvh.nodes.data(), s.bvh.nodes.size());
+  p.words(s.bvh.leaf_triangles.data(), s.bvh.leaf_triangles.size());
   for (const TexelPageRecord& page : s.texels.pages) {
     p.u32(page.width);
     p.u32(page.height);
     p.u32(page.live_texels);
   }
   const std::vector<TexelRecord>& texels = s.texels.texels;
-  for (const TexelRecord& r : texels) p.u32(r.triangle);
-  for (const TexelRecord& r : texels) p.u32(uint32_t(r.x) | (uint32_t(r.y) << 16));
-  for (const TexelRecord& r : texels) p.f32(r.b1), p.f32(r.b2);
-  for (const PartialCoverageRecord& c : s.texels.partial_coverage) p.u32(c.texel), p.f32(c.coverage);
+  {
+    std::vector<uint32_t> column(texels.size());
+    for (size_t i = 0; i < texels.size(); ++i) column[i] = texels[i].triangle;
+    p.words(column.data(), column.size());
+    for (size_t i = 0; i < texels.size(); ++i) column[i] = uint32_t(texels[i].x) | (uint32_t(texels[i].y) << 16);
+    p.words(column.data(), column.size());
+    std::vector<Float2> barycentrics(texels.size());
+    for (size_t i = 0; i < texels.size(); ++i) barycentrics[i] = {texels[i].b1, texels[i].b2};
+    p.words(barycentrics.data(), barycentrics.size());
+  }
+  p.words(s.texels.partial_coverage.data(), s.texels.partial_coverage.size());  // texel, coverage
   for (const MovedTexelRecord& m : s.texels.moved) {
     p.u32(m.texel);
     put(p, m.position);
@@ -836,8 +849,8 @@ std::vector<uint8_t> encode_scene(const SceneFile& s, uint32_t version) {
   // Version 3's section after them.
   for (const Float3& v : s.tangents) put(p, v);
   for (float w : s.tangent_signs) p.f32(w);
-  const framing::FileKind kind{kSceneMagic, version, kSceneHeaderSize, version};
-  return framing::build_frame(kind, header, payload);
+  framing::finish_frame(kind, header, file);
+  return file;
 }
 
 void write_scene_file(const std::string& path, const SceneFile& scene) {

@@ -111,6 +111,27 @@ bool shrink_to_closer_triangle(RTCPointQueryFunctionArguments* args) {
   return true;
 }
 
+// Point-query state for any_triangle_within.
+struct RelevantTriangleSearch {
+  const Scene* scene;
+  const std::function<bool(uint32_t, const Vec3*)>* relevant;
+  bool found = false;
+};
+
+// Point-query callback: stops the query (radius 0) at the first relevant triangle within the radius.
+bool stop_at_relevant_triangle(RTCPointQueryFunctionArguments* args) {
+  auto* search = static_cast<RelevantTriangleSearch*>(args->userPtr);
+  if (search->found) return false;
+  const uint32_t t = args->primID;
+  const Vec3 p{args->query->x, args->query->y, args->query->z};
+  const Vec3* v = &search->scene->positions[size_t(t) * 3];
+  if (!(length(closest_point_on_triangle(p, v[0], v[1], v[2]) - p) <= args->query->radius)) return false;
+  if (!(*search->relevant)(t, v)) return false;
+  search->found = true;
+  args->query->radius = 0;
+  return true;
+}
+
 }  // namespace
 
 EmbreeScene::EmbreeScene(const Scene& scene) : scene_(scene) {
@@ -181,6 +202,19 @@ float EmbreeScene::distance_to_nearest_triangle(Vec3 point, float max_distance) 
   rtcInitPointQueryContext(&context);
   rtcPointQuery(rtc_scene_, &query, &context, shrink_to_closer_triangle, const_cast<Scene*>(&scene_));
   return query.radius < max_distance ? query.radius : INFINITY;
+}
+
+bool EmbreeScene::any_triangle_within(Vec3 center, float radius,
+                                      const std::function<bool(uint32_t, const Vec3*)>& relevant) const {
+  RTCPointQuery query{};
+  query.x = center.x, query.y = center.y, query.z = center.z;
+  query.time = 0;
+  query.radius = radius;
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  RelevantTriangleSearch search{&scene_, &relevant};
+  rtcPointQuery(rtc_scene_, &query, &context, stop_at_relevant_triangle, &search);
+  return search.found;
 }
 
 bool EmbreeScene::occluded(Vec3 origin, Vec3 direction, float t_max) const {

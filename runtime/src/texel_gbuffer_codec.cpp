@@ -1,9 +1,12 @@
 #include "exitance/runtime/texel_gbuffer_codec.h"
 
+#include <atomic>
 #include <bit>
 #include <cstring>
 #include <string>
+#include <vector>
 
+#include "exitance/runtime/core/parallel_chunks.h"
 #include "exitance/runtime/texel_surface.h"
 
 namespace exitance {
@@ -14,6 +17,15 @@ using formats::FormatError;
 bool same_bits(Vec3 a, Vec3 b) { return std::memcmp(&a, &b, sizeof(Vec3)) == 0; }
 
 std::string texel_where(size_t i) { return "scene.bin (writing): texel " + std::to_string(i) + ": "; }
+
+// What a texel's triangle gives at the texel, derived in parallel before the ordered pass that
+// checks and stores the texels (it throws at the first bad texel, as a serial loop would). Left
+// at its defaults where the texel's page, cell, triangle or instance is invalid: that pass throws
+// before it reads them.
+struct DerivedTexel {
+  float b1 = 0, b2 = 0;
+  bool geometric_normal_differs = false, shading_differs = false, moved = false;
+};
 
 }  // namespace
 
@@ -44,6 +56,28 @@ formats::TexelGBufferRecords encode_texel_gbuffer(const TexelGBuffer& gbuffer, c
   // World texel size is per triangle (the rasterizer's): the first texel of a triangle sets it.
   records.triangle_texel_size.assign(scene.triangle_count(), 0.0f);
   std::vector<uint8_t> size_set(scene.triangle_count(), 0);
+  // Re-deriving each texel's surface is the bulk of the work at 10 M texels: done in parallel
+  // (for_each_chunk bodies must not throw: a texel that cannot be derived is left for the
+  // ordered pass to report).
+  std::vector<DerivedTexel> derived(gbuffer.texels.size());
+  for_each_chunk(gbuffer.texels.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const LiveTexel& texel = gbuffer.texels[i];
+      if (texel.page >= gbuffer.pages.size() || texel.triangle >= scene.triangle_count()) continue;
+      const AtlasPage& page = gbuffer.pages[texel.page];
+      if (texel.x >= uint32_t(page.width) || texel.y >= uint32_t(page.height)) continue;
+      const uint32_t instance = scene.triangle_instance[texel.triangle];
+      if (texel.instance != instance || instance >= atlas.rects.size() || atlas.rects[instance].page != int(texel.page))
+        continue;
+      DerivedTexel& d = derived[i];
+      texel_barycentrics(scene, atlas.rects[instance], page.width, page.height, texel.triangle, texel.x, texel.y, d.b1,
+                         d.b2);
+      const TexelSurface surface = texel_surface(scene, texel.triangle, d.b1, d.b2);
+      d.geometric_normal_differs = !same_bits(surface.geometric_normal, texel.geometric_normal);
+      d.shading_differs = !same_bits(surface.shading_normal, texel.shading_normal) || !same_bits(surface.albedo, texel.albedo);
+      d.moved = !same_bits(surface.position, texel.position);
+    }
+  });
   uint32_t previous_page = 0;
   uint64_t previous_code = 0;
   for (size_t i = 0; i < gbuffer.texels.size(); ++i) {
@@ -86,25 +120,37 @@ formats::TexelGBufferRecords encode_texel_gbuffer(const TexelGBuffer& gbuffer, c
                         std::to_string(texel.triangle));
     }
     if (coverage != 1.0f) records.partial_coverage.push_back({uint32_t(i), coverage});
-    texel_barycentrics(scene, atlas.rects[instance], page.width, page.height, texel.triangle, texel.x, texel.y, r.b1, r.b2);
-    const TexelSurface surface = texel_surface(scene, texel.triangle, r.b1, r.b2);
-    if (!same_bits(surface.geometric_normal, texel.geometric_normal))
-      throw FormatError(texel_where(i) + "geometric normal is not its triangle's");
-    if (!same_bits(surface.shading_normal, texel.shading_normal) || !same_bits(surface.albedo, texel.albedo))
+    const DerivedTexel& d = derived[i];  // derived: every check above passed
+    r.b1 = d.b1, r.b2 = d.b2;
+    if (d.geometric_normal_differs) throw FormatError(texel_where(i) + "geometric normal is not its triangle's");
+    if (d.shading_differs)
       throw FormatError(texel_where(i) +
                         "shading normal or albedo is not what its triangle gives at the texel "
                         "(scene.bin derives them; is this G-buffer the rasterizer's?)");
-    if (!same_bits(surface.position, texel.position))
+    if (d.moved)
       records.moved.push_back({uint32_t(i), {texel.position.x, texel.position.y, texel.position.z}});
     records.texels.push_back(r);
     ++records.pages[texel.page].live_texels;
   }
-  for (size_t p = 0; p < gbuffer.pages.size(); ++p)
-    for (size_t k = 0; k < live[p].size(); ++k)
-      if (!live[p][k] && gbuffer.pages[p].coverage[k] != 0.0f)
-        throw FormatError("scene.bin (writing): page " + std::to_string(p) + ": texel (" +
-                          std::to_string(k % size_t(gbuffer.pages[p].width)) + ", " +
-                          std::to_string(k / size_t(gbuffer.pages[p].width)) + ") has coverage but is not live");
+  for (size_t p = 0; p < gbuffer.pages.size(); ++p) {
+    // Pages are mostly empty cells at scale: find a covered cell that is not live in parallel.
+    const std::vector<float>& coverage = gbuffer.pages[p].coverage;
+    std::atomic<size_t> first_stray{live[p].size()};
+    for_each_chunk(live[p].size(), [&](size_t begin, size_t end) {
+      for (size_t k = begin; k < end; ++k)
+        if (!live[p][k] && coverage[k] != 0.0f) {
+          size_t seen = first_stray.load();
+          while (k < seen && !first_stray.compare_exchange_weak(seen, k)) {
+          }
+          break;
+        }
+    });
+    const size_t k = first_stray.load();
+    if (k < live[p].size())
+      throw FormatError("scene.bin (writing): page " + std::to_string(p) + ": texel (" +
+                        std::to_string(k % size_t(gbuffer.pages[p].width)) + ", " +
+                        std::to_string(k / size_t(gbuffer.pages[p].width)) + ") has coverage but is not live");
+  }
   return records;
 }
 

@@ -9,7 +9,7 @@ namespace exitance {
 
 bool unocclude_texel(LiveTexel& texel, float scene_extent, const ClosestHitQuery& closest_hit) {
   constexpr int kDirections = 8;
-  const float reach = texel.world_texel_size * 0.75f;  // a texel's half-diagonal, slightly more
+  const float reach = unocclude_reach(texel);
   if (!(reach > 0)) return false;
   Vec3 t, b;
   orthonormal_basis(texel.geometric_normal, t, b);

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "exitance/bake/layout/atlas_layout.h"
+#include "exitance/bake/raster/cell_rejection.h"
 #include "exitance/runtime/bundle/lightmap_assembly.h"
 #include "exitance/bake/raster/texel_raster.h"
 #include "exitance/runtime/distribution_1d.h"
@@ -29,6 +30,40 @@ TEST(TexelClipping, FullPartialAndEmptyCoverage) {
   EXPECT_NEAR(c.x, 1.0f / 3.0f, 1e-6f);
   EXPECT_NEAR(clipped_texel_coverage(half_cw, 0, 0, c), 0.5f, 1e-6f);
   EXPECT_EQ(clipped_texel_coverage(half_ccw, 3, 3, c), 0.0f);
+}
+
+// The raster skips the cells CellRejection rejects: the clip must give every one of them no area,
+// for large and thin triangles anywhere on a 2048 page (where float rounding is coarsest), and the
+// rejection must still take most of a thin diagonal triangle's bounding box.
+TEST(TexelClipping, RejectedCellsGetNoCoverage) {
+  Pcg32 rng = pcg_init(42, 0, 0);
+  size_t rejected = 0, cells = 0;
+  for (int n = 0; n < 3000; ++n) {
+    Vec2 tri[3];
+    const Vec2 base{2040.0f * pcg_uniform(rng), 2040.0f * pcg_uniform(rng)};
+    const float size = n % 3 == 0 ? 0.5f : n % 3 == 1 ? 8.0f : 200.0f;
+    for (Vec2& v : tri) v = {base.x + size * pcg_uniform(rng), base.y + size * pcg_uniform(rng)};
+    if (n % 2) tri[2] = tri[0] + (tri[1] - tri[0]) * pcg_uniform(rng) + Vec2{0.02f, -0.01f};  // slivers
+    const CellRejection outside(tri);
+    const int x0 = int(std::floor(std::min({tri[0].x, tri[1].x, tri[2].x}))), x1 = int(std::ceil(std::max({tri[0].x, tri[1].x, tri[2].x})));
+    const int y0 = int(std::floor(std::min({tri[0].y, tri[1].y, tri[2].y}))), y1 = int(std::ceil(std::max({tri[0].y, tri[1].y, tri[2].y})));
+    for (int y = y0; y <= y1 && cells < 4000000; ++y)
+      for (int x = x0; x <= x1; ++x) {
+        ++cells;
+        if (!outside.rejects(x, y)) continue;
+        ++rejected;
+        Vec2 centroid;
+        ASSERT_EQ(clipped_texel_coverage(tri, x, y, centroid), 0.0f) << "triangle " << n << ", cell " << x << ", " << y;
+      }
+  }
+  EXPECT_GT(rejected, cells / 4);
+  // A thin diagonal triangle: most of its box is far from it.
+  const Vec2 diagonal[3] = {{100.2f, 100.3f}, {180.7f, 180.1f}, {181.4f, 180.2f}};
+  const CellRejection outside(diagonal);
+  size_t kept = 0;
+  for (int y = 100; y <= 181; ++y)
+    for (int x = 100; x <= 182; ++x) kept += outside.rejects(x, y) ? 0 : 1;
+  EXPECT_LT(kept, size_t(82 * 83 / 10));
 }
 
 TEST(AtlasLayout, RectanglesAreDisjointAndScaleWithArea) {

@@ -34,6 +34,11 @@ class EmbreeScene {
   // Distance from `point` to the nearest triangle (any side, any material), by Embree's point
   // query (rtcPointQuery); +infinity when no triangle is within `max_distance`.
   float distance_to_nearest_triangle(Vec3 point, float max_distance) const;
+  // Whether some triangle within `radius` of `center` (by its closest point) passes `relevant`,
+  // given the triangle's index and its three corners: an Embree point query that stops at the
+  // first one, for tests that rule out every hit of a bundle of short rays in one BVH descent.
+  bool any_triangle_within(Vec3 center, float radius,
+                           const std::function<bool(uint32_t triangle, const Vec3* corners)>& relevant) const;
   // Largest side of the scene's bounding box: the scale of ray-offset error floors.
   float extent() const { return extent_; }
 

@@ -19,9 +19,14 @@ struct OccluderHit {
 };
 using ClosestHitQuery = std::function<OccluderHit(const Vec3& origin, const Vec3& direction, float t_max)>;
 
+// How far unocclude_texel looks: a texel's half-diagonal, slightly more.
+inline float unocclude_reach(const LiveTexel& texel) { return texel.world_texel_size * 0.75f; }
+
 // Casts 8 rays sideways (tilted slightly up) within 0.75 texel of the centre; when the nearest
 // surface seen is a back face, moves texel.position just past it, on the texel's own plane.
-// Returns whether it moved. `scene_extent`: the scale of ray-offset floors (ray_offset.h).
+// Every ray starts at offset_ray_origin(position, geometric_normal) and climbs away from the
+// texel's plane (its direction has a positive normal component): bake/raster/unocclude.cpp relies
+// on that to skip texels with nothing but their own plane within reach. Returns whether it moved. `scene_extent`: the scale of ray-offset floors (ray_offset.h).
 bool unocclude_texel(LiveTexel& texel, float scene_extent, const ClosestHitQuery& closest_hit);
 
 }  // namespace exitance
