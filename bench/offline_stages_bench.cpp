@@ -20,19 +20,13 @@
 
 #include "exitance/bake/command/bake_stages.h"
 
+#include "wall_clock.h"
+
 using namespace exitance;
+using exitance::bench::median;
+using exitance::bench::seconds_since;
 
 namespace {
-
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // FNV-1a over bytes: equal digests on both builds mean (all but surely) equal results.
 struct Digest {

@@ -17,21 +17,11 @@
 #include "exitance/bake/command/bake_stages.h"
 #include "exitance/bake/command/gbuffer_without_skipped.h"
 
+#include "wall_clock.h"
+
 using namespace exitance;
-
-namespace {
-
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-}  // namespace
+using exitance::bench::median;
+using exitance::bench::seconds_since;
 
 int main(int argc, char** argv) {
   BakeOptions options;

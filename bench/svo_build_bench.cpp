@@ -15,17 +15,11 @@
 #include "exitance/bake/bundle/radiance_vdb.h"
 #include "exitance/bake/voxelize/svo_build.h"
 
+#include "wall_clock.h"
+
 using namespace exitance;
-
-namespace {
-
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
-}  // namespace
+using exitance::bench::median;
+using exitance::bench::seconds_since;
 
 int main(int argc, char** argv) {
   std::string scene_path, vdb_path;
