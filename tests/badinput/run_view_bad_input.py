@@ -82,7 +82,7 @@ def refresh_scene_checksums(data):
 
 
 def last_texture_record(data):
-    """Offset of the last texture record of a version 2 or 3 scene.bin with textures, no environment
+    """Offset of the last texture record of a version 2, 3 or 4 scene.bin with textures, no environment
     map and no tangents: the record that ends the file (u32 width, height, wrap_s, wrap_t, has_alpha, then pixels)."""
     for offset in range(len(data) - 20, SCENE_HEADER - 4, -4):
         w, h, _, _, alpha = struct.unpack_from("<5I", data, offset)
@@ -92,7 +92,7 @@ def last_texture_record(data):
 
 
 def make_textured_fixtures(bake, root, fixtures):
-    """hostile/valid_texture.gltf baked (scene.bin version 3 with one texture, no normal map), and its scene.bin
+    """hostile/valid_texture.gltf baked (scene.bin version 4 with one texture, no normal map), and its scene.bin
     truncated inside the texture, with an oversized texture (right checksums) and with a flipped
     texel byte (wrong checksum)."""
     out = os.path.join(root, "textured.bake")
@@ -102,9 +102,9 @@ def make_textured_fixtures(bake, root, fixtures):
     fixtures["textured"] = out
     with open(os.path.join(out, "scene.bin"), "rb") as f:
         original = bytearray(f.read())
-    if (struct.unpack_from("<I", original, 8)[0] not in (2, 3) or struct.unpack_from("<I", original, 132)[0] != 1
+    if (struct.unpack_from("<I", original, 8)[0] not in (2, 3, 4) or struct.unpack_from("<I", original, 132)[0] != 1
             or struct.unpack_from("<I", original, 140)[0] != 0):
-        raise SystemExit("textured fixture: scene.bin is not version 2 or 3 with one texture and no tangents")
+        raise SystemExit("textured fixture: scene.bin is not version 2, 3 or 4 with one texture and no tangents")
     texture = last_texture_record(original)
     truncated = original[: texture + 20 + 8]
     oversized = bytearray(original)
