@@ -1,8 +1,9 @@
-// exitance-relight BUNDLE [-o OUT] [--edits EDITS.json] [--spp N] [--time S] [--budget-ms N] [--frames N] [--guiding off|grid|svo] [--seed N] [--device N] [--json]
+// exitance-relight BUNDLE [-o OUT] [--edits EDITS.json] [--spp N] [--time S] [--budget-ms N] [--frames N] [--guiding off|grid|svo] [--seed N] [--device N] [--json] [--share R/N]
 // Re-lights a baked bundle from its scene.bin on the GPU (runtime/src/relight). Links the runtime
 // library and nothing of the offline stage; runs where only a Vulkan driver exists.
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
 #include <cstdlib>
 #include <iostream>
 #include <optional>
@@ -56,6 +57,10 @@ int main(int argc, char** argv) {
                "time each wavefront stage on the GPU (timestamps, lane counters; slower, for benchmarks)");
   app.add_option("--traversal-rays", options.traversal_rays,
                  "also time N incoherent closest-hit rays (origins in the scene bounds, uniform directions) alone");
+  std::string share;
+  app.add_option("--share", share,
+                 "R/N: time rank R's share of an N-rank bake (bake under mpirun) alone on this device, by path tracing "
+                 "at --spp (benchmarks: the split's balance on one GPU); writes nothing");
   try {
     if (argc > 1 && std::string(argv[1]) == "--list-devices") {
       for (const auto& d : exitance::enumerate_vulkan_devices())
@@ -67,6 +72,16 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
     return e.get_exit_code() == 0 ? 0 : (code == 0 ? 0 : 2);
+  }
+  if (!share.empty()) {
+    int rank = -1, ranks = 0;
+    char slash = 0, extra = 0;
+    if (std::sscanf(share.c_str(), "%d%c%d%c", &rank, &slash, &ranks, &extra) != 3 || slash != '/' || ranks < 1 || rank < 0 ||
+        rank >= ranks) {
+      std::cerr << "exitance-relight: error: --share " << share << ": expected R/N with 0 <= R < N\n";
+      return 2;
+    }
+    options.share_rank = rank, options.share_ranks = ranks;
   }
   options.spp = spp;
   options.frame_errors = !no_frame_errors;
@@ -83,6 +98,9 @@ int main(int argc, char** argv) {
       for (const auto& w : report["warnings"]) std::cerr << "exitance-relight: warning: " << w.get<std::string>() << "\n";
     if (json_report) {
       std::cout << report.dump(2) << "\n";
+    } else if (options.share_ranks > 0) {
+      std::cerr << "exitance-relight: share " << share << ": " << report["lighting_seconds"].get<double>() << " s, "
+                << report["rays_per_second"].get<double>() * 1e-6 << " Mrays/s on " << report["device"].get<std::string>() << "\n";
     } else {
       std::cerr << "exitance-relight: wrote " << report["output"].get<std::string>() << " ("
                 << report["rays_per_second"].get<double>() * 1e-6 << " Mrays/s on " << report["device"].get<std::string>()

@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -19,6 +20,8 @@
 #include "exitance/formats/scene_file.h"
 #include "exitance/loader/bundle.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
+#include "exitance/runtime/core/work_share.h"
+#include "exitance/runtime/refresh/refresh_session.h"
 #include "exitance/runtime/relight/relight.h"
 #include "exitance/runtime/scene_file_conversion.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
@@ -414,6 +417,61 @@ TEST(Relight, BadScenesAreOneLineAndExitTwo) {
   EXPECT_EQ(std::count(errors.begin(), errors.end(), '\n'), 1) << errors;
   EXPECT_NE(errors.find("svo.bin"), std::string::npos) << errors;
   EXPECT_FALSE(fs::exists(guided_out)) << "partial output";
+}
+
+// What relight --share R/N times: rank R's texels of a bake under mpirun, alone. Each rank's
+// texels are estimated bit for bit as in the one-process run (per-texel streams); the ranks' texels
+// are disjoint and cover every texel; the CLI takes only a well-formed share of a fixed --spp run.
+class RankWithoutExchange final : public WorkShare {
+ public:
+  RankWithoutExchange(int rank, int ranks) : rank_(rank), ranks_(ranks) {}
+  int rank() const override { return rank_; }
+  int ranks() const override { return ranks_; }
+  void allgather_ranges(void*, const std::vector<size_t>&) override {}
+  void broadcast(void*, size_t) override {}
+  uint64_t sum(uint64_t value) override { return value; }
+
+ private:
+  int rank_, ranks_;
+};
+
+TEST(Relight, EachRanksShareIsItsTexelsOfTheWholeRun) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const Fixture& f = vulkan_bake();
+  RefreshSessionOptions session_options;
+  session_options.seed = 11;
+  const std::unique_ptr<RefreshSession> session = RefreshSession::open(f.baked.string(), session_options);
+  const LightmapEstimate whole = session->bake_path(2, 0);
+  ASSERT_GT(whole.texels.size(), 2048u) << "too few texels for two ranks' blocks";
+  std::vector<int> owner(whole.texels.size(), -1);
+  for (int rank = 0; rank < 2; ++rank) {
+    RankWithoutExchange share(rank, 2);
+    const LightmapEstimate part = session->bake_path(2, 0, &share);
+    ASSERT_EQ(part.texels.size(), whole.texels.size());
+    for (size_t i = 0; i < part.texels.size(); ++i) {
+      if (part.texels[i].samples == 0) continue;
+      ASSERT_EQ(owner[i], -1) << "texel " << i << " estimated by two ranks";
+      owner[i] = rank;
+      ASSERT_EQ(part.texels[i].samples, whole.texels[i].samples);
+      for (int c = 0; c < 3; ++c) {
+        ASSERT_EQ(part.texels[i].total[c], whole.texels[i].total[c]) << "texel " << i;
+        ASSERT_EQ(part.texels[i].total_squared[c], whole.texels[i].total_squared[c]) << "texel " << i;
+      }
+    }
+  }
+  EXPECT_EQ(std::count(owner.begin(), owner.end(), -1), 0) << "texels no rank estimated";
+  EXPECT_GT(std::count(owner.begin(), owner.end(), 1), std::ptrdiff_t(whole.texels.size() / 3));
+
+  std::string errors;
+  for (const char* bad : {"--spp 1 --share 2/2", "--spp 1 --share 1/0", "--spp 1 --share x", "--spp 1 --share 0/2 --time 1",
+                          "--spp 0 --share 0/2", "--share 0/2"}) {
+    EXPECT_EQ(run_relight(f.baked.string() + " " + bad, errors), 2) << bad;
+    EXPECT_EQ(std::count(errors.begin(), errors.end(), '\n'), 1) << bad << ": " << errors;
+    EXPECT_NE(errors.find("--share"), std::string::npos) << bad << ": " << errors;
+  }
+  const fs::path out = f.dir / "share-out.bake";
+  EXPECT_EQ(run_relight(f.baked.string() + " --spp 1 --share 1/2 -o " + out.string(), errors), 2);
+  EXPECT_FALSE(fs::exists(out)) << "a share writes nothing";
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
-// bake under mpirun (issue 15): the split of items over ranks by counted cost (core/work_share.h).
+// bake under mpirun (issue 15): the split of items over ranks by counted cost (CPU backend) and in
+// interleaved blocks (Vulkan backend), and the gather of an interleaved split (core/work_share.h).
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <numeric>
 
 #include "exitance/runtime/core/work_share.h"
@@ -47,6 +49,68 @@ TEST(SplitByCost, MoreRanksThanItemsLeavesSomeEmpty) {
   EXPECT_EQ(b.front(), 0u);
   EXPECT_EQ(b.back(), 2u);
   for (size_t r = 0; r + 1 < b.size(); ++r) EXPECT_LE(b[r], b[r + 1]);
+}
+
+TEST(InterleavedSplit, EveryItemHasOneRankAndRanksGetBlocksInTurn) {
+  InterleavedSplit split;
+  split.items = 10;
+  split.ranks = 3;
+  split.block = 2;
+  EXPECT_EQ(split.items_of(0), (std::vector<uint32_t>{0, 1, 6, 7}));
+  EXPECT_EQ(split.items_of(1), (std::vector<uint32_t>{2, 3, 8, 9}));
+  EXPECT_EQ(split.items_of(2), (std::vector<uint32_t>{4, 5}));
+  std::vector<size_t> bounds;
+  EXPECT_EQ(split.rank_major_order(bounds), (std::vector<uint32_t>{0, 1, 6, 7, 2, 3, 8, 9, 4, 5}));
+  EXPECT_EQ(bounds, (std::vector<size_t>{0, 4, 8, 10}));
+  split.ranks = 1;
+  EXPECT_EQ(split.items_of(0).size(), 10u);
+  split.items = 0;
+  split.ranks = 2;
+  EXPECT_TRUE(split.items_of(1).empty());
+}
+
+// N ranks in one process, one after another: each exchange writes the caller's range into a shared
+// world and reads everybody's from it, so a second round sees every rank's items (what MPI's
+// allgather gives all ranks at once).
+class SequentialRanks final : public WorkShare {
+ public:
+  SequentialRanks(std::vector<char>& world, int rank, int ranks) : world_(world), rank_(rank), ranks_(ranks) {}
+  int rank() const override { return rank_; }
+  int ranks() const override { return ranks_; }
+  void allgather_ranges(void* data, const std::vector<size_t>& b) override {
+    world_.resize(b.back());
+    std::memcpy(world_.data() + b[size_t(rank_)], static_cast<char*>(data) + b[size_t(rank_)], b[size_t(rank_) + 1] - b[size_t(rank_)]);
+    for (int r = 0; r < ranks_; ++r)
+      if (r != rank_) std::memcpy(static_cast<char*>(data) + b[size_t(r)], world_.data() + b[size_t(r)], b[size_t(r) + 1] - b[size_t(r)]);
+  }
+  void broadcast(void*, size_t) override {}
+  uint64_t sum(uint64_t value) override { return value; }
+
+ private:
+  std::vector<char>& world_;
+  int rank_, ranks_;
+};
+
+TEST(InterleavedSplit, GatherGivesEveryRankEveryItem) {
+  InterleavedSplit split;
+  split.items = 1000;
+  split.ranks = 3;
+  split.block = 64;
+  constexpr size_t kValues = 3;
+  std::vector<char> world;
+  std::vector<std::vector<double>> rank_data(3);
+  for (int round = 0; round < 2; ++round)
+    for (int r = 0; r < 3; ++r) {
+      std::vector<double>& data = rank_data[size_t(r)];
+      data.assign(split.items * kValues, -1.0);  // items of other ranks: unknown here
+      for (uint32_t i : split.items_of(r))
+        for (size_t c = 0; c < kValues; ++c) data[i * kValues + c] = double(i) * 10 + double(c);
+      SequentialRanks share(world, r, 3);
+      allgather_interleaved(share, data.data(), kValues, split);
+    }
+  for (int r = 0; r < 3; ++r)
+    for (size_t i = 0; i < split.items; ++i)
+      for (size_t c = 0; c < kValues; ++c) ASSERT_EQ(rank_data[size_t(r)][i * kValues + c], double(i) * 10 + double(c)) << "rank " << r << " item " << i;
 }
 
 }  // namespace

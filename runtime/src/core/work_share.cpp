@@ -1,5 +1,7 @@
 #include "exitance/runtime/core/work_share.h"
 
+#include <algorithm>
+
 namespace exitance {
 
 std::vector<size_t> split_by_cost(size_t items, const std::vector<uint64_t>& cost, int ranks) {
@@ -21,6 +23,26 @@ std::vector<size_t> split_by_cost(size_t items, const std::vector<uint64_t>& cos
     prefix += cost[i] + 1;
   }
   return bounds;
+}
+
+std::vector<uint32_t> InterleavedSplit::items_of(int rank) const {
+  std::vector<uint32_t> out;
+  const size_t step = block * size_t(ranks);
+  for (size_t start = size_t(rank) * block; start < items; start += step)
+    for (size_t i = start; i < std::min(items, start + block); ++i) out.push_back(uint32_t(i));
+  return out;
+}
+
+std::vector<uint32_t> InterleavedSplit::rank_major_order(std::vector<size_t>& bounds) const {
+  std::vector<uint32_t> order;
+  order.reserve(items);
+  bounds.assign(size_t(ranks) + 1, 0);
+  for (int r = 0; r < ranks; ++r) {
+    const std::vector<uint32_t> own = items_of(r);
+    order.insert(order.end(), own.begin(), own.end());
+    bounds[size_t(r) + 1] = order.size();
+  }
+  return order;
 }
 
 std::vector<RankWork> gather_rank_work(WorkShare& share) {

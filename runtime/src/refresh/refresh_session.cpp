@@ -62,8 +62,10 @@ struct RefreshSession::State {
   uint32_t near_samples = 0, far_samples = 0, all_samples = 0;
   // What texels show until they have samples again after an edit (published_lightmap).
   std::optional<LightmapEstimate> previous;
-  // A bake_per_bounce() or bake_guided() result: lightmap() until the next restart, edit or refresh.
+  // A bake_per_bounce(), bake_guided() or bake_path() result: lightmap() until the next restart, edit
+  // or refresh.
   std::optional<LightmapEstimate> per_bounce;
+  bool whole_run_path = false;    // per_bounce holds a bake_guided() or bake_path() result (path tracing)
   bool whole_run_guided = false;  // per_bounce holds a bake_guided() result
 };
 
@@ -167,7 +169,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
 void RefreshSession::restart() {
   State& s = *state_;
   s.per_bounce.reset();
-  s.whole_run_guided = false;
+  s.whole_run_path = s.whole_run_guided = false;
   s.integrator->start_progressive(s.persisted.gbuffer, s.settings);
   s.near_texels.clear();
   s.far_texels.clear();
@@ -285,11 +287,11 @@ LightmapEstimate RefreshSession::bake_per_bounce(uint32_t spp, double time_budge
   const formats::BakeSettings baked = s.manifest.settings.value_or(formats::BakeSettings{});
   settings.trace_first_bounce = baked.first_bounce != "cached";
   s.per_bounce = s.integrator->bake(s.persisted.gbuffer, settings);
-  s.whole_run_guided = false;
+  s.whole_run_path = s.whole_run_guided = false;
   return *s.per_bounce;
 }
 
-bool RefreshSession::per_bounce() const { return state_->per_bounce.has_value() && !state_->whole_run_guided; }
+bool RefreshSession::per_bounce() const { return state_->per_bounce.has_value() && !state_->whole_run_path; }
 
 LightmapEstimate RefreshSession::bake_guided(uint32_t spp, double time_budget_seconds, float guiding_mix, GuidingMode mode) {
   State& s = *state_;
@@ -308,7 +310,22 @@ LightmapEstimate RefreshSession::bake_guided(uint32_t spp, double time_budget_se
   settings.spp = spp;
   settings.time_budget_seconds = time_budget_seconds;
   s.per_bounce = s.integrator->bake(s.persisted.gbuffer, settings);
-  s.whole_run_guided = true;
+  s.whole_run_path = s.whole_run_guided = true;
+  return *s.per_bounce;
+}
+
+LightmapEstimate RefreshSession::bake_path(uint32_t spp, double time_budget_seconds, WorkShare* share) {
+  State& s = *state_;
+  if (spp == 0 && !(time_budget_seconds > 0)) throw std::invalid_argument("path tracing in one run needs samples per texel or a time budget");
+  IntegratorSettings settings = s.settings;
+  settings.integrator = IntegratorMode::Path;
+  settings.guiding = GuidingMode::Off;
+  settings.spp = spp;
+  settings.time_budget_seconds = time_budget_seconds;
+  settings.work_share = share;
+  s.per_bounce = s.integrator->bake(s.persisted.gbuffer, settings);
+  s.whole_run_path = true;
+  s.whole_run_guided = false;
   return *s.per_bounce;
 }
 

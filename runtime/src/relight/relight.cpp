@@ -8,11 +8,13 @@
 #include <iterator>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include "exitance/formats/bundle_manifest.h"
 #include "exitance/runtime/refresh/refreshed_bundle.h"
 #include "exitance/runtime/stage_clock.h"
 #include "exitance/runtime/vulkan/validation_messages.h"
+#include "one_rank_alone.h"
 
 namespace exitance {
 
@@ -42,6 +44,16 @@ json relight_bundle(const RelightOptions& options) {
   if (guided && (options.frames > 0 || options.frame_budget_ms > 0))
     throw RelightInputError("--guiding " + options.guiding + " runs the whole lightmap at once: --frames and --budget-ms need --guiding off");
 
+  const bool share = options.share_ranks > 0;
+  if (share) {
+    if (options.share_rank < 0 || options.share_rank >= options.share_ranks)
+      throw RelightInputError("--share " + std::to_string(options.share_rank) + "/" + std::to_string(options.share_ranks) +
+                              ": expected R/N with 0 <= R < N");
+    if (per_bounce || guided || options.frames > 0 || options.frame_budget_ms > 0 || options.time_budget_seconds > 0 ||
+        !options.edits_file.empty() || !options.output.empty() || !options.spp || *options.spp == 0)
+      throw RelightInputError("--share measures one rank's share of path tracing at a fixed --spp: it takes no --integrator bounces, "
+                              "--guiding, --frames, --budget-ms, --time, --edits or -o (it writes nothing)");
+  }
   const fs::path bundle(options.bundle);
   const fs::path out = options.output.empty() ? bundle : fs::path(options.output);
   report("load", 0, 0);
@@ -106,7 +118,19 @@ json relight_bundle(const RelightOptions& options) {
                                 options.guiding == "svo" ? GuidingMode::Svo : GuidingMode::Grid).rays;
     report("lighting", 1, rays);
   }
-  for (uint32_t frame = 0; !per_bounce && !guided && (options.frames == 0 || frame < options.frames); ++frame) {
+  std::optional<OneRankAlone> rank_alone;
+  size_t share_texels = 0;
+  double share_passes_seconds = 0;
+  if (share) {
+    report("lighting", 0, 0);
+    rank_alone.emplace(options.share_rank, options.share_ranks);
+    const LightmapEstimate e = session->bake_path(spp, 0, &*rank_alone);
+    rays = e.rays;
+    share_passes_seconds = e.seconds;
+    for (const TexelAccumulator& t : e.texels) share_texels += t.samples > 0 ? 1 : 0;
+    report("lighting", 1, rays);
+  }
+  for (uint32_t frame = 0; !per_bounce && !guided && !share && (options.frames == 0 || frame < options.frames); ++frame) {
     RefreshBudget budget;
     budget.max_samples_per_texel = spp;
     budget.milliseconds = options.frame_budget_ms;
@@ -164,6 +188,14 @@ json relight_bundle(const RelightOptions& options) {
   if (!edits_report.is_null()) run["edits"] = edits_report;
   if (options.traversal_rays > 0)
     run["traversal_only_rays_per_second"] = session->integrator().measure_incoherent_traversal(options.traversal_rays);
+  if (share) {
+    run["share"] = {{"rank", options.share_rank}, {"ranks", options.share_ranks}, {"texels", share_texels},
+                    {"passes_seconds", share_passes_seconds}};
+    run["rays"] = rays;
+    run["device"] = session->integrator().device_description();
+    validation->throw_if_any();
+    return run;
+  }
   json written = write_refreshed_bundle(*session, out.string(), run, options.progress,
                                         [&] { validation->throw_if_any(); });
   for (auto& [stage, value] : written["seconds"].items()) seconds[stage] = value;

@@ -162,7 +162,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   if (a.texel_count == 0) return download(a);
 
   const uint32_t spp_limit = settings.spp == 0 ? std::numeric_limits<uint32_t>::max() : settings.spp;
-  // Split over processes (core/work_share.h): this rank's device runs its contiguous range of the
+  // Split over processes (core/work_share.h): this rank's device runs its interleaved blocks of the
   // texels through the work list (global indices, so the same random streams); the sums are
   // gathered once at the end. Every rank follows every pass (rank 0 decides them), work or not.
   WorkShare* share = distributed(settings.work_share);
@@ -231,12 +231,11 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   // SVO: ramped throughout, as on the CPU, so its rebuilds (1, 2, 4, ... spp) end passes of the same sizes.
   if (svo_guide) policy.ramp = true, policy.ramp_below = PassPolicy{}.ramp_below;
   PassScheduler passes(settings, policy);
-  std::vector<size_t> bounds;
+  InterleavedSplit split;
   if (share) {
-    bounds = split_by_cost(a.texel_count, {}, share->ranks());
-    const size_t own_begin = bounds[size_t(share->rank())], own_end = bounds[size_t(share->rank()) + 1];
-    a.work_list.resize(own_end - own_begin);
-    for (size_t i = own_begin; i < own_end; ++i) a.work_list[i - own_begin] = uint32_t(i);
+    split.items = a.texel_count;
+    split.ranks = share->ranks();
+    a.work_list = split.items_of(share->rank());
     if (!a.work_list.empty())
       runner_.context().upload(runner_.buffers().items.batch_items, a.work_list.data(), a.work_list.size() * 4);
   }
@@ -300,10 +299,10 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   if (svo_guide && settings.inspect_svo_guiding) settings.inspect_svo_guiding(*svo_guide);
   if (settings.work_share) settings.work_share->work.rays += estimate.rays;
   if (share) {
-    allgather_items(*share, estimate.texels.data(), 1, bounds);
+    allgather_interleaved(*share, estimate.texels.data(), 1, split);
     for (int k = 0; k < estimate.recorded_bounces; ++k)
-      allgather_items(*share, estimate.bounces.data() + size_t(k) * a.texel_count * 3, 3, bounds);
-    if (!estimate.sh1.empty()) allgather_items(*share, estimate.sh1.data(), 9, bounds);
+      allgather_interleaved(*share, estimate.bounces.data() + size_t(k) * a.texel_count * 3, 3, split);
+    if (!estimate.sh1.empty()) allgather_interleaved(*share, estimate.sh1.data(), 9, split);
     estimate.rays = share->sum(estimate.rays);
     estimate.nonfinite_samples = share->sum(estimate.nonfinite_samples);
   } else if (settings.work_share) {

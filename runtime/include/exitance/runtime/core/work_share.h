@@ -57,6 +57,36 @@ void allgather_items(WorkShare& share, T* base, size_t values_per_item, const st
   share.allgather_ranges(base, bytes);
 }
 
+// Items dealt to ranks in blocks, round robin: rank r takes blocks r, r + N, r + 2N, ... of `block`
+// consecutive items. Each rank's items then sample every region of the item range, so ranks get
+// about equal cost without counting it: the Vulkan backend's split, whose devices do not count rays
+// per item (the CPU backend re-splits contiguous ranges by counted rays after every pass).
+struct InterleavedSplit {
+  size_t items = 0;
+  int ranks = 1;
+  size_t block = 1024;  // texels: long enough runs for coherent work lists, short enough to balance
+  // The items of `rank`, ascending.
+  std::vector<uint32_t> items_of(int rank) const;
+  // Rank-major order (rank 0's items, then rank 1's, ...) and each rank's start in it (ranks + 1 entries).
+  std::vector<uint32_t> rank_major_order(std::vector<size_t>& bounds) const;
+};
+
+// Gathers an interleaved split's items, `values_per_item` consecutive T each at `base`: every rank
+// holds every rank's items afterwards. Through a rank-major copy (allgather_items moves contiguous ranges).
+template <class T>
+void allgather_interleaved(WorkShare& share, T* base, size_t values_per_item, const InterleavedSplit& split) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  std::vector<size_t> bounds;
+  const std::vector<uint32_t> order = split.rank_major_order(bounds);
+  const size_t own_begin = bounds[size_t(share.rank())], own_end = bounds[size_t(share.rank()) + 1];
+  const size_t item_bytes = values_per_item * sizeof(T);
+  std::vector<T> packed(order.size() * values_per_item);  // only this rank's part is read before the exchange
+  for (size_t k = own_begin; k < own_end; ++k) std::memcpy(&packed[k * values_per_item], base + size_t(order[k]) * values_per_item, item_bytes);
+  allgather_items(share, packed.data(), values_per_item, bounds);
+  for (size_t k = 0; k < order.size(); ++k)
+    if (k < own_begin || k >= own_end) std::memcpy(base + size_t(order[k]) * values_per_item, &packed[k * values_per_item], item_bytes);
+}
+
 // Every rank's `work`, on every rank, in rank order.
 std::vector<RankWork> gather_rank_work(WorkShare& share);
 

@@ -25,6 +25,7 @@
 #include "exitance/runtime/core/estimates.h"
 #include "exitance/runtime/core/integrator_settings.h"
 #include "exitance/runtime/core/lighting_scene.h"
+#include "exitance/runtime/core/work_share.h"
 #include "exitance/runtime/refresh/scene_edits.h"
 #include "exitance/runtime/scene_file_conversion.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
@@ -101,6 +102,11 @@ class RefreshSession {
                                GuidingMode mode = GuidingMode::Grid);
   // Whether lightmap() holds a bake_guided() result.
   bool guided() const;
+  // The whole lightmap by unguided path tracing in one run, as bake --backend vulkan runs it (ramped
+  // passes, not progressive frames); otherwise as bake_guided. `share`: this process's share of a
+  // split bake (core/work_share.h: the texel range bake under mpirun gives its rank); null: every
+  // texel. relight --share runs one rank's share alone, to measure how a split balances.
+  LightmapEstimate bake_path(uint32_t spp, double time_budget_seconds, WorkShare* share = nullptr);
 
   // The lightmap accumulated since the last edit or restart (a read-back: it waits for the device).
   LightmapEstimate lightmap() const;

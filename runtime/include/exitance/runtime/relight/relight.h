@@ -39,12 +39,19 @@ struct RelightOptions {
   // grid|svo on the Vulkan backend; svo's octree is the bundle's svo.bin: no --frames or --budget-ms;
   // RefreshSession::bake_guided).
   std::string guiding = "off";
+  // > 0: --share R/N, a benchmark of one rank's share of a split bake: rank `share_rank` of
+  // `share_ranks` (the texel range bake under mpirun gives it) by path tracing in one run
+  // (RefreshSession::bake_path), alone on this device; needs --spp; writes no bundle (the other
+  // ranks' texels are empty). 0: the usual relight.
+  int share_ranks = 0;
+  int share_rank = 0;
   // Stage reporting: (stage, fraction done, rays so far).
   std::function<void(const std::string&, double, uint64_t)> progress;
 };
 
-// Runs the relight and writes the bundle atomically (nothing is written on failure). Returns the
-// run report (the manifest's "relight" entry, plus per-frame figures when frames were asked for).
+// Runs the relight and writes the bundle atomically (nothing is written on failure; nothing at all
+// with share_ranks > 0). Returns the run report (the manifest's "relight" entry, plus per-frame
+// figures when frames were asked for; with share_ranks > 0 the run entry alone).
 // Throws RelightInputError for bad input and std::runtime_error for other failures (no Vulkan
 // device, device loss).
 nlohmann::json relight_bundle(const RelightOptions& options);
