@@ -314,7 +314,7 @@ LightmapEstimate RefreshSession::bake_guided(uint32_t spp, double time_budget_se
   return *s.per_bounce;
 }
 
-LightmapEstimate RefreshSession::bake_path(uint32_t spp, double time_budget_seconds, WorkShare* share) {
+const LightmapEstimate& RefreshSession::bake_path(uint32_t spp, double time_budget_seconds, WorkShare* share) {
   State& s = *state_;
   if (spp == 0 && !(time_budget_seconds > 0)) throw std::invalid_argument("path tracing in one run needs samples per texel or a time budget");
   IntegratorSettings settings = s.settings;

@@ -124,7 +124,7 @@ json relight_bundle(const RelightOptions& options) {
   if (share) {
     report("lighting", 0, 0);
     rank_alone.emplace(options.share_rank, options.share_ranks);
-    const LightmapEstimate e = session->bake_path(spp, 0, &*rank_alone);
+    const LightmapEstimate& e = session->bake_path(spp, 0, &*rank_alone);
     rays = e.rays;
     share_passes_seconds = e.seconds;
     for (const TexelAccumulator& t : e.texels) share_texels += t.samples > 0 ? 1 : 0;

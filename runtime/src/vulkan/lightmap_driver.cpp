@@ -109,23 +109,26 @@ LightmapEstimate LightmapDriver::download(const Accumulation& a) {
   if (texel_count > 0) {
     Context& context = runner_.context();
     const WavefrontBuffers& buffers = runner_.buffers();
-    std::vector<double> sums(texel_count * 6);
-    std::vector<uint32_t> samples(texel_count);
-    context.download(buffers.texels.sums, sums.data(), sums.size() * 8);
-    context.download(buffers.texels.samples, samples.data(), samples.size() * 4);
+    // Converted straight from the staging mappings (a million texels' sums are ~50 MB: no host copy).
     context.download(buffers.texels.bounce_sums, estimate.bounces.data(), estimate.bounces.size() * 8);
+    context.read_back(buffers.texels.sums, texel_count * 6 * 8, 0, [&](const void* mapped) {
+      const double* sums = static_cast<const double*>(mapped);
+      for (size_t i = 0; i < texel_count; ++i) {
+        TexelAccumulator& t = estimate.texels[i];
+        for (int c = 0; c < 3; ++c) {
+          t.total[c] = sums[i * 6 + size_t(c)];
+          t.total_squared[c] = sums[i * 6 + 3 + size_t(c)];
+          t.direct[c] = estimate.bounces[i * 3 + size_t(c)];  // layer 0 is the direct light
+        }
+      }
+    });
+    context.read_back(buffers.texels.samples, texel_count * 4, 0, [&](const void* mapped) {
+      const uint32_t* samples = static_cast<const uint32_t*>(mapped);
+      for (size_t i = 0; i < texel_count; ++i) estimate.texels[i].samples = samples[i];
+    });
     if (a.directional) {
       estimate.sh1.assign(texel_count * 9, 0.0);
       context.download(buffers.texels.sums, estimate.sh1.data(), estimate.sh1.size() * 8, texel_count * 6 * 8);
-    }
-    for (size_t i = 0; i < texel_count; ++i) {
-      TexelAccumulator& t = estimate.texels[i];
-      for (int c = 0; c < 3; ++c) {
-        t.total[c] = sums[i * 6 + size_t(c)];
-        t.total_squared[c] = sums[i * 6 + 3 + size_t(c)];
-        t.direct[c] = estimate.bounces[i * 3 + size_t(c)];  // layer 0 is the direct light
-      }
-      t.samples = samples[i];
     }
   }
   estimate.rays = a.totals.rays();

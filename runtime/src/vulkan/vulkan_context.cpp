@@ -359,13 +359,17 @@ void Context::upload_ranges(const Buffer& dst, const void* data, const std::vect
 }
 
 void Context::download(const Buffer& src, void* data, VkDeviceSize size, VkDeviceSize offset) {
+  read_back(src, size, offset, [&](const void* mapped) { std::memcpy(data, mapped, size_t(size)); });
+}
+
+void Context::read_back(const Buffer& src, VkDeviceSize size, VkDeviceSize offset, const std::function<void(const void*)>& read) {
   if (size == 0) return;
   Buffer staging = create_buffer(size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
   VkCommandBuffer cmd = begin();
   VkBufferCopy region{offset, 0, size};
   vkCmdCopyBuffer(cmd, src.handle(), staging.handle(), 1, &region);
   submit_and_wait(cmd);
-  std::memcpy(data, staging.mapped(), size_t(size));
+  read(staging.mapped());
 }
 
 }  // namespace exitance::vulkan

@@ -106,7 +106,9 @@ class RefreshSession {
   // passes, not progressive frames); otherwise as bake_guided. `share`: this process's share of a
   // split bake (core/work_share.h: the texel range bake under mpirun gives its rank); null: every
   // texel. relight --share runs one rank's share alone, to measure how a split balances.
-  LightmapEstimate bake_path(uint32_t spp, double time_budget_seconds, WorkShare* share = nullptr);
+  // Returns the result lightmap() returns, by reference (valid until the next restart, edit or
+  // refresh: a million texels' estimate is ~100 MB).
+  const LightmapEstimate& bake_path(uint32_t spp, double time_budget_seconds, WorkShare* share = nullptr);
 
   // The lightmap accumulated since the last edit or restart (a read-back: it waits for the device).
   LightmapEstimate lightmap() const;
