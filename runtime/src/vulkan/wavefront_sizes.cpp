@@ -20,8 +20,10 @@ WavefrontSizes choose_wavefront_sizes(const Context& context, const VulkanDevice
   for (uint32_t h = 0; h < memory.memoryHeapCount; ++h)
     if (memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
       device_local = std::max(device_local, memory.memoryHeaps[h].size);
+  // An engine's adopted device renders the game too: at most 4 Mi paths there (VulkanDeviceOptions::max_paths sets more).
+  const uint32_t most_paths = context.adopted() ? (1u << 22) : (1u << 24);
   uint32_t gpu_paths = 1u << 20;
-  for (uint32_t paths = 1u << 22; paths <= (1u << 24) && device_local >= (VkDeviceSize(paths >> 22) << 34); paths *= 2)
+  for (uint32_t paths = 1u << 22; paths <= most_paths && device_local >= (VkDeviceSize(paths >> 22) << 34); paths *= 2)
     gpu_paths = paths;
   WavefrontSizes sizes;
   sizes.paths = std::max<uint32_t>(options.max_paths ? options.max_paths : (cpu_device ? (1u << 14) : gpu_paths), kGroupSize);

@@ -45,8 +45,10 @@ struct VulkanDeviceOptions {
   bool validation = false; // enable VK_LAYER_KHRONOS_validation + a debug messenger
   // Receives every validation/debug message (warnings and errors), including those at teardown.
   std::function<void(const std::string&)> on_validation_message;
-  // Paths in flight = threads of the largest dispatch; 0 = automatic (4 Mi on a GPU with 16 GiB or
-  // more of device memory, else 1 Mi; 16 Ki on a CPU device).
+  // Paths in flight = threads of the largest dispatch; 0 = automatic: on a GPU the most, up to
+  // 16 Mi, whose ~1.7 GB per 4 Mi stays within an eighth of its device memory (4 Mi from 16 GiB,
+  // 8 Mi from 32, 16 Mi from 64; 1 Mi below 16 GiB), at most 4 Mi on an engine's adopted device;
+  // 16 Ki on a CPU device.
   uint32_t max_paths = 0;
   // Wavefront iterations (shade+generate+connect+extend) recorded per submission; 0 = automatic
   // (32 on a GPU, 8 on a CPU device).
