@@ -20,8 +20,8 @@
 #include "exitance/formats/scene_file.h"
 #include "exitance/loader/bundle.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
-#include "exitance/runtime/core/work_share.h"
 #include "exitance/runtime/refresh/refresh_session.h"
+#include "exitance/runtime/relight/one_rank_alone.h"
 #include "exitance/runtime/relight/relight.h"
 #include "exitance/runtime/scene_file_conversion.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
@@ -422,19 +422,6 @@ TEST(Relight, BadScenesAreOneLineAndExitTwo) {
 // What relight --share R/N times: rank R's texels of a bake under mpirun, alone. Each rank's
 // texels are estimated bit for bit as in the one-process run (per-texel streams); the ranks' texels
 // are disjoint and cover every texel; the CLI takes only a well-formed share of a fixed --spp run.
-class RankWithoutExchange final : public WorkShare {
- public:
-  RankWithoutExchange(int rank, int ranks) : rank_(rank), ranks_(ranks) {}
-  int rank() const override { return rank_; }
-  int ranks() const override { return ranks_; }
-  void allgather_ranges(void*, const std::vector<size_t>&) override {}
-  void broadcast(void*, size_t) override {}
-  uint64_t sum(uint64_t value) override { return value; }
-
- private:
-  int rank_, ranks_;
-};
-
 TEST(Relight, EachRanksShareIsItsTexelsOfTheWholeRun) {
   if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
   const Fixture& f = vulkan_bake();
@@ -445,7 +432,7 @@ TEST(Relight, EachRanksShareIsItsTexelsOfTheWholeRun) {
   ASSERT_GT(whole.texels.size(), 2048u) << "too few texels for two ranks' blocks";
   std::vector<int> owner(whole.texels.size(), -1);
   for (int rank = 0; rank < 2; ++rank) {
-    RankWithoutExchange share(rank, 2);
+    OneRankAlone share(rank, 2);
     const LightmapEstimate part = session->bake_path(2, 0, &share);
     ASSERT_EQ(part.texels.size(), whole.texels.size());
     for (size_t i = 0; i < part.texels.size(); ++i) {

@@ -14,7 +14,7 @@
 #include "exitance/runtime/refresh/refreshed_bundle.h"
 #include "exitance/runtime/stage_clock.h"
 #include "exitance/runtime/vulkan/validation_messages.h"
-#include "one_rank_alone.h"
+#include "exitance/runtime/relight/one_rank_alone.h"
 
 namespace exitance {
 
