@@ -132,6 +132,18 @@ bool stop_at_relevant_triangle(RTCPointQueryFunctionArguments* args) {
   return true;
 }
 
+// An Embree point query of `radius` around `center`; returns the radius the callback left.
+float point_query(RTCScene scene, Vec3 center, float radius, RTCPointQueryFunction callback, void* user) {
+  RTCPointQuery query{};
+  query.x = center.x, query.y = center.y, query.z = center.z;
+  query.time = 0;
+  query.radius = radius;
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  rtcPointQuery(scene, &query, &context, callback, user);
+  return query.radius;
+}
+
 }  // namespace
 
 EmbreeScene::EmbreeScene(const Scene& scene) : scene_(scene) {
@@ -194,26 +206,14 @@ bool EmbreeScene::any_hit_where(Vec3 origin, Vec3 direction, float t_max,
 }
 
 float EmbreeScene::distance_to_nearest_triangle(Vec3 point, float max_distance) const {
-  RTCPointQuery query{};
-  query.x = point.x, query.y = point.y, query.z = point.z;
-  query.time = 0;
-  query.radius = max_distance;
-  RTCPointQueryContext context;
-  rtcInitPointQueryContext(&context);
-  rtcPointQuery(rtc_scene_, &query, &context, shrink_to_closer_triangle, const_cast<Scene*>(&scene_));
-  return query.radius < max_distance ? query.radius : INFINITY;
+  const float nearest = point_query(rtc_scene_, point, max_distance, shrink_to_closer_triangle, const_cast<Scene*>(&scene_));
+  return nearest < max_distance ? nearest : INFINITY;
 }
 
 bool EmbreeScene::any_triangle_within(Vec3 center, float radius,
                                       const std::function<bool(uint32_t, const Vec3*)>& relevant) const {
-  RTCPointQuery query{};
-  query.x = center.x, query.y = center.y, query.z = center.z;
-  query.time = 0;
-  query.radius = radius;
-  RTCPointQueryContext context;
-  rtcInitPointQueryContext(&context);
   RelevantTriangleSearch search{&scene_, &relevant};
-  rtcPointQuery(rtc_scene_, &query, &context, stop_at_relevant_triangle, &search);
+  point_query(rtc_scene_, center, radius, stop_at_relevant_triangle, &search);
   return search.found;
 }
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Run bake on every row of expectations.tsv and check the bad-input contract (DESIGN.md §3, §6.4).
 
-For each case:  BAKE INPUT -o TMP/out [ARGS] --spp 1 --texel-density 4   (timeout 60 s)
+For each case:  BAKE INPUT -o TMP/out [ARGS] --spp 1 --texel-density 4   (timeout 60 s unless --timeout)
 
 Checked:
   * the exit status is the expected one; never a signal, never a timeout;
