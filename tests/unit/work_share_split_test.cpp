@@ -59,6 +59,7 @@ TEST(InterleavedSplit, EveryItemHasOneRankAndRanksGetBlocksInTurn) {
   EXPECT_EQ(split.items_of(0), (std::vector<uint32_t>{0, 1, 6, 7}));
   EXPECT_EQ(split.items_of(1), (std::vector<uint32_t>{2, 3, 8, 9}));
   EXPECT_EQ(split.items_of(2), (std::vector<uint32_t>{4, 5}));
+  EXPECT_EQ(split.runs_of(1), (std::vector<std::pair<size_t, size_t>>{{2, 4}, {8, 10}}));
   std::vector<size_t> bounds;
   EXPECT_EQ(split.rank_major_order(bounds), (std::vector<uint32_t>{0, 1, 6, 7, 2, 3, 8, 9, 4, 5}));
   EXPECT_EQ(bounds, (std::vector<size_t>{0, 4, 8, 10}));

@@ -25,11 +25,17 @@ std::vector<size_t> split_by_cost(size_t items, const std::vector<uint64_t>& cos
   return bounds;
 }
 
+std::vector<std::pair<size_t, size_t>> InterleavedSplit::runs_of(int rank) const {
+  std::vector<std::pair<size_t, size_t>> runs;
+  const size_t step = block * size_t(ranks);
+  for (size_t start = size_t(rank) * block; start < items; start += step) runs.emplace_back(start, std::min(items, start + block));
+  return runs;
+}
+
 std::vector<uint32_t> InterleavedSplit::items_of(int rank) const {
   std::vector<uint32_t> out;
-  const size_t step = block * size_t(ranks);
-  for (size_t start = size_t(rank) * block; start < items; start += step)
-    for (size_t i = start; i < std::min(items, start + block); ++i) out.push_back(uint32_t(i));
+  for (const auto& [first, end] : runs_of(rank))
+    for (size_t i = first; i < end; ++i) out.push_back(uint32_t(i));
   return out;
 }
 

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <stdexcept>
 
 #include "exitance/runtime/core/grid_guiding_cache.h"
@@ -100,7 +102,7 @@ void LightmapDriver::run_pass(Accumulation& a, uint32_t first, uint32_t pass) {
   }
 }
 
-LightmapEstimate LightmapDriver::download(const Accumulation& a) {
+LightmapEstimate LightmapDriver::download(const Accumulation& a, const std::vector<std::pair<size_t, size_t>>* only) {
   LightmapEstimate estimate;
   const size_t texel_count = a.texel_count;
   estimate.recorded_bounces = a.recorded;
@@ -109,26 +111,45 @@ LightmapEstimate LightmapDriver::download(const Accumulation& a) {
   if (texel_count > 0) {
     Context& context = runner_.context();
     const WavefrontBuffers& buffers = runner_.buffers();
-    // Converted straight from the staging mappings (a million texels' sums are ~50 MB: no host copy).
-    context.download(buffers.texels.bounce_sums, estimate.bounces.data(), estimate.bounces.size() * 8);
-    context.read_back(buffers.texels.sums, texel_count * 6 * 8, 0, [&](const void* mapped) {
-      const double* sums = static_cast<const double*>(mapped);
-      for (size_t i = 0; i < texel_count; ++i) {
-        TexelAccumulator& t = estimate.texels[i];
-        for (int c = 0; c < 3; ++c) {
-          t.total[c] = sums[i * 6 + size_t(c)];
-          t.total_squared[c] = sums[i * 6 + 3 + size_t(c)];
-          t.direct[c] = estimate.bounces[i * 3 + size_t(c)];  // layer 0 is the direct light
+    const std::vector<std::pair<size_t, size_t>> all{{0, texel_count}};
+    const std::vector<std::pair<size_t, size_t>>& runs = only ? *only : all;
+    // The runs' bytes of a per-texel array of `texel_bytes` per texel starting at byte `base`.
+    auto ranges = [&runs](size_t texel_bytes, size_t base) {
+      std::vector<ByteRange> r;
+      for (const auto& [first, end] : runs) r.push_back({base + first * texel_bytes, (end - first) * texel_bytes});
+      return r;
+    };
+    // Read through the staging mappings (a million texels' sums are ~50 MB: no host copy in between).
+    std::vector<ByteRange> layers;
+    for (int k = 0; k < a.recorded; ++k)
+      for (const ByteRange& r : ranges(24, size_t(k) * texel_count * 24)) layers.push_back(r);
+    context.read_back_ranges(buffers.texels.bounce_sums, layers, [&](const char* packed) {
+      for (const ByteRange& r : layers) std::memcpy(reinterpret_cast<char*>(estimate.bounces.data()) + r.offset, packed, r.size), packed += r.size;
+    });
+    context.read_back_ranges(buffers.texels.sums, ranges(48, 0), [&](const char* packed) {
+      const double* sums = reinterpret_cast<const double*>(packed);
+      for (const auto& [first, end] : runs)
+        for (size_t i = first; i < end; ++i, sums += 6) {
+          TexelAccumulator& t = estimate.texels[i];
+          for (int c = 0; c < 3; ++c) {
+            t.total[c] = sums[c];
+            t.total_squared[c] = sums[3 + c];
+            t.direct[c] = estimate.bounces[i * 3 + size_t(c)];  // layer 0 is the direct light
+          }
         }
-      }
     });
-    context.read_back(buffers.texels.samples, texel_count * 4, 0, [&](const void* mapped) {
-      const uint32_t* samples = static_cast<const uint32_t*>(mapped);
-      for (size_t i = 0; i < texel_count; ++i) estimate.texels[i].samples = samples[i];
+    context.read_back_ranges(buffers.texels.samples, ranges(4, 0), [&](const char* packed) {
+      const uint32_t* samples = reinterpret_cast<const uint32_t*>(packed);
+      for (const auto& [first, end] : runs)
+        for (size_t i = first; i < end; ++i) estimate.texels[i].samples = *samples++;
     });
-    if (a.directional) {
+    if (a.directional) {  // L1 sums: 9 doubles per texel after the 6 of every texel
       estimate.sh1.assign(texel_count * 9, 0.0);
-      context.download(buffers.texels.sums, estimate.sh1.data(), estimate.sh1.size() * 8, texel_count * 6 * 8);
+      const std::vector<ByteRange> sh1 = ranges(72, texel_count * 48);
+      context.read_back_ranges(buffers.texels.sums, sh1, [&](const char* packed) {
+        for (const ByteRange& r : sh1)
+          std::memcpy(reinterpret_cast<char*>(estimate.sh1.data()) + (r.offset - texel_count * 48), packed, r.size), packed += r.size;
+      });
     }
   }
   estimate.rays = a.totals.rays();
@@ -292,7 +313,9 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   }
   a.seconds = std::chrono::duration<double>(Clock::now() - start_time).count();
   runner_.record_statistics(a.totals, kTexelBatch);
-  LightmapEstimate estimate = download(a);
+  // Under a split only this rank's texels are read back (the gather below brings the others').
+  const std::vector<std::pair<size_t, size_t>> own_runs = share ? split.runs_of(share->rank()) : std::vector<std::pair<size_t, size_t>>{};
+  LightmapEstimate estimate = download(a, share ? &own_runs : nullptr);
   if (choice) {
     estimate.guiding_auto = true;
     estimate.guiding_auto_pilot = choice->pilot();

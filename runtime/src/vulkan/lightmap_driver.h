@@ -65,7 +65,9 @@ class LightmapDriver {
   void prepare(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, Accumulation& a);
   void upload_items(const Accumulation& a);
   void run_pass(Accumulation& a, uint32_t first, uint32_t pass);
-  LightmapEstimate download(const Accumulation& a);
+  // The sums read back; `only`: just these runs [first, end) of texels (a rank's own, gathered
+  // after), the others' left empty; null: every texel.
+  LightmapEstimate download(const Accumulation& a, const std::vector<std::pair<size_t, size_t>>* only = nullptr);
   // The texels of `work_list` whose relative standard error is still above the target.
   std::vector<uint32_t> unconverged(const std::vector<uint32_t>& work_list, size_t texel_count, double target);
 

@@ -359,17 +359,23 @@ void Context::upload_ranges(const Buffer& dst, const void* data, const std::vect
 }
 
 void Context::download(const Buffer& src, void* data, VkDeviceSize size, VkDeviceSize offset) {
-  read_back(src, size, offset, [&](const void* mapped) { std::memcpy(data, mapped, size_t(size)); });
+  read_back_ranges(src, {{offset, size}}, [&](const char* mapped) { std::memcpy(data, mapped, size_t(size)); });
 }
 
-void Context::read_back(const Buffer& src, VkDeviceSize size, VkDeviceSize offset, const std::function<void(const void*)>& read) {
-  if (size == 0) return;
-  Buffer staging = create_buffer(size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+void Context::read_back_ranges(const Buffer& src, const std::vector<ByteRange>& ranges, const std::function<void(const char*)>& read) {
+  std::vector<VkBufferCopy> regions;
+  VkDeviceSize packed = 0;
+  for (const ByteRange& r : ranges) {
+    if (r.size == 0) continue;
+    regions.push_back({r.offset, packed, r.size});
+    packed += r.size;
+  }
+  if (packed == 0) return;
+  Buffer staging = create_buffer(packed, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
   VkCommandBuffer cmd = begin();
-  VkBufferCopy region{offset, 0, size};
-  vkCmdCopyBuffer(cmd, src.handle(), staging.handle(), 1, &region);
+  vkCmdCopyBuffer(cmd, src.handle(), staging.handle(), uint32_t(regions.size()), regions.data());
   submit_and_wait(cmd);
-  read(staging.mapped());
+  read(static_cast<const char*>(staging.mapped()));
 }
 
 }  // namespace exitance::vulkan

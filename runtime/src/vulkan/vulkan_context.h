@@ -71,9 +71,10 @@ class Context {
   // Copies the ranges of `data`, a host mirror of `dst`, to the same ranges of `dst`, and waits.
   void upload_ranges(const Buffer& dst, const void* data, const std::vector<ByteRange>& ranges);
   void download(const Buffer& src, void* data, VkDeviceSize size, VkDeviceSize offset = 0);
-  // Copies `size` bytes at `offset` of `src` into a host-visible staging buffer, waits, and hands
-  // `read` its mapping: for read-backs converted on the way, without a host copy in between.
-  void read_back(const Buffer& src, VkDeviceSize size, VkDeviceSize offset, const std::function<void(const void*)>& read);
+  // Copies the `ranges` of `src`, packed in order, into a host-visible staging buffer, waits, and
+  // hands `read` its mapping: for read-backs converted on the way, without a host copy in between
+  // (`read` is not called when the ranges hold no bytes).
+  void read_back_ranges(const Buffer& src, const std::vector<ByteRange>& ranges, const std::function<void(const char*)>& read);
 
   VkCommandBuffer begin();  // the context's single command buffer, reset
   // Submits the command buffer and waits for its fence; throws on timeout or device loss.

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <memory>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace exitance {
@@ -66,8 +67,9 @@ struct InterleavedSplit {
   size_t items = 0;
   int ranks = 1;
   size_t block = 1024;  // texels: long enough runs for coherent work lists, short enough to balance
-  // The items of `rank`, ascending.
+  // The items of `rank`, ascending; and as runs [first, end) of consecutive items.
   std::vector<uint32_t> items_of(int rank) const;
+  std::vector<std::pair<size_t, size_t>> runs_of(int rank) const;
   // Rank-major order (rank 0's items, then rank 1's, ...) and each rank's start in it (ranks + 1 entries).
   std::vector<uint32_t> rank_major_order(std::vector<size_t>& bounds) const;
 };
