@@ -200,9 +200,12 @@ LightmapEstimate lighting_stage(const Integrator& backend, const TexelGBuffer& g
   // backend's own setup count against it too.
   if (settings.time_budget_seconds > 0)
     settings.budget_clock = [start] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  // Under mpirun only rank 0's estimate holds the texels (Integrator::bake): the others keep theirs as is.
+  const WorkShare* share = distributed(settings.work_share);
+  const bool writer = !share || share->rank() == 0;
   if (skip && skip->texels > 0) {
     LightmapEstimate traced = backend.bake(gbuffer_without_skipped(gbuffer, skip->sealed), settings);
-    estimate = expand_lightmap_estimate(std::move(traced), skip->sealed);
+    estimate = writer ? expand_lightmap_estimate(std::move(traced), skip->sealed) : std::move(traced);
   } else {
     estimate = backend.bake(gbuffer, settings);
   }

@@ -56,6 +56,37 @@ void MpiWorkShare::allgather_ranges(void* data, const std::vector<size_t>& byte_
   }
 }
 
+void MpiWorkShare::gather_to_root(const void* own, void* received, const std::vector<size_t>& byte_bounds) {
+  const size_t parts = size_t(ranks_);
+  if (byte_bounds.size() != parts + 1) throw std::logic_error("gather_to_root: one range per rank expected");
+  // Point to point, in pieces of at most kLargestPiece (MPI counts are ints); rank 0 posts every
+  // receive at once so the ranks' sends proceed together.
+  constexpr int kTag = 15;
+  std::vector<MPI_Request> requests;
+  auto pieces = [&](size_t r, auto&& each) {
+    for (size_t begin = byte_bounds[r]; begin < byte_bounds[r + 1]; begin += kLargestPiece)
+      each(begin, int(std::min(kLargestPiece, byte_bounds[r + 1] - begin)));
+  };
+  if (rank_ == 0) {
+    for (size_t r = 1; r < parts; ++r)
+      pieces(r, [&](size_t begin, int count) {
+        requests.emplace_back();
+        check(MPI_Irecv(static_cast<char*>(received) + begin, count, MPI_BYTE, int(r), kTag, MPI_COMM_WORLD, &requests.back()),
+              "MPI_Irecv");
+      });
+  } else {
+    const size_t own_begin = byte_bounds[size_t(rank_)];
+    pieces(size_t(rank_), [&](size_t begin, int count) {
+      requests.emplace_back();
+      // MPI 3 takes a const buffer; the cast is for MPI 2 headers.
+      check(MPI_Isend(const_cast<char*>(static_cast<const char*>(own)) + (begin - own_begin), count, MPI_BYTE, 0, kTag,
+                      MPI_COMM_WORLD, &requests.back()),
+            "MPI_Isend");
+    });
+  }
+  check(MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
+}
+
 void MpiWorkShare::broadcast(void* data, size_t bytes) {
   if (bytes > size_t(INT_MAX)) throw std::logic_error("broadcast: too large");
   check(MPI_Bcast(data, int(bytes), MPI_BYTE, 0, MPI_COMM_WORLD), "MPI_Bcast");

@@ -76,8 +76,8 @@ int main(int argc, char** argv) {
   if (!share.empty()) {
     int rank = -1, ranks = 0;
     char slash = 0, extra = 0;
-    if (std::sscanf(share.c_str(), "%d%c%d%c", &rank, &slash, &ranks, &extra) != 3 || slash != '/' || ranks < 1 || rank < 0 ||
-        rank >= ranks) {
+    // The form here; relight_bundle checks the range, except N = 0, which it would read as no share.
+    if (std::sscanf(share.c_str(), "%d%c%d%c", &rank, &slash, &ranks, &extra) != 3 || slash != '/' || ranks < 1) {
       std::cerr << "exitance-relight: error: --share " << share << ": expected R/N with 0 <= R < N\n";
       return 2;
     }

@@ -25,6 +25,7 @@
 #include "exitance/runtime/relight/relight.h"
 #include "exitance/runtime/scene_file_conversion.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
+#include "support/sequential_ranks.h"
 #include "support/sphere_over_floor_gltf.h"
 #include "support/vulkan_device_available.h"
 
@@ -421,7 +422,8 @@ TEST(Relight, BadScenesAreOneLineAndExitTwo) {
 
 // What relight --share R/N times: rank R's texels of a bake under mpirun, alone. Each rank's
 // texels are estimated bit for bit as in the one-process run (per-texel streams); the ranks' texels
-// are disjoint and cover every texel; the CLI takes only a well-formed share of a fixed --spp run.
+// are disjoint and cover every texel; gathered onto rank 0 they are the one-process estimate, and
+// the other ranks keep no per-texel sums. The CLI takes only a well-formed share of a fixed --spp run.
 TEST(Relight, EachRanksShareIsItsTexelsOfTheWholeRun) {
   if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
   const Fixture& f = vulkan_bake();
@@ -430,24 +432,51 @@ TEST(Relight, EachRanksShareIsItsTexelsOfTheWholeRun) {
   const std::unique_ptr<RefreshSession> session = RefreshSession::open(f.baked.string(), session_options);
   const LightmapEstimate whole = session->bake_path(2, 0);
   ASSERT_GT(whole.texels.size(), 2048u) << "too few texels for two ranks' blocks";
-  std::vector<int> owner(whole.texels.size(), -1);
-  for (int rank = 0; rank < 2; ++rank) {
-    OneRankAlone share(rank, 2);
+  auto same_texel = [&](const LightmapEstimate& e, size_t i) {
+    if (e.texels[i].samples != whole.texels[i].samples) return false;
+    for (int c = 0; c < 3; ++c)
+      if (e.texels[i].total[c] != whole.texels[i].total[c] || e.texels[i].total_squared[c] != whole.texels[i].total_squared[c] ||
+          e.texels[i].direct[c] != whole.texels[i].direct[c])
+        return false;
+    return true;
+  };
+
+  // Alone, as relight --share runs it: rank 1 keeps nothing per texel; rank 0 has its own texels
+  // (the others' arrive as zeros).
+  {
+    OneRankAlone share(1, 2);
+    const LightmapEstimate part = session->bake_path(2, 0, &share);
+    EXPECT_TRUE(part.texels.empty() && part.bounces.empty()) << "only rank 0 keeps per-texel sums";
+    EXPECT_GT(part.rays, 0u);
+    EXPECT_GT(share.work.texel_samples, whole.texels.size() / 3 * 2);
+  }
+  std::vector<int> owner(whole.texels.size(), 1);
+  {
+    OneRankAlone share(0, 2);
     const LightmapEstimate part = session->bake_path(2, 0, &share);
     ASSERT_EQ(part.texels.size(), whole.texels.size());
     for (size_t i = 0; i < part.texels.size(); ++i) {
       if (part.texels[i].samples == 0) continue;
-      ASSERT_EQ(owner[i], -1) << "texel " << i << " estimated by two ranks";
-      owner[i] = rank;
-      ASSERT_EQ(part.texels[i].samples, whole.texels[i].samples);
-      for (int c = 0; c < 3; ++c) {
-        ASSERT_EQ(part.texels[i].total[c], whole.texels[i].total[c]) << "texel " << i;
-        ASSERT_EQ(part.texels[i].total_squared[c], whole.texels[i].total_squared[c]) << "texel " << i;
-      }
+      owner[i] = 0;
+      ASSERT_TRUE(same_texel(part, i)) << "texel " << i;
     }
   }
-  EXPECT_EQ(std::count(owner.begin(), owner.end(), -1), 0) << "texels no rank estimated";
-  EXPECT_GT(std::count(owner.begin(), owner.end(), 1), std::ptrdiff_t(whole.texels.size() / 3));
+  const auto rank0 = std::count(owner.begin(), owner.end(), 0);
+  EXPECT_GT(rank0, std::ptrdiff_t(whole.texels.size() / 3));
+  EXPECT_LT(rank0, std::ptrdiff_t(whole.texels.size() * 2 / 3));
+
+  // Both ranks, one after the other, rank 0 receiving what rank 1 sent: the whole estimate.
+  testing::SequentialRanks::World world;
+  {
+    testing::SequentialRanks share(world, 1, 2);
+    EXPECT_TRUE(session->bake_path(2, 0, &share).texels.empty());
+  }
+  testing::SequentialRanks share(world, 0, 2);
+  const LightmapEstimate gathered = session->bake_path(2, 0, &share);
+  ASSERT_EQ(gathered.texels.size(), whole.texels.size());
+  for (size_t i = 0; i < whole.texels.size(); ++i) ASSERT_TRUE(same_texel(gathered, i)) << "texel " << i << " of rank " << owner[i];
+  EXPECT_EQ(gathered.recorded_bounces, whole.recorded_bounces);
+  EXPECT_TRUE(gathered.bounces == whole.bounces) << "bounce layers differ";
 
   std::string errors;
   for (const char* bad : {"--spp 1 --share 2/2", "--spp 1 --share 1/0", "--spp 1 --share x", "--spp 1 --share 0/2 --time 1",

@@ -1,11 +1,12 @@
 // bake under mpirun (issue 15): the split of items over ranks by counted cost (CPU backend) and in
-// interleaved blocks (Vulkan backend), and the gather of an interleaved split (core/work_share.h).
+// interleaved blocks (Vulkan backend), and the gather of an interleaved split onto rank 0 (core/work_share.h).
 #include <gtest/gtest.h>
 
 #include <cstring>
 #include <numeric>
 
 #include "exitance/runtime/core/work_share.h"
+#include "support/sequential_ranks.h"
 
 namespace exitance {
 namespace {
@@ -60,9 +61,9 @@ TEST(InterleavedSplit, EveryItemHasOneRankAndRanksGetBlocksInTurn) {
   EXPECT_EQ(split.items_of(1), (std::vector<uint32_t>{2, 3, 8, 9}));
   EXPECT_EQ(split.items_of(2), (std::vector<uint32_t>{4, 5}));
   EXPECT_EQ(split.runs_of(1), (std::vector<std::pair<size_t, size_t>>{{2, 4}, {8, 10}}));
-  std::vector<size_t> bounds;
-  EXPECT_EQ(split.rank_major_order(bounds), (std::vector<uint32_t>{0, 1, 6, 7, 2, 3, 8, 9, 4, 5}));
-  EXPECT_EQ(bounds, (std::vector<size_t>{0, 4, 8, 10}));
+  EXPECT_EQ(split.runs_of(2), (std::vector<std::pair<size_t, size_t>>{{4, 6}}));
+  EXPECT_EQ(split.count_of(0) + split.count_of(1) + split.count_of(2), 10u);
+  EXPECT_EQ(split.count_of(2), 2u);
   split.ranks = 1;
   EXPECT_EQ(split.items_of(0).size(), 10u);
   split.items = 0;
@@ -70,48 +71,31 @@ TEST(InterleavedSplit, EveryItemHasOneRankAndRanksGetBlocksInTurn) {
   EXPECT_TRUE(split.items_of(1).empty());
 }
 
-// N ranks in one process, one after another: each exchange writes the caller's range into a shared
-// world and reads everybody's from it, so a second round sees every rank's items (what MPI's
-// allgather gives all ranks at once).
-class SequentialRanks final : public WorkShare {
- public:
-  SequentialRanks(std::vector<char>& world, int rank, int ranks) : world_(world), rank_(rank), ranks_(ranks) {}
-  int rank() const override { return rank_; }
-  int ranks() const override { return ranks_; }
-  void allgather_ranges(void* data, const std::vector<size_t>& b) override {
-    world_.resize(b.back());
-    std::memcpy(world_.data() + b[size_t(rank_)], static_cast<char*>(data) + b[size_t(rank_)], b[size_t(rank_) + 1] - b[size_t(rank_)]);
-    for (int r = 0; r < ranks_; ++r)
-      if (r != rank_) std::memcpy(static_cast<char*>(data) + b[size_t(r)], world_.data() + b[size_t(r)], b[size_t(r) + 1] - b[size_t(r)]);
-  }
-  void broadcast(void*, size_t) override {}
-  uint64_t sum(uint64_t value) override { return value; }
-
- private:
-  std::vector<char>& world_;
-  int rank_, ranks_;
-};
-
-TEST(InterleavedSplit, GatherGivesEveryRankEveryItem) {
+TEST(InterleavedSplit, GatherToRootGivesRankZeroEveryItem) {
   InterleavedSplit split;
-  split.items = 1000;
+  split.items = 1000;  // not a multiple of the blocks: the last run is short
   split.ranks = 3;
   split.block = 64;
   constexpr size_t kValues = 3;
-  std::vector<char> world;
-  std::vector<std::vector<double>> rank_data(3);
-  for (int round = 0; round < 2; ++round)
-    for (int r = 0; r < 3; ++r) {
-      std::vector<double>& data = rank_data[size_t(r)];
-      data.assign(split.items * kValues, -1.0);  // items of other ranks: unknown here
-      for (uint32_t i : split.items_of(r))
-        for (size_t c = 0; c < kValues; ++c) data[i * kValues + c] = double(i) * 10 + double(c);
-      SequentialRanks share(world, r, 3);
-      allgather_interleaved(share, data.data(), kValues, split);
-    }
-  for (int r = 0; r < 3; ++r)
-    for (size_t i = 0; i < split.items; ++i)
-      for (size_t c = 0; c < kValues; ++c) ASSERT_EQ(rank_data[size_t(r)][i * kValues + c], double(i) * 10 + double(c)) << "rank " << r << " item " << i;
+  auto value = [](size_t item, size_t c) { return double(item) * 10 + double(c); };
+  testing::SequentialRanks::World world;
+  // Ranks 2 and 1 send their items packed, run after run.
+  for (int r = 2; r >= 1; --r) {
+    std::vector<double> packed;
+    for (uint32_t i : split.items_of(r))
+      for (size_t c = 0; c < kValues; ++c) packed.push_back(value(i, c));
+    ASSERT_EQ(packed.size(), split.count_of(r) * kValues);
+    testing::SequentialRanks share(world, r, 3);
+    gather_interleaved_to_root(share, packed.data(), kValues, split);
+  }
+  // Rank 0 holds the whole array with its own items in place.
+  std::vector<double> whole(split.items * kValues, -1.0);
+  for (uint32_t i : split.items_of(0))
+    for (size_t c = 0; c < kValues; ++c) whole[i * kValues + c] = value(i, c);
+  testing::SequentialRanks root(world, 0, 3);
+  gather_interleaved_to_root(root, whole.data(), kValues, split);
+  for (size_t i = 0; i < split.items; ++i)
+    for (size_t c = 0; c < kValues; ++c) ASSERT_EQ(whole[i * kValues + c], value(i, c)) << "item " << i;
 }
 
 }  // namespace

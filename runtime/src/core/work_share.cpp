@@ -39,16 +39,10 @@ std::vector<uint32_t> InterleavedSplit::items_of(int rank) const {
   return out;
 }
 
-std::vector<uint32_t> InterleavedSplit::rank_major_order(std::vector<size_t>& bounds) const {
-  std::vector<uint32_t> order;
-  order.reserve(items);
-  bounds.assign(size_t(ranks) + 1, 0);
-  for (int r = 0; r < ranks; ++r) {
-    const std::vector<uint32_t> own = items_of(r);
-    order.insert(order.end(), own.begin(), own.end());
-    bounds[size_t(r) + 1] = order.size();
-  }
-  return order;
+size_t InterleavedSplit::count_of(int rank) const {
+  size_t count = 0;
+  for (const auto& [first, end] : runs_of(rank)) count += end - first;
+  return count;
 }
 
 std::vector<RankWork> gather_rank_work(WorkShare& share) {

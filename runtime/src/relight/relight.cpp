@@ -8,7 +8,6 @@
 #include <iterator>
 #include <limits>
 #include <memory>
-#include <optional>
 
 #include "exitance/formats/bundle_manifest.h"
 #include "exitance/runtime/refresh/refreshed_bundle.h"
@@ -118,16 +117,16 @@ json relight_bundle(const RelightOptions& options) {
                                 options.guiding == "svo" ? GuidingMode::Svo : GuidingMode::Grid).rays;
     report("lighting", 1, rays);
   }
-  std::optional<OneRankAlone> rank_alone;
-  size_t share_texels = 0;
+  uint64_t share_texels = 0;
   double share_passes_seconds = 0;
   if (share) {
     report("lighting", 0, 0);
-    rank_alone.emplace(options.share_rank, options.share_ranks);
-    const LightmapEstimate& e = session->bake_path(spp, 0, &*rank_alone);
+    OneRankAlone rank_alone(options.share_rank, options.share_ranks);
+    const LightmapEstimate& e = session->bake_path(spp, 0, &rank_alone);
     rays = e.rays;
     share_passes_seconds = e.seconds;
-    for (const TexelAccumulator& t : e.texels) share_texels += t.samples > 0 ? 1 : 0;
+    // Every texel of the share takes all --spp samples (only rank 0 keeps per-texel sums).
+    share_texels = rank_alone.work.texel_samples / spp;
     report("lighting", 1, rays);
   }
   for (uint32_t frame = 0; !per_bounce && !guided && !share && (options.frames == 0 || frame < options.frames); ++frame) {

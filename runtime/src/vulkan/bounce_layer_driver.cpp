@@ -72,10 +72,7 @@ void BounceLayerDriver::prepare() {
   WavefrontBuffers& buffers = runner_.buffers();
   max_work_ = runner_.work_items_per_batch(kResultBytes);
   std::vector<GpuSurfacePoint> start_points(texels);
-  for (size_t i = 0; i < texels; ++i) {
-    const LiveTexel& t = gbuffer_.texels[i];
-    start_points[i] = {Vec4(t.position, 0.0f), Vec4(t.geometric_normal, 0.0f), Vec4(t.shading_normal, 0.0f)};
-  }
+  for (size_t i = 0; i < texels; ++i) start_points[i] = texel_start_point(gbuffer_.texels[i]);
   buffers.items.reserve(context, texels);
   buffers.texels.reserve(context, texels, 1);
   buffers.results.reserve(context, max_work_ * kResultBytes);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <future>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -51,8 +52,12 @@ void import_strategy_sums(const std::vector<double>& sums, GuidingChoice& choice
 
 }  // namespace
 
-// Buffers sized and bound, texels uploaded, sums cleared: an accumulation at sample 0.
-void LightmapDriver::prepare(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, Accumulation& a) {
+// Buffers sized and bound, texels uploaded, sums cleared: an accumulation at sample 0. start()'s
+// (`bake_runs` null): every texel, its start point kept on the host too (uploaded again after a
+// probe bake took the buffer). bake()'s: the texels of `bake_runs` (a rank's own under a split),
+// their start points written straight into the staging memory, and on the work list.
+void LightmapDriver::prepare(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, Accumulation& a,
+                             const Runs* bake_runs) {
   a.texel_count = gbuffer.texels.size();
   a.recorded = std::clamp(settings.recorded_bounces, 1, kMaxRecordedBounces);
   if (a.texel_count >= (1ull << 31)) throw std::runtime_error("Vulkan backend: too many texels");
@@ -62,13 +67,16 @@ void LightmapDriver::prepare(const TexelGBuffer& gbuffer, const IntegratorSettin
   a.result_bytes = size_t(a.recorded + 1) * 12 + (a.directional ? 36 : 0);  // + 9 floats of L1 (sh1_result_index)
   if (settings.guiding == GuidingMode::Auto) a.result_bytes += kAutoCostWords * 4;  // bindings.glsl auto_cost_index
   a.max_work = runner_.work_items_per_batch(a.result_bytes);
-  a.start_points.resize(a.texel_count);
-  for (size_t i = 0; i < a.texel_count; ++i) {
-    const LiveTexel& t = gbuffer.texels[i];
-    a.start_points[i] = {Vec4(t.position, 0.0f), Vec4(t.geometric_normal, 0.0f), Vec4(t.shading_normal, 0.0f)};
+  a.work_list.clear();
+  if (bake_runs) {
+    for (const auto& [first, end] : *bake_runs)
+      for (size_t i = first; i < end; ++i) a.work_list.push_back(uint32_t(i));
+  } else {
+    a.start_points.resize(a.texel_count);
+    for (size_t i = 0; i < a.texel_count; ++i) a.start_points[i] = texel_start_point(gbuffer.texels[i]);
+    a.work_list.resize(a.texel_count);
+    for (size_t i = 0; i < a.texel_count; ++i) a.work_list[i] = uint32_t(i);
   }
-  a.work_list.resize(a.texel_count);
-  for (size_t i = 0; i < a.texel_count; ++i) a.work_list[i] = uint32_t(i);
   a.params = runner_.bake_params(settings, uint32_t(a.recorded), uint32_t(a.texel_count));
   a.params.directional = a.directional ? 1u : 0u;
   if (a.texel_count == 0) return;
@@ -79,7 +87,22 @@ void LightmapDriver::prepare(const TexelGBuffer& gbuffer, const IntegratorSettin
   buffers.texels.reserve(context, a.texel_count, a.recorded, a.directional);
   buffers.results.reserve(context, a.max_work * a.result_bytes);
   runner_.bind_buffers();
-  upload_items(a);
+  if (bake_runs) {
+    constexpr size_t kPoint = sizeof(GpuSurfacePoint);
+    std::vector<ByteRange> ranges;
+    for (const auto& [first, end] : *bake_runs) ranges.push_back({first * kPoint, (end - first) * kPoint});
+    context.write_ranges(buffers.items.start_points, ranges, [&](char* staging) {
+      for (const auto& [first, end] : *bake_runs)
+        for (size_t i = first; i < end; ++i, staging += kPoint) {
+          const GpuSurfacePoint p = texel_start_point(gbuffer.texels[i]);
+          std::memcpy(staging, &p, kPoint);
+        }
+    });
+    if (!a.work_list.empty()) context.upload(buffers.items.batch_items, a.work_list.data(), a.work_list.size() * 4);
+    buffers.items.owner = WorkItems::Owner::None;  // not start()'s texels: a later start() uploads its own
+  } else {
+    upload_items(a);
+  }
   VkCommandBuffer cmd = context.begin();
   buffers.texels.clear(cmd);
   context.submit_and_wait(cmd);
@@ -102,34 +125,61 @@ void LightmapDriver::run_pass(Accumulation& a, uint32_t first, uint32_t pass) {
   }
 }
 
-LightmapEstimate LightmapDriver::download(const Accumulation& a, const std::vector<std::pair<size_t, size_t>>* only) {
+LightmapEstimate LightmapDriver::sized_estimate(size_t texels, int recorded, bool directional) {
   LightmapEstimate estimate;
+  estimate.recorded_bounces = recorded;
+  estimate.texels.resize(texels);
+  estimate.bounces.assign(size_t(recorded) * texels * 3, 0.0);
+  if (directional) estimate.sh1.assign(texels * 9, 0.0);
+  return estimate;
+}
+
+LightmapEstimate LightmapDriver::download(const Accumulation& a, const Runs* only, LightmapEstimate into, bool packed) {
   const size_t texel_count = a.texel_count;
-  estimate.recorded_bounces = a.recorded;
-  estimate.texels.resize(texel_count);
-  estimate.bounces.assign(size_t(a.recorded) * texel_count * 3, 0.0);
+  const Runs all{{0, texel_count}};
+  const Runs& runs = only ? *only : all;
+  // Where each run's first texel goes on the host: its own index, or after the runs before it.
+  std::vector<size_t> to(runs.size());
+  size_t host_texels = texel_count;
+  if (packed) {
+    host_texels = 0;
+    for (size_t k = 0; k < runs.size(); ++k) to[k] = host_texels, host_texels += runs[k].second - runs[k].first;
+  } else {
+    for (size_t k = 0; k < runs.size(); ++k) to[k] = runs[k].first;
+  }
+  LightmapEstimate estimate = into.texels.size() == host_texels && !into.texels.empty()
+                                  ? std::move(into)
+                                  : sized_estimate(host_texels, a.recorded, a.directional);
   if (texel_count > 0) {
     Context& context = runner_.context();
     const WavefrontBuffers& buffers = runner_.buffers();
-    const std::vector<std::pair<size_t, size_t>> all{{0, texel_count}};
-    const std::vector<std::pair<size_t, size_t>>& runs = only ? *only : all;
     // The runs' bytes of a per-texel array of `texel_bytes` per texel starting at byte `base`.
     auto ranges = [&runs](size_t texel_bytes, size_t base) {
       std::vector<ByteRange> r;
       for (const auto& [first, end] : runs) r.push_back({base + first * texel_bytes, (end - first) * texel_bytes});
       return r;
     };
+    // Copies packed ranges of a per-texel array of `texel_bytes` per texel, `layers` of them one
+    // after another (device: texel_count texels per layer; host: host_texels), to their host places.
+    auto place = [&](char* host, size_t texel_bytes, int layers, const char* packed_bytes) {
+      for (int k = 0; k < layers; ++k)
+        for (size_t j = 0; j < runs.size(); ++j) {
+          const size_t bytes = (runs[j].second - runs[j].first) * texel_bytes;
+          std::memcpy(host + (size_t(k) * host_texels + to[j]) * texel_bytes, packed_bytes, bytes);
+          packed_bytes += bytes;
+        }
+    };
     // Read through the staging mappings (a million texels' sums are ~50 MB: no host copy in between).
     std::vector<ByteRange> layers;
     for (int k = 0; k < a.recorded; ++k)
       for (const ByteRange& r : ranges(24, size_t(k) * texel_count * 24)) layers.push_back(r);
-    context.read_back_ranges(buffers.texels.bounce_sums, layers, [&](const char* packed) {
-      for (const ByteRange& r : layers) std::memcpy(reinterpret_cast<char*>(estimate.bounces.data()) + r.offset, packed, r.size), packed += r.size;
+    context.read_back_ranges(buffers.texels.bounce_sums, layers, [&](const char* bytes) {
+      place(reinterpret_cast<char*>(estimate.bounces.data()), 24, a.recorded, bytes);
     });
-    context.read_back_ranges(buffers.texels.sums, ranges(48, 0), [&](const char* packed) {
-      const double* sums = reinterpret_cast<const double*>(packed);
-      for (const auto& [first, end] : runs)
-        for (size_t i = first; i < end; ++i, sums += 6) {
+    context.read_back_ranges(buffers.texels.sums, ranges(48, 0), [&](const char* bytes) {
+      const double* sums = reinterpret_cast<const double*>(bytes);
+      for (size_t k = 0; k < runs.size(); ++k)
+        for (size_t i = to[k], end = to[k] + runs[k].second - runs[k].first; i < end; ++i, sums += 6) {
           TexelAccumulator& t = estimate.texels[i];
           for (int c = 0; c < 3; ++c) {
             t.total[c] = sums[c];
@@ -138,19 +188,15 @@ LightmapEstimate LightmapDriver::download(const Accumulation& a, const std::vect
           }
         }
     });
-    context.read_back_ranges(buffers.texels.samples, ranges(4, 0), [&](const char* packed) {
-      const uint32_t* samples = reinterpret_cast<const uint32_t*>(packed);
-      for (const auto& [first, end] : runs)
-        for (size_t i = first; i < end; ++i) estimate.texels[i].samples = *samples++;
+    context.read_back_ranges(buffers.texels.samples, ranges(4, 0), [&](const char* bytes) {
+      const uint32_t* samples = reinterpret_cast<const uint32_t*>(bytes);
+      for (size_t k = 0; k < runs.size(); ++k)
+        for (size_t i = to[k], end = to[k] + runs[k].second - runs[k].first; i < end; ++i) estimate.texels[i].samples = *samples++;
     });
-    if (a.directional) {  // L1 sums: 9 doubles per texel after the 6 of every texel
-      estimate.sh1.assign(texel_count * 9, 0.0);
-      const std::vector<ByteRange> sh1 = ranges(72, texel_count * 48);
-      context.read_back_ranges(buffers.texels.sums, sh1, [&](const char* packed) {
-        for (const ByteRange& r : sh1)
-          std::memcpy(reinterpret_cast<char*>(estimate.sh1.data()) + (r.offset - texel_count * 48), packed, r.size), packed += r.size;
+    if (a.directional)  // L1 sums: 9 doubles per texel after the 6 of every texel
+      context.read_back_ranges(buffers.texels.sums, ranges(72, texel_count * 48), [&](const char* bytes) {
+        place(reinterpret_cast<char*>(estimate.sh1.data()), 72, 1, bytes);
       });
-    }
   }
   estimate.rays = a.totals.rays();
   estimate.nonfinite_samples = a.totals.nonfinite;
@@ -181,15 +227,19 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   const auto start_time = Clock::now();
   progressive_.reset();  // the buffers are this bake's now
   runner_.statistics().clear();
+  // Split over processes (core/work_share.h): this rank's device runs its interleaved blocks of the
+  // texels through the work list (global indices, so the same random streams); the sums are
+  // gathered onto rank 0 once at the end. Every rank follows every pass (rank 0 decides them), work or not.
+  WorkShare* share = distributed(settings.work_share);
+  InterleavedSplit split;
+  split.items = gbuffer.texels.size();
+  split.ranks = share ? share->ranks() : 1;
+  const Runs own_runs = share ? split.runs_of(share->rank()) : Runs{{0, split.items}};
   Accumulation a;
-  prepare(gbuffer, settings, a);
+  prepare(gbuffer, settings, a, &own_runs);
   if (a.texel_count == 0) return download(a);
 
   const uint32_t spp_limit = settings.spp == 0 ? std::numeric_limits<uint32_t>::max() : settings.spp;
-  // Split over processes (core/work_share.h): this rank's device runs its interleaved blocks of the
-  // texels through the work list (global indices, so the same random streams); the sums are
-  // gathered once at the end. Every rank follows every pass (rank 0 decides them), work or not.
-  WorkShare* share = distributed(settings.work_share);
   // Grid guiding (guide_buffer.h): the CPU reference's cache and its passes. Built inside the timed
   // bake, as on the CPU: guided results are measured with the cost of their guiding data.
   std::unique_ptr<GridGuidingCache> guide;
@@ -255,14 +305,12 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   // SVO: ramped throughout, as on the CPU, so its rebuilds (1, 2, 4, ... spp) end passes of the same sizes.
   if (svo_guide) policy.ramp = true, policy.ramp_below = PassPolicy{}.ramp_below;
   PassScheduler passes(settings, policy);
-  InterleavedSplit split;
-  if (share) {
-    split.items = a.texel_count;
-    split.ranks = share->ranks();
-    a.work_list = split.items_of(share->rank());
-    if (!a.work_list.empty())
-      runner_.context().upload(runner_.buffers().items.batch_items, a.work_list.data(), a.work_list.size() * 4);
-  }
+  // The estimate is hundreds of MB at millions of texels: a thread allocates it and touches its
+  // pages while the host waits on the device's passes. Under a split it is whole on rank 0 alone,
+  // and holds just their own texels on the other ranks (which send them).
+  const bool whole_here = !share || share->rank() == 0;
+  std::future<LightmapEstimate> sized = std::async(std::launch::async, &LightmapDriver::sized_estimate,
+                                                   whole_here ? a.texel_count : a.work_list.size(), a.recorded, a.directional);
   uint32_t first = 0, pass = 0;
   while ((share || !a.work_list.empty()) && passes.next_pass(first, pass)) {
     const auto pass_start = Clock::now();
@@ -313,9 +361,9 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   }
   a.seconds = std::chrono::duration<double>(Clock::now() - start_time).count();
   runner_.record_statistics(a.totals, kTexelBatch);
-  // Under a split only this rank's texels are read back (the gather below brings the others').
-  const std::vector<std::pair<size_t, size_t>> own_runs = share ? split.runs_of(share->rank()) : std::vector<std::pair<size_t, size_t>>{};
-  LightmapEstimate estimate = download(a, share ? &own_runs : nullptr);
+  // Under a split only this rank's texels are read back: in place on rank 0, which gathers the
+  // others' below; packed on the others, which send them.
+  LightmapEstimate estimate = download(a, share ? &own_runs : nullptr, sized.get(), /*packed=*/!whole_here);
   if (choice) {
     estimate.guiding_auto = true;
     estimate.guiding_auto_pilot = choice->pilot();
@@ -325,10 +373,13 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   if (svo_guide && settings.inspect_svo_guiding) settings.inspect_svo_guiding(*svo_guide);
   if (settings.work_share) settings.work_share->work.rays += estimate.rays;
   if (share) {
-    allgather_interleaved(*share, estimate.texels.data(), 1, split);
+    // Rank 0 alone writes the bundle: the per-texel sums go to it, and the other ranks keep none.
+    const size_t layer_texels = estimate.texels.size();
+    gather_interleaved_to_root(*share, estimate.texels.data(), 1, split);
     for (int k = 0; k < estimate.recorded_bounces; ++k)
-      allgather_interleaved(*share, estimate.bounces.data() + size_t(k) * a.texel_count * 3, 3, split);
-    if (!estimate.sh1.empty()) allgather_interleaved(*share, estimate.sh1.data(), 9, split);
+      gather_interleaved_to_root(*share, estimate.bounces.data() + size_t(k) * layer_texels * 3, 3, split);
+    if (!estimate.sh1.empty()) gather_interleaved_to_root(*share, estimate.sh1.data(), 9, split);
+    if (!whole_here) estimate.texels = {}, estimate.bounces = {}, estimate.sh1 = {};
     estimate.rays = share->sum(estimate.rays);
     estimate.nonfinite_samples = share->sum(estimate.nonfinite_samples);
   } else if (settings.work_share) {

@@ -49,7 +49,7 @@ class LightmapDriver {
  private:
   // What one accumulation keeps between its passes.
   struct Accumulation {
-    std::vector<GpuSurfacePoint> start_points;  // to upload again after a probe bake took the buffer
+    std::vector<GpuSurfacePoint> start_points;  // start()'s, to upload again after a probe bake took the buffer
     std::vector<uint32_t> work_list;
     size_t texel_count = 0;
     int recorded = 1;
@@ -62,12 +62,17 @@ class LightmapDriver {
     double seconds = 0;
   };
 
-  void prepare(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, Accumulation& a);
+  using Runs = std::vector<std::pair<size_t, size_t>>;
+  void prepare(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, Accumulation& a, const Runs* bake_runs = nullptr);
   void upload_items(const Accumulation& a);
   void run_pass(Accumulation& a, uint32_t first, uint32_t pass);
-  // The sums read back; `only`: just these runs [first, end) of texels (a rank's own, gathered
-  // after), the others' left empty; null: every texel.
-  LightmapEstimate download(const Accumulation& a, const std::vector<std::pair<size_t, size_t>>* only = nullptr);
+  // The per-texel arrays of `texels` texels, zero (their memory touched: bake() has it done while
+  // the passes run).
+  static LightmapEstimate sized_estimate(size_t texels, int recorded, bool directional);
+  // The sums read back into `into` (sized here when empty); `only`: just these runs [first, end) of
+  // texels (a rank's own), in place among all texels (the others' left zero) or, `packed`, run after
+  // run in arrays of the runs' texels alone; null: every texel.
+  LightmapEstimate download(const Accumulation& a, const Runs* only = nullptr, LightmapEstimate into = {}, bool packed = false);
   // The texels of `work_list` whose relative standard error is still above the target.
   std::vector<uint32_t> unconverged(const std::vector<uint32_t>& work_list, size_t texel_count, double target);
 

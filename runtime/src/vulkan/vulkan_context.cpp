@@ -358,6 +358,22 @@ void Context::upload_ranges(const Buffer& dst, const void* data, const std::vect
   submit_and_wait(cmd);
 }
 
+void Context::write_ranges(const Buffer& dst, const std::vector<ByteRange>& ranges, const std::function<void(char*)>& write) {
+  std::vector<VkBufferCopy> regions;
+  VkDeviceSize packed = 0;
+  for (const ByteRange& r : ranges) {
+    if (r.size == 0) continue;
+    regions.push_back({packed, r.offset, r.size});
+    packed += r.size;
+  }
+  if (packed == 0) return;
+  Buffer staging = create_buffer(packed, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+  write(static_cast<char*>(staging.mapped()));
+  VkCommandBuffer cmd = begin();
+  vkCmdCopyBuffer(cmd, staging.handle(), dst.handle(), uint32_t(regions.size()), regions.data());
+  submit_and_wait(cmd);
+}
+
 void Context::download(const Buffer& src, void* data, VkDeviceSize size, VkDeviceSize offset) {
   read_back_ranges(src, {{offset, size}}, [&](const char* mapped) { std::memcpy(data, mapped, size_t(size)); });
 }

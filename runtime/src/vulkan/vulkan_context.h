@@ -70,6 +70,10 @@ class Context {
   void upload(const Buffer& dst, const void* data, VkDeviceSize size, VkDeviceSize offset = 0);
   // Copies the ranges of `data`, a host mirror of `dst`, to the same ranges of `dst`, and waits.
   void upload_ranges(const Buffer& dst, const void* data, const std::vector<ByteRange>& ranges);
+  // Hands `write` a host-visible staging mapping to fill with the `ranges`' bytes, packed in order,
+  // then copies them to those ranges of `dst` and waits: for uploads made on the way, without a host
+  // copy in between (`write` is not called when the ranges hold no bytes).
+  void write_ranges(const Buffer& dst, const std::vector<ByteRange>& ranges, const std::function<void(char*)>& write);
   void download(const Buffer& src, void* data, VkDeviceSize size, VkDeviceSize offset = 0);
   // Copies the `ranges` of `src`, packed in order, into a host-visible staging buffer, waits, and
   // hands `read` its mapping: for read-backs converted on the way, without a host copy in between

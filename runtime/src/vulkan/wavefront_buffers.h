@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "exitance/common/gpu_layout.h"
+#include "exitance/runtime/texel_gbuffer.h"
 #include "vulkan_context.h"
 #include "wavefront_kernels.h"
 
@@ -79,6 +80,11 @@ struct QueueDispatches {
 
 // A bake's items (texels or probes): their start points, and the list a batch takes its items
 // from (batch_items[batch_item_offset + i]). Grown as bakes need, never shrunk.
+// A live texel as the estimator's start point (WorkItems::start_points).
+inline GpuSurfacePoint texel_start_point(const LiveTexel& t) {
+  return {Vec4(t.position, 0.0f), Vec4(t.geometric_normal, 0.0f), Vec4(t.shading_normal, 0.0f)};
+}
+
 struct WorkItems {
   Buffer start_points;  // GpuSurfacePoint per item
   Buffer batch_items;   // item indices

@@ -20,7 +20,8 @@ class Integrator {
   // E/pi at every live texel of the G-buffer (path.h's estimator), with per-bounce layers.
   // Settings: spp (0 needs a time budget or a target error), time_budget_seconds,
   // target_relative_error, max_bounces, seed, recorded_bounces, russian_roulette_start,
-  // safety_bounce_cap, sampling_strategy, progress.
+  // safety_bounce_cap, sampling_strategy, progress. Split over several ranks (work_share), rank 0
+  // gets the whole estimate; another rank's per-texel arrays may be empty (the Vulkan backend's).
   virtual LightmapEstimate bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const = 0;
 
   // A batch of rays from arbitrary origins, one set per origin: today light probes (stratified

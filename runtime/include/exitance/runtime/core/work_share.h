@@ -1,9 +1,10 @@
 // One process's share of a bake split over several (bake under mpirun, issue 15 "Scale out"). The
 // scene is replicated; each process estimates a contiguous range of the live texels (or probe
-// origins) and the integrators exchange the per-item sums after every pass through the collectives
-// below, so every process holds the whole estimate before anything global (error stats, the
-// per-bounce tail, the next bounce's cache) is computed from it. Items keep their global indices, so
-// their random streams - and the result bits - do not depend on the split.
+// origins) and the integrators exchange the per-item sums through the collectives below: after
+// every pass where the next one needs them all (the CPU's re-split, the per-bounce tail, the next
+// bounce's cache), else once at the end, onto rank 0 alone (Vulkan path tracing: only rank 0 writes
+// the bundle). Items keep their global indices, so their random streams - and the result bits - do
+// not depend on the split.
 //
 // The runtime stays free of MPI: this is an interface; bake/distributed implements it over MPI.
 // No share (IntegratorSettings::work_share null) or one rank: the integrators run as before.
@@ -34,6 +35,10 @@ class WorkShare {
   // In place over `data`, the same size on every rank: rank r has filled bytes
   // [byte_bounds[r], byte_bounds[r + 1]); afterwards every rank holds every range.
   virtual void allgather_ranges(void* data, const std::vector<size_t>& byte_bounds) = 0;
+  // Rank r's bytes at `own` (byte_bounds[r + 1] - byte_bounds[r] of them) onto rank 0, at `received`
+  // + byte_bounds[r] there (byte_bounds.back() bytes; rank 0's own range is not written, nor is
+  // `received` read on the other ranks): what only rank 0 needs, since it alone writes the bundle.
+  virtual void gather_to_root(const void* own, void* received, const std::vector<size_t>& byte_bounds) = 0;
   // Rank 0's `bytes` bytes at `data` onto every rank (its decisions: pass sizes under a time budget).
   virtual void broadcast(void* data, size_t bytes) = 0;
   // The sum over ranks (exact: integers).
@@ -67,28 +72,35 @@ struct InterleavedSplit {
   size_t items = 0;
   int ranks = 1;
   size_t block = 1024;  // texels: long enough runs for coherent work lists, short enough to balance
-  // The items of `rank`, ascending; and as runs [first, end) of consecutive items.
+  // The items of `rank`, ascending; as runs [first, end) of consecutive items; and how many.
   std::vector<uint32_t> items_of(int rank) const;
   std::vector<std::pair<size_t, size_t>> runs_of(int rank) const;
-  // Rank-major order (rank 0's items, then rank 1's, ...) and each rank's start in it (ranks + 1 entries).
-  std::vector<uint32_t> rank_major_order(std::vector<size_t>& bounds) const;
+  size_t count_of(int rank) const;
 };
 
-// Gathers an interleaved split's items, `values_per_item` consecutive T each at `base`: every rank
-// holds every rank's items afterwards. Through a rank-major copy (allgather_items moves contiguous ranges).
+// An interleaved split's items onto rank 0, `values_per_item` consecutive T each. On rank 0 `data`
+// is the whole array with its own items in place, and receives every other rank's; on the others it
+// holds their own items packed, run after run (what they send). One copy per run on rank 0.
 template <class T>
-void allgather_interleaved(WorkShare& share, T* base, size_t values_per_item, const InterleavedSplit& split) {
+void gather_interleaved_to_root(WorkShare& share, T* data, size_t values_per_item, const InterleavedSplit& split) {
   static_assert(std::is_trivially_copyable_v<T>);
-  std::vector<size_t> bounds;
-  const std::vector<uint32_t> order = split.rank_major_order(bounds);
-  const size_t own_begin = bounds[size_t(share.rank())], own_end = bounds[size_t(share.rank()) + 1];
   const size_t item_bytes = values_per_item * sizeof(T);
-  // Not zero-filled: this rank writes its part, the exchange the others' (hundreds of MB at 10 M texels).
-  const std::unique_ptr<T[]> packed(new T[order.size() * values_per_item]);
-  for (size_t k = own_begin; k < own_end; ++k) std::memcpy(&packed[k * values_per_item], base + size_t(order[k]) * values_per_item, item_bytes);
-  allgather_items(share, packed.get(), values_per_item, bounds);
-  for (size_t k = 0; k < order.size(); ++k)
-    if (k < own_begin || k >= own_end) std::memcpy(base + size_t(order[k]) * values_per_item, &packed[k * values_per_item], item_bytes);
+  std::vector<size_t> bounds(size_t(split.ranks) + 1, 0);
+  for (int r = 0; r < split.ranks; ++r) bounds[size_t(r) + 1] = bounds[size_t(r)] + split.count_of(r) * item_bytes;
+  if (share.rank() != 0) {
+    share.gather_to_root(data, nullptr, bounds);
+    return;
+  }
+  // Not zero-filled, and rank 0's own range never touched: the exchange writes the others' bytes.
+  const std::unique_ptr<char[]> received(new char[bounds.back()]);
+  share.gather_to_root(nullptr, received.get(), bounds);
+  for (int r = 1; r < split.ranks; ++r) {
+    const char* from = received.get() + bounds[size_t(r)];
+    for (const auto& [first, end] : split.runs_of(r)) {
+      std::memcpy(reinterpret_cast<char*>(data + first * values_per_item), from, (end - first) * item_bytes);
+      from += (end - first) * item_bytes;
+    }
+  }
 }
 
 // Every rank's `work`, on every rank, in rank order.

@@ -1,9 +1,12 @@
 // relight --share R/N: rank R's share of a bake split over N processes (core/work_share.h), run
-// alone on this process's device. Nothing is exchanged: the other ranks' texels stay empty, and
-// every decision a real split takes from rank 0 is this process's own. What it measures is the
+// alone on this process's device. Nothing is exchanged: the other ranks' texels stay empty (as rank 0
+// it writes zeros where they would arrive, the writes a real gather makes), and every decision a
+// real split takes from rank 0 is this process's own. What it measures is the
 // time one rank's texels take, so that a split's balance and its speed-up over one device can be
 // found on a machine with a single GPU (bench/results/open-city-gpu.md).
 #pragma once
+#include <cstring>
+
 #include "exitance/runtime/core/work_share.h"
 
 namespace exitance {
@@ -14,6 +17,10 @@ class OneRankAlone final : public WorkShare {
   int rank() const override { return rank_; }
   int ranks() const override { return ranks_; }
   void allgather_ranges(void*, const std::vector<size_t>&) override {}
+  void gather_to_root(const void*, void* received, const std::vector<size_t>& byte_bounds) override {
+    if (rank_ == 0 && byte_bounds.size() > 1)
+      std::memset(static_cast<char*>(received) + byte_bounds[1], 0, byte_bounds.back() - byte_bounds[1]);
+  }
   void broadcast(void*, size_t) override {}
   uint64_t sum(uint64_t value) override { return value; }
 
