@@ -56,33 +56,41 @@ void MpiWorkShare::allgather_ranges(void* data, const std::vector<size_t>& byte_
   }
 }
 
-void MpiWorkShare::gather_to_root(const void* own, void* received, const std::vector<size_t>& byte_bounds) {
-  const size_t parts = size_t(ranks_);
-  if (byte_bounds.size() != parts + 1) throw std::logic_error("gather_to_root: one range per rank expected");
-  // Point to point, in pieces of at most kLargestPiece (MPI counts are ints); rank 0 posts every
-  // receive at once so the ranks' sends proceed together.
+void MpiWorkShare::gather_pieces_to_root(const void* own, void* whole, const std::vector<std::vector<BytePiece>>& pieces) {
+  if (pieces.size() != size_t(ranks_)) throw std::logic_error("gather_pieces_to_root: one list of pieces per rank expected");
+  // Point to point, one message per piece of at most kLargestPiece (MPI counts are ints), received
+  // in place on rank 0; messages between two ranks match in order (same tag). Requests are waited
+  // for in batches, which bounds their number (a run of 1024 texels is a piece: ~10 k per array
+  // at 10 M texels).
   constexpr int kTag = 15;
+  constexpr size_t kBatch = 1024;
   std::vector<MPI_Request> requests;
-  auto pieces = [&](size_t r, auto&& each) {
-    for (size_t begin = byte_bounds[r]; begin < byte_bounds[r + 1]; begin += kLargestPiece)
-      each(begin, int(std::min(kLargestPiece, byte_bounds[r + 1] - begin)));
+  auto post = [&](int status, const char* call) {
+    check(status, call);
+    if (requests.size() >= kBatch) {
+      check(MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
+      requests.clear();
+    }
   };
   if (rank_ == 0) {
-    for (size_t r = 1; r < parts; ++r)
-      pieces(r, [&](size_t begin, int count) {
-        requests.emplace_back();
-        check(MPI_Irecv(static_cast<char*>(received) + begin, count, MPI_BYTE, int(r), kTag, MPI_COMM_WORLD, &requests.back()),
-              "MPI_Irecv");
-      });
+    for (size_t r = 1; r < pieces.size(); ++r)
+      for (const BytePiece& p : pieces[r])
+        for (size_t done = 0; done < p.size; done += kLargestPiece) {
+          requests.emplace_back();
+          post(MPI_Irecv(static_cast<char*>(whole) + p.offset + done, int(std::min(kLargestPiece, p.size - done)), MPI_BYTE,
+                         int(r), kTag, MPI_COMM_WORLD, &requests.back()),
+               "MPI_Irecv");
+        }
   } else {
-    const size_t own_begin = byte_bounds[size_t(rank_)];
-    pieces(size_t(rank_), [&](size_t begin, int count) {
-      requests.emplace_back();
-      // MPI 3 takes a const buffer; the cast is for MPI 2 headers.
-      check(MPI_Isend(const_cast<char*>(static_cast<const char*>(own)) + (begin - own_begin), count, MPI_BYTE, 0, kTag,
-                      MPI_COMM_WORLD, &requests.back()),
-            "MPI_Isend");
-    });
+    const char* from = static_cast<const char*>(own);
+    for (const BytePiece& p : pieces[size_t(rank_)])
+      for (size_t done = 0; done < p.size; done += kLargestPiece) {
+        const size_t count = std::min(kLargestPiece, p.size - done);
+        requests.emplace_back();
+        // MPI 3 takes a const buffer; the cast is for MPI 2 headers.
+        post(MPI_Isend(const_cast<char*>(from), int(count), MPI_BYTE, 0, kTag, MPI_COMM_WORLD, &requests.back()), "MPI_Isend");
+        from += count;
+      }
   }
   check(MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
 }

@@ -11,8 +11,6 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
-#include <memory>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -27,6 +25,11 @@ struct RankWork {
   double seconds = 0;          // spent estimating its items (not waiting for the others)
 };
 
+// A byte range [offset, offset + size) of an array.
+struct BytePiece {
+  size_t offset = 0, size = 0;
+};
+
 class WorkShare {
  public:
   virtual ~WorkShare() = default;
@@ -35,10 +38,11 @@ class WorkShare {
   // In place over `data`, the same size on every rank: rank r has filled bytes
   // [byte_bounds[r], byte_bounds[r + 1]); afterwards every rank holds every range.
   virtual void allgather_ranges(void* data, const std::vector<size_t>& byte_bounds) = 0;
-  // Rank r's bytes at `own` (byte_bounds[r + 1] - byte_bounds[r] of them) onto rank 0, at `received`
-  // + byte_bounds[r] there (byte_bounds.back() bytes; rank 0's own range is not written, nor is
-  // `received` read on the other ranks): what only rank 0 needs, since it alone writes the bundle.
-  virtual void gather_to_root(const void* own, void* received, const std::vector<size_t>& byte_bounds) = 0;
+  // Rank r's pieces (pieces[r], byte ranges of an array every rank indexes alike) onto rank 0: rank
+  // r sends them from `own`, packed in order; rank 0 receives every other rank's straight into
+  // `whole` at their offsets (its own are not written; `whole` is not read on the other ranks, nor
+  // `own` on rank 0). What only rank 0 needs, since it alone writes the bundle.
+  virtual void gather_pieces_to_root(const void* own, void* whole, const std::vector<std::vector<BytePiece>>& pieces) = 0;
   // Rank 0's `bytes` bytes at `data` onto every rank (its decisions: pass sizes under a time budget).
   virtual void broadcast(void* data, size_t bytes) = 0;
   // The sum over ranks (exact: integers).
@@ -79,28 +83,19 @@ struct InterleavedSplit {
 };
 
 // An interleaved split's items onto rank 0, `values_per_item` consecutive T each. On rank 0 `data`
-// is the whole array with its own items in place, and receives every other rank's; on the others it
-// holds their own items packed, run after run (what they send). One copy per run on rank 0.
+// is the whole array with its own items in place, and receives every other rank's run by run; on
+// the others it holds their own items packed, run after run (what they send).
 template <class T>
 void gather_interleaved_to_root(WorkShare& share, T* data, size_t values_per_item, const InterleavedSplit& split) {
   static_assert(std::is_trivially_copyable_v<T>);
   const size_t item_bytes = values_per_item * sizeof(T);
-  std::vector<size_t> bounds(size_t(split.ranks) + 1, 0);
-  for (int r = 0; r < split.ranks; ++r) bounds[size_t(r) + 1] = bounds[size_t(r)] + split.count_of(r) * item_bytes;
-  if (share.rank() != 0) {
-    share.gather_to_root(data, nullptr, bounds);
-    return;
-  }
-  // Not zero-filled, and rank 0's own range never touched: the exchange writes the others' bytes.
-  const std::unique_ptr<char[]> received(new char[bounds.back()]);
-  share.gather_to_root(nullptr, received.get(), bounds);
-  for (int r = 1; r < split.ranks; ++r) {
-    const char* from = received.get() + bounds[size_t(r)];
-    for (const auto& [first, end] : split.runs_of(r)) {
-      std::memcpy(reinterpret_cast<char*>(data + first * values_per_item), from, (end - first) * item_bytes);
-      from += (end - first) * item_bytes;
-    }
-  }
+  std::vector<std::vector<BytePiece>> pieces(size_t(split.ranks));
+  for (int r = 0; r < split.ranks; ++r)
+    for (const auto& [first, end] : split.runs_of(r)) pieces[size_t(r)].push_back({first * item_bytes, (end - first) * item_bytes});
+  if (share.rank() == 0)
+    share.gather_pieces_to_root(nullptr, data, pieces);
+  else
+    share.gather_pieces_to_root(data, nullptr, pieces);
 }
 
 // Every rank's `work`, on every rank, in rank order.

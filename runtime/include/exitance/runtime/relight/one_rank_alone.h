@@ -17,9 +17,10 @@ class OneRankAlone final : public WorkShare {
   int rank() const override { return rank_; }
   int ranks() const override { return ranks_; }
   void allgather_ranges(void*, const std::vector<size_t>&) override {}
-  void gather_to_root(const void*, void* received, const std::vector<size_t>& byte_bounds) override {
-    if (rank_ == 0 && byte_bounds.size() > 1)
-      std::memset(static_cast<char*>(received) + byte_bounds[1], 0, byte_bounds.back() - byte_bounds[1]);
+  void gather_pieces_to_root(const void*, void* whole, const std::vector<std::vector<BytePiece>>& pieces) override {
+    if (rank_ != 0) return;
+    for (size_t r = 1; r < pieces.size(); ++r)
+      for (const BytePiece& p : pieces[r]) std::memset(static_cast<char*>(whole) + p.offset, 0, p.size);
   }
   void broadcast(void*, size_t) override {}
   uint64_t sum(uint64_t value) override { return value; }

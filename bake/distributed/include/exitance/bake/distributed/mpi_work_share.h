@@ -17,7 +17,7 @@ class MpiWorkShare final : public WorkShare {
   int rank() const override { return rank_; }
   int ranks() const override { return ranks_; }
   void allgather_ranges(void* data, const std::vector<size_t>& byte_bounds) override;
-  void gather_to_root(const void* own, void* received, const std::vector<size_t>& byte_bounds) override;
+  void gather_pieces_to_root(const void* own, void* whole, const std::vector<std::vector<BytePiece>>& pieces) override;
   void broadcast(void* data, size_t bytes) override;
   uint64_t sum(uint64_t value) override;
 
