@@ -134,7 +134,16 @@ LightmapEstimate LightmapDriver::sized_estimate(size_t texels, int recorded, boo
   return estimate;
 }
 
-LightmapEstimate LightmapDriver::download(const Accumulation& a, const Runs* only, LightmapEstimate into, bool packed) {
+LightmapDriver::ReadBackSpace LightmapDriver::read_back_space(size_t host_texels, size_t read_texels, int recorded,
+                                                              bool directional) {
+  ReadBackSpace space;
+  space.estimate = sized_estimate(host_texels, recorded, directional);
+  const size_t largest = read_texels * std::max<size_t>({size_t(recorded) * 24, 48, directional ? 72u : 0u});
+  if (largest > 0) space.staging = runner_.context().create_buffer(largest, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+  return space;
+}
+
+LightmapEstimate LightmapDriver::download(const Accumulation& a, const Runs* only, ReadBackSpace space, bool packed) {
   const size_t texel_count = a.texel_count;
   const Runs all{{0, texel_count}};
   const Runs& runs = only ? *only : all;
@@ -147,9 +156,10 @@ LightmapEstimate LightmapDriver::download(const Accumulation& a, const Runs* onl
   } else {
     for (size_t k = 0; k < runs.size(); ++k) to[k] = runs[k].first;
   }
-  LightmapEstimate estimate = into.texels.size() == host_texels && !into.texels.empty()
-                                  ? std::move(into)
+  LightmapEstimate estimate = space.estimate.texels.size() == host_texels && !space.estimate.texels.empty()
+                                  ? std::move(space.estimate)
                                   : sized_estimate(host_texels, a.recorded, a.directional);
+  const Buffer* staging = space.staging.handle() ? &space.staging : nullptr;
   if (texel_count > 0) {
     Context& context = runner_.context();
     const WavefrontBuffers& buffers = runner_.buffers();
@@ -175,7 +185,7 @@ LightmapEstimate LightmapDriver::download(const Accumulation& a, const Runs* onl
       for (const ByteRange& r : ranges(24, size_t(k) * texel_count * 24)) layers.push_back(r);
     context.read_back_ranges(buffers.texels.bounce_sums, layers, [&](const char* bytes) {
       place(reinterpret_cast<char*>(estimate.bounces.data()), 24, a.recorded, bytes);
-    });
+    }, staging);
     context.read_back_ranges(buffers.texels.sums, ranges(48, 0), [&](const char* bytes) {
       const double* sums = reinterpret_cast<const double*>(bytes);
       for (size_t k = 0; k < runs.size(); ++k)
@@ -187,16 +197,16 @@ LightmapEstimate LightmapDriver::download(const Accumulation& a, const Runs* onl
             t.direct[c] = estimate.bounces[i * 3 + size_t(c)];  // layer 0 is the direct light
           }
         }
-    });
+    }, staging);
     context.read_back_ranges(buffers.texels.samples, ranges(4, 0), [&](const char* bytes) {
       const uint32_t* samples = reinterpret_cast<const uint32_t*>(bytes);
       for (size_t k = 0; k < runs.size(); ++k)
         for (size_t i = to[k], end = to[k] + runs[k].second - runs[k].first; i < end; ++i) estimate.texels[i].samples = *samples++;
-    });
+    }, staging);
     if (a.directional)  // L1 sums: 9 doubles per texel after the 6 of every texel
       context.read_back_ranges(buffers.texels.sums, ranges(72, texel_count * 48), [&](const char* bytes) {
         place(reinterpret_cast<char*>(estimate.sh1.data()), 72, 1, bytes);
-      });
+      }, staging);
   }
   estimate.rays = a.totals.rays();
   estimate.nonfinite_samples = a.totals.nonfinite;
@@ -306,11 +316,13 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   if (svo_guide) policy.ramp = true, policy.ramp_below = PassPolicy{}.ramp_below;
   PassScheduler passes(settings, policy);
   // The estimate is hundreds of MB at millions of texels: a thread allocates it and touches its
-  // pages while the host waits on the device's passes. Under a split it is whole on rank 0 alone,
-  // and holds just their own texels on the other ranks (which send them).
+  // pages, and makes the read-back's pinned staging buffer, while the host waits on the device's
+  // passes. Under a split it is whole on rank 0 alone, and holds just their own texels on the other
+  // ranks (which send them).
   const bool whole_here = !share || share->rank() == 0;
-  std::future<LightmapEstimate> sized = std::async(std::launch::async, &LightmapDriver::sized_estimate,
-                                                   whole_here ? a.texel_count : a.work_list.size(), a.recorded, a.directional);
+  std::future<ReadBackSpace> space = std::async(std::launch::async, &LightmapDriver::read_back_space, this,
+                                                whole_here ? a.texel_count : a.work_list.size(), a.work_list.size(), a.recorded,
+                                                a.directional);
   uint32_t first = 0, pass = 0;
   while ((share || !a.work_list.empty()) && passes.next_pass(first, pass)) {
     const auto pass_start = Clock::now();
@@ -363,7 +375,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   runner_.record_statistics(a.totals, kTexelBatch);
   // Under a split only this rank's texels are read back: in place on rank 0, which gathers the
   // others' below; packed on the others, which send them.
-  LightmapEstimate estimate = download(a, share ? &own_runs : nullptr, sized.get(), /*packed=*/!whole_here);
+  LightmapEstimate estimate = download(a, share ? &own_runs : nullptr, space.get(), /*packed=*/!whole_here);
   if (choice) {
     estimate.guiding_auto = true;
     estimate.guiding_auto_pilot = choice->pilot();

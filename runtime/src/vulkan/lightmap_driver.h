@@ -66,13 +66,20 @@ class LightmapDriver {
   void prepare(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, Accumulation& a, const Runs* bake_runs = nullptr);
   void upload_items(const Accumulation& a);
   void run_pass(Accumulation& a, uint32_t first, uint32_t pass);
-  // The per-texel arrays of `texels` texels, zero (their memory touched: bake() has it done while
-  // the passes run).
+  // What a read-back fills, made ahead of time (bake(): on a thread while the passes run): the
+  // estimate's per-texel arrays for `host_texels`, zero (their memory touched), and a pinned
+  // staging buffer for the largest array of `read_texels` texels (allocating it is part of a
+  // read-back's cost).
+  struct ReadBackSpace {
+    LightmapEstimate estimate;
+    Buffer staging;
+  };
   static LightmapEstimate sized_estimate(size_t texels, int recorded, bool directional);
-  // The sums read back into `into` (sized here when empty); `only`: just these runs [first, end) of
-  // texels (a rank's own), in place among all texels (the others' left zero) or, `packed`, run after
-  // run in arrays of the runs' texels alone; null: every texel.
-  LightmapEstimate download(const Accumulation& a, const Runs* only = nullptr, LightmapEstimate into = {}, bool packed = false);
+  ReadBackSpace read_back_space(size_t host_texels, size_t read_texels, int recorded, bool directional);
+  // The sums read back into `space` (sized here when it does not fit); `only`: just these runs
+  // [first, end) of texels (a rank's own), in place among all texels (the others' left zero) or,
+  // `packed`, run after run in arrays of the runs' texels alone; null: every texel.
+  LightmapEstimate download(const Accumulation& a, const Runs* only = nullptr, ReadBackSpace space = {}, bool packed = false);
   // The texels of `work_list` whose relative standard error is still above the target.
   std::vector<uint32_t> unconverged(const std::vector<uint32_t>& work_list, size_t texel_count, double target);
 

@@ -378,7 +378,8 @@ void Context::download(const Buffer& src, void* data, VkDeviceSize size, VkDevic
   read_back_ranges(src, {{offset, size}}, [&](const char* mapped) { std::memcpy(data, mapped, size_t(size)); });
 }
 
-void Context::read_back_ranges(const Buffer& src, const std::vector<ByteRange>& ranges, const std::function<void(const char*)>& read) {
+void Context::read_back_ranges(const Buffer& src, const std::vector<ByteRange>& ranges, const std::function<void(const char*)>& read,
+                               const Buffer* staging) {
   std::vector<VkBufferCopy> regions;
   VkDeviceSize packed = 0;
   for (const ByteRange& r : ranges) {
@@ -387,11 +388,13 @@ void Context::read_back_ranges(const Buffer& src, const std::vector<ByteRange>& 
     packed += r.size;
   }
   if (packed == 0) return;
-  Buffer staging = create_buffer(packed, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+  Buffer own;
+  if (!staging || !staging->mapped() || staging->size() < packed) own = create_buffer(packed, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+  const Buffer& through = own.handle() ? own : *staging;
   VkCommandBuffer cmd = begin();
-  vkCmdCopyBuffer(cmd, src.handle(), staging.handle(), uint32_t(regions.size()), regions.data());
+  vkCmdCopyBuffer(cmd, src.handle(), through.handle(), uint32_t(regions.size()), regions.data());
   submit_and_wait(cmd);
-  read(static_cast<const char*>(staging.mapped()));
+  read(static_cast<const char*>(through.mapped()));
 }
 
 }  // namespace exitance::vulkan

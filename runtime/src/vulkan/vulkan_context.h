@@ -78,7 +78,10 @@ class Context {
   // Copies the `ranges` of `src`, packed in order, into a host-visible staging buffer, waits, and
   // hands `read` its mapping: for read-backs converted on the way, without a host copy in between
   // (`read` is not called when the ranges hold no bytes).
-  void read_back_ranges(const Buffer& src, const std::vector<ByteRange>& ranges, const std::function<void(const char*)>& read);
+  // `staging`: a host-visible buffer to copy through when it is large enough (made ahead of time:
+  // allocating pinned memory is part of a read-back's cost), else one is made here.
+  void read_back_ranges(const Buffer& src, const std::vector<ByteRange>& ranges, const std::function<void(const char*)>& read,
+                        const Buffer* staging = nullptr);
 
   VkCommandBuffer begin();  // the context's single command buffer, reset
   // Submits the command buffer and waits for its fence; throws on timeout or device loss.
