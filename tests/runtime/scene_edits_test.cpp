@@ -594,6 +594,53 @@ TEST(Bvh4Refit, MovedTrianglesStayInsideEveryBoxAbove) {
   EXPECT_THROW(refit_bvh4(broken, p.scene.positions), std::invalid_argument);
 }
 
+// A spatial-split builder's leaf holds a fragment of a triangle: its box is tighter than the
+// triangle's bounds. Refit against the positions the boxes were fitted to, a leaf whose triangles
+// did not move keeps that box; a leaf with a moved triangle gets its triangles' whole bounds; inner
+// boxes are their children's union. Without the fitted positions every leaf is refit.
+TEST(Bvh4Refit, LeavesOfUnmovedTrianglesKeepTheirFragmentBoxes) {
+  // Triangle 0 spans x in [0, 2] and is split at x = 1 into two leaves; triangle 1 is a small one far away.
+  const std::vector<Vec3> before = {{0, 0, 0}, {2, 0, 0}, {0, 1, 0}, {5, 5, 5}, {6, 5, 5}, {5, 6, 5}};
+  Bvh4 bvh;
+  bvh.leaf_triangles = {0, 0, 1};
+  Bvh4Node root{};
+  auto set_box = [](Bvh4Node& n, int i, Vec3 lo, Vec3 hi) {
+    n.lo_x[i] = lo.x, n.lo_y[i] = lo.y, n.lo_z[i] = lo.z, n.hi_x[i] = hi.x, n.hi_y[i] = hi.y, n.hi_z[i] = hi.z;
+  };
+  for (int i = 0; i < 4; ++i) set_box(root, i, {INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}), root.child[i] = kBvhEmptyChild;
+  root.child[0] = kBvhLeafBit | (0u << 2) | 0u;  // slot 0: triangle 0's part with x <= 1
+  root.child[1] = kBvhLeafBit | (1u << 2) | 0u;  // slot 1: its part with x >= 1
+  root.child[2] = kBvhLeafBit | (2u << 2) | 0u;  // slot 2: triangle 1
+  set_box(root, 0, {0, 0, 0}, {1, 1, 0});
+  set_box(root, 1, {1, 0, 0}, {2, 0.5f, 0});
+  set_box(root, 2, {5, 5, 5}, {6, 6, 5});
+  bvh.nodes = {root};
+
+  Bvh4 same = bvh;
+  refit_bvh4(same, before, &before);
+  EXPECT_EQ(std::memcmp(same.nodes.data(), bvh.nodes.data(), sizeof(Bvh4Node)), 0) << "unmoved fragments keep their boxes";
+
+  std::vector<Vec3> after = before;  // triangle 1 moves up by 1
+  for (int k = 3; k < 6; ++k) after[size_t(k)].z += 1;
+  Bvh4 partly = bvh;
+  refit_bvh4(partly, after, &before);
+  const Bvh4Node& n = partly.nodes[0];
+  EXPECT_EQ(n.hi_x[0], 1.0f) << "triangle 0's fragments kept";
+  EXPECT_EQ(n.lo_x[1], 1.0f);
+  EXPECT_EQ(n.hi_y[1], 0.5f);
+  EXPECT_EQ(n.lo_z[2], 6.0f) << "the moved triangle's leaf refit";
+  EXPECT_EQ(n.hi_z[2], 6.0f);
+  EXPECT_EQ(n.lo_x[2], 5.0f);
+  EXPECT_EQ(n.hi_y[2], 6.0f);
+
+  Bvh4 all = bvh;
+  refit_bvh4(all, after);
+  EXPECT_EQ(all.nodes[0].hi_x[0], 2.0f) << "without the fitted positions a fragment widens to its triangle";
+  EXPECT_EQ(all.nodes[0].lo_x[1], 0.0f);
+  const std::vector<Vec3> one_triangle(3);
+  EXPECT_THROW(refit_bvh4(all, after, &one_triangle), std::invalid_argument);
+}
+
 // set_geometry derives what build_lighting_scene derives from the edited scene, over the refit BVH.
 TEST(LightingSceneGeometry, SetGeometryEqualsABuildOfTheEditedScene) {
   PersistedScene p = baked();

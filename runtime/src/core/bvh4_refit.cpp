@@ -8,8 +8,11 @@
 
 namespace exitance {
 
-void refit_bvh4(Bvh4& bvh, const std::vector<Vec3>& positions) {
+void refit_bvh4(Bvh4& bvh, const std::vector<Vec3>& positions, const std::vector<Vec3>* fitted_to) {
   const size_t triangle_count = positions.size() / 3;
+  if (fitted_to && fitted_to->size() != positions.size())
+    throw std::invalid_argument("refit_bvh4: " + std::to_string(fitted_to->size()) + " fitted positions for " +
+                                std::to_string(positions.size()));
   for (uint32_t t : bvh.leaf_triangles)
     if (t >= triangle_count)
       throw std::invalid_argument("refit_bvh4: leaf references triangle " + std::to_string(t) + " of " +
@@ -26,6 +29,17 @@ void refit_bvh4(Bvh4& bvh, const std::vector<Vec3>& positions) {
                                     " (children come after their parent)");
       }
     }
+  // Per triangle: whether a vertex moved since the boxes were fitted (all of them without `fitted_to`).
+  std::vector<uint8_t> moved(triangle_count, 1);
+  if (fitted_to)
+    for (size_t t = 0; t < triangle_count; ++t) {
+      bool same = true;
+      for (size_t k = 0; k < 3; ++k) {
+        const Vec3 a = positions[t * 3 + k], b = (*fitted_to)[t * 3 + k];
+        same = same && a.x == b.x && a.y == b.y && a.z == b.z;
+      }
+      moved[t] = same ? 0 : 1;
+    }
   // Children come after their parents: one pass from the last node up sees every child's box first.
   std::vector<WorldBox> node_box(bvh.nodes.size());
   for (size_t n = bvh.nodes.size(); n-- > 0;) {
@@ -36,8 +50,15 @@ void refit_bvh4(Bvh4& bvh, const std::vector<Vec3>& positions) {
       WorldBox box;
       if (child & kBvhLeafBit) {
         const uint32_t first = (child & ~kBvhLeafBit) >> 2, count = (child & 3u) + 1;
-        for (uint32_t s = first; s < first + count; ++s)
-          for (int k = 0; k < 3; ++k) box.grow(positions[size_t(bvh.leaf_triangles[s]) * 3 + size_t(k)]);
+        bool leaf_moved = false;
+        for (uint32_t s = first; s < first + count; ++s) leaf_moved = leaf_moved || moved[bvh.leaf_triangles[s]];
+        if (leaf_moved) {
+          for (uint32_t s = first; s < first + count; ++s)
+            for (int k = 0; k < 3; ++k) box.grow(positions[size_t(bvh.leaf_triangles[s]) * 3 + size_t(k)]);
+        } else {  // as fitted (a split fragment's box stays the fragment's)
+          box.grow(Vec3{node.lo_x[i], node.lo_y[i], node.lo_z[i]});
+          box.grow(Vec3{node.hi_x[i], node.hi_y[i], node.hi_z[i]});
+        }
       } else {
         box = node_box[child];
       }

@@ -163,7 +163,10 @@ void set_geometry(LightingScene& lighting, std::shared_ptr<const Scene> edited) 
                                 std::to_string(edited ? edited->triangle_count() : 0) + " triangles, not " +
                                 std::to_string(lighting.triangles.size()));
   Bvh4 bvh = lighting.bvh;
-  if (!bvh.nodes.empty()) refit_bvh4(bvh, edited->positions);
+  // The boxes fit the source's positions: the leaves of triangles that did not move keep theirs.
+  const std::vector<Vec3>* fitted_to =
+      lighting.source && lighting.source->positions.size() == edited->positions.size() ? &lighting.source->positions : nullptr;
+  if (!bvh.nodes.empty()) refit_bvh4(bvh, edited->positions, fitted_to);
   lighting = build_lighting_scene(std::move(edited), std::move(bvh));
 }
 

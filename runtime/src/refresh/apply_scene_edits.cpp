@@ -165,7 +165,7 @@ EditEffects apply_scene_edits(PersistedScene& persisted, const std::vector<Scene
     if (!moved.instances.empty() && !persisted.bvh.nodes.empty()) {
       Bvh4 refit = to_bvh4(persisted.bvh);
       try {
-        refit_bvh4(refit, next.positions);
+        refit_bvh4(refit, next.positions, &persisted.scene.positions);  // its boxes fit the scene before the edits
       } catch (const std::invalid_argument& e) {
         fail("scene", std::string("BVH: ") + e.what());
       }
