@@ -23,6 +23,7 @@
 #include "exitance/runtime/node_transform.h"
 #include "exitance/runtime/refresh/scene_edits.h"
 #include "exitance/runtime/scene_file_conversion.h"
+#include "exitance/runtime/world_box.h"
 
 namespace exitance {
 namespace {
@@ -596,8 +597,9 @@ TEST(Bvh4Refit, MovedTrianglesStayInsideEveryBoxAbove) {
 
 // A spatial-split builder's leaf holds a fragment of a triangle: its box is tighter than the
 // triangle's bounds. Refit against the positions the boxes were fitted to, a leaf whose triangles
-// did not move keeps that box; a leaf with a moved triangle gets its triangles' whole bounds; inner
-// boxes are their children's union. Without the fitted positions every leaf is refit.
+// did not move keeps that box; a leaf with a moved triangle gets the box of each triangle's part in
+// it, carried to where the triangle went; inner boxes are their children's union. Without the
+// fitted positions every leaf gets its triangles' whole bounds.
 TEST(Bvh4Refit, LeavesOfUnmovedTrianglesKeepTheirFragmentBoxes) {
   // Triangle 0 spans x in [0, 2] and is split at x = 1 into two leaves; triangle 1 is a small one far away.
   const std::vector<Vec3> before = {{0, 0, 0}, {2, 0, 0}, {0, 1, 0}, {5, 5, 5}, {6, 5, 5}, {5, 6, 5}};
@@ -632,6 +634,32 @@ TEST(Bvh4Refit, LeavesOfUnmovedTrianglesKeepTheirFragmentBoxes) {
   EXPECT_EQ(n.hi_z[2], 6.0f);
   EXPECT_EQ(n.lo_x[2], 5.0f);
   EXPECT_EQ(n.hi_y[2], 6.0f);
+
+  // Triangle 0 turned and moved: its two fragments' boxes go with it, and between them still hold
+  // every point of the moved triangle, each well inside the triangle's whole bounds.
+  std::vector<Vec3> turned = before;
+  const float c = std::cos(0.7f), s = std::sin(0.7f);
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 v = before[size_t(k)];
+    turned[size_t(k)] = Vec3{c * v.x - s * v.z + 0.3f, v.y - 2.0f, s * v.x + c * v.z + 7.1f};
+  }
+  Bvh4 carried = bvh;
+  refit_bvh4(carried, turned, &before);
+  const Bvh4Node& m = carried.nodes[0];
+  auto inside = [&](int i, Vec3 p) {
+    return m.lo_x[i] <= p.x && p.x <= m.hi_x[i] && m.lo_y[i] <= p.y && p.y <= m.hi_y[i] && m.lo_z[i] <= p.z && p.z <= m.hi_z[i];
+  };
+  for (int a = 0; a <= 64; ++a)
+    for (int b = 0; a + b <= 64; ++b) {
+      const float u = float(a) / 64, v = float(b) / 64;
+      const Vec3 p = turned[0] + (turned[1] - turned[0]) * u + (turned[2] - turned[0]) * v;
+      ASSERT_TRUE(inside(0, p) || inside(1, p)) << "point (" << u << ", " << v << ") of the moved triangle in no fragment";
+    }
+  WorldBox whole;
+  for (int k = 0; k < 3; ++k) whole.grow(turned[size_t(k)]);
+  for (int i = 0; i < 2; ++i)
+    EXPECT_LT((m.hi_x[i] - m.lo_x[i]) * (m.hi_y[i] - m.lo_y[i]), 0.8f * (whole.hi.x - whole.lo.x) * (whole.hi.y - whole.lo.y))
+        << "fragment " << i << " widened to the whole triangle";
 
   Bvh4 all = bvh;
   refit_bvh4(all, after);

@@ -1,12 +1,98 @@
 #include "exitance/runtime/core/bvh4_refit.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "exitance/runtime/world_box.h"
 
 namespace exitance {
+namespace {
+
+using Point = std::array<double, 3>;
+
+float float_below(double v) {
+  const float f = float(v);
+  return double(f) > v ? std::nextafter(f, -INFINITY) : f;
+}
+float float_above(double v) {
+  const float f = float(v);
+  return double(f) < v ? std::nextafter(f, INFINITY) : f;
+}
+
+// The part of a triangle inside a box, as a polygon (Sutherland-Hodgman in double, points on the
+// box's faces kept): it holds the part of the triangle a spatial-split leaf with that box refers to.
+std::vector<Point> clip_to_box(const Vec3 triangle[3], const WorldBox& box) {
+  std::vector<Point> polygon(3), next;
+  for (int i = 0; i < 3; ++i) polygon[size_t(i)] = {triangle[i].x, triangle[i].y, triangle[i].z};
+  const double lo[3] = {box.lo.x, box.lo.y, box.lo.z}, hi[3] = {box.hi.x, box.hi.y, box.hi.z};
+  for (int axis = 0; axis < 3 && !polygon.empty(); ++axis)
+    for (int side = 0; side < 2 && !polygon.empty(); ++side) {
+      const double plane = side == 0 ? lo[axis] : hi[axis];
+      auto inside = [&](const Point& p) { return side == 0 ? p[size_t(axis)] >= plane : p[size_t(axis)] <= plane; };
+      next.clear();
+      for (size_t i = 0; i < polygon.size(); ++i) {
+        const Point& a = polygon[i];
+        const Point& b = polygon[(i + 1) % polygon.size()];
+        if (inside(a)) next.push_back(a);
+        if (inside(a) != inside(b)) {
+          const double t = (plane - a[size_t(axis)]) / (b[size_t(axis)] - a[size_t(axis)]);
+          Point crossing;
+          for (size_t k = 0; k < 3; ++k) crossing[k] = a[k] + t * (b[k] - a[k]);
+          crossing[size_t(axis)] = plane;
+          next.push_back(crossing);
+        }
+      }
+      polygon.swap(next);
+    }
+  return polygon;
+}
+
+// Where the part of a triangle inside `box` went when the triangle's vertices moved from `before`
+// to `after`: the part's corners carried by their barycentric coordinates, as a float box that
+// holds them (one more float step outward than rounding gives, for the double arithmetic), within
+// the moved triangle's bounds. The moved triangle's whole bounds where the part cannot be carried
+// (a degenerate triangle, or no part left by the clip in double).
+WorldBox carried_part_box(const Vec3 before[3], const Vec3 after[3], const WorldBox& box) {
+  WorldBox whole;
+  for (int k = 0; k < 3; ++k) whole.grow(after[k]);
+  const std::vector<Point> part = clip_to_box(before, box);
+  auto point = [](const Vec3& v) { return Point{v.x, v.y, v.z}; };
+  auto minus = [](const Point& a, const Point& b) { return Point{a[0] - b[0], a[1] - b[1], a[2] - b[2]}; };
+  const Point v0 = point(before[0]), e1 = minus(point(before[1]), v0), e2 = minus(point(before[2]), v0);
+  auto dot = [](const Point& a, const Point& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+  const double d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2);
+  const double det = d11 * d22 - d12 * d12;
+  // Nearly collinear vertices make the barycentric coordinates ill-conditioned: keep the whole bounds.
+  if (part.empty() || !(det > 1e-10 * d11 * d22)) return whole;
+  const Point w0 = point(after[0]), f1 = minus(point(after[1]), w0), f2 = minus(point(after[2]), w0);
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (const Point& p : part) {
+    const Point r = minus(p, v0);
+    const double r1 = dot(r, e1), r2 = dot(r, e2);
+    const double b = (d22 * r1 - d12 * r2) / det, c = (d11 * r2 - d12 * r1) / det;
+    for (size_t k = 0; k < 3; ++k) {
+      const double q = w0[k] + b * f1[k] + c * f2[k];
+      lo[k] = std::min(lo[k], q), hi[k] = std::max(hi[k], q);
+    }
+  }
+  WorldBox carried;
+  const float whole_lo[3] = {whole.lo.x, whole.lo.y, whole.lo.z}, whole_hi[3] = {whole.hi.x, whole.hi.y, whole.hi.z};
+  float out_lo[3], out_hi[3];
+  for (int k = 0; k < 3; ++k) {
+    out_lo[k] = std::max(std::nextafter(float_below(lo[k]), -INFINITY), whole_lo[k]);
+    out_hi[k] = std::min(std::nextafter(float_above(hi[k]), INFINITY), whole_hi[k]);
+    if (!(out_lo[k] <= out_hi[k])) return whole;
+  }
+  carried.grow(Vec3{out_lo[0], out_lo[1], out_lo[2]});
+  carried.grow(Vec3{out_hi[0], out_hi[1], out_hi[2]});
+  return carried;
+}
+
+}  // namespace
 
 void refit_bvh4(Bvh4& bvh, const std::vector<Vec3>& positions, const std::vector<Vec3>* fitted_to) {
   const size_t triangle_count = positions.size() / 3;
@@ -52,7 +138,15 @@ void refit_bvh4(Bvh4& bvh, const std::vector<Vec3>& positions, const std::vector
         const uint32_t first = (child & ~kBvhLeafBit) >> 2, count = (child & 3u) + 1;
         bool leaf_moved = false;
         for (uint32_t s = first; s < first + count; ++s) leaf_moved = leaf_moved || moved[bvh.leaf_triangles[s]];
-        if (leaf_moved) {
+        if (leaf_moved && fitted_to) {
+          // Each triangle's part in the leaf's box, carried to where the triangle went: a split
+          // fragment of a moved triangle stays a fragment.
+          const WorldBox fitted{Vec3{node.lo_x[i], node.lo_y[i], node.lo_z[i]}, Vec3{node.hi_x[i], node.hi_y[i], node.hi_z[i]}};
+          for (uint32_t s = first; s < first + count; ++s) {
+            const size_t t = bvh.leaf_triangles[s];
+            box.grow(carried_part_box(&(*fitted_to)[t * 3], &positions[t * 3], fitted));
+          }
+        } else if (leaf_moved) {
           for (uint32_t s = first; s < first + count; ++s)
             for (int k = 0; k < 3; ++k) box.grow(positions[size_t(bvh.leaf_triangles[s]) * 3 + size_t(k)]);
         } else {  // as fitted (a split fragment's box stays the fragment's)
