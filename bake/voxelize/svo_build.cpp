@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "exitance/runtime/float_rounding.h"
 #include "morton_code.h"
 #include "svo_node_normals.h"
 #include "triangle_voxel_overlap.h"
@@ -24,17 +25,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-float float_at_or_below(double x) {
-  float f = float(x);
-  if (double(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
-  return f;
-}
-float float_at_or_above(double x) {
-  float f = float(x);
-  if (double(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
-  return f;
-}
 
 // Twice the area-weighted normal of triangle t, from its world positions in double.
 Double3 world_cross(const Scene& scene, size_t t) {

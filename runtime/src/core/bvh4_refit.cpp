@@ -7,21 +7,13 @@
 #include <string>
 #include <vector>
 
+#include "exitance/runtime/float_rounding.h"
 #include "exitance/runtime/world_box.h"
 
 namespace exitance {
 namespace {
 
 using Point = std::array<double, 3>;
-
-float float_below(double v) {
-  const float f = float(v);
-  return double(f) > v ? std::nextafter(f, -INFINITY) : f;
-}
-float float_above(double v) {
-  const float f = float(v);
-  return double(f) < v ? std::nextafter(f, INFINITY) : f;
-}
 
 // The part of a triangle inside a box, as a polygon (Sutherland-Hodgman in double, points on the
 // box's faces kept): it holds the part of the triangle a spatial-split leaf with that box refers to.
@@ -83,8 +75,8 @@ WorldBox carried_part_box(const Vec3 before[3], const Vec3 after[3], const World
   const float whole_lo[3] = {whole.lo.x, whole.lo.y, whole.lo.z}, whole_hi[3] = {whole.hi.x, whole.hi.y, whole.hi.z};
   float out_lo[3], out_hi[3];
   for (int k = 0; k < 3; ++k) {
-    out_lo[k] = std::max(std::nextafter(float_below(lo[k]), -INFINITY), whole_lo[k]);
-    out_hi[k] = std::min(std::nextafter(float_above(hi[k]), INFINITY), whole_hi[k]);
+    out_lo[k] = std::max(std::nextafter(float_at_or_below(lo[k]), -INFINITY), whole_lo[k]);
+    out_hi[k] = std::min(std::nextafter(float_at_or_above(hi[k]), INFINITY), whole_hi[k]);
     if (!(out_lo[k] <= out_hi[k])) return whole;
   }
   carried.grow(Vec3{out_lo[0], out_lo[1], out_lo[2]});

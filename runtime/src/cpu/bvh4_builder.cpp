@@ -10,6 +10,7 @@
 #include <string>
 
 #include "exitance/runtime/embree_device.h"
+#include "exitance/runtime/float_rounding.h"
 
 namespace exitance {
 namespace {
@@ -50,16 +51,6 @@ void* create_leaf(RTCThreadLocalAllocator alloc, const RTCBuildPrimitive* primit
   return node;
 }
 
-// Rounds a double down (up) to the nearest float at or below (above) it.
-float float_below(double v) {
-  float f = float(v);
-  return double(f) > v ? std::nextafter(f, -INFINITY) : f;
-}
-float float_above(double v) {
-  float f = float(v);
-  return double(f) < v ? std::nextafter(f, INFINITY) : f;
-}
-
 struct DoubleBox {
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   void grow(const double p[3]) {
@@ -98,8 +89,8 @@ void split_triangle(const RTCBuildPrimitive* primitive, unsigned int dimension, 
     float lo[3], hi[3];
     for (int k = 0; k < 3; ++k) {
       // One more float step outward: the crossings' double arithmetic rounds too.
-      lo[k] = std::max(std::nextafter(float_below(box.lo[k]), -INFINITY), fragment_lo[k]);
-      hi[k] = std::min(std::nextafter(float_above(box.hi[k]), INFINITY), fragment_hi[k]);
+      lo[k] = std::max(std::nextafter(float_at_or_below(box.lo[k]), -INFINITY), fragment_lo[k]);
+      hi[k] = std::min(std::nextafter(float_at_or_above(box.hi[k]), INFINITY), fragment_hi[k]);
       // The triangle's part on this side can miss the fragment's box (the box is not tight around
       // the fragment): a point box keeps the reference valid; it holds nothing a ray can miss.
       if (lo[k] > hi[k]) lo[k] = hi[k] = std::clamp(lo[k], fragment_lo[k], fragment_hi[k]);

@@ -101,6 +101,19 @@ VkInstance create_instance(bool validation, VkDebugUtilsMessengerCreateInfoEXT* 
   return instance;
 }
 
+// One copy region per range that holds bytes, its bytes packed after the ones before it in a
+// staging buffer: staging -> buffer when `from_staging`, else buffer -> staging. `packed`: their total.
+std::vector<VkBufferCopy> staging_regions(const std::vector<ByteRange>& ranges, bool from_staging, VkDeviceSize& packed) {
+  std::vector<VkBufferCopy> regions;
+  packed = 0;
+  for (const ByteRange& r : ranges) {
+    if (r.size == 0) continue;
+    regions.push_back(from_staging ? VkBufferCopy{packed, r.offset, r.size} : VkBufferCopy{r.offset, packed, r.size});
+    packed += r.size;
+  }
+  return regions;
+}
+
 }  // namespace
 
 Context::Context(const VulkanDeviceOptions& options) : options_(options), messages_(new Messages) {
@@ -341,31 +354,17 @@ void Context::upload(const Buffer& dst, const void* data, VkDeviceSize size, VkD
 }
 
 void Context::upload_ranges(const Buffer& dst, const void* data, const std::vector<ByteRange>& ranges) {
-  VkDeviceSize total = 0;
-  for (const ByteRange& r : ranges) total += r.size;
-  if (total == 0) return;
-  Buffer staging = create_buffer(total, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
-  std::vector<VkBufferCopy> regions;
-  VkDeviceSize packed = 0;
-  for (const ByteRange& r : ranges) {
-    if (r.size == 0) continue;
-    std::memcpy(static_cast<char*>(staging.mapped()) + packed, static_cast<const char*>(data) + r.offset, size_t(r.size));
-    regions.push_back({packed, r.offset, r.size});
-    packed += r.size;
-  }
-  VkCommandBuffer cmd = begin();
-  vkCmdCopyBuffer(cmd, staging.handle(), dst.handle(), uint32_t(regions.size()), regions.data());
-  submit_and_wait(cmd);
+  write_ranges(dst, ranges, [&](char* staging) {
+    for (const ByteRange& r : ranges) {
+      std::memcpy(staging, static_cast<const char*>(data) + r.offset, size_t(r.size));
+      staging += r.size;
+    }
+  });
 }
 
 void Context::write_ranges(const Buffer& dst, const std::vector<ByteRange>& ranges, const std::function<void(char*)>& write) {
-  std::vector<VkBufferCopy> regions;
   VkDeviceSize packed = 0;
-  for (const ByteRange& r : ranges) {
-    if (r.size == 0) continue;
-    regions.push_back({packed, r.offset, r.size});
-    packed += r.size;
-  }
+  const std::vector<VkBufferCopy> regions = staging_regions(ranges, /*from_staging=*/true, packed);
   if (packed == 0) return;
   Buffer staging = create_buffer(packed, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
   write(static_cast<char*>(staging.mapped()));
@@ -380,13 +379,8 @@ void Context::download(const Buffer& src, void* data, VkDeviceSize size, VkDevic
 
 void Context::read_back_ranges(const Buffer& src, const std::vector<ByteRange>& ranges, const std::function<void(const char*)>& read,
                                const Buffer* staging) {
-  std::vector<VkBufferCopy> regions;
   VkDeviceSize packed = 0;
-  for (const ByteRange& r : ranges) {
-    if (r.size == 0) continue;
-    regions.push_back({r.offset, packed, r.size});
-    packed += r.size;
-  }
+  const std::vector<VkBufferCopy> regions = staging_regions(ranges, /*from_staging=*/false, packed);
   if (packed == 0) return;
   Buffer own;
   if (!staging || !staging->mapped() || staging->size() < packed) own = create_buffer(packed, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);

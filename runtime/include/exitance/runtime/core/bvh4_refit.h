@@ -1,14 +1,16 @@
 // Refitting the BVH4 after geometry moved (runtime scene edits, refresh/scene_edits.h): the tree's
 // topology and leaf slots stay as the offline stage built them, only the child boxes are
-// recomputed bottom-up from the triangles' current vertices. Exact: each refit leaf box is the float
-// min/max of its triangles' vertices and each inner box the min/max of its children's, so every
-// triangle lies inside every box above it (traversal stays correct); the tree's quality degrades
-// as instances move far from where it was built, which only costs speed.
+// recomputed bottom-up from the triangles' current vertices, each inner box the min/max of its
+// children's, so every part of a triangle a leaf refers to lies inside every box above it
+// (traversal stays correct); the tree's quality degrades as instances move far from where it was
+// built, which only costs speed.
 //
-// Given the positions the boxes were fitted to, a leaf whose triangles all kept their vertices keeps
-// its box: the spatial-split builder's leaf boxes hold a clipped fragment of a triangle, tighter
-// than the triangle's bounds, and an edit that moves one instance would otherwise widen every
-// fragment in the scene back to its whole triangle.
+// Leaf boxes: without the positions the boxes were fitted to, the float min/max of the leaf's
+// triangles' vertices. With them, a leaf whose triangles all kept their vertices keeps its box, and
+// a leaf with a moved triangle boxes each triangle's part in its old box carried to where the
+// triangle went (rounded outward): the spatial-split builder's leaf boxes hold a clipped fragment
+// of a triangle, tighter than the triangle's bounds, and an edit that moves one instance would
+// otherwise widen every fragment in the scene back to its whole triangle.
 #pragma once
 #include <vector>
 
