@@ -18,7 +18,9 @@ if command -v ccache > /dev/null; then
 fi
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$jobs"
-ctest --test-dir build --output-on-failure -j"$jobs" -LE badinput
+# Every test has its own TIMEOUT (tests/CMakeLists.txt); --timeout is the backstop for one without.
+ctest_run=(ctest --output-on-failure -j"$jobs" --timeout 900)
+"${ctest_run[@]}" --test-dir build -LE badinput
 
 # Embree picks its kernels per CPU (SSE4.2, AVX2, AVX-512), and they need not report the same one of
 # several equidistant hits: rerun the CPU-reference tests (pipeline tests included) on the SSE4.2
@@ -30,7 +32,7 @@ isa=$(EXITANCE_EMBREE_CONFIG=isa=sse4.2,verbose=1 build/tests/geometry_warning_t
 if ! grep -q 'SSE4\.2' <<<"$isa" || grep -q AVX <<<"$isa"; then
   echo "EXITANCE_EMBREE_CONFIG=isa=sse4.2 did not select Embree's SSE4.2 kernels (ISA: '$isa')"; exit 1
 fi
-EXITANCE_EMBREE_CONFIG=isa=sse4.2 ctest --test-dir build --output-on-failure -j"$jobs" -L "analytic|stress|unit" -E "/vulkan"
+EXITANCE_EMBREE_CONFIG=isa=sse4.2 "${ctest_run[@]}" --test-dir build -L "analytic|stress|unit" -E "/vulkan"
 
 # The sanitizer build uses clang, so it also checks that everything the unit, stress and bad-input
 # tests run compiles with clang (one build instead of two: a separate clang Release build plus a
@@ -52,7 +54,7 @@ cmake --build build-asan -j"$jobs" --target bake stress_tests geometry_warning_t
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-ctest --test-dir build-asan --output-on-failure -j"$jobs" -L "badinput|stress|unit"
+"${ctest_run[@]}" --test-dir build-asan -L "badinput|stress|unit"
 
 # libFuzzer (clang) on the on-disk readers; non-zero on any crash or sanitizer report.
 bash tests/fuzz/run_fuzzers.sh 6

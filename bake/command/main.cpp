@@ -344,7 +344,11 @@ int main(int argc, char** argv) {
   }
 
   exitance::ProgressBar bar;
-  options.progress = [&](const std::string& stage, double fraction, uint64_t rays) { bar.update(stage, fraction, rays); };
+  std::string stage = "import";  // the stage a device failure names
+  options.progress = [&](const std::string& name, double fraction, uint64_t rays) {
+    stage = name;
+    bar.update(name, fraction, rays);
+  };
   try {
     const nlohmann::json report = exitance::run_bake(options, diagnostics);
     bar.finish();
@@ -368,6 +372,20 @@ int main(int argc, char** argv) {
     // output folder) must not leave the others waiting in an exchange.
     if (several_ranks) mpi->abort(2);
     return 2;
+  } catch (const exitance::VulkanDeviceFailure& e) {
+    // Nothing was written (bundles are renamed into place at the end). The device may still run the
+    // hung submission: leave without static destructors, which could wait for it.
+    bar.finish();
+    print_warnings(diagnostics);
+    if (several_ranks) {
+      std::fprintf(rank_stderr, "bake: error: rank %d: device failure during %s: %s\n", mpi->rank(), stage.c_str(),
+                   one_line(e.what()).c_str());
+      std::fflush(rank_stderr);
+      mpi->abort(exitance::kDeviceFailureExitCode);
+    }
+    std::cerr << "bake: error: device failure during " << stage << ": " << one_line(e.what()) << "\n";
+    std::fflush(stderr);
+    std::_Exit(exitance::kDeviceFailureExitCode);
   } catch (const std::exception& e) {
     bar.finish();
     print_warnings(diagnostics);

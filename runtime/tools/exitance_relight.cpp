@@ -90,7 +90,11 @@ int main(int argc, char** argv) {
   options.validation = validation && std::string(validation) == "1";
 
   exitance::ProgressBar bar;
-  options.progress = [&](const std::string& stage, double fraction, uint64_t rays) { bar.update(stage, fraction, rays); };
+  std::string stage = "open";  // the stage a device failure names
+  options.progress = [&](const std::string& name, double fraction, uint64_t rays) {
+    stage = name;
+    bar.update(name, fraction, rays);
+  };
   try {
     const nlohmann::json report = exitance::relight_bundle(options);
     bar.finish();
@@ -111,6 +115,14 @@ int main(int argc, char** argv) {
     bar.finish();
     std::cerr << "exitance-relight: error: " << one_line(e.what()) << "\n";
     return 2;
+  } catch (const exitance::VulkanDeviceFailure& e) {
+    // Nothing was written (the bundle is renamed into place at the end). The device may still run
+    // the hung submission: leave without static destructors, which could wait for it or unload
+    // the code it runs.
+    bar.finish();
+    std::cerr << "exitance-relight: error: device failure during " << stage << ": " << one_line(e.what()) << "\n";
+    std::fflush(stderr);
+    std::_Exit(exitance::kDeviceFailureExitCode);
   } catch (const std::exception& e) {
     bar.finish();
     std::cerr << "exitance-relight: error: " << one_line(e.what()) << "\n";

@@ -265,6 +265,10 @@ int main(int argc, char** argv) {
   } catch (const ViewInputError& e) {
     std::cerr << "exitance-view: error: " << one_line(e.what()) << "\n";
     return 2;
+  } catch (const exitance::VulkanDeviceFailure& e) {  // --path-traced; see exitance_relight.cpp
+    std::cerr << "exitance-view: error: " << cl.bundle << ": device failure while path tracing: " << one_line(e.what()) << "\n";
+    std::fflush(stderr);
+    std::_Exit(exitance::kDeviceFailureExitCode);
   } catch (const std::exception& e) {
     std::cerr << "exitance-view: error: " << cl.bundle << ": " << one_line(e.what()) << "\n";
     return 1;

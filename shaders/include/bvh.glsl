@@ -19,6 +19,11 @@
 
 layout(constant_id = 0) const uint kStackSize = 64u;  // host sets the exact bound of this BVH
 layout(constant_id = 1) const bool kQuantizedNodes = false;
+// Every loop here is bounded: a valid BVH visits each node and leaf at most once per ray, so more
+// steps than params.traversal_steps (the host sets nodes + leaf slots), or a push past kStackSize,
+// means corrupt nodes or a broken invariant. The ray then ends (a miss; occluded for trace_any),
+// and counters[kCounterFaultTraversal] counts it so the host fails the run with a message instead
+// of a shader that never returns (lavapipe has no GPU watchdog).
 const uint kLeafBit = 0x80000000u;
 const float kBoxRobustScale = 1.0 + 2.0 * 3.0 * 5.96046448e-8 / (1.0 - 3.0 * 5.96046448e-8);  // 1 + 2 gamma(3)
 
@@ -114,6 +119,8 @@ vec4 intersect_children(Ray r, uint node, float t_max, out uvec4 child) {
   return mix(vec4(kInfinity), tnear, hit);
 }
 
+void traversal_fault() { atomicAdd(counters[kCounterFaultTraversal], 1u); }
+
 // Compare-exchange of entries i < j by key (ascending).
 #define BVH_CSWAP(K, C, i, j)                                   \
   {                                                             \
@@ -133,6 +140,8 @@ vec4 trace_closest(vec3 o, vec3 d, float t_max, inout uint steps) {
   uint stack[kStackSize];
   uint sp = 0u;
   uint node = 0u;
+  uint budget = params.traversal_steps;
+  bool fault = false;  // breaks out of both loops (a return inside them cost lavapipe 2x the compile time)
   while (node != kInvalid) {
     while (node != kInvalid && (node & kLeafBit) == 0u) {
       ++steps;
@@ -145,6 +154,8 @@ vec4 trace_closest(vec3 o, vec3 d, float t_max, inout uint steps) {
       BVH_CSWAP(key, child, 1, 3);
       BVH_CSWAP(key, child, 1, 2);
       // Far children to the stack first, the nearest stays in a register.
+      uint pushes = uint(key.w != kInfinity) + uint(key.z != kInfinity) + uint(key.y != kInfinity);
+      if (sp + pushes > kStackSize || --budget == 0u) { fault = true; node = kInvalid; break; }
       if (key.w != kInfinity) stack[sp++] = child.w;
       if (key.z != kInfinity) stack[sp++] = child.z;
       if (key.y != kInfinity) stack[sp++] = child.y;
@@ -153,6 +164,7 @@ vec4 trace_closest(vec3 o, vec3 d, float t_max, inout uint steps) {
     // Leaves until the next inner node (or the end).
     while (node != kInvalid && (node & kLeafBit) != 0u) {
       ++steps;
+      if (--budget == 0u) { fault = true; node = kInvalid; break; }
       uint first = (node & 0x7FFFFFFFu) >> 2u, count = (node & 3u) + 1u;
       for (uint i = 0u; i < count; ++i) {
         uint base = (first + i) * 3u;
@@ -170,6 +182,10 @@ vec4 trace_closest(vec3 o, vec3 d, float t_max, inout uint steps) {
       node = sp == 0u ? kInvalid : stack[--sp];
     }
   }
+  if (fault) {
+    traversal_fault();
+    return vec4(t_max, uintBitsToFloat(kInvalid), 0.0, 0.0);
+  }
   return vec4(best_t, uintBitsToFloat(best_tri), best_b1, best_b2);
 }
 
@@ -180,11 +196,15 @@ bool trace_any(vec3 o, vec3 d, float t_max, inout uint steps) {
   uint stack[kStackSize];
   uint sp = 0u;
   uint node = 0u;
+  uint budget = params.traversal_steps;
+  bool fault = false;
   while (node != kInvalid) {
     while (node != kInvalid && (node & kLeafBit) == 0u) {
       ++steps;
       uvec4 child;
       vec4 key = intersect_children(r, node, t_max, child);
+      uint pushes = uint(key.x != kInfinity) + uint(key.y != kInfinity) + uint(key.z != kInfinity) + uint(key.w != kInfinity);
+      if (sp + max(pushes, 1u) - 1u > kStackSize || --budget == 0u) { fault = true; node = kInvalid; break; }
       uint next = kInvalid;
       for (int i = 3; i >= 0; --i) {
         if (key[i] == kInfinity) continue;
@@ -195,6 +215,7 @@ bool trace_any(vec3 o, vec3 d, float t_max, inout uint steps) {
     }
     if (node == kInvalid) break;
     ++steps;
+    if (--budget == 0u) { fault = true; break; }
     uint first = (node & 0x7FFFFFFFu) >> 2u, count = (node & 3u) + 1u;
     for (uint i = 0u; i < count; ++i) {
       uint base = (first + i) * 3u;
@@ -207,5 +228,6 @@ bool trace_any(vec3 o, vec3 d, float t_max, inout uint steps) {
     }
     node = sp == 0u ? kInvalid : stack[--sp];
   }
-  return false;
+  if (fault) traversal_fault();
+  return fault;  // a faulted ray counts as blocked
 }

@@ -67,8 +67,17 @@ void regenerate(uint p) {
     else generate_probe_ray(p, w, seed);
     return;
   }
+  // Bounded: every claim must advance the work counter past this lane's previous claim, so the loop
+  // ends within batch_work_total claims; a claim that does not (a lost atomic) is a counted fault.
+  uint previous_claim = kInvalid;
   while (true) {
     uint w = queue_append(kCounterNextWork);
+    if (previous_claim != kInvalid && w <= previous_claim) {
+      atomicAdd(counters[kCounterFaultWorkClaim], 1u);
+      path_work[p] = kInvalid;
+      return;
+    }
+    previous_claim = w;
     if (w >= params.batch_work_total) { path_work[p] = kInvalid; return; }
     uint n = params.batch_item_count;
     uint texel = batch_items[params.batch_item_offset + w % n];

@@ -23,6 +23,7 @@
 #include "support/lightmap_comparison.h"
 #include "support/textured_scenes.h"
 #include "support/validated_vulkan_backend.h"
+#include "support/vulkan_device_available.h"
 
 namespace exitance {
 namespace {
@@ -307,6 +308,59 @@ TEST(VulkanLaunches, StatisticsAreKeyedByLaunchNames) {
   EXPECT_EQ(stage("connect: shadow rays (any hit)").rays + stage("extend: continuation rays (closest hit)").rays, e.rays);
   EXPECT_NO_THROW(stage("reduce: samples into texel sums"));
   EXPECT_EQ(stage("rays: primary").rays, uint64_t(a.gbuffer.texels.size()) * settings.spp);
+}
+
+// Device failures (issue 31) end a bake with VulkanDeviceFailure, never a hang. A BVH whose root
+// lists itself as a child sends every ray round a cycle: the traversal's stack and step bounds end
+// each such ray and count it, and the host fails the bake naming the fault.
+TEST(VulkanDeviceFailures, CorruptBvhIsACountedFaultNotAHang) {
+  const AnalyticScene a = testing::white_furnace(0.5f);
+  std::shared_ptr<const LightingScene> good = make_lighting_scene(a.scene);
+  auto corrupt = std::make_shared<LightingScene>(*good);
+  ASSERT_FALSE(corrupt->bvh.nodes.empty());
+  Bvh4Node& root = corrupt->bvh.nodes[0];
+  const auto inner = std::find_if(std::begin(root.child), std::end(root.child),
+                                  [](uint32_t c) { return c != kBvhEmptyChild; });
+  ASSERT_NE(inner, std::end(root.child)) << "the root has no child";
+  *inner = 0;  // the root is its own child
+  CREATE_VULKAN_OR_SKIP(vk, std::shared_ptr<const LightingScene>(corrupt), VulkanDeviceOptions{});
+  IntegratorSettings settings;
+  settings.spp = 2;
+  try {
+    vk->bake(a.gbuffer, settings);
+    ADD_FAILURE() << "a bake over a cyclic BVH returned";
+  } catch (const VulkanDeviceFailure& e) {
+    EXPECT_NE(std::string(e.what()).find("BVH traversals exceeded"), std::string::npos) << e.what();
+  }
+  // The integrator refuses further work on that device; a fresh one on the intact scene works.
+  EXPECT_THROW(vk->bake(a.gbuffer, settings), std::runtime_error);
+  CREATE_VULKAN_OR_SKIP(fresh, good, VulkanDeviceOptions{});
+  EXPECT_EQ(fresh->bake(a.gbuffer, settings).texels.size(), a.gbuffer.texels.size());
+}
+
+// A submission past the fence timeout (here 1 ms: the scene's uploads, the kernels' first
+// dispatches or a submission of 4096 wavefront iterations each take longer on any device) is a
+// VulkanDeviceFailure, thrown by creation or by the bake, whichever waits first; destroying the
+// integrator afterwards returns (it neither waits for the device nor frees what the submission may
+// still use; the test's CTest TIMEOUT would catch a wait), and it is never used again.
+TEST(VulkanDeviceFailures, TimedOutSubmissionFailsFastAndTeardownReturns) {
+  if (!testing::has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const AnalyticScene a = testing::white_furnace(0.5f);
+  VulkanDeviceOptions options;
+  options.fence_timeout_seconds = 1e-3;
+  options.iterations_per_submit = 4096;
+  std::unique_ptr<VulkanIntegrator> vk;
+  IntegratorSettings settings;
+  settings.spp = 4096;
+  try {
+    vk = VulkanIntegrator::create(make_lighting_scene(a.scene), options);
+    vk->bake(a.gbuffer, settings);
+    ADD_FAILURE() << "a 4096-spp bake finished within 1 ms per submission";
+  } catch (const VulkanDeviceFailure& e) {
+    EXPECT_NE(std::string(e.what()).find("did not finish within 0.001 s"), std::string::npos) << e.what();
+  }
+  if (vk) EXPECT_THROW(vk->bake(a.gbuffer, settings), VulkanDeviceFailure);  // never reused
+  vk.reset();  // returns
 }
 
 }  // namespace

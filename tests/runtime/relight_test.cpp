@@ -361,9 +361,10 @@ TEST(Relight, AgreesWithTheCpuReference) {
 }
 
 // Runs exitance-relight; returns its exit status and stderr.
-int run_relight(const std::string& arguments, std::string& errors) {
+// `environment`: assignments put before the command ("NAME=VALUE ").
+int run_relight(const std::string& arguments, std::string& errors, const std::string& environment = "") {
   const std::string err_path = (fs::temp_directory_path() / ("relight-err-" + std::to_string(::getpid()))).string();
-  const int status = std::system((std::string(EXITANCE_RELIGHT) + " " + arguments + " 2> " + err_path).c_str());
+  const int status = std::system((environment + std::string(EXITANCE_RELIGHT) + " " + arguments + " 2> " + err_path).c_str());
   errors = file_bytes(err_path);
   fs::remove(err_path);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -418,6 +419,26 @@ TEST(Relight, BadScenesAreOneLineAndExitTwo) {
   EXPECT_EQ(std::count(errors.begin(), errors.end(), '\n'), 1) << errors;
   EXPECT_NE(errors.find("svo.bin"), std::string::npos) << errors;
   EXPECT_FALSE(fs::exists(guided_out)) << "partial output";
+}
+
+// A submission past the fence timeout (EXITANCE_VULKAN_FENCE_TIMEOUT, here 1 ms) ends the run
+// with one line naming the stage, exit 3 (device failure), nothing written, and no wait for the
+// device; the test's CTest TIMEOUT would catch a wait.
+TEST(Relight, ADeviceTimeoutExitsThreeWritingNothing) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const Fixture& f = vulkan_bake();
+  const fs::path output = f.dir / "timed-out.bake";
+  fs::remove_all(output);
+  std::string errors;
+  EXPECT_EQ(run_relight(f.baked.string() + " -o " + output.string() + " --spp 256", errors, "EXITANCE_VULKAN_FENCE_TIMEOUT=0.001 "),
+            kDeviceFailureExitCode);
+  EXPECT_EQ(std::count(errors.begin(), errors.end(), '\n'), 1) << errors;
+  EXPECT_NE(errors.find("exitance-relight: error: device failure during "), std::string::npos) << errors;
+  EXPECT_NE(errors.find("did not finish within 0.001 s"), std::string::npos) << errors;
+  EXPECT_FALSE(fs::exists(output)) << "partial output";
+  EXPECT_EQ(run_relight(f.baked.string() + " -o " + output.string() + " --spp 1", errors, "EXITANCE_VULKAN_FENCE_TIMEOUT=soon "), 1);
+  EXPECT_NE(errors.find("EXITANCE_VULKAN_FENCE_TIMEOUT: expected seconds > 0, got 'soon'"), std::string::npos) << errors;
+  EXPECT_FALSE(fs::exists(output)) << "partial output";
 }
 
 // What relight --share R/N times: rank R's texels of a bake under mpirun, alone. Each rank's

@@ -61,6 +61,8 @@ json relight_bundle(const RelightOptions& options) {
   session_options.device.device_index = options.device_index;
   session_options.device.validation = options.validation;
   session_options.device.collect_stage_statistics = options.stage_statistics;
+  // lavapipe compiles each kernel at its first dispatch: 20-60 s with a cold shader cache.
+  session_options.device.on_compile_progress = [&](double fraction) { report("compiling kernels", fraction, 0); };
   auto validation = std::make_shared<ValidationMessages>();
   if (options.validation) session_options.device.on_validation_message = ValidationMessages::collector(validation);
   const std::unique_ptr<RefreshSession> session = RefreshSession::open(options.bundle, session_options);

@@ -55,6 +55,9 @@ class GpuScene {
   uint32_t environment_height() const { return environment_height_; }
 
   uint32_t traversal_stack_bound() const { return stack_bound_; }
+  // Steps of one ray's traversal in a valid BVH: each inner node and leaf at most once (bvh.glsl
+  // counts a fault beyond it). Fixed per scene: edits refit, never rebuild, the node arrays.
+  uint32_t traversal_step_bound() const { return node_count_ + leaf_slots_ + 1u; }
   bool quantized_nodes() const { return quantized_; }
   uint32_t bvh_node_count() const { return node_count_; }
   size_t bvh_bytes() const;

@@ -1,5 +1,9 @@
 #include "kernel_launches.h"
 
+#include <algorithm>
+
+#include "exitance/runtime/vulkan/vulkan_device_failure.h"
+
 namespace exitance::vulkan {
 
 VulkanStageStatistics& StageStatistics::operator[](const std::string& name) {
@@ -39,7 +43,19 @@ void KernelLaunches::bind(Kernel kernel, PushConstants push) {
   vkCmdPushConstants(cmd_, kernels_.layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
 }
 
+void KernelLaunches::note_launch(const std::string& name) {
+  if (std::find(launched_.begin(), launched_.end(), name) == launched_.end()) launched_.push_back(name);
+}
+
+void KernelLaunches::launch_to_compile(Kernel kernel) {
+  note_launch(std::string("compiling ") + kernel_file(kernel));
+  bind(kernel, {});
+  vkCmdDispatch(cmd_, 1, 1, 1);
+  barrier();
+}
+
 void KernelLaunches::launch(const char* name, Kernel kernel, uint32_t groups, PushConstants push) {
+  note_launch(name);
   statistics_[name];  // the stage is listed in launch order, timed or not
   bind(kernel, push);
   vkCmdDispatch(cmd_, groups, 1, 1);
@@ -48,6 +64,7 @@ void KernelLaunches::launch(const char* name, Kernel kernel, uint32_t groups, Pu
 }
 
 void KernelLaunches::launch_queued(const char* name, Kernel kernel, IndirectDispatch dispatch, PushConstants push) {
+  note_launch(name);
   statistics_[name];
   bind(kernel, push);
   vkCmdDispatchIndirect(cmd_, dispatch.buffer, dispatch.offset);
@@ -63,8 +80,14 @@ void KernelLaunches::stamp(const char* name) {
   stamped_.push_back(name);
 }
 
-void KernelLaunches::submit_and_wait() {
-  context_.submit_and_wait(cmd_);
+void KernelLaunches::submit_and_wait(double timeout_seconds) {
+  try {
+    context_.submit_and_wait(cmd_, timeout_seconds);
+  } catch (const VulkanDeviceFailure& e) {
+    std::string names;
+    for (const std::string& n : launched_) names += (names.empty() ? "" : "; ") + n;
+    throw VulkanDeviceFailure(std::string(e.what()) + " [submission: " + (names.empty() ? "copies" : names) + "]");
+  }
   if (stamped_.size() < 2) return;
   std::vector<uint64_t> ts(stamped_.size());
   check(vkGetQueryPoolResults(context_.device(), kernels_.timestamp_queries(), 0, uint32_t(ts.size()), ts.size() * 8,

@@ -42,10 +42,15 @@ class KernelLaunches {
   void barrier() const;  // every write so far is visible to what follows
   // Timed: the commands recorded since the last timestamp are charged to no launch.
   void leave_untimed();
-  // Submits, waits, and charges each timed launch's GPU time to its name.
-  void submit_and_wait();
+  // One workgroup of `kernel` with the parameters as they are, outside the statistics: makes a
+  // driver that compiles pipelines at their first dispatch (lavapipe) compile it now.
+  void launch_to_compile(Kernel kernel);
+  // Submits, waits (`timeout_seconds` > 0: instead of the fence timeout), and charges each timed
+  // launch's GPU time to its name. A device failure's message names the submission's launches.
+  void submit_and_wait(double timeout_seconds = 0);
 
  private:
+  void note_launch(const std::string& name);
   void bind(Kernel kernel, PushConstants push);
   void stamp(const char* name);
 
@@ -55,6 +60,7 @@ class KernelLaunches {
   bool timed_;
   VkCommandBuffer cmd_;
   std::vector<const char*> stamped_;  // per timestamp, the launch it ends (null: none)
+  std::vector<std::string> launched_;  // distinct launch names, in order (device failure messages)
 };
 
 }  // namespace exitance::vulkan

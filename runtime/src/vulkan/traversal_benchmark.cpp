@@ -12,6 +12,7 @@ double measure_incoherent_traversal(WavefrontBatchRunner& runner, uint32_t ray_c
   GpuParams params{};
   params.path_capacity = runner.sizes().paths;
   params.batch_work_total = ray_count;
+  params.traversal_steps = runner.scene().traversal_step_bound();
   params.collect_stats = 1;
   params.seed_lo = 12345;
   params.bench_lo = Vec4(runner.scene().bounds_lo(), 0.0f);

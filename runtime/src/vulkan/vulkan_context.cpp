@@ -1,12 +1,17 @@
 #include "vulkan_context.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <mutex>
+#include <stdexcept>
 #include <utility>
 
 #include "device_requirements.h"
 #include "driver_allocation_scope.h"
+#include "exitance/runtime/vulkan/vulkan_device_failure.h"
 
 namespace exitance::vulkan {
 
@@ -116,7 +121,20 @@ std::vector<VkBufferCopy> staging_regions(const std::vector<ByteRange>& ranges, 
 
 }  // namespace
 
-Context::Context(const VulkanDeviceOptions& options) : options_(options), messages_(new Messages) {
+// EXITANCE_VULKAN_FENCE_TIMEOUT=SECONDS replaces VulkanDeviceOptions::fence_timeout_seconds (a very
+// slow or shared machine; the tests use a tiny one to exercise the timeout path).
+static VulkanDeviceOptions with_environment(VulkanDeviceOptions options) {
+  const char* text = std::getenv("EXITANCE_VULKAN_FENCE_TIMEOUT");
+  if (!text) return options;
+  char* end = nullptr;
+  const double seconds = std::strtod(text, &end);
+  if (end == text || *end != '\0' || !(seconds > 0) || !std::isfinite(seconds))
+    throw std::invalid_argument(std::string("EXITANCE_VULKAN_FENCE_TIMEOUT: expected seconds > 0, got '") + text + "'");
+  options.fence_timeout_seconds = seconds;
+  return options;
+}
+
+Context::Context(const VulkanDeviceOptions& options) : options_(with_environment(options)), messages_(new Messages) {
   try {
     if (options.external_device) adopt(*options.external_device);
     else create_own_device(options);
@@ -233,6 +251,13 @@ Context::~Context() { cleanup(); }
 // Every submission was waited for, so nothing of ours is in flight; an adopted device may run the
 // engine's work, which vkDeviceWaitIdle would wait for (and which needs its queues synchronised).
 void Context::cleanup() {
+  // A submission that timed out may still run: destroying its device (or waiting for it) blocks
+  // forever on a CPU driver and faults on a GPU, so a hung device and its instance are leaked, and
+  // so is what the instance's debug messenger calls.
+  if (hung_) {
+    (void)messages_.release();
+    return;
+  }
   if (device_) {
     if (owns_device_ && !lost_) vkDeviceWaitIdle(device_);
     if (fence_) vkDestroyFence(device_, fence_, nullptr);
@@ -309,13 +334,15 @@ Buffer Context::create_storage_buffer(VkDeviceSize size, VkBufferUsageFlags extr
 }
 
 void Context::destroy(Buffer& b) {
-  if (b.buffer_) vkDestroyBuffer(device_, b.buffer_, nullptr);
-  if (b.memory_) vkFreeMemory(device_, b.memory_, nullptr);
+  if (!hung_) {  // a running submission may still read it (cleanup)
+    if (b.buffer_) vkDestroyBuffer(device_, b.buffer_, nullptr);
+    if (b.memory_) vkFreeMemory(device_, b.memory_, nullptr);
+  }
   b.owner_ = nullptr, b.buffer_ = VK_NULL_HANDLE, b.memory_ = VK_NULL_HANDLE, b.size_ = 0, b.mapped_ = nullptr;
 }
 
 VkCommandBuffer Context::begin() {
-  if (lost_) throw std::runtime_error("Vulkan device was lost earlier; create a new integrator");
+  if (lost_) throw VulkanDeviceFailure("Vulkan device failed earlier; create a new integrator");
   check(vkResetCommandBuffer(cmd_, 0), "vkResetCommandBuffer");
   VkCommandBufferBeginInfo info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -323,24 +350,31 @@ VkCommandBuffer Context::begin() {
   return cmd_;
 }
 
-void Context::submit_and_wait(VkCommandBuffer cmd) {
+void Context::submit_and_wait(VkCommandBuffer cmd, double timeout_seconds) {
   check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
   VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   submit.commandBufferCount = 1;
   submit.pCommandBuffers = &cmd;
   check(vkResetFences(device_, 1, &fence_), "vkResetFences");
   VkResult r = vkQueueSubmit(queue_, 1, &submit, fence_);
-  if (r == VK_ERROR_DEVICE_LOST) lost_ = true;
+  if (r == VK_ERROR_DEVICE_LOST) fail("Vulkan device lost (vkQueueSubmit)");
   check(r, "vkQueueSubmit");
-  const uint64_t timeout_ns = uint64_t(std::max(0.001, options_.fence_timeout_seconds) * 1e9);
-  r = vkWaitForFences(device_, 1, &fence_, VK_TRUE, timeout_ns);
+  const double limit = timeout_seconds > 0 ? timeout_seconds : std::max(0.001, options_.fence_timeout_seconds);
+  r = vkWaitForFences(device_, 1, &fence_, VK_TRUE, uint64_t(limit * 1e9));
   if (r == VK_TIMEOUT) {
-    lost_ = true;  // the submission may still run: never reuse this device
-    throw std::runtime_error("Vulkan submission did not finish within " + std::to_string(options_.fence_timeout_seconds) +
-                             " s (GPU hang or dispatch too large; lower max_paths / iterations_per_submit)");
+    hung_ = true;  // the submission may still run: never reuse, wait for or destroy this device
+    char seconds[32];
+    std::snprintf(seconds, sizeof(seconds), "%g", limit);
+    fail(std::string("Vulkan submission did not finish within ") + seconds +
+         " s (GPU hang or dispatch too large; lower max_paths / iterations_per_submit)");
   }
-  if (r == VK_ERROR_DEVICE_LOST) lost_ = true;
+  if (r == VK_ERROR_DEVICE_LOST) fail("Vulkan device lost (vkWaitForFences)");
   check(r, "vkWaitForFences");
+}
+
+void Context::fail(const std::string& message) {
+  lost_ = true;
+  throw VulkanDeviceFailure(message);
 }
 
 void Context::upload(const Buffer& dst, const void* data, VkDeviceSize size, VkDeviceSize offset) {

@@ -84,9 +84,17 @@ class Context {
                         const Buffer* staging = nullptr);
 
   VkCommandBuffer begin();  // the context's single command buffer, reset
-  // Submits the command buffer and waits for its fence; throws on timeout or device loss.
-  void submit_and_wait(VkCommandBuffer cmd);
+  // Submits the command buffer and waits for its fence (bounded by fence_timeout_seconds); throws
+  // VulkanDeviceFailure on timeout or device loss.
+  // `timeout_seconds` > 0 replaces the fence timeout for this submission (kernel compilation).
+  void submit_and_wait(VkCommandBuffer cmd, double timeout_seconds = 0);
   bool lost() const { return lost_; }
+  // A submission may still be running (its fence timed out): from here on nothing is destroyed on
+  // this device and nothing waits for it; its objects are leaked on purpose.
+  bool hung() const { return hung_; }
+  // Marks the device unusable after a fault the kernels counted, and throws VulkanDeviceFailure
+  // with `message`; the device is idle, so teardown proceeds as usual.
+  [[noreturn]] void fail(const std::string& message);
 
  private:
   friend class Buffer;
@@ -115,6 +123,7 @@ class Context {
   VkFence fence_ = VK_NULL_HANDLE;
   VulkanDeviceInfo info_;
   bool lost_ = false;
+  bool hung_ = false;
 };
 
 }  // namespace exitance::vulkan

@@ -57,7 +57,7 @@ struct VulkanIntegrator::Impl {
       : context(options),
         sizes(choose_wavefront_sizes(context, options)),
         scene(context, lighting, sizes.quantized_nodes),
-        kernels(context, scene.traversal_stack_bound(), sizes.quantized_nodes),
+        kernels(context, kernel_stack_bound(sizes, scene.traversal_stack_bound()), sizes.quantized_nodes),
         buffers(context, sizes.paths),
         runner(context, scene, kernels, buffers, statistics, sizes, options.collect_stage_statistics),
         lightmap(runner),
@@ -65,6 +65,7 @@ struct VulkanIntegrator::Impl {
         source(lighting.source),
         created_on(std::move(lighting_ptr)) {
     runner.bind_buffers();
+    runner.compile_kernels(options.compile_timeout_seconds, options.on_compile_progress);
     lightmap.set_guiding_scene(guiding_scene(lighting, created_on));
   }
 };

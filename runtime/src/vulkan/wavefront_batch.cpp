@@ -1,11 +1,12 @@
 #include "wavefront_batch.h"
 
 #include <algorithm>
+#include <string>
 
 namespace exitance::vulkan {
 namespace {
 
-static_assert(sizeof(GpuParams) == 160);  // 148 bytes of fields, padded to Vec4 alignment
+static_assert(sizeof(GpuParams) == 176);  // 164 bytes of fields, padded to Vec4 alignment
 static_assert(sizeof(GpuSurfacePoint) == 48 && sizeof(ShadowRay) == 32);
 
 uint64_t stat64(const uint32_t* c, uint32_t slot) { return uint64_t(c[slot]) | (uint64_t(c[slot + 1]) << 32); }
@@ -51,6 +52,19 @@ void WavefrontBatchRunner::bind_buffers() {
   kernels_.write_descriptors(writes);
 }
 
+void WavefrontBatchRunner::compile_kernels(double timeout_seconds, const std::function<void(double)>& progress) {
+  for (uint32_t k = 0; k < uint32_t(Kernel::Count); ++k) {
+    if (progress) progress(double(k) / double(Kernel::Count));
+    KernelLaunches launches(context_, kernels_, statistics_, false);
+    update_params(launches, GpuParams{});  // no paths, items or work: every kernel returns at once
+    vkCmdFillBuffer(launches.commands(), buffers_.control.counters.handle(), 0, VK_WHOLE_SIZE, 0);
+    launches.barrier();
+    launches.launch_to_compile(Kernel(k));
+    launches.submit_and_wait(timeout_seconds);
+  }
+  if (progress) progress(1.0);
+}
+
 GpuParams WavefrontBatchRunner::bake_params(const IntegratorSettings& settings, uint32_t recorded, uint32_t item_count) const {
   GpuParams params{};
   params.sky = Vec4(scene_.sky(), 0.0f);
@@ -71,6 +85,7 @@ GpuParams WavefrontBatchRunner::bake_params(const IntegratorSettings& settings, 
   params.sampler_mode = settings.sampler;
   params.collect_stats = collect_statistics_ ? 1u : 0u;
   params.item_count_total = item_count;
+  params.traversal_steps = scene_.traversal_step_bound();
   return params;
 }
 
@@ -125,6 +140,13 @@ void WavefrontBatchRunner::run(GpuParams& params, BatchRange range, size_t resul
     copy_counters(first);
     first.submit_and_wait();
   }
+  check_faults(kernels.generate_name);
+  // Progress watchdog: a path ends within its bounce cap (path.h safety_cap) plus its probe ray and
+  // direct-light step, and every path that ends claims work, so the claim counter must move at least
+  // once in that many iterations while rays are queued; if it does not, the wavefront is stuck.
+  const uint64_t stall_limit = 2 * (uint64_t(std::max(params.safety_cap, 0)) + 4) + sizes_.iterations_per_submit;
+  uint32_t claims = buffers_.control.read_back()[kCounterNextWork];
+  uint64_t idle_iterations = 0;
   uint32_t queue = 0;
   while (buffers_.control.read_back()[kCounterRayQueue0 + queue] > 0) {
     KernelLaunches rounds = launches(timed);
@@ -134,12 +156,32 @@ void WavefrontBatchRunner::run(GpuParams& params, BatchRange range, size_t resul
     }
     copy_counters(rounds);
     rounds.submit_and_wait();
+    check_faults(kernels.shade_name);
+    const uint32_t now = buffers_.control.read_back()[kCounterNextWork];
+    idle_iterations = now != claims ? 0 : idle_iterations + sizes_.iterations_per_submit;
+    claims = now;
+    if (idle_iterations > stall_limit)
+      context_.fail(std::string("Vulkan wavefront stopped making progress in \"") + kernels.shade_name + "\": no path finished in " +
+                    std::to_string(idle_iterations) + " iterations (the bounce cap allows " + std::to_string(stall_limit) + ")");
   }
   KernelLaunches reduce = launches(timed);
   reduce.launch(kernels.reduce_name, kernels.reduce, groups_for(range.count));
   copy_counters(reduce);
   reduce.submit_and_wait();
+  check_faults(kernels.reduce_name);
   totals.add(buffers_.control.read_back());
+}
+
+// Faults the kernels counted (gpu_layout.h) end the bake: they mean a broken invariant, whose
+// results cannot be trusted, and the message names the stage that met it.
+void WavefrontBatchRunner::check_faults(const char* stage_name) {
+  const uint32_t* c = buffers_.control.read_back();
+  if (c[kCounterFaultTraversal] > 0)
+    context_.fail("Vulkan kernels: " + std::to_string(c[kCounterFaultTraversal]) + " BVH traversals exceeded the BVH's " +
+                  "stack or step bound (corrupt nodes?) by the end of \"" + stage_name + "\"");
+  if (c[kCounterFaultWorkClaim] > 0)
+    context_.fail("Vulkan kernels: " + std::to_string(c[kCounterFaultWorkClaim]) +
+                  " work claims did not advance the work counter by the end of \"" + stage_name + "\"");
 }
 
 void WavefrontBatchRunner::record_statistics(const BatchTotals& t, const BatchKernels& kernels) {

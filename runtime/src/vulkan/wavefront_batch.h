@@ -7,6 +7,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 
 #include "exitance/runtime/core/integrator_settings.h"
 #include "gpu_scene.h"
@@ -72,6 +73,9 @@ class WavefrontBatchRunner {
   // Writes the descriptor set from the scene's and the wavefront's buffers; drivers call it after
   // growing a buffer, and before each bake (a scene update may have grown one).
   void bind_buffers();
+  // Dispatches every kernel once with no work (after bind_buffers), each in its own submission
+  // bounded by `timeout_seconds`: drivers that compile at the first dispatch compile here.
+  void compile_kernels(double timeout_seconds, const std::function<void(double)>& progress);
   // A bake's parameters before its batches: scene, settings, `recorded` result layers per work
   // item beyond the first, the bake's item count (the stride of per-item sums).
   GpuParams bake_params(const IntegratorSettings& settings, uint32_t recorded, uint32_t item_count) const;
@@ -93,6 +97,7 @@ class WavefrontBatchRunner {
   void copy_counters(KernelLaunches& launches);
 
  private:
+  void check_faults(const char* stage_name);  // throws VulkanDeviceFailure on a counted kernel fault
   void shade_queued_hits(KernelLaunches& launches, const BatchKernels& kernels, uint32_t queue);
   void trace_queued_rays(KernelLaunches& launches, uint32_t queue);
 

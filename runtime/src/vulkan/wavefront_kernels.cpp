@@ -41,6 +41,8 @@ KernelSource source_of(Kernel k) {
 
 }  // namespace
 
+const char* kernel_file(Kernel kernel) { return source_of(kernel).file; }
+
 void DescriptorWrites::write(VkDevice device, VkDescriptorSet set) const {
   std::array<VkDescriptorBufferInfo, kBindingCount> infos{};
   std::array<VkWriteDescriptorSet, kBindingCount> writes{};
@@ -125,6 +127,7 @@ WavefrontKernels::WavefrontKernels(Context& context, uint32_t stack_bound, bool 
 WavefrontKernels::~WavefrontKernels() { release(); }
 
 void WavefrontKernels::release() {
+  if (context_.hung()) return;  // a running submission may still use them (Context::cleanup)
   VkDevice d = context_.device();
   for (VkPipeline& p : pipelines_)
     if (p) vkDestroyPipeline(d, std::exchange(p, VK_NULL_HANDLE), nullptr);

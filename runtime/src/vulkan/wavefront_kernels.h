@@ -18,6 +18,8 @@ enum class Kernel {
   Count
 };
 
+const char* kernel_file(Kernel kernel);  // "shade.comp (probes)", ...
+
 // Threads per workgroup of every kernel but prepare (local_size_x in shaders/wavefront/*.comp).
 constexpr uint32_t kGroupSize = 64;
 constexpr uint32_t groups_for(uint64_t threads) { return uint32_t((threads + kGroupSize - 1) / kGroupSize); }

@@ -34,7 +34,15 @@ WavefrontSizes choose_wavefront_sizes(const Context& context, const VulkanDevice
   // bytes: the BVH stays in L2).
   sizes.quantized_nodes = options.node_layout == VulkanNodeLayout::Automatic ? cpu_device
                                                                            : options.node_layout == VulkanNodeLayout::Quantized;
+  sizes.round_stack_bound = cpu_device;
   return sizes;
+}
+
+uint32_t kernel_stack_bound(const WavefrontSizes& sizes, uint32_t bvh_stack_bound) {
+  if (!sizes.round_stack_bound) return bvh_stack_bound;
+  uint32_t bound = 32;
+  while (bound < bvh_stack_bound) bound *= 2;
+  return bound;
 }
 
 }  // namespace exitance::vulkan

@@ -117,6 +117,9 @@ struct GpuParams {
   uint bounce_flags;       // texel batches: 0 = path tracing; else a per-bounce layer pass (kBouncePass | ...)
   uint bounce_layer;       // per-bounce layer pass: k, the layer B_k estimated (0 = direct light)
   uint guiding;            // texel path batches: kGuiding* bits (the guide buffer, kBindingGuide); 0 = cosine
+  uint traversal_steps;    // a ray's traversal steps beyond which it is a counted fault (bvh.glsl;
+                           // GpuScene::traversal_step_bound; a parameter, not a specialization
+                           // constant, so one compiled kernel serves every scene's BVH)
 };
 
 // Descriptor bindings of the wavefront (one set).
@@ -267,6 +270,11 @@ const uint kCounterStatConnectActive = 20u;
 const uint kCounterStatConnectLaunched = 22u;
 const uint kCounterStatShadeItems = 24u;
 const uint kCounterStatShadeLanes = 26u;
+// Device faults: counted, never silent, and each makes the host throw (wavefront_batch.cpp).
+// A traversal that needed more stack entries or steps than a valid BVH allows (bvh.glsl), and a
+// work claim that did not advance the work counter (kernel_prelude.glsl regenerate).
+const uint kCounterFaultTraversal = 28u;
+const uint kCounterFaultWorkClaim = 29u;
 const uint kCounterCount = 32u;
 
 // Light probes: random streams path_sampler(seed, kProbeRngStreamBase + probe, sample), and stratified

@@ -14,6 +14,7 @@
 #include "exitance/runtime/core/integrator.h"
 #include "exitance/runtime/core/lighting_scene.h"
 #include "exitance/runtime/texel_gbuffer.h"
+#include "exitance/runtime/vulkan/vulkan_device_failure.h"
 #include "exitance/runtime/vulkan/vulkan_external_device.h"
 
 namespace exitance {
@@ -59,7 +60,14 @@ struct VulkanDeviceOptions {
   // the shade stage slower than the drains they saved).
   uint32_t work_items_per_path = 0;
   VulkanNodeLayout node_layout = VulkanNodeLayout::Automatic;
-  double fence_timeout_seconds = 20.0;  // a submission that does not finish in this time -> exception
+  double fence_timeout_seconds = 20.0;  // a submission that does not finish in this time -> VulkanDeviceFailure
+  // Each kernel is dispatched once when the integrator is created, so drivers that compile
+  // pipelines at their first dispatch (lavapipe: LLVM, 2-20 s per kernel on 2 loaded cores) do it
+  // there, under this bound, and not inside a timed submission. -> VulkanDeviceFailure.
+  double compile_timeout_seconds = 300.0;
+  // Called with the fraction of kernels compiled (0..1) while the integrator is created; set by
+  // tools for their progress bars ("compiling kernels").
+  std::function<void(double)> on_compile_progress;
   bool collect_stage_statistics = false;  // timestamps + lane counters per stage (bench only; slower)
 };
 
