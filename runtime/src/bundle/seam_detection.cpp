@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <map>
 #include <unordered_map>
 
 #include "exitance/runtime/texel_surface.h"
@@ -81,21 +80,32 @@ std::vector<SeamEdge> find_lightmap_seams(const Scene& scene, const AtlasLayout&
       chart_triangle_in_texels(scene, t, rect.scale_offset, page_width, page_height, tri);
       for (int k = 0; k < 3; ++k) texel[size_t(t) * 3 + size_t(k) - first_corner] = tri[k];
     }
-    // Undirected welded edge -> the half-edges on it (ordered map: the output order is deterministic).
-    std::map<std::pair<uint32_t, uint32_t>, std::vector<HalfEdge>> edges;
+    // Half-edges keyed by their undirected welded edge, sorted by (key, corner): the edges come out
+    // in key order, each edge's half-edges in corner order, as deterministic as an ordered map of
+    // lists and several times faster (no node per edge).
+    struct KeyedHalfEdge {
+      uint64_t key;
+      HalfEdge edge;
+    };
+    std::vector<KeyedHalfEdge> keyed;
+    keyed.reserve(end_corner - first_corner);
     for (size_t t = instance.first_triangle; t < size_t(instance.first_triangle) + instance.triangle_count; ++t)
       for (size_t k = 0; k < 3; ++k) {
         const size_t from = t * 3 + k, to = t * 3 + (k + 1) % 3;
         const uint32_t a = welded[from - first_corner], b = welded[to - first_corner];
         if (a == b) continue;  // degenerate edge
-        edges[{std::min(a, b), std::max(a, b)}].push_back({from, to});
+        keyed.push_back({(uint64_t(std::min(a, b)) << 32) | std::max(a, b), {from, to}});
       }
-    for (const auto& entry : edges) {
-      const std::vector<HalfEdge>& pair = entry.second;
-      if (pair.size() != 2) continue;  // a border, or non-manifold
-      const HalfEdge e0 = pair[0];
+    std::sort(keyed.begin(), keyed.end(), [](const KeyedHalfEdge& x, const KeyedHalfEdge& y) {
+      return x.key != y.key ? x.key < y.key : x.edge.from < y.edge.from;
+    });
+    for (size_t begin = 0, end = 0; begin < keyed.size(); begin = end) {
+      end = begin;
+      while (end < keyed.size() && keyed[end].key == keyed[begin].key) ++end;
+      if (end - begin != 2) continue;  // a border, or non-manifold
+      const HalfEdge e0 = keyed[begin].edge;
       // The second half-edge's corners in the order of the first's 3-D endpoints.
-      HalfEdge e1 = pair[1];
+      HalfEdge e1 = keyed[begin + 1].edge;
       if (welded[e1.from - first_corner] != welded[e0.from - first_corner]) std::swap(e1.from, e1.to);
       const Vec2 a0 = texel[e0.from - first_corner], a1 = texel[e0.to - first_corner];
       const Vec2 b0 = texel[e1.from - first_corner], b1 = texel[e1.to - first_corner];

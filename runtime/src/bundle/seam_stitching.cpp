@@ -1,6 +1,7 @@
 #include "exitance/runtime/bundle/seam_stitching.h"
 
 #include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
@@ -119,7 +120,11 @@ PageSystem page_system(const formats::LightmapImage& page, const std::vector<Sea
   return system;
 }
 
-// Solves (R^T R + lambda I) x = lambda x0 - R^T c for each colour channel and writes x back.
+// Solves (R^T R + lambda I) x = lambda x0 - R^T c for every colour channel and writes x back. The
+// matrix is the same for all channels: one sparse Cholesky factorization (LDL^T, fill-reducing
+// ordering) and one back-substitution per channel, where conjugate gradient solved each channel
+// from scratch (issue 33: 13.9-27 s for 218 k texels on the open city). Conjugate gradient stays as
+// the fallback should the factorization fail (it cannot for lambda > 0: the matrix is SPD).
 void solve_page(formats::LightmapImage& page, const PageSystem& system, double lambda) {
   const int n = int(system.unknown_texel.size());
   if (n == 0) return;
@@ -128,25 +133,41 @@ void solve_page(formats::LightmapImage& page, const PageSystem& system, double l
   Eigen::SparseMatrix<double> identity(n, n);
   identity.setIdentity();
   const Eigen::SparseMatrix<double> normal = Eigen::SparseMatrix<double>(r.transpose() * r) + lambda * identity;
-  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg;
-  cg.setTolerance(1e-7);  // relative residual; the pages hold floats (24-bit mantissa)
-  cg.setMaxIterations(10 * n + 100);
-  cg.compute(normal);
-  for (auto& [name, values] : page.channels) {
-    if (!is_colour_channel(name)) continue;
-    Eigen::VectorXd x0(n), c(int(system.rows));
-    for (int j = 0; j < n; ++j) x0[j] = values[system.unknown_texel[size_t(j)]];
+  std::vector<std::vector<float>*> channels;
+  for (auto& [name, values] : page.channels)
+    if (is_colour_channel(name)) channels.push_back(&values);
+  if (channels.empty()) return;
+  const int k = int(channels.size());
+  Eigen::MatrixXd x0(n, k), c(int(system.rows), k);
+  for (int ch = 0; ch < k; ++ch) {
+    const std::vector<float>& values = *channels[size_t(ch)];
+    for (int j = 0; j < n; ++j) x0(j, ch) = values[system.unknown_texel[size_t(j)]];
     for (size_t row = 0; row < system.rows; ++row) {
       double sum = 0;
       for (const auto& [texel, w] : system.row_constants[row]) sum += w * values[texel];
-      c[int(row)] = sum;
+      c(int(row), ch) = sum;
     }
-    const Eigen::VectorXd rhs = lambda * x0 - r.transpose() * c;
-    const Eigen::VectorXd x = cg.solveWithGuess(rhs, x0);
-    if (cg.info() != Eigen::Success || !x.allFinite()) continue;  // keep the unstitched values
+  }
+  const Eigen::MatrixXd rhs = lambda * x0 - Eigen::MatrixXd(r.transpose() * c);
+  Eigen::MatrixXd x;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factor(normal);
+  if (factor.info() == Eigen::Success) {
+    x = factor.solve(rhs);
+  } else {
+    Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg;
+    cg.setTolerance(1e-7);  // relative residual; the pages hold floats (24-bit mantissa)
+    cg.setMaxIterations(10 * n + 100);
+    cg.compute(normal);
+    x.resize(n, k);
+    for (int ch = 0; ch < k; ++ch) x.col(ch) = cg.solveWithGuess(rhs.col(ch), x0.col(ch));
+  }
+  for (int ch = 0; ch < k; ++ch) {
+    if (!x.col(ch).allFinite()) continue;  // keep the unstitched values
+    std::vector<float>& values = *channels[size_t(ch)];
     // Irradiance is never negative: a texel that was not keeps to >= 0 (the solve can overshoot
     // where a bright texel's footprint neighbours a dark one).
-    for (int j = 0; j < n; ++j) values[system.unknown_texel[size_t(j)]] = float(x0[j] >= 0 ? std::max(0.0, x[j]) : x[j]);
+    for (int j = 0; j < n; ++j)
+      values[system.unknown_texel[size_t(j)]] = float(x0(j, ch) >= 0 ? std::max(0.0, x(j, ch)) : x(j, ch));
   }
 }
 
