@@ -74,7 +74,9 @@ done
 echo
 echo "| what | runs | failed or hung | longest (s) |"
 echo "|---|---|---|---|"
-echo "| ctest ${selection[*]} (+ Vulkan stress/unit) | $rounds | $test_failures | $test_seconds_max |"
+what="ctest ${selection[*]}"
+[ -z "$regex" ] && what="$what, then -R 'stress_tests.*vulkan|vulkan_host'"
+echo "| $what | $rounds | $test_failures | $test_seconds_max |"
 echo "| exitance-relight cornell_room --spp 8 | $relights | $relight_failures | $relight_seconds_max |"
 echo "(load: $cores busy loops; logs in $work)"
 [ "$test_failures" -eq 0 ] && [ "$relight_failures" -eq 0 ]
