@@ -62,8 +62,10 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   assembly.dilation_texels = std::max(2, int(baked.padding) * 2);
   std::vector<formats::LightmapImage> pages = assemble_lightmap_pages(persisted.gbuffer, estimate, assembly);
   // Seams stitched as `bake` stitched them (seam_stage.h), or only measured where it ran --seams off.
+  stage("seams");
   const json seams = stitch_bundle_seams(pages, persisted.scene, persisted.atlas, assembly.dilation_texels,
                                          bundle_stitches_seams(manifest.stats_json));
+  stage("write");
   // The pages as assembled now, under the file names the manifest gave them.
   if (pages.size() != manifest.pages.size())
     throw BundleInputError((bundle / "manifest.json").string() + ": pages: " + std::to_string(manifest.pages.size()) +
