@@ -344,11 +344,7 @@ int main(int argc, char** argv) {
   }
 
   exitance::ProgressBar bar;
-  std::string stage = "import";  // the stage a device failure names
-  options.progress = [&](const std::string& name, double fraction, uint64_t rays) {
-    stage = name;
-    bar.update(name, fraction, rays);
-  };
+  options.progress = [&](const std::string& stage, double fraction, uint64_t rays) { bar.update(stage, fraction, rays); };
   try {
     const nlohmann::json report = exitance::run_bake(options, diagnostics);
     bar.finish();
@@ -378,12 +374,12 @@ int main(int argc, char** argv) {
     bar.finish();
     print_warnings(diagnostics);
     if (several_ranks) {
-      std::fprintf(rank_stderr, "bake: error: rank %d: device failure during %s: %s\n", mpi->rank(), stage.c_str(),
+      std::fprintf(rank_stderr, "bake: error: rank %d: device failure during %s: %s\n", mpi->rank(), bar.stage().c_str(),
                    one_line(e.what()).c_str());
       std::fflush(rank_stderr);
       mpi->abort(exitance::kDeviceFailureExitCode);
     }
-    std::cerr << "bake: error: device failure during " << stage << ": " << one_line(e.what()) << "\n";
+    std::cerr << "bake: error: device failure during " << bar.stage() << ": " << one_line(e.what()) << "\n";
     std::fflush(stderr);
     std::_Exit(exitance::kDeviceFailureExitCode);
   } catch (const std::exception& e) {

@@ -90,11 +90,7 @@ int main(int argc, char** argv) {
   options.validation = validation && std::string(validation) == "1";
 
   exitance::ProgressBar bar;
-  std::string stage = "open";  // the stage a device failure names
-  options.progress = [&](const std::string& name, double fraction, uint64_t rays) {
-    stage = name;
-    bar.update(name, fraction, rays);
-  };
+  options.progress = [&](const std::string& stage, double fraction, uint64_t rays) { bar.update(stage, fraction, rays); };
   try {
     const nlohmann::json report = exitance::relight_bundle(options);
     bar.finish();
@@ -120,7 +116,7 @@ int main(int argc, char** argv) {
     // the hung submission: leave without static destructors, which could wait for it or unload
     // the code it runs.
     bar.finish();
-    std::cerr << "exitance-relight: error: device failure during " << stage << ": " << one_line(e.what()) << "\n";
+    std::cerr << "exitance-relight: error: device failure during " << bar.stage() << ": " << one_line(e.what()) << "\n";
     std::fflush(stderr);
     std::_Exit(exitance::kDeviceFailureExitCode);
   } catch (const std::exception& e) {

@@ -9,9 +9,9 @@ namespace exitance {
 ProgressBar::ProgressBar() : enabled_(::isatty(STDERR_FILENO) != 0) {}
 
 void ProgressBar::update(const std::string& stage, double fraction, uint64_t rays) {
-  if (!enabled_) return;
   const auto now = std::chrono::steady_clock::now();
   if (stage != stage_) stage_ = stage, stage_start_ = now;
+  if (!enabled_) return;
   const double elapsed = std::chrono::duration<double>(now - stage_start_).count();
   constexpr int kWidth = 30;
   const int filled = int(fraction * kWidth + 0.5);

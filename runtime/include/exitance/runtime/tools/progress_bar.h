@@ -11,11 +11,13 @@ class ProgressBar {
   ProgressBar();
   void update(const std::string& stage, double fraction, uint64_t rays);
   void finish();
+  // The stage of the last update, drawn or not ("start" before any): what a failure names.
+  const std::string& stage() const { return stage_; }
 
  private:
   bool enabled_ = false;
   bool drawn_ = false;
-  std::string stage_;
+  std::string stage_ = "start";
   std::chrono::steady_clock::time_point stage_start_;
 };
 
