@@ -37,7 +37,9 @@ int main(int argc, char** argv) {
   app.add_option("--budget-ms", options.frame_budget_ms, "bound each frame (refresh call) to this many milliseconds")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--frames", options.frames, "refresh at most this many frames; the report lists each frame's time and error");
-  bool no_frame_errors = false;
+  bool no_frame_errors = false, ignore_baked = false;
+  app.add_flag("--ignore-baked", ignore_baked,
+               "start every texel from nothing instead of from the bundle's baked lightmap (which is shown until refreshed samples are better, and which light edits are estimated as a change from)");
   app.add_flag("--no-frame-errors", no_frame_errors,
                "with --frames: no per-frame error (it reads the lightmap back between frames, which idles the GPU)");
   app.add_option("--integrator", options.integrator,
@@ -85,6 +87,7 @@ int main(int argc, char** argv) {
   }
   options.spp = spp;
   options.frame_errors = !no_frame_errors;
+  options.from_baked = !ignore_baked;
   options.seed = seed;
   const char* validation = std::getenv("EXITANCE_VULKAN_VALIDATION");
   options.validation = validation && std::string(validation) == "1";

@@ -66,7 +66,12 @@ uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rn
     if (guide.guided_probability > 0.0) add_auto_cost(path_work[p], 1u, 1u);
   }
   if (directional_texel) guide = with_uniform_component(guide, kDirectionalUniformProbability);
-  next_event_estimation(x, origin, throughput, guide, rng, area, punctual_light, environment);
+  if (params.changed_light_pairs > 0u) {  // the runtime's change estimate: the edited lights alone
+    environment = no_shadow_ray();
+    punctual_change_rays(x, throughput, params.punctual_count, params.changed_light_pairs, rng, punctual_light, area);
+  } else {
+    next_event_estimation(x, origin, throughput, guide, rng, area, punctual_light, environment);
+  }
   uint first = p * params.shadow_slots;
   shadow_rays[first] = area;
   shadow_rays[first + 1u] = punctual_light;

@@ -7,11 +7,14 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <cstring>
 #include <limits>
 
 #include "exitance/formats/format_error.h"
 #include "exitance/formats/scene_file.h"
 #include "exitance/formats/svo_file.h"
+#include "exitance/runtime/refresh/baked_lightmap.h"
+#include "exitance/runtime/refresh/published_estimate.h"
 #include "exitance/runtime/refresh/texels_near_change.h"
 #include "exitance/runtime/refresh/unocclude_near_moved.h"
 
@@ -60,8 +63,15 @@ struct RefreshSession::State {
   std::vector<uint32_t> near_texels, far_texels, all_texels;
   std::vector<uint32_t> last_edit_near;  // near_texels of the last edit, kept after the others caught up
   uint32_t near_samples = 0, far_samples = 0, all_samples = 0;
-  // What texels show until they have samples again after an edit (published_lightmap).
+  // What texels showed before the last edit (published_lightmap keeps it until the refreshed
+  // estimate is better; published_estimate.h); at open, the bundle's baked lightmap.
   std::optional<LightmapEstimate> previous;
+  // After edits that changed punctual lights only: the estimate the accumulation's change is added
+  // to (what was published before the first of them), the punctual lights as they were then, and
+  // how many changed lights the accumulation estimates (0: the accumulation is E/pi itself).
+  std::optional<LightmapEstimate> base;
+  std::vector<GpuPunctualLight> base_lights;
+  uint32_t changed_lights = 0;
   // A bake_per_bounce(), bake_guided() or bake_path() result: lightmap() until the next restart, edit
   // or refresh.
   std::optional<LightmapEstimate> per_bounce;
@@ -127,6 +137,14 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   state->all_texels.resize(state->persisted.gbuffer.texels.size());
   for (size_t i = 0; i < state->all_texels.size(); ++i) state->all_texels[i] = uint32_t(i);
   state->integrator->start_progressive(state->persisted.gbuffer, settings);
+  if (options.start_from_baked) {
+    try {
+      state->previous = read_baked_lightmap(bundle_folder, manifest, state->persisted.gbuffer,
+                                            std::clamp(settings.recorded_bounces, 1, int(kMaxRecordedLayers)));
+    } catch (const std::runtime_error& e) {
+      throw BundleInputError(e.what());
+    }
+  }
   return std::unique_ptr<RefreshSession>(new RefreshSession(std::move(state)));
 }
 
@@ -142,6 +160,21 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   update_lighting_scene(lighting, std::make_shared<const Scene>(edited.scene), effects);
   unocclude_near_moved(edited, s.persisted.scene, lighting, effects);
 
+  // Edits of punctual lights alone are estimated as a change from what was published before them
+  // (path.h punctual_change_rays): the same paths, each vertex adding the edited lights' direct
+  // light as edited minus as it was, so texels no edited light reaches keep their value exactly.
+  const bool lights_only = !effects.geometry_changed() && effects.materials.empty() && !effects.sky && !effects.lights.empty() &&
+                           !s.per_bounce && s.settings.directional == DirectionalMode::Off;
+  std::vector<GpuPunctualLight> pairs;
+  const std::vector<GpuPunctualLight>& base_lights = s.base ? s.base_lights : s.lighting->punctual_lights;
+  if (lights_only && base_lights.size() == lighting.punctual_lights.size())
+    for (size_t i = 0; i < base_lights.size(); ++i)
+      if (std::memcmp(&base_lights[i], &lighting.punctual_lights[i], sizeof(GpuPunctualLight)) != 0) {
+        pairs.push_back(lighting.punctual_lights[i]);
+        pairs.push_back(base_lights[i]);
+      }
+  const bool as_change = lights_only && !pairs.empty() && pairs.size() / 2 <= kMaxChangedLights;
+
   if (effects.geometry_changed()) {
     s.integrator->update_geometry(lighting);
   } else {
@@ -150,11 +183,26 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   }
   std::vector<uint32_t> near = texels_near_change(edited, s.persisted.scene, lighting, effects);
   s.last_edit_near.clear();
-  s.previous = published_lightmap();  // what texels show until refreshed again
+  LightmapEstimate published = published_lightmap();  // what texels show until refreshed again
+  if (as_change && !s.base) {
+    s.base = published;
+    s.base_lights = s.lighting->punctual_lights;
+  }
+  s.previous = std::move(published);
   s.persisted = std::move(edited);
   s.lighting = std::make_shared<const LightingScene>(std::move(lighting));
   s.scene_file.reset();  // encoded again from the edited scene when a bundle is written
-  restart();  // moved texels are uploaded again with the rest
+  if (as_change) {
+    s.per_bounce.reset();
+    s.whole_run_path = s.whole_run_guided = false;
+    s.integrator->start_progressive_change(s.persisted.gbuffer, s.settings, *s.lighting, pairs);
+    s.changed_lights = uint32_t(pairs.size() / 2);
+    s.near_texels.clear();
+    s.far_texels.clear();
+    s.near_samples = s.far_samples = s.all_samples = 0;
+  } else {
+    restart();  // moved texels are uploaded again with the rest
+  }
   if (s.priority_samples > 0 && !near.empty() && near.size() < s.all_texels.size()) {
     std::vector<uint8_t> is_near(s.all_texels.size(), 0);
     for (uint32_t i : near) is_near[i] = 1;
@@ -166,8 +214,19 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   return effects;
 }
 
+void RefreshSession::end_change_estimate() {
+  State& s = *state_;
+  if (!s.base) return;
+  // What the change estimate published is what texels show until refreshed again.
+  s.previous = published_lightmap();
+  s.base.reset();
+  s.base_lights.clear();
+  s.changed_lights = 0;
+}
+
 void RefreshSession::restart() {
   State& s = *state_;
+  end_change_estimate();
   s.per_bounce.reset();
   s.whole_run_path = s.whole_run_guided = false;
   s.integrator->start_progressive(s.persisted.gbuffer, s.settings);
@@ -276,6 +335,7 @@ LightmapEstimate RefreshSession::lightmap() const {
 
 LightmapEstimate RefreshSession::bake_per_bounce(uint32_t spp, double time_budget_seconds) {
   State& s = *state_;
+  end_change_estimate();
   if (s.settings.directional != DirectionalMode::Off)
     throw std::invalid_argument("the per-bounce mode estimates no directional (sh1) layers: relight this bundle with path tracing");
   if (spp == 0 && !(time_budget_seconds > 0))
@@ -295,6 +355,7 @@ bool RefreshSession::per_bounce() const { return state_->per_bounce.has_value() 
 
 LightmapEstimate RefreshSession::bake_guided(uint32_t spp, double time_budget_seconds, float guiding_mix, GuidingMode mode) {
   State& s = *state_;
+  end_change_estimate();
   if (spp == 0 && !(time_budget_seconds > 0))
     throw std::invalid_argument("guided path tracing needs samples per texel or a time budget");
   if (mode != GuidingMode::Grid && mode != GuidingMode::Svo) throw std::invalid_argument("bake_guided: the mode must be grid or svo");
@@ -316,6 +377,7 @@ LightmapEstimate RefreshSession::bake_guided(uint32_t spp, double time_budget_se
 
 const LightmapEstimate& RefreshSession::bake_path(uint32_t spp, double time_budget_seconds, WorkShare* share) {
   State& s = *state_;
+  end_change_estimate();
   if (spp == 0 && !(time_budget_seconds > 0)) throw std::invalid_argument("path tracing in one run needs samples per texel or a time budget");
   IntegratorSettings settings = s.settings;
   settings.integrator = IntegratorMode::Path;
@@ -331,12 +393,22 @@ const LightmapEstimate& RefreshSession::bake_path(uint32_t spp, double time_budg
 
 bool RefreshSession::guided() const { return state_->per_bounce.has_value() && state_->whole_run_guided; }
 
+LightmapEstimate RefreshSession::refreshed_lightmap() const {
+  const State& s = *state_;
+  return s.base ? add_change(*s.base, lightmap()) : lightmap();
+}
+
+uint32_t RefreshSession::changed_lights() const { return state_->changed_lights; }
+
 LightmapEstimate RefreshSession::published_lightmap() const {
   LightmapEstimate estimate = lightmap();
   const State& s = *state_;
+  if (s.base) return publish_change(s.previous ? *s.previous : *s.base, *s.base, estimate);
   if (!s.previous || s.previous->texels.size() != estimate.texels.size() ||
-      s.previous->recorded_bounces != estimate.recorded_bounces)
+      s.previous->recorded_bounces != estimate.recorded_bounces || s.previous->has_sh1() != estimate.has_sh1())
     return estimate;
+  if (!s.per_bounce) return publish_restart(*s.previous, estimate);
+  // A whole run (bake_per_bounce, bake_guided, bake_path) is a bake: shown wherever it has samples.
   const size_t n = estimate.texels.size();
   for (size_t i = 0; i < n; ++i) {
     if (estimate.texels[i].samples > 0) continue;

@@ -127,7 +127,7 @@ ExitanceRuntimeError exitance_runtime_estimated_relative_mse(ExitanceRuntime* ru
   return guarded("exitance_runtime_estimated_relative_mse", [&] {
     require(runtime != nullptr, "runtime is NULL");
     require(out_relative_mse != nullptr, "out_relative_mse is NULL");
-    *out_relative_mse = RefreshSession::estimated_relative_mse(runtime->session->lightmap());
+    *out_relative_mse = RefreshSession::estimated_relative_mse(runtime->session->refreshed_lightmap());
   });
 }
 

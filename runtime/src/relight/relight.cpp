@@ -58,6 +58,7 @@ json relight_bundle(const RelightOptions& options) {
   report("load", 0, 0);
   RefreshSessionOptions session_options;
   session_options.seed = options.seed;
+  session_options.start_from_baked = options.from_baked;
   session_options.device.device_index = options.device_index;
   session_options.device.validation = options.validation;
   session_options.device.collect_stage_statistics = options.stage_statistics;
@@ -86,7 +87,9 @@ json relight_bundle(const RelightOptions& options) {
                       {"moved_texels", effects.moved_texels},
                       {"lights", effects.lights},
                       {"materials", effects.materials},
-                      {"sky", effects.sky}};
+                      {"sky", effects.sky},
+                      // punctual lights whose change from the pre-edit lighting is estimated (0: restarted)
+                      {"changed_lights", session->changed_lights()}};
     } catch (const SceneEditError& e) {
       throw RelightInputError(e.what());
     }
@@ -147,7 +150,7 @@ json relight_bundle(const RelightOptions& options) {
       // Per-frame figures cost a read-back of the sums, outside the frame's time.
       json entry = {{"frame", frame}, {"milliseconds", r.milliseconds}, {"rays", r.rays},
                     {"samples_added", r.samples_added}, {"samples_per_texel", r.samples_per_texel}};
-      const LightmapEstimate now = options.frame_errors ? session->lightmap() : LightmapEstimate{};
+      const LightmapEstimate now = options.frame_errors ? session->refreshed_lightmap() : LightmapEstimate{};
       if (options.frame_errors) {
         const double error = RefreshSession::estimated_relative_mse(now);
         entry["estimated_relative_mse"] = std::isfinite(error) ? json(error) : json(nullptr);

@@ -203,6 +203,13 @@ void GpuScene::update_lights(const LightingScene& edited) {
   update_environment(edited);
 }
 
+void GpuScene::set_changed_light_pairs(const LightingScene& edited, const std::vector<GpuPunctualLight>& pairs) {
+  check_same_shape(edited);
+  std::vector<GpuPunctualLight> records = edited.punctual_lights;
+  records.insert(records.end(), pairs.begin(), pairs.end());
+  if (!records.empty()) upload_growing(punctual_lights_, records.data(), records.size() * sizeof(GpuPunctualLight));
+}
+
 void GpuScene::update_environment(const LightingScene& edited) {
   const uint32_t width = edited.environment.enabled() ? edited.environment.width() : 0;
   const uint32_t height = edited.environment.enabled() ? edited.environment.height() : 0;

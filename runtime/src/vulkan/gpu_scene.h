@@ -34,6 +34,10 @@ class GpuScene {
   // constant sky, and uploads the image sky (texels and CDFs, growing their buffers when the new
   // image is larger) or switches it off when the edited sky is constant.
   void update_lights(const LightingScene& edited);
+  // The runtime's change estimate (path.h punctual_change_rays): after `edited`'s punctual lights,
+  // `pairs` of records (each edited light as edited, then as it was at the base), the buffer grown
+  // to fit. The kernels read them only when GpuParams::changed_light_pairs says so.
+  void set_changed_light_pairs(const LightingScene& edited, const std::vector<GpuPunctualLight>& pairs);
 
   // After set_geometry (lighting_scene.h): uploads the triangles, the BVH nodes (in this scene's
   // node layout) and per-slot vertex copies, then what update_materials and update_lights upload,

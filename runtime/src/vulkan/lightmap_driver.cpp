@@ -401,12 +401,13 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   return estimate;
 }
 
-void LightmapDriver::start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) {
+void LightmapDriver::start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, uint32_t changed_light_pairs) {
   const auto start_time = Clock::now();
   progressive_.reset();
   runner_.statistics().clear();
   Accumulation a;
   prepare(gbuffer, settings, a);
+  a.params.changed_light_pairs = changed_light_pairs;
   a.seconds = std::chrono::duration<double>(Clock::now() - start_time).count();
   progressive_ = std::move(a);
 }

@@ -34,7 +34,9 @@ class LightmapDriver {
   void set_guiding_scene(const GuidingScene& scene) { guiding_scene_ = scene; }
   LightmapEstimate bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings);
 
-  void start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings);
+  // `changed_light_pairs` > 0: the accumulation estimates the change of direct light from that many
+  // edited punctual lights (GpuParams::changed_light_pairs; their records set on the scene first).
+  void start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, uint32_t changed_light_pairs = 0);
   // `samples` more per texel (sample indices continue where the last call ended); returns the rays traced.
   uint64_t add_samples(uint32_t samples);
   // Samples [first_sample, first_sample + samples) of the listed texels only (indices into the

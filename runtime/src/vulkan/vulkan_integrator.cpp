@@ -112,6 +112,15 @@ void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const Inte
     throw std::runtime_error("Vulkan backend: guiding runs in whole bakes only, not in progressive accumulation (relight)");
   impl_->lightmap.start(gbuffer, settings);
 }
+void VulkanIntegrator::start_progressive_change(const TexelGBuffer& gbuffer, const IntegratorSettings& settings,
+                                                const LightingScene& edited, const std::vector<GpuPunctualLight>& pairs) {
+  if (settings.guiding != GuidingMode::Off)
+    throw std::runtime_error("Vulkan backend: guiding runs in whole bakes only, not in progressive accumulation (relight)");
+  if (pairs.empty() || pairs.size() % 2 != 0)
+    throw std::invalid_argument("Vulkan backend: a change estimate needs pairs of light records (edited, base)");
+  impl_->scene.set_changed_light_pairs(edited, pairs);
+  impl_->lightmap.start(gbuffer, settings, uint32_t(pairs.size() / 2));
+}
 uint64_t VulkanIntegrator::add_samples(uint32_t samples) { return impl_->lightmap.add_samples(samples); }
 uint64_t VulkanIntegrator::add_samples_to(const std::vector<uint32_t>& texels, uint32_t first_sample, uint32_t samples) {
   return impl_->lightmap.add_samples_to(texels, first_sample, samples);

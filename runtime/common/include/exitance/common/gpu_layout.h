@@ -120,6 +120,8 @@ struct GpuParams {
   uint traversal_steps;    // a ray's traversal steps beyond which it is a counted fault (bvh.glsl;
                            // GpuScene::traversal_step_bound; a parameter, not a specialization
                            // constant, so one compiled kernel serves every scene's BVH)
+  uint changed_light_pairs;  // texel batches: 0 = the estimator; n > 0 = the change of direct light from n edited
+                             // punctual lights (path.h punctual_change_rays), pairs of records after the scene's own
 };
 
 // Descriptor bindings of the wavefront (one set).

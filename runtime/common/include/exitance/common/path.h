@@ -173,6 +173,35 @@ EXITANCE_FN vec3 triangle_geometric_normal(SCENE_PARAM uint tri) {
 }
 EXITANCE_FN bool material_double_sided(GpuMaterial m) { return m.albedo_double_sided.w != 0.0f; }
 
+// Punctual light `light`'s direct E/pi at x, chosen with `probability`: its shadow ray, carrying
+// throughput * I falloff cos / (pi probability) when unoccluded (no ray where the light cannot reach
+// x). Returns luminance(I falloff cos / pi) / probability, what emitter guiding learns.
+EXITANCE_FN float punctual_light_ray(GpuPunctualLight light, SurfacePoint x, vec3 throughput, float probability,
+                                     OUT(ShadowRay) ray) {
+  ray = no_shadow_ray();
+  uint type = floatBitsToUint(light.position_type.w);
+  vec3 direction = vec3(light.direction_cos_inner.x, light.direction_cos_inner.y, light.direction_cos_inner.z);
+  vec3 wi;
+  float distance = uintBitsToFloat(0x7F800000u);
+  float falloff = 1.0f;
+  if (type == kPunctualDirectional) {
+    wi = -direction;
+  } else {
+    vec3 to_light = vec3(light.position_type.x, light.position_type.y, light.position_type.z) - x.position;
+    distance = length(to_light);
+    wi = to_light / distance;
+    falloff = 1.0f / (distance * distance);
+    if (type == kPunctualSpot)
+      falloff *= spot_attenuation(direction, light.direction_cos_inner.w, light.intensity_cos_outer.w, -wi);
+  }
+  float cos_x = dot(x.shading_normal, wi);
+  if (!(distance > 0.0f && falloff > 0.0f && cos_x > 0.0f && dot(x.geometric_normal, wi) > 0.0f && probability > 0.0f)) return 0.0f;
+  vec3 intensity = vec3(light.intensity_cos_outer.x, light.intensity_cos_outer.y, light.intensity_cos_outer.z);
+  ray.direction_length = vec4(wi, distance);
+  ray.contribution_state = vec4(throughput * (intensity * (falloff * cos_x * kInvPi / probability)), kShadowTrace);
+  return luminance(intensity) * falloff * cos_x * kInvPi / probability;
+}
+
 // One sample of each light strategy at x: (1/pi) * integral of direct radiance * cos, as shadow rays.
 // Random numbers, in order: area light (choice, then a 2-D point), punctual light (choice),
 // environment (a 2-D direction);
@@ -249,31 +278,10 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
     float u_choose = sample_1d(rng);
     float probability;
     uint light_index = punctual_mixture_sample(scene_punctual_cdf(SCENE_ALONE_ARG), punctual, emitter_guide, u_choose, probability);
-    GpuPunctualLight light = scene_punctual_light(SCENE_ARG light_index);
-    uint type = floatBitsToUint(light.position_type.w);
-    vec3 direction = vec3(light.direction_cos_inner.x, light.direction_cos_inner.y, light.direction_cos_inner.z);
-    vec3 wi;
-    float distance = uintBitsToFloat(0x7F800000u);
-    float falloff = 1.0f;
-    if (type == kPunctualDirectional) {
-      wi = -direction;
-    } else {
-      vec3 to_light = vec3(light.position_type.x, light.position_type.y, light.position_type.z) - x.position;
-      distance = length(to_light);
-      wi = to_light / distance;
-      falloff = 1.0f / (distance * distance);
-      if (type == kPunctualSpot)
-        falloff *= spot_attenuation(direction, light.direction_cos_inner.w, light.intensity_cos_outer.w, -wi);
-    }
-    float cos_x = dot(x.shading_normal, wi);
-    if (distance > 0.0f && falloff > 0.0f && cos_x > 0.0f && dot(x.geometric_normal, wi) > 0.0f && probability > 0.0f) {
-      vec3 intensity = vec3(light.intensity_cos_outer.x, light.intensity_cos_outer.y, light.intensity_cos_outer.z);
-      punctual_ray.direction_length = vec4(wi, distance);
-      punctual_ray.contribution_state = vec4(throughput * (intensity * (falloff * cos_x * kInvPi / probability)), kShadowTrace);
-      if (emitter_guide.punctual_count > 0u) {
-        learning.punctual_light = light_index;
-        learning.punctual_value = luminance(intensity) * falloff * cos_x * kInvPi / probability;
-      }
+    float value = punctual_light_ray(scene_punctual_light(SCENE_ARG light_index), x, throughput, probability, punctual_ray);
+    if (punctual_ray.contribution_state.w != kShadowNone && emitter_guide.punctual_count > 0u) {
+      learning.punctual_light = light_index;
+      learning.punctual_value = value;
     }
   }
   if (scene_has_environment(SCENE_ALONE_ARG)) {
@@ -296,6 +304,23 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
   EmitterLearning learning;
   next_event_estimation(SCENE_ARG x, origin, throughput, guide, emitter_guide_none(), rng, area_ray, punctual_ray,
                         environment_ray, learning);
+}
+
+// ---- The change of direct light from edited punctual lights (the runtime's refresh) ----
+// After an edit that only changed punctual lights, the runtime estimates the change of E/pi from a
+// base estimate (RefreshSession, docs/runtime.md): paths are sampled as usual, but each vertex adds
+// only the edited lights' direct light as edited minus as it was at the base, both with the same
+// shadow-ray origin and path, so where neither version reaches a vertex the change is exactly 0.
+// Emission and the sky add nothing (they did not change). Pair k's records are punctual lights
+// first + 2k (as edited) and first + 2k + 1 (at the base), after the scene's own; one pair per vertex,
+// chosen uniformly (a random number only when there are several).
+EXITANCE_FN void punctual_change_rays(SCENE_PARAM SurfacePoint x, vec3 throughput, uint first, uint pairs,
+                                      INOUT(PathSampler) rng, OUT(ShadowRay) edited_ray, OUT(ShadowRay) base_ray) {
+  uint k = 0u;
+  if (pairs > 1u) k = min(uint(sample_1d(rng) * float(pairs)), pairs - 1u);
+  float probability = 1.0f / float(pairs);
+  punctual_light_ray(scene_punctual_light(SCENE_ARG first + 2u * k), x, throughput, probability, edited_ray);
+  punctual_light_ray(scene_punctual_light(SCENE_ARG first + 2u * k + 1u), x, -throughput, probability, base_ray);
 }
 
 EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, vec3 throughput, uint strategy,

@@ -4,13 +4,16 @@
 //
 // refresh() adds samples to every live texel, continuing the sample indices of the calls before:
 // after N samples in any number of calls the lightmap equals bake --backend vulkan's N samples
-// with the same seed. restart() drops every accumulated sample, so no texel keeps a value from
-// before it; apply_edits restarts, and after a local edit (a moved instance, a point or spot light,
-// an emissive material) refreshes the texels near it first (priority_samples), then the others
-// until they catch up; each texel's samples are still a bake's samples 0..N-1. Until a texel has
-// samples again, published_lightmap() shows its value from before the edit (never averaged with
-// new samples). Probes and voxel exitance are computed on request
-// (probe_estimate, fill_svo_exitance), not per frame yet.
+// with the same seed (lightmap(); published_lightmap() also weighs the baked or pre-edit value).
+// restart() drops every accumulated sample (lightmap() keeps no value from before it); apply_edits
+// restarts, except after edits of punctual lights alone, which it estimates as a change from what
+// was shown (apply_edits below). After a local edit (a moved instance, a point or spot light, an
+// emissive material) the texels near it are refreshed first (priority_samples), then the others
+// until they catch up; each texel's samples are still a bake's samples 0..N-1. What a texel shows
+// (published_lightmap) is its value from before the edit (at open: the bundle's baked lightmap)
+// until the refreshed estimate has the lower estimated error (refresh/published_estimate.h).
+// Probes and voxel exitance are computed on request (probe_estimate, fill_svo_exitance), not per
+// frame yet.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -45,7 +48,15 @@ struct RefreshSessionOptions {
   // After a local edit, the texels near it get this many samples before the others get any
   // (texels_near_change.h); 0: every pass takes every texel.
   uint32_t priority_samples = 16;
+  // Start from the bundle's baked lightmap (refresh/baked_lightmap.h): published_lightmap() shows it
+  // until refreshed samples are better (published_estimate.h), and the first light edit is estimated
+  // as a change from it. false: every texel starts with nothing, as before issue 32.
+  bool start_from_baked = true;
 };
+
+// Edits that change at most this many punctual lights (counted against the base) are estimated as
+// a change (RefreshSession::apply_edits); more, and the accumulation restarts.
+constexpr uint32_t kMaxChangedLights = 8;
 
 // What one refresh() call may spend; it ends at whichever limit comes first. A call with neither
 // limit set adds what the sample cap allows.
@@ -81,6 +92,13 @@ class RefreshSession {
   // texel keeps a value from before the edit. All or nothing: throws SceneEditError (one line
   // naming the edit and the problem) with the session unchanged. std::runtime_error on device
   // failure.
+  //
+  // Edits that change only punctual lights (position, direction, cone, intensity, colour; at most
+  // kMaxChangedLights of them since the base) do not restart E/pi: the accumulation becomes an
+  // estimate of the change of E/pi from the base (what was published before the first such edit),
+  // the same paths with each vertex adding the edited lights' direct light as edited minus as it was
+  // (path.h punctual_change_rays), so texels that no edited light reaches keep their value exactly.
+  // lightmap() is then that change; refreshed_lightmap() is base + change.
   EditEffects apply_edits(const std::vector<SceneEdit>& edits);
   // Drops every accumulated sample; the next refresh starts at sample 0.
   void restart();
@@ -110,10 +128,18 @@ class RefreshSession {
   // refresh: a million texels' estimate is ~100 MB).
   const LightmapEstimate& bake_path(uint32_t spp, double time_budget_seconds, WorkShare* share = nullptr);
 
-  // The lightmap accumulated since the last edit or restart (a read-back: it waits for the device).
+  // The lightmap accumulated since the last edit or restart (a read-back: it waits for the device);
+  // after a light edit estimated as a change (changed_lights() > 0), that change.
   LightmapEstimate lightmap() const;
-  // lightmap(), where texels without samples since the last edit keep their value from before it:
-  // what an engine shows, and what write_refreshed_bundle and the C API's read_page publish.
+  // The unbiased estimate of the current scene: lightmap(), or base + change after light edits.
+  LightmapEstimate refreshed_lightmap() const;
+  // Edited punctual lights the accumulation estimates the change of (0: it estimates E/pi).
+  uint32_t changed_lights() const;
+  // What an engine shows, and what write_refreshed_bundle and the C API's read_page publish: per
+  // texel, of what it showed before the last edit (at open, the baked lightmap) and the refreshed
+  // estimate, the one with the lower estimated error (published_estimate.h): never a value with
+  // fewer than 2 refreshed samples, and a texel no change reaches keeps its value. A whole run
+  // (bake_per_bounce, bake_guided, bake_path) is shown wherever it has samples.
   LightmapEstimate published_lightmap() const;
   // Samples every texel has since the last edit or restart.
   uint32_t samples_per_texel() const;
@@ -143,6 +169,7 @@ class RefreshSession {
 
  private:
   explicit RefreshSession(std::unique_ptr<State> state);
+  void end_change_estimate();
   std::unique_ptr<State> state_;
 };
 

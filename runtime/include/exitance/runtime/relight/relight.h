@@ -26,6 +26,7 @@ struct RelightOptions {
   double time_budget_seconds = 0;  // > 0: the whole lightmap refresh
   double frame_budget_ms = 0;      // > 0: each frame (refresh call)
   uint32_t frames = 0;             // > 0: at most this many frames
+  bool from_baked = true;          // start from the bundle's baked lightmap (RefreshSessionOptions::start_from_baked)
   bool frame_errors = true;        // with frames: each frame's estimated error (a read-back of the sums between frames)
   std::optional<uint64_t> seed;    // default: the bake's
   int device_index = -1;           // Vulkan device; -1 = prefer a discrete GPU

@@ -116,6 +116,13 @@ class VulkanIntegrator final : public Integrator {
   // safety_bounce_cap, sampling_strategy. bake() ends an accumulation (start again after it);
   // bake_probes in between does not. Throws as bake() does; std::logic_error before a start.
   void start_progressive(const TexelGBuffer& gbuffer, const IntegratorSettings& settings);
+  // A progressive accumulation of the change of E/pi from edited punctual lights (path.h
+  // punctual_change_rays: the same paths, each vertex adding an edited light's direct light as edited
+  // minus as it was; no emission, no sky). `edited`: the scene as update_lights last uploaded it;
+  // `pairs`: per edited light its record in `edited` then its record at the base (at least one
+  // pair). Otherwise as start_progressive; the next start_progressive estimates E/pi again.
+  void start_progressive_change(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, const LightingScene& edited,
+                                const std::vector<GpuPunctualLight>& pairs);
   uint64_t add_samples(uint32_t samples);
   // Samples [first_sample, first_sample + samples) of the listed texels only (G-buffer indices, each
   // at most once): the runtime's priorities. The caller keeps each texel's count (add_samples'

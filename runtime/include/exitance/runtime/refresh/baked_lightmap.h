@@ -1,0 +1,28 @@
+// A bundle's baked lightmap as the estimate the runtime starts from (RefreshSession::open): each
+// live texel's E/pi, direct part and error.Y read back from its page, with the variance of the mean
+// that error.Y and the bake's error floor give (SE of the luminance = error.Y * (luminance + floor);
+// per channel in proportion to its mean). Its sums are synthesized for the bake's smallest sample
+// count per texel (published_estimate.h). Layers: bounce 0 = direct, bounce 1 = the rest.
+#pragma once
+#include <optional>
+#include <string>
+
+#include "exitance/formats/bundle_manifest.h"
+#include "exitance/runtime/core/estimates.h"
+#include "exitance/runtime/texel_gbuffer.h"
+
+namespace exitance {
+
+// Fewer samples per texel than this and the baked lightmap is not a starting state: its variances
+// are too rough to weigh it against refreshed samples.
+constexpr uint32_t kBakedStartMinimumSamples = 16;
+
+// The baked lightmap of `bundle` (a folder) over `gbuffer`'s texels; nullopt when the bundle has no
+// usable one: no pages, directional (sh1) layers, fewer than kBakedStartMinimumSamples samples per
+// texel (stats.samples_per_texel.min), or pages without R, G, B, direct.R/G/B and error.Y. Throws
+// std::runtime_error naming the file when a listed page cannot be read or does not match the
+// G-buffer's page size.
+std::optional<LightmapEstimate> read_baked_lightmap(const std::string& bundle, const formats::BundleManifest& manifest,
+                                                    const TexelGBuffer& gbuffer, int recorded_bounces);
+
+}  // namespace exitance

@@ -1,0 +1,33 @@
+// What a texel publishes while the runtime refreshes (docs/runtime.md "Never worse than before the
+// edit"): of the estimates it has, the one with the lower estimated error. The value a texel showed
+// before an edit is an estimate of the edited scene too, biased by the change, so it is kept until
+// the refreshed estimate is measurably better:
+//   error(kept) = V_kept + max(0, |D|^2 - V_D),  error(refreshed) = V_refreshed,
+// with D = refreshed - kept and V_D its variance, summed over the colour channels, and V the
+// variances of the means. The refreshed estimate needs 2 samples (a variance) to be chosen.
+// Estimates are LightmapEstimate sums; a composite's sums are synthesized to give its mean and
+// variance of the mean exactly (so the bundle's error layer and relMSE estimates read it as usual).
+#pragma once
+#include "exitance/runtime/core/estimates.h"
+
+namespace exitance {
+
+// base + change per texel (the change estimate of RefreshSession's light edits, path.h
+// punctual_change_rays, is an unbiased estimate of E/pi(edited) - E/pi(base)): means and every
+// layer add, variances of the mean add (the two are independent), the sample count is the sum.
+// Texels where either has no samples: base alone (change has none) or nothing. Same shapes required
+// (std::invalid_argument).
+LightmapEstimate add_change(const LightmapEstimate& base, const LightmapEstimate& change);
+
+// After a light edit estimated as a change from `base`: per texel, `previous` (what it showed before
+// the edit) while the change has fewer than 2 samples, then base + change where the change is
+// significant (|d|^2 > 2 V_d summed over channels: the rule above, with kept = base and
+// D = d sharing the base), else base.
+LightmapEstimate publish_change(const LightmapEstimate& previous, const LightmapEstimate& base, const LightmapEstimate& change);
+
+// After any other edit (or none, from a bundle's baked lighting): `refreshed` is accumulated from
+// nothing, independent of `previous`: per texel the rule above with V_D = V_previous + V_refreshed;
+// texels that had nothing before show the refreshed estimate.
+LightmapEstimate publish_restart(const LightmapEstimate& previous, const LightmapEstimate& refreshed);
+
+}  // namespace exitance

@@ -1,0 +1,73 @@
+// The runtime's publishing rule (refresh/published_estimate.h) on texels whose sums come from
+// explicit sample lists, so every mean and variance of the mean is known in closed form.
+#include <gtest/gtest.h>
+
+#include <initializer_list>
+
+#include "exitance/runtime/refresh/published_estimate.h"
+
+namespace exitance {
+namespace {
+
+// One texel (grey: the three channels equal) from its samples; direct = half of each sample.
+LightmapEstimate texel(std::initializer_list<double> samples, int recorded = 2) {
+  LightmapEstimate e;
+  e.recorded_bounces = recorded;
+  e.texels.resize(1);
+  e.bounces.assign(size_t(recorded) * 3, 0.0);
+  for (double s : samples) {
+    TexelAccumulator& t = e.texels[0];
+    for (int c = 0; c < 3; ++c) {
+      t.total[c] += s, t.total_squared[c] += s * s, t.direct[c] += 0.5 * s;
+      e.bounces[size_t(c)] += 0.5 * s;
+      e.bounces[3 + size_t(c)] += 0.5 * s;
+    }
+    ++t.samples;
+  }
+  return e;
+}
+
+TEST(PublishedEstimate, AddChangeAddsMeansLayersAndVariances) {
+  const LightmapEstimate base = texel({1, 3, 2, 2});  // mean 2, sample variance 2/3, V = 1/6
+  const LightmapEstimate change = texel({-1, 1});     // mean 0, sample variance 2, V = 1
+  const LightmapEstimate sum = add_change(base, change);
+  EXPECT_EQ(sum.texels[0].samples, 6u);
+  EXPECT_NEAR(sum.mean_total(0)[1], 2.0, 1e-6);
+  EXPECT_NEAR(sum.variance_of_mean(0)[2], 1.0 / 6 + 1.0, 1e-6);
+  EXPECT_NEAR(sum.mean_direct(0)[0], 1.0, 1e-6);
+  EXPECT_NEAR(sum.mean_bounce(1, 0)[0], 1.0, 1e-6);
+  const LightmapEstimate shifted = add_change(base, texel({4, 6}));  // change mean 5, V = 1
+  EXPECT_NEAR(shifted.mean_total(0)[0], 7.0, 1e-6);
+  EXPECT_NEAR(shifted.mean_direct(0)[0], 3.5, 1e-6);
+  EXPECT_NEAR(shifted.variance_of_mean(0)[0], 1.0 / 6 + 1.0, 1e-5);
+  EXPECT_THROW(add_change(base, texel({1, 2}, 3)), std::invalid_argument);
+}
+
+TEST(PublishedEstimate, AChangeIsPublishedOnlyWithTwoSamplesAndWhereItIsSignificant) {
+  const LightmapEstimate previous = texel({5, 5, 5, 5}), base = texel({1, 3, 2, 2});
+  // One sample of the change: what the texel showed before the edit, bit for bit.
+  EXPECT_EQ(publish_change(previous, base, texel({9})).texels[0].total[0], previous.texels[0].total[0]);
+  // Mean 0.5, V = 0.25 per channel: 3 * 0.25 <= 2 * 3 * 0.25, not significant: the base exactly.
+  EXPECT_EQ(publish_change(previous, base, texel({0, 1})).texels[0].total[0], base.texels[0].total[0]);
+  // Mean 5, V = 1: significant: base + change.
+  EXPECT_NEAR(publish_change(previous, base, texel({4, 6})).mean_total(0)[0], 7.0, 1e-6);
+  // A change exactly 0 (no edited light reaches the texel): the base exactly.
+  EXPECT_EQ(publish_change(previous, base, texel({0, 0, 0})).texels[0].total[1], base.texels[0].total[1]);
+}
+
+TEST(PublishedEstimate, ARestartKeepsThePreviousValueUntilTheRefreshedOneHasLowerError) {
+  const LightmapEstimate previous = texel({1, 3, 2, 2});  // mean 2, V = 1/6
+  // Nothing before: the refreshed estimate, even with one sample.
+  EXPECT_NEAR(publish_restart(texel({}), texel({7})).mean_total(0)[0], 7.0, 1e-6);
+  // One refreshed sample: the previous value.
+  EXPECT_EQ(publish_restart(previous, texel({7})).texels[0].total[0], previous.texels[0].total[0]);
+  // Same mean, larger variance (V = 1): kept.
+  EXPECT_EQ(publish_restart(previous, texel({1, 3})).texels[0].total[0], previous.texels[0].total[0]);
+  // Same mean, smaller variance (V = 1/24 from 8 samples): refreshed.
+  EXPECT_NEAR(publish_restart(previous, texel({1.5, 2.5, 2, 2, 1.5, 2.5, 2, 2})).variance_of_mean(0)[0], 1.0 / 56, 1e-6);
+  // Far from the previous value (mean 10, V = 1): the difference dwarfs both variances: refreshed.
+  EXPECT_NEAR(publish_restart(previous, texel({9, 11})).mean_total(0)[0], 10.0, 1e-6);
+}
+
+}  // namespace
+}  // namespace exitance
