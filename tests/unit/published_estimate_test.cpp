@@ -55,6 +55,12 @@ TEST(PublishedEstimate, AChangeIsPublishedOnlyWithTwoSamplesAndWhereItIsSignific
   EXPECT_EQ(publish_change(previous, base, texel({0, 0, 0})).texels[0].total[1], base.texels[0].total[1]);
 }
 
+TEST(PublishedEstimate, AChangeBaseNeedsVariances) {
+  EXPECT_TRUE(can_be_change_base(texel({1, 2})));
+  EXPECT_FALSE(can_be_change_base(texel({1})));
+  EXPECT_FALSE(can_be_change_base(texel({})));
+}
+
 TEST(PublishedEstimate, ARestartKeepsThePreviousValueUntilTheRefreshedOneHasLowerError) {
   const LightmapEstimate previous = texel({1, 3, 2, 2});  // mean 2, V = 1/6
   // Nothing before: the refreshed estimate, even with one sample.

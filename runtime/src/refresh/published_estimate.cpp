@@ -61,6 +61,15 @@ LightmapEstimate add_change(const LightmapEstimate& base, const LightmapEstimate
   return sum;
 }
 
+bool can_be_change_base(const LightmapEstimate& estimate) {
+  bool some = false;
+  for (const TexelAccumulator& t : estimate.texels) {
+    if (t.samples == 1) return false;
+    some = some || t.samples >= 2;
+  }
+  return some;
+}
+
 LightmapEstimate publish_change(const LightmapEstimate& previous, const LightmapEstimate& base, const LightmapEstimate& change) {
   check_shapes(base, change, "publish_change");
   check_shapes(previous, change, "publish_change");

@@ -173,7 +173,10 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
         pairs.push_back(lighting.punctual_lights[i]);
         pairs.push_back(base_lights[i]);
       }
-  const bool as_change = lights_only && !pairs.empty() && pairs.size() / 2 <= kMaxChangedLights;
+  LightmapEstimate published = published_lightmap();  // what texels show until refreshed again
+  // A base needs variances: after opening without the baked lightmap and before any refresh, restart.
+  const bool as_change = lights_only && !pairs.empty() && pairs.size() / 2 <= kMaxChangedLights &&
+                         (s.base || can_be_change_base(published));
 
   if (effects.geometry_changed()) {
     s.integrator->update_geometry(lighting);
@@ -183,7 +186,6 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   }
   std::vector<uint32_t> near = texels_near_change(edited, s.persisted.scene, lighting, effects);
   s.last_edit_near.clear();
-  LightmapEstimate published = published_lightmap();  // what texels show until refreshed again
   if (as_change && !s.base) {
     s.base = published;
     s.base_lights = s.lighting->punctual_lights;

@@ -19,6 +19,11 @@ namespace exitance {
 // (std::invalid_argument).
 LightmapEstimate add_change(const LightmapEstimate& base, const LightmapEstimate& change);
 
+// Whether `estimate` can be the base of a change estimate: some texel has a variance (2 samples or
+// more) and none has a single sample (texels with none, e.g. sealed texels a bake skipped, keep
+// showing nothing).
+bool can_be_change_base(const LightmapEstimate& estimate);
+
 // After a light edit estimated as a change from `base`: per texel, `previous` (what it showed before
 // the edit) while the change has fewer than 2 samples, then base + change where the change is
 // significant (|d|^2 > 2 V_d summed over channels: the rule above, with kept = base and
