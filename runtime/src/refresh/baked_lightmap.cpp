@@ -15,10 +15,12 @@ namespace fs = std::filesystem;
 
 std::optional<LightmapEstimate> read_baked_lightmap(const std::string& bundle, const formats::BundleManifest& manifest,
                                                     const TexelGBuffer& gbuffer, int recorded_bounces) {
-  if (manifest.pages.empty() || manifest.pages.size() != gbuffer.pages.size() || manifest.stats_json.empty()) return std::nullopt;
+  // A relit bundle's pages are described by its "relight" report, a baked one's by "stats".
+  const std::string& described = manifest.relight_json.empty() ? manifest.stats_json : manifest.relight_json;
+  if (manifest.pages.empty() || manifest.pages.size() != gbuffer.pages.size() || described.empty()) return std::nullopt;
   const formats::BakeSettings settings = manifest.settings.value_or(formats::BakeSettings{});
   if (settings.directional != "off") return std::nullopt;
-  const nlohmann::json stats = nlohmann::json::parse(manifest.stats_json, nullptr, false);
+  const nlohmann::json stats = nlohmann::json::parse(described, nullptr, false);
   if (stats.is_discarded() || !stats.is_object()) return std::nullopt;
   const nlohmann::json* samples = stats.contains("samples_per_texel") ? &stats["samples_per_texel"] : nullptr;
   if (!samples || !samples->is_object() || !samples->contains("min") || !(*samples)["min"].is_number()) return std::nullopt;

@@ -72,6 +72,7 @@ struct RefreshSession::State {
   std::optional<LightmapEstimate> base;
   std::vector<GpuPunctualLight> base_lights;
   uint32_t changed_lights = 0;
+  bool started_from_baked = false;  // previous was the bundle's baked lightmap at open
   // A bake_per_bounce(), bake_guided() or bake_path() result: lightmap() until the next restart, edit
   // or refresh.
   std::optional<LightmapEstimate> per_bounce;
@@ -141,6 +142,7 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
     try {
       state->previous = read_baked_lightmap(bundle_folder, manifest, state->persisted.gbuffer,
                                             std::clamp(settings.recorded_bounces, 1, int(kMaxRecordedLayers)));
+      state->started_from_baked = state->previous.has_value();
     } catch (const std::runtime_error& e) {
       throw BundleInputError(e.what());
     }
@@ -401,6 +403,7 @@ LightmapEstimate RefreshSession::refreshed_lightmap() const {
 }
 
 uint32_t RefreshSession::changed_lights() const { return state_->changed_lights; }
+bool RefreshSession::started_from_baked() const { return state_->started_from_baked; }
 
 LightmapEstimate RefreshSession::published_lightmap() const {
   LightmapEstimate estimate = lightmap();

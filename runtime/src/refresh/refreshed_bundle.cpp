@@ -82,7 +82,9 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   report["source_bundle"] = fs::absolute(bundle).lexically_normal().string();
   report["source_generator"] = manifest.generator;
   report["what"] = std::string(report.contains("edits") ? "scene.bin edited, then " : "") +
-                   "full relight from scene.bin: lightmaps, probes and voxel exitance recomputed; input lightmaps not read";
+                   "full relight from scene.bin: lightmaps, probes and voxel exitance recomputed; " +
+                   (session.started_from_baked() ? "input lightmaps the starting state (shown until refreshed samples are better)"
+                                                 : "input lightmaps not read");
   report["device"] = integrator.device_description();
   report["spp"] = session.samples_per_texel();
   report["seed"] = session.settings().seed;
@@ -92,6 +94,16 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   const double relative_mse = RefreshSession::estimated_relative_mse(estimate);
   report["estimated_relative_mse"] = std::isfinite(relative_mse) ? json(relative_mse) : json(nullptr);
   report["live_texels"] = persisted.gbuffer.texels.size();
+  // As stats has them for a bake: what a later session needs to start from these pages
+  // (refresh/baked_lightmap.h): the fewest samples of a texel and error.Y's floor.
+  {
+    uint64_t sum = 0;
+    uint32_t least = estimate.texels.empty() ? 0 : ~0u, most = 0;
+    for (const TexelAccumulator& t : estimate.texels) least = std::min(least, t.samples), most = std::max(most, t.samples), sum += t.samples;
+    report["samples_per_texel"] = {{"min", least}, {"max", most},
+                                   {"mean", estimate.texels.empty() ? 0.0 : double(sum) / double(estimate.texels.size())}};
+    report["error"] = {{"floor", estimate.error_floor()}};
+  }
   report["nonfinite_samples"] = estimate.nonfinite_samples + probe_estimate.nonfinite_samples;
   report["seams"] = seams;
 

@@ -19,7 +19,8 @@ constexpr uint32_t kBakedStartMinimumSamples = 16;
 
 // The baked lightmap of `bundle` (a folder) over `gbuffer`'s texels; nullopt when the bundle has no
 // usable one: no pages, directional (sh1) layers, fewer than kBakedStartMinimumSamples samples per
-// texel (stats.samples_per_texel.min), or pages without R, G, B, direct.R/G/B and error.Y. Throws
+// texel (stats.samples_per_texel.min; for a bundle exitance-relight wrote, relight.samples_per_texel.min,
+// and its error floor from relight.error.floor), or pages without R, G, B, direct.R/G/B and error.Y. Throws
 // std::runtime_error naming the file when a listed page cannot be read or does not match the
 // G-buffer's page size.
 std::optional<LightmapEstimate> read_baked_lightmap(const std::string& bundle, const formats::BundleManifest& manifest,

@@ -135,6 +135,8 @@ class RefreshSession {
   LightmapEstimate refreshed_lightmap() const;
   // Edited punctual lights the accumulation estimates the change of (0: it estimates E/pi).
   uint32_t changed_lights() const;
+  // Whether open() took the bundle's baked lightmap as the starting state (refresh/baked_lightmap.h).
+  bool started_from_baked() const;
   // What an engine shows, and what write_refreshed_bundle and the C API's read_page publish: per
   // texel, of what it showed before the last edit (at open, the baked lightmap) and the refreshed
   // estimate, the one with the lower estimated error (published_estimate.h): never a value with

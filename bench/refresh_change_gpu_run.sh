@@ -1,0 +1,38 @@
+#!/bin/bash
+# Runs on the GPU machine (bench/refresh_change_gpu_pack.sh packs what it needs): the building at
+# 12 texels/m and the open city at 1.5 texels/m lit to 4096 spp as the shipped bundles, then each edit refreshed frame by frame from it
+# (light edits estimated as a change; docs/runtime.md) and restarted from nothing (--ignore-baked,
+# the behaviour before), each output's relMSE against two 4096-spp relights of the edited scene.
+# Writes $OUT/summary.txt.
+set -e
+for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
+export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+W=/tmp/w; mkdir -p $W && tar -C $W -xJf .replay/refresh_change.txz
+R=$W/runtime/bin/exitance-relight
+export LD_LIBRARY_PATH=$W/runtime/lib
+S=$OUT/summary.txt
+$R --list-devices > $S
+for b in ${BUNDLES:-building city}; do
+  $R $W/$b.bake -o $W/base_$b.bake --spp 4096 --seed 7 --no-frame-errors --json > $W/base_$b.json
+  python3 -c "import json; r=json.load(open('$W/base_$b.json')); print('base $b', r['spp'], 'spp', r['live_texels'], 'texels', r['seconds'])" >> $S
+done
+for e in ${EDITS:-move double block}; do
+  b=building; [ $e = block ] && b=city
+  cp -r $W/base_$b.bake $W/base.bake.tmp && rm -rf $W/base.bake && mv $W/base.bake.tmp $W/base.bake
+  for s in 101 202; do $R $W/base.bake -o $W/ref_${e}_$s.bake --edits $W/$e.json --spp 4096 --seed $s --ignore-baked --json > /dev/null; done
+  list=""
+  for f in ${FRAMES:-1 6 60}; do
+    for mode in change restart; do
+      flag=""; [ $mode = restart ] && flag=--ignore-baked
+      o=${e}_${mode}_$f
+      $R $W/base.bake -o $W/$o.bake --edits $W/$e.json --spp 4096 --frames $f --budget-ms 16 --seed 3 --no-frame-errors $flag --json > $W/$o.json
+      python3 -c "
+import json; r=json.load(open('$W/$o.json')); ms=[f['milliseconds'] for f in r['frames']]
+print('$o', 'edits_s %.4f'%r['seconds']['edits'], 'changed_lights', r['edits']['changed_lights'], 'frames', len(ms), 'frame_ms_sum %.1f max %.1f'%(sum(ms), max(ms)), 'over_17ms', sum(1 for m in ms if m > 17), 'spp', r['spp'])" >> $S
+      list="$list $W/$o.bake"
+    done
+  done
+  echo "relMSE $e (unrefreshed = base.bake):" >> $S
+  $W/bench_bundle_rel_mse $W/ref_${e}_101.bake $W/ref_${e}_202.bake $W/base.bake $list >> $S
+done
+cat $S
