@@ -321,6 +321,16 @@ EXITANCE_FN void punctual_change_rays(SCENE_PARAM SurfacePoint x, vec3 throughpu
   float probability = 1.0f / float(pairs);
   punctual_light_ray(scene_punctual_light(SCENE_ARG first + 2u * k), x, throughput, probability, edited_ray);
   punctual_light_ray(scene_punctual_light(SCENE_ARG first + 2u * k + 1u), x, -throughput, probability, base_ray);
+  // A light that did not move (intensity, colour or cone edited) asks for the same shadow ray twice:
+  // one ray carries the difference, which is then exactly 0 wherever the light is occluded.
+  if (edited_ray.contribution_state.w == kShadowTrace && base_ray.contribution_state.w == kShadowTrace &&
+      edited_ray.direction_length.x == base_ray.direction_length.x && edited_ray.direction_length.y == base_ray.direction_length.y &&
+      edited_ray.direction_length.z == base_ray.direction_length.z && edited_ray.direction_length.w == base_ray.direction_length.w) {
+    edited_ray.contribution_state = vec4(vec3(edited_ray.contribution_state.x, edited_ray.contribution_state.y, edited_ray.contribution_state.z) +
+                                             vec3(base_ray.contribution_state.x, base_ray.contribution_state.y, base_ray.contribution_state.z),
+                                         kShadowTrace);
+    base_ray = no_shadow_ray();
+  }
 }
 
 EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, vec3 throughput, uint strategy,
