@@ -65,14 +65,15 @@ TEST(PublishedEstimate, ARestartKeepsThePreviousValueUntilTheRefreshedOneHasLowe
   const LightmapEstimate previous = texel({1, 3, 2, 2});  // mean 2, V = 1/6
   // Nothing before: the refreshed estimate, even with one sample.
   EXPECT_NEAR(publish_restart(texel({}), texel({7})).mean_total(0)[0], 7.0, 1e-6);
-  // One refreshed sample: the previous value.
+  // Fewer than kRestartMinimumSamples refreshed samples: the previous value, even far from it.
   EXPECT_EQ(publish_restart(previous, texel({7})).texels[0].total[0], previous.texels[0].total[0]);
-  // Same mean, larger variance (V = 1): kept.
-  EXPECT_EQ(publish_restart(previous, texel({1, 3})).texels[0].total[0], previous.texels[0].total[0]);
+  EXPECT_EQ(publish_restart(previous, texel({9, 11, 9, 11, 9, 11, 10})).texels[0].total[0], previous.texels[0].total[0]);
+  // Same mean, larger variance (V = 4/7): kept.
+  EXPECT_EQ(publish_restart(previous, texel({0, 4, 0, 4, 0, 4, 0, 4})).texels[0].total[0], previous.texels[0].total[0]);
   // Same mean, smaller variance (V = 1/24 from 8 samples): refreshed.
   EXPECT_NEAR(publish_restart(previous, texel({1.5, 2.5, 2, 2, 1.5, 2.5, 2, 2})).variance_of_mean(0)[0], 1.0 / 56, 1e-6);
-  // Far from the previous value (mean 10, V = 1): the difference dwarfs both variances: refreshed.
-  EXPECT_NEAR(publish_restart(previous, texel({9, 11})).mean_total(0)[0], 10.0, 1e-6);
+  // Far from the previous value (mean 10): the difference dwarfs both variances: refreshed.
+  EXPECT_NEAR(publish_restart(previous, texel({9, 11, 9, 11, 9, 11, 9, 11})).mean_total(0)[0], 10.0, 1e-6);
 }
 
 }  // namespace

@@ -93,7 +93,7 @@ LightmapEstimate publish_restart(const LightmapEstimate& previous, const Lightma
     const TexelAccumulator& kept = previous.texels[i];
     const TexelAccumulator& fresh = refreshed.texels[i];
     if (kept.samples == 0) continue;  // nothing before: the refreshed estimate, whatever it has
-    if (fresh.samples < 2) {
+    if (fresh.samples < kRestartMinimumSamples) {
       copy_texel(previous, published, i);
       continue;
     }
