@@ -47,9 +47,9 @@ TEST(PublishedEstimate, AChangeIsPublishedOnlyWithTwoSamplesAndWhereItIsSignific
   const LightmapEstimate previous = texel({5, 5, 5, 5}), base = texel({1, 3, 2, 2});
   // One sample of the change: what the texel showed before the edit, bit for bit.
   EXPECT_EQ(publish_change(previous, base, texel({9})).texels[0].total[0], previous.texels[0].total[0]);
-  // Mean 0.5, V = 0.25 per channel: 3 * 0.25 <= 2 * 3 * 0.25, not significant: the base exactly.
-  EXPECT_EQ(publish_change(previous, base, texel({0, 1})).texels[0].total[0], base.texels[0].total[0]);
-  // Mean 5, V = 1: significant: base + change.
+  // Mean 2, V = 1 per channel: 3 * 4 <= 9 * 3 * 1, within 3 standard errors: the base exactly.
+  EXPECT_EQ(publish_change(previous, base, texel({1, 3})).texels[0].total[0], base.texels[0].total[0]);
+  // Mean 5, V = 1: 75 > 27, significant: base + change.
   EXPECT_NEAR(publish_change(previous, base, texel({4, 6})).mean_total(0)[0], 7.0, 1e-6);
   // A change exactly 0 (no edited light reaches the texel): the base exactly.
   EXPECT_EQ(publish_change(previous, base, texel({0, 0, 0})).texels[0].total[1], base.texels[0].total[1]);
@@ -61,7 +61,7 @@ TEST(PublishedEstimate, AChangeBaseNeedsVariances) {
   EXPECT_FALSE(can_be_change_base(texel({})));
 }
 
-TEST(PublishedEstimate, ARestartKeepsThePreviousValueUntilTheRefreshedOneHasLowerError) {
+TEST(PublishedEstimate, ARestartKeepsThePreviousValueUntilTheRefreshedOneIsMorePreciseOrSignificantlyDifferent) {
   const LightmapEstimate previous = texel({1, 3, 2, 2});  // mean 2, V = 1/6
   // Nothing before: the refreshed estimate, even with one sample.
   EXPECT_NEAR(publish_restart(texel({}), texel({7})).mean_total(0)[0], 7.0, 1e-6);
@@ -72,6 +72,8 @@ TEST(PublishedEstimate, ARestartKeepsThePreviousValueUntilTheRefreshedOneHasLowe
   EXPECT_EQ(publish_restart(previous, texel({0, 4, 0, 4, 0, 4, 0, 4})).texels[0].total[0], previous.texels[0].total[0]);
   // Same mean, smaller variance (V = 1/24 from 8 samples): refreshed.
   EXPECT_NEAR(publish_restart(previous, texel({1.5, 2.5, 2, 2, 1.5, 2.5, 2, 2})).variance_of_mean(0)[0], 1.0 / 56, 1e-6);
+  // Mean 2.9, V = 4/7: 3 * 0.81 < 9 * 3 * (1/6 + 4/7): not significant, less precise: kept.
+  EXPECT_EQ(publish_restart(previous, texel({0.9, 4.9, 0.9, 4.9, 0.9, 4.9, 0.9, 4.9})).texels[0].total[0], previous.texels[0].total[0]);
   // Far from the previous value (mean 10): the difference dwarfs both variances: refreshed.
   EXPECT_NEAR(publish_restart(previous, texel({9, 11, 9, 11, 9, 11, 9, 11})).mean_total(0)[0], 10.0, 1e-6);
 }

@@ -80,8 +80,8 @@ LightmapEstimate publish_change(const LightmapEstimate& previous, const Lightmap
       continue;
     }
     const Vec3 d = change.mean_total(i);
-    const double significant = double(d[0]) * d[0] + double(d[1]) * d[1] + double(d[2]) * d[2];
-    if (!(significant > 2 * channel_sum(change.variance_of_mean(i)))) copy_texel(base, published, i);
+    const double squared = double(d[0]) * d[0] + double(d[1]) * d[1] + double(d[2]) * d[2];
+    if (!(squared > kSignificance * kSignificance * channel_sum(change.variance_of_mean(i)))) copy_texel(base, published, i);
   }
   return published;
 }
@@ -102,8 +102,8 @@ LightmapEstimate publish_restart(const LightmapEstimate& previous, const Lightma
     for (int c = 0; c < 3; ++c) difference += (double(f[c]) - k[c]) * (double(f[c]) - k[c]);
     const double kept_variance = channel_sum(previous.variance_of_mean(i));
     const double fresh_variance = channel_sum(refreshed.variance_of_mean(i));
-    const double kept_error = kept_variance + std::max(0.0, difference - kept_variance - fresh_variance);
-    if (!(fresh_variance < kept_error)) copy_texel(previous, published, i);
+    const bool significant = difference > kSignificance * kSignificance * (kept_variance + fresh_variance);
+    if (!(fresh_variance < kept_variance || significant)) copy_texel(previous, published, i);
   }
   return published;
 }

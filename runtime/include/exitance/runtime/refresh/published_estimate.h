@@ -1,16 +1,23 @@
 // What a texel publishes while the runtime refreshes (docs/runtime.md "Never worse than before the
-// edit"): of the estimates it has, the one with the lower estimated error. The value a texel showed
-// before an edit is an estimate of the edited scene too, biased by the change, so it is kept until
-// the refreshed estimate is measurably better:
-//   error(kept) = V_kept + max(0, |D|^2 - V_D),  error(refreshed) = V_refreshed,
-// with D = refreshed - kept and V_D its variance, summed over the colour channels, and V the
-// variances of the means. The refreshed estimate needs 2 samples (a variance) to be chosen.
+// edit"). The value a texel showed before an edit is an estimate of the edited scene too, exact
+// where the edit changed nothing there and biased by the change elsewhere; the refreshed estimate is
+// unbiased but noisy. A texel keeps its previous value unless the refreshed estimate is the more
+// precise one or differs from it significantly: |D|^2 > kSignificance^2 V_D, with D the difference
+// of the two, V_D its variance (variances of the mean, summed over the colour channels). Choosing by
+// the lower estimated error instead (V_kept + max(0, |D|^2 - V_D) against V_refreshed) switched
+// about a sixth of the unchanged texels to the noisy estimate (H200, city block moved: relMSE 0.0066
+// after 60 frames against 0.0036 after 20; bench/results/refresh-change.md). The refreshed estimate
+// needs 2 samples (a change) or kRestartMinimumSamples (a restart) first.
 // Estimates are LightmapEstimate sums; a composite's sums are synthesized to give its mean and
 // variance of the mean exactly (so the bundle's error layer and relMSE estimates read it as usual).
 #pragma once
 #include "exitance/runtime/core/estimates.h"
 
 namespace exitance {
+
+// Standard errors of the difference beyond which a refreshed estimate replaces a kept value (3: an
+// unchanged texel switches about 0.3 % of the time for Gaussian noise).
+constexpr double kSignificance = 3.0;
 
 // base + change per texel (the change estimate of RefreshSession's light edits, path.h
 // punctual_change_rays, is an unbiased estimate of E/pi(edited) - E/pi(base)): means and every
@@ -26,8 +33,8 @@ bool can_be_change_base(const LightmapEstimate& estimate);
 
 // After a light edit estimated as a change from `base`: per texel, `previous` (what it showed before
 // the edit) while the change has fewer than 2 samples, then base + change where the change is
-// significant (|d|^2 > 2 V_d summed over channels: the rule above, with kept = base and
-// D = d sharing the base), else base.
+// significant (|d|^2 > kSignificance^2 V_d summed over channels: the rule above, with kept = base
+// and D = d sharing the base), else base.
 LightmapEstimate publish_change(const LightmapEstimate& previous, const LightmapEstimate& base, const LightmapEstimate& change);
 
 // After any other edit (or none, from a bundle's baked lighting): `refreshed` is accumulated from
