@@ -67,7 +67,12 @@ TEST(PublishedEstimate, ARestartKeepsThePreviousValueUntilTheRefreshedOneIsMoreP
   EXPECT_NEAR(publish_restart(texel({}), texel({7})).mean_total(0)[0], 7.0, 1e-6);
   // Fewer than kRestartMinimumSamples refreshed samples: the previous value, even far from it.
   EXPECT_EQ(publish_restart(previous, texel({7})).texels[0].total[0], previous.texels[0].total[0]);
-  EXPECT_EQ(publish_restart(previous, texel({9, 11, 9, 11, 9, 11, 10})).texels[0].total[0], previous.texels[0].total[0]);
+  const LightmapEstimate eight = texel({1, 3, 2, 2, 1, 3, 2, 2});
+  EXPECT_EQ(publish_restart(eight, texel({9, 11, 9, 11, 9, 11, 10})).texels[0].total[0], eight.texels[0].total[0]);
+  // A kept value of 4 samples is replaced after 4 refreshed ones, where they differ significantly.
+  const LightmapEstimate four = texel({1, 3, 1, 3});  // mean 2, V = 1/3
+  EXPECT_NEAR(publish_restart(four, texel({9, 11, 9, 11})).mean_total(0)[0], 10.0, 1e-6);
+  EXPECT_EQ(publish_restart(four, texel({9, 11, 10})).texels[0].total[0], four.texels[0].total[0]);
   // Same mean, larger variance (V = 4/7): kept.
   EXPECT_EQ(publish_restart(previous, texel({0, 4, 0, 4, 0, 4, 0, 4})).texels[0].total[0], previous.texels[0].total[0]);
   // Same mean, smaller variance (V = 1/24 from 8 samples): refreshed.

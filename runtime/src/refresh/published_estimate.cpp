@@ -93,7 +93,9 @@ LightmapEstimate publish_restart(const LightmapEstimate& previous, const Lightma
     const TexelAccumulator& kept = previous.texels[i];
     const TexelAccumulator& fresh = refreshed.texels[i];
     if (kept.samples == 0) continue;  // nothing before: the refreshed estimate, whatever it has
-    if (fresh.samples < kRestartMinimumSamples) {
+    // Enough samples to trust the refreshed variance, but never more than the kept value had (an
+    // object moved every frame, refreshed a few samples per frame, must still show its moves).
+    if (fresh.samples < std::max(2u, std::min(kRestartMinimumSamples, kept.samples))) {
       copy_texel(previous, published, i);
       continue;
     }

@@ -39,8 +39,10 @@ LightmapEstimate publish_change(const LightmapEstimate& previous, const Lightmap
 
 // After any other edit (or none, from a bundle's baked lighting): `refreshed` is accumulated from
 // nothing, independent of `previous`: per texel the rule above with V_D = V_previous + V_refreshed,
-// once it has kRestartMinimumSamples (a variance from 2 samples is below a tenth of the true one a
-// quarter of the time, and the rule would then trade a converged value for a 2-sample one);
+// once it has kRestartMinimumSamples, or as many as the kept value had if that is fewer (at least
+// 2): a variance from 2 samples is below a tenth of the true one a quarter of the time, and the
+// rule would then trade a converged value for a 2-sample one, while an object moved every frame
+// and refreshed a few samples per frame must still show its moves;
 // texels that had nothing before show the refreshed estimate.
 constexpr uint32_t kRestartMinimumSamples = 8;
 LightmapEstimate publish_restart(const LightmapEstimate& previous, const LightmapEstimate& refreshed);
