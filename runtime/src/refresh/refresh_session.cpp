@@ -65,11 +65,12 @@ struct RefreshSession::State {
   uint32_t near_samples = 0, far_samples = 0, all_samples = 0;
   // What texels showed before the last edit (published_lightmap keeps it until the refreshed
   // estimate is better; published_estimate.h); at open, the bundle's baked lightmap.
-  std::optional<LightmapEstimate> previous;
+  // Shared with `base` when a light edit starts a change estimate (the same 100-odd MB at 1 M texels).
+  std::shared_ptr<const LightmapEstimate> previous;
   // After edits that changed punctual lights only: the estimate the accumulation's change is added
   // to (what was published before the first of them), the punctual lights as they were then, and
   // how many changed lights the accumulation estimates (0: the accumulation is E/pi itself).
-  std::optional<LightmapEstimate> base;
+  std::shared_ptr<const LightmapEstimate> base;
   std::vector<GpuPunctualLight> base_lights;
   uint32_t changed_lights = 0;
   bool started_from_baked = false;  // previous was the bundle's baked lightmap at open
@@ -78,6 +79,16 @@ struct RefreshSession::State {
   std::optional<LightmapEstimate> per_bounce;
   bool whole_run_path = false;    // per_bounce holds a bake_guided() or bake_path() result (path tracing)
   bool whole_run_guided = false;  // per_bounce holds a bake_guided() result
+
+  // What a new accumulation (restart or change estimate) starts without: a whole run's result and
+  // every texel list's samples.
+  void clear_accumulation() {
+    per_bounce.reset();
+    whole_run_path = whole_run_guided = false;
+    near_texels.clear();
+    far_texels.clear();
+    near_samples = far_samples = all_samples = 0;
+  }
 };
 
 namespace {
@@ -140,9 +151,10 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   state->integrator->start_progressive(state->persisted.gbuffer, settings);
   if (options.start_from_baked) {
     try {
-      state->previous = read_baked_lightmap(bundle_folder, manifest, state->persisted.gbuffer,
-                                            std::clamp(settings.recorded_bounces, 1, int(kMaxRecordedLayers)));
-      state->started_from_baked = state->previous.has_value();
+      std::optional<LightmapEstimate> baked = read_baked_lightmap(
+          bundle_folder, manifest, state->persisted.gbuffer, std::clamp(settings.recorded_bounces, 1, int(kMaxRecordedLayers)));
+      if (baked) state->previous = std::make_shared<const LightmapEstimate>(std::move(*baked));
+      state->started_from_baked = state->previous != nullptr;
     } catch (const std::runtime_error& e) {
       throw BundleInputError(e.what());
     }
@@ -175,10 +187,10 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
         pairs.push_back(lighting.punctual_lights[i]);
         pairs.push_back(base_lights[i]);
       }
-  LightmapEstimate published = published_lightmap();  // what texels show until refreshed again
+  auto published = std::make_shared<const LightmapEstimate>(published_lightmap());  // shown until refreshed again
   // A base needs variances: after opening without the baked lightmap and before any refresh, restart.
   const bool as_change = lights_only && !pairs.empty() && pairs.size() / 2 <= kMaxChangedLights &&
-                         (s.base || can_be_change_base(published));
+                         (s.base || can_be_change_base(*published));
 
   if (effects.geometry_changed()) {
     s.integrator->update_geometry(lighting);
@@ -197,13 +209,9 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   s.lighting = std::make_shared<const LightingScene>(std::move(lighting));
   s.scene_file.reset();  // encoded again from the edited scene when a bundle is written
   if (as_change) {
-    s.per_bounce.reset();
-    s.whole_run_path = s.whole_run_guided = false;
+    s.clear_accumulation();
     s.integrator->start_progressive_change(s.persisted.gbuffer, s.settings, *s.lighting, pairs);
     s.changed_lights = uint32_t(pairs.size() / 2);
-    s.near_texels.clear();
-    s.far_texels.clear();
-    s.near_samples = s.far_samples = s.all_samples = 0;
   } else {
     restart();  // moved texels are uploaded again with the rest
   }
@@ -222,7 +230,7 @@ void RefreshSession::end_change_estimate() {
   State& s = *state_;
   if (!s.base) return;
   // What the change estimate published is what texels show until refreshed again.
-  s.previous = published_lightmap();
+  s.previous = std::make_shared<const LightmapEstimate>(published_lightmap());
   s.base.reset();
   s.base_lights.clear();
   s.changed_lights = 0;
@@ -231,12 +239,8 @@ void RefreshSession::end_change_estimate() {
 void RefreshSession::restart() {
   State& s = *state_;
   end_change_estimate();
-  s.per_bounce.reset();
-  s.whole_run_path = s.whole_run_guided = false;
+  s.clear_accumulation();
   s.integrator->start_progressive(s.persisted.gbuffer, s.settings);
-  s.near_texels.clear();
-  s.far_texels.clear();
-  s.near_samples = s.far_samples = s.all_samples = 0;
 }
 
 const std::vector<uint32_t>& RefreshSession::texels_near_last_edit() const { return state_->last_edit_near; }
