@@ -1,6 +1,7 @@
 #include "exitance/runtime/refresh/baked_lightmap.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <stdexcept>
@@ -8,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "exitance/formats/lightmap_exr.h"
+#include "exitance/runtime/refresh/published_estimate.h"
 
 namespace exitance {
 
@@ -32,7 +34,10 @@ std::optional<LightmapEstimate> read_baked_lightmap(const std::string& bundle, c
   if (!(floor >= 0)) return std::nullopt;
 
   std::vector<formats::LightmapImage> pages;
+  // Per page, the channels read per texel: R, G, B, direct.R, direct.G, direct.B, error.Y, and valid
+  // (null when the page has none).
   const char* needed[] = {"R", "G", "B", "direct.R", "direct.G", "direct.B", "error.Y"};
+  std::vector<std::array<const float*, 8>> channels;
   for (size_t p = 0; p < manifest.pages.size(); ++p) {
     const std::string path = (fs::path(bundle) / manifest.pages[p].file).string();
     pages.push_back(formats::read_lightmap_exr(path));
@@ -41,8 +46,14 @@ std::optional<LightmapEstimate> read_baked_lightmap(const std::string& bundle, c
       throw std::runtime_error(path + ": " + std::to_string(image.width) + "x" + std::to_string(image.height) +
                                " pixels, but scene.bin's atlas page " + std::to_string(p) + " has " +
                                std::to_string(gbuffer.pages[p].width) + "x" + std::to_string(gbuffer.pages[p].height));
-    for (const char* name : needed)
-      if (!image.channels.count(name)) return std::nullopt;
+    std::array<const float*, 8>& page = channels.emplace_back();
+    for (size_t k = 0; k < 7; ++k) {
+      const auto found = image.channels.find(needed[k]);
+      if (found == image.channels.end()) return std::nullopt;
+      page[k] = found->second.data();
+    }
+    const auto valid = image.channels.find("valid");
+    page[7] = valid == image.channels.end() ? nullptr : valid->second.data();
   }
 
   LightmapEstimate estimate;
@@ -50,32 +61,33 @@ std::optional<LightmapEstimate> read_baked_lightmap(const std::string& bundle, c
   estimate.recorded_bounces = recorded_bounces;
   estimate.texels.resize(n);
   estimate.bounces.assign(size_t(recorded_bounces) * n * 3, 0.0);
-  const double m = std::floor(minimum);
+  const uint32_t m = uint32_t(minimum);
   for (size_t i = 0; i < n; ++i) {
     const LiveTexel& texel = gbuffer.texels[i];
-    const formats::LightmapImage& page = pages[texel.page];
-    const size_t at = size_t(texel.y) * size_t(page.width) + size_t(texel.x);
+    const std::array<const float*, 8>& page = channels[texel.page];
+    const size_t at = size_t(texel.y) * size_t(pages[texel.page].width) + size_t(texel.x);
     // Sealed texels the bake skipped hold dilated neighbours, not estimates: nothing to start from.
-    const auto valid = page.channels.find("valid");
-    if (valid != page.channels.end() && !(valid->second[at] > 0)) continue;
-    const Vec3 total{page.channels.at("R")[at], page.channels.at("G")[at], page.channels.at("B")[at]};
-    const Vec3 direct{page.channels.at("direct.R")[at], page.channels.at("direct.G")[at], page.channels.at("direct.B")[at]};
-    const double relative = page.channels.at("error.Y")[at];
+    if (page[7] && !(page[7][at] > 0)) continue;
+    const Vec3 total{page[0][at], page[1][at], page[2][at]};
+    const Vec3 direct{page[3][at], page[4][at], page[5][at]};
+    const double relative = page[6][at];
     bool finite = std::isfinite(relative) && relative >= 0;
     for (int c = 0; c < 3; ++c) finite = finite && std::isfinite(total[c]) && std::isfinite(direct[c]);
     if (!finite) continue;
     const double y = std::max(0.0f, luminance(total));
     const double se = relative * (y + floor);
-    TexelAccumulator& t = estimate.texels[i];
-    t.samples = uint32_t(m);
+    double mean[3], variance[3];
     for (int c = 0; c < 3; ++c) {
       // The luminance's relative error for every channel (error.Y is all the bundle keeps).
-      const double variance = y > 0 ? se * se * (double(total[c]) / y) * (double(total[c]) / y) : se * se;
-      t.total[c] = m * total[c];
-      t.total_squared[c] = m * double(total[c]) * total[c] + m * (m - 1) * variance;
-      t.direct[c] = m * direct[c];
-      estimate.bounces[i * 3 + size_t(c)] = m * direct[c];
-      if (recorded_bounces > 1) estimate.bounces[(n + i) * 3 + size_t(c)] = m * (double(total[c]) - direct[c]);
+      mean[c] = total[c];
+      variance[c] = y > 0 ? se * se * (double(total[c]) / y) * (double(total[c]) / y) : se * se;
+    }
+    TexelAccumulator& t = estimate.texels[i];
+    set_total_sums(t, m, mean, variance);
+    for (int c = 0; c < 3; ++c) {
+      t.direct[c] = double(m) * direct[c];
+      estimate.bounces[i * 3 + size_t(c)] = double(m) * direct[c];
+      if (recorded_bounces > 1) estimate.bounces[(n + i) * 3 + size_t(c)] = double(m) * (double(total[c]) - direct[c]);
     }
   }
   return estimate;

@@ -25,6 +25,15 @@ void copy_texel(const LightmapEstimate& from, LightmapEstimate& to, size_t i) {
 
 }  // namespace
 
+void set_total_sums(TexelAccumulator& texel, uint32_t samples, const double mean[3], const double variance_of_mean[3]) {
+  const double n = samples;
+  texel.samples = samples;
+  for (int c = 0; c < 3; ++c) {
+    texel.total[c] = n * mean[c];
+    texel.total_squared[c] = n * mean[c] * mean[c] + n * (n - 1) * variance_of_mean[c];
+  }
+}
+
 LightmapEstimate add_change(const LightmapEstimate& base, const LightmapEstimate& change) {
   check_shapes(base, change, "add_change");
   LightmapEstimate sum = base;
@@ -37,19 +46,18 @@ LightmapEstimate add_change(const LightmapEstimate& base, const LightmapEstimate
       sum.texels[i] = TexelAccumulator{};
       continue;
     }
-    // Sums over `m` samples whose mean is the sum of the means and whose variance of the mean is
-    // the sum of the variances: total = m * mean, total_squared = m * mean^2 + m (m - 1) V.
+    // Over the two's samples: the mean is the sum of the means, the variance of the mean the sum of
+    // the variances.
     const double m = double(b.samples) + double(d.samples);
     const Vec3 vb = base.variance_of_mean(i), vd = change.variance_of_mean(i);
-    TexelAccumulator& t = sum.texels[i];
+    double mean[3], variance[3];
     for (int c = 0; c < 3; ++c) {
-      const double mean = b.total[c] / b.samples + d.total[c] / d.samples;
-      const double variance = double(vb[c]) + double(vd[c]);
-      t.total[c] = m * mean;
-      t.total_squared[c] = m * mean * mean + m * (m - 1) * variance;
-      t.direct[c] = m * (b.direct[c] / b.samples + d.direct[c] / d.samples);
+      mean[c] = b.total[c] / b.samples + d.total[c] / d.samples;
+      variance[c] = double(vb[c]) + double(vd[c]);
     }
-    t.samples = uint32_t(m);
+    TexelAccumulator& t = sum.texels[i];
+    set_total_sums(t, uint32_t(m), mean, variance);
+    for (int c = 0; c < 3; ++c) t.direct[c] = m * (b.direct[c] / b.samples + d.direct[c] / d.samples);
     for (int k = 0; k < base.recorded_bounces; ++k)
       for (size_t c = 0; c < 3; ++c) {
         const size_t at = (size_t(k) * n + i) * 3 + c;
