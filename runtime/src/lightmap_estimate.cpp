@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "exitance/common/publishing_rule.h"
 #include "exitance/runtime/core/estimates.h"
 
 namespace exitance {
@@ -38,12 +39,7 @@ Vec3 LightmapEstimate::variance_of_mean(size_t texel) const {
   const TexelAccumulator& a = texels[texel];
   if (a.samples < 2) return {0, 0, 0};
   Vec3 v;
-  for (int c = 0; c < 3; ++c) {
-    const double n = a.samples;
-    const double mean = a.total[c] / n;
-    const double sample_variance = std::max(0.0, (a.total_squared[c] - n * mean * mean) / (n - 1));
-    v[c] = float(sample_variance / n);
-  }
+  for (int c = 0; c < 3; ++c) v[c] = variance_of_mean_from_sums(a.total[c], a.total_squared[c], a.samples);
   return v;
 }
 

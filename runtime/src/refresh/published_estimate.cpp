@@ -83,13 +83,12 @@ LightmapEstimate publish_change(const LightmapEstimate& previous, const Lightmap
   check_shapes(previous, change, "publish_change");
   LightmapEstimate published = add_change(base, change);
   for (size_t i = 0; i < change.texels.size(); ++i) {
-    if (change.texels[i].samples < 2 || base.texels[i].samples == 0) {
-      copy_texel(previous, published, i);
-      continue;
-    }
     const Vec3 d = change.mean_total(i);
     const double squared = double(d[0]) * d[0] + double(d[1]) * d[1] + double(d[2]) * d[2];
-    if (!(squared > kSignificance * kSignificance * channel_sum(change.variance_of_mean(i)))) copy_texel(base, published, i);
+    const uint32_t choice = publish_after_change(base.texels[i].samples, change.texels[i].samples, squared,
+                                                 channel_sum(change.variance_of_mean(i)));
+    if (choice == kPublishPrevious) copy_texel(previous, published, i);
+    if (choice == kPublishBase) copy_texel(base, published, i);
   }
   return published;
 }
@@ -98,22 +97,13 @@ LightmapEstimate publish_restart(const LightmapEstimate& previous, const Lightma
   check_shapes(previous, refreshed, "publish_restart");
   LightmapEstimate published = refreshed;
   for (size_t i = 0; i < refreshed.texels.size(); ++i) {
-    const TexelAccumulator& kept = previous.texels[i];
-    const TexelAccumulator& fresh = refreshed.texels[i];
-    if (kept.samples == 0) continue;  // nothing before: the refreshed estimate, whatever it has
-    // Enough samples to trust the refreshed variance, but never more than the kept value had (an
-    // object moved every frame, refreshed a few samples per frame, must still show its moves).
-    if (fresh.samples < std::max(2u, std::min(kRestartMinimumSamples, kept.samples))) {
-      copy_texel(previous, published, i);
-      continue;
-    }
     const Vec3 k = previous.mean_total(i), f = refreshed.mean_total(i);
     double difference = 0;
     for (int c = 0; c < 3; ++c) difference += (double(f[c]) - k[c]) * (double(f[c]) - k[c]);
-    const double kept_variance = channel_sum(previous.variance_of_mean(i));
-    const double fresh_variance = channel_sum(refreshed.variance_of_mean(i));
-    const bool significant = difference > kSignificance * kSignificance * (kept_variance + fresh_variance);
-    if (!(fresh_variance < kept_variance || significant)) copy_texel(previous, published, i);
+    const uint32_t choice =
+        publish_after_restart(previous.texels[i].samples, refreshed.texels[i].samples, difference,
+                              channel_sum(previous.variance_of_mean(i)), channel_sum(refreshed.variance_of_mean(i)));
+    if (choice == kPublishPrevious) copy_texel(previous, published, i);
   }
   return published;
 }

@@ -64,13 +64,14 @@ struct RefreshSession::State {
   std::vector<uint32_t> last_edit_near;  // near_texels of the last edit, kept after the others caught up
   uint32_t near_samples = 0, far_samples = 0, all_samples = 0;
   // What texels showed before the last edit (published_lightmap keeps it until the refreshed
-  // estimate is better; published_estimate.h); at open, the bundle's baked lightmap.
-  // Shared with `base` when a light edit starts a change estimate (the same 100-odd MB at 1 M texels).
-  std::shared_ptr<const LightmapEstimate> previous;
+  // estimate is better; published_estimate.h); at open, the bundle's baked lightmap. In device
+  // memory (VulkanIntegrator::publish composes what is published there); shared with `base` when a
+  // light edit starts a change estimate.
+  std::shared_ptr<DeviceLightmap> previous;
   // After edits that changed punctual lights only: the estimate the accumulation's change is added
   // to (what was published before the first of them), the punctual lights as they were then, and
   // how many changed lights the accumulation estimates (0: the accumulation is E/pi itself).
-  std::shared_ptr<const LightmapEstimate> base;
+  std::shared_ptr<DeviceLightmap> base;
   std::vector<GpuPunctualLight> base_lights;
   uint32_t changed_lights = 0;
   bool started_from_baked = false;  // previous was the bundle's baked lightmap at open
@@ -153,7 +154,7 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
     try {
       std::optional<LightmapEstimate> baked = read_baked_lightmap(
           bundle_folder, manifest, state->persisted.gbuffer, std::clamp(settings.recorded_bounces, 1, int(kMaxRecordedLayers)));
-      if (baked) state->previous = std::make_shared<const LightmapEstimate>(std::move(*baked));
+      if (baked) state->previous = state->integrator->upload_lightmap(*baked);
       state->started_from_baked = state->previous != nullptr;
     } catch (const std::runtime_error& e) {
       throw BundleInputError(e.what());
@@ -187,10 +188,11 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
         pairs.push_back(lighting.punctual_lights[i]);
         pairs.push_back(base_lights[i]);
       }
-  auto published = std::make_shared<const LightmapEstimate>(published_lightmap());  // shown until refreshed again
+  // What is shown until refreshed again, kept on the device.
+  const PublishedLightmap published = publish_on_device();
   // A base needs variances: after opening without the baked lightmap and before any refresh, restart.
   const bool as_change = lights_only && !pairs.empty() && pairs.size() / 2 <= kMaxChangedLights &&
-                         (s.base || can_be_change_base(*published));
+                         (s.base || (published.single_sample_texels == 0 && published.sampled_texels > 0));
 
   if (effects.geometry_changed()) {
     s.integrator->update_geometry(lighting);
@@ -201,10 +203,10 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   std::vector<uint32_t> near = texels_near_change(edited, s.persisted.scene, lighting, effects);
   s.last_edit_near.clear();
   if (as_change && !s.base) {
-    s.base = published;
+    s.base = published.lightmap;
     s.base_lights = s.lighting->punctual_lights;
   }
-  s.previous = std::move(published);
+  s.previous = published.lightmap;
   s.persisted = std::move(edited);
   s.lighting = std::make_shared<const LightingScene>(std::move(lighting));
   s.scene_file.reset();  // encoded again from the edited scene when a bundle is written
@@ -230,7 +232,7 @@ void RefreshSession::end_change_estimate() {
   State& s = *state_;
   if (!s.base) return;
   // What the change estimate published is what texels show until refreshed again.
-  s.previous = std::make_shared<const LightmapEstimate>(published_lightmap());
+  s.previous = publish_on_device().lightmap;
   s.base.reset();
   s.base_lights.clear();
   s.changed_lights = 0;
@@ -403,27 +405,44 @@ bool RefreshSession::guided() const { return state_->per_bounce.has_value() && s
 
 LightmapEstimate RefreshSession::refreshed_lightmap() const {
   const State& s = *state_;
-  return s.base ? add_change(*s.base, lightmap()) : lightmap();
+  return s.base ? add_change(s.integrator->read_lightmap(*s.base), lightmap()) : lightmap();
 }
 
 uint32_t RefreshSession::changed_lights() const { return state_->changed_lights; }
 bool RefreshSession::started_from_baked() const { return state_->started_from_baked; }
 
-LightmapEstimate RefreshSession::published_lightmap() const {
-  LightmapEstimate estimate = lightmap();
+PublishedLightmap RefreshSession::publish_on_device() const {
   const State& s = *state_;
-  if (s.base) return publish_change(s.previous ? *s.previous : *s.base, *s.base, estimate);
-  if (!s.previous || s.previous->texels.size() != estimate.texels.size() ||
-      s.previous->recorded_bounces != estimate.recorded_bounces || s.previous->has_sh1() != estimate.has_sh1())
+  if (s.per_bounce) {  // a whole run's result is on the host
+    const LightmapEstimate estimate = published_lightmap();
+    PublishedLightmap published;
+    for (const TexelAccumulator& t : estimate.texels) {
+      published.single_sample_texels += t.samples == 1;
+      published.sampled_texels += t.samples >= 2;
+    }
+    published.lightmap = s.integrator->upload_lightmap(estimate);
+    return published;
+  }
+  if (s.base) return s.integrator->publish(PublishMode::Change, s.previous ? s.previous.get() : s.base.get(), s.base.get());
+  return s.integrator->publish(s.previous ? PublishMode::Restart : PublishMode::Accumulation, s.previous.get(), nullptr);
+}
+
+LightmapEstimate RefreshSession::published_lightmap() const {
+  const State& s = *state_;
+  if (!s.per_bounce) return s.integrator->read_lightmap(*publish_on_device().lightmap);
+  LightmapEstimate estimate = *s.per_bounce;
+  if (!s.previous) return estimate;
+  const LightmapEstimate previous = s.integrator->read_lightmap(*s.previous);
+  if (previous.texels.size() != estimate.texels.size() || previous.recorded_bounces != estimate.recorded_bounces ||
+      previous.has_sh1() != estimate.has_sh1())
     return estimate;
-  if (!s.per_bounce) return publish_restart(*s.previous, estimate);
   // A whole run (bake_per_bounce, bake_guided, bake_path) is a bake: shown wherever it has samples.
   const size_t n = estimate.texels.size();
   for (size_t i = 0; i < n; ++i) {
     if (estimate.texels[i].samples > 0) continue;
-    estimate.texels[i] = s.previous->texels[i];
+    estimate.texels[i] = previous.texels[i];
     for (int k = 0; k < estimate.recorded_bounces; ++k)
-      for (int c = 0; c < 3; ++c) estimate.bounces[(size_t(k) * n + i) * 3 + size_t(c)] = s.previous->bounces[(size_t(k) * n + i) * 3 + size_t(c)];
+      for (int c = 0; c < 3; ++c) estimate.bounces[(size_t(k) * n + i) * 3 + size_t(c)] = previous.bounces[(size_t(k) * n + i) * 3 + size_t(c)];
   }
   return estimate;
 }

@@ -143,7 +143,8 @@ LightmapDriver::ReadBackSpace LightmapDriver::read_back_space(size_t host_texels
   return space;
 }
 
-LightmapEstimate LightmapDriver::download(const Accumulation& a, const Runs* only, ReadBackSpace space, bool packed) {
+LightmapEstimate LightmapDriver::download(const Accumulation& a, const Runs* only, ReadBackSpace space, bool packed,
+                                          const TexelAccumulators* from) {
   const size_t texel_count = a.texel_count;
   const Runs all{{0, texel_count}};
   const Runs& runs = only ? *only : all;
@@ -162,7 +163,7 @@ LightmapEstimate LightmapDriver::download(const Accumulation& a, const Runs* onl
   const Buffer* staging = space.staging.handle() ? &space.staging : nullptr;
   if (texel_count > 0) {
     Context& context = runner_.context();
-    const WavefrontBuffers& buffers = runner_.buffers();
+    const TexelAccumulators& sums = from ? *from : runner_.buffers().texels;
     // The runs' bytes of a per-texel array of `texel_bytes` per texel starting at byte `base`.
     auto ranges = [&runs](size_t texel_bytes, size_t base) {
       std::vector<ByteRange> r;
@@ -183,10 +184,10 @@ LightmapEstimate LightmapDriver::download(const Accumulation& a, const Runs* onl
     std::vector<ByteRange> layers;
     for (int k = 0; k < a.recorded; ++k)
       for (const ByteRange& r : ranges(24, size_t(k) * texel_count * 24)) layers.push_back(r);
-    context.read_back_ranges(buffers.texels.bounce_sums, layers, [&](const char* bytes) {
+    context.read_back_ranges(sums.bounce_sums, layers, [&](const char* bytes) {
       place(reinterpret_cast<char*>(estimate.bounces.data()), 24, a.recorded, bytes);
     }, staging);
-    context.read_back_ranges(buffers.texels.sums, ranges(48, 0), [&](const char* bytes) {
+    context.read_back_ranges(sums.sums, ranges(48, 0), [&](const char* bytes) {
       const double* sums = reinterpret_cast<const double*>(bytes);
       for (size_t k = 0; k < runs.size(); ++k)
         for (size_t i = to[k], end = to[k] + runs[k].second - runs[k].first; i < end; ++i, sums += 6) {
@@ -198,13 +199,13 @@ LightmapEstimate LightmapDriver::download(const Accumulation& a, const Runs* onl
           }
         }
     }, staging);
-    context.read_back_ranges(buffers.texels.samples, ranges(4, 0), [&](const char* bytes) {
+    context.read_back_ranges(sums.samples, ranges(4, 0), [&](const char* bytes) {
       const uint32_t* samples = reinterpret_cast<const uint32_t*>(bytes);
       for (size_t k = 0; k < runs.size(); ++k)
         for (size_t i = to[k], end = to[k] + runs[k].second - runs[k].first; i < end; ++i) estimate.texels[i].samples = *samples++;
     }, staging);
     if (a.directional)  // L1 sums: 9 doubles per texel after the 6 of every texel
-      context.read_back_ranges(buffers.texels.sums, ranges(72, texel_count * 48), [&](const char* bytes) {
+      context.read_back_ranges(sums.sums, ranges(72, texel_count * 48), [&](const char* bytes) {
         place(reinterpret_cast<char*>(estimate.sh1.data()), 72, 1, bytes);
       }, staging);
   }
@@ -457,6 +458,22 @@ uint64_t LightmapDriver::add_samples_to(const std::vector<uint32_t>& texels, uin
 LightmapEstimate LightmapDriver::read() {
   if (!progressive_) throw std::logic_error("Vulkan backend: progressive_estimate before start_progressive");
   return download(*progressive_);
+}
+
+LightmapEstimate LightmapDriver::read(const DeviceLightmap& lightmap) {
+  // The shape, with the progressive accumulation's rays, seconds and counters (what is published
+  // was composed from it).
+  Accumulation a;
+  if (progressive_) a.totals = progressive_->totals, a.seconds = progressive_->seconds;
+  a.texel_count = lightmap.texels;
+  a.recorded = lightmap.layers;
+  a.directional = lightmap.directional;
+  return download(a, nullptr, {}, false, &lightmap.sums);
+}
+
+LightmapDriver::Shape LightmapDriver::shape() const {
+  if (!progressive_) throw std::logic_error("Vulkan backend: publishing before start_progressive");
+  return {progressive_->texel_count, progressive_->recorded, progressive_->directional};
 }
 
 }  // namespace exitance::vulkan

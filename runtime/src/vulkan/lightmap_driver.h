@@ -14,6 +14,7 @@
 #include "exitance/runtime/core/integrator_settings.h"
 #include "exitance/runtime/core/lighting_scene.h"
 #include "exitance/runtime/texel_gbuffer.h"
+#include "device_lightmaps.h"
 #include "wavefront_batch.h"
 
 namespace exitance::vulkan {
@@ -43,6 +44,16 @@ class LightmapDriver {
   // G-buffer, each at most once); the caller keeps each texel's count. Returns the rays traced.
   uint64_t add_samples_to(const std::vector<uint32_t>& texels, uint32_t first_sample, uint32_t samples);
   LightmapEstimate read();
+  // The sums of a device estimate (device_lightmaps.h), read back, with the progressive
+  // accumulation's rays, seconds and counters.
+  LightmapEstimate read(const DeviceLightmap& lightmap);
+  // The accumulation's texels, recorded layers and L1 sums; throws std::logic_error before a start.
+  struct Shape {
+    size_t texels = 0;
+    int layers = 1;
+    bool directional = false;
+  };
+  Shape shape() const;
   bool started() const { return progressive_.has_value(); }
   // Another bake takes the texel buffers (the per-bounce mode): the progressive accumulation ends.
   void end_progressive() { progressive_.reset(); }
@@ -81,7 +92,9 @@ class LightmapDriver {
   // The sums read back into `space` (sized here when it does not fit); `only`: just these runs
   // [first, end) of texels (a rank's own), in place among all texels (the others' left zero) or,
   // `packed`, run after run in arrays of the runs' texels alone; null: every texel.
-  LightmapEstimate download(const Accumulation& a, const Runs* only = nullptr, ReadBackSpace space = {}, bool packed = false);
+  // `from`: another estimate's buffers shaped as `a` (default: the accumulation's).
+  LightmapEstimate download(const Accumulation& a, const Runs* only = nullptr, ReadBackSpace space = {}, bool packed = false,
+                            const TexelAccumulators* from = nullptr);
   // The texels of `work_list` whose relative standard error is still above the target.
   std::vector<uint32_t> unconverged(const std::vector<uint32_t>& work_list, size_t texel_count, double target);
 

@@ -4,9 +4,11 @@
 // the core's host loop (core/per_bounce_bake.h) over this backend's layer estimator (bounce_layer_driver.h).
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 
+#include <optional>
 #include <stdexcept>
 
 #include "bounce_layer_driver.h"
+#include "device_lightmaps.h"
 #include "exitance/runtime/core/grid_guiding_cache.h"
 #include "exitance/runtime/core/per_bounce_bake.h"
 #include "gpu_scene.h"
@@ -46,6 +48,7 @@ struct VulkanIntegrator::Impl {
   WavefrontBatchRunner runner;
   LightmapDriver lightmap;
   ProbeDriver probes;
+  std::optional<LightmapPublisher> publisher;  // made at the first publish or upload
   // The per-bounce gather reads each triangle's instance and lightmap UVs from here (shared, not a
   // reference to the caller's scene); update_geometry keeps it current.
   std::shared_ptr<const Scene> source;
@@ -126,6 +129,29 @@ uint64_t VulkanIntegrator::add_samples_to(const std::vector<uint32_t>& texels, u
   return impl_->lightmap.add_samples_to(texels, first_sample, samples);
 }
 LightmapEstimate VulkanIntegrator::progressive_estimate() const { return impl_->lightmap.read(); }
+
+PublishedLightmap VulkanIntegrator::publish(PublishMode mode, const DeviceLightmap* previous, const DeviceLightmap* base) {
+  const LightmapDriver::Shape shape = impl_->lightmap.shape();
+  // An estimate of another shape (a whole run's, with other recorded layers) is nothing to keep.
+  auto fits = [&](const DeviceLightmap* e) {
+    return e && e->texels == shape.texels && e->layers == shape.layers && e->directional == shape.directional;
+  };
+  if (mode == PublishMode::Change && !(fits(base) && fits(previous)))
+    throw std::logic_error("VulkanIntegrator::publish: a change estimate's base and previous must be shaped as the accumulation");
+  if (mode == PublishMode::Restart && !fits(previous)) mode = PublishMode::Accumulation, previous = nullptr;
+  if (!impl_->publisher) impl_->publisher.emplace(impl_->context);
+  auto out = std::make_shared<DeviceLightmap>(impl_->context, shape.texels, shape.layers, shape.directional);
+  return impl_->publisher->publish(mode, impl_->buffers.texels, previous, base, std::move(out));
+}
+
+std::shared_ptr<DeviceLightmap> VulkanIntegrator::upload_lightmap(const LightmapEstimate& estimate) {
+  if (!impl_->publisher) impl_->publisher.emplace(impl_->context);
+  auto lightmap = std::make_shared<DeviceLightmap>(impl_->context, estimate.texels.size(), estimate.recorded_bounces, estimate.has_sh1());
+  impl_->publisher->upload(estimate, *lightmap);
+  return lightmap;
+}
+
+LightmapEstimate VulkanIntegrator::read_lightmap(const DeviceLightmap& lightmap) const { return impl_->lightmap.read(lightmap); }
 uint32_t VulkanIntegrator::progressive_samples() const { return impl_->lightmap.samples_done(); }
 
 void VulkanIntegrator::update_materials(const LightingScene& edited) {

@@ -11,13 +11,10 @@
 // Estimates are LightmapEstimate sums; a composite's sums are synthesized to give its mean and
 // variance of the mean exactly (so the bundle's error layer and relMSE estimates read it as usual).
 #pragma once
+#include "exitance/common/publishing_rule.h"
 #include "exitance/runtime/core/estimates.h"
 
 namespace exitance {
-
-// Standard errors of the difference beyond which a refreshed estimate replaces a kept value (3: an
-// unchanged texel switches about 0.3 % of the time for Gaussian noise).
-constexpr double kSignificance = 3.0;
 
 // Sums over `samples` samples (at least 2) whose mean is `mean` and whose variance of the mean is
 // `variance_of_mean`, per channel: total = n mean, total_squared = n mean^2 + n (n - 1) V, so
@@ -49,7 +46,6 @@ LightmapEstimate publish_change(const LightmapEstimate& previous, const Lightmap
 // rule would then trade a converged value for a 2-sample one, while an object moved every frame
 // and refreshed a few samples per frame must still show its moves;
 // texels that had nothing before show the refreshed estimate.
-constexpr uint32_t kRestartMinimumSamples = 8;
 LightmapEstimate publish_restart(const LightmapEstimate& previous, const LightmapEstimate& refreshed);
 
 }  // namespace exitance

@@ -172,6 +172,8 @@ class RefreshSession {
  private:
   explicit RefreshSession(std::unique_ptr<State> state);
   void end_change_estimate();
+  // What texels publish now (published_lightmap), composed in device memory.
+  PublishedLightmap publish_on_device() const;
   std::unique_ptr<State> state_;
 };
 

@@ -82,6 +82,23 @@ struct VulkanStageStatistics {
   double lane_efficiency = 0;  // active lanes / launched lanes (traversal stages: inside the traversal loop)
 };
 
+// A lightmap estimate in device memory (runtime/src/vulkan/device_lightmaps.h): what the runtime
+// keeps of what texels showed before an edit, and what they publish, without reading it back.
+class DeviceLightmap;
+
+// Which rule VulkanIntegrator::publish applies (exitance/common/publishing_rule.h).
+enum class PublishMode {
+  Accumulation,  // the progressive accumulation as it is (nothing was shown before it)
+  Restart,       // refresh/published_estimate.h publish_restart(previous, accumulation)
+  Change,        // publish_change(previous, base, accumulation): the accumulation is a change estimate
+};
+
+struct PublishedLightmap {
+  std::shared_ptr<DeviceLightmap> lightmap;
+  uint64_t single_sample_texels = 0;  // published texels with one sample (no variance)
+  uint64_t sampled_texels = 0;        // with two or more
+};
+
 class VulkanIntegrator final : public Integrator {
  public:
   // Uploads the scene (its BVH4 as built by the offline stage or read from scene.bin). Throws
@@ -123,6 +140,16 @@ class VulkanIntegrator final : public Integrator {
   // pair). Otherwise as start_progressive; the next start_progressive estimates E/pi again.
   void start_progressive_change(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, const LightingScene& edited,
                                 const std::vector<GpuPunctualLight>& pairs);
+  // What texels publish now, composed on the device from the progressive accumulation and the
+  // estimates given (null where `mode` reads none; shaped as the accumulation), into a new device
+  // estimate; waits for the device (a dispatch, no read-back of the lightmap). std::logic_error
+  // before a start.
+  PublishedLightmap publish(PublishMode mode, const DeviceLightmap* previous, const DeviceLightmap* base);
+  // A host estimate into device memory. publish() reads a previous estimate shaped otherwise than
+  // the accumulation (texels, recorded layers, sh1) as none.
+  std::shared_ptr<DeviceLightmap> upload_lightmap(const LightmapEstimate& estimate);
+  // A device estimate read back, with the progressive accumulation's rays, seconds and counters.
+  LightmapEstimate read_lightmap(const DeviceLightmap& lightmap) const;
   uint64_t add_samples(uint32_t samples);
   // Samples [first_sample, first_sample + samples) of the listed texels only (G-buffer indices, each
   // at most once): the runtime's priorities. The caller keeps each texel's count (add_samples'

@@ -1,0 +1,168 @@
+#include "device_lightmaps.h"
+
+#include <array>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "exitance_spirv/publish.h"
+
+namespace exitance {
+
+DeviceLightmap::DeviceLightmap(vulkan::Context& context, size_t texel_count, int layer_count, bool is_directional)
+    : sums(context), texels(texel_count), layers(layer_count), directional(is_directional) {
+  sums.reserve(context, texels, layers, directional);
+}
+
+size_t DeviceLightmap::bytes() const { return texels * vulkan::device_lightmap_bytes_per_texel(layers, directional); }
+
+namespace vulkan {
+namespace {
+
+constexpr uint32_t kBindings = 13;  // publish.comp: accumulation, previous, base, out (3 each), counts
+
+struct PublishPush {
+  uint32_t texel_count, layers, directional, mode;
+};
+
+void set_estimate(std::array<VkDescriptorBufferInfo, kBindings>& infos, uint32_t first, const TexelAccumulators& e) {
+  infos[first] = {e.sums.handle(), 0, VK_WHOLE_SIZE};
+  infos[first + 1] = {e.bounce_sums.handle(), 0, VK_WHOLE_SIZE};
+  infos[first + 2] = {e.samples.handle(), 0, VK_WHOLE_SIZE};
+}
+
+}  // namespace
+
+LightmapPublisher::LightmapPublisher(Context& context) : context_(context) {
+  VkDevice d = context.device();
+  try {
+    std::array<VkDescriptorSetLayoutBinding, kBindings> bindings{};
+    for (uint32_t i = 0; i < kBindings; ++i) bindings[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+    VkDescriptorSetLayoutCreateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    set_info.bindingCount = kBindings;
+    set_info.pBindings = bindings.data();
+    check(vkCreateDescriptorSetLayout(d, &set_info, nullptr, &set_layout_), "vkCreateDescriptorSetLayout (publish)");
+    VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(PublishPush)};
+    VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    layout_info.setLayoutCount = 1;
+    layout_info.pSetLayouts = &set_layout_;
+    layout_info.pushConstantRangeCount = 1;
+    layout_info.pPushConstantRanges = &range;
+    check(vkCreatePipelineLayout(d, &layout_info, nullptr, &layout_), "vkCreatePipelineLayout (publish)");
+    VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindings};
+    VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    pool_info.maxSets = 1;
+    pool_info.poolSizeCount = 1;
+    pool_info.pPoolSizes = &pool_size;
+    check(vkCreateDescriptorPool(d, &pool_info, nullptr, &pool_), "vkCreateDescriptorPool (publish)");
+    VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    alloc.descriptorPool = pool_;
+    alloc.descriptorSetCount = 1;
+    alloc.pSetLayouts = &set_layout_;
+    check(vkAllocateDescriptorSets(d, &alloc, &set_), "vkAllocateDescriptorSets (publish)");
+    VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    module_info.codeSize = sizeof(spirv_publish);
+    module_info.pCode = spirv_publish;
+    VkShaderModule module;
+    check(vkCreateShaderModule(d, &module_info, nullptr, &module), "vkCreateShaderModule (publish)");
+    VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    info.stage.module = module;
+    info.stage.pName = "main";
+    info.layout = layout_;
+    const VkResult r = vkCreateComputePipelines(d, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_);
+    vkDestroyShaderModule(d, module, nullptr);
+    check(r, "creating the pipeline of publish.comp");
+    counts_ = context.create_storage_buffer(8);
+  } catch (...) {
+    release();
+    throw;
+  }
+}
+
+LightmapPublisher::~LightmapPublisher() { release(); }
+
+void LightmapPublisher::release() {
+  if (context_.hung()) return;  // a running submission may still use them (Context::cleanup)
+  VkDevice d = context_.device();
+  if (pipeline_) vkDestroyPipeline(d, std::exchange(pipeline_, VK_NULL_HANDLE), nullptr);
+  if (pool_) vkDestroyDescriptorPool(d, std::exchange(pool_, VK_NULL_HANDLE), nullptr);
+  if (layout_) vkDestroyPipelineLayout(d, std::exchange(layout_, VK_NULL_HANDLE), nullptr);
+  if (set_layout_) vkDestroyDescriptorSetLayout(d, std::exchange(set_layout_, VK_NULL_HANDLE), nullptr);
+}
+
+PublishedLightmap LightmapPublisher::publish(PublishMode mode, const TexelAccumulators& accumulation, const DeviceLightmap* previous,
+                                             const DeviceLightmap* base, std::shared_ptr<DeviceLightmap> out) {
+  if ((mode != PublishMode::Accumulation && !previous) || (mode == PublishMode::Change && !base))
+    throw std::logic_error("LightmapPublisher::publish: the mode reads an estimate that was not given");
+  for (const DeviceLightmap* e : {previous, base})
+    if (e && (e->texels != out->texels || e->layers != out->layers || e->directional != out->directional))
+      throw std::logic_error("LightmapPublisher::publish: the estimates differ in texels, layers or L1 sums");
+  PublishedLightmap result;
+  result.lightmap = out;
+  if (out->texels == 0) return result;
+  std::array<VkDescriptorBufferInfo, kBindings> infos{};
+  // Bindings a mode does not read point at the accumulation (read-only there, never written).
+  set_estimate(infos, 0, accumulation);
+  set_estimate(infos, 3, previous ? previous->sums : accumulation);
+  set_estimate(infos, 6, base ? base->sums : accumulation);
+  set_estimate(infos, 9, out->sums);
+  infos[12] = {counts_.handle(), 0, VK_WHOLE_SIZE};
+  std::array<VkWriteDescriptorSet, kBindings> writes{};
+  for (uint32_t i = 0; i < kBindings; ++i) {
+    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[i].dstSet = set_;
+    writes[i].dstBinding = i;
+    writes[i].descriptorCount = 1;
+    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[i].pBufferInfo = &infos[i];
+  }
+  vkUpdateDescriptorSets(context_.device(), kBindings, writes.data(), 0, nullptr);
+
+  VkCommandBuffer cmd = context_.begin();
+  vkCmdFillBuffer(cmd, counts_.handle(), 0, VK_WHOLE_SIZE, 0);
+  VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+  barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set_, 0, nullptr);
+  const PublishPush push{uint32_t(out->texels), uint32_t(out->layers), out->directional ? 1u : 0u, uint32_t(mode)};
+  vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+  vkCmdDispatch(cmd, uint32_t((out->texels + 63) / 64), 1, 1);
+  barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+  barrier.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       0, 1, &barrier, 0, nullptr, 0, nullptr);
+  context_.submit_and_wait(cmd);
+  uint32_t counts[2] = {0, 0};
+  context_.download(counts_, counts, sizeof(counts));
+  result.single_sample_texels = counts[0];
+  result.sampled_texels = counts[1];
+  return result;
+}
+
+void LightmapPublisher::upload(const LightmapEstimate& estimate, DeviceLightmap& to) {
+  const size_t n = estimate.texels.size();
+  if (n != to.texels || estimate.recorded_bounces != to.layers || estimate.has_sh1() != to.directional)
+    throw std::invalid_argument("upload_lightmap: the estimate differs from the accumulation in texels, recorded bounces or sh1 layers");
+  if (n == 0) return;
+  const size_t sum_doubles = n * 6 + (to.directional ? n * 9 : 0);
+  context_.write_ranges(to.sums.sums, {{0, sum_doubles * 8}}, [&](char* staging) {
+    double* sums = reinterpret_cast<double*>(staging);
+    for (size_t i = 0; i < n; ++i)
+      for (int c = 0; c < 3; ++c) sums[i * 6 + size_t(c)] = estimate.texels[i].total[c], sums[i * 6 + 3 + size_t(c)] = estimate.texels[i].total_squared[c];
+    if (to.directional) std::memcpy(sums + n * 6, estimate.sh1.data(), n * 9 * 8);
+  });
+  context_.upload(to.sums.bounce_sums, estimate.bounces.data(), estimate.bounces.size() * 8);
+  context_.write_ranges(to.sums.samples, {{0, n * 4}}, [&](char* staging) {
+    uint32_t* samples = reinterpret_cast<uint32_t*>(staging);
+    for (size_t i = 0; i < n; ++i) samples[i] = estimate.texels[i].samples;
+  });
+}
+
+}  // namespace vulkan
+}  // namespace exitance

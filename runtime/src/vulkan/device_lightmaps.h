@@ -1,0 +1,64 @@
+// Lightmap estimates kept in device memory for the runtime's publishing (issue 32): what each texel
+// showed before the last edit, a change estimate's base, and what it publishes now, each in the
+// layout of the wavefront's texel sums, composed from the progressive accumulation on the device by
+// shaders/wavefront/publish.comp (exitance/common/publishing_rule.h: the rule
+// refresh/published_estimate.cpp applies on the host). An edit then keeps what was shown with one
+// dispatch instead of a read-back of the whole lightmap.
+#pragma once
+#include <cstdint>
+
+#include "exitance/runtime/core/estimates.h"
+#include "exitance/runtime/vulkan/vulkan_integrator.h"
+#include "vulkan_context.h"
+#include "wavefront_buffers.h"
+
+namespace exitance {
+
+// Per texel: 6 doubles of sums (+ 9 of L1 when directional), 3 doubles per recorded layer, the
+// sample count (LightmapEstimate's fields, layer 0 being the direct light).
+class DeviceLightmap {
+ public:
+  DeviceLightmap(vulkan::Context& context, size_t texels, int layers, bool directional);
+  vulkan::TexelAccumulators sums;
+  size_t texels = 0;
+  int layers = 1;
+  bool directional = false;
+  size_t bytes() const;
+};
+
+namespace vulkan {
+
+// Device bytes of one estimate per texel (docs/runtime.md states them).
+constexpr size_t device_lightmap_bytes_per_texel(int layers, bool directional) {
+  return (directional ? 15 : 6) * 8 + size_t(layers) * 24 + 4;
+}
+
+// publish.comp's pipeline, its descriptor set and a counter buffer.
+class LightmapPublisher {
+ public:
+  explicit LightmapPublisher(Context& context);
+  ~LightmapPublisher();
+  LightmapPublisher(const LightmapPublisher&) = delete;
+  LightmapPublisher& operator=(const LightmapPublisher&) = delete;
+
+  // out := the rule of `mode` over the accumulation, `previous` and `base` (null where the mode
+  // reads none; same shape as `out`). Waits for the device; returns the counts of published texels
+  // with one sample and with two or more.
+  PublishedLightmap publish(PublishMode mode, const TexelAccumulators& accumulation, const DeviceLightmap* previous,
+                            const DeviceLightmap* base, std::shared_ptr<DeviceLightmap> out);
+  // Writes `estimate`'s sums, layers and sample counts into `to` (same texels and layers).
+  void upload(const LightmapEstimate& estimate, DeviceLightmap& to);
+
+ private:
+  void release();
+  Context& context_;
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet set_ = VK_NULL_HANDLE;
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  Buffer counts_;
+};
+
+}  // namespace vulkan
+}  // namespace exitance
