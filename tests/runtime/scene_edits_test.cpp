@@ -733,5 +733,53 @@ TEST(SceneEditsLighting, UpdateEqualsABuildOfTheEditedScene) {
   }
 }
 
+// The cheap path: edits of lights, the sky and a light's node, applied in place, leave the scene
+// bit for bit as apply_scene_edits does, and the lighting scene refreshed from its own (edited)
+// source equals a build of the edited scene; material edits and nodes that move an instance are
+// left to apply_scene_edits, and a bad edit leaves the scene as it was.
+TEST(SceneEditsApply, LightEditsInPlaceEqualTheCopyingPath) {
+  LightEdit cone;
+  cone.light.name = "Lamp";
+  cone.outer_cone_angle = 0.7;
+  cone.color = std::array<float, 3>{0.2f, 0.4f, 1.0f};
+  const std::vector<std::vector<SceneEdit>> cases = {
+      {light_intensity(EditTarget{"Lamp", {}}, 9), {cone, ""}},
+      {{SkyEdit{{0.1f, 0.2f, 0.3f}}, ""}, light_intensity(EditTarget{"Sun", {}}, 0.5f)},
+      {node_edit("LampNode", std::array<double, 3>{1, 4, -2}), node_edit("sun", std::nullopt, std::array<double, 4>{0, 0.6, 0, 0.8})},
+  };
+  for (size_t c = 0; c < cases.size(); ++c) {
+    PersistedScene copied = baked(), in_place = baked();
+    const EditEffects expected = apply_scene_edits(copied, cases[c]);
+    LightingScene lighting = build_lighting_scene(
+        std::shared_ptr<const Scene>(std::shared_ptr<const Scene>{}, &in_place.scene), to_bvh4(in_place.bvh));
+    const std::optional<EditEffects> effects = apply_light_edits_in_place(in_place.scene, cases[c]);
+    ASSERT_TRUE(effects.has_value()) << "case " << c;
+    EXPECT_EQ(effects->lights, expected.lights) << "case " << c;
+    EXPECT_EQ(effects->sky, expected.sky) << "case " << c;
+    EXPECT_TRUE(effects->materials.empty() && effects->moved_instances.empty()) << "case " << c;
+    EXPECT_EQ(bytes_of(in_place), bytes_of(copied)) << "case " << c;
+    refresh_lights_from_source(lighting, effects->lights, effects->sky);
+    const LightingScene fresh = build_lighting_scene(std::make_shared<const Scene>(copied.scene), to_bvh4(copied.bvh));
+    EXPECT_TRUE(same_bytes(lighting.punctual_lights, fresh.punctual_lights)) << "case " << c;
+    EXPECT_EQ(lighting.punctual_cdf, fresh.punctual_cdf) << "case " << c;
+    EXPECT_EQ(lighting.sky.x, fresh.sky.x) << "case " << c;
+  }
+  MaterialEdit strength;
+  strength.material.name = "Panel";
+  strength.emissive_strength = 3;
+  for (const std::vector<SceneEdit>& left : {std::vector<SceneEdit>{{strength, ""}},
+                                             std::vector<SceneEdit>{light_intensity(EditTarget{"Lamp", {}}, 2),
+                                                                    node_edit("Box", std::array<double, 3>{5, 0, 0})}}) {
+    PersistedScene p = baked();
+    EXPECT_FALSE(apply_light_edits_in_place(p.scene, left).has_value());
+    EXPECT_EQ(bytes_of(p), bytes_of(baked()));
+  }
+  PersistedScene p = baked();
+  EXPECT_THROW(apply_light_edits_in_place(p.scene, {light_intensity(EditTarget{"Lamp", {}}, 2),
+                                                    light_intensity(EditTarget{"Lamp", {}}, -1)}),
+               SceneEditError);
+  EXPECT_EQ(bytes_of(p), bytes_of(baked()));
+}
+
 }  // namespace
 }  // namespace exitance

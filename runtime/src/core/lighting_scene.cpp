@@ -182,6 +182,22 @@ void set_material(LightingScene& lighting, uint32_t index, const Material& mater
   build_emitter_distribution(lighting);
 }
 
+void refresh_lights_from_source(LightingScene& lighting, const std::vector<uint32_t>& lights, bool sky) {
+  const Scene& scene = *lighting.source;
+  if (scene.lights.size() != lighting.punctual_lights.size())
+    throw std::invalid_argument("refresh_lights_from_source: the source has " + std::to_string(scene.lights.size()) +
+                                " lights, the lighting scene " + std::to_string(lighting.punctual_lights.size()));
+  for (uint32_t l : lights)
+    if (l >= scene.lights.size())
+      throw std::out_of_range("refresh_lights_from_source: light " + std::to_string(l) + " of " + std::to_string(scene.lights.size()));
+  for (uint32_t l : lights) lighting.punctual_lights[l] = punctual_record(scene.lights[l]);
+  if (!lights.empty()) build_punctual_distribution(lighting);
+  if (sky) {
+    lighting.sky = scene.sky.constant;
+    lighting.environment = scene.sky.has_environment() ? EnvironmentSampler(scene.sky.environment) : EnvironmentSampler{};
+  }
+}
+
 void set_punctual_light(LightingScene& lighting, uint32_t index, const PunctualLight& light) {
   if (index >= lighting.punctual_lights.size())
     throw std::out_of_range("set_punctual_light: light " + std::to_string(index) + " of " +

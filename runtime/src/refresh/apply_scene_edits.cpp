@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <set>
 
 #include "edit_checks.h"
@@ -126,13 +127,21 @@ std::string label_of(const SceneEdit& edit) {
 
 std::vector<uint32_t> sorted(const std::set<uint32_t>& s) { return {s.begin(), s.end()}; }
 
-}  // namespace
 
-EditEffects apply_scene_edits(PersistedScene& persisted, const std::vector<SceneEdit>& edits) {
-  Scene next = persisted.scene;
+// The edits applied in order to `next` (nodes' transforms only recorded in edit_of_node: moving
+// what hangs under them is the caller's): the edited lights, materials and whether the sky changed.
+struct EditedParts {
   std::set<uint32_t> lights, materials;
   bool sky = false;
-  std::vector<std::string> edit_of_node(next.nodes.size());
+  std::vector<std::string> edit_of_node;
+  bool any_node() const {
+    return std::any_of(edit_of_node.begin(), edit_of_node.end(), [](const std::string& s) { return !s.empty(); });
+  }
+};
+
+EditedParts edit_parts(Scene& next, const std::vector<SceneEdit>& edits) {
+  EditedParts parts;
+  parts.edit_of_node.resize(next.nodes.size());
   for (size_t i = 0; i < edits.size(); ++i) {
     const SceneEdit& edit = edits[i];
     const std::string where = edit.where.empty() ? "edits[" + std::to_string(i) + "] (" + label_of(edit) + ")" : edit.where;
@@ -140,26 +149,67 @@ EditEffects apply_scene_edits(PersistedScene& persisted, const std::vector<Scene
     if (const auto* e = std::get_if<NodeEdit>(&edit.change)) {
       const uint32_t node = refresh::resolve_node(next, e->node, where);
       edit_node(next.nodes[node], *e, where);
-      edit_of_node[node] = where;
+      parts.edit_of_node[node] = where;
     } else if (const auto* e = std::get_if<LightEdit>(&edit.change)) {
       const uint32_t light = refresh::resolve_light(next, e->light, where);
       edit_light(next.lights[light], *e, where);
-      lights.insert(light);
+      parts.lights.insert(light);
     } else if (const auto* e = std::get_if<MaterialEdit>(&edit.change)) {
       const uint32_t material = refresh::resolve_material(next, e->material, where);
       edit_material(next.materials[material], *e, where);
-      materials.insert(material);
+      parts.materials.insert(material);
     } else if (const auto* e = std::get_if<SkyEdit>(&edit.change)) {
       next.sky.constant = to_vec3(e->color);
       next.sky.environment = Texture{};
-      sky = true;
+      parts.sky = true;
     }
   }
+  return parts;
+}
+
+}  // namespace
+
+std::optional<EditEffects> apply_light_edits_in_place(Scene& scene, const std::vector<SceneEdit>& edits) {
+  if (std::any_of(edits.begin(), edits.end(), [](const SceneEdit& e) { return std::holds_alternative<MaterialEdit>(e.change); }))
+    return std::nullopt;
+  // The parts these edits change or read (names, the node tree, lights, the sky's colour); not the
+  // geometry, textures or an environment image.
+  Scene next;
+  next.nodes = scene.nodes;
+  next.instances = scene.instances;
+  next.lights = scene.lights;
+  next.sky.constant = scene.sky.constant;
+  EditedParts parts = edit_parts(next, edits);
+  refresh::MovedGeometry moved;
+  if (parts.any_node()) {
+    if (refresh::moves_an_instance(next, parts.edit_of_node)) return std::nullopt;
+    moved = refresh::move_under_edited_nodes(next, scene, TexelGBuffer{}, AtlasLayout{}, parts.edit_of_node);
+    parts.lights.insert(moved.lights.begin(), moved.lights.end());
+  }
+  EditEffects effects;
+  effects.lights = sorted(parts.lights);
+  effects.sky = parts.sky;
+  // Commit: moves of plain values only, nothing here throws.
+  scene.nodes = std::move(next.nodes);
+  scene.lights = std::move(next.lights);
+  if (parts.sky) {
+    scene.sky.constant = next.sky.constant;
+    scene.sky.environment = Texture{};
+  }
+  return effects;
+}
+
+EditEffects apply_scene_edits(PersistedScene& persisted, const std::vector<SceneEdit>& edits) {
+  Scene next = persisted.scene;
+  EditedParts parts = edit_parts(next, edits);
+  std::set<uint32_t>& lights = parts.lights;
+  const std::set<uint32_t>& materials = parts.materials;
+  const bool sky = parts.sky;
+  const std::vector<std::string>& edit_of_node = parts.edit_of_node;
   EditEffects effects;
   refresh::MovedGeometry moved;
   formats::SceneBvh bvh;
-  const bool any_node = std::any_of(edit_of_node.begin(), edit_of_node.end(), [](const std::string& s) { return !s.empty(); });
-  if (any_node) {
+  if (parts.any_node()) {
     moved = refresh::move_under_edited_nodes(next, persisted.scene, persisted.gbuffer, persisted.atlas, edit_of_node);
     lights.insert(moved.lights.begin(), moved.lights.end());
     if (!moved.instances.empty() && !persisted.bvh.nodes.empty()) {

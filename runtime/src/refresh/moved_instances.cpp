@@ -99,6 +99,22 @@ LiveTexel moved_texel(const LiveTexel& texel, const Scene& next, const Scene& ol
 
 }  // namespace
 
+bool moves_an_instance(const Scene& next, const std::vector<std::string>& edit_of_node) {
+  const std::vector<std::string> responsible = responsible_edits(next, edit_of_node);
+  std::vector<std::optional<Matrix4d>> world;
+  try {
+    world = node_world_matrices(next);
+  } catch (const std::invalid_argument& e) {
+    fail("scene", std::string("node hierarchy: ") + e.what());
+  }
+  for (const Instance& instance : next.instances) {
+    const size_t node = size_t(instance.node);
+    if (instance.node < 0 || node >= world.size() || responsible[node].empty() || !world[node]) continue;
+    if (!same_bits(*world[node], instance.world)) return true;
+  }
+  return false;
+}
+
 MovedGeometry move_under_edited_nodes(Scene& next, const Scene& old, const TexelGBuffer& gbuffer,
                                       const AtlasLayout& atlas, const std::vector<std::string>& edit_of_node) {
   const std::vector<std::string> responsible = responsible_edits(next, edit_of_node);

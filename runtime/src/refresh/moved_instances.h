@@ -22,6 +22,11 @@ struct MovedGeometry {
 // edited nodes again; returns the texels of moved instances re-derived on `next`. Throws
 // SceneEditError naming the responsible edit (the nearest edited ancestor) for a transform that is
 // singular or not finite, collapses a triangle or a light's direction.
+// Whether the edited node transforms of `next` change the world transform of a mesh instance
+// (move_under_edited_nodes would move its triangles). Throws SceneEditError for a node hierarchy
+// that does not compose.
+bool moves_an_instance(const Scene& next, const std::vector<std::string>& edit_of_node);
+
 MovedGeometry move_under_edited_nodes(Scene& next, const Scene& old, const TexelGBuffer& gbuffer,
                                       const AtlasLayout& atlas, const std::vector<std::string>& edit_of_node);
 

@@ -9,6 +9,7 @@
 #include <iterator>
 #include <cstring>
 #include <limits>
+#include <optional>
 
 #include "exitance/formats/format_error.h"
 #include "exitance/formats/scene_file.h"
@@ -29,7 +30,8 @@ struct RefreshSession::State {
   mutable std::optional<formats::SceneFile> scene_file;
   PersistedScene persisted;
   std::optional<formats::SparseVoxelOctree> svo;
-  std::shared_ptr<const LightingScene> lighting;
+  // Its source is `persisted.scene` itself (not a copy): light and sky edits change both in place.
+  std::shared_ptr<LightingScene> lighting;
   IntegratorSettings settings;
   std::unique_ptr<VulkanIntegrator> integrator;
   // What a pass over a work list costs, to size passes to a millisecond budget: a fixed part (its
@@ -94,6 +96,10 @@ struct RefreshSession::State {
 
 namespace {
 
+// The session's scene as a lighting scene's source: persisted.scene itself, not owned (the
+// session outlives its lighting scenes and integrator, State keeps it at one address).
+std::shared_ptr<const Scene> scene_of(const RefreshSession::State& s) { return std::shared_ptr<const Scene>(std::shared_ptr<const Scene>{}, &s.persisted.scene); }
+
 formats::BundleManifest read_manifest(const fs::path& bundle) {
   const fs::path path = bundle / "manifest.json";
   std::ifstream in(path, std::ios::binary);
@@ -139,9 +145,8 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   // A bundle baked with directional layers is refreshed with them (the same estimator, path.h).
   if (baked.directional == "sh1") settings.directional = DirectionalMode::Sh1;
 
-  auto scene = std::make_shared<const Scene>(state->persisted.scene);
   try {
-    state->lighting = std::make_shared<const LightingScene>(build_lighting_scene(scene, to_bvh4(state->persisted.bvh)));
+    state->lighting = std::make_shared<LightingScene>(build_lighting_scene(scene_of(*state), to_bvh4(state->persisted.bvh)));
   } catch (const std::invalid_argument& e) {
     throw BundleInputError((bundle / manifest.scene->file).string() + ": " + e.what());
   }
@@ -160,6 +165,8 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
       throw BundleInputError(e.what());
     }
   }
+  // The publishing pipeline made (and on lavapipe compiled) here, not in the first edit.
+  if (!state->previous) state->integrator->publish(PublishMode::Accumulation, nullptr, nullptr);
   return std::unique_ptr<RefreshSession>(new RefreshSession(std::move(state)));
 }
 
@@ -168,12 +175,40 @@ RefreshSession::~RefreshSession() = default;
 
 EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   State& s = *state_;
-  // Everything on copies first; the session changes only when every step succeeded.
-  PersistedScene edited = s.persisted;
-  const EditEffects effects = apply_scene_edits(edited, edits);
-  LightingScene lighting = *s.lighting;
-  update_lighting_scene(lighting, std::make_shared<const Scene>(edited.scene), effects);
-  unocclude_near_moved(edited, s.persisted.scene, lighting, effects);
+  const std::vector<GpuPunctualLight> lights_before = s.lighting->punctual_lights;
+  const std::vector<PunctualLight> scene_lights_before = s.persisted.scene.lights;
+  // Edits of lights, the sky's colour and light nodes: in place, without copying the scene.
+  std::optional<EditEffects> in_place = apply_light_edits_in_place(s.persisted.scene, edits);
+  std::vector<uint32_t> near;
+  if (in_place) {
+    // Committed: the lighting scene reads persisted.scene; nothing below throws for bad input.
+    s.scene_file.reset();
+    refresh_lights_from_source(*s.lighting, in_place->lights, in_place->sky);
+    if (!in_place->lights.empty() || in_place->sky) s.integrator->update_lights(*s.lighting);
+    Scene before;  // texels_near_change reads the lights' positions before the edit (no instance moved)
+    before.lights = scene_lights_before;
+    near = texels_near_change(s.persisted, before, *s.lighting, *in_place);
+  } else {
+    // Everything on copies first; the session changes only when every step succeeded.
+    PersistedScene edited = s.persisted;
+    const EditEffects effects = apply_scene_edits(edited, edits);
+    LightingScene lighting = *s.lighting;
+    update_lighting_scene(lighting, std::make_shared<const Scene>(edited.scene), effects);
+    unocclude_near_moved(edited, s.persisted.scene, lighting, effects);
+    if (effects.geometry_changed()) {
+      s.integrator->update_geometry(lighting);
+    } else {
+      if (!effects.materials.empty()) s.integrator->update_materials(lighting);
+      if (!effects.lights.empty() || effects.sky) s.integrator->update_lights(lighting);
+    }
+    near = texels_near_change(edited, s.persisted.scene, lighting, effects);
+    s.persisted = std::move(edited);
+    s.lighting = std::make_shared<LightingScene>(std::move(lighting));
+    s.lighting->source = scene_of(s);  // the same scene: later light edits change it in place
+    s.scene_file.reset();  // encoded again from the edited scene when a bundle is written
+    in_place = effects;
+  }
+  const EditEffects& effects = *in_place;
 
   // Edits of punctual lights alone are estimated as a change from what was published before them
   // (path.h punctual_change_rays): the same paths, each vertex adding the edited lights' direct
@@ -181,11 +216,12 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   const bool lights_only = !effects.geometry_changed() && effects.materials.empty() && !effects.sky && !effects.lights.empty() &&
                            !s.per_bounce && s.settings.directional == DirectionalMode::Off;
   std::vector<GpuPunctualLight> pairs;
-  const std::vector<GpuPunctualLight>& base_lights = s.base ? s.base_lights : s.lighting->punctual_lights;
-  if (lights_only && base_lights.size() == lighting.punctual_lights.size())
+  const std::vector<GpuPunctualLight>& base_lights = s.base ? s.base_lights : lights_before;
+  const std::vector<GpuPunctualLight>& lights_now = s.lighting->punctual_lights;
+  if (lights_only && base_lights.size() == lights_now.size())
     for (size_t i = 0; i < base_lights.size(); ++i)
-      if (std::memcmp(&base_lights[i], &lighting.punctual_lights[i], sizeof(GpuPunctualLight)) != 0) {
-        pairs.push_back(lighting.punctual_lights[i]);
+      if (std::memcmp(&base_lights[i], &lights_now[i], sizeof(GpuPunctualLight)) != 0) {
+        pairs.push_back(lights_now[i]);
         pairs.push_back(base_lights[i]);
       }
   // What is shown until refreshed again, kept on the device.
@@ -193,29 +229,19 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   // A base needs variances: after opening without the baked lightmap and before any refresh, restart.
   const bool as_change = lights_only && !pairs.empty() && pairs.size() / 2 <= kMaxChangedLights &&
                          (s.base || (published.single_sample_texels == 0 && published.sampled_texels > 0));
-
-  if (effects.geometry_changed()) {
-    s.integrator->update_geometry(lighting);
-  } else {
-    if (!effects.materials.empty()) s.integrator->update_materials(lighting);
-    if (!effects.lights.empty() || effects.sky) s.integrator->update_lights(lighting);
-  }
-  std::vector<uint32_t> near = texels_near_change(edited, s.persisted.scene, lighting, effects);
   s.last_edit_near.clear();
   if (as_change && !s.base) {
     s.base = published.lightmap;
-    s.base_lights = s.lighting->punctual_lights;
+    s.base_lights = lights_before;
   }
   s.previous = published.lightmap;
-  s.persisted = std::move(edited);
-  s.lighting = std::make_shared<const LightingScene>(std::move(lighting));
-  s.scene_file.reset();  // encoded again from the edited scene when a bundle is written
+  const bool texels_as_before = !effects.geometry_changed();
   if (as_change) {
     s.clear_accumulation();
-    s.integrator->start_progressive_change(s.persisted.gbuffer, s.settings, *s.lighting, pairs);
+    s.integrator->start_progressive_change(s.persisted.gbuffer, s.settings, *s.lighting, pairs, texels_as_before);
     s.changed_lights = uint32_t(pairs.size() / 2);
   } else {
-    restart();  // moved texels are uploaded again with the rest
+    restart(texels_as_before);  // moved texels are uploaded again with the rest
   }
   if (s.priority_samples > 0 && !near.empty() && near.size() < s.all_texels.size()) {
     std::vector<uint8_t> is_near(s.all_texels.size(), 0);
@@ -238,11 +264,15 @@ void RefreshSession::end_change_estimate() {
   s.changed_lights = 0;
 }
 
-void RefreshSession::restart() {
+void RefreshSession::restart() { restart(false); }
+
+void RefreshSession::restart(bool texels_as_before) {
   State& s = *state_;
   end_change_estimate();
+  // After a whole run the texel buffers were its own: upload the texels again.
+  const bool same_texels = texels_as_before && !s.per_bounce;
   s.clear_accumulation();
-  s.integrator->start_progressive(s.persisted.gbuffer, s.settings);
+  s.integrator->start_progressive(s.persisted.gbuffer, s.settings, same_texels);
 }
 
 const std::vector<uint32_t>& RefreshSession::texels_near_last_edit() const { return state_->last_edit_near; }

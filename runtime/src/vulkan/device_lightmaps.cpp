@@ -76,6 +76,7 @@ LightmapPublisher::LightmapPublisher(Context& context) : context_(context) {
     vkDestroyShaderModule(d, module, nullptr);
     check(r, "creating the pipeline of publish.comp");
     counts_ = context.create_storage_buffer(8);
+    warm();
   } catch (...) {
     release();
     throw;
@@ -91,6 +92,34 @@ void LightmapPublisher::release() {
   if (pool_) vkDestroyDescriptorPool(d, std::exchange(pool_, VK_NULL_HANDLE), nullptr);
   if (layout_) vkDestroyPipelineLayout(d, std::exchange(layout_, VK_NULL_HANDLE), nullptr);
   if (set_layout_) vkDestroyDescriptorSetLayout(d, std::exchange(set_layout_, VK_NULL_HANDLE), nullptr);
+}
+
+// One dispatch over no texels, so drivers that compile a pipeline at its first dispatch (lavapipe)
+// do it here and not inside the first edit.
+void LightmapPublisher::warm() {
+  std::array<VkDescriptorBufferInfo, kBindings> infos{};
+  for (VkDescriptorBufferInfo& info : infos) info = {counts_.handle(), 0, VK_WHOLE_SIZE};
+  write_set(infos);
+  VkCommandBuffer cmd = context_.begin();
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set_, 0, nullptr);
+  const PublishPush push{0, 1, 0, 0};
+  vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+  vkCmdDispatch(cmd, 1, 1, 1);
+  context_.submit_and_wait(cmd);
+}
+
+void LightmapPublisher::write_set(const std::array<VkDescriptorBufferInfo, 13>& infos) {
+  std::array<VkWriteDescriptorSet, kBindings> writes{};
+  for (uint32_t i = 0; i < kBindings; ++i) {
+    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[i].dstSet = set_;
+    writes[i].dstBinding = i;
+    writes[i].descriptorCount = 1;
+    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[i].pBufferInfo = &infos[i];
+  }
+  vkUpdateDescriptorSets(context_.device(), kBindings, writes.data(), 0, nullptr);
 }
 
 PublishedLightmap LightmapPublisher::publish(PublishMode mode, const TexelAccumulators& accumulation, const DeviceLightmap* previous,
@@ -110,16 +139,7 @@ PublishedLightmap LightmapPublisher::publish(PublishMode mode, const TexelAccumu
   set_estimate(infos, 6, base ? base->sums : accumulation);
   set_estimate(infos, 9, out->sums);
   infos[12] = {counts_.handle(), 0, VK_WHOLE_SIZE};
-  std::array<VkWriteDescriptorSet, kBindings> writes{};
-  for (uint32_t i = 0; i < kBindings; ++i) {
-    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    writes[i].dstSet = set_;
-    writes[i].dstBinding = i;
-    writes[i].descriptorCount = 1;
-    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[i].pBufferInfo = &infos[i];
-  }
-  vkUpdateDescriptorSets(context_.device(), kBindings, writes.data(), 0, nullptr);
+  write_set(infos);
 
   VkCommandBuffer cmd = context_.begin();
   vkCmdFillBuffer(cmd, counts_.handle(), 0, VK_WHOLE_SIZE, 0);

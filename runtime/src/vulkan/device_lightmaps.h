@@ -5,6 +5,7 @@
 // refresh/published_estimate.cpp applies on the host). An edit then keeps what was shown with one
 // dispatch instead of a read-back of the whole lightmap.
 #pragma once
+#include <array>
 #include <cstdint>
 
 #include "exitance/runtime/core/estimates.h"
@@ -50,6 +51,8 @@ class LightmapPublisher {
   void upload(const LightmapEstimate& estimate, DeviceLightmap& to);
 
  private:
+  void warm();
+  void write_set(const std::array<VkDescriptorBufferInfo, 13>& infos);
   void release();
   Context& context_;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;

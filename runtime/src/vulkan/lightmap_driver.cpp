@@ -57,7 +57,7 @@ void import_strategy_sums(const std::vector<double>& sums, GuidingChoice& choice
 // probe bake took the buffer). bake()'s: the texels of `bake_runs` (a rank's own under a split),
 // their start points written straight into the staging memory, and on the work list.
 void LightmapDriver::prepare(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, Accumulation& a,
-                             const Runs* bake_runs) {
+                             const Runs* bake_runs, Accumulation* reuse) {
   a.texel_count = gbuffer.texels.size();
   a.recorded = std::clamp(settings.recorded_bounces, 1, kMaxRecordedBounces);
   if (a.texel_count >= (1ull << 31)) throw std::runtime_error("Vulkan backend: too many texels");
@@ -68,7 +68,10 @@ void LightmapDriver::prepare(const TexelGBuffer& gbuffer, const IntegratorSettin
   if (settings.guiding == GuidingMode::Auto) a.result_bytes += kAutoCostWords * 4;  // bindings.glsl auto_cost_index
   a.max_work = runner_.work_items_per_batch(a.result_bytes);
   a.work_list.clear();
-  if (bake_runs) {
+  if (reuse) {
+    a.start_points = std::move(reuse->start_points);
+    a.work_list = std::move(reuse->work_list);  // on the device as the last pass left it
+  } else if (bake_runs) {
     for (const auto& [first, end] : *bake_runs)
       for (size_t i = first; i < end; ++i) a.work_list.push_back(uint32_t(i));
   } else {
@@ -100,7 +103,7 @@ void LightmapDriver::prepare(const TexelGBuffer& gbuffer, const IntegratorSettin
     });
     if (!a.work_list.empty()) context.upload(buffers.items.batch_items, a.work_list.data(), a.work_list.size() * 4);
     buffers.items.owner = WorkItems::Owner::None;  // not start()'s texels: a later start() uploads its own
-  } else {
+  } else if (!reuse || buffers.items.owner != WorkItems::Owner::Texels) {
     upload_items(a);
   }
   VkCommandBuffer cmd = context.begin();
@@ -402,12 +405,16 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   return estimate;
 }
 
-void LightmapDriver::start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, uint32_t changed_light_pairs) {
+void LightmapDriver::start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, uint32_t changed_light_pairs,
+                           bool texels_as_before) {
   const auto start_time = Clock::now();
+  std::optional<Accumulation> before = std::move(progressive_);
   progressive_.reset();
   runner_.statistics().clear();
   Accumulation a;
-  prepare(gbuffer, settings, a);
+  const bool reuse = texels_as_before && before && before->texel_count == gbuffer.texels.size() &&
+                     before->start_points.size() == gbuffer.texels.size();
+  prepare(gbuffer, settings, a, nullptr, reuse ? &*before : nullptr);
   a.params.changed_light_pairs = changed_light_pairs;
   a.seconds = std::chrono::duration<double>(Clock::now() - start_time).count();
   progressive_ = std::move(a);

@@ -37,7 +37,10 @@ class LightmapDriver {
 
   // `changed_light_pairs` > 0: the accumulation estimates the change of direct light from that many
   // edited punctual lights (GpuParams::changed_light_pairs; their records set on the scene first).
-  void start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, uint32_t changed_light_pairs = 0);
+  // `texels_as_before`: the G-buffer's texels are those of the running accumulation (an edit that
+  // moved none): their start points are not derived and uploaded again, only the sums cleared.
+  void start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, uint32_t changed_light_pairs = 0,
+             bool texels_as_before = false);
   // `samples` more per texel (sample indices continue where the last call ended); returns the rays traced.
   uint64_t add_samples(uint32_t samples);
   // Samples [first_sample, first_sample + samples) of the listed texels only (indices into the
@@ -76,7 +79,9 @@ class LightmapDriver {
   };
 
   using Runs = std::vector<std::pair<size_t, size_t>>;
-  void prepare(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, Accumulation& a, const Runs* bake_runs = nullptr);
+  // `reuse`: an accumulation over the same texels whose start points and work list `a` takes.
+  void prepare(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, Accumulation& a, const Runs* bake_runs = nullptr,
+               Accumulation* reuse = nullptr);
   void upload_items(const Accumulation& a);
   void run_pass(Accumulation& a, uint32_t first, uint32_t pass);
   // What a read-back fills, made ahead of time (bake(): on a thread while the passes run): the

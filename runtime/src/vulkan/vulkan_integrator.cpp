@@ -49,6 +49,10 @@ struct VulkanIntegrator::Impl {
   LightmapDriver lightmap;
   ProbeDriver probes;
   std::optional<LightmapPublisher> publisher;  // made at the first publish or upload
+  // Device estimates publish() wrote, reused once their holders let go of them (an edit replaces
+  // the previous estimate: at 1 M texels ~100 MB not allocated again).
+  std::vector<std::shared_ptr<DeviceLightmap>> spare_lightmaps;
+  static constexpr size_t kSpareLightmaps = 4;
   // The per-bounce gather reads each triangle's instance and lightmap UVs from here (shared, not a
   // reference to the caller's scene); update_geometry keeps it current.
   std::shared_ptr<const Scene> source;
@@ -108,21 +112,22 @@ ProbeEstimate VulkanIntegrator::bake_probes(const std::vector<Vec3>& positions, 
   return impl_->probes.bake(positions, settings);
 }
 
-void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) {
+void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, bool texels_as_before) {
   // The progressive accumulation (exitance-relight) adds samples in calls the caller sizes, with no
   // pass where a learned table could swap: guiding runs in bake() only.
   if (settings.guiding != GuidingMode::Off)
     throw std::runtime_error("Vulkan backend: guiding runs in whole bakes only, not in progressive accumulation (relight)");
-  impl_->lightmap.start(gbuffer, settings);
+  impl_->lightmap.start(gbuffer, settings, 0, texels_as_before);
 }
 void VulkanIntegrator::start_progressive_change(const TexelGBuffer& gbuffer, const IntegratorSettings& settings,
-                                                const LightingScene& edited, const std::vector<GpuPunctualLight>& pairs) {
+                                                const LightingScene& edited, const std::vector<GpuPunctualLight>& pairs,
+                                                bool texels_as_before) {
   if (settings.guiding != GuidingMode::Off)
     throw std::runtime_error("Vulkan backend: guiding runs in whole bakes only, not in progressive accumulation (relight)");
   if (pairs.empty() || pairs.size() % 2 != 0)
     throw std::invalid_argument("Vulkan backend: a change estimate needs pairs of light records (edited, base)");
   impl_->scene.set_changed_light_pairs(edited, pairs);
-  impl_->lightmap.start(gbuffer, settings, uint32_t(pairs.size() / 2));
+  impl_->lightmap.start(gbuffer, settings, uint32_t(pairs.size() / 2), texels_as_before);
 }
 uint64_t VulkanIntegrator::add_samples(uint32_t samples) { return impl_->lightmap.add_samples(samples); }
 uint64_t VulkanIntegrator::add_samples_to(const std::vector<uint32_t>& texels, uint32_t first_sample, uint32_t samples) {
@@ -140,7 +145,23 @@ PublishedLightmap VulkanIntegrator::publish(PublishMode mode, const DeviceLightm
     throw std::logic_error("VulkanIntegrator::publish: a change estimate's base and previous must be shaped as the accumulation");
   if (mode == PublishMode::Restart && !fits(previous)) mode = PublishMode::Accumulation, previous = nullptr;
   if (!impl_->publisher) impl_->publisher.emplace(impl_->context);
-  auto out = std::make_shared<DeviceLightmap>(impl_->context, shape.texels, shape.layers, shape.directional);
+  std::shared_ptr<DeviceLightmap> out;
+  for (const std::shared_ptr<DeviceLightmap>& spare : impl_->spare_lightmaps)
+    if (spare.use_count() == 1 && spare->texels == shape.texels && spare->layers == shape.layers &&
+        spare->directional == shape.directional) {
+      out = spare;
+      break;
+    }
+  if (!out) {
+    out = std::make_shared<DeviceLightmap>(impl_->context, shape.texels, shape.layers, shape.directional);
+    if (impl_->spare_lightmaps.size() >= Impl::kSpareLightmaps)  // of another shape, or all in use: the oldest free one goes
+      for (auto it = impl_->spare_lightmaps.begin(); it != impl_->spare_lightmaps.end(); ++it)
+        if (it->use_count() == 1) {
+          impl_->spare_lightmaps.erase(it);
+          break;
+        }
+    if (impl_->spare_lightmaps.size() < Impl::kSpareLightmaps) impl_->spare_lightmaps.push_back(out);
+  }
   return impl_->publisher->publish(mode, impl_->buffers.texels, previous, base, std::move(out));
 }
 

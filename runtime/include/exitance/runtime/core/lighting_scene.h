@@ -55,4 +55,11 @@ void set_geometry(LightingScene& scene, std::shared_ptr<const Scene> edited);
 void set_material(LightingScene& scene, uint32_t index, const Material& material);
 void set_punctual_light(LightingScene& scene, uint32_t index, const PunctualLight& light);
 
+// After the listed lights (and the sky, when `sky`) changed in `scene.source` itself: a Scene its
+// owner edits in place (the runtime's session, whose lighting scene reads its own scene), with no
+// copy on write. The records of those lights, the punctual CDF and the sky, as build_lighting_scene
+// derives them. Throws std::invalid_argument when the source's light count differs (nothing changed),
+// std::out_of_range for a light index beyond it.
+void refresh_lights_from_source(LightingScene& scene, const std::vector<uint32_t>& lights, bool sky);
+
 }  // namespace exitance

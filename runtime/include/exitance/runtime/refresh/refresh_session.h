@@ -172,6 +172,9 @@ class RefreshSession {
  private:
   explicit RefreshSession(std::unique_ptr<State> state);
   void end_change_estimate();
+  // `texels_as_before`: the G-buffer's texels are those of the accumulation's last start (no
+  // instance moved): not uploaded again.
+  void restart(bool texels_as_before);
   // What texels publish now (published_lightmap), composed in device memory.
   PublishedLightmap publish_on_device() const;
   std::unique_ptr<State> state_;

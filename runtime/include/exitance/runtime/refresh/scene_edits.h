@@ -115,6 +115,14 @@ struct EditEffects {
 // parse_scene_edits checks (edits built in code are checked the same way).
 EditEffects apply_scene_edits(PersistedScene& scene, const std::vector<SceneEdit>& edits);
 
+// The cheap case of apply_scene_edits, in place: edits of lights, the sky's colour and nodes that
+// move no mesh instance (a light's node) are validated and computed on copies of the scene's small
+// parts (nodes, lights) and committed into `scene` without copying its geometry or textures; the
+// result is apply_scene_edits' (the same edit functions). nullopt, `scene` untouched, when an edit
+// edits a material or moves an instance (apply_scene_edits then). Throws SceneEditError as
+// apply_scene_edits does, `scene` untouched.
+std::optional<EditEffects> apply_light_edits_in_place(Scene& scene, const std::vector<SceneEdit>& edits);
+
 // Brings `lighting`, built on the scene before apply_scene_edits, to `edited` (the scene after):
 // set_geometry (lighting_scene.h: everything re-derived, BVH refit) when geometry moved, else
 // set_material / set_punctual_light for what `effects` lists and the sky. The result equals

@@ -132,14 +132,16 @@ class VulkanIntegrator final : public Integrator {
   // sums. Settings used: seed, max_bounces, recorded_bounces, russian_roulette_start,
   // safety_bounce_cap, sampling_strategy. bake() ends an accumulation (start again after it);
   // bake_probes in between does not. Throws as bake() does; std::logic_error before a start.
-  void start_progressive(const TexelGBuffer& gbuffer, const IntegratorSettings& settings);
+  // `texels_as_before`: `gbuffer`'s texels are those of the running accumulation (an edit that moved
+  // no instance): they are not uploaded again, only the sums cleared.
+  void start_progressive(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, bool texels_as_before = false);
   // A progressive accumulation of the change of E/pi from edited punctual lights (path.h
   // punctual_change_rays: the same paths, each vertex adding an edited light's direct light as edited
   // minus as it was; no emission, no sky). `edited`: the scene as update_lights last uploaded it;
   // `pairs`: per edited light its record in `edited` then its record at the base (at least one
   // pair). Otherwise as start_progressive; the next start_progressive estimates E/pi again.
   void start_progressive_change(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, const LightingScene& edited,
-                                const std::vector<GpuPunctualLight>& pairs);
+                                const std::vector<GpuPunctualLight>& pairs, bool texels_as_before = false);
   // What texels publish now, composed on the device from the progressive accumulation and the
   // estimates given (null where `mode` reads none; shaped as the accumulation), into a new device
   // estimate; waits for the device (a dispatch, no read-back of the lightmap). std::logic_error
