@@ -3,6 +3,7 @@
 # 12 texels/m and the open city at 1.5 texels/m lit to 4096 spp as the shipped bundles, then each edit refreshed frame by frame from it
 # (light edits estimated as a change; docs/runtime.md) and restarted from nothing (--ignore-baked,
 # the behaviour before), each output's relMSE against two 4096-spp relights of the edited scene.
+# Env: BUNDLES (building city), EDITS (move double block), FRAMES (1 6 60), MODES (change restart).
 # Writes $OUT/summary.txt.
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
@@ -22,7 +23,7 @@ for e in ${EDITS:-move double block}; do
   for s in 101 202; do $R $W/base.bake -o $W/ref_${e}_$s.bake --edits $W/$e.json --spp 4096 --seed $s --ignore-baked --json > /dev/null; done
   list=""
   for f in ${FRAMES:-1 6 60}; do
-    for mode in change restart; do
+    for mode in ${MODES:-change restart}; do
       flag=""; [ $mode = restart ] && flag=--ignore-baked
       o=${e}_${mode}_$f
       $R $W/base.bake -o $W/$o.bake --edits $W/$e.json --spp 4096 --frames $f --budget-ms 16 --seed 3 --no-frame-errors $flag --json > $W/$o.json
