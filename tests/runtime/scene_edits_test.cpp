@@ -10,6 +10,7 @@
 #include <fstream>
 #include <limits>
 #include <numbers>
+#include <random>
 
 #include <nlohmann/json.hpp>
 #include <unistd.h>
@@ -22,6 +23,7 @@
 #include "exitance/runtime/cpu/bvh4_builder.h"
 #include "exitance/runtime/node_transform.h"
 #include "exitance/runtime/refresh/scene_edits.h"
+#include "exitance/runtime/refresh/texels_near_change.h"
 #include "exitance/runtime/scene_file_conversion.h"
 #include "exitance/runtime/world_box.h"
 
@@ -779,6 +781,37 @@ TEST(SceneEditsApply, LightEditsInPlaceEqualTheCopyingPath) {
                                                     light_intensity(EditTarget{"Lamp", {}}, -1)}),
                SceneEditError);
   EXPECT_EQ(bytes_of(p), bytes_of(baked()));
+}
+
+// The texel grid finds the same near texels as a pass over every texel: lights inside, at the edge
+// of and outside the texels' bounds, in a flat and scattered G-buffer (cells of one size).
+TEST(TexelsNearChange, TheGridFindsWhatAFullPassFinds) {
+  PersistedScene p;
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (int i = 0; i < 20000; ++i) {
+    LiveTexel t;
+    t.position = {40.0f * u(random), 0.5f * u(random), 25.0f * u(random)};
+    p.gbuffer.texels.push_back(t);
+  }
+  PunctualLight light;
+  light.type = PunctualLight::Type::Point;
+  p.scene.lights = {light};
+  Scene before = p.scene;
+  LightingScene lighting;
+  lighting.extent = 40.0f;
+  EditEffects effects;
+  effects.lights = {0};
+  const TexelGrid grid(p.gbuffer);
+  size_t found = 0;
+  for (const Vec3 at : {Vec3{20, 0.2f, 12}, Vec3{0, 0, 0}, Vec3{40, 0.5f, 25}, Vec3{-30, 5, 60}, Vec3{3, -2, 24}}) {
+    p.scene.lights[0].position = at;
+    before.lights[0].position = at + Vec3{1.5f, 0, -1};
+    const std::vector<uint32_t> full = texels_near_change(p, before, lighting, effects);
+    EXPECT_EQ(texels_near_change(p, before, lighting, effects, &grid), full) << at.x << " " << at.y << " " << at.z;
+    found += full.size();
+  }
+  EXPECT_GT(found, 1000u);  // the cases are not all empty
 }
 
 }  // namespace

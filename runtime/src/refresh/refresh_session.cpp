@@ -16,6 +16,7 @@
 #include "exitance/formats/svo_file.h"
 #include "exitance/runtime/refresh/baked_lightmap.h"
 #include "exitance/runtime/refresh/published_estimate.h"
+#include "exitance/runtime/refresh/texel_grid.h"
 #include "exitance/runtime/refresh/texels_near_change.h"
 #include "exitance/runtime/refresh/unocclude_near_moved.h"
 
@@ -64,6 +65,8 @@ struct RefreshSession::State {
   // of a bake.
   std::vector<uint32_t> near_texels, far_texels, all_texels;
   std::vector<uint32_t> last_edit_near;  // near_texels of the last edit, kept after the others caught up
+  TexelGrid texel_grid;  // over persisted.gbuffer's texels: rebuilt when texels move
+  EditTimings edit_timings;
   uint32_t near_samples = 0, far_samples = 0, all_samples = 0;
   // What texels showed before the last edit (published_lightmap keeps it until the refreshed
   // estimate is better; published_estimate.h); at open, the bundle's baked lightmap. In device
@@ -152,6 +155,7 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   }
   state->integrator = VulkanIntegrator::create(state->lighting, options.device);
   state->priority_samples = options.priority_samples;
+  state->texel_grid = TexelGrid(state->persisted.gbuffer);
   state->all_texels.resize(state->persisted.gbuffer.texels.size());
   for (size_t i = 0; i < state->all_texels.size(); ++i) state->all_texels[i] = uint32_t(i);
   state->integrator->start_progressive(state->persisted.gbuffer, settings);
@@ -175,6 +179,15 @@ RefreshSession::~RefreshSession() = default;
 
 EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   State& s = *state_;
+  using Clock = std::chrono::steady_clock;
+  auto since = [](Clock::time_point& t) {
+    const Clock::time_point now = Clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - t).count();
+    t = now;
+    return ms;
+  };
+  Clock::time_point lap = Clock::now();
+  EditTimings timings;
   const std::vector<GpuPunctualLight> lights_before = s.lighting->punctual_lights;
   const std::vector<PunctualLight> scene_lights_before = s.persisted.scene.lights;
   // Edits of lights, the sky's colour and light nodes: in place, without copying the scene.
@@ -185,9 +198,11 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
     s.scene_file.reset();
     refresh_lights_from_source(*s.lighting, in_place->lights, in_place->sky);
     if (!in_place->lights.empty() || in_place->sky) s.integrator->update_lights(*s.lighting);
+    timings.scene = since(lap);
     Scene before;  // texels_near_change reads the lights' positions before the edit (no instance moved)
     before.lights = scene_lights_before;
-    near = texels_near_change(s.persisted, before, *s.lighting, *in_place);
+    near = texels_near_change(s.persisted, before, *s.lighting, *in_place, &s.texel_grid);
+    timings.near_texels = since(lap);
   } else {
     // Everything on copies first; the session changes only when every step succeeded.
     PersistedScene edited = s.persisted;
@@ -201,7 +216,11 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
       if (!effects.materials.empty()) s.integrator->update_materials(lighting);
       if (!effects.lights.empty() || effects.sky) s.integrator->update_lights(lighting);
     }
-    near = texels_near_change(edited, s.persisted.scene, lighting, effects);
+    timings.scene = since(lap);
+    TexelGrid grid = effects.geometry_changed() ? TexelGrid(edited.gbuffer) : TexelGrid{};
+    near = texels_near_change(edited, s.persisted.scene, lighting, effects, effects.geometry_changed() ? &grid : &s.texel_grid);
+    if (effects.geometry_changed()) s.texel_grid = std::move(grid);
+    timings.near_texels = since(lap);
     s.persisted = std::move(edited);
     s.lighting = std::make_shared<LightingScene>(std::move(lighting));
     s.lighting->source = scene_of(s);  // the same scene: later light edits change it in place
@@ -225,7 +244,9 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
         pairs.push_back(base_lights[i]);
       }
   // What is shown until refreshed again, kept on the device.
+  since(lap);
   const PublishedLightmap published = publish_on_device();
+  timings.publish = since(lap);
   // A base needs variances: after opening without the baked lightmap and before any refresh, restart.
   const bool as_change = lights_only && !pairs.empty() && pairs.size() / 2 <= kMaxChangedLights &&
                          (s.base || (published.single_sample_texels == 0 && published.sampled_texels > 0));
@@ -244,13 +265,11 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
     restart(texels_as_before);  // moved texels are uploaded again with the rest
   }
   if (s.priority_samples > 0 && !near.empty() && near.size() < s.all_texels.size()) {
-    std::vector<uint8_t> is_near(s.all_texels.size(), 0);
-    for (uint32_t i : near) is_near[i] = 1;
-    s.near_texels = std::move(near);
+    s.near_texels = std::move(near);  // the far texels are listed when their turn comes (refresh)
     s.last_edit_near = s.near_texels;
-    for (uint32_t i = 0; i < is_near.size(); ++i)
-      if (!is_near[i]) s.far_texels.push_back(i);
   }
+  timings.restart = since(lap);
+  s.edit_timings = timings;
   return effects;
 }
 
@@ -274,6 +293,8 @@ void RefreshSession::restart(bool texels_as_before) {
   s.clear_accumulation();
   s.integrator->start_progressive(s.persisted.gbuffer, s.settings, same_texels);
 }
+
+const EditTimings& RefreshSession::last_edit_timings() const { return state_->edit_timings; }
 
 const std::vector<uint32_t>& RefreshSession::texels_near_last_edit() const { return state_->last_edit_near; }
 
@@ -311,6 +332,17 @@ RefreshReport RefreshSession::refresh(const RefreshBudget& budget) {
       if (s.near_samples < std::min(cap, s.priority_samples)) {
         list = &s.near_texels, count = &s.near_samples, limit = std::min(cap, s.priority_samples);
       } else if (s.far_samples < s.near_samples) {
+        if (s.far_texels.empty()) {  // every texel not near (near_texels ascends), listed at its first turn
+          s.far_texels.reserve(s.all_texels.size() - s.near_texels.size());
+          size_t k = 0;
+          for (uint32_t i = 0; i < uint32_t(s.all_texels.size()); ++i) {
+            if (k < s.near_texels.size() && s.near_texels[k] == i) {
+              ++k;
+              continue;
+            }
+            s.far_texels.push_back(i);
+          }
+        }
         list = &s.far_texels, count = &s.far_samples, limit = s.near_samples;
       } else {  // caught up: one list again, at their common count
         s.all_samples = s.near_samples;

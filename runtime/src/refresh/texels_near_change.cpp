@@ -8,7 +8,8 @@
 namespace exitance {
 
 std::vector<uint32_t> texels_near_change(const PersistedScene& edited, const Scene& before,
-                                         const LightingScene& edited_lighting, const EditEffects& effects) {
+                                         const LightingScene& edited_lighting, const EditEffects& effects,
+                                         const TexelGrid* grid) {
   if (effects.sky) return {};  // the sky lights everything
   std::vector<WorldBox> boxes;
   for (uint32_t k : effects.moved_instances) {
@@ -44,6 +45,15 @@ std::vector<uint32_t> texels_near_change(const PersistedScene& edited, const Sce
     radius_squared.push_back(r * r);
   }
   std::vector<uint32_t> near;
+  if (grid && grid->texel_count() == edited.gbuffer.texels.size()) {
+    for (size_t b = 0; b < boxes.size(); ++b)
+      grid->for_each_candidate(boxes[b], std::sqrt(radius_squared[b]), [&](uint32_t i) {
+        if (boxes[b].distance_squared(edited.gbuffer.texels[i].position) <= radius_squared[b]) near.push_back(i);
+      });
+    std::sort(near.begin(), near.end());
+    near.erase(std::unique(near.begin(), near.end()), near.end());
+    return near;
+  }
   for (size_t i = 0; i < edited.gbuffer.texels.size(); ++i) {
     const Vec3& p = edited.gbuffer.texels[i].position;
     for (size_t b = 0; b < boxes.size(); ++b)

@@ -90,6 +90,8 @@ json relight_bundle(const RelightOptions& options) {
                       {"sky", effects.sky},
                       // punctual lights whose change from the pre-edit lighting is estimated (0: restarted)
                       {"changed_lights", session->changed_lights()}};
+      const EditTimings& t = session->last_edit_timings();
+      edits_report["milliseconds"] = {{"scene", t.scene}, {"near_texels", t.near_texels}, {"publish", t.publish}, {"restart", t.restart}};
     } catch (const SceneEditError& e) {
       throw RelightInputError(e.what());
     }

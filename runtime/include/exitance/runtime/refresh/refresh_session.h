@@ -77,6 +77,14 @@ struct RefreshReport {
   bool capped = false;              // the sample cap is reached: further calls add nothing
 };
 
+// Where the last RefreshSession::apply_edits call spent its time, in milliseconds (benchmarks).
+struct EditTimings {
+  double scene = 0;        // validating and applying the edits: host scene, lighting scene, device uploads
+  double near_texels = 0;  // finding the texels near the change (texels_near_change.h)
+  double publish = 0;      // keeping what texels showed, on the device (publish.comp)
+  double restart = 0;      // starting the accumulation again (a restart or a change estimate)
+};
+
 class RefreshSession {
  public:
   // Reads manifest.json, scene.bin and (when listed) svo.bin from `bundle`, builds the lighting
@@ -100,6 +108,7 @@ class RefreshSession {
   // (path.h punctual_change_rays), so texels that no edited light reaches keep their value exactly.
   // lightmap() is then that change; refreshed_lightmap() is base + change.
   EditEffects apply_edits(const std::vector<SceneEdit>& edits);
+  const EditTimings& last_edit_timings() const;
   // Drops every accumulated sample; the next refresh starts at sample 0.
   void restart();
   RefreshReport refresh(const RefreshBudget& budget);

@@ -6,6 +6,7 @@
 
 #include "exitance/runtime/core/lighting_scene.h"
 #include "exitance/runtime/refresh/scene_edits.h"
+#include "exitance/runtime/refresh/texel_grid.h"
 #include "exitance/runtime/scene_file_conversion.h"
 
 namespace exitance {
@@ -14,7 +15,10 @@ namespace exitance {
 // tenth of the scene's extent) of a box of what the edit changed: a moved instance's bounds before and after, a point or spot light's
 // position (before and after), the triangles of a material whose emission changed. Empty when the
 // change is not local (a directional light, the sky), or nothing changed.
+// `grid`: over `edited`'s G-buffer (the same texels at the same positions), to visit only the cells
+// around the changed boxes; null (or over other texels): a pass over every texel. Same result.
 std::vector<uint32_t> texels_near_change(const PersistedScene& edited, const Scene& before,
-                                         const LightingScene& edited_lighting, const EditEffects& effects);
+                                         const LightingScene& edited_lighting, const EditEffects& effects,
+                                         const TexelGrid* grid = nullptr);
 
 }  // namespace exitance

@@ -1,0 +1,46 @@
+#include "exitance/runtime/refresh/texel_grid.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace exitance {
+
+TexelGrid::TexelGrid(const TexelGBuffer& gbuffer) {
+  const size_t n = gbuffer.texels.size();
+  if (n == 0) return;
+  WorldBox bounds;
+  for (const LiveTexel& t : gbuffer.texels) bounds.grow(t.position);
+  const Vec3 extent = bounds.hi - bounds.lo;
+  const float largest = std::max({extent.x, extent.y, extent.z, 1e-6f});
+  // Cells of one size, about 8 texels each over the bounds' volume (a flat scene: over its area).
+  double volume = 1;
+  for (int a = 0; a < 3; ++a) volume *= std::max(double(extent[a]), 1e-3 * largest);
+  const double cell = std::cbrt(volume / std::max(1.0, double(n) / 8.0));
+  for (int a = 0; a < 3; ++a) {
+    cells_[a] = int(std::clamp(std::ceil(double(extent[a]) / cell), 1.0, 1024.0));
+    cells_per_unit_[a] = extent[a] > 0 ? float(cells_[a]) / extent[a] : 0.0f;
+  }
+  lo_ = bounds.lo;
+  const size_t cell_count = size_t(cells_[0]) * size_t(cells_[1]) * size_t(cells_[2]);
+  std::vector<uint32_t> cell_of_texel(n);
+  cell_start_.assign(cell_count + 1, 0);
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 p = gbuffer.texels[i].position;
+    const size_t c = (size_t(cell_of(2, p.z)) * size_t(cells_[1]) + size_t(cell_of(1, p.y))) * size_t(cells_[0]) + size_t(cell_of(0, p.x));
+    cell_of_texel[i] = uint32_t(c);
+    ++cell_start_[c + 1];
+  }
+  for (size_t c = 0; c < cell_count; ++c) cell_start_[c + 1] += cell_start_[c];
+  texels_.resize(n);
+  std::vector<uint32_t> next(cell_start_.begin(), cell_start_.end() - 1);
+  for (size_t i = 0; i < n; ++i) texels_[next[cell_of_texel[i]]++] = uint32_t(i);  // ascending within a cell
+}
+
+int TexelGrid::cell_of(int axis, float p) const {
+  const float at = (p - lo_[axis]) * cells_per_unit_[axis];
+  if (!(at > 0)) return 0;  // below the bounds, or NaN
+  if (!(at < float(cells_[axis]))) return cells_[axis] - 1;
+  return int(at);
+}
+
+}  // namespace exitance
