@@ -1,9 +1,12 @@
 #include "exitance/bake/uvgen/lightmap_uv_generation.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 #include <stdexcept>
+#include <thread>
 
 #include "chart_halving.h"
 #include "chart_packing.h"
@@ -71,6 +74,34 @@ GeneratedUvs generate_lightmap_uvs(std::span<const Vec3> positions, std::span<co
     const double scale = area_uv > 0 && area_3d > 0 ? std::sqrt(area_3d / area_uv) : 0;
     for (auto& corners : flat.corner_uv)
       for (Point2& q : corners) q = {q[0] * scale, q[1] * scale};
+    return flat;
+  };
+
+  // Every chart flattened, largest first, on up to hardware_concurrency threads (charts are
+  // independent: the same UVs whatever the threads); report(fraction of the triangles) from the
+  // calling thread.
+  auto flatten_all = [&](const std::vector<uvgen::Chart>& charts, const std::function<void(double)>& report) {
+    std::vector<uvgen::FlatChart> flat(charts.size());
+    std::vector<size_t> order(charts.size());
+    std::iota(order.begin(), order.end(), size_t(0));
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return charts[a].triangles.size() > charts[b].triangles.size(); });
+    std::atomic<size_t> next{0}, flattened{0};
+    auto work = [&](bool reporting) {
+      for (size_t i; (i = next.fetch_add(1)) < order.size();) {
+        flat[order[i]] = flatten_scaled(charts[order[i]]);
+        const size_t done = flattened.fetch_add(charts[order[i]].triangles.size()) + charts[order[i]].triangles.size();
+        if (reporting) report(double(done) / double(std::max<size_t>(triangle_count, 1)));
+      }
+    };
+    // Threads only where there is work to share: a thread costs about as much as a small chart.
+    size_t chart_triangles = 0;
+    for (const uvgen::Chart& chart : charts) chart_triangles += chart.triangles.size();
+    const size_t threads = chart_triangles < 2000 ? 1 : std::clamp<size_t>(std::thread::hardware_concurrency(), 1, charts.size());
+    std::vector<std::thread> helpers;
+    for (size_t t = 1; t < threads; ++t) helpers.emplace_back(work, false);
+    work(true);
+    for (std::thread& t : helpers) t.join();
     return flat;
   };
 
@@ -143,17 +174,12 @@ GeneratedUvs generate_lightmap_uvs(std::span<const Vec3> positions, std::span<co
     l.charts = uvgen::segment_into_charts(mesh, neighbour, segmentation, splitter, first_seed);
     if (report) progress.at(0.05);
     const double flattened_end = 0.05 + 0.6 * (first_end - 0.05);
-    l.flat.resize(l.charts.size());
-    size_t flattened = 0;
-    for (size_t c = 0; c < l.charts.size(); ++c) {
-      l.flat[c] = flatten_scaled(l.charts[c]);
-      flattened += l.charts[c].triangles.size();
-      const double fraction = double(flattened) / double(std::max<size_t>(triangle_count, 1));
+    l.flat = flatten_all(l.charts, [&](double fraction) {
       if (report)
         progress.at(0.05 + (flattened_end - 0.05) * fraction);
       else
         search_progress(0.5 * fraction);
-    }
+    });
     l.outlines = outline(l.charts, l.flat);
     uvgen::PackingSettings trial = packing;
     trial.fill_to_beat = to_beat;
