@@ -96,24 +96,41 @@ struct ChartMask {
   bool at(int x, int y) const { return texels[size_t(y) * size_t(width) + size_t(x)] != 0; }
 };
 
-// Separating-axis test of a triangle against the texel [x, x+1] x [y, y+1] grown by `grow`.
-bool touches(const std::array<Point2, 3>& p, int x, int y, double grow) {
-  auto separated = [&](double ax, double ay) {
-    double lo = 1e300, hi = -1e300;
-    for (const Point2& q : p) lo = std::min(lo, ax * q[0] + ay * q[1]), hi = std::max(hi, ax * q[0] + ay * q[1]);
-    const double centre = ax * (x + 0.5) + ay * (y + 0.5);
-    const double radius = (0.5 + grow) * (std::fabs(ax) + std::fabs(ay));
-    return hi < centre - radius || lo > centre + radius;
-  };
-  if (separated(1, 0) || separated(0, 1)) return false;
-  for (int k = 0; k < 3; ++k) {
-    const Point2 &a = p[size_t(k)], &b = p[size_t(k + 1) % 3];
-    const double ex = b[0] - a[0], ey = b[1] - a[1];
-    const double length = std::sqrt(ex * ex + ey * ey);
-    if (length > 0 && separated(-ey / length, ex / length)) return false;
+// Separating-axis test of a triangle against texels [x, x+1] x [y, y+1] grown by `grow`: the
+// triangle's extent along the two texel axes and its three edge normals, computed once per triangle.
+class TriangleTexelTest {
+ public:
+  TriangleTexelTest(const std::array<Point2, 3>& p, double grow) {
+    add(p, grow, 1, 0);
+    add(p, grow, 0, 1);
+    for (int k = 0; k < 3; ++k) {
+      const Point2 &a = p[size_t(k)], &b = p[size_t(k + 1) % 3];
+      const double ex = b[0] - a[0], ey = b[1] - a[1];
+      const double length = std::sqrt(ex * ex + ey * ey);
+      if (length > 0) add(p, grow, -ey / length, ex / length);
+    }
   }
-  return true;
-}
+  bool touches(int x, int y) const {
+    for (int i = 0; i < count_; ++i) {
+      const Axis& a = axes_[size_t(i)];
+      const double centre = a.ax * (x + 0.5) + a.ay * (y + 0.5);
+      if (a.hi < centre - a.radius || a.lo > centre + a.radius) return false;
+    }
+    return true;
+  }
+
+ private:
+  struct Axis {
+    double ax, ay, lo, hi, radius;
+  };
+  void add(const std::array<Point2, 3>& p, double grow, double ax, double ay) {
+    Axis& a = axes_[size_t(count_++)];
+    a = {ax, ay, 1e300, -1e300, (0.5 + grow) * (std::fabs(ax) + std::fabs(ay))};
+    for (const Point2& q : p) a.lo = std::min(a.lo, ax * q[0] + ay * q[1]), a.hi = std::max(a.hi, ax * q[0] + ay * q[1]);
+  }
+  std::array<Axis, 5> axes_{};
+  int count_ = 0;
+};
 
 // Chart points in texels after the placement's rotation and minimum, before the quarter turns.
 Point2 to_texels(const ChartPlacement& c, Point2 point, double density) {
@@ -133,9 +150,10 @@ ChartMask rasterize_chart(const ChartOutline& chart, const ChartPlacement& place
     const int x1 = std::min(mask.width - 1, int(std::floor(std::max({p[0][0], p[1][0], p[2][0]}) + grow)));
     const int y0 = std::max(0, int(std::floor(std::min({p[0][1], p[1][1], p[2][1]}) - grow)));
     const int y1 = std::min(mask.height - 1, int(std::floor(std::max({p[0][1], p[1][1], p[2][1]}) + grow)));
+    const TriangleTexelTest test(p, grow);
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x)
-        if (!mask.at(x, y) && touches(p, x, y, grow)) mask.texels[size_t(y) * size_t(mask.width) + size_t(x)] = 1;
+        if (!mask.at(x, y) && test.touches(x, y)) mask.texels[size_t(y) * size_t(mask.width) + size_t(x)] = 1;
   }
   return mask;
 }
@@ -175,7 +193,9 @@ struct BitMask {
   std::vector<int> row_first;  // height + 1: the runs of row r are runs[row_first[r] .. row_first[r + 1])
   std::vector<MaskRun> runs;
   std::vector<int> order;      // rows with texels, in the order the search tests them
+  std::vector<int> row_longest;     // per row: its longest run
   int key_row = 0, key_length = 0;  // the first row holding the longest run, and that run's length
+  int longest_run = 0;              // == key_length
   int dilated_words = 0;               // per row of the dilated mask: width + 2 dilation bits
   std::vector<uint64_t> dilated_rows;  // (height + 2 dilation) x dilated_words
 };
@@ -197,6 +217,7 @@ BitMask bit_mask_of(const ChartMask& m, int dilation) {
   b.dilated_words = (dilated_width + 63) / 64;
   b.dilated_rows.assign(size_t(dilated_height) * size_t(b.dilated_words), 0);
   b.row_first.assign(size_t(m.height) + 1, 0);
+  b.row_longest.assign(size_t(m.height), 0);
   // Each row's runs, and the row widened by 2 dilation texels; then rows dilated upwards.
   std::vector<uint64_t> wide(size_t(m.height) * size_t(b.dilated_words), 0);
   for (int y = 0; y < m.height; ++y) {
@@ -210,11 +231,13 @@ BitMask bit_mask_of(const ChartMask& m, int dilation) {
       while (end < m.width && m.at(end, y)) ++end;
       b.runs.push_back({x, end - x, int(std::bit_width(unsigned(end - x))) - 1});
       if (end - x > b.key_length) b.key_length = end - x, b.key_row = y;
+      b.row_longest[size_t(y)] = std::max(b.row_longest[size_t(y)], end - x);
       set_range(&wide[size_t(y) * size_t(b.dilated_words)], x, end + 2 * dilation);
       x = end;
     }
   }
   b.row_first[size_t(m.height)] = int(b.runs.size());
+  b.longest_run = b.key_length;
   for (int y = 0; y < m.height; ++y)
     for (int d = 0; d <= 2 * dilation; ++d)
       for (int w = 0; w < b.dilated_words; ++w)
@@ -242,11 +265,12 @@ BitMask bit_mask_of(const ChartMask& m, int dilation) {
 // column c overlaps the row is two shifted reads of level floor(log2 L), for 64 columns at a time.
 class OccupancyGrid {
  public:
-  explicit OccupancyGrid(int width)
+  // `longest_run`: the longest mask run that will be tested (the levels kept).
+  OccupancyGrid(int width, int longest_run)
       : width_(width),
         used_words_((width + 63) / 64),
         words_(used_words_ + 1),  // a zero word past the end for the shifted reads
-        levels_(std::bit_width(unsigned(std::max(width, 1)))) {}
+        levels_(int(std::bit_width(unsigned(std::clamp(longest_run, 1, std::max(width, 1)))))) {}
 
   int width() const { return width_; }
   int rows() const { return int(longest_free_.size()); }
@@ -286,7 +310,7 @@ class OccupancyGrid {
         if (shift && target + 1 < used_words_) row[target + 1] |= word >> (64 - shift);
       }
       if (width_ & 63) row[used_words_ - 1] &= (uint64_t(1) << (width_ & 63)) - 1;  // and right of it
-      update_row(gy);
+      update_row(gy, std::max(left, 0), std::min(width_, left + 64 * m.dilated_words));
     }
   }
 
@@ -300,13 +324,16 @@ class OccupancyGrid {
     return bits;
   }
 
-  void update_row(int y) {
+  // Row y's levels after its columns [begin, end) changed: level k changes from 2^k - 1 columns
+  // before `begin` on.
+  void update_row(int y, int begin, int end) {
     uint64_t* base = &table_[size_t(y) * size_t(levels_) * size_t(words_)];
+    const int last_word = std::min(used_words_ - 1, (end - 1) >> 6);
     for (int k = 1; k < levels_; ++k) {
       const uint64_t* below = base + size_t(k - 1) * size_t(words_);
       uint64_t* level = base + size_t(k) * size_t(words_);
       const int half = 1 << (k - 1);
-      for (int w = 0; w < used_words_; ++w) level[w] = below[w] | read_safe(below, 64 * w + half);
+      for (int w = std::max(0, begin - (1 << k) + 1) >> 6; w <= last_word; ++w) level[w] = below[w] | read_safe(below, 64 * w + half);
     }
     int longest = 0;  // the longest run of free texels
     for (int x = 0; x < width_;) {
@@ -361,8 +388,9 @@ std::array<int, 2> bottom_left_position(const OccupancyGrid& grid, const BitMask
   int killer = m.order.empty() ? 0 : m.order.front();
   for (int y = 0; y <= y_limit; ++y) {
     if (y >= grid.rows()) return {0, y};  // nothing placed from here up
-    const int key = y + m.key_row;
+    const int key = y + m.key_row, killer_row = y + killer;
     if (key < grid.rows() && grid.longest_free(key) < m.key_length) continue;
+    if (killer_row < grid.rows() && grid.longest_free(killer_row) < m.row_longest[size_t(killer)]) continue;
     int lo = 0, hi = words;  // the words that may still hold a candidate
     bool started = false;    // false: every column is still a candidate (`candidates` not written yet)
     auto empties = [&](int r) {
@@ -411,7 +439,10 @@ StripResult pack_strip(const std::vector<std::array<BitMask, 4>>& masks, const s
   StripResult result;
   result.position.resize(masks.size());
   result.turns.resize(masks.size());
-  OccupancyGrid grid(strip_width);
+  int longest_run = 1;
+  for (const std::array<BitMask, 4>& turns : masks)
+    for (int t = 0; t < turn_choices; ++t) longest_run = std::max(longest_run, turns[size_t(t)].longest_run);
+  OccupancyGrid grid(strip_width, longest_run);
   std::vector<uint64_t> candidates;
   for (size_t chart : order) {
     int best_top = INT32_MAX, best_x = 0, best_y = 0, best_turns = -1;
