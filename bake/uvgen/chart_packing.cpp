@@ -482,6 +482,9 @@ StripResult pack_strip(const std::vector<std::array<BitMask, 4>>& masks, const s
   return result;
 }
 
+// Strips of fewer texels (the charts' masks with their gutters) are packed on the calling thread.
+constexpr double kThreadedStripTexels = 100000;
+
 }  // namespace
 
 Point2 PackedCharts::uv(size_t chart, Point2 point) const {
@@ -622,8 +625,11 @@ PackedCharts pack_charts(const std::vector<ChartOutline>& charts, const PackingS
         if (!least_finished || key < *least_finished) least_finished = key;
       }
     };
+    // Threads only for strips of some size: a small packing takes less than a helper thread's
+    // start on a busy machine.
     std::vector<std::thread> helpers;
-    for (unsigned t = 1; t < threads; ++t) helpers.emplace_back(work, false);
+    if (total_area >= kThreadedStripTexels)
+      for (unsigned t = 1; t < threads; ++t) helpers.emplace_back(work, false);
     work(true);
     for (std::thread& t : helpers) t.join();
     // A strip kept unless given up for fill_to_beat fills more than asked (or it would have been

@@ -94,10 +94,11 @@ GeneratedUvs generate_lightmap_uvs(std::span<const Vec3> positions, std::span<co
         if (reporting) report(double(done) / double(std::max<size_t>(triangle_count, 1)));
       }
     };
-    // Threads only where there is work to share: a thread costs about as much as a small chart.
+    // Threads only where there is work to share: on a busy machine a helper thread can take longer
+    // to start than a few thousand triangles take to flatten.
     size_t chart_triangles = 0;
     for (const uvgen::Chart& chart : charts) chart_triangles += chart.triangles.size();
-    const size_t threads = chart_triangles < 2000 ? 1 : std::clamp<size_t>(std::thread::hardware_concurrency(), 1, charts.size());
+    const size_t threads = chart_triangles < 20000 ? 1 : std::clamp<size_t>(std::thread::hardware_concurrency(), 1, charts.size());
     std::vector<std::thread> helpers;
     for (size_t t = 1; t < threads; ++t) helpers.emplace_back(work, false);
     work(true);
