@@ -3,8 +3,12 @@
 // quarter turns, at the lowest then leftmost position where its mask overlaps no texel of the charts
 // already placed dilated by the gutter), at the largest density, up to the one asked, whose
 // rectangle fits the page. Masks let a chart nest inside another's arch or C, which bounding boxes
-// and skylines cannot.
+// and skylines cannot. The search tests 64 columns at a time against per-row run tables of the
+// occupancy (two shifted reads per mask run), packs the strip widths on all hardware threads and
+// gives up a strip as soon as its rectangle loses to another's; the placements are those of testing
+// every position (bench/results/uvgen.md).
 #pragma once
+#include <functional>
 #include <vector>
 
 #include "chart_parameterization.h"
@@ -23,6 +27,11 @@ struct PackingSettings {
   // Least distance between two charts, in texels: masks are dilated by ceil(gutter) - 1 texels and
   // triangles rasterized grown by the rest over 2, so charts end at least `gutter_texels` apart.
   double gutter_texels = 3.1;
+  // > 0: the caller keeps the packing only if it fits with texels_per_unit^2 / (width * height)
+  // above this (a layout search); one that fits at texels_per_unit and fills no more comes back as
+  // `beaten`, given up as soon as that is certain.
+  double fill_to_beat = 0;
+  std::function<void(double)> progress;  // fraction of the packing done, called from the calling thread
 };
 
 // Where every chart went: rotate to the minimal-area box, subtract its minimum, scale to texels,
@@ -41,6 +50,7 @@ struct PackedCharts {
   int width = 0, height = 0;  // texels
   double texels_per_unit = 0;
   bool fits = true;           // false: the smallest density tried still exceeded max_side_texels
+  bool beaten = false;        // PackingSettings::fill_to_beat was not beaten: no placements
 
   // The chart point in normalized UVs (the rectangle divided by its longer side).
   Point2 uv(size_t chart, Point2 point) const;

@@ -64,7 +64,8 @@ ChartSplitter::ChartSplitter(const WeldedMesh& mesh, const std::vector<int32_t>&
       neighbour_(neighbour),
       max_triangles_(std::max<size_t>(max_triangles, 1)),
       member_(mesh.triangle_count(), 0),
-      distance_(mesh.triangle_count(), 0) {}
+      distance_(mesh.triangle_count(), 0),
+      label_(mesh.triangle_count(), 0) {}
 
 void ChartSplitter::add(Chart chart, std::vector<Chart>& out) {
   std::vector<Chart> pending{std::move(chart)};
@@ -87,33 +88,28 @@ std::vector<Chart> ChartSplitter::split(const Chart& chart) {
     member_[t] = stamp_;
   const uint32_t a = farthest_from(chart.triangles.front());
   const uint32_t b = farthest_from(a);
-  std::vector<uint8_t> label;  // per chart face, by position in chart.triangles: 0 none, 1 a, 2 b
-  label.assign(chart.triangles.size(), 0);
-  auto position = [&](uint32_t t) {
-    return size_t(std::lower_bound(chart.triangles.begin(), chart.triangles.end(), t) - chart.triangles.begin());
-  };
+  for (uint32_t t : chart.triangles) label_[t] = 0;  // 0 none, 1 grown from a, 2 from b
   std::deque<uint32_t> queue{a};
-  label[position(a)] = 1;
+  label_[a] = 1;
   if (b != a) {
     queue.push_back(b);
-    label[position(b)] = 2;
+    label_[b] = 2;
   }
   while (!queue.empty()) {
     const uint32_t t = queue.front();
     queue.pop_front();
-    const uint8_t l = label[position(t)];
+    const uint8_t l = label_[t];
     for (int k = 0; k < 3; ++k) {
       const int32_t u = neighbour_[3 * size_t(t) + size_t(k)];
       if (u == kNoNeighbour || member_[size_t(u)] != stamp_) continue;
-      uint8_t& lu = label[position(uint32_t(u))];
+      uint8_t& lu = label_[size_t(u)];
       if (lu) continue;
       lu = l;
       queue.push_back(uint32_t(u));
     }
   }
   std::vector<Chart> parts(3);
-  for (size_t i = 0; i < chart.triangles.size(); ++i)
-    parts[label[i]].triangles.push_back(chart.triangles[i]);
+  for (uint32_t t : chart.triangles) parts[label_[t]].triangles.push_back(t);
   parts[1].normal = mesh_.normals[a];
   parts[2].normal = mesh_.normals[b];
   parts[0].normal = chart.normal;

@@ -42,6 +42,7 @@ class ChartSplitter {
   size_t max_triangles_;
   std::vector<uint32_t> member_;    // == stamp_: in the chart being split
   std::vector<uint32_t> distance_;  // == walk_: visited by the current walk
+  std::vector<uint8_t> label_;      // per face of the chart being split: which part it grew into
   uint32_t stamp_ = 0, walk_ = 0;
 };
 

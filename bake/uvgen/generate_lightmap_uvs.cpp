@@ -1,9 +1,12 @@
 #include "exitance/bake/uvgen/lightmap_uv_generation.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 #include <stdexcept>
+#include <thread>
 
 #include "chart_halving.h"
 #include "chart_packing.h"
@@ -74,6 +77,35 @@ GeneratedUvs generate_lightmap_uvs(std::span<const Vec3> positions, std::span<co
     return flat;
   };
 
+  // Every chart flattened, largest first, on up to hardware_concurrency threads (charts are
+  // independent: the same UVs whatever the threads); report(fraction of the triangles) from the
+  // calling thread.
+  auto flatten_all = [&](const std::vector<uvgen::Chart>& charts, const std::function<void(double)>& report) {
+    std::vector<uvgen::FlatChart> flat(charts.size());
+    std::vector<size_t> order(charts.size());
+    std::iota(order.begin(), order.end(), size_t(0));
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return charts[a].triangles.size() > charts[b].triangles.size(); });
+    std::atomic<size_t> next{0}, flattened{0};
+    auto work = [&](bool reporting) {
+      for (size_t i; (i = next.fetch_add(1)) < order.size();) {
+        flat[order[i]] = flatten_scaled(charts[order[i]]);
+        const size_t done = flattened.fetch_add(charts[order[i]].triangles.size()) + charts[order[i]].triangles.size();
+        if (reporting) report(double(done) / double(std::max<size_t>(triangle_count, 1)));
+      }
+    };
+    // Threads only where there is work to share: on a busy machine a helper thread can take longer
+    // to start than a few thousand triangles take to flatten.
+    size_t chart_triangles = 0;
+    for (const uvgen::Chart& chart : charts) chart_triangles += chart.triangles.size();
+    const size_t threads = chart_triangles < 20000 ? 1 : std::clamp<size_t>(std::thread::hardware_concurrency(), 1, charts.size());
+    std::vector<std::thread> helpers;
+    for (size_t t = 1; t < threads; ++t) helpers.emplace_back(work, false);
+    work(true);
+    for (std::thread& t : helpers) t.join();
+    return flat;
+  };
+
   // The charts' outlines for the packer. Degenerate faces: collapsed onto a chart's copy of one of
   // their vertices (no area, so they cover nothing of their own), or, when no chart has any of their
   // vertices, a point chart each (after the real charts).
@@ -122,31 +154,55 @@ GeneratedUvs generate_lightmap_uvs(std::span<const Vec3> positions, std::span<co
     Outlines outlines;
     uvgen::PackedCharts packed;
   };
+  // Progress: segmentation to 0.05, then flattening and packing the first layout to `first_end`,
+  // then the layout search (if any) to 0.95, each step an equal share.
+  const bool may_search = triangle_count <= settings.layout_search_max_triangles;
+  const double first_end = may_search ? 0.5 : 0.95;
+  const int search_steps = 6 + std::max(settings.split_charts, 0);
+  int search_step = 0;
+  auto search_progress = [&](double fraction) {
+    progress.at(first_end + (0.95 - first_end) * (search_step + fraction) / search_steps);
+  };
+  // What a search layout must beat: a packing that fits the page and fills more of its rectangle.
+  auto fill_to_beat = [](const uvgen::PackedCharts& best) {
+    return best.fits ? best.texels_per_unit * best.texels_per_unit / (double(best.width) * best.height) : 0.0;
+  };
   // Charts grown from `first_seed` (-1: the first face), flattened and packed; `report`: progress
-  // over the flattening, which takes most of the time.
-  auto lay_out = [&](int64_t first_seed, bool report) {
+  // over the first layout (flattening 0.05 to 60 % of the way to first_end, packing the rest), else
+  // over one search step. `to_beat`: PackingSettings::fill_to_beat.
+  auto lay_out = [&](int64_t first_seed, bool report, double to_beat) {
     Layout l;
     l.charts = uvgen::segment_into_charts(mesh, neighbour, segmentation, splitter, first_seed);
     if (report) progress.at(0.05);
-    l.flat.resize(l.charts.size());
-    size_t flattened = 0;
-    for (size_t c = 0; c < l.charts.size(); ++c) {
-      l.flat[c] = flatten_scaled(l.charts[c]);
-      flattened += l.charts[c].triangles.size();
-      if (report) progress.at(0.05 + 0.8 * double(flattened) / double(std::max<size_t>(triangle_count, 1)));
-    }
+    const double flattened_end = 0.05 + 0.6 * (first_end - 0.05);
+    l.flat = flatten_all(l.charts, [&](double fraction) {
+      if (report)
+        progress.at(0.05 + (flattened_end - 0.05) * fraction);
+      else
+        search_progress(0.5 * fraction);
+    });
     l.outlines = outline(l.charts, l.flat);
-    l.packed = uvgen::pack_charts(l.outlines.charts, packing);
-    if (report) progress.at(0.9);
+    uvgen::PackingSettings trial = packing;
+    trial.fill_to_beat = to_beat;
+    trial.progress = [&](double fraction) {
+      if (report)
+        progress.at(flattened_end + (first_end - flattened_end) * fraction);
+      else
+        search_progress(0.5 + 0.5 * fraction);
+    };
+    l.packed = uvgen::pack_charts(l.outlines.charts, trial);
+    if (report) progress.at(first_end);
     return l;
   };
-  Layout best = lay_out(-1, true);
+  Layout best = lay_out(-1, true, 0);
 
   // Two searches on small meshes (bench/results/uvgen.md), each layout kept only when its charts
   // fill more of the packed rectangle. First, where the first chart's cone boundaries fall decides
   // the charts' shapes: on a torus, arches across the tube or the tube's top and bottom halves; the
-  // charts are also grown from the faces whose normals point farthest along each axis.
+  // charts are also grown from the faces whose normals point farthest along each axis. A search
+  // layout's packing is given up (beaten) once it cannot fill more than the best so far.
   auto fills_more = [](const uvgen::PackedCharts& a, const uvgen::PackedCharts& b) {
+    if (a.beaten) return false;
     if (a.fits != b.fits) return a.fits;
     return a.texels_per_unit * a.texels_per_unit / (double(a.width) * a.height) >
            b.texels_per_unit * b.texels_per_unit / (double(b.width) * b.height);
@@ -159,12 +215,14 @@ GeneratedUvs generate_lightmap_uvs(std::span<const Vec3> positions, std::span<co
       const uvgen::Point3& n = mesh.normals[t];
       curved = curved || n[0] * chart.normal[0] + n[1] * chart.normal[1] + n[2] * chart.normal[2] < kCurvedChartCos;
     }
-  const bool search = curved && triangle_count <= settings.layout_search_max_triangles;
+  const bool search = curved && may_search;
   if (search)
     for (uint32_t seed : uvgen::axis_seed_faces(mesh)) {
-      Layout trial = lay_out(int64_t(seed), false);
+      Layout trial = lay_out(int64_t(seed), false, fill_to_beat(best.packed));
       if (fills_more(trial.packed, best.packed)) best = std::move(trial);
+      search_step = std::min(search_step + 1, 6);
     }
+  search_step = 6;
   // Then arches (a torus's halves flatten to ~200-degree arches) fill little of their bounding box
   // and stack badly: the largest chart filling less than split_below_fill of its box is halved
   // across its long axis, up to split_charts times in a row; halving one arch of two does not pay,
@@ -196,8 +254,12 @@ GeneratedUvs generate_lightmap_uvs(std::span<const Vec3> positions, std::span<co
         }
       }
       next.outlines = outline(next.charts, next.flat);
-      next.packed = uvgen::pack_charts(next.outlines.charts, packing);
+      uvgen::PackingSettings trial = packing;
+      trial.fill_to_beat = fill_to_beat(best.packed);
+      trial.progress = search_progress;
+      next.packed = uvgen::pack_charts(next.outlines.charts, trial);
       current = std::move(next);
+      ++search_step;
       if (fills_more(current.packed, best.packed)) best = current;
     }
   }
