@@ -29,7 +29,7 @@ for e in ${EDITS:-move double block}; do
       $R $W/base.bake -o $W/$o.bake --edits $W/$e.json --spp 4096 --frames $f --budget-ms 16 --seed 3 --no-frame-errors $flag --json > $W/$o.json
       python3 -c "
 import json; r=json.load(open('$W/$o.json')); ms=[f['milliseconds'] for f in r['frames']]
-print('$o', 'edits_s %.4f'%r['seconds']['edits'], 'changed_lights', r['edits']['changed_lights'], 'frames', len(ms), 'frame_ms_sum %.1f max %.1f'%(sum(ms), max(ms)), 'over_17ms', sum(1 for m in ms if m > 17), 'spp', r['spp'], 'samples_added', [f['samples_added'] for f in r['frames']][:8])" >> $S
+print('$o', 'edits_s %.4f'%r['seconds']['edits'], 'edit_ms', {k: round(v, 2) for k, v in r['edits'].get('milliseconds', {}).items()}, 'changed_lights', r['edits']['changed_lights'], 'frames', len(ms), 'frame_ms_sum %.1f max %.1f'%(sum(ms), max(ms)), 'over_17ms', sum(1 for m in ms if m > 17), 'spp', r['spp'], 'samples_added', [f['samples_added'] for f in r['frames']][:8])" >> $S
       list="$list $W/$o.bake"
     done
   done
