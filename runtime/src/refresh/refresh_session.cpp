@@ -169,8 +169,9 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
       throw BundleInputError(e.what());
     }
   }
-  // The publishing pipeline made (and on lavapipe compiled) here, not in the first edit.
-  if (!state->previous) state->integrator->publish(PublishMode::Accumulation, nullptr, nullptr);
+  // The publishing pipeline made (on lavapipe compiled) and a published estimate's device memory
+  // allocated here, not in the first edit (which reuses it).
+  state->integrator->publish(PublishMode::Accumulation, nullptr, nullptr);
   return std::unique_ptr<RefreshSession>(new RefreshSession(std::move(state)));
 }
 

@@ -260,6 +260,7 @@ void Context::cleanup() {
   }
   if (device_) {
     if (owns_device_ && !lost_) vkDeviceWaitIdle(device_);
+    small_staging_ = Buffer{};
     if (fence_) vkDestroyFence(device_, fence_, nullptr);
     if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
     fence_ = VK_NULL_HANDLE, pool_ = VK_NULL_HANDLE;
@@ -377,9 +378,32 @@ void Context::fail(const std::string& message) {
   throw VulkanDeviceFailure(message);
 }
 
+// Marks the reused staging buffer busy for one transfer's scope.
+struct StagingLease {
+  bool& busy;
+  bool leased;
+  ~StagingLease() {
+    if (leased) busy = false;
+  }
+};
+
+const Buffer& Context::staging_for(VkDeviceSize size, Buffer& own, bool& leased) {
+  leased = false;
+  if (size <= kSmallStagingBytes && !small_staging_busy_) {
+    if (!small_staging_.handle()) small_staging_ = create_buffer(kSmallStagingBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+    small_staging_busy_ = leased = true;
+    return small_staging_;
+  }
+  own = create_buffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+  return own;
+}
+
 void Context::upload(const Buffer& dst, const void* data, VkDeviceSize size, VkDeviceSize offset) {
   if (size == 0) return;
-  Buffer staging = create_buffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+  Buffer own;
+  bool leased = false;
+  const Buffer& staging = staging_for(size, own, leased);
+  StagingLease lease{small_staging_busy_, leased};
   std::memcpy(staging.mapped(), data, size_t(size));
   VkCommandBuffer cmd = begin();
   VkBufferCopy region{0, offset, size};
@@ -400,7 +424,10 @@ void Context::write_ranges(const Buffer& dst, const std::vector<ByteRange>& rang
   VkDeviceSize packed = 0;
   const std::vector<VkBufferCopy> regions = staging_regions(ranges, /*from_staging=*/true, packed);
   if (packed == 0) return;
-  Buffer staging = create_buffer(packed, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+  Buffer own;
+  bool leased = false;
+  const Buffer& staging = staging_for(packed, own, leased);
+  StagingLease lease{small_staging_busy_, leased};
   write(static_cast<char*>(staging.mapped()));
   VkCommandBuffer cmd = begin();
   vkCmdCopyBuffer(cmd, staging.handle(), dst.handle(), uint32_t(regions.size()), regions.data());
@@ -417,8 +444,10 @@ void Context::read_back_ranges(const Buffer& src, const std::vector<ByteRange>& 
   const std::vector<VkBufferCopy> regions = staging_regions(ranges, /*from_staging=*/false, packed);
   if (packed == 0) return;
   Buffer own;
-  if (!staging || !staging->mapped() || staging->size() < packed) own = create_buffer(packed, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
-  const Buffer& through = own.handle() ? own : *staging;
+  bool leased = false;
+  const Buffer& through =
+      staging && staging->mapped() && staging->size() >= packed ? *staging : staging_for(packed, own, leased);
+  StagingLease lease{small_staging_busy_, leased};
   VkCommandBuffer cmd = begin();
   vkCmdCopyBuffer(cmd, src.handle(), through.handle(), uint32_t(regions.size()), regions.data());
   submit_and_wait(cmd);

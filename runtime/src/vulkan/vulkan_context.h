@@ -122,6 +122,14 @@ class Context {
   VkCommandBuffer cmd_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
   VulkanDeviceInfo info_;
+  // Host-visible staging reused by uploads and read-backs up to its size (each waits for its copy,
+  // so one buffer serves them in turn): small transfers (an edit's lights, a counter) allocate nothing.
+  Buffer small_staging_;
+  bool small_staging_busy_ = false;
+  static constexpr VkDeviceSize kSmallStagingBytes = 256 * 1024;
+  // The reused staging when `size` fits and it is free (marked busy until `own` is released by the
+  // caller's scope: see StagingLease in the .cpp), else a new buffer in `own`.
+  const Buffer& staging_for(VkDeviceSize size, Buffer& own, bool& leased);
   bool lost_ = false;
   bool hung_ = false;
 };
