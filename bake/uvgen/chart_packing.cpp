@@ -12,24 +12,10 @@
 #include <thread>
 #include <tuple>
 
+#include "progress_steps.h"
+
 namespace exitance::uvgen {
 namespace {
-
-// Reports progress at most every 1 % of the work, from the calling thread.
-class ProgressReporter {
- public:
-  explicit ProgressReporter(const std::function<void(double)>& report) : report_(report) {}
-  void at(double fraction) {
-    if (report_ && fraction >= last_ + 0.01) {
-      last_ = fraction;
-      report_(fraction);
-    }
-  }
-
- private:
-  const std::function<void(double)>& report_;
-  double last_ = -1;
-};
 
 // Andrew's monotone chain; collinear points dropped. Fewer than three points come back as they are.
 std::vector<Point2> convex_hull(std::vector<Point2> points) {
@@ -534,7 +520,7 @@ PackedCharts pack_charts(const std::vector<ChartOutline>& charts, const PackingS
   const int max_side = std::max(settings.max_side_texels, 1);
   // Progress: the n-th packing (0-based) covers [1 - 2^-n, 1 - 2^-(n+1)] (one packing is the
   // common case: the first density fits), each packing by the charts placed in all its strips.
-  ProgressReporter progress(settings.progress);
+  ProgressSteps progress(settings.progress);
   int packings = 0;
   // One packing at `density`: the best strip, and the charts' mask sizes at that density (those of
   // the last density rasterized when this one was not).

@@ -10,6 +10,7 @@
 
 #include "chart_halving.h"
 #include "chart_packing.h"
+#include "progress_steps.h"
 #include "chart_parameterization.h"
 #include "chart_segmentation.h"
 #include "uv_distortion.h"
@@ -27,28 +28,12 @@ double uv_area(const std::array<Point2, 3>& uv) {
   return 0.5 * std::fabs((uv[1][0] - uv[0][0]) * (uv[2][1] - uv[0][1]) - (uv[1][1] - uv[0][1]) * (uv[2][0] - uv[0][0]));
 }
 
-// Reports progress at most every 1 % of the work.
-class ProgressSteps {
- public:
-  explicit ProgressSteps(const std::function<void(double)>& report) : report_(report) {}
-  void at(double fraction) {
-    if (report_ && fraction >= last_ + 0.01) {
-      last_ = fraction;
-      report_(fraction);
-    }
-  }
-
- private:
-  const std::function<void(double)>& report_;
-  double last_ = -1;
-};
-
 }  // namespace
 
 GeneratedUvs generate_lightmap_uvs(std::span<const Vec3> positions, std::span<const uint32_t> indices,
                                    const UvGenerationSettings& settings) {
   if (indices.size() % 3) throw std::invalid_argument("index count is not a multiple of 3");
-  ProgressSteps progress(settings.progress);
+  uvgen::ProgressSteps progress(settings.progress);
   progress.at(0);
   const uvgen::WeldedMesh mesh = uvgen::weld_by_position(positions, indices);
   const size_t triangle_count = mesh.triangle_count();

@@ -97,16 +97,27 @@ LiveTexel moved_texel(const LiveTexel& texel, const Scene& next, const Scene& ol
   return moved;
 }
 
-}  // namespace
-
-bool moves_an_instance(const Scene& next, const std::vector<std::string>& edit_of_node) {
-  const std::vector<std::string> responsible = responsible_edits(next, edit_of_node);
+// Per node of `next`: the edit responsible for moving it ("" if none) and its world matrix.
+struct EditedWorld {
+  std::vector<std::string> responsible;
   std::vector<std::optional<Matrix4d>> world;
+};
+
+EditedWorld edited_world(const Scene& next, const std::vector<std::string>& edit_of_node) {
+  EditedWorld w;
+  w.responsible = responsible_edits(next, edit_of_node);
   try {
-    world = node_world_matrices(next);
+    w.world = node_world_matrices(next);
   } catch (const std::invalid_argument& e) {
     fail("scene", std::string("node hierarchy: ") + e.what());
   }
+  return w;
+}
+
+}  // namespace
+
+bool moves_an_instance(const Scene& next, const std::vector<std::string>& edit_of_node) {
+  const auto [responsible, world] = edited_world(next, edit_of_node);
   for (const Instance& instance : next.instances) {
     const size_t node = size_t(instance.node);
     if (instance.node < 0 || node >= world.size() || responsible[node].empty() || !world[node]) continue;
@@ -117,13 +128,7 @@ bool moves_an_instance(const Scene& next, const std::vector<std::string>& edit_o
 
 MovedGeometry move_under_edited_nodes(Scene& next, const Scene& old, const TexelGBuffer& gbuffer,
                                       const AtlasLayout& atlas, const std::vector<std::string>& edit_of_node) {
-  const std::vector<std::string> responsible = responsible_edits(next, edit_of_node);
-  std::vector<std::optional<Matrix4d>> world;
-  try {
-    world = node_world_matrices(next);
-  } catch (const std::invalid_argument& e) {
-    fail("scene", std::string("node hierarchy: ") + e.what());
-  }
+  const auto [responsible, world] = edited_world(next, edit_of_node);
   for (size_t i = 0; i < world.size(); ++i)
     if (!responsible[i].empty() && world[i] && (!finite_matrix(*world[i]) || !(std::fabs(determinant3(*world[i])) > 0)))
       fail(responsible[i], "the world transform of node " + std::to_string(i) + " is " +
