@@ -735,52 +735,81 @@ TEST(SceneEditsLighting, UpdateEqualsABuildOfTheEditedScene) {
   }
 }
 
-// The cheap path: edits of lights, the sky and a light's node, applied in place, leave the scene
-// bit for bit as apply_scene_edits does, and the lighting scene refreshed from its own (edited)
-// source equals a build of the edited scene; material edits and nodes that move an instance are
-// left to apply_scene_edits, and a bad edit leaves the scene as it was.
-TEST(SceneEditsApply, LightEditsInPlaceEqualTheCopyingPath) {
+// The runtime's path: edits applied in place (lights, the sky, materials, nodes that move lights,
+// instances, an emissive panel under a matrix node, a mirror) leave the scene, its texels and,
+// once the caller refits the BVH over the moved triangles, scene.bin's bytes exactly as
+// apply_scene_edits does; the lighting scene refreshed from its own (edited) source equals a
+// build of the edited scene; the moved texels listed are those that changed; a bad edit after
+// good ones leaves the scene bit for bit as it was.
+TEST(SceneEditsApply, InPlaceEqualsTheCopyingPath) {
   LightEdit cone;
   cone.light.name = "Lamp";
   cone.outer_cone_angle = 0.7;
   cone.color = std::array<float, 3>{0.2f, 0.4f, 1.0f};
+  MaterialEdit strength;
+  strength.material.name = "Panel";
+  strength.emissive_strength = 3;
   const std::vector<std::vector<SceneEdit>> cases = {
       {light_intensity(EditTarget{"Lamp", {}}, 9), {cone, ""}},
       {{SkyEdit{{0.1f, 0.2f, 0.3f}}, ""}, light_intensity(EditTarget{"Sun", {}}, 0.5f)},
       {node_edit("LampNode", std::array<double, 3>{1, 4, -2}), node_edit("sun", std::nullopt, std::array<double, 4>{0, 0.6, 0, 0.8})},
+      {{strength, ""}},
+      {node_edit("Box", std::array<double, 3>{-8, 3, 2}, std::array<double, 4>{0.6, 0, 0, 0.8})},
+      {node_edit("Group", std::array<double, 3>{0, 5, 1}), {strength, ""}, light_intensity(EditTarget{"Lamp", {}}, 2)},
+      {node_edit("Root", std::nullopt, std::nullopt, std::array<double, 3>{-1, 2, 2})},
   };
   for (size_t c = 0; c < cases.size(); ++c) {
+    SCOPED_TRACE("case " + std::to_string(c));
     PersistedScene copied = baked(), in_place = baked();
     const EditEffects expected = apply_scene_edits(copied, cases[c]);
     LightingScene lighting = build_lighting_scene(
         std::shared_ptr<const Scene>(std::shared_ptr<const Scene>{}, &in_place.scene), to_bvh4(in_place.bvh));
-    const std::optional<EditEffects> effects = apply_light_edits_in_place(in_place.scene, cases[c]);
-    ASSERT_TRUE(effects.has_value()) << "case " << c;
-    EXPECT_EQ(effects->lights, expected.lights) << "case " << c;
-    EXPECT_EQ(effects->sky, expected.sky) << "case " << c;
-    EXPECT_TRUE(effects->materials.empty() && effects->moved_instances.empty()) << "case " << c;
-    EXPECT_EQ(bytes_of(in_place), bytes_of(copied)) << "case " << c;
-    refresh_lights_from_source(lighting, effects->lights, effects->sky);
+    const Bvh4Links links = link_bvh4(lighting.bvh, in_place.scene.triangle_count());
+    const InstanceTexels by_instance(in_place.gbuffer, in_place.scene.instances.size());
+    const InPlaceEdits edited = apply_scene_edits_in_place(in_place, cases[c], c % 2 ? &by_instance : nullptr);
+    const EditEffects& effects = edited.effects;
+    EXPECT_EQ(effects.lights, expected.lights);
+    EXPECT_EQ(effects.materials, expected.materials);
+    EXPECT_EQ(effects.sky, expected.sky);
+    EXPECT_EQ(effects.moved_instances, expected.moved_instances);
+    EXPECT_EQ(effects.moved_texels, expected.moved_texels);
+    std::vector<uint32_t> changed_texels;
+    for (size_t i = 0; i < copied.gbuffer.texels.size(); ++i)
+      if (std::memcmp(&copied.gbuffer.texels[i], &baked().gbuffer.texels[i], sizeof(LiveTexel)) != 0) changed_texels.push_back(uint32_t(i));
+    EXPECT_EQ(edited.moved_texels, changed_texels);
+    EXPECT_EQ(edited.moved_boxes_before.size(), effects.moved_instances.size());
+    if (effects.geometry_changed()) {
+      EXPECT_FALSE(edited.moved_triangles.empty());
+      const MovedTrianglesRefresh moved = refresh_moved_triangles_from_source(
+          lighting, links, edited.moved_triangles, edited.moved_triangles_before, scene_world_box(in_place.scene));
+      for (uint32_t n : moved.bvh_nodes) std::memcpy(&in_place.bvh.nodes[n], &lighting.bvh.nodes[n], sizeof(Bvh4Node));
+    }
+    EXPECT_EQ(bytes_of(in_place), bytes_of(copied));
+    refresh_materials_from_source(lighting, effects.materials);
+    refresh_lights_from_source(lighting, effects.lights, effects.sky);
     const LightingScene fresh = build_lighting_scene(std::make_shared<const Scene>(copied.scene), to_bvh4(copied.bvh));
-    EXPECT_TRUE(same_bytes(lighting.punctual_lights, fresh.punctual_lights)) << "case " << c;
-    EXPECT_EQ(lighting.punctual_cdf, fresh.punctual_cdf) << "case " << c;
-    EXPECT_EQ(lighting.sky.x, fresh.sky.x) << "case " << c;
+    EXPECT_TRUE(same_bytes(lighting.triangles, fresh.triangles));
+    EXPECT_TRUE(same_bytes(lighting.materials, fresh.materials));
+    EXPECT_TRUE(same_bytes(lighting.punctual_lights, fresh.punctual_lights));
+    EXPECT_TRUE(same_bytes(lighting.bvh.nodes, fresh.bvh.nodes));
+    EXPECT_EQ(lighting.emitter_triangles, fresh.emitter_triangles);
+    EXPECT_EQ(lighting.emitter_cdf, fresh.emitter_cdf);
+    EXPECT_EQ(lighting.punctual_cdf, fresh.punctual_cdf);
+    EXPECT_EQ(lighting.sky.x, fresh.sky.x);
+    EXPECT_EQ(lighting.extent, fresh.extent);
+    EXPECT_EQ(lighting.bounds_lo.y, fresh.bounds_lo.y);
+    EXPECT_EQ(lighting.bounds_hi.z, fresh.bounds_hi.z);
+    EXPECT_EQ(lighting.textured, fresh.textured);
   }
-  MaterialEdit strength;
-  strength.material.name = "Panel";
-  strength.emissive_strength = 3;
-  for (const std::vector<SceneEdit>& left : {std::vector<SceneEdit>{{strength, ""}},
-                                             std::vector<SceneEdit>{light_intensity(EditTarget{"Lamp", {}}, 2),
-                                                                    node_edit("Box", std::array<double, 3>{5, 0, 0})}}) {
+  for (const std::vector<SceneEdit>& bad :
+       {std::vector<SceneEdit>{light_intensity(EditTarget{"Lamp", {}}, 2), light_intensity(EditTarget{"Lamp", {}}, -1)},
+        std::vector<SceneEdit>{node_edit("Box", std::array<double, 3>{5, 0, 0}), {strength, ""},
+                               node_edit("Group", std::nullopt, std::nullopt, std::array<double, 3>{1, 0, 1})}}) {
     PersistedScene p = baked();
-    EXPECT_FALSE(apply_light_edits_in_place(p.scene, left).has_value());
+    const InstanceTexels by_instance(p.gbuffer, p.scene.instances.size());
+    EXPECT_THROW(apply_scene_edits_in_place(p, bad, &by_instance), SceneEditError);
     EXPECT_EQ(bytes_of(p), bytes_of(baked()));
   }
-  PersistedScene p = baked();
-  EXPECT_THROW(apply_light_edits_in_place(p.scene, {light_intensity(EditTarget{"Lamp", {}}, 2),
-                                                    light_intensity(EditTarget{"Lamp", {}}, -1)}),
-               SceneEditError);
-  EXPECT_EQ(bytes_of(p), bytes_of(baked()));
 }
 
 // The texel grid finds the same near texels as a pass over every texel: lights inside, at the edge

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "exitance/runtime/core/parallel_chunks.h"
 #include "exitance/runtime/float_rounding.h"
 #include "exitance/runtime/world_box.h"
 
@@ -86,39 +87,146 @@ WorldBox carried_part_box(const Vec3 before[3], const Vec3 after[3], const World
 
 }  // namespace
 
-void refit_bvh4(Bvh4& bvh, const std::vector<Vec3>& positions, const std::vector<Vec3>* fitted_to) {
-  const size_t triangle_count = positions.size() / 3;
-  if (fitted_to && fitted_to->size() != positions.size())
-    throw std::invalid_argument("refit_bvh4: " + std::to_string(fitted_to->size()) + " fitted positions for " +
-                                std::to_string(positions.size()));
+Bvh4Links link_bvh4(const Bvh4& bvh, size_t triangle_count) {
   for (uint32_t t : bvh.leaf_triangles)
     if (t >= triangle_count)
       throw std::invalid_argument("refit_bvh4: leaf references triangle " + std::to_string(t) + " of " +
                                   std::to_string(triangle_count));
+  Bvh4Links links;
+  links.slot_leaf.assign(bvh.leaf_triangles.size(), kNoBvhLink);
+  links.node_parent.assign(bvh.nodes.size(), kNoBvhLink);
   for (size_t n = 0; n < bvh.nodes.size(); ++n)
-    for (uint32_t child : bvh.nodes[n].child) {
+    for (uint32_t i = 0; i < 4; ++i) {
+      const uint32_t child = bvh.nodes[n].child[i];
       if (child == kBvhEmptyChild) continue;
       if (child & kBvhLeafBit) {
         const uint32_t first = (child & ~kBvhLeafBit) >> 2, count = (child & 3u) + 1;
         if (size_t(first) + count > bvh.leaf_triangles.size())
           throw std::invalid_argument("refit_bvh4: node " + std::to_string(n) + " has a leaf past the last slot");
+        for (uint32_t s = first; s < first + count; ++s) links.slot_leaf[s] = uint32_t(n) * 4 + i;
       } else if (child <= n || child >= bvh.nodes.size()) {
         throw std::invalid_argument("refit_bvh4: node " + std::to_string(n) + " has child " + std::to_string(child) +
                                     " (children come after their parent)");
+      } else {
+        links.node_parent[child] = uint32_t(n) * 4 + i;
       }
     }
-  // Per triangle: whether a vertex moved since the boxes were fitted (all of them without `fitted_to`).
-  std::vector<uint8_t> moved(triangle_count, 1);
-  if (fitted_to)
+  links.triangle_slot_start.assign(triangle_count + 1, 0);
+  for (uint32_t t : bvh.leaf_triangles) ++links.triangle_slot_start[size_t(t) + 1];
+  for (size_t t = 0; t < triangle_count; ++t) links.triangle_slot_start[t + 1] += links.triangle_slot_start[t];
+  links.triangle_slots.resize(bvh.leaf_triangles.size());
+  std::vector<uint32_t> next(links.triangle_slot_start.begin(), links.triangle_slot_start.end() - 1);
+  for (uint32_t s = 0; s < uint32_t(bvh.leaf_triangles.size()); ++s) links.triangle_slots[next[bvh.leaf_triangles[s]]++] = s;
+  return links;
+}
+
+namespace {
+
+void set_child_box(Bvh4Node& node, int i, const WorldBox& box) {
+  node.lo_x[i] = box.lo.x, node.lo_y[i] = box.lo.y, node.lo_z[i] = box.lo.z;
+  node.hi_x[i] = box.hi.x, node.hi_y[i] = box.hi.y, node.hi_z[i] = box.hi.z;
+}
+
+WorldBox child_box(const Bvh4Node& node, int i) {
+  return WorldBox{Vec3{node.lo_x[i], node.lo_y[i], node.lo_z[i]}, Vec3{node.hi_x[i], node.hi_y[i], node.hi_z[i]}};
+}
+
+// The union of a node's children's boxes: its box in its parent.
+WorldBox node_union(const Bvh4Node& node) {
+  WorldBox box;
+  for (int i = 0; i < 4; ++i)
+    if (node.child[i] != kBvhEmptyChild) box.grow(child_box(node, i));
+  return box;
+}
+
+}  // namespace
+
+std::vector<uint32_t> refit_bvh4_moved(Bvh4& bvh, const Bvh4Links& links, const std::vector<Vec3>& positions,
+                                       const std::vector<uint32_t>& moved, const std::vector<Vec3>& moved_before) {
+  const size_t triangle_count = positions.size() / 3;
+  if (links.slot_leaf.size() != bvh.leaf_triangles.size() || links.node_parent.size() != bvh.nodes.size() ||
+      links.triangle_slot_start.size() != triangle_count + 1)
+    throw std::invalid_argument("refit_bvh4_moved: the links are not this tree's over these triangles");
+  if (moved_before.size() != moved.size() * 3)
+    throw std::invalid_argument("refit_bvh4_moved: " + std::to_string(moved_before.size()) + " positions before for " +
+                                std::to_string(moved.size()) + " moved triangles");
+  for (size_t k = 0; k < moved.size(); ++k)
+    if (moved[k] >= triangle_count || (k > 0 && moved[k] <= moved[k - 1]))
+      throw std::invalid_argument("refit_bvh4_moved: the moved triangles must ascend, each below " + std::to_string(triangle_count));
+  // The leaves that hold a moved triangle, and the nodes above them.
+  std::vector<uint32_t> leaves;
+  for (uint32_t t : moved)
+    for (uint32_t k = links.triangle_slot_start[t]; k < links.triangle_slot_start[size_t(t) + 1]; ++k)
+      if (links.slot_leaf[links.triangle_slots[k]] != kNoBvhLink) leaves.push_back(links.slot_leaf[links.triangle_slots[k]]);
+  std::sort(leaves.begin(), leaves.end());
+  leaves.erase(std::unique(leaves.begin(), leaves.end()), leaves.end());
+  auto before_of = [&](uint32_t t) -> const Vec3* {
+    const auto it = std::lower_bound(moved.begin(), moved.end(), t);
+    return it != moved.end() && *it == t ? &moved_before[size_t(it - moved.begin()) * 3] : &positions[size_t(t) * 3];
+  };
+  // Each triangle's part in the leaf's box, carried to where the triangle went: a split fragment of
+  // a moved triangle stays a fragment. Leaves on threads (each reads its own box), written after.
+  std::vector<WorldBox> leaf_box(leaves.size());
+  for_each_chunk(leaves.size(), [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) {
+      const Bvh4Node& node = bvh.nodes[leaves[k] / 4];
+      const int i = int(leaves[k] % 4);
+      const uint32_t first = (node.child[i] & ~kBvhLeafBit) >> 2, count = (node.child[i] & 3u) + 1;
+      const WorldBox fitted = child_box(node, i);
+      for (uint32_t s = first; s < first + count; ++s) {
+        const uint32_t t = bvh.leaf_triangles[s];
+        leaf_box[k].grow(carried_part_box(before_of(t), &positions[size_t(t) * 3], fitted));
+      }
+    }
+  }, 256);
+  std::vector<uint32_t> dirty;
+  for (size_t k = 0; k < leaves.size(); ++k) {
+    set_child_box(bvh.nodes[leaves[k] / 4], int(leaves[k] % 4), leaf_box[k]);
+    dirty.push_back(leaves[k] / 4);
+  }
+  // Every node above a refit leaf, children before parents (a child's index exceeds its parent's).
+  std::vector<uint8_t> marked(bvh.nodes.size(), 0);
+  std::vector<uint32_t> above;
+  for (uint32_t n : dirty)
+    for (uint32_t at = n; !marked[at];) {
+      marked[at] = 1;
+      above.push_back(at);
+      if (links.node_parent[at] == kNoBvhLink) break;
+      at = links.node_parent[at] / 4;
+    }
+  std::sort(above.begin(), above.end(), std::greater<>());
+  for (uint32_t n : above) {
+    const uint32_t link = links.node_parent[n];
+    if (link != kNoBvhLink) set_child_box(bvh.nodes[link / 4], int(link % 4), node_union(bvh.nodes[n]));
+  }
+  std::sort(above.begin(), above.end());
+  return above;
+}
+
+void refit_bvh4(Bvh4& bvh, const std::vector<Vec3>& positions, const std::vector<Vec3>* fitted_to) {
+  const size_t triangle_count = positions.size() / 3;
+  if (fitted_to && fitted_to->size() != positions.size())
+    throw std::invalid_argument("refit_bvh4: " + std::to_string(fitted_to->size()) + " fitted positions for " +
+                                std::to_string(positions.size()));
+  const Bvh4Links links = link_bvh4(bvh, triangle_count);
+  if (fitted_to) {
+    std::vector<uint32_t> moved;
+    std::vector<Vec3> moved_before;
     for (size_t t = 0; t < triangle_count; ++t) {
       bool same = true;
       for (size_t k = 0; k < 3; ++k) {
         const Vec3 a = positions[t * 3 + k], b = (*fitted_to)[t * 3 + k];
         same = same && a.x == b.x && a.y == b.y && a.z == b.z;
       }
-      moved[t] = same ? 0 : 1;
+      if (same) continue;
+      moved.push_back(uint32_t(t));
+      for (size_t k = 0; k < 3; ++k) moved_before.push_back((*fitted_to)[t * 3 + k]);
     }
-  // Children come after their parents: one pass from the last node up sees every child's box first.
+    refit_bvh4_moved(bvh, links, positions, moved, moved_before);
+    return;
+  }
+  // Every leaf boxes its triangles' whole bounds; children come after their parents, so one pass
+  // from the last node up sees every child's box first.
   std::vector<WorldBox> node_box(bvh.nodes.size());
   for (size_t n = bvh.nodes.size(); n-- > 0;) {
     Bvh4Node& node = bvh.nodes[n];
@@ -128,28 +236,12 @@ void refit_bvh4(Bvh4& bvh, const std::vector<Vec3>& positions, const std::vector
       WorldBox box;
       if (child & kBvhLeafBit) {
         const uint32_t first = (child & ~kBvhLeafBit) >> 2, count = (child & 3u) + 1;
-        bool leaf_moved = false;
-        for (uint32_t s = first; s < first + count; ++s) leaf_moved = leaf_moved || moved[bvh.leaf_triangles[s]];
-        if (leaf_moved && fitted_to) {
-          // Each triangle's part in the leaf's box, carried to where the triangle went: a split
-          // fragment of a moved triangle stays a fragment.
-          const WorldBox fitted{Vec3{node.lo_x[i], node.lo_y[i], node.lo_z[i]}, Vec3{node.hi_x[i], node.hi_y[i], node.hi_z[i]}};
-          for (uint32_t s = first; s < first + count; ++s) {
-            const size_t t = bvh.leaf_triangles[s];
-            box.grow(carried_part_box(&(*fitted_to)[t * 3], &positions[t * 3], fitted));
-          }
-        } else if (leaf_moved) {
-          for (uint32_t s = first; s < first + count; ++s)
-            for (int k = 0; k < 3; ++k) box.grow(positions[size_t(bvh.leaf_triangles[s]) * 3 + size_t(k)]);
-        } else {  // as fitted (a split fragment's box stays the fragment's)
-          box.grow(Vec3{node.lo_x[i], node.lo_y[i], node.lo_z[i]});
-          box.grow(Vec3{node.hi_x[i], node.hi_y[i], node.hi_z[i]});
-        }
+        for (uint32_t s = first; s < first + count; ++s)
+          for (int k = 0; k < 3; ++k) box.grow(positions[size_t(bvh.leaf_triangles[s]) * 3 + size_t(k)]);
       } else {
         box = node_box[child];
       }
-      node.lo_x[i] = box.lo.x, node.lo_y[i] = box.lo.y, node.lo_z[i] = box.lo.z;
-      node.hi_x[i] = box.hi.x, node.hi_y[i] = box.hi.y, node.hi_z[i] = box.hi.z;
+      set_child_box(node, i, box);
       node_box[n].grow(box);
     }
   }

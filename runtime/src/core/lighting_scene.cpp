@@ -72,26 +72,57 @@ double punctual_power(const PunctualLight& light, float radius) {
   }
 }
 
+void set_emitter_distribution(LightingScene& lighting, const std::vector<double>& powers);
+
+// Area x luminance of the mean emission, x2 when double sided.
+double emitter_power(const Scene& scene, uint32_t t, double area) {
+  const Material& m = scene.materials[scene.triangle_material[t]];
+  Vec3 mean = m.emission;
+  if (m.emissive_texture.texture >= 0) mean = mean * texture_mean(scene.textures[size_t(m.emissive_texture.texture)]);
+  return area * double(luminance(mean)) * (m.double_sided ? 2.0 : 1.0);
+}
+
 // Emitters by power (area x luminance of the mean emission, x2 when double sided), and every
 // triangle's area density under that choice, which NEE's MIS needs at any hit on it.
 void build_emitter_distribution(LightingScene& lighting) {
   const Scene& scene = *lighting.source;
   lighting.emitter_triangles.clear();
+  for (GpuTriangle& g : lighting.triangles) g.p1_area_pdf.w = 0.0f;
   std::vector<double> powers;
   for (uint32_t t = 0; t < scene.triangle_count(); ++t) {
     if (!is_emissive(scene, t)) continue;
-    const Material& m = scene.materials[scene.triangle_material[t]];
     const double area = triangle_area(scene, t);
-    Vec3 mean = m.emission;
-    if (m.emissive_texture.texture >= 0) mean = mean * texture_mean(scene.textures[size_t(m.emissive_texture.texture)]);
-    const double power = area * double(luminance(mean)) * (m.double_sided ? 2.0 : 1.0);
+    const double power = emitter_power(scene, t, area);
     if (!(power > 0) || !(area > 0)) continue;  // zero-area or black emitters can never be hit usefully
     lighting.emitter_triangles.push_back(t);
     powers.push_back(power);
   }
+  set_emitter_distribution(lighting, powers);
+}
+
+// After emitters moved (their areas may change by rounding or a scale, the set cannot: emission
+// is the material's, and a move that collapses a triangle is refused): the same distribution as
+// build_emitter_distribution from the emitters alone. False, nothing changed, when a listed
+// emitter no longer qualifies (build_emitter_distribution then).
+bool refresh_emitter_powers(LightingScene& lighting) {
+  const Scene& scene = *lighting.source;
+  std::vector<double> powers;
+  powers.reserve(lighting.emitter_triangles.size());
+  for (uint32_t t : lighting.emitter_triangles) {
+    const double area = triangle_area(scene, t);
+    const double power = emitter_power(scene, t, area);
+    if (!(power > 0) || !(area > 0)) return false;
+    powers.push_back(power);
+  }
+  set_emitter_distribution(lighting, powers);
+  return true;
+}
+
+// The emitter CDF over `powers` (per lighting.emitter_triangles) and the emitters' area pdfs.
+void set_emitter_distribution(LightingScene& lighting, const std::vector<double>& powers) {
+  const Scene& scene = *lighting.source;
   const Distribution1D emitters(powers);
   lighting.emitter_cdf = padded_cdf(emitters);
-  for (GpuTriangle& g : lighting.triangles) g.p1_area_pdf.w = 0.0f;
   for (size_t i = 0; i < lighting.emitter_triangles.size(); ++i) {
     const uint32_t t = lighting.emitter_triangles[i];
     lighting.triangles[t].p1_area_pdf.w = emitters.pmf(i) / triangle_area(scene, t);
@@ -196,6 +227,53 @@ void refresh_lights_from_source(LightingScene& lighting, const std::vector<uint3
     lighting.sky = scene.sky.constant;
     lighting.environment = scene.sky.has_environment() ? EnvironmentSampler(scene.sky.environment) : EnvironmentSampler{};
   }
+}
+
+void refresh_materials_from_source(LightingScene& lighting, const std::vector<uint32_t>& materials) {
+  const Scene& scene = *lighting.source;
+  if (scene.materials.size() != lighting.materials.size())
+    throw std::invalid_argument("refresh_materials_from_source: the source has " + std::to_string(scene.materials.size()) +
+                                " materials, the lighting scene " + std::to_string(lighting.materials.size()));
+  for (uint32_t m : materials)
+    if (m >= scene.materials.size())
+      throw std::out_of_range("refresh_materials_from_source: material " + std::to_string(m) + " of " +
+                              std::to_string(scene.materials.size()));
+  if (materials.empty()) return;
+  for (uint32_t m : materials) lighting.materials[m] = material_record(scene.materials[m]);
+  lighting.textured = !scene.vertex_color.empty();
+  for (const Material& m : scene.materials) lighting.textured = lighting.textured || varies_per_point(m);
+  build_emitter_distribution(lighting);
+}
+
+MovedTrianglesRefresh refresh_moved_triangles_from_source(LightingScene& lighting, const Bvh4Links& links,
+                                                          const std::vector<uint32_t>& moved,
+                                                          const std::vector<Vec3>& moved_before, const WorldBox& bounds) {
+  const Scene& scene = *lighting.source;
+  if (scene.triangle_count() != lighting.triangles.size() || scene.positions.size() != scene.triangle_count() * 3)
+    throw std::invalid_argument("refresh_moved_triangles_from_source: the source has " + std::to_string(scene.triangle_count()) +
+                                " triangles, the lighting scene " + std::to_string(lighting.triangles.size()));
+  MovedTrianglesRefresh out;
+  if (!lighting.bvh.nodes.empty()) out.bvh_nodes = refit_bvh4_moved(lighting.bvh, links, scene.positions, moved, moved_before);
+  bool& emitter_moved = out.emitters_changed;
+  for (uint32_t t : moved) {
+    const Vec3* p = &scene.positions[size_t(t) * 3];
+    const Vec3* n = &scene.normals[size_t(t) * 3];
+    GpuTriangle& g = lighting.triangles[t];
+    emitter_moved = emitter_moved || g.p1_area_pdf.w != 0.0f || is_emissive(scene, t);
+    g.p0_material = Vec4(p[0], g.p0_material.w);
+    g.p1_area_pdf = Vec4(p[1], g.p1_area_pdf.w);
+    g.p2_instance = Vec4(p[2], g.p2_instance.w);
+    g.n0 = Vec4(n[0], 0.0f), g.n1 = Vec4(n[1], 0.0f), g.n2 = Vec4(n[2], 0.0f);
+  }
+  if (!lighting.triangles.empty()) {
+    lighting.bounds_lo = bounds.lo, lighting.bounds_hi = bounds.hi;
+    lighting.extent = std::max(max_component(bounds.hi - bounds.lo), 1e-30f);
+  }
+  if (emitter_moved && !refresh_emitter_powers(lighting)) build_emitter_distribution(lighting);  // areas follow the moved emitters
+  build_punctual_distribution(lighting);                      // directional powers follow the bounds
+  for (size_t l = 0; l < scene.lights.size() && l < lighting.punctual_lights.size(); ++l)
+    lighting.punctual_lights[l] = punctual_record(scene.lights[l]);
+  return out;
 }
 
 void set_punctual_light(LightingScene& lighting, uint32_t index, const PunctualLight& light) {

@@ -10,6 +10,8 @@
 #include "edit_targets.h"
 #include "exitance/runtime/core/bvh4_refit.h"
 #include "moved_instances.h"
+#include "exitance/runtime/core/parallel_chunks.h"
+#include "exitance/runtime/world_box.h"
 
 namespace exitance {
 namespace {
@@ -169,34 +171,81 @@ EditedParts edit_parts(Scene& next, const std::vector<SceneEdit>& edits) {
 
 }  // namespace
 
-std::optional<EditEffects> apply_light_edits_in_place(Scene& scene, const std::vector<SceneEdit>& edits) {
-  if (std::any_of(edits.begin(), edits.end(), [](const SceneEdit& e) { return std::holds_alternative<MaterialEdit>(e.change); }))
-    return std::nullopt;
-  // The parts these edits change or read (names, the node tree, lights, the sky's colour); not the
-  // geometry, textures or an environment image.
+InstanceTexels::InstanceTexels(const TexelGBuffer& gbuffer, size_t instance_count) {
+  start.assign(instance_count + 1, 0);
+  for (const LiveTexel& t : gbuffer.texels)
+    if (t.instance < instance_count) ++start[size_t(t.instance) + 1];
+  for (size_t k = 0; k < instance_count; ++k) start[k + 1] += start[k];
+  texels.resize(start.back());
+  std::vector<uint32_t> next(start.begin(), start.end() - 1);
+  for (size_t i = 0; i < gbuffer.texels.size(); ++i)
+    if (gbuffer.texels[i].instance < instance_count) texels[next[gbuffer.texels[i].instance]++] = uint32_t(i);
+}
+
+InPlaceEdits apply_scene_edits_in_place(PersistedScene& persisted, const std::vector<SceneEdit>& edits,
+                                        const InstanceTexels* by_instance) {
+  Scene& scene = persisted.scene;
+  // The parts edits change or read (names, the node tree, instances' world matrices, lights,
+  // materials, the sky's colour), copied; the geometry, textures and an environment image are not.
   Scene next;
   next.nodes = scene.nodes;
   next.instances = scene.instances;
   next.lights = scene.lights;
+  next.materials = scene.materials;
   next.sky.constant = scene.sky.constant;
   EditedParts parts = edit_parts(next, edits);
-  refresh::MovedGeometry moved;
+  refresh::PlannedMoves planned;
+  std::vector<refresh::MovingTexel> texels;
   if (parts.any_node()) {
-    if (refresh::moves_an_instance(next, parts.edit_of_node)) return std::nullopt;
-    moved = refresh::move_under_edited_nodes(next, scene, TexelGBuffer{}, AtlasLayout{}, parts.edit_of_node);
-    parts.lights.insert(moved.lights.begin(), moved.lights.end());
+    planned = refresh::plan_moves(next, scene, parts.edit_of_node);
+    parts.lights.insert(planned.lights.begin(), planned.lights.end());
+    const bool indexed = by_instance && by_instance->start.size() == scene.instances.size() + 1;
+    texels = refresh::moving_texels(planned, scene, persisted.gbuffer, persisted.atlas, indexed ? &by_instance->start : nullptr,
+                                    indexed ? &by_instance->texels : nullptr);
   }
-  EditEffects effects;
+  InPlaceEdits out;
+  EditEffects& effects = out.effects;
   effects.lights = sorted(parts.lights);
+  effects.materials = sorted(parts.materials);
   effects.sky = parts.sky;
-  // Commit: moves of plain values only, nothing here throws.
+  effects.moved_instances = planned.instances;
+  effects.moved_texels = texels.size();
+  for (size_t j = 0; j < planned.instances.size(); ++j) {
+    const refresh::MovedTriangles& m = planned.triangles[j];
+    out.moved_boxes_before.push_back(triangles_world_box(scene, m.first, m.count));
+    WorldBox after;
+    for (const Vec3& p : m.positions) after.grow(p);
+    out.moved_boxes_after.push_back(after);
+  }
+  // Triangles in the order the instances' ranges ascend (ranges do not overlap: one instance per triangle).
+  std::vector<size_t> by_first(planned.triangles.size());
+  for (size_t j = 0; j < by_first.size(); ++j) by_first[j] = j;
+  std::sort(by_first.begin(), by_first.end(), [&](size_t a, size_t b) { return planned.triangles[a].first < planned.triangles[b].first; });
+  for (size_t j : by_first) {
+    const refresh::MovedTriangles& m = planned.triangles[j];
+    for (uint32_t t = m.first; t < m.first + m.count; ++t) out.moved_triangles.push_back(t);
+    out.moved_triangles_before.insert(out.moved_triangles_before.end(), scene.positions.begin() + ptrdiff_t(m.first) * 3,
+                                      scene.positions.begin() + (ptrdiff_t(m.first) + m.count) * 3);
+  }
+
+  // Commit: moves and copies of plain values only, nothing here throws.
   scene.nodes = std::move(next.nodes);
+  scene.instances = std::move(next.instances);
   scene.lights = std::move(next.lights);
+  scene.materials = std::move(next.materials);
   if (parts.sky) {
     scene.sky.constant = next.sky.constant;
     scene.sky.environment = Texture{};
   }
-  return effects;
+  for (const refresh::MovedTriangles& m : planned.triangles) m.write_into(scene);
+  for_each_chunk(texels.size(), [&](size_t begin, size_t end) {  // each texel reads the scene and writes itself
+    for (size_t k = begin; k < end; ++k) {
+      LiveTexel& texel = persisted.gbuffer.texels[texels[k].index];
+      texel = refresh::moved_texel(texel, texels[k], planned, scene, persisted.gbuffer, persisted.atlas);
+    }
+  }, 1024);
+  for (const refresh::MovingTexel& t : texels) out.moved_texels.push_back(uint32_t(t.index));
+  return out;
 }
 
 EditEffects apply_scene_edits(PersistedScene& persisted, const std::vector<SceneEdit>& edits) {

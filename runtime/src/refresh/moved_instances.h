@@ -27,6 +27,48 @@ struct MovedGeometry {
 // that does not compose.
 bool moves_an_instance(const Scene& next, const std::vector<std::string>& edit_of_node);
 
+// One instance's triangles (its range of every per-corner array the scene has), copied out of a
+// scene to be moved and written back: what lets an edit be computed before anything is written.
+struct MovedTriangles {
+  uint32_t first = 0, count = 0;
+  std::vector<Vec3> positions, normals, vertex_color, tangents;
+  std::vector<Vec2> uv0, lightmap_uv;
+  std::vector<float> vertex_alpha, tangent_signs;
+  static MovedTriangles of(const Scene& scene, uint32_t first, uint32_t count);
+  void write_into(Scene& scene) const;  // the arrays the scene has; cannot throw
+};
+
+// What edited node transforms move, computed without writing geometry: per moved instance (ascending)
+// its delta (new world x old world^-1) and its triangles as moved; the lights whose position or
+// direction changed. `next` holds the edited nodes: its instances get their new world matrices and
+// its lights are placed again; `geometry` holds the triangles as they are (it may be `next`).
+// Throws SceneEditError as move_under_edited_nodes does.
+struct PlannedMoves {
+  std::vector<uint32_t> instances;
+  std::vector<Matrix4d> delta;
+  std::vector<MovedTriangles> triangles;
+  std::vector<uint32_t> lights;
+};
+PlannedMoves plan_moves(Scene& next, const Scene& geometry, const std::vector<std::string>& edit_of_node);
+
+// A texel of a moved instance: its index, which planned move carries it, and whether the unocclude
+// step had pushed it off its surface (read on the scene before the move).
+struct MovingTexel {
+  size_t index = 0;
+  uint32_t move = 0;
+  bool pushed = false;
+};
+// The texels of the planned moves' instances, ascending: from `texels_by_instance` (texel_start[k]
+// .. texel_start[k + 1] lists instance k's texels) when given, else by a pass over the G-buffer.
+// Throws SceneEditError for an atlas without a rectangle per instance or a texel naming a page or
+// triangle the scene does not have.
+std::vector<MovingTexel> moving_texels(const PlannedMoves& planned, const Scene& before, const TexelGBuffer& gbuffer,
+                                       const AtlasLayout& atlas, const std::vector<uint32_t>* texel_start,
+                                       const std::vector<uint32_t>* texels_by_instance);
+// The texel re-derived on `next` (the scene with the moved triangles written).
+LiveTexel moved_texel(const LiveTexel& texel, const MovingTexel& moving, const PlannedMoves& planned, const Scene& next,
+                      const TexelGBuffer& gbuffer, const AtlasLayout& atlas);
+
 MovedGeometry move_under_edited_nodes(Scene& next, const Scene& old, const TexelGBuffer& gbuffer,
                                       const AtlasLayout& atlas, const std::vector<std::string>& edit_of_node);
 

@@ -65,7 +65,14 @@ struct RefreshSession::State {
   // of a bake.
   std::vector<uint32_t> near_texels, far_texels, all_texels;
   std::vector<uint32_t> last_edit_near;  // near_texels of the last edit, kept after the others caught up
-  TexelGrid texel_grid;  // over persisted.gbuffer's texels: rebuilt when texels move
+  TexelGrid texel_grid;  // over persisted.gbuffer's texels: moved ones set aside, rebuilt when many are
+  // What an edit made in place needs without a pass over the scene: each instance's texels, where
+  // each BVH leaf slot and node hangs, and the bounds of each instance's triangles (and of those in
+  // no instance), whose union is the scene's bounds.
+  InstanceTexels instance_texels;
+  Bvh4Links bvh_links;
+  std::vector<WorldBox> instance_boxes;
+  WorldBox uninstanced_box;
   EditTimings edit_timings;
   uint32_t near_samples = 0, far_samples = 0, all_samples = 0;
   // What texels showed before the last edit (published_lightmap keeps it until the refreshed
@@ -115,6 +122,27 @@ formats::BundleManifest read_manifest(const fs::path& bundle) {
   }
 }
 
+void index_for_edits(RefreshSession::State& s) {
+  const Scene& scene = s.persisted.scene;
+  s.instance_texels = InstanceTexels(s.persisted.gbuffer, scene.instances.size());
+  try {
+    s.bvh_links = link_bvh4(s.lighting->bvh, scene.triangle_count());
+  } catch (const std::invalid_argument& e) {
+    throw BundleInputError(s.bundle + ": scene.bin: BVH: " + e.what());
+  }
+  std::vector<uint8_t> instanced(scene.triangle_count(), 0);
+  s.instance_boxes.clear();
+  for (const Instance& instance : scene.instances) {
+    const uint32_t end = uint32_t(std::min<size_t>(size_t(instance.first_triangle) + instance.triangle_count, scene.triangle_count()));
+    const uint32_t first = std::min(instance.first_triangle, end);
+    s.instance_boxes.push_back(triangles_world_box(scene, first, end - first));
+    std::fill(instanced.begin() + first, instanced.begin() + end, uint8_t(1));
+  }
+  s.uninstanced_box = WorldBox{};
+  for (uint32_t t = 0; t < uint32_t(scene.triangle_count()); ++t)
+    if (!instanced[t]) s.uninstanced_box.grow(triangles_world_box(scene, t, 1));
+}
+
 }  // namespace
 
 std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_folder, const RefreshSessionOptions& options) {
@@ -156,6 +184,7 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   state->integrator = VulkanIntegrator::create(state->lighting, options.device);
   state->priority_samples = options.priority_samples;
   state->texel_grid = TexelGrid(state->persisted.gbuffer);
+  index_for_edits(*state);
   state->all_texels.resize(state->persisted.gbuffer.texels.size());
   for (size_t i = 0; i < state->all_texels.size(); ++i) state->all_texels[i] = uint32_t(i);
   state->integrator->start_progressive(state->persisted.gbuffer, settings);
@@ -189,46 +218,62 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   };
   Clock::time_point lap = Clock::now();
   EditTimings timings;
+  const uint64_t submissions_before = s.integrator->waited_submissions();
+  const double wait_before = s.integrator->wait_seconds();
   const std::vector<GpuPunctualLight> lights_before = s.lighting->punctual_lights;
-  const std::vector<PunctualLight> scene_lights_before = s.persisted.scene.lights;
-  // Edits of lights, the sky's colour and light nodes: in place, without copying the scene.
-  std::optional<EditEffects> in_place = apply_light_edits_in_place(s.persisted.scene, edits);
-  std::vector<uint32_t> near;
-  if (in_place) {
-    // Committed: the lighting scene reads persisted.scene; nothing below throws for bad input.
-    s.scene_file.reset();
-    refresh_lights_from_source(*s.lighting, in_place->lights, in_place->sky);
-    if (!in_place->lights.empty() || in_place->sky) s.integrator->update_lights(*s.lighting);
-    timings.scene = since(lap);
-    Scene before;  // texels_near_change reads the lights' positions before the edit (no instance moved)
-    before.lights = scene_lights_before;
-    near = texels_near_change(s.persisted, before, *s.lighting, *in_place, &s.texel_grid);
-    timings.near_texels = since(lap);
+  ChangeBefore was;
+  for (const PunctualLight& light : s.persisted.scene.lights) was.light_positions.push_back(light.position);
+  // Validated and computed on copies of the small parts, then committed in place (the session's
+  // lighting scene reads persisted.scene itself); nothing below throws for bad input.
+  InPlaceEdits in_place = apply_scene_edits_in_place(s.persisted, edits, &s.instance_texels);
+  const EditEffects& effects = in_place.effects;
+  s.scene_file.reset();  // encoded again from the edited scene when a bundle is written
+  LightingScene& lighting = *s.lighting;
+  if (effects.geometry_changed()) {
+    for (size_t j = 0; j < effects.moved_instances.size(); ++j) s.instance_boxes[effects.moved_instances[j]] = in_place.moved_boxes_after[j];
+    WorldBox bounds = s.uninstanced_box;
+    for (const WorldBox& b : s.instance_boxes) bounds.grow(b);
+    const MovedTrianglesRefresh moved = refresh_moved_triangles_from_source(lighting, s.bvh_links, in_place.moved_triangles,
+                                                                            in_place.moved_triangles_before, bounds);
+    for (uint32_t n : moved.bvh_nodes) std::memcpy(&s.persisted.bvh.nodes[n], &lighting.bvh.nodes[n], sizeof(Bvh4Node));
+    if (!effects.materials.empty()) refresh_materials_from_source(lighting, effects.materials);
+    if (effects.sky) refresh_lights_from_source(lighting, {}, true);
+    s.integrator->update_moved_geometry(lighting, s.bvh_links, in_place.moved_triangles, moved.bvh_nodes,
+                                        moved.emitters_changed || !effects.materials.empty());
+    if (effects.sky) s.integrator->update_lights(lighting);
   } else {
-    // Everything on copies first; the session changes only when every step succeeded.
-    PersistedScene edited = s.persisted;
-    const EditEffects effects = apply_scene_edits(edited, edits);
-    LightingScene lighting = *s.lighting;
-    update_lighting_scene(lighting, std::make_shared<const Scene>(edited.scene), effects);
-    unocclude_near_moved(edited, s.persisted.scene, lighting, effects);
-    if (effects.geometry_changed()) {
-      s.integrator->update_geometry(lighting);
-    } else {
-      if (!effects.materials.empty()) s.integrator->update_materials(lighting);
-      if (!effects.lights.empty() || effects.sky) s.integrator->update_lights(lighting);
+    if (!effects.materials.empty()) {
+      refresh_materials_from_source(lighting, effects.materials);
+      s.integrator->update_materials(lighting);
     }
-    timings.scene = since(lap);
-    TexelGrid grid = effects.geometry_changed() ? TexelGrid(edited.gbuffer) : TexelGrid{};
-    near = texels_near_change(edited, s.persisted.scene, lighting, effects, effects.geometry_changed() ? &grid : &s.texel_grid);
-    if (effects.geometry_changed()) s.texel_grid = std::move(grid);
-    timings.near_texels = since(lap);
-    s.persisted = std::move(edited);
-    s.lighting = std::make_shared<LightingScene>(std::move(lighting));
-    s.lighting->source = scene_of(s);  // the same scene: later light edits change it in place
-    s.scene_file.reset();  // encoded again from the edited scene when a bundle is written
-    in_place = effects;
+    if (!effects.lights.empty() || effects.sky) {
+      refresh_lights_from_source(lighting, effects.lights, effects.sky);
+      s.integrator->update_lights(lighting);
+    }
   }
-  const EditEffects& effects = *in_place;
+  timings.scene = since(lap);
+  if (effects.geometry_changed()) {
+    // Moved texels leave their grid cells; the unocclude step again near the moved bounds (as a
+    // fresh bake would place the texels); the start points of every texel that moved, uploaded.
+    for (uint32_t i : in_place.moved_texels) s.texel_grid.displace(i, s.persisted.gbuffer.texels[i]);
+    std::vector<WorldBox> boxes;
+    for (size_t j = 0; j < effects.moved_instances.size(); ++j) {
+      boxes.push_back(in_place.moved_boxes_before[j]);
+      boxes.push_back(in_place.moved_boxes_after[j]);
+    }
+    const std::vector<uint32_t> unoccluded = unocclude_near_boxes(s.persisted, boxes, lighting, &s.texel_grid);
+    for (uint32_t i : unoccluded) s.texel_grid.displace(i, s.persisted.gbuffer.texels[i]);
+    std::vector<uint32_t> changed;
+    std::set_union(in_place.moved_texels.begin(), in_place.moved_texels.end(), unoccluded.begin(), unoccluded.end(),
+                   std::back_inserter(changed));
+    s.integrator->update_texels(s.persisted.gbuffer, changed);
+  }
+  was.moved_boxes_before = in_place.moved_boxes_before;
+  was.moved_boxes_after = in_place.moved_boxes_after;
+  std::vector<uint32_t> near = texels_near_change(s.persisted, was, lighting, effects, &s.texel_grid);
+  // Set-aside texels are visited by every query: past an eighth of them, the grid is built again.
+  if (s.texel_grid.displaced_count() > s.persisted.gbuffer.texels.size() / 8) s.texel_grid = TexelGrid(s.persisted.gbuffer);
+  timings.near_texels = since(lap);
 
   // Edits of punctual lights alone are estimated as a change from what was published before them
   // (path.h punctual_change_rays): the same paths, each vertex adding the edited lights' direct
@@ -257,19 +302,21 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
     s.base_lights = lights_before;
   }
   s.previous = published.lightmap;
-  const bool texels_as_before = !effects.geometry_changed();
+  const bool texels_as_before = true;  // moved texels' start points were uploaded above
   if (as_change) {
     s.clear_accumulation();
     s.integrator->start_progressive_change(s.persisted.gbuffer, s.settings, *s.lighting, pairs, texels_as_before);
     s.changed_lights = uint32_t(pairs.size() / 2);
   } else {
-    restart(texels_as_before);  // moved texels are uploaded again with the rest
+    restart(texels_as_before);
   }
   if (s.priority_samples > 0 && !near.empty() && near.size() < s.all_texels.size()) {
     s.near_texels = std::move(near);  // the far texels are listed when their turn comes (refresh)
     s.last_edit_near = s.near_texels;
   }
   timings.restart = since(lap);
+  timings.device_submissions = s.integrator->waited_submissions() - submissions_before;
+  timings.device_wait = (s.integrator->wait_seconds() - wait_before) * 1e3;
   s.edit_timings = timings;
   return effects;
 }

@@ -9,7 +9,10 @@ TexelGrid::TexelGrid(const TexelGBuffer& gbuffer) {
   const size_t n = gbuffer.texels.size();
   if (n == 0) return;
   WorldBox bounds;
-  for (const LiveTexel& t : gbuffer.texels) bounds.grow(t.position);
+  for (const LiveTexel& t : gbuffer.texels) {
+    bounds.grow(t.position);
+    largest_texel_size_ = std::max(largest_texel_size_, t.world_texel_size);
+  }
   const Vec3 extent = bounds.hi - bounds.lo;
   const float largest = std::max({extent.x, extent.y, extent.z, 1e-6f});
   // Cells of one size, about 8 texels each over the bounds' volume (a flat scene: over its area).
@@ -34,6 +37,15 @@ TexelGrid::TexelGrid(const TexelGBuffer& gbuffer) {
   texels_.resize(n);
   std::vector<uint32_t> next(cell_start_.begin(), cell_start_.end() - 1);
   for (size_t i = 0; i < n; ++i) texels_[next[cell_of_texel[i]]++] = uint32_t(i);  // ascending within a cell
+}
+
+void TexelGrid::displace(uint32_t i, const LiveTexel& texel) {
+  if (i >= texels_.size()) return;
+  largest_texel_size_ = std::max(largest_texel_size_, texel.world_texel_size);
+  if (is_displaced_.empty()) is_displaced_.assign(texels_.size(), 0);
+  if (is_displaced_[i]) return;
+  is_displaced_[i] = 1;
+  displaced_.push_back(i);
 }
 
 int TexelGrid::cell_of(int axis, float p) const {

@@ -10,18 +10,30 @@ namespace exitance {
 std::vector<uint32_t> texels_near_change(const PersistedScene& edited, const Scene& before,
                                          const LightingScene& edited_lighting, const EditEffects& effects,
                                          const TexelGrid* grid) {
+  ChangeBefore was;
+  for (const PunctualLight& light : before.lights) was.light_positions.push_back(light.position);
+  for (uint32_t k : effects.moved_instances) {
+    was.moved_boxes_before.push_back(instance_world_box(before, before.instances[k]));
+    was.moved_boxes_after.push_back(instance_world_box(edited.scene, edited.scene.instances[k]));
+  }
+  return texels_near_change(edited, was, edited_lighting, effects, grid);
+}
+
+std::vector<uint32_t> texels_near_change(const PersistedScene& edited, const ChangeBefore& was,
+                                         const LightingScene& edited_lighting, const EditEffects& effects,
+                                         const TexelGrid* grid) {
   if (effects.sky) return {};  // the sky lights everything
   std::vector<WorldBox> boxes;
-  for (uint32_t k : effects.moved_instances) {
-    boxes.push_back(instance_world_box(before, before.instances[k]));
-    boxes.push_back(instance_world_box(edited.scene, edited.scene.instances[k]));
+  for (size_t j = 0; j < effects.moved_instances.size() && j < was.moved_boxes_before.size() && j < was.moved_boxes_after.size(); ++j) {
+    boxes.push_back(was.moved_boxes_before[j]);
+    boxes.push_back(was.moved_boxes_after[j]);
   }
   for (uint32_t l : effects.lights) {
     const PunctualLight& light = edited.scene.lights[l];
     if (light.type == PunctualLight::Type::Directional) return {};  // it lights everything it reaches
     WorldBox box;
     box.grow(light.position);
-    if (l < before.lights.size()) box.grow(before.lights[l].position);
+    if (l < was.light_positions.size()) box.grow(was.light_positions[l]);
     boxes.push_back(box);
   }
   if (!effects.materials.empty()) {
@@ -46,12 +58,17 @@ std::vector<uint32_t> texels_near_change(const PersistedScene& edited, const Sce
   }
   std::vector<uint32_t> near;
   if (grid && grid->texel_count() == edited.gbuffer.texels.size()) {
+    // Marked per texel (boxes overlap), then listed in order: no sort of a list that can hold
+    // hundreds of thousands of texels.
+    std::vector<uint8_t> is_near(edited.gbuffer.texels.size(), 0);
+    size_t count = 0;
     for (size_t b = 0; b < boxes.size(); ++b)
       grid->for_each_candidate(boxes[b], std::sqrt(radius_squared[b]), [&](uint32_t i) {
-        if (boxes[b].distance_squared(edited.gbuffer.texels[i].position) <= radius_squared[b]) near.push_back(i);
+        if (!is_near[i] && boxes[b].distance_squared(edited.gbuffer.texels[i].position) <= radius_squared[b]) is_near[i] = 1, ++count;
       });
-    std::sort(near.begin(), near.end());
-    near.erase(std::unique(near.begin(), near.end()), near.end());
+    near.reserve(count);
+    for (uint32_t i = 0; i < uint32_t(is_near.size()); ++i)
+      if (is_near[i]) near.push_back(i);
     return near;
   }
   for (size_t i = 0; i < edited.gbuffer.texels.size(); ++i) {

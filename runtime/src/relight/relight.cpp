@@ -91,7 +91,9 @@ json relight_bundle(const RelightOptions& options) {
                       // punctual lights whose change from the pre-edit lighting is estimated (0: restarted)
                       {"changed_lights", session->changed_lights()}};
       const EditTimings& t = session->last_edit_timings();
-      edits_report["milliseconds"] = {{"scene", t.scene}, {"near_texels", t.near_texels}, {"publish", t.publish}, {"restart", t.restart}};
+      edits_report["milliseconds"] = {{"scene", t.scene}, {"near_texels", t.near_texels}, {"publish", t.publish}, {"restart", t.restart},
+                                      {"device_wait", t.device_wait}};
+      edits_report["device_submissions"] = t.device_submissions;
     } catch (const SceneEditError& e) {
       throw RelightInputError(e.what());
     }

@@ -112,22 +112,10 @@ GpuScene::GpuScene(Context& context, const LightingScene& scene, bool quantized_
       node_count_(uint32_t(scene.bvh.nodes.size())),
       leaf_slots_(uint32_t(scene.bvh.leaf_triangles.size())),
       quantized_(quantized_nodes) {
-  upload_surfaces(scene);
-}
-
-void GpuScene::upload_surfaces(const LightingScene& scene) {
   surface_flags_ = vulkan::surface_flags(scene);
-  // Textures and corners exist only in textured scenes; a material edit cannot change them, so it
-  // uploads the header and the material records alone. An edit that makes an untextured scene
-  // textured uploads everything (the buffer grows; the integrator binds it again before each bake).
-  if (surfaces_.size() == 0 || (scene.textured && !surfaces_textured_)) {
-    const std::vector<Vec4> words = surface_words(scene, surface_layout_);
-    upload_growing(surfaces_, words.data(), words.size() * sizeof(Vec4));
-    surfaces_textured_ = scene.textured;
-    return;
-  }
-  const std::vector<Vec4> words = material_surface_words(*scene.source, surface_layout_);
-  context_.upload(surfaces_, words.data(), words.size() * sizeof(Vec4));
+  const std::vector<Vec4> words = surface_words(scene, surface_layout_);
+  upload_growing(surfaces_, words.data(), words.size() * sizeof(Vec4));
+  surfaces_textured_ = scene.textured;
 }
 
 size_t GpuScene::bvh_bytes() const {
@@ -155,24 +143,67 @@ void GpuScene::check_same_shape(const LightingScene& edited) const {
 }
 
 void GpuScene::upload_growing(Buffer& buffer, const void* data, size_t bytes) {
-  if (bytes > buffer.size()) buffer = context_.create_storage_buffer(bytes);
+  grow(buffer, bytes);
   context_.upload(buffer, data, bytes);
+}
+
+void GpuScene::grow(Buffer& buffer, size_t bytes) {
+  if (bytes > buffer.size()) buffer = context_.create_storage_buffer(bytes);
 }
 
 void GpuScene::update_materials(const LightingScene& edited) {
   check_same_shape(edited);
   check_supported_by_vulkan(edited);
-  if (!edited.materials.empty()) context_.upload(materials_, edited.materials.data(), edited.materials.size() * sizeof(GpuMaterial));
+  std::vector<Context::RangeWrite> writes;
+  std::vector<Vec4> surfaces;
+  std::vector<uint32_t> emitters;
+  add_material_writes(edited, writes, surfaces, emitters);
+  context_.write_ranges(writes);
+  materials_uploaded(edited);
+}
+
+void GpuScene::add_material_writes(const LightingScene& edited, std::vector<Context::RangeWrite>& writes, std::vector<Vec4>& surfaces,
+                                   std::vector<uint32_t>& emitters) {
+  // The material records, the triangle records of old and new emitters (their area pdfs), the
+  // emitter CDF and list (their buffers grown first when larger) and the surface records, in one
+  // submission. A material edit cannot change textures or corners, so the surfaces are the header
+  // and material records alone, unless the edit makes an untextured scene textured (everything).
   std::vector<uint32_t> changed = emitters_;
   changed.insert(changed.end(), edited.emitter_triangles.begin(), edited.emitter_triangles.end());
   std::sort(changed.begin(), changed.end());
   changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
-  context_.upload_ranges(triangles_, edited.triangles.data(), triangle_ranges(changed));
-  upload_growing(emitter_cdf_, edited.emitter_cdf.data(), edited.emitter_cdf.size() * sizeof(double));
-  const std::vector<uint32_t> emitters = at_least_one(edited.emitter_triangles);
-  upload_growing(emitter_triangles_, emitters.data(), emitters.size() * 4);
+  emitters = at_least_one(edited.emitter_triangles);
+  const bool whole_surfaces = surfaces_.size() == 0 || (edited.textured && !surfaces_textured_);
+  surfaces = whole_surfaces ? surface_words(edited, surface_layout_) : material_surface_words(*edited.source, surface_layout_);
+  grow(emitter_cdf_, edited.emitter_cdf.size() * sizeof(double));
+  grow(emitter_triangles_, emitters.size() * 4);
+  grow(surfaces_, surfaces.size() * sizeof(Vec4));
+  writes.reserve(writes.size() + 5);  // the reference below stays valid
+  auto whole = [&](const Buffer& dst, const void* data, size_t bytes) {
+    Context::RangeWrite& w = writes.emplace_back();
+    w.dst = &dst;
+    if (bytes > 0) w.ranges.push_back({0, bytes});
+    w.write = [data, bytes](char* staging) { std::memcpy(staging, data, bytes); };
+  };
+  whole(materials_, edited.materials.data(), edited.materials.size() * sizeof(GpuMaterial));
+  Context::RangeWrite& triangle_write = writes.emplace_back();
+  triangle_write.dst = &triangles_;
+  triangle_write.ranges = triangle_ranges(changed);
+  triangle_write.write = [&edited, ranges = triangle_write.ranges](char* staging) {
+    for (const ByteRange& r : ranges) {
+      std::memcpy(staging, reinterpret_cast<const char*>(edited.triangles.data()) + r.offset, size_t(r.size));
+      staging += r.size;
+    }
+  };
+  whole(emitter_cdf_, edited.emitter_cdf.data(), edited.emitter_cdf.size() * sizeof(double));
+  whole(emitter_triangles_, emitters.data(), emitters.size() * 4);
+  whole(surfaces_, surfaces.data(), surfaces.size() * sizeof(Vec4));
+}
+
+void GpuScene::materials_uploaded(const LightingScene& edited) {
   emitters_ = edited.emitter_triangles;
-  upload_surfaces(edited);
+  surface_flags_ = vulkan::surface_flags(edited);
+  surfaces_textured_ = surfaces_textured_ || edited.textured;
 }
 
 void GpuScene::update_geometry(const LightingScene& edited) {
@@ -196,11 +227,86 @@ void GpuScene::update_geometry(const LightingScene& edited) {
 void GpuScene::update_lights(const LightingScene& edited) {
   check_same_shape(edited);
   check_supported_by_vulkan(edited);
-  if (punctual_count_ > 0)
-    context_.upload(punctual_lights_, edited.punctual_lights.data(), edited.punctual_lights.size() * sizeof(GpuPunctualLight));
-  context_.upload(punctual_cdf_, edited.punctual_cdf.data(), edited.punctual_cdf.size() * sizeof(double));
+  upload_punctual(edited);
   sky_ = edited.sky;
   update_environment(edited);
+}
+
+void GpuScene::upload_punctual(const LightingScene& edited) { context_.write_ranges(punctual_writes(edited)); }
+
+std::vector<Context::RangeWrite> GpuScene::punctual_writes(const LightingScene& edited) const {
+  std::vector<Context::RangeWrite> writes;
+  writes.reserve(2);
+  auto whole = [&](const Buffer& dst, const void* data, size_t bytes) {
+    Context::RangeWrite& w = writes.emplace_back();
+    w.dst = &dst;
+    if (bytes > 0) w.ranges.push_back({0, bytes});
+    w.write = [data, bytes](char* staging) { std::memcpy(staging, data, bytes); };
+  };
+  if (punctual_count_ > 0) whole(punctual_lights_, edited.punctual_lights.data(), edited.punctual_lights.size() * sizeof(GpuPunctualLight));
+  whole(punctual_cdf_, edited.punctual_cdf.data(), edited.punctual_cdf.size() * sizeof(double));
+  return writes;
+}
+
+void GpuScene::update_moved_geometry(const LightingScene& edited, const Bvh4Links& links,
+                                     const std::vector<uint32_t>& moved_triangles, const std::vector<uint32_t>& changed_nodes,
+                                     bool emitters_changed) {
+  check_same_shape(edited);
+  check_supported_by_vulkan(edited);
+  if (links.triangle_slot_start.size() != edited.triangles.size() + 1 || links.slot_leaf.size() != leaf_slots_)
+    throw std::invalid_argument("Vulkan backend: the BVH links are not this scene's");
+  for (size_t k = 0; k < moved_triangles.size(); ++k)
+    if (moved_triangles[k] >= edited.triangles.size() || (k > 0 && moved_triangles[k] <= moved_triangles[k - 1]))
+      throw std::invalid_argument("Vulkan backend: moved triangles must ascend within the scene");
+  for (uint32_t n : changed_nodes)
+    if (n >= node_count_) throw std::invalid_argument("Vulkan backend: BVH node " + std::to_string(n) + " of " + std::to_string(node_count_));
+  // The changed nodes (in this scene's node layout), the moved triangles' leaf-slot vertex copies
+  // and records, and the punctual lights and CDF (directional powers follow the bounds; moved
+  // lights), in one submission.
+  std::vector<Bvh4Node> nodes;
+  for (uint32_t n : changed_nodes) nodes.push_back(edited.bvh.nodes[n]);
+  const size_t node_bytes = quantized_ ? kQuantizedNodeWords * 4 : sizeof(Bvh4Node);
+  const std::vector<uint32_t> words = node_words(Bvh4{nodes, {}, 1, 0}, quantized_);
+  std::vector<Context::RangeWrite> writes;
+  writes.reserve(5);  // the references below stay valid
+  Context::RangeWrite& node_write = writes.emplace_back();
+  node_write.dst = &nodes_;
+  for (uint32_t n : changed_nodes) node_write.ranges.push_back({VkDeviceSize(n) * node_bytes, node_bytes});
+  node_write.write = [&](char* staging) { std::memcpy(staging, words.data(), words.size() * 4); };
+  std::vector<uint32_t> slots;
+  for (uint32_t t : moved_triangles)
+    for (uint32_t k = links.triangle_slot_start[t]; k < links.triangle_slot_start[size_t(t) + 1]; ++k) slots.push_back(links.triangle_slots[k]);
+  std::sort(slots.begin(), slots.end());
+  Context::RangeWrite& leaf_write = writes.emplace_back();
+  leaf_write.dst = &leaf_triangles_;
+  for (uint32_t s : slots) leaf_write.ranges.push_back({VkDeviceSize(s) * 3 * sizeof(Vec4), 3 * sizeof(Vec4)});
+  leaf_write.write = [&](char* staging) {
+    for (uint32_t s : slots) {
+      const uint32_t t = edited.bvh.leaf_triangles[s];
+      const Vec4 copy[3] = {Vec4(scene_triangle_vertex(edited, t, 0), uintBitsToFloat(t)),
+                            Vec4(scene_triangle_vertex(edited, t, 1), 0.0f), Vec4(scene_triangle_vertex(edited, t, 2), 0.0f)};
+      std::memcpy(staging, copy, sizeof(copy));
+      staging += sizeof(copy);
+    }
+  };
+  Context::RangeWrite& triangle_write = writes.emplace_back();
+  triangle_write.dst = &triangles_;
+  triangle_write.ranges = triangle_ranges(moved_triangles);
+  triangle_write.write = [&edited, ranges = triangle_write.ranges](char* staging) {
+    for (const ByteRange& r : ranges) {
+      std::memcpy(staging, reinterpret_cast<const char*>(edited.triangles.data()) + r.offset, size_t(r.size));
+      staging += r.size;
+    }
+  };
+  for (Context::RangeWrite& w : punctual_writes(edited)) writes.push_back(std::move(w));
+  std::vector<Vec4> surfaces;
+  std::vector<uint32_t> emitters;
+  if (emitters_changed) add_material_writes(edited, writes, surfaces, emitters);  // areas and the emitter CDF follow the moved emitters
+  context_.write_ranges(writes);
+  if (emitters_changed) materials_uploaded(edited);
+  bounds_lo_ = edited.bounds_lo;
+  bounds_hi_ = edited.bounds_hi;
+  extent_ = edited.extent;
 }
 
 void GpuScene::set_changed_light_pairs(const LightingScene& edited, const std::vector<GpuPunctualLight>& pairs) {

@@ -44,6 +44,13 @@ class GpuScene {
   // and takes the bounds and extent. Throws std::invalid_argument when the scene's shape (counts,
   // BVH nodes and leaf slots, traversal stack bound) differs.
   void update_geometry(const LightingScene& edited);
+  // After refresh_moved_triangles_from_source (lighting_scene.h): only the moved triangles' records
+  // and leaf-slot vertex copies, the changed BVH nodes, the punctual lights and CDF, and (when an
+  // emitter moved) what update_materials uploads; takes the bounds and extent. The device scene
+  // then equals update_geometry's. Throws std::invalid_argument for a shape, link or index that is
+  // not this scene's.
+  void update_moved_geometry(const LightingScene& edited, const Bvh4Links& links, const std::vector<uint32_t>& moved_triangles,
+                             const std::vector<uint32_t>& changed_nodes, bool emitters_changed);
 
   void bind(DescriptorWrites& writes) const;  // kBindingBvhNodes .. kBindingPunctualCdf, kBindingSurfaces, kBindingEnvironment
 
@@ -71,7 +78,14 @@ class GpuScene {
   // Uploads `bytes` of `data` into `buffer`, first growing it when they do not fit (a material edit
   // can add emitters); the integrator writes its descriptors again before each bake.
   void upload_growing(Buffer& buffer, const void* data, size_t bytes);
-  void upload_surfaces(const LightingScene& scene);
+  void grow(Buffer& buffer, size_t bytes);  // a larger buffer when `bytes` exceed it (contents not kept)
+  // update_materials' writes appended to `writes` (buffers grown first; `surfaces` and `emitters`
+  // hold what they copy until written), and what this scene records once they are written.
+  void add_material_writes(const LightingScene& edited, std::vector<Context::RangeWrite>& writes, std::vector<Vec4>& surfaces,
+                           std::vector<uint32_t>& emitters);
+  void materials_uploaded(const LightingScene& edited);
+  void upload_punctual(const LightingScene& edited);  // the punctual records and their CDF, one submission
+  std::vector<Context::RangeWrite> punctual_writes(const LightingScene& edited) const;
   void update_environment(const LightingScene& edited);
 
   Context& context_;

@@ -420,6 +420,26 @@ void LightmapDriver::start(const TexelGBuffer& gbuffer, const IntegratorSettings
   progressive_ = std::move(a);
 }
 
+void LightmapDriver::update_texels(const TexelGBuffer& gbuffer, const std::vector<uint32_t>& texels) {
+  if (!progressive_ || texels.empty()) return;
+  Accumulation& a = *progressive_;
+  if (a.start_points.size() != gbuffer.texels.size()) return;  // a whole run's accumulation: start() uploads all
+  for (uint32_t i : texels)
+    if (i >= a.start_points.size()) throw std::out_of_range("Vulkan backend: texel " + std::to_string(i) + " of " + std::to_string(a.start_points.size()));
+  for (uint32_t i : texels) a.start_points[i] = texel_start_point(gbuffer.texels[i]);
+  WavefrontBuffers& buffers = runner_.buffers();
+  if (buffers.items.owner != WorkItems::Owner::Texels) return;  // uploaded whole before the next pass
+  constexpr size_t kPoint = sizeof(GpuSurfacePoint);
+  std::vector<ByteRange> ranges;
+  for (uint32_t i : texels) ranges.push_back({VkDeviceSize(i) * kPoint, kPoint});
+  runner_.context().write_ranges(buffers.items.start_points, ranges, [&](char* staging) {
+    for (uint32_t i : texels) {
+      std::memcpy(staging, &a.start_points[i], kPoint);
+      staging += kPoint;
+    }
+  });
+}
+
 uint64_t LightmapDriver::add_samples(uint32_t samples) {
   if (!progressive_) throw std::logic_error("Vulkan backend: add_samples before start_progressive");
   Accumulation& a = *progressive_;

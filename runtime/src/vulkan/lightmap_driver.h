@@ -43,6 +43,9 @@ class LightmapDriver {
              bool texels_as_before = false);
   // `samples` more per texel (sample indices continue where the last call ended); returns the rays traced.
   uint64_t add_samples(uint32_t samples);
+  // The start points of `texels` taken from `gbuffer` again (an edit moved them), on the host and,
+  // where the texel buffers are the accumulation's, on the device. Nothing before a start.
+  void update_texels(const TexelGBuffer& gbuffer, const std::vector<uint32_t>& texels);
   // Samples [first_sample, first_sample + samples) of the listed texels only (indices into the
   // G-buffer, each at most once); the caller keeps each texel's count. Returns the rays traced.
   uint64_t add_samples_to(const std::vector<uint32_t>& texels, uint32_t first_sample, uint32_t samples);

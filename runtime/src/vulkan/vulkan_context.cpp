@@ -1,6 +1,7 @@
 #include "vulkan_context.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -361,7 +362,10 @@ void Context::submit_and_wait(VkCommandBuffer cmd, double timeout_seconds) {
   if (r == VK_ERROR_DEVICE_LOST) fail("Vulkan device lost (vkQueueSubmit)");
   check(r, "vkQueueSubmit");
   const double limit = timeout_seconds > 0 ? timeout_seconds : std::max(0.001, options_.fence_timeout_seconds);
+  const auto waiting = std::chrono::steady_clock::now();
   r = vkWaitForFences(device_, 1, &fence_, VK_TRUE, uint64_t(limit * 1e9));
+  ++waits_.submissions;
+  waits_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - waiting).count();
   if (r == VK_TIMEOUT) {
     hung_ = true;  // the submission may still run: never reuse, wait for or destroy this device
     char seconds[32];
@@ -431,6 +435,31 @@ void Context::write_ranges(const Buffer& dst, const std::vector<ByteRange>& rang
   write(static_cast<char*>(staging.mapped()));
   VkCommandBuffer cmd = begin();
   vkCmdCopyBuffer(cmd, staging.handle(), dst.handle(), uint32_t(regions.size()), regions.data());
+  submit_and_wait(cmd);
+}
+
+void Context::write_ranges(const std::vector<RangeWrite>& writes) {
+  std::vector<std::vector<VkBufferCopy>> regions(writes.size());
+  std::vector<VkDeviceSize> start(writes.size(), 0);
+  VkDeviceSize total = 0;
+  for (size_t w = 0; w < writes.size(); ++w) {
+    VkDeviceSize packed = 0;
+    regions[w] = staging_regions(writes[w].ranges, /*from_staging=*/true, packed);
+    for (VkBufferCopy& r : regions[w]) r.srcOffset += total;
+    start[w] = total;
+    total += packed;
+  }
+  if (total == 0) return;
+  Buffer own;
+  bool leased = false;
+  const Buffer& staging = staging_for(total, own, leased);
+  StagingLease lease{small_staging_busy_, leased};
+  VkCommandBuffer cmd = begin();
+  for (size_t w = 0; w < writes.size(); ++w) {
+    if (regions[w].empty()) continue;
+    writes[w].write(static_cast<char*>(staging.mapped()) + start[w]);
+    vkCmdCopyBuffer(cmd, staging.handle(), writes[w].dst->handle(), uint32_t(regions[w].size()), regions[w].data());
+  }
   submit_and_wait(cmd);
 }
 

@@ -74,6 +74,14 @@ class Context {
   // then copies them to those ranges of `dst` and waits: for uploads made on the way, without a host
   // copy in between (`write` is not called when the ranges hold no bytes).
   void write_ranges(const Buffer& dst, const std::vector<ByteRange>& ranges, const std::function<void(char*)>& write);
+  // Several write_ranges to different buffers, staged together and copied in one submission waited
+  // for once: an edit's few small uploads cost one round trip instead of one each.
+  struct RangeWrite {
+    const Buffer* dst = nullptr;
+    std::vector<ByteRange> ranges;
+    std::function<void(char*)> write;  // fills the ranges' bytes, packed in order
+  };
+  void write_ranges(const std::vector<RangeWrite>& writes);
   void download(const Buffer& src, void* data, VkDeviceSize size, VkDeviceSize offset = 0);
   // Copies the `ranges` of `src`, packed in order, into a host-visible staging buffer, waits, and
   // hands `read` its mapping: for read-backs converted on the way, without a host copy in between
@@ -89,6 +97,13 @@ class Context {
   // `timeout_seconds` > 0 replaces the fence timeout for this submission (kernel compilation).
   void submit_and_wait(VkCommandBuffer cmd, double timeout_seconds = 0);
   bool lost() const { return lost_; }
+  // Submissions waited for so far and the host time spent waiting (what an edit's few small
+  // uploads cost is mostly these round trips: exitance-relight --json edits.device).
+  struct Waits {
+    uint64_t submissions = 0;
+    double seconds = 0;
+  };
+  const Waits& waits() const { return waits_; }
   // A submission may still be running (its fence timed out): from here on nothing is destroyed on
   // this device and nothing waits for it; its objects are leaked on purpose.
   bool hung() const { return hung_; }
@@ -132,6 +147,7 @@ class Context {
   const Buffer& staging_for(VkDeviceSize size, Buffer& own, bool& leased);
   bool lost_ = false;
   bool hung_ = false;
+  Waits waits_;
 };
 
 }  // namespace exitance::vulkan

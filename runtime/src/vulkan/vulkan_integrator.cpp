@@ -183,6 +183,16 @@ void VulkanIntegrator::update_lights(const LightingScene& edited) {
   impl_->scene.update_lights(edited);
   impl_->lightmap.set_guiding_scene(guiding_scene(edited, impl_->created_on));
 }
+void VulkanIntegrator::update_moved_geometry(const LightingScene& edited, const Bvh4Links& links,
+                                             const std::vector<uint32_t>& moved_triangles,
+                                             const std::vector<uint32_t>& changed_nodes, bool emitters_changed) {
+  impl_->scene.update_moved_geometry(edited, links, moved_triangles, changed_nodes, emitters_changed);
+  impl_->lightmap.set_guiding_scene(guiding_scene(edited, impl_->created_on));
+  impl_->source = edited.source;
+}
+void VulkanIntegrator::update_texels(const TexelGBuffer& gbuffer, const std::vector<uint32_t>& texels) {
+  impl_->lightmap.update_texels(gbuffer, texels);
+}
 void VulkanIntegrator::update_geometry(const LightingScene& edited) {
   impl_->scene.update_geometry(edited);
   impl_->lightmap.set_guiding_scene(guiding_scene(edited, impl_->created_on));
@@ -190,6 +200,8 @@ void VulkanIntegrator::update_geometry(const LightingScene& edited) {
 }
 
 const VulkanDeviceInfo& VulkanIntegrator::device() const { return impl_->context.info(); }
+uint64_t VulkanIntegrator::waited_submissions() const { return impl_->context.waits().submissions; }
+double VulkanIntegrator::wait_seconds() const { return impl_->context.waits().seconds; }
 std::string VulkanIntegrator::device_description() const {
   return device().name + " (" + to_string(device().type) + (impl_->context.adopted() ? ", adopted" : "") + ")";
 }

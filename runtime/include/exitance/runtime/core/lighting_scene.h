@@ -8,8 +8,10 @@
 
 #include "exitance/common/gpu_layout.h"
 #include "exitance/runtime/core/bvh4.h"
+#include "exitance/runtime/core/bvh4_refit.h"
 #include "exitance/runtime/environment_sampler.h"
 #include "exitance/runtime/scene.h"
+#include "exitance/runtime/world_box.h"
 
 namespace exitance {
 
@@ -61,5 +63,25 @@ void set_punctual_light(LightingScene& scene, uint32_t index, const PunctualLigh
 // derives them. Throws std::invalid_argument when the source's light count differs (nothing changed),
 // std::out_of_range for a light index beyond it.
 void refresh_lights_from_source(LightingScene& scene, const std::vector<uint32_t>& lights, bool sky);
+
+// The same for materials edited in the source itself: their records, `textured` and the emitter
+// distribution, as build_lighting_scene derives them. Throws as refresh_lights_from_source does.
+void refresh_materials_from_source(LightingScene& scene, const std::vector<uint32_t>& materials);
+
+// After triangles moved in the source itself (apply_scene_edits_in_place): `moved` ascending, with
+// their vertices before (`moved_before`, 3 each), `bounds` the box of every source position now
+// (the caller keeps it per instance rather than passing over the scene). The BVH refit over them
+// (refit_bvh4_moved with `links`), their records, the bounds and extent, the emitter distribution
+// when an emitter moved, the punctual records and CDF (directional powers follow the bounds): what
+// set_geometry derives, without a pass over every triangle. Returns the BVH nodes that changed
+// (ascending) and whether the emitter distribution was derived again. Throws
+// std::invalid_argument when the source's triangle count differs (nothing changed).
+struct MovedTrianglesRefresh {
+  std::vector<uint32_t> bvh_nodes;
+  bool emitters_changed = false;
+};
+MovedTrianglesRefresh refresh_moved_triangles_from_source(LightingScene& scene, const Bvh4Links& links,
+                                                         const std::vector<uint32_t>& moved,
+                                                         const std::vector<Vec3>& moved_before, const WorldBox& bounds);
 
 }  // namespace exitance

@@ -83,6 +83,9 @@ struct EditTimings {
   double near_texels = 0;  // finding the texels near the change (texels_near_change.h)
   double publish = 0;      // keeping what texels showed, on the device (publish.comp)
   double restart = 0;      // starting the accumulation again (a restart or a change estimate)
+  // Of all of the above: device submissions waited for, and the milliseconds spent waiting.
+  uint64_t device_submissions = 0;
+  double device_wait = 0;
 };
 
 class RefreshSession {
@@ -99,7 +102,11 @@ class RefreshSession {
   // and scene.bin as write_refreshed_bundle will write it, then restarts the accumulation, so no
   // texel keeps a value from before the edit. All or nothing: throws SceneEditError (one line
   // naming the edit and the problem) with the session unchanged. std::runtime_error on device
-  // failure.
+  // failure. Nothing is copied whole: edits are validated on copies of the scene's small parts and
+  // the moved instances' triangles, then applied in place (apply_scene_edits_in_place); a moved
+  // instance refits only its BVH leaves and the nodes above them, and uploads only those, its
+  // triangles and the start points of the texels that moved (its own, and those unocclude placed
+  // again near its bounds).
   //
   // Edits that change only punctual lights (position, direction, cone, intensity, colour; at most
   // kMaxChangedLights of them since the base) do not restart E/pi: the accumulation becomes an

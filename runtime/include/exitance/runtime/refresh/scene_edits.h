@@ -32,6 +32,7 @@
 
 #include "exitance/runtime/core/lighting_scene.h"
 #include "exitance/runtime/scene_file_conversion.h"
+#include "exitance/runtime/world_box.h"
 
 namespace exitance {
 
@@ -115,13 +116,34 @@ struct EditEffects {
 // parse_scene_edits checks (edits built in code are checked the same way).
 EditEffects apply_scene_edits(PersistedScene& scene, const std::vector<SceneEdit>& edits);
 
-// The cheap case of apply_scene_edits, in place: edits of lights, the sky's colour and nodes that
-// move no mesh instance (a light's node) are validated and computed on copies of the scene's small
-// parts (nodes, lights) and committed into `scene` without copying its geometry or textures; the
-// result is apply_scene_edits' (the same edit functions). nullopt, `scene` untouched, when an edit
-// edits a material or moves an instance (apply_scene_edits then). Throws SceneEditError as
-// apply_scene_edits does, `scene` untouched.
-std::optional<EditEffects> apply_light_edits_in_place(Scene& scene, const std::vector<SceneEdit>& edits);
+// Instance k's live texels: texels[start[k] .. start[k + 1]) (ascending), so an edit that moves
+// an instance finds its texels without a pass over the G-buffer. Texels never change instance.
+struct InstanceTexels {
+  InstanceTexels() = default;
+  InstanceTexels(const TexelGBuffer& gbuffer, size_t instance_count);
+  std::vector<uint32_t> start, texels;
+};
+
+// What apply_scene_edits_in_place changed, for the caller to bring the BVH, the lighting scene, the
+// device and its own indices along without a pass over the scene.
+struct InPlaceEdits {
+  EditEffects effects;
+  std::vector<uint32_t> moved_triangles;            // ascending
+  std::vector<Vec3> moved_triangles_before;         // their 3 vertices each, as before the edits
+  std::vector<WorldBox> moved_boxes_before, moved_boxes_after;  // per effects.moved_instances
+  std::vector<uint32_t> moved_texels;               // ascending: the G-buffer texels rewritten
+};
+
+// apply_scene_edits without copying the scene (the runtime's edit path): every edit is validated and
+// computed on copies of the scene's small parts (nodes, instances, lights, materials, the sky's
+// colour) and of the moved instances' triangles, then committed in place, with the same edit
+// functions, so the scene, its texels and what the result lists are apply_scene_edits' bit for bit.
+// `persisted.bvh` is left as it was: the caller refits it over `moved_triangles` (refit_bvh4_moved;
+// RefreshSession does, on its lighting scene's BVH, and copies the changed nodes back).
+// `by_instance` (may be null: a pass over the texels) must be built on this G-buffer. Throws
+// SceneEditError as apply_scene_edits does, `persisted` untouched.
+InPlaceEdits apply_scene_edits_in_place(PersistedScene& persisted, const std::vector<SceneEdit>& edits,
+                                        const InstanceTexels* by_instance);
 
 // Brings `lighting`, built on the scene before apply_scene_edits, to `edited` (the scene after):
 // set_geometry (lighting_scene.h: everything re-derived, BVH refit) when geometry moved, else

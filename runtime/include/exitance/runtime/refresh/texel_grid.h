@@ -1,7 +1,9 @@
 // Live texels bucketed by position in a uniform grid over their bounds, so the texels near an edit
 // (texels_near_change.h) are found from the cells around it instead of by a pass over every texel
 // (a million texels: ~10 ms per edit on a laptop-class core otherwise). Built once per G-buffer
-// (RefreshSession: at open and after texels moved), about 8 texels per cell.
+// (RefreshSession: at open), about 8 texels per cell. Texels an edit moves are set aside
+// (`displace`): their cells no longer list them and every query visits them, until there are so many
+// that the owner builds the grid again.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -16,11 +18,17 @@ class TexelGrid {
   TexelGrid() = default;
   explicit TexelGrid(const TexelGBuffer& gbuffer);
   size_t texel_count() const { return texels_.size(); }
-  // The texels of the cells that `box` grown by `margin` overlaps (a superset of those within
-  // `margin` of it), cell by cell.
+  // The largest world_texel_size of the texels (as built; displaced texels raise it).
+  float largest_texel_size() const { return largest_texel_size_; }
+  // Texel i moved (to `texel`): no longer found through its cell, visited by every query instead.
+  void displace(uint32_t i, const LiveTexel& texel);
+  size_t displaced_count() const { return displaced_.size(); }
+  // The texels of the cells that `box` grown by `margin` overlaps, and every displaced texel (a
+  // superset of those within `margin` of it), each once.
   template <typename Visit>
   void for_each_candidate(const WorldBox& box, float margin, Visit visit) const {
     if (texels_.empty() || box.empty()) return;
+    for (uint32_t i : displaced_) visit(i);
     int first[3], last[3];
     for (int a = 0; a < 3; ++a) {
       first[a] = cell_of(a, box.lo[a] - margin);
@@ -30,7 +38,8 @@ class TexelGrid {
       for (int y = first[1]; y <= last[1]; ++y)
         for (int x = first[0]; x <= last[0]; ++x) {
           const size_t cell = (size_t(z) * size_t(cells_[1]) + size_t(y)) * size_t(cells_[0]) + size_t(x);
-          for (uint32_t k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) visit(texels_[k]);
+          for (uint32_t k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k)
+            if (is_displaced_.empty() || !is_displaced_[texels_[k]]) visit(texels_[k]);
         }
   }
 
@@ -41,6 +50,9 @@ class TexelGrid {
   int cells_[3] = {1, 1, 1};
   std::vector<uint32_t> cell_start_;  // per cell, its first entry in texels_ (and one past the last)
   std::vector<uint32_t> texels_;      // texel indices, by cell
+  std::vector<uint32_t> displaced_;   // texels moved since the build
+  std::vector<uint8_t> is_displaced_;  // per texel (empty until one is)
+  float largest_texel_size_ = 0;
 };
 
 }  // namespace exitance

@@ -21,4 +21,14 @@ std::vector<uint32_t> texels_near_change(const PersistedScene& edited, const Sce
                                          const LightingScene& edited_lighting, const EditEffects& effects,
                                          const TexelGrid* grid = nullptr);
 
+// What texels_near_change reads of the scene before the edit, kept by an edit made in place
+// (apply_scene_edits_in_place) instead of a copy of that scene.
+struct ChangeBefore {
+  std::vector<Vec3> light_positions;                            // every light's, before the edit
+  std::vector<WorldBox> moved_boxes_before, moved_boxes_after;  // per effects.moved_instances
+};
+std::vector<uint32_t> texels_near_change(const PersistedScene& edited, const ChangeBefore& before,
+                                         const LightingScene& edited_lighting, const EditEffects& effects,
+                                         const TexelGrid* grid = nullptr);
+
 }  // namespace exitance

@@ -3,9 +3,11 @@
 // point, and one it now buries must be pushed out, as a fresh bake would do.
 #pragma once
 #include <cstddef>
+#include <vector>
 
 #include "exitance/runtime/core/lighting_scene.h"
 #include "exitance/runtime/refresh/scene_edits.h"
+#include "exitance/runtime/refresh/texel_grid.h"
 #include "exitance/runtime/scene_file_conversion.h"
 
 namespace exitance {
@@ -16,5 +18,12 @@ namespace exitance {
 // `before`: the scene before the edit. Returns the number of texels reconsidered.
 size_t unocclude_near_moved(PersistedScene& edited, const Scene& before, const LightingScene& edited_lighting,
                             const EditEffects& effects);
+
+// The same given the moved instances' bounds before and after (`boxes`), for an edit made in
+// place. `grid` (may be null: a pass over every texel): over the G-buffer's texels, with every
+// texel that moved since its build displaced (texel_grid.h); only its candidates are visited.
+// Returns the texels reconsidered, ascending (the caller displaces them in its grid).
+std::vector<uint32_t> unocclude_near_boxes(PersistedScene& edited, const std::vector<WorldBox>& boxes,
+                                           const LightingScene& edited_lighting, const TexelGrid* grid);
 
 }  // namespace exitance

@@ -176,8 +176,21 @@ class VulkanIntegrator final : public Integrator {
   // on `edited`. Throws std::invalid_argument when the triangle, material or light count or the
   // BVH's node count, leaf slots or stack bound differ.
   void update_geometry(const LightingScene& edited);
+  // update_geometry for an edit made in place (RefreshSession): after
+  // refresh_moved_triangles_from_source, which returned `changed_nodes` for `moved_triangles`;
+  // `emitters_changed` when an emitter was among them. Uploads only what those change; the device
+  // scene then equals update_geometry's.
+  void update_moved_geometry(const LightingScene& edited, const Bvh4Links& links, const std::vector<uint32_t>& moved_triangles,
+                             const std::vector<uint32_t>& changed_nodes, bool emitters_changed);
+  // The running accumulation's start points of `texels` (G-buffer indices) taken from `gbuffer`
+  // again (texels an edit moved), so a later start_progressive(..., texels_as_before = true) traces
+  // from where they are now. Nothing before a start. std::out_of_range for an index beyond it.
+  void update_texels(const TexelGBuffer& gbuffer, const std::vector<uint32_t>& texels);
 
   const VulkanDeviceInfo& device() const;
+  // Submissions this integrator has waited for, and the seconds spent waiting, so far.
+  uint64_t waited_submissions() const;
+  double wait_seconds() const;
   uint32_t max_paths() const;
   size_t path_state_bytes_per_path() const;  // SoA path state + queues + shadow rays, per path slot
   size_t bvh_bytes() const;
