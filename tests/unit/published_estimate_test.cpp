@@ -49,8 +49,11 @@ TEST(PublishedEstimate, AChangeIsPublishedOnlyWithTwoSamplesAndWhereItIsSignific
   EXPECT_EQ(publish_change(previous, base, texel({9})).texels[0].total[0], previous.texels[0].total[0]);
   // Mean 2, V = 1 per channel: 3 * 4 <= 9 * 3 * 1, within 3 standard errors: the base exactly.
   EXPECT_EQ(publish_change(previous, base, texel({1, 3})).texels[0].total[0], base.texels[0].total[0]);
-  // Mean 5, V = 1: 75 > 27, significant: base + change.
-  EXPECT_NEAR(publish_change(previous, base, texel({4, 6})).mean_total(0)[0], 7.0, 1e-6);
+  // Mean 5 from 2 samples, V = 1: a variance from 2 samples widens 3 standard errors to 235.8
+  // (significance_for_samples): 75 < 235.8^2 * 3, the base.
+  EXPECT_EQ(publish_change(previous, base, texel({4, 6})).texels[0].total[0], base.texels[0].total[0]);
+  // Mean 5 from 8 samples, V = 1/7: 75 > 4.53^2 * 3 / 7 = 8.8, significant: base + change.
+  EXPECT_NEAR(publish_change(previous, base, texel({4, 6, 4, 6, 4, 6, 4, 6})).mean_total(0)[0], 7.0, 1e-6);
   // A change exactly 0 (no edited light reaches the texel): the base exactly.
   EXPECT_EQ(publish_change(previous, base, texel({0, 0, 0})).texels[0].total[1], base.texels[0].total[1]);
 }
@@ -69,9 +72,18 @@ TEST(PublishedEstimate, ARestartKeepsThePreviousValueUntilTheRefreshedOneIsMoreP
   EXPECT_EQ(publish_restart(previous, texel({7})).texels[0].total[0], previous.texels[0].total[0]);
   const LightmapEstimate eight = texel({1, 3, 2, 2, 1, 3, 2, 2});
   EXPECT_EQ(publish_restart(eight, texel({9, 11, 9, 11, 9, 11, 10})).texels[0].total[0], eight.texels[0].total[0]);
-  // A kept value of 4 samples is replaced after 4 refreshed ones, where they differ significantly.
+  // A kept value of 4 samples is replaced after 4 refreshed ones, where they differ significantly
+  // (3 * 64 > 9.22^2 * 3 * (1/3 + 1/3): 3 standard errors widened for variances from 4 samples).
   const LightmapEstimate four = texel({1, 3, 1, 3});  // mean 2, V = 1/3
   EXPECT_NEAR(publish_restart(four, texel({9, 11, 9, 11})).mean_total(0)[0], 10.0, 1e-6);
+  // ...but not a difference of about 5 standard errors, significant only were the variances known.
+  EXPECT_EQ(publish_restart(four, texel({5, 7, 5, 7})).texels[0].total[0], four.texels[0].total[0]);
+  // A kept value of one sample has no variance: two refreshed samples replace it.
+  EXPECT_NEAR(publish_restart(texel({2}), texel({4, 6})).mean_total(0)[0], 5.0, 1e-6);
+  // Eight refreshed samples with a smaller variance than a kept value of 16 (less precise as the
+  // counts go, the variance from 8 samples being too uncertain): kept.
+  const LightmapEstimate sixteen = texel({1, 3, 1, 3, 1, 3, 1, 3, 1, 3, 1, 3, 1, 3, 1, 3});  // V = 1/15
+  EXPECT_EQ(publish_restart(sixteen, texel({2, 2, 2, 2, 2, 2, 2, 2.5})).texels[0].total[0], sixteen.texels[0].total[0]);
   EXPECT_EQ(publish_restart(four, texel({9, 11, 10})).texels[0].total[0], four.texels[0].total[0]);
   // Same mean, larger variance (V = 4/7): kept.
   EXPECT_EQ(publish_restart(previous, texel({0, 4, 0, 4, 0, 4, 0, 4})).texels[0].total[0], previous.texels[0].total[0]);
