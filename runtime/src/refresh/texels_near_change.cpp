@@ -58,15 +58,20 @@ std::vector<uint32_t> texels_near_change(const PersistedScene& edited, const Cha
   }
   std::vector<uint32_t> near;
   if (grid && grid->texel_count() == edited.gbuffer.texels.size()) {
-    // Marked per texel (boxes overlap), then listed in order: no sort of a list that can hold
-    // hundreds of thousands of texels.
-    std::vector<uint8_t> is_near(edited.gbuffer.texels.size(), 0);
-    size_t count = 0;
     for (size_t b = 0; b < boxes.size(); ++b)
       grid->for_each_candidate(boxes[b], std::sqrt(radius_squared[b]), [&](uint32_t i) {
-        if (!is_near[i] && boxes[b].distance_squared(edited.gbuffer.texels[i].position) <= radius_squared[b]) is_near[i] = 1, ++count;
+        if (boxes[b].distance_squared(edited.gbuffer.texels[i].position) <= radius_squared[b]) near.push_back(i);
       });
-    near.reserve(count);
+    // In order and each once (boxes overlap): a sort for a short list, a mark per texel for a long
+    // one (hundreds of thousands of texels near a moved block).
+    if (near.size() < edited.gbuffer.texels.size() / 32) {
+      std::sort(near.begin(), near.end());
+      near.erase(std::unique(near.begin(), near.end()), near.end());
+      return near;
+    }
+    std::vector<uint8_t> is_near(edited.gbuffer.texels.size(), 0);
+    for (uint32_t i : near) is_near[i] = 1;
+    near.clear();
     for (uint32_t i = 0; i < uint32_t(is_near.size()); ++i)
       if (is_near[i]) near.push_back(i);
     return near;

@@ -29,6 +29,14 @@ Buffer upload_new(Context& context, const std::vector<T>& data) {
   return b;
 }
 
+// The same, with room for `extra` more records (a change estimate's light pairs, set later).
+template <typename T>
+Buffer upload_with_room(Context& context, const std::vector<T>& data, size_t extra) {
+  Buffer b = context.create_storage_buffer((data.size() + extra) * sizeof(T));
+  context.upload(b, data.data(), data.size() * sizeof(T));
+  return b;
+}
+
 std::vector<uint32_t> node_words(const Bvh4& bvh, bool quantized) {
   if (quantized) return quantize_bvh4_nodes(bvh.nodes);
   std::vector<uint32_t> words(bvh.nodes.size() * sizeof(Bvh4Node) / 4);
@@ -36,27 +44,23 @@ std::vector<uint32_t> node_words(const Bvh4& bvh, bool quantized) {
   return words;
 }
 
-// Per leaf slot, its triangle's vertices (and index, in the first w) where traversal reads them together.
+// A leaf slot's triangle's vertices (and index, in the first w) where traversal reads them together.
+void leaf_triangle_copy(const LightingScene& scene, size_t slot, Vec4 out[3]) {
+  const uint32_t t = scene.bvh.leaf_triangles[slot];
+  out[0] = Vec4(scene_triangle_vertex(scene, t, 0), uintBitsToFloat(t));
+  out[1] = Vec4(scene_triangle_vertex(scene, t, 1), 0.0f);
+  out[2] = Vec4(scene_triangle_vertex(scene, t, 2), 0.0f);
+}
+
 std::vector<Vec4> leaf_triangle_copies(const LightingScene& scene) {
   std::vector<Vec4> leaf(std::max<size_t>(scene.bvh.leaf_triangles.size(), 1) * 3);
-  for (size_t slot = 0; slot < scene.bvh.leaf_triangles.size(); ++slot) {
-    const uint32_t t = scene.bvh.leaf_triangles[slot];
-    leaf[slot * 3] = Vec4(scene_triangle_vertex(scene, t, 0), uintBitsToFloat(t));
-    leaf[slot * 3 + 1] = Vec4(scene_triangle_vertex(scene, t, 1), 0.0f);
-    leaf[slot * 3 + 2] = Vec4(scene_triangle_vertex(scene, t, 2), 0.0f);
-  }
+  for (size_t slot = 0; slot < scene.bvh.leaf_triangles.size(); ++slot) leaf_triangle_copy(scene, slot, &leaf[slot * 3]);
   return leaf;
 }
 
-// The records of `triangles` (sorted, unique) as byte ranges, consecutive ones merged.
+// The records of `triangles` (sorted, unique) as byte ranges, near ones joined.
 std::vector<ByteRange> triangle_ranges(const std::vector<uint32_t>& triangles) {
-  std::vector<ByteRange> ranges;
-  for (uint32_t t : triangles) {
-    const VkDeviceSize offset = VkDeviceSize(t) * sizeof(GpuTriangle);
-    if (!ranges.empty() && ranges.back().offset + ranges.back().size == offset) ranges.back().size += sizeof(GpuTriangle);
-    else ranges.push_back({offset, sizeof(GpuTriangle)});
-  }
-  return ranges;
+  return byte_ranges(record_runs(triangles, sizeof(GpuTriangle)), sizeof(GpuTriangle));
 }
 
 // The image sky as the kernels read it (gpu_layout.h kBindingEnvironment): marginal CDF, row CDFs,
@@ -95,7 +99,7 @@ GpuScene::GpuScene(Context& context, const LightingScene& scene, bool quantized_
       materials_(upload_new(context, at_least_one(scene.materials))),
       emitter_cdf_(upload_new(context, scene.emitter_cdf)),
       emitter_triangles_(upload_new(context, at_least_one(scene.emitter_triangles))),
-      punctual_lights_(upload_new(context, at_least_one(scene.punctual_lights))),
+      punctual_lights_(upload_with_room(context, at_least_one(scene.punctual_lights), 2 * kMaxChangedLightPairs)),
       punctual_cdf_(upload_new(context, scene.punctual_cdf)),
       environment_(upload_new(context, environment_words(scene))),
       emitters_(scene.emitter_triangles),
@@ -263,31 +267,34 @@ void GpuScene::update_moved_geometry(const LightingScene& edited, const Bvh4Link
   // The changed nodes (in this scene's node layout), the moved triangles' leaf-slot vertex copies
   // and records, and the punctual lights and CDF (directional powers follow the bounds; moved
   // lights), in one submission.
-  std::vector<Bvh4Node> nodes;
-  for (uint32_t n : changed_nodes) nodes.push_back(edited.bvh.nodes[n]);
   const size_t node_bytes = quantized_ ? kQuantizedNodeWords * 4 : sizeof(Bvh4Node);
+  const std::vector<std::pair<uint32_t, uint32_t>> node_runs = record_runs(changed_nodes, node_bytes);
+  std::vector<Bvh4Node> nodes;
+  for (const auto& [first, end] : node_runs) nodes.insert(nodes.end(), edited.bvh.nodes.begin() + first, edited.bvh.nodes.begin() + end);
   const std::vector<uint32_t> words = node_words(Bvh4{nodes, {}, 1, 0}, quantized_);
   std::vector<Context::RangeWrite> writes;
   writes.reserve(5);  // the references below stay valid
   Context::RangeWrite& node_write = writes.emplace_back();
   node_write.dst = &nodes_;
-  for (uint32_t n : changed_nodes) node_write.ranges.push_back({VkDeviceSize(n) * node_bytes, node_bytes});
+  node_write.ranges = byte_ranges(node_runs, node_bytes);
   node_write.write = [&](char* staging) { std::memcpy(staging, words.data(), words.size() * 4); };
   std::vector<uint32_t> slots;
   for (uint32_t t : moved_triangles)
     for (uint32_t k = links.triangle_slot_start[t]; k < links.triangle_slot_start[size_t(t) + 1]; ++k) slots.push_back(links.triangle_slots[k]);
   std::sort(slots.begin(), slots.end());
+  constexpr size_t kSlotBytes = 3 * sizeof(Vec4);
+  const std::vector<std::pair<uint32_t, uint32_t>> slot_runs = record_runs(slots, kSlotBytes);
   Context::RangeWrite& leaf_write = writes.emplace_back();
   leaf_write.dst = &leaf_triangles_;
-  for (uint32_t s : slots) leaf_write.ranges.push_back({VkDeviceSize(s) * 3 * sizeof(Vec4), 3 * sizeof(Vec4)});
+  leaf_write.ranges = byte_ranges(slot_runs, kSlotBytes);
   leaf_write.write = [&](char* staging) {
-    for (uint32_t s : slots) {
-      const uint32_t t = edited.bvh.leaf_triangles[s];
-      const Vec4 copy[3] = {Vec4(scene_triangle_vertex(edited, t, 0), uintBitsToFloat(t)),
-                            Vec4(scene_triangle_vertex(edited, t, 1), 0.0f), Vec4(scene_triangle_vertex(edited, t, 2), 0.0f)};
-      std::memcpy(staging, copy, sizeof(copy));
-      staging += sizeof(copy);
-    }
+    for (const auto& [first, end] : slot_runs)
+      for (uint32_t s = first; s < end; ++s) {
+        Vec4 copy[3];
+        leaf_triangle_copy(edited, s, copy);
+        std::memcpy(staging, copy, sizeof(copy));
+        staging += sizeof(copy);
+      }
   };
   Context::RangeWrite& triangle_write = writes.emplace_back();
   triangle_write.dst = &triangles_;

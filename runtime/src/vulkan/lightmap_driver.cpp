@@ -430,12 +430,14 @@ void LightmapDriver::update_texels(const TexelGBuffer& gbuffer, const std::vecto
   WavefrontBuffers& buffers = runner_.buffers();
   if (buffers.items.owner != WorkItems::Owner::Texels) return;  // uploaded whole before the next pass
   constexpr size_t kPoint = sizeof(GpuSurfacePoint);
-  std::vector<ByteRange> ranges;
-  for (uint32_t i : texels) ranges.push_back({VkDeviceSize(i) * kPoint, kPoint});
+  std::vector<uint32_t> sorted = texels;
+  std::sort(sorted.begin(), sorted.end());
+  sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+  const std::vector<ByteRange> ranges = byte_ranges(record_runs(sorted, kPoint), kPoint);  // the host's start points fill the gaps
   runner_.context().write_ranges(buffers.items.start_points, ranges, [&](char* staging) {
-    for (uint32_t i : texels) {
-      std::memcpy(staging, &a.start_points[i], kPoint);
-      staging += kPoint;
+    for (const ByteRange& r : ranges) {
+      std::memcpy(staging, reinterpret_cast<const char*>(a.start_points.data()) + r.offset, size_t(r.size));
+      staging += r.size;
     }
   });
 }

@@ -124,6 +124,11 @@ struct GpuParams {
                              // punctual lights (path.h punctual_change_rays), pairs of records after the scene's own
 };
 
+// The most edited punctual lights a change estimate carries (GpuParams::changed_light_pairs; the
+// runtime restarts beyond it): the punctual light buffer has room for their pairs from the start,
+// so the first light edit allocates nothing.
+const uint kMaxChangedLightPairs = 8u;
+
 // Descriptor bindings of the wavefront (one set).
 const uint kBindingParams = 0u;
 const uint kBindingBvhNodes = 1u;

@@ -56,7 +56,7 @@ struct RefreshSessionOptions {
 
 // Edits that change at most this many punctual lights (counted against the base) are estimated as
 // a change (RefreshSession::apply_edits); more, and the accumulation restarts.
-constexpr uint32_t kMaxChangedLights = 8;
+constexpr uint32_t kMaxChangedLights = kMaxChangedLightPairs;  // gpu_layout.h
 
 // What one refresh() call may spend; it ends at whichever limit comes first. A call with neither
 // limit set adds what the sample cap allows.
