@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 
 #include "exitance/bake/layout/atlas_layout.h"
 #include "exitance/bake/raster/cell_rejection.h"
@@ -120,6 +121,64 @@ TEST(Dilation, FillsGutterFromNeighbours) {
   std::vector<float> value = {0, 0, 0, 0, 5, 0, 0, 0, 0};
   dilate_into_gutter(3, 3, coverage, {value.data()}, 2);
   for (float v : value) EXPECT_EQ(v, 5.0f);
+}
+
+// The ring-by-ring fill as it was written before its rows ran in parallel (one pass: scan the page,
+// then apply), the reference the parallel dilate_into must match bit for bit.
+void serial_dilate(int width, int height, std::vector<uint8_t> filled, const std::vector<uint8_t>& fillable,
+                   const std::vector<float*>& channels, int passes) {
+  for (int pass = 0; passes < 0 || pass < passes; ++pass) {
+    std::vector<size_t> newly;
+    std::vector<float> values;
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) {
+        const size_t i = size_t(y) * size_t(width) + size_t(x);
+        if (filled[i] || !fillable[i]) continue;
+        std::vector<double> sum(channels.size(), 0.0);
+        int n = 0;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int nx = x + dx, ny = y + dy;
+            if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
+            const size_t j = size_t(ny) * size_t(width) + size_t(nx);
+            if (!filled[j]) continue;
+            for (size_t c = 0; c < channels.size(); ++c) sum[c] += channels[c][j];
+            ++n;
+          }
+        if (n == 0) continue;
+        newly.push_back(i);
+        for (double v : sum) values.push_back(float(v / n));
+      }
+    if (newly.empty()) break;
+    for (size_t k = 0; k < newly.size(); ++k) {
+      filled[newly[k]] = 1;
+      for (size_t c = 0; c < channels.size(); ++c) channels[c][newly[k]] = values[k * channels.size() + c];
+    }
+  }
+}
+
+TEST(Dilation, ParallelRowsMatchTheSerialFill) {
+  // Big enough for several row chunks; scattered covered texels and a fillable mask with holes, so
+  // rings meet across chunk borders; 4 passes and "until nothing changes" (-1).
+  const int width = 700, height = 1100;
+  const size_t n = size_t(width) * size_t(height);
+  Pcg32 rng = pcg_init(7, 0, 0);
+  std::vector<uint8_t> filled(n), fillable(n);
+  std::vector<float> a(n), b(n);
+  for (size_t i = 0; i < n; ++i) {
+    filled[i] = pcg_uniform(rng) < 0.05f;
+    fillable[i] = pcg_uniform(rng) < 0.9f;
+    a[i] = filled[i] ? pcg_uniform(rng) * 100.0f : 0.0f;
+    b[i] = filled[i] ? pcg_uniform(rng) : 0.0f;
+  }
+  for (int passes : {4, -1}) {
+    std::vector<float> a_serial = a, b_serial = b, a_parallel = a, b_parallel = b;
+    serial_dilate(width, height, filled, fillable, {a_serial.data(), b_serial.data()}, passes);
+    dilate_into(width, height, filled, fillable, {a_parallel.data(), b_parallel.data()}, passes);
+    EXPECT_EQ(std::memcmp(a_serial.data(), a_parallel.data(), n * sizeof(float)), 0) << passes;
+    EXPECT_EQ(std::memcmp(b_serial.data(), b_parallel.data(), n * sizeof(float)), 0) << passes;
+    EXPECT_NE(std::memcmp(a.data(), a_parallel.data(), n * sizeof(float)), 0);  // it did fill something
+  }
 }
 
 TEST(Sampling, CosineHemisphereIsNormalisedAndUpward) {
