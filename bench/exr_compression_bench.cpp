@@ -8,7 +8,6 @@
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
-#include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfThreading.h>
 
@@ -20,10 +19,9 @@
 
 #include "exitance/formats/lightmap_exr.h"
 
-#include <sys/resource.h>
-
 #include "wall_clock.h"
 
+using exitance::bench::cpu_seconds;
 using exitance::bench::median;
 using exitance::bench::seconds_since;
 
@@ -43,29 +41,6 @@ void write_with(const std::string& path, const exitance::formats::LightmapImage&
   Imf::OutputFile file(path.c_str(), header, threads);
   file.setFrameBuffer(frame);
   file.writePixels(image.height);
-}
-
-exitance::formats::LightmapImage read_with(const std::string& path, int threads) {
-  Imf::InputFile file(path.c_str(), threads);
-  const Imath::Box2i window = file.header().dataWindow();
-  exitance::formats::LightmapImage image;
-  image.width = window.max.x - window.min.x + 1;
-  image.height = window.max.y - window.min.y + 1;
-  Imf::FrameBuffer frame;
-  for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it) {
-    auto& data = image.channels[it.name()];
-    data.assign(size_t(image.width) * size_t(image.height), 0.0f);
-    frame.insert(it.name(), Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(data.data()), sizeof(float), sizeof(float) * size_t(image.width)));
-  }
-  file.setFrameBuffer(frame);
-  file.readPixels(window.min.y, window.max.y);
-  return image;
-}
-
-double cpu_seconds() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) + 1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
 }
 
 bool bit_identical(const exitance::formats::LightmapImage& a, const exitance::formats::LightmapImage& b) {
@@ -128,7 +103,7 @@ int main(int argc, char** argv) {
         write.push_back(seconds_since(start));
         write_cpu.push_back(cpu_seconds() - cpu_start);
         start = std::chrono::steady_clock::now();
-        const exitance::formats::LightmapImage back = read_with(path, threads);
+        const exitance::formats::LightmapImage back = exitance::formats::read_lightmap_exr(path, threads);
         read.push_back(seconds_since(start));
         same = same && bit_identical(image, back);
       }

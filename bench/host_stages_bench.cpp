@@ -20,8 +20,6 @@
 #include <thread>
 #include <vector>
 
-#include <sys/resource.h>
-
 #include "exitance/formats/bundle_manifest.h"
 #include "exitance/formats/lightmap_exr.h"
 #include "exitance/formats/probes_file.h"
@@ -38,19 +36,13 @@
 #include "wall_clock.h"
 
 using namespace exitance;
+using exitance::bench::cpu_seconds;
+using exitance::bench::Digest;
 using exitance::bench::median;
 using exitance::bench::seconds_since;
 namespace fs = std::filesystem;
 
 namespace {
-
-struct Digest {
-  uint64_t value = 0xcbf29ce484222325ull;
-  void add(const void* data, size_t size) {
-    const auto* bytes = static_cast<const uint8_t*>(data);
-    for (size_t i = 0; i < size; ++i) value = (value ^ bytes[i]) * 0x100000001b3ull;
-  }
-};
 
 uint64_t file_digest(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -65,12 +57,6 @@ uint64_t pixel_digest(const formats::LightmapImage& image) {
   d.add(&image.width, sizeof image.width), d.add(&image.height, sizeof image.height);
   for (const auto& [name, data] : image.channels) d.add(name.data(), name.size()), d.add(data.data(), data.size() * sizeof(float));
   return d.value;
-}
-
-double cpu_seconds() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) + 1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
 }
 
 // A deterministic estimate over `texels` live texels: 256 samples each, values from a hash of the index.

@@ -123,37 +123,34 @@ TEST(Dilation, FillsGutterFromNeighbours) {
   for (float v : value) EXPECT_EQ(v, 5.0f);
 }
 
-// The ring-by-ring fill as it was written before its rows ran in parallel (one pass: scan the page,
-// then apply), the reference the parallel dilate_into must match bit for bit.
+// The ring-by-ring fill computed plainly on one thread, the reference the parallel dilate_into must
+// match bit for bit: per pass, every fillable unfilled texel's filled 8-neighbours (row by row, the
+// order the sums run in) averaged in double against the state before the pass.
 void serial_dilate(int width, int height, std::vector<uint8_t> filled, const std::vector<uint8_t>& fillable,
                    const std::vector<float*>& channels, int passes) {
+  static const int offsets[8][2] = {{-1, -1}, {0, -1}, {1, -1}, {-1, 0}, {1, 0}, {-1, 1}, {0, 1}, {1, 1}};
   for (int pass = 0; passes < 0 || pass < passes; ++pass) {
-    std::vector<size_t> newly;
-    std::vector<float> values;
-    for (int y = 0; y < height; ++y)
-      for (int x = 0; x < width; ++x) {
-        const size_t i = size_t(y) * size_t(width) + size_t(x);
-        if (filled[i] || !fillable[i]) continue;
-        std::vector<double> sum(channels.size(), 0.0);
-        int n = 0;
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int nx = x + dx, ny = y + dy;
-            if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
-            const size_t j = size_t(ny) * size_t(width) + size_t(nx);
-            if (!filled[j]) continue;
-            for (size_t c = 0; c < channels.size(); ++c) sum[c] += channels[c][j];
-            ++n;
-          }
-        if (n == 0) continue;
-        newly.push_back(i);
-        for (double v : sum) values.push_back(float(v / n));
+    std::vector<uint8_t> before = filled;
+    std::vector<std::vector<float>> old(channels.size());
+    for (size_t c = 0; c < channels.size(); ++c) old[c].assign(channels[c], channels[c] + size_t(width) * size_t(height));
+    bool changed = false;
+    for (size_t i = 0; i < before.size(); ++i) {
+      if (before[i] || !fillable[i]) continue;
+      const int x = int(i % size_t(width)), y = int(i / size_t(width));
+      std::vector<size_t> from;
+      for (const auto& o : offsets)
+        if (x + o[0] >= 0 && x + o[0] < width && y + o[1] >= 0 && y + o[1] < height &&
+            before[size_t(y + o[1]) * size_t(width) + size_t(x + o[0])])
+          from.push_back(size_t(y + o[1]) * size_t(width) + size_t(x + o[0]));
+      if (from.empty()) continue;
+      for (size_t c = 0; c < channels.size(); ++c) {
+        double total = 0;
+        for (size_t j : from) total += old[c][j];
+        channels[c][i] = float(total / double(from.size()));
       }
-    if (newly.empty()) break;
-    for (size_t k = 0; k < newly.size(); ++k) {
-      filled[newly[k]] = 1;
-      for (size_t c = 0; c < channels.size(); ++c) channels[c][newly[k]] = values[k * channels.size() + c];
+      filled[i] = 1, changed = true;
     }
+    if (!changed) break;
   }
 }
 
