@@ -30,7 +30,7 @@ echo "| run | load | edits | lighting | probes | exitance | write | whole call s
 echo "|---|---|---|---|---|---|---|---|---|---|" >> $S
 for rep in $(seq 1 ${REPS:-3}); do
   relight $W/runtime/bin/exitance-relight after $rep
-  [ -x $W/before/exitance-relight ] && relight $W/before/exitance-relight before $rep
+  if [ -x $W/before/exitance-relight ]; then relight $W/before/exitance-relight before $rep; fi
 done
 echo >> $S
 echo "bench_host_stages (host part of load and write, no device):" >> $S
