@@ -16,28 +16,18 @@
 #include <iostream>
 #include <vector>
 
-#include <sys/resource.h>
 
 #include "exitance/bake/command/bake_stages.h"
 
 #include "wall_clock.h"
 
 using namespace exitance;
+using exitance::bench::cpu_seconds;
+using exitance::bench::Digest;
 using exitance::bench::median;
 using exitance::bench::seconds_since;
 
 namespace {
-
-// FNV-1a over bytes: equal digests on both builds mean (all but surely) equal results.
-struct Digest {
-  uint64_t value = 0xcbf29ce484222325ull;
-  void add(const void* data, size_t size) {
-    const auto* bytes = static_cast<const uint8_t*>(data);
-    for (size_t i = 0; i < size; ++i) value = (value ^ bytes[i]) * 0x100000001b3ull;
-  }
-  template <class T>
-  void add_value(const T& v) { add(&v, sizeof v); }
-};
 
 uint64_t texel_digest(const TexelGBuffer& gbuffer) {
   Digest d;
@@ -48,12 +38,6 @@ uint64_t texel_digest(const TexelGBuffer& gbuffer) {
   }
   for (const AtlasPage& p : gbuffer.pages) d.add(p.coverage.data(), p.coverage.size() * sizeof(float));
   return d.value;
-}
-
-double cpu_seconds() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) + 1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
 }
 
 struct Seconds {

@@ -6,15 +6,30 @@
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
+#include <ImfThreading.h>
 
+#include <algorithm>
 #include <stdexcept>
+#include <thread>
 
 namespace exitance::formats {
 
-void write_lightmap_exr(const std::string& path, const LightmapImage& image) {
+int lightmap_exr_threads() {
+  static const int threads = [] {
+    const int hardware = int(std::max(1u, std::thread::hardware_concurrency()));
+    if (Imf::globalThreadCount() < hardware) Imf::setGlobalThreadCount(hardware);
+    return hardware;
+  }();
+  return threads;
+}
+
+void write_lightmap_exr(const std::string& path, const LightmapImage& image, int threads) {
   try {
     Imf::Header header(image.width, image.height);
     header.compression() = Imf::ZIP_COMPRESSION;
+    // zlib level 1: a third less CPU than OpenEXR 3.1's default 4 for 4-11 % larger files, the
+    // same pixels (bench_exr_compression, bench/results/host-stages.md).
+    header.zipCompressionLevel() = 1;
     header.insert("generator", Imf::StringAttribute("exitance"));
     Imf::FrameBuffer frame;
     for (const auto& [name, data] : image.channels) {
@@ -24,7 +39,7 @@ void write_lightmap_exr(const std::string& path, const LightmapImage& image) {
       frame.insert(name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(data.data())), sizeof(float),
                                     sizeof(float) * size_t(image.width)));
     }
-    Imf::OutputFile file(path.c_str(), header);
+    Imf::OutputFile file(path.c_str(), header, threads < 0 ? lightmap_exr_threads() : threads);
     file.setFrameBuffer(frame);
     file.writePixels(image.height);
   } catch (const std::exception& e) {
@@ -32,9 +47,9 @@ void write_lightmap_exr(const std::string& path, const LightmapImage& image) {
   }
 }
 
-LightmapImage read_lightmap_exr(const std::string& path) {
+LightmapImage read_lightmap_exr(const std::string& path, int threads) {
   try {
-    Imf::InputFile file(path.c_str());
+    Imf::InputFile file(path.c_str(), threads < 0 ? lightmap_exr_threads() : threads);
     const Imath::Box2i window = file.header().dataWindow();
     LightmapImage image;
     image.width = window.max.x - window.min.x + 1;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 
 #include "exitance/bake/layout/atlas_layout.h"
 #include "exitance/bake/raster/cell_rejection.h"
@@ -120,6 +121,61 @@ TEST(Dilation, FillsGutterFromNeighbours) {
   std::vector<float> value = {0, 0, 0, 0, 5, 0, 0, 0, 0};
   dilate_into_gutter(3, 3, coverage, {value.data()}, 2);
   for (float v : value) EXPECT_EQ(v, 5.0f);
+}
+
+// The ring-by-ring fill computed plainly on one thread, the reference the parallel dilate_into must
+// match bit for bit: per pass, every fillable unfilled texel's filled 8-neighbours (row by row, the
+// order the sums run in) averaged in double against the state before the pass.
+void serial_dilate(int width, int height, std::vector<uint8_t> filled, const std::vector<uint8_t>& fillable,
+                   const std::vector<float*>& channels, int passes) {
+  static const int offsets[8][2] = {{-1, -1}, {0, -1}, {1, -1}, {-1, 0}, {1, 0}, {-1, 1}, {0, 1}, {1, 1}};
+  for (int pass = 0; passes < 0 || pass < passes; ++pass) {
+    std::vector<uint8_t> before = filled;
+    std::vector<std::vector<float>> old(channels.size());
+    for (size_t c = 0; c < channels.size(); ++c) old[c].assign(channels[c], channels[c] + size_t(width) * size_t(height));
+    bool changed = false;
+    for (size_t i = 0; i < before.size(); ++i) {
+      if (before[i] || !fillable[i]) continue;
+      const int x = int(i % size_t(width)), y = int(i / size_t(width));
+      std::vector<size_t> from;
+      for (const auto& o : offsets)
+        if (x + o[0] >= 0 && x + o[0] < width && y + o[1] >= 0 && y + o[1] < height &&
+            before[size_t(y + o[1]) * size_t(width) + size_t(x + o[0])])
+          from.push_back(size_t(y + o[1]) * size_t(width) + size_t(x + o[0]));
+      if (from.empty()) continue;
+      for (size_t c = 0; c < channels.size(); ++c) {
+        double total = 0;
+        for (size_t j : from) total += old[c][j];
+        channels[c][i] = float(total / double(from.size()));
+      }
+      filled[i] = 1, changed = true;
+    }
+    if (!changed) break;
+  }
+}
+
+TEST(Dilation, ParallelRowsMatchTheSerialFill) {
+  // Big enough for several row chunks; scattered covered texels and a fillable mask with holes, so
+  // rings meet across chunk borders; 4 passes and "until nothing changes" (-1).
+  const int width = 700, height = 1100;
+  const size_t n = size_t(width) * size_t(height);
+  Pcg32 rng = pcg_init(7, 0, 0);
+  std::vector<uint8_t> filled(n), fillable(n);
+  std::vector<float> a(n), b(n);
+  for (size_t i = 0; i < n; ++i) {
+    filled[i] = pcg_uniform(rng) < 0.05f;
+    fillable[i] = pcg_uniform(rng) < 0.9f;
+    a[i] = filled[i] ? pcg_uniform(rng) * 100.0f : 0.0f;
+    b[i] = filled[i] ? pcg_uniform(rng) : 0.0f;
+  }
+  for (int passes : {4, -1}) {
+    std::vector<float> a_serial = a, b_serial = b, a_parallel = a, b_parallel = b;
+    serial_dilate(width, height, filled, fillable, {a_serial.data(), b_serial.data()}, passes);
+    dilate_into(width, height, filled, fillable, {a_parallel.data(), b_parallel.data()}, passes);
+    EXPECT_EQ(std::memcmp(a_serial.data(), a_parallel.data(), n * sizeof(float)), 0) << passes;
+    EXPECT_EQ(std::memcmp(b_serial.data(), b_parallel.data(), n * sizeof(float)), 0) << passes;
+    EXPECT_NE(std::memcmp(a.data(), a_parallel.data(), n * sizeof(float)), 0);  // it did fill something
+  }
 }
 
 TEST(Sampling, CosineHemisphereIsNormalisedAndUpward) {

@@ -1,8 +1,13 @@
 #include "exitance/runtime/bundle/lightmap_assembly.h"
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <string>
+#include <thread>
 #include <utility>
+
+#include "exitance/runtime/core/parallel_chunks.h"
 
 namespace exitance {
 
@@ -15,35 +20,65 @@ void dilate_into_gutter(int width, int height, const std::vector<float>& coverag
 
 void dilate_into(int width, int height, std::vector<uint8_t> filled, const std::vector<uint8_t>& fillable,
                  std::vector<float*> channels, int passes) {
-  std::vector<size_t> newly;
-  std::vector<float> values;
+  // Each pass reads the state the previous one left (what it fills is applied after the whole page
+  // is scanned), so rows can be scanned in parallel: each chunk of rows keeps its own list, and the
+  // lists are applied after every chunk is done. Per texel, the same sums in the same order.
+  const size_t channel_count = channels.size();
+  struct Fill {
+    std::vector<size_t> newly;
+    std::vector<float> values;
+  };
+  const size_t rows = size_t(std::max(height, 0));
+  const size_t min_rows = std::max<size_t>(1, 65536 / std::max<size_t>(size_t(std::max(width, 1)), 1));
+  std::vector<Fill> fills;
   for (int pass = 0; passes < 0 || pass < passes; ++pass) {
-    newly.clear();
-    values.clear();
-    for (int y = 0; y < height; ++y)
-      for (int x = 0; x < width; ++x) {
-        const size_t i = size_t(y) * size_t(width) + size_t(x);
-        if (filled[i] || !fillable[i]) continue;
-        std::vector<double> sum(channels.size(), 0.0);
-        int n = 0;
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int nx = x + dx, ny = y + dy;
-            if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
-            const size_t j = size_t(ny) * size_t(width) + size_t(nx);
-            if (!filled[j]) continue;
-            for (size_t c = 0; c < channels.size(); ++c) sum[c] += channels[c][j];
-            ++n;
+    const size_t chunks = std::clamp<size_t>(rows / min_rows, 1, std::max<size_t>(std::thread::hardware_concurrency(), 1));
+    fills.assign(chunks, Fill{});
+    const size_t per_chunk = (rows + chunks - 1) / chunks;
+    for_each_chunk(
+        chunks,
+        [&](size_t first_chunk, size_t end_chunk) {
+          std::vector<double> sum(channel_count);
+          for (size_t chunk = first_chunk; chunk < end_chunk; ++chunk) {
+            Fill& fill = fills[chunk];
+            const int y_end = int(std::min(rows, (chunk + 1) * per_chunk));
+            for (int y = int(chunk * per_chunk); y < y_end; ++y)
+              for (int x = 0; x < width; ++x) {
+                const size_t i = size_t(y) * size_t(width) + size_t(x);
+                if (filled[i] || !fillable[i]) continue;
+                std::fill(sum.begin(), sum.end(), 0.0);
+                int n = 0;
+                for (int dy = -1; dy <= 1; ++dy)
+                  for (int dx = -1; dx <= 1; ++dx) {
+                    const int nx = x + dx, ny = y + dy;
+                    if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
+                    const size_t j = size_t(ny) * size_t(width) + size_t(nx);
+                    if (!filled[j]) continue;
+                    for (size_t c = 0; c < channel_count; ++c) sum[c] += channels[c][j];
+                    ++n;
+                  }
+                if (n == 0) continue;
+                fill.newly.push_back(i);
+                for (double v : sum) fill.values.push_back(float(v / n));
+              }
           }
-        if (n == 0) continue;
-        newly.push_back(i);
-        for (double s : sum) values.push_back(float(s / n));
-      }
-    if (newly.empty()) break;
-    for (size_t k = 0; k < newly.size(); ++k) {
-      filled[newly[k]] = 1;
-      for (size_t c = 0; c < channels.size(); ++c) channels[c][newly[k]] = values[k * channels.size() + c];
-    }
+        },
+        1);
+    bool any = false;
+    for (const Fill& fill : fills) any = any || !fill.newly.empty();
+    if (!any) break;
+    for_each_chunk(
+        chunks,
+        [&](size_t first_chunk, size_t end_chunk) {
+          for (size_t chunk = first_chunk; chunk < end_chunk; ++chunk) {
+            const Fill& fill = fills[chunk];
+            for (size_t k = 0; k < fill.newly.size(); ++k) {
+              filled[fill.newly[k]] = 1;
+              for (size_t c = 0; c < channel_count; ++c) channels[c][fill.newly[k]] = fill.values[k * channel_count + c];
+            }
+          }
+        },
+        1);
   }
 }
 
@@ -68,38 +103,76 @@ std::vector<formats::LightmapImage> assemble_lightmap_pages(const TexelGBuffer& 
     pages[p].channels["valid"].assign(n, 0.0f);
   }
   const double error_floor = estimate.error_floor();
-  // Per page, the texels to fill from traced neighbours before the gutter is dilated.
-  std::vector<std::vector<uint8_t>> skipped(pages.size());
-  for (size_t i = 0; i < gbuffer.texels.size(); ++i) {
-    const LiveTexel& texel = gbuffer.texels[i];
-    formats::LightmapImage& page = pages[texel.page];
-    const size_t at = size_t(texel.y) * size_t(page.width) + size_t(texel.x);
-    if (!untraced.empty() && untraced[i]) {
-      if (skipped[texel.page].empty()) skipped[texel.page].assign(page.channels["valid"].size(), 0);
-      skipped[texel.page][at] = 1;
-      continue;
-    }
-    page.channels["valid"][at] = 1.0f;
-    const Vec3 total = estimate.mean_total(i), direct = estimate.mean_direct(i);
-    const Vec3 indirect = total - direct;
-    const char* names[3] = {"R", "G", "B"};
+  // Per page, the channels' arrays looked up once (not by name per texel).
+  struct PageChannels {
+    int width = 0;
+    float* total[3];
+    float* direct[3];
+    float* indirect[3];
+    float* error = nullptr;
+    float* valid = nullptr;
+    std::vector<std::array<float*, 3>> bounces;
+    std::array<float*, 3> sh1[3] = {};
+  };
+  std::vector<PageChannels> targets(pages.size());
+  const char* names[3] = {"R", "G", "B"};
+  for (size_t p = 0; p < pages.size(); ++p) {
+    PageChannels& t = targets[p];
+    auto& channels = pages[p].channels;
+    t.width = pages[p].width;
     for (int c = 0; c < 3; ++c) {
-      page.channels[names[c]][at] = total[c];
-      page.channels[std::string("direct.") + names[c]][at] = direct[c];
-      page.channels[std::string("indirect.") + names[c]][at] = std::max(0.0f, indirect[c]);
+      t.total[c] = channels[names[c]].data();
+      t.direct[c] = channels[std::string("direct.") + names[c]].data();
+      t.indirect[c] = channels[std::string("indirect.") + names[c]].data();
     }
-    page.channels["error.Y"][at] = estimate.relative_standard_error(i, error_floor);
+    t.error = channels["error.Y"].data();
+    t.valid = channels["valid"].data();
     if (options.bounce_layers)
       for (int k = 0; k < estimate.recorded_bounces; ++k) {
-        const Vec3 b = estimate.mean_bounce(k, i);
-        for (int c = 0; c < 3; ++c) page.channels["bounce" + std::to_string(k) + "." + names[c]][at] = b[c];
+        std::array<float*, 3>& b = t.bounces.emplace_back();
+        for (int c = 0; c < 3; ++c) b[c] = channels["bounce" + std::to_string(k) + "." + names[c]].data();
       }
     if (estimate.has_sh1())
-      for (int axis = 0; axis < 3; ++axis) {
-        const Vec3 l1 = estimate.mean_sh1(axis, i);
-        for (int c = 0; c < 3; ++c) page.channels[std::string("sh1.") + "xyz"[axis] + "." + names[c]][at] = l1[c];
-      }
+      for (int axis = 0; axis < 3; ++axis)
+        for (int c = 0; c < 3; ++c) t.sh1[axis][c] = channels[std::string("sh1.") + "xyz"[axis] + "." + names[c]].data();
   }
+  // Per page, the texels to fill from traced neighbours before the gutter is dilated.
+  std::vector<std::vector<uint8_t>> skipped(pages.size());
+  if (!untraced.empty())
+    for (size_t i = 0; i < gbuffer.texels.size(); ++i) {
+      if (!untraced[i]) continue;
+      const LiveTexel& texel = gbuffer.texels[i];
+      std::vector<uint8_t>& page_skipped = skipped[texel.page];
+      if (page_skipped.empty()) page_skipped.assign(size_t(pages[texel.page].width) * size_t(pages[texel.page].height), 0);
+      page_skipped[size_t(texel.y) * size_t(pages[texel.page].width) + size_t(texel.x)] = 1;
+    }
+  // Every live texel writes its own cell only: the texels run in parallel.
+  for_each_chunk(gbuffer.texels.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      if (!untraced.empty() && untraced[i]) continue;
+      const LiveTexel& texel = gbuffer.texels[i];
+      const PageChannels& t = targets[texel.page];
+      const size_t at = size_t(texel.y) * size_t(t.width) + size_t(texel.x);
+      t.valid[at] = 1.0f;
+      const Vec3 total = estimate.mean_total(i), direct = estimate.mean_direct(i);
+      const Vec3 indirect = total - direct;
+      for (int c = 0; c < 3; ++c) {
+        t.total[c][at] = total[c];
+        t.direct[c][at] = direct[c];
+        t.indirect[c][at] = std::max(0.0f, indirect[c]);
+      }
+      t.error[at] = estimate.relative_standard_error(i, error_floor);
+      for (size_t k = 0; k < t.bounces.size(); ++k) {
+        const Vec3 b = estimate.mean_bounce(int(k), i);
+        for (int c = 0; c < 3; ++c) t.bounces[k][c][at] = b[c];
+      }
+      if (estimate.has_sh1())
+        for (int axis = 0; axis < 3; ++axis) {
+          const Vec3 l1 = estimate.mean_sh1(axis, i);
+          for (int c = 0; c < 3; ++c) t.sh1[axis][c][at] = l1[c];
+        }
+    }
+  });
   for (size_t p = 0; p < pages.size(); ++p) {
     std::vector<float*> channels;
     for (auto& [name, data] : pages[p].channels)

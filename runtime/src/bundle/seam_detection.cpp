@@ -5,7 +5,6 @@
 #include <atomic>
 #include <cmath>
 #include <thread>
-#include <unordered_map>
 
 #include "exitance/runtime/texel_surface.h"
 
@@ -13,27 +12,46 @@ namespace exitance {
 namespace {
 
 // Welds corners by position: a grid of cells one tolerance wide, each corner joined to an earlier
-// point within the tolerance in its own or a neighbouring cell.
+// point within the tolerance in its own or a neighbouring cell. Cells are found by a 64-bit hash of
+// their coordinates (cells whose hashes collide share a list, as they would share a map entry); each
+// cell lists its points in the order they were added, so the first match is the same whatever the
+// table's layout. An open-addressing table with the lists threaded through the points (27 lookups
+// per corner: a node-based map spent most of seam detection there).
 class PositionWeld {
  public:
-  explicit PositionWeld(float tolerance) : tolerance_(tolerance) {}
+  explicit PositionWeld(float tolerance, size_t expected_points = 0) : tolerance_(tolerance) {
+    size_t capacity = 64;
+    while (capacity < 2 * expected_points) capacity *= 2;
+    slots_.assign(capacity, Slot{});
+  }
 
   uint32_t id(Vec3 p) {
     const std::array<int64_t, 3> cell = cell_of(p);
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
-          auto found = cells_.find(key({cell[0] + dx, cell[1] + dy, cell[2] + dz}));
-          if (found == cells_.end()) continue;
-          for (uint32_t candidate : found->second)
+          const Slot* found = find(key({cell[0] + dx, cell[1] + dy, cell[2] + dz}));
+          if (!found) continue;
+          for (uint32_t candidate = found->first; candidate != kNone; candidate = next_[candidate])
             if (length(points_[candidate] - p) <= tolerance_) return candidate;
         }
+    const uint32_t added = uint32_t(points_.size());
     points_.push_back(p);
-    cells_[key(cell)].push_back(uint32_t(points_.size() - 1));
-    return uint32_t(points_.size() - 1);
+    next_.push_back(kNone);
+    Slot& slot = insert(key(cell));
+    if (slot.first == kNone) slot.first = added;
+    else next_[slot.last] = added;
+    slot.last = added;
+    return added;
   }
 
  private:
+  static constexpr uint32_t kNone = ~0u;
+  struct Slot {
+    uint64_t key = 0;
+    uint32_t first = kNone, last = kNone;  // first == kNone: empty
+  };
+
   std::array<int64_t, 3> cell_of(Vec3 p) const {
     return {int64_t(std::floor(p.x / tolerance_)), int64_t(std::floor(p.y / tolerance_)),
             int64_t(std::floor(p.z / tolerance_))};
@@ -41,10 +59,43 @@ class PositionWeld {
   static uint64_t key(const std::array<int64_t, 3>& c) {
     return (uint64_t(c[0]) * 73856093u) ^ (uint64_t(c[1]) * 19349663u) ^ (uint64_t(c[2]) * 83492791u);
   }
+  size_t home(uint64_t k) const { return size_t((k * 0x9E3779B97F4A7C15ull) >> 20) & (slots_.size() - 1); }
+
+  const Slot* find(uint64_t k) const {
+    for (size_t i = home(k);; i = (i + 1) & (slots_.size() - 1)) {
+      const Slot& slot = slots_[i];
+      if (slot.first == kNone) return nullptr;
+      if (slot.key == k) return &slot;
+    }
+  }
+  Slot& insert(uint64_t k) {
+    if (2 * (used_ + 1) > slots_.size()) grow();
+    for (size_t i = home(k);; i = (i + 1) & (slots_.size() - 1)) {
+      Slot& slot = slots_[i];
+      if (slot.first == kNone) {
+        slot.key = k;
+        ++used_;
+        return slot;
+      }
+      if (slot.key == k) return slot;
+    }
+  }
+  void grow() {
+    std::vector<Slot> old = std::move(slots_);
+    slots_.assign(old.size() * 2, Slot{});
+    for (const Slot& slot : old) {
+      if (slot.first == kNone) continue;
+      size_t i = home(slot.key);
+      while (slots_[i].first != kNone) i = (i + 1) & (slots_.size() - 1);
+      slots_[i] = slot;
+    }
+  }
 
   float tolerance_;
   std::vector<Vec3> points_;
-  std::unordered_map<uint64_t, std::vector<uint32_t>> cells_;
+  std::vector<uint32_t> next_;  // the next point of the same cell list, in the order added
+  std::vector<Slot> slots_;
+  size_t used_ = 0;
 };
 
 // One triangle's edge from corner `from` to corner `to` (indices into the scene's corner arrays).
@@ -71,7 +122,7 @@ std::vector<SeamEdge> instance_seams(const Scene& scene, const AtlasLayout& layo
   for (size_t c = first_corner; c < end_corner; ++c) lo = min(lo, scene.positions[c]), hi = max(hi, scene.positions[c]);
   const float diagonal = length(hi - lo);
   if (!(diagonal > 0)) return seams;
-  PositionWeld weld(settings.weld_tolerance * diagonal);
+  PositionWeld weld(settings.weld_tolerance * diagonal, end_corner - first_corner);
   std::vector<uint32_t> welded(end_corner - first_corner);
   for (size_t c = first_corner; c < end_corner; ++c) welded[c - first_corner] = weld.id(scene.positions[c]);
   std::vector<Vec2> texel(end_corner - first_corner);
