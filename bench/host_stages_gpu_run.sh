@@ -33,6 +33,11 @@ for rep in $(seq 1 ${REPS:-3}); do
   if [ -x $W/before/exitance-relight ]; then relight $W/before/exitance-relight before $rep; fi
 done
 echo >> $S
+echo "load split (seconds.load_split: RefreshSession::open's parts):" >> $S
+for j in $W/after_*.json; do
+  python3 -c "import json,sys; r=json.load(open(sys.argv[1])); print(sys.argv[1].split('/')[-1], {k: round(v, 3) for k, v in r['seconds'].get('load_split', {}).items()})" $j >> $S
+done
+echo >> $S
 echo "bench_host_stages (host part of load and write, no device):" >> $S
 $W/bench_host_stages $W/building.bake --out $W/hs.bake --repeat 3 >> $S
 cat $S

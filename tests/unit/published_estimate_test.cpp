@@ -84,6 +84,12 @@ TEST(PublishedEstimate, ARestartKeepsThePreviousValueUntilTheRefreshedOneIsMoreP
   // counts go, the variance from 8 samples being too uncertain): kept.
   const LightmapEstimate sixteen = texel({1, 3, 1, 3, 1, 3, 1, 3, 1, 3, 1, 3, 1, 3, 1, 3});  // V = 1/15
   EXPECT_EQ(publish_restart(sixteen, texel({2, 2, 2, 2, 2, 2, 2, 2.5})).texels[0].total[0], sixteen.texels[0].total[0]);
+  // Eight refreshed samples that happen to agree (3.5 each: no variance of their own) against a kept
+  // value of 16 whose samples vary: the refreshed variance is taken as at least what the kept
+  // samples predict for 8 (2/15), so 3 * 1.5^2 = 6.75 < 4.53^2 * 3 * (1/15 + 2/15) = 12.3: kept.
+  EXPECT_EQ(publish_restart(sixteen, texel({3.5, 3.5, 3.5, 3.5, 3.5, 3.5, 3.5, 3.5})).texels[0].total[0], sixteen.texels[0].total[0]);
+  // Far enough (mean 5: 27 > 12.3): refreshed.
+  EXPECT_NEAR(publish_restart(sixteen, texel({5, 5, 5, 5, 5, 5, 5, 5})).mean_total(0)[0], 5.0, 1e-6);
   EXPECT_EQ(publish_restart(four, texel({9, 11, 10})).texels[0].total[0], four.texels[0].total[0]);
   // Same mean, larger variance (V = 4/7): kept.
   EXPECT_EQ(publish_restart(previous, texel({0, 4, 0, 4, 0, 4, 0, 4})).texels[0].total[0], previous.texels[0].total[0]);

@@ -74,6 +74,7 @@ struct RefreshSession::State {
   std::vector<WorldBox> instance_boxes;
   WorldBox uninstanced_box;
   EditTimings edit_timings;
+  OpenTimings open_timings;
   uint32_t near_samples = 0, far_samples = 0, all_samples = 0;
   // What texels showed before the last edit (published_lightmap keeps it until the refreshed
   // estimate is better; published_estimate.h); at open, the bundle's baked lightmap. In device
@@ -147,6 +148,15 @@ void index_for_edits(RefreshSession::State& s) {
 
 std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_folder, const RefreshSessionOptions& options) {
   auto state = std::make_unique<State>();
+  using Clock = std::chrono::steady_clock;
+  Clock::time_point lap = Clock::now();
+  auto since = [&lap] {
+    const Clock::time_point now = Clock::now();
+    const double seconds = std::chrono::duration<double>(now - lap).count();
+    lap = now;
+    return seconds;
+  };
+  OpenTimings& timings = state->open_timings;
   const fs::path bundle(bundle_folder);
   state->bundle = bundle_folder;
   state->manifest = read_manifest(bundle);
@@ -163,6 +173,7 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   } catch (const formats::FormatError& e) {
     throw BundleInputError(e.what());
   }
+  timings.read = since();
 
   // Settings absent from an older manifest take bake's defaults (formats::BakeSettings).
   const formats::BakeSettings baked = manifest.settings.value_or(formats::BakeSettings{});
@@ -181,13 +192,17 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   } catch (const std::invalid_argument& e) {
     throw BundleInputError((bundle / manifest.scene->file).string() + ": " + e.what());
   }
+  timings.lighting_scene = since();
   state->integrator = VulkanIntegrator::create(state->lighting, options.device);
+  timings.device = since();
   state->priority_samples = options.priority_samples;
   state->texel_grid = TexelGrid(state->persisted.gbuffer);
   index_for_edits(*state);
   state->all_texels.resize(state->persisted.gbuffer.texels.size());
   for (size_t i = 0; i < state->all_texels.size(); ++i) state->all_texels[i] = uint32_t(i);
+  timings.indices = since();
   state->integrator->start_progressive(state->persisted.gbuffer, settings);
+  timings.texels = since();
   if (options.start_from_baked) {
     try {
       std::optional<LightmapEstimate> baked = read_baked_lightmap(
@@ -198,9 +213,11 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
       throw BundleInputError(e.what());
     }
   }
+  timings.baked = since();
   // The publishing pipeline made (on lavapipe compiled) and a published estimate's device memory
   // allocated here, not in the first edit (which reuses it).
   state->integrator->publish(PublishMode::Accumulation, nullptr, nullptr);
+  timings.publish = since();
   return std::unique_ptr<RefreshSession>(new RefreshSession(std::move(state)));
 }
 
@@ -343,6 +360,7 @@ void RefreshSession::restart(bool texels_as_before) {
 }
 
 const EditTimings& RefreshSession::last_edit_timings() const { return state_->edit_timings; }
+const OpenTimings& RefreshSession::open_timings() const { return state_->open_timings; }
 
 const std::vector<uint32_t>& RefreshSession::texels_near_last_edit() const { return state_->last_edit_near; }
 

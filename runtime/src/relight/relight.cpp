@@ -71,6 +71,10 @@ json relight_bundle(const RelightOptions& options) {
     throw RelightInputError(options.bundle + ": --guiding svo reads the bundle's svo.bin, which it has none of (baked with --voxel-resolution none)");
   const formats::BakeSettings baked = session->manifest().settings.value_or(formats::BakeSettings{});
   seconds["load"] = clock.lap();
+  const OpenTimings& opened = session->open_timings();
+  seconds["load_split"] = {{"read", opened.read},     {"lighting_scene", opened.lighting_scene}, {"device", opened.device},
+                           {"indices", opened.indices}, {"texels", opened.texels},               {"baked", opened.baked},
+                           {"publish", opened.publish}};
 
   json edits_report;
   if (!options.edits_file.empty()) {

@@ -5,8 +5,9 @@
 // refreshed estimate is unbiased but noisy. A texel keeps its previous value unless the refreshed
 // estimate is the more precise one (lower variance from at least as many samples) or differs from
 // it significantly: |D|^2 > k(n)^2 V_D, with D the difference of the two, V_D its variance
-// (variances of the mean, summed over the colour channels) and k(n) kSignificance widened for a
-// variance estimated from n samples (significance_for_samples).
+// (variances of the mean, summed over the colour channels; after a restart the refreshed part at
+// least what the kept samples' variance predicts for its sample count) and k(n) kSignificance
+// widened for a variance estimated from n samples (significance_for_samples).
 #ifndef EXITANCE_COMMON_PUBLISHING_RULE_H
 #define EXITANCE_COMMON_PUBLISHING_RULE_H
 #include "exitance/common/dialect.h"
@@ -64,7 +65,11 @@ EXITANCE_FN uint publish_after_restart(uint kept_samples, uint refreshed_samples
   if (refreshed_samples < max(2u, min(kRestartMinimumSamples, kept_samples))) return kPublishPrevious;
   if (kept_samples < 2u) return kPublishRefreshed;  // one kept sample has no variance: two refreshed ones are better
   double k = significance_for_samples(min(kept_samples, refreshed_samples));
-  bool significant = difference_squared > k * k * (kept_variance + refreshed_variance);
+  // Where the edit changed nothing, the refreshed estimate's per-sample variance is the kept one's,
+  // which many kept samples measure far better than a few refreshed ones (those miss the rare bright
+  // paths): the refreshed variance is taken as at least the kept per-sample variance over its samples.
+  double expected_variance = kept_variance * double(kept_samples) / double(refreshed_samples);
+  bool significant = difference_squared > k * k * (kept_variance + max(refreshed_variance, expected_variance));
   bool more_precise = refreshed_samples >= kept_samples && refreshed_variance < kept_variance;
   return (more_precise || significant) ? kPublishRefreshed : kPublishPrevious;
 }

@@ -88,6 +88,18 @@ struct EditTimings {
   double device_wait = 0;
 };
 
+// Where RefreshSession::open spent its time, in seconds (benchmarks; exitance-relight --json
+// seconds.load_split).
+struct OpenTimings {
+  double read = 0;            // manifest, scene.bin (read and restored), svo.bin
+  double lighting_scene = 0;  // the lighting scene (records, light CDFs) over scene.bin's BVH
+  double device = 0;          // the Vulkan backend: device, kernels compiled (or found in the driver's cache), scene uploaded
+  double indices = 0;         // the texel grid, each instance's texels, the BVH links, the texel list
+  double texels = 0;          // the texels' start points uploaded, the accumulation cleared
+  double baked = 0;           // the baked lightmap read (EXR pages) and uploaded
+  double publish = 0;         // the first publish (pipeline and memory the first edit reuses)
+};
+
 class RefreshSession {
  public:
   // Reads manifest.json, scene.bin and (when listed) svo.bin from `bundle`, builds the lighting
@@ -116,6 +128,7 @@ class RefreshSession {
   // lightmap() is then that change; refreshed_lightmap() is base + change.
   EditEffects apply_edits(const std::vector<SceneEdit>& edits);
   const EditTimings& last_edit_timings() const;
+  const OpenTimings& open_timings() const;
   // Drops every accumulated sample; the next refresh starts at sample 0.
   void restart();
   RefreshReport refresh(const RefreshBudget& budget);
