@@ -182,26 +182,12 @@ void GpuScene::add_material_writes(const LightingScene& edited, std::vector<Cont
   grow(emitter_cdf_, edited.emitter_cdf.size() * sizeof(double));
   grow(emitter_triangles_, emitters.size() * 4);
   grow(surfaces_, surfaces.size() * sizeof(Vec4));
-  writes.reserve(writes.size() + 5);  // the reference below stays valid
-  auto whole = [&](const Buffer& dst, const void* data, size_t bytes) {
-    Context::RangeWrite& w = writes.emplace_back();
-    w.dst = &dst;
-    if (bytes > 0) w.ranges.push_back({0, bytes});
-    w.write = [data, bytes](char* staging) { std::memcpy(staging, data, bytes); };
-  };
-  whole(materials_, edited.materials.data(), edited.materials.size() * sizeof(GpuMaterial));
-  Context::RangeWrite& triangle_write = writes.emplace_back();
-  triangle_write.dst = &triangles_;
-  triangle_write.ranges = triangle_ranges(changed);
-  triangle_write.write = [&edited, ranges = triangle_write.ranges](char* staging) {
-    for (const ByteRange& r : ranges) {
-      std::memcpy(staging, reinterpret_cast<const char*>(edited.triangles.data()) + r.offset, size_t(r.size));
-      staging += r.size;
-    }
-  };
-  whole(emitter_cdf_, edited.emitter_cdf.data(), edited.emitter_cdf.size() * sizeof(double));
-  whole(emitter_triangles_, emitters.data(), emitters.size() * 4);
-  whole(surfaces_, surfaces.data(), surfaces.size() * sizeof(Vec4));
+  using Write = Context::RangeWrite;
+  writes.push_back(Write::whole(materials_, edited.materials.data(), edited.materials.size() * sizeof(GpuMaterial)));
+  writes.push_back(Write::mirrored(triangles_, edited.triangles.data(), triangle_ranges(changed)));
+  writes.push_back(Write::whole(emitter_cdf_, edited.emitter_cdf.data(), edited.emitter_cdf.size() * sizeof(double)));
+  writes.push_back(Write::whole(emitter_triangles_, emitters.data(), emitters.size() * 4));
+  writes.push_back(Write::whole(surfaces_, surfaces.data(), surfaces.size() * sizeof(Vec4)));
 }
 
 void GpuScene::materials_uploaded(const LightingScene& edited) {
@@ -239,16 +225,11 @@ void GpuScene::update_lights(const LightingScene& edited) {
 void GpuScene::upload_punctual(const LightingScene& edited) { context_.write_ranges(punctual_writes(edited)); }
 
 std::vector<Context::RangeWrite> GpuScene::punctual_writes(const LightingScene& edited) const {
-  std::vector<Context::RangeWrite> writes;
-  writes.reserve(2);
-  auto whole = [&](const Buffer& dst, const void* data, size_t bytes) {
-    Context::RangeWrite& w = writes.emplace_back();
-    w.dst = &dst;
-    if (bytes > 0) w.ranges.push_back({0, bytes});
-    w.write = [data, bytes](char* staging) { std::memcpy(staging, data, bytes); };
-  };
-  if (punctual_count_ > 0) whole(punctual_lights_, edited.punctual_lights.data(), edited.punctual_lights.size() * sizeof(GpuPunctualLight));
-  whole(punctual_cdf_, edited.punctual_cdf.data(), edited.punctual_cdf.size() * sizeof(double));
+  using Write = Context::RangeWrite;
+  std::vector<Write> writes;
+  if (punctual_count_ > 0)
+    writes.push_back(Write::whole(punctual_lights_, edited.punctual_lights.data(), edited.punctual_lights.size() * sizeof(GpuPunctualLight)));
+  writes.push_back(Write::whole(punctual_cdf_, edited.punctual_cdf.data(), edited.punctual_cdf.size() * sizeof(double)));
   return writes;
 }
 
@@ -273,38 +254,22 @@ void GpuScene::update_moved_geometry(const LightingScene& edited, const Bvh4Link
   for (const auto& [first, end] : node_runs) nodes.insert(nodes.end(), edited.bvh.nodes.begin() + first, edited.bvh.nodes.begin() + end);
   const std::vector<uint32_t> words = node_words(Bvh4{nodes, {}, 1, 0}, quantized_);
   std::vector<Context::RangeWrite> writes;
-  writes.reserve(5);  // the references below stay valid
-  Context::RangeWrite& node_write = writes.emplace_back();
-  node_write.dst = &nodes_;
-  node_write.ranges = byte_ranges(node_runs, node_bytes);
-  node_write.write = [&](char* staging) { std::memcpy(staging, words.data(), words.size() * 4); };
+  writes.push_back({&nodes_, byte_ranges(node_runs, node_bytes), [&](char* staging) { std::memcpy(staging, words.data(), words.size() * 4); }});
   std::vector<uint32_t> slots;
   for (uint32_t t : moved_triangles)
     for (uint32_t k = links.triangle_slot_start[t]; k < links.triangle_slot_start[size_t(t) + 1]; ++k) slots.push_back(links.triangle_slots[k]);
   std::sort(slots.begin(), slots.end());
   constexpr size_t kSlotBytes = 3 * sizeof(Vec4);
   const std::vector<std::pair<uint32_t, uint32_t>> slot_runs = record_runs(slots, kSlotBytes);
-  Context::RangeWrite& leaf_write = writes.emplace_back();
-  leaf_write.dst = &leaf_triangles_;
-  leaf_write.ranges = byte_ranges(slot_runs, kSlotBytes);
-  leaf_write.write = [&](char* staging) {
-    for (const auto& [first, end] : slot_runs)
-      for (uint32_t s = first; s < end; ++s) {
-        Vec4 copy[3];
-        leaf_triangle_copy(edited, s, copy);
-        std::memcpy(staging, copy, sizeof(copy));
-        staging += sizeof(copy);
-      }
-  };
-  Context::RangeWrite& triangle_write = writes.emplace_back();
-  triangle_write.dst = &triangles_;
-  triangle_write.ranges = triangle_ranges(moved_triangles);
-  triangle_write.write = [&edited, ranges = triangle_write.ranges](char* staging) {
-    for (const ByteRange& r : ranges) {
-      std::memcpy(staging, reinterpret_cast<const char*>(edited.triangles.data()) + r.offset, size_t(r.size));
-      staging += r.size;
-    }
-  };
+  writes.push_back({&leaf_triangles_, byte_ranges(slot_runs, kSlotBytes), [&](char* staging) {
+                      for (const auto& [first, end] : slot_runs)
+                        for (uint32_t s = first; s < end; ++s, staging += kSlotBytes) {
+                          Vec4 copy[3];
+                          leaf_triangle_copy(edited, s, copy);
+                          std::memcpy(staging, copy, kSlotBytes);
+                        }
+                    }});
+  writes.push_back(Context::RangeWrite::mirrored(triangles_, edited.triangles.data(), triangle_ranges(moved_triangles)));
   for (Context::RangeWrite& w : punctual_writes(edited)) writes.push_back(std::move(w));
   std::vector<Vec4> surfaces;
   std::vector<uint32_t> emitters;

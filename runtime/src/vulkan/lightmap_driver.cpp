@@ -433,13 +433,8 @@ void LightmapDriver::update_texels(const TexelGBuffer& gbuffer, const std::vecto
   std::vector<uint32_t> sorted = texels;
   std::sort(sorted.begin(), sorted.end());
   sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
-  const std::vector<ByteRange> ranges = byte_ranges(record_runs(sorted, kPoint), kPoint);  // the host's start points fill the gaps
-  runner_.context().write_ranges(buffers.items.start_points, ranges, [&](char* staging) {
-    for (const ByteRange& r : ranges) {
-      std::memcpy(staging, reinterpret_cast<const char*>(a.start_points.data()) + r.offset, size_t(r.size));
-      staging += r.size;
-    }
-  });
+  // The host's start points fill the gaps between joined runs.
+  runner_.context().upload_ranges(buffers.items.start_points, a.start_points.data(), byte_ranges(record_runs(sorted, kPoint), kPoint));
 }
 
 uint64_t LightmapDriver::add_samples(uint32_t samples) {

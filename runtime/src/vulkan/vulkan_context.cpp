@@ -415,27 +415,33 @@ void Context::upload(const Buffer& dst, const void* data, VkDeviceSize size, VkD
   submit_and_wait(cmd);
 }
 
-void Context::upload_ranges(const Buffer& dst, const void* data, const std::vector<ByteRange>& ranges) {
-  write_ranges(dst, ranges, [&](char* staging) {
+Context::RangeWrite Context::RangeWrite::whole(const Buffer& dst, const void* data, size_t bytes) {
+  RangeWrite w;
+  w.dst = &dst;
+  if (bytes > 0) w.ranges.push_back({0, bytes});
+  w.write = [data, bytes](char* staging) { std::memcpy(staging, data, bytes); };
+  return w;
+}
+
+Context::RangeWrite Context::RangeWrite::mirrored(const Buffer& dst, const void* mirror, std::vector<ByteRange> ranges) {
+  RangeWrite w;
+  w.dst = &dst;
+  w.ranges = std::move(ranges);
+  w.write = [mirror, ranges = w.ranges](char* staging) {
     for (const ByteRange& r : ranges) {
-      std::memcpy(staging, static_cast<const char*>(data) + r.offset, size_t(r.size));
+      std::memcpy(staging, static_cast<const char*>(mirror) + r.offset, size_t(r.size));
       staging += r.size;
     }
-  });
+  };
+  return w;
+}
+
+void Context::upload_ranges(const Buffer& dst, const void* data, const std::vector<ByteRange>& ranges) {
+  write_ranges({RangeWrite::mirrored(dst, data, ranges)});
 }
 
 void Context::write_ranges(const Buffer& dst, const std::vector<ByteRange>& ranges, const std::function<void(char*)>& write) {
-  VkDeviceSize packed = 0;
-  const std::vector<VkBufferCopy> regions = staging_regions(ranges, /*from_staging=*/true, packed);
-  if (packed == 0) return;
-  Buffer own;
-  bool leased = false;
-  const Buffer& staging = staging_for(packed, own, leased);
-  StagingLease lease{small_staging_busy_, leased};
-  write(static_cast<char*>(staging.mapped()));
-  VkCommandBuffer cmd = begin();
-  vkCmdCopyBuffer(cmd, staging.handle(), dst.handle(), uint32_t(regions.size()), regions.data());
-  submit_and_wait(cmd);
+  write_ranges({RangeWrite{&dst, ranges, write}});
 }
 
 void Context::write_ranges(const std::vector<RangeWrite>& writes) {

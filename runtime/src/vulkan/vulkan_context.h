@@ -102,6 +102,10 @@ class Context {
     const Buffer* dst = nullptr;
     std::vector<ByteRange> ranges;
     std::function<void(char*)> write;  // fills the ranges' bytes, packed in order
+    // The first `bytes` of `dst` from `data` (which must outlive the write).
+    static RangeWrite whole(const Buffer& dst, const void* data, size_t bytes);
+    // The `ranges` of `dst` from the same ranges of `mirror`, a host copy of it (which must outlive the write).
+    static RangeWrite mirrored(const Buffer& dst, const void* mirror, std::vector<ByteRange> ranges);
   };
   void write_ranges(const std::vector<RangeWrite>& writes);
   void download(const Buffer& src, void* data, VkDeviceSize size, VkDeviceSize offset = 0);
