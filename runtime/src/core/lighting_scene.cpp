@@ -137,6 +137,18 @@ void build_punctual_distribution(LightingScene& lighting) {
   lighting.punctual_cdf = padded_cdf(Distribution1D(powers));
 }
 
+// The refresh_*_from_source functions' checks: as many records in the source as in the lighting
+// scene, and every listed index within them.
+void check_source_indices(const char* function, const char* what, size_t source_count, size_t lighting_count,
+                          const std::vector<uint32_t>& indices) {
+  if (source_count != lighting_count)
+    throw std::invalid_argument(std::string(function) + ": the source has " + std::to_string(source_count) + " " + what +
+                                "s, the lighting scene " + std::to_string(lighting_count));
+  for (uint32_t i : indices)
+    if (i >= source_count)
+      throw std::out_of_range(std::string(function) + ": " + what + " " + std::to_string(i) + " of " + std::to_string(source_count));
+}
+
 // Edits copy the source Scene (copy on write): the CPU reference, other LightingScenes and the
 // offline stage may share it, and it is immutable for them.
 Scene& writable_source(LightingScene& lighting) {
@@ -205,22 +217,13 @@ void set_material(LightingScene& lighting, uint32_t index, const Material& mater
   if (index >= lighting.materials.size())
     throw std::out_of_range("set_material: material " + std::to_string(index) + " of " +
                             std::to_string(lighting.materials.size()));
-  Scene& scene = writable_source(lighting);
-  scene.materials[index] = material;
-  lighting.materials[index] = material_record(material);
-  lighting.textured = !scene.vertex_color.empty();
-  for (const Material& m : scene.materials) lighting.textured = lighting.textured || varies_per_point(m);
-  build_emitter_distribution(lighting);
+  writable_source(lighting).materials[index] = material;
+  refresh_materials_from_source(lighting, {index});
 }
 
 void refresh_lights_from_source(LightingScene& lighting, const std::vector<uint32_t>& lights, bool sky) {
   const Scene& scene = *lighting.source;
-  if (scene.lights.size() != lighting.punctual_lights.size())
-    throw std::invalid_argument("refresh_lights_from_source: the source has " + std::to_string(scene.lights.size()) +
-                                " lights, the lighting scene " + std::to_string(lighting.punctual_lights.size()));
-  for (uint32_t l : lights)
-    if (l >= scene.lights.size())
-      throw std::out_of_range("refresh_lights_from_source: light " + std::to_string(l) + " of " + std::to_string(scene.lights.size()));
+  check_source_indices("refresh_lights_from_source", "light", scene.lights.size(), lighting.punctual_lights.size(), lights);
   for (uint32_t l : lights) lighting.punctual_lights[l] = punctual_record(scene.lights[l]);
   if (!lights.empty()) build_punctual_distribution(lighting);
   if (sky) {
@@ -231,13 +234,7 @@ void refresh_lights_from_source(LightingScene& lighting, const std::vector<uint3
 
 void refresh_materials_from_source(LightingScene& lighting, const std::vector<uint32_t>& materials) {
   const Scene& scene = *lighting.source;
-  if (scene.materials.size() != lighting.materials.size())
-    throw std::invalid_argument("refresh_materials_from_source: the source has " + std::to_string(scene.materials.size()) +
-                                " materials, the lighting scene " + std::to_string(lighting.materials.size()));
-  for (uint32_t m : materials)
-    if (m >= scene.materials.size())
-      throw std::out_of_range("refresh_materials_from_source: material " + std::to_string(m) + " of " +
-                              std::to_string(scene.materials.size()));
+  check_source_indices("refresh_materials_from_source", "material", scene.materials.size(), lighting.materials.size(), materials);
   if (materials.empty()) return;
   for (uint32_t m : materials) lighting.materials[m] = material_record(scene.materials[m]);
   lighting.textured = !scene.vertex_color.empty();
