@@ -11,17 +11,6 @@
 
 namespace exitance {
 
-size_t unocclude_near_moved(PersistedScene& edited, const Scene& before, const LightingScene& edited_lighting,
-                            const EditEffects& effects) {
-  if (effects.moved_instances.empty()) return 0;
-  std::vector<WorldBox> boxes;
-  for (uint32_t k : effects.moved_instances) {
-    boxes.push_back(instance_world_box(before, before.instances[k]));
-    boxes.push_back(instance_world_box(edited.scene, edited.scene.instances[k]));
-  }
-  return unocclude_near_boxes(edited, boxes, edited_lighting, nullptr).size();
-}
-
 std::vector<uint32_t> unocclude_near_boxes(PersistedScene& edited, const std::vector<WorldBox>& boxes,
                                            const LightingScene& edited_lighting, const TexelGrid* grid) {
   std::vector<uint32_t> reconsidered;

@@ -2,7 +2,6 @@
 // the moved object used to bury (a floor texel where a box stood) must come back to its surface
 // point, and one it now buries must be pushed out, as a fresh bake would do.
 #pragma once
-#include <cstddef>
 #include <vector>
 
 #include "exitance/runtime/core/lighting_scene.h"
@@ -12,17 +11,13 @@
 
 namespace exitance {
 
-// Every live texel within unocclude's reach (0.75 texel) of a moved instance's bounds before or
-// after the edit goes back to its surface point (texel_surface.h, as the rasterizer places it) and
-// through unocclude_texel on `edited_lighting` (the edited scene, its BVH refit), on the CPU.
-// `before`: the scene before the edit. Returns the number of texels reconsidered.
-size_t unocclude_near_moved(PersistedScene& edited, const Scene& before, const LightingScene& edited_lighting,
-                            const EditEffects& effects);
-
-// The same given the moved instances' bounds before and after (`boxes`), for an edit made in
-// place. `grid` (may be null: a pass over every texel): over the G-buffer's texels, with every
-// texel that moved since its build displaced (texel_grid.h); only its candidates are visited.
-// Returns the texels reconsidered, ascending (the caller displaces them in its grid).
+// Every live texel within unocclude's reach (0.75 texel) of a box (the moved instances' bounds
+// before and after the edit) goes back to its surface point (texel_surface.h, as the rasterizer
+// places it) and through unocclude_texel on `edited_lighting` (the edited scene, its BVH refit), on
+// the CPU, chunks of texels on threads. `grid` (may be null: a pass over every texel): over the
+// G-buffer's texels, with every texel that moved since its build displaced (texel_grid.h); only its
+// candidates are visited. Returns the texels reconsidered, ascending (the caller displaces them in
+// its grid).
 std::vector<uint32_t> unocclude_near_boxes(PersistedScene& edited, const std::vector<WorldBox>& boxes,
                                            const LightingScene& edited_lighting, const TexelGrid* grid);
 
