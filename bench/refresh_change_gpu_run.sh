@@ -2,8 +2,10 @@
 # Runs on the GPU machine (bench/refresh_change_gpu_pack.sh packs what it needs): the building at
 # 12 texels/m and the open city at 1.5 texels/m lit to 4096 spp as the shipped bundles, then each edit refreshed frame by frame from it
 # (light edits estimated as a change; docs/runtime.md) and restarted from nothing (--ignore-baked,
-# the behaviour before), each output's relMSE against two 4096-spp relights of the edited scene.
-# Env: BUNDLES (building city), EDITS (move double block), FRAMES (1 6 60), MODES (change restart).
+# the behaviour before), each output's relMSE against two 4096-spp relights of the edited scene; with
+# REPS, first what the edit costs alone (`seconds.edits`, `edits.milliseconds`, waited submissions),
+# REPS one-frame runs per edit.
+# Env: BUNDLES (building city), EDITS (move double block), FRAMES (1 6 60), MODES (change restart), REPS (0).
 # Writes $OUT/summary.txt.
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
@@ -17,9 +19,18 @@ for b in ${BUNDLES:-building city}; do
   $R $W/$b.bake -o $W/base_$b.bake --spp 4096 --seed 7 --no-frame-errors --json > $W/base_$b.json
   python3 -c "import json; r=json.load(open('$W/base_$b.json')); print('base $b', r['spp'], 'spp', r['live_texels'], 'texels', r['seconds'])" >> $S
 done
+report() {  # $1 the run's JSON, $2 its label
+  python3 -c "
+import json; r=json.load(open('$1')); e=r['edits']; ms=[f['milliseconds'] for f in r['frames']]
+print('$2', 'edits_s %.4f'%r['seconds']['edits'], 'edit_ms', {k: round(v, 2) for k, v in e.get('milliseconds', {}).items()}, 'submissions', e.get('device_submissions'), 'moved_texels', e['moved_texels'], 'changed_lights', e['changed_lights'], 'frames', len(ms), 'frame_ms_sum %.1f max %.1f'%(sum(ms), max(ms)), 'over_17ms', sum(1 for m in ms if m > 17), 'spp', r['spp'], 'samples_added', [f['samples_added'] for f in r['frames']][:8])" >> $S
+}
 for e in ${EDITS:-move double block}; do
   b=building; [ $e = block ] && b=city
   cp -r $W/base_$b.bake $W/base.bake.tmp && rm -rf $W/base.bake && mv $W/base.bake.tmp $W/base.bake
+  for k in $(seq ${REPS:-0}); do  # the edit's cost alone, one frame, another seed each time
+    $R $W/base.bake -o $W/cost.bake --edits $W/$e.json --spp 4096 --frames 1 --budget-ms 16 --seed $k --no-frame-errors --json > $W/cost.json
+    report $W/cost.json ${e}_cost_$k
+  done
   for s in 101 202; do $R $W/base.bake -o $W/ref_${e}_$s.bake --edits $W/$e.json --spp 4096 --seed $s --ignore-baked --json > /dev/null; done
   list=""
   for f in ${FRAMES:-1 6 60}; do
@@ -27,9 +38,7 @@ for e in ${EDITS:-move double block}; do
       flag=""; [ $mode = restart ] && flag=--ignore-baked
       o=${e}_${mode}_$f
       $R $W/base.bake -o $W/$o.bake --edits $W/$e.json --spp 4096 --frames $f --budget-ms 16 --seed 3 --no-frame-errors $flag --json > $W/$o.json
-      python3 -c "
-import json; r=json.load(open('$W/$o.json')); ms=[f['milliseconds'] for f in r['frames']]
-print('$o', 'edits_s %.4f'%r['seconds']['edits'], 'edit_ms', {k: round(v, 2) for k, v in r['edits'].get('milliseconds', {}).items()}, 'changed_lights', r['edits']['changed_lights'], 'frames', len(ms), 'frame_ms_sum %.1f max %.1f'%(sum(ms), max(ms)), 'over_17ms', sum(1 for m in ms if m > 17), 'spp', r['spp'], 'samples_added', [f['samples_added'] for f in r['frames']][:8])" >> $S
+      report $W/$o.json $o
       list="$list $W/$o.bake"
     done
   done
