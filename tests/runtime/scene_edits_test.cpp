@@ -841,6 +841,24 @@ TEST(TexelsNearChange, TheGridFindsWhatAFullPassFinds) {
     found += full.size();
   }
   EXPECT_GT(found, 1000u);  // the cases are not all empty
+  // Texels moved since the grid's build (displaced: their cells no longer hold them), then a box
+  // near most texels (the marks path for long lists) and a light (the sorted path for short ones).
+  TexelGrid moved_grid(p.gbuffer);
+  for (uint32_t i = 0; i < 20000; i += 37) {
+    p.gbuffer.texels[i].position = {40.0f * u(random), 0.5f * u(random), 25.0f * u(random)};
+    moved_grid.displace(i, p.gbuffer.texels[i]);
+  }
+  p.scene.lights[0].position = before.lights[0].position = {11, 0.3f, 6};
+  const std::vector<uint32_t> full_light = texels_near_change(p, before, lighting, effects);
+  EXPECT_EQ(texels_near_change(p, before, lighting, effects, &moved_grid), full_light);
+  EditEffects moved_effects;
+  moved_effects.moved_instances = {0};
+  ChangeBefore was;
+  was.moved_boxes_before = {WorldBox{{18, 0, 10}, {22, 0.5f, 14}}};
+  was.moved_boxes_after = {WorldBox{{8, 0, 3}, {12, 0.5f, 7}}};
+  const std::vector<uint32_t> full_block = texels_near_change(p, was, lighting, moved_effects);
+  EXPECT_EQ(texels_near_change(p, was, lighting, moved_effects, &moved_grid), full_block);
+  EXPECT_GT(full_block.size(), 20000u / 32);  // long enough for the marks path
 }
 
 }  // namespace

@@ -210,6 +210,7 @@ InPlaceEdits apply_scene_edits_in_place(PersistedScene& persisted, const std::ve
   effects.sky = parts.sky;
   effects.moved_instances = planned.instances;
   effects.moved_texels = texels.size();
+  out.moved_deltas = planned.delta;
   for (size_t j = 0; j < planned.instances.size(); ++j) {
     const refresh::MovedTriangles& m = planned.triangles[j];
     out.moved_boxes_before.push_back(triangles_world_box(scene, m.first, m.count));

@@ -92,19 +92,24 @@ void put_corners(std::vector<T>& all, const std::vector<T>& slice, uint32_t firs
   if (!slice.empty()) std::copy(slice.begin(), slice.end(), all.begin() + ptrdiff_t(first) * 3);
 }
 
-// Whether the unocclude step had pushed the texel off its surface point (on the scene it was derived on).
-bool pushed_off_surface(const LiveTexel& texel, const Scene& scene, const InstanceRect& rect, const AtlasPage& page) {
-  float b1, b2;
+// Whether the unocclude step had pushed the texel off its surface point (on the scene it was
+// derived on), and the texel's barycentrics there.
+bool pushed_off_surface(const LiveTexel& texel, const Scene& scene, const InstanceRect& rect, const AtlasPage& page,
+                        float& b1, float& b2) {
   texel_barycentrics(scene, rect, page.width, page.height, texel.triangle, texel.x, texel.y, b1, b2);
   return !same_bits(texel_surface(scene, texel.triangle, b1, b2).position, texel.position);
 }
 
-// A texel of a moved instance, re-derived on `next` as the rasterizer derives it; a texel the
-// unocclude step had pushed off its surface point keeps that offset, moved rigidly by `delta`.
+// A texel of a moved instance, re-derived on `next` as the rasterizer derives it (barycentrics
+// `b1`, `b2` when given, as texel_barycentrics computes them on `next`); a texel the unocclude step
+// had pushed off its surface point keeps that offset, moved rigidly by `delta`.
 LiveTexel moved_texel(const LiveTexel& texel, bool pushed, const Scene& next, const InstanceRect& rect,
-                      const AtlasPage& page, const Matrix4d& delta) {
+                      const AtlasPage& page, const Matrix4d& delta, const float* known_b1, const float* known_b2) {
   float b1, b2;
-  texel_barycentrics(next, rect, page.width, page.height, texel.triangle, texel.x, texel.y, b1, b2);
+  if (known_b1 && known_b2)
+    b1 = *known_b1, b2 = *known_b2;
+  else
+    texel_barycentrics(next, rect, page.width, page.height, texel.triangle, texel.x, texel.y, b1, b2);
   const TexelSurface surface = texel_surface(next, texel.triangle, b1, b2);
   LiveTexel moved = texel;
   moved.position = pushed ? transform_point(delta, texel.position) : surface.position;
@@ -233,7 +238,7 @@ std::vector<MovingTexel> moving_texels(const PlannedMoves& planned, const Scene&
   for_each_chunk(out.size(), [&](size_t begin, size_t end) {
     for (size_t k = begin; k < end; ++k) {
       const LiveTexel& texel = gbuffer.texels[out[k].index];
-      out[k].pushed = pushed_off_surface(texel, before, atlas.rects[texel.instance], gbuffer.pages[texel.page]);
+      out[k].pushed = pushed_off_surface(texel, before, atlas.rects[texel.instance], gbuffer.pages[texel.page], out[k].b1, out[k].b2);
     }
   }, 1024);
   return out;
@@ -241,7 +246,10 @@ std::vector<MovingTexel> moving_texels(const PlannedMoves& planned, const Scene&
 
 LiveTexel moved_texel(const LiveTexel& texel, const MovingTexel& moving, const PlannedMoves& planned, const Scene& next,
                       const TexelGBuffer& gbuffer, const AtlasLayout& atlas) {
-  return moved_texel(texel, moving.pushed, next, atlas.rects[texel.instance], gbuffer.pages[texel.page], planned.delta[moving.move]);
+  // A mirroring move reverses the triangle's corners (move_triangles): its barycentrics are derived again.
+  const bool same_corners = !(determinant3(planned.delta[moving.move]) < 0);
+  return moved_texel(texel, moving.pushed, next, atlas.rects[texel.instance], gbuffer.pages[texel.page], planned.delta[moving.move],
+                     same_corners ? &moving.b1 : nullptr, same_corners ? &moving.b2 : nullptr);
 }
 
 MovedGeometry move_under_edited_nodes(Scene& next, const Scene& old, const TexelGBuffer& gbuffer,

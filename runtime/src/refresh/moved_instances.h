@@ -51,12 +51,15 @@ struct PlannedMoves {
 };
 PlannedMoves plan_moves(Scene& next, const Scene& geometry, const std::vector<std::string>& edit_of_node);
 
-// A texel of a moved instance: its index, which planned move carries it, and whether the unocclude
-// step had pushed it off its surface (read on the scene before the move).
+// A texel of a moved instance: its index, which planned move carries it, whether the unocclude
+// step had pushed it off its surface (read on the scene before the move), and its barycentrics on
+// its triangle (lightmap UVs do not move: moved_texel reuses them unless the move mirrors, which
+// reorders the triangle's corners).
 struct MovingTexel {
   size_t index = 0;
   uint32_t move = 0;
   bool pushed = false;
+  float b1 = 0, b2 = 0;
 };
 // The texels of the planned moves' instances, ascending: from `texels_by_instance` (texel_start[k]
 // .. texel_start[k + 1] lists instance k's texels) when given, else by a pass over the G-buffer.

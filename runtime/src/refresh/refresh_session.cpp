@@ -278,7 +278,10 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
       boxes.push_back(in_place.moved_boxes_before[j]);
       boxes.push_back(in_place.moved_boxes_after[j]);
     }
-    const std::vector<uint32_t> unoccluded = unocclude_near_boxes(s.persisted, boxes, lighting, &s.texel_grid);
+    const std::vector<uint32_t> carried =
+        texels_carried_rigidly(s.persisted, in_place.moved_texels, effects.moved_instances, in_place.moved_deltas,
+                               in_place.moved_boxes_before, s.instance_boxes, s.uninstanced_box);
+    const std::vector<uint32_t> unoccluded = unocclude_near_boxes(s.persisted, boxes, lighting, &s.texel_grid, &carried);
     for (uint32_t i : unoccluded) s.texel_grid.displace(i, s.persisted.gbuffer.texels[i]);
     std::vector<uint32_t> changed;
     std::set_union(in_place.moved_texels.begin(), in_place.moved_texels.end(), unoccluded.begin(), unoccluded.end(),

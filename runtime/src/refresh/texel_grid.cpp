@@ -35,8 +35,13 @@ TexelGrid::TexelGrid(const TexelGBuffer& gbuffer) {
   }
   for (size_t c = 0; c < cell_count; ++c) cell_start_[c + 1] += cell_start_[c];
   texels_.resize(n);
+  positions_.resize(n);
   std::vector<uint32_t> next(cell_start_.begin(), cell_start_.end() - 1);
-  for (size_t i = 0; i < n; ++i) texels_[next[cell_of_texel[i]]++] = uint32_t(i);  // ascending within a cell
+  for (size_t i = 0; i < n; ++i) {  // ascending within a cell
+    const uint32_t k = next[cell_of_texel[i]]++;
+    texels_[k] = uint32_t(i);
+    positions_[k] = gbuffer.texels[i].position;
+  }
 }
 
 void TexelGrid::displace(uint32_t i, const LiveTexel& texel) {
@@ -46,6 +51,24 @@ void TexelGrid::displace(uint32_t i, const LiveTexel& texel) {
   if (is_displaced_[i]) return;
   is_displaced_[i] = 1;
   displaced_.push_back(i);
+}
+
+size_t TexelGrid::candidate_rows(const WorldBox& box, float margin, std::vector<std::pair<uint32_t, uint32_t>>& rows) const {
+  rows.clear();
+  if (texels_.empty() || box.empty()) return 0;
+  int first[3], last[3];
+  for (int a = 0; a < 3; ++a) {
+    first[a] = cell_of(a, box.lo[a] - margin);
+    last[a] = cell_of(a, box.hi[a] + margin);
+  }
+  size_t entries = 0;
+  for (int z = first[2]; z <= last[2]; ++z)
+    for (int y = first[1]; y <= last[1]; ++y) {
+      const size_t row = (size_t(z) * size_t(cells_[1]) + size_t(y)) * size_t(cells_[0]);
+      const uint32_t begin = cell_start_[row + size_t(first[0])], end = cell_start_[row + size_t(last[0]) + 1];
+      if (begin < end) rows.emplace_back(begin, end), entries += end - begin;
+    }
+  return entries;
 }
 
 int TexelGrid::cell_of(int axis, float p) const {

@@ -2,6 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <thread>
+#include <utility>
+
+#include "exitance/runtime/core/parallel_chunks.h"
 
 #include "exitance/runtime/world_box.h"
 
@@ -57,23 +62,57 @@ std::vector<uint32_t> texels_near_change(const PersistedScene& edited, const Cha
     radius_squared.push_back(r * r);
   }
   std::vector<uint32_t> near;
-  if (grid && grid->texel_count() == edited.gbuffer.texels.size()) {
-    for (size_t b = 0; b < boxes.size(); ++b)
-      grid->for_each_candidate(boxes[b], std::sqrt(radius_squared[b]), [&](uint32_t i) {
-        if (boxes[b].distance_squared(edited.gbuffer.texels[i].position) <= radius_squared[b]) near.push_back(i);
-      });
-    // In order and each once (boxes overlap): a sort for a short list, a mark per texel for a long
-    // one (hundreds of thousands of texels near a moved block).
-    if (near.size() < edited.gbuffer.texels.size() / 32) {
+  const size_t n = edited.gbuffer.texels.size();
+  if (grid && grid->texel_count() == n) {
+    std::vector<std::vector<std::pair<uint32_t, uint32_t>>> rows(boxes.size());
+    size_t entries = 0;
+    for (size_t b = 0; b < boxes.size(); ++b) entries += grid->candidate_rows(boxes[b], std::sqrt(radius_squared[b]), rows[b]);
+    auto near_box = [&](size_t b, uint32_t i) { return boxes[b].distance_squared(edited.gbuffer.texels[i].position) <= radius_squared[b]; };
+    if (entries < n / 32) {
+      // A short list (a light's room): in order and each once by a sort (boxes overlap).
+      for (size_t b = 0; b < boxes.size(); ++b) {
+        for (const auto& [begin, end] : rows[b])
+          for (uint32_t k = begin; k < end; ++k)
+            if (boxes[b].distance_squared(grid->entry_position(k)) <= radius_squared[b]) {
+              const uint32_t i = grid->entry(k);
+              if (!grid->is_displaced(i)) near.push_back(i);
+            }
+        for (uint32_t i : grid->displaced())
+          if (near_box(b, i)) near.push_back(i);
+      }
       std::sort(near.begin(), near.end());
       near.erase(std::unique(near.begin(), near.end()), near.end());
       return near;
     }
-    std::vector<uint8_t> is_near(edited.gbuffer.texels.size(), 0);
-    for (uint32_t i : near) is_near[i] = 1;
-    near.clear();
-    for (uint32_t i = 0; i < uint32_t(is_near.size()); ++i)
-      if (is_near[i]) near.push_back(i);
+    // A long one (hundreds of thousands of texels near a moved block): a mark per texel, the rows
+    // on all cores (a row lists a texel once, so one box's rows write distinct marks), then the
+    // marks read back in order, also on all cores.
+    std::vector<uint8_t> is_near(n, 0);
+    for (size_t b = 0; b < boxes.size(); ++b) {
+      const auto& box_rows = rows[b];
+      for_each_chunk(box_rows.size(), [&](size_t first, size_t last) {
+        for (size_t r = first; r < last; ++r)
+          for (uint32_t k = box_rows[r].first; k < box_rows[r].second; ++k)
+            if (boxes[b].distance_squared(grid->entry_position(k)) <= radius_squared[b]) {
+              const uint32_t i = grid->entry(k);
+              if (!grid->is_displaced(i)) is_near[i] = 1;
+            }
+      }, 64);
+      for (uint32_t i : grid->displaced())
+        if (near_box(b, i)) is_near[i] = 1;
+    }
+    // Read back 8 marks at a time: the near texels cluster, most words are zero.
+    near.reserve(std::min(entries, n));
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+      uint64_t word;
+      std::memcpy(&word, &is_near[i], 8);
+      if (word == 0) continue;
+      for (size_t j = i; j < i + 8; ++j)
+        if (is_near[j]) near.push_back(uint32_t(j));
+    }
+    for (; i < n; ++i)
+      if (is_near[i]) near.push_back(uint32_t(i));
     return near;
   }
   for (size_t i = 0; i < edited.gbuffer.texels.size(); ++i) {

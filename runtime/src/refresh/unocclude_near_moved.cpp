@@ -1,10 +1,13 @@
 #include "exitance/runtime/refresh/unocclude_near_moved.h"
 
 #include <algorithm>
+#include <cmath>
+#include <optional>
 #include <vector>
 
 #include "exitance/runtime/core/bvh4_closest_hit.h"
 #include "exitance/runtime/core/parallel_chunks.h"
+#include "exitance/runtime/node_transform.h"
 #include "exitance/runtime/texel_surface.h"
 #include "exitance/runtime/unocclude_texel.h"
 #include "exitance/runtime/world_box.h"
@@ -12,7 +15,8 @@
 namespace exitance {
 
 std::vector<uint32_t> unocclude_near_boxes(PersistedScene& edited, const std::vector<WorldBox>& boxes,
-                                           const LightingScene& edited_lighting, const TexelGrid* grid) {
+                                           const LightingScene& edited_lighting, const TexelGrid* grid,
+                                           const std::vector<uint32_t>* carried) {
   std::vector<uint32_t> reconsidered;
   if (boxes.empty()) return reconsidered;
   const ClosestHitQuery query = [&](const Vec3& origin, const Vec3& direction, float t_max) {
@@ -22,6 +26,7 @@ std::vector<uint32_t> unocclude_near_boxes(PersistedScene& edited, const std::ve
   // Whether texel i lies within reach of a box, and then its unocclude step again (each texel reads
   // only itself and the BVH: chunks of texels run on threads).
   auto reconsider = [&](uint32_t i) {
+    if (carried && std::binary_search(carried->begin(), carried->end(), i)) return false;
     LiveTexel& texel = edited.gbuffer.texels[i];
     // A pushed texel lies at most its reach from its surface point: test the current position
     // against the bounds grown by twice the reach, then the surface point by the reach.
@@ -59,6 +64,87 @@ std::vector<uint32_t> unocclude_near_boxes(PersistedScene& edited, const std::ve
     reconsider_all(all);
   }
   return reconsidered;
+}
+
+namespace {
+
+// A rotation, translation and uniform scale (no mirror): its 3x3 part M has M^T M = s^2 I. Returns s,
+// or 0 when `m` is none.
+double similarity_scale(const Matrix4d& m) {
+  double gram[3][3];
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) {
+      double sum = 0;
+      for (int k = 0; k < 3; ++k) sum += m[size_t(a * 4 + k)] * m[size_t(b * 4 + k)];  // column a . column b
+      gram[a][b] = sum;
+    }
+  const double s2 = (gram[0][0] + gram[1][1] + gram[2][2]) / 3;
+  if (!(s2 > 0) || !std::isfinite(s2) || !(determinant3(m) > 0)) return 0;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b)
+      if (std::fabs(gram[a][b] - (a == b ? s2 : 0.0)) > 1e-6 * s2) return 0;
+  return std::sqrt(s2);
+}
+
+}  // namespace
+
+std::vector<uint32_t> texels_carried_rigidly(const PersistedScene& edited, const std::vector<uint32_t>& moved_texels,
+                                             const std::vector<uint32_t>& moved_instances, const std::vector<Matrix4d>& deltas,
+                                             const std::vector<WorldBox>& moved_boxes_before,
+                                             const std::vector<WorldBox>& instance_boxes, const WorldBox& uninstanced) {
+  std::vector<uint32_t> carried;
+  if (moved_instances.size() != deltas.size() || moved_instances.size() != moved_boxes_before.size()) return carried;
+  // Per moved instance: its move's inverse, its scale, and the other geometry's boxes near it.
+  struct Move {
+    Matrix4d inverse;
+    double scale = 0;
+    std::vector<WorldBox> others;
+  };
+  std::vector<Move> moves(moved_instances.size());
+  std::vector<uint32_t> move_of(instance_boxes.size(), UINT32_MAX);
+  float largest_reach = 0;
+  for (uint32_t i : moved_texels) largest_reach = std::max(largest_reach, unocclude_reach(edited.gbuffer.texels[i]));
+  for (size_t j = 0; j < moved_instances.size(); ++j) {
+    const uint32_t k = moved_instances[j];
+    if (k >= instance_boxes.size()) return {};
+    move_of[k] = uint32_t(j);
+    const std::optional<Matrix4d> inverse = affine_inverse(deltas[j]);
+    moves[j].scale = inverse ? similarity_scale(deltas[j]) : 0;
+    if (moves[j].scale == 0) continue;  // not rigid: every texel of it goes through unocclude again
+    moves[j].inverse = *inverse;
+    // Texels lie within their reach of their instance's bounds (a push moves at most that far).
+    const float margin = 3 * largest_reach * float(std::max(1.0, 1 / moves[j].scale));
+    WorldBox region = moved_boxes_before[j];
+    region.grow(instance_boxes[k]);
+    auto near_region = [&](const WorldBox& b) {
+      return !b.empty() && b.lo.x <= region.hi.x + margin && b.hi.x >= region.lo.x - margin && b.lo.y <= region.hi.y + margin &&
+             b.hi.y >= region.lo.y - margin && b.lo.z <= region.hi.z + margin && b.hi.z >= region.lo.z - margin;
+    };
+    for (size_t o = 0; o < instance_boxes.size(); ++o)
+      if (o != k && near_region(instance_boxes[o])) moves[j].others.push_back(instance_boxes[o]);
+    for (size_t o = 0; o < moved_instances.size(); ++o)
+      if (o != j && near_region(moved_boxes_before[o])) moves[j].others.push_back(moved_boxes_before[o]);
+    if (near_region(uninstanced)) moves[j].others.push_back(uninstanced);
+  }
+  std::vector<uint8_t> keep(moved_texels.size(), 0);
+  for_each_chunk(moved_texels.size(), [&](size_t begin, size_t end) {
+    for (size_t t = begin; t < end; ++t) {
+      const LiveTexel& texel = edited.gbuffer.texels[moved_texels[t]];
+      if (texel.instance >= move_of.size() || move_of[texel.instance] == UINT32_MAX) continue;
+      const Move& move = moves[move_of[texel.instance]];
+      if (move.scale == 0) continue;
+      // Where it is and where it was, each within twice the reach it had there (as unocclude_near_boxes tests).
+      const float reach_now = unocclude_reach(texel), reach_before = reach_now / float(move.scale);
+      const Vec3 before = transform_point(move.inverse, texel.position);
+      const bool near_other = std::any_of(move.others.begin(), move.others.end(), [&](const WorldBox& b) {
+        return b.contains(texel.position, 2 * reach_now) || b.contains(before, 2 * reach_before);
+      });
+      keep[t] = !near_other;
+    }
+  }, 1024);
+  for (size_t t = 0; t < moved_texels.size(); ++t)
+    if (keep[t]) carried.push_back(moved_texels[t]);
+  return carried;
 }
 
 }  // namespace exitance

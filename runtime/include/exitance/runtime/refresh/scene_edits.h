@@ -131,6 +131,7 @@ struct InPlaceEdits {
   std::vector<uint32_t> moved_triangles;            // ascending
   std::vector<Vec3> moved_triangles_before;         // their 3 vertices each, as before the edits
   std::vector<WorldBox> moved_boxes_before, moved_boxes_after;  // per effects.moved_instances
+  std::vector<Matrix4d> moved_deltas;               // per effects.moved_instances: world after * world before^-1
   std::vector<uint32_t> moved_texels;               // ascending: the G-buffer texels rewritten
 };
 

@@ -6,6 +6,7 @@
 // that the owner builds the grid again.
 #pragma once
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "exitance/runtime/texel_gbuffer.h"
@@ -42,6 +43,17 @@ class TexelGrid {
             if (is_displaced_.empty() || !is_displaced_[texels_[k]]) visit(texels_[k]);
         }
   }
+  // The candidates of for_each_candidate as ranges of entries (entry(k) for k in [first, second)),
+  // one per row of cells, without the displaced texels (displaced(), which the caller visits too):
+  // for a query split across threads. A displaced texel is still listed in its row: skip it
+  // (is_displaced). Returns the number of entries the ranges hold.
+  size_t candidate_rows(const WorldBox& box, float margin, std::vector<std::pair<uint32_t, uint32_t>>& rows) const;
+  uint32_t entry(size_t k) const { return texels_[k]; }
+  // Where entry k's texel was at the build (its position now unless displaced): read in entry
+  // order, not from the G-buffer's 72-byte texels scattered over it.
+  const Vec3& entry_position(size_t k) const { return positions_[k]; }
+  const std::vector<uint32_t>& displaced() const { return displaced_; }
+  bool is_displaced(uint32_t i) const { return !is_displaced_.empty() && is_displaced_[i]; }
 
  private:
   int cell_of(int axis, float p) const;
@@ -50,6 +62,7 @@ class TexelGrid {
   int cells_[3] = {1, 1, 1};
   std::vector<uint32_t> cell_start_;  // per cell, its first entry in texels_ (and one past the last)
   std::vector<uint32_t> texels_;      // texel indices, by cell
+  std::vector<Vec3> positions_;       // their positions at the build, by cell
   std::vector<uint32_t> displaced_;   // texels moved since the build
   std::vector<uint8_t> is_displaced_;  // per texel (empty until one is)
   float largest_texel_size_ = 0;
