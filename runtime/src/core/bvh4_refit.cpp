@@ -18,28 +18,39 @@ using Point = std::array<double, 3>;
 
 // The part of a triangle inside a box, as a polygon (Sutherland-Hodgman in double, points on the
 // box's faces kept): it holds the part of the triangle a spatial-split leaf with that box refers to.
-std::vector<Point> clip_to_box(const Vec3 triangle[3], const WorldBox& box) {
-  std::vector<Point> polygon(3), next;
-  for (int i = 0; i < 3; ++i) polygon[size_t(i)] = {triangle[i].x, triangle[i].y, triangle[i].z};
+// Each of the 6 planes adds at most one corner: 9 at most, kept on the stack (a moved block clips
+// thousands of triangles per edit).
+struct ClippedPolygon {
+  std::array<Point, 9> points;
+  size_t count = 0;
+  bool empty() const { return count == 0; }
+  const Point* begin() const { return points.data(); }
+  const Point* end() const { return points.data() + count; }
+};
+
+ClippedPolygon clip_to_box(const Vec3 triangle[3], const WorldBox& box) {
+  ClippedPolygon polygon, next;
+  polygon.count = 3;
+  for (int i = 0; i < 3; ++i) polygon.points[size_t(i)] = {triangle[i].x, triangle[i].y, triangle[i].z};
   const double lo[3] = {box.lo.x, box.lo.y, box.lo.z}, hi[3] = {box.hi.x, box.hi.y, box.hi.z};
   for (int axis = 0; axis < 3 && !polygon.empty(); ++axis)
     for (int side = 0; side < 2 && !polygon.empty(); ++side) {
       const double plane = side == 0 ? lo[axis] : hi[axis];
       auto inside = [&](const Point& p) { return side == 0 ? p[size_t(axis)] >= plane : p[size_t(axis)] <= plane; };
-      next.clear();
-      for (size_t i = 0; i < polygon.size(); ++i) {
-        const Point& a = polygon[i];
-        const Point& b = polygon[(i + 1) % polygon.size()];
-        if (inside(a)) next.push_back(a);
-        if (inside(a) != inside(b)) {
+      next.count = 0;
+      for (size_t i = 0; i < polygon.count; ++i) {
+        const Point& a = polygon.points[i];
+        const Point& b = polygon.points[(i + 1) % polygon.count];
+        if (inside(a) && next.count < next.points.size()) next.points[next.count++] = a;
+        if (inside(a) != inside(b) && next.count < next.points.size()) {
           const double t = (plane - a[size_t(axis)]) / (b[size_t(axis)] - a[size_t(axis)]);
           Point crossing;
           for (size_t k = 0; k < 3; ++k) crossing[k] = a[k] + t * (b[k] - a[k]);
           crossing[size_t(axis)] = plane;
-          next.push_back(crossing);
+          next.points[next.count++] = crossing;
         }
       }
-      polygon.swap(next);
+      std::swap(polygon, next);
     }
   return polygon;
 }
@@ -52,7 +63,7 @@ std::vector<Point> clip_to_box(const Vec3 triangle[3], const WorldBox& box) {
 WorldBox carried_part_box(const Vec3 before[3], const Vec3 after[3], const WorldBox& box) {
   WorldBox whole;
   for (int k = 0; k < 3; ++k) whole.grow(after[k]);
-  const std::vector<Point> part = clip_to_box(before, box);
+  const ClippedPolygon part = clip_to_box(before, box);
   auto point = [](const Vec3& v) { return Point{v.x, v.y, v.z}; };
   auto minus = [](const Point& a, const Point& b) { return Point{a[0] - b[0], a[1] - b[1], a[2] - b[2]}; };
   const Point v0 = point(before[0]), e1 = minus(point(before[1]), v0), e2 = minus(point(before[2]), v0);

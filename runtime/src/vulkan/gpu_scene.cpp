@@ -1,6 +1,7 @@
 #include "gpu_scene.h"
 
 #include <algorithm>
+#include <iterator>
 #include <bit>
 #include <cstring>
 #include <stdexcept>
@@ -172,10 +173,21 @@ void GpuScene::add_material_writes(const LightingScene& edited, std::vector<Cont
   // emitter CDF and list (their buffers grown first when larger) and the surface records, in one
   // submission. A material edit cannot change textures or corners, so the surfaces are the header
   // and material records alone, unless the edit makes an untextured scene textured (everything).
-  std::vector<uint32_t> changed = emitters_;
-  changed.insert(changed.end(), edited.emitter_triangles.begin(), edited.emitter_triangles.end());
-  std::sort(changed.begin(), changed.end());
-  changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+  // Old and new emitters: the same list after a move (areas change, not which triangles emit),
+  // else their union (both ascend as the lighting scene lists them; sorted here when not).
+  std::vector<uint32_t> changed;
+  const std::vector<uint32_t>& now = edited.emitter_triangles;
+  if (now == emitters_) {
+    changed = emitters_;
+  } else if (std::is_sorted(now.begin(), now.end()) && std::is_sorted(emitters_.begin(), emitters_.end())) {
+    std::set_union(emitters_.begin(), emitters_.end(), now.begin(), now.end(), std::back_inserter(changed));
+    changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+  } else {
+    changed = emitters_;
+    changed.insert(changed.end(), now.begin(), now.end());
+    std::sort(changed.begin(), changed.end());
+    changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+  }
   emitters = at_least_one(edited.emitter_triangles);
   const bool whole_surfaces = surfaces_.size() == 0 || (edited.textured && !surfaces_textured_);
   surfaces = whole_surfaces ? surface_words(edited, surface_layout_) : material_surface_words(*edited.source, surface_layout_);
