@@ -66,6 +66,7 @@ struct RefreshSession::State {
   std::vector<uint32_t> near_texels, far_texels, all_texels;
   std::vector<uint32_t> last_edit_near;  // near_texels of the last edit, kept after the others caught up
   TexelGrid texel_grid;  // over persisted.gbuffer's texels: moved ones set aside, rebuilt when many are
+  std::vector<uint8_t> near_marks;  // texels_near_change's scratch: a zero byte per texel
   // What an edit made in place needs without a pass over the scene: each instance's texels, where
   // each BVH leaf slot and node hangs, and the bounds of each instance's triangles (and of those in
   // no instance), whose union is the scene's bounds.
@@ -197,6 +198,7 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   timings.device = since();
   state->priority_samples = options.priority_samples;
   state->texel_grid = TexelGrid(state->persisted.gbuffer);
+  state->near_marks.assign(state->persisted.gbuffer.texels.size(), 0);
   index_for_edits(*state);
   state->all_texels.resize(state->persisted.gbuffer.texels.size());
   for (size_t i = 0; i < state->all_texels.size(); ++i) state->all_texels[i] = uint32_t(i);
@@ -244,6 +246,9 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   // lighting scene reads persisted.scene itself); nothing below throws for bad input.
   InPlaceEdits in_place = apply_scene_edits_in_place(s.persisted, edits, &s.instance_texels);
   const EditEffects& effects = in_place.effects;
+  // Edits of punctual lights alone upload the lights after the publish below, in the submission
+  // that starts the accumulation again (start_progressive_change) or in one of their own.
+  const bool punctual_only = !effects.geometry_changed() && effects.materials.empty() && !effects.sky && !effects.lights.empty();
   s.scene_file.reset();  // encoded again from the edited scene when a bundle is written
   LightingScene& lighting = *s.lighting;
   if (effects.geometry_changed()) {
@@ -265,7 +270,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
     }
     if (!effects.lights.empty() || effects.sky) {
       refresh_lights_from_source(lighting, effects.lights, effects.sky);
-      s.integrator->update_lights(lighting);
+      if (!punctual_only) s.integrator->update_lights(lighting);
     }
   }
   timings.scene = since(lap);
@@ -290,7 +295,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   }
   was.moved_boxes_before = in_place.moved_boxes_before;
   was.moved_boxes_after = in_place.moved_boxes_after;
-  std::vector<uint32_t> near = texels_near_change(s.persisted, was, lighting, effects, &s.texel_grid);
+  std::vector<uint32_t> near = texels_near_change(s.persisted, was, lighting, effects, &s.texel_grid, &s.near_marks);
   // Set-aside texels are visited by every query: past an eighth of them, the grid is built again.
   if (s.texel_grid.displaced_count() > s.persisted.gbuffer.texels.size() / 8) s.texel_grid = TexelGrid(s.persisted.gbuffer);
   timings.near_texels = since(lap);
@@ -298,8 +303,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   // Edits of punctual lights alone are estimated as a change from what was published before them
   // (path.h punctual_change_rays): the same paths, each vertex adding the edited lights' direct
   // light as edited minus as it was, so texels no edited light reaches keep their value exactly.
-  const bool lights_only = !effects.geometry_changed() && effects.materials.empty() && !effects.sky && !effects.lights.empty() &&
-                           !s.per_bounce && s.settings.directional == DirectionalMode::Off;
+  const bool lights_only = punctual_only && !s.per_bounce && s.settings.directional == DirectionalMode::Off;
   std::vector<GpuPunctualLight> pairs;
   const std::vector<GpuPunctualLight>& base_lights = s.base ? s.base_lights : lights_before;
   const std::vector<GpuPunctualLight>& lights_now = s.lighting->punctual_lights;
@@ -309,9 +313,11 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
         pairs.push_back(lights_now[i]);
         pairs.push_back(base_lights[i]);
       }
-  // What is shown until refreshed again, kept on the device.
+  // What is shown until refreshed again, kept on the device; the accumulation cleared in the same
+  // submission (it starts again below) unless a whole run's result is published from the host.
   since(lap);
-  const PublishedLightmap published = publish_on_device();
+  const bool clears = !s.per_bounce;
+  const PublishedLightmap published = publish_on_device(clears);
   timings.publish = since(lap);
   // A base needs variances: after opening without the baked lightmap and before any refresh, restart.
   const bool as_change = lights_only && !pairs.empty() && pairs.size() / 2 <= kMaxChangedLights &&
@@ -325,10 +331,17 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   const bool texels_as_before = true;  // moved texels' start points were uploaded above
   if (as_change) {
     s.clear_accumulation();
-    s.integrator->start_progressive_change(s.persisted.gbuffer, s.settings, *s.lighting, pairs, texels_as_before);
+    s.integrator->start_progressive_change(s.persisted.gbuffer, s.settings, *s.lighting, pairs, texels_as_before, clears);
     s.changed_lights = uint32_t(pairs.size() / 2);
   } else {
-    restart(texels_as_before);
+    if (punctual_only) s.integrator->update_punctual_lights(lighting);
+    // A change estimate ends here: `published` is what it showed (restart() would publish it again).
+    s.base.reset();
+    s.base_lights.clear();
+    s.changed_lights = 0;
+    const bool same_texels = texels_as_before && !s.per_bounce;
+    s.clear_accumulation();
+    s.integrator->start_progressive(s.persisted.gbuffer, s.settings, same_texels, clears);
   }
   if (s.priority_samples > 0 && !near.empty() && near.size() < s.all_texels.size()) {
     s.near_texels = std::move(near);  // the far texels are listed when their turn comes (refresh)
@@ -542,7 +555,7 @@ LightmapEstimate RefreshSession::refreshed_lightmap() const {
 uint32_t RefreshSession::changed_lights() const { return state_->changed_lights; }
 bool RefreshSession::started_from_baked() const { return state_->started_from_baked; }
 
-PublishedLightmap RefreshSession::publish_on_device() const {
+PublishedLightmap RefreshSession::publish_on_device(bool clear_accumulation) const {
   const State& s = *state_;
   if (s.per_bounce) {  // a whole run's result is on the host
     const LightmapEstimate estimate = published_lightmap();
@@ -554,8 +567,9 @@ PublishedLightmap RefreshSession::publish_on_device() const {
     published.lightmap = s.integrator->upload_lightmap(estimate);
     return published;
   }
-  if (s.base) return s.integrator->publish(PublishMode::Change, s.previous ? s.previous.get() : s.base.get(), s.base.get());
-  return s.integrator->publish(s.previous ? PublishMode::Restart : PublishMode::Accumulation, s.previous.get(), nullptr);
+  if (s.base)
+    return s.integrator->publish(PublishMode::Change, s.previous ? s.previous.get() : s.base.get(), s.base.get(), clear_accumulation);
+  return s.integrator->publish(s.previous ? PublishMode::Restart : PublishMode::Accumulation, s.previous.get(), nullptr, clear_accumulation);
 }
 
 LightmapEstimate RefreshSession::published_lightmap() const {

@@ -1,13 +1,12 @@
 #include "exitance/runtime/refresh/texels_near_change.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
-#include <thread>
 #include <utility>
 
 #include "exitance/runtime/core/parallel_chunks.h"
-
 #include "exitance/runtime/world_box.h"
 
 namespace exitance {
@@ -26,7 +25,7 @@ std::vector<uint32_t> texels_near_change(const PersistedScene& edited, const Sce
 
 std::vector<uint32_t> texels_near_change(const PersistedScene& edited, const ChangeBefore& was,
                                          const LightingScene& edited_lighting, const EditEffects& effects,
-                                         const TexelGrid* grid) {
+                                         const TexelGrid* grid, std::vector<uint8_t>* marks) {
   if (effects.sky) return {};  // the sky lights everything
   std::vector<WorldBox> boxes;
   for (size_t j = 0; j < effects.moved_instances.size() && j < was.moved_boxes_before.size() && j < was.moved_boxes_after.size(); ++j) {
@@ -64,55 +63,47 @@ std::vector<uint32_t> texels_near_change(const PersistedScene& edited, const Cha
   std::vector<uint32_t> near;
   const size_t n = edited.gbuffer.texels.size();
   if (grid && grid->texel_count() == n) {
-    std::vector<std::vector<std::pair<uint32_t, uint32_t>>> rows(boxes.size());
-    size_t entries = 0;
-    for (size_t b = 0; b < boxes.size(); ++b) entries += grid->candidate_rows(boxes[b], std::sqrt(radius_squared[b]), rows[b]);
-    auto near_box = [&](size_t b, uint32_t i) { return boxes[b].distance_squared(edited.gbuffer.texels[i].position) <= radius_squared[b]; };
-    if (entries < n / 32) {
-      // A short list (a light's room): in order and each once by a sort (boxes overlap).
-      for (size_t b = 0; b < boxes.size(); ++b) {
-        for (const auto& [begin, end] : rows[b])
-          for (uint32_t k = begin; k < end; ++k)
-            if (boxes[b].distance_squared(grid->entry_position(k)) <= radius_squared[b]) {
-              const uint32_t i = grid->entry(k);
-              if (!grid->is_displaced(i)) near.push_back(i);
-            }
-        for (uint32_t i : grid->displaced())
-          if (near_box(b, i)) near.push_back(i);
-      }
-      std::sort(near.begin(), near.end());
-      near.erase(std::unique(near.begin(), near.end()), near.end());
-      return near;
-    }
-    // A long one (hundreds of thousands of texels near a moved block): a mark per texel, the rows
-    // on all cores (a row lists a texel once, so one box's rows write distinct marks), then the
-    // marks read back in order, also on all cores.
-    std::vector<uint8_t> is_near(n, 0);
+    // A mark per texel (the caller's zeroed scratch when given: an edit allocates and zeroes no
+    // megabyte), the rows of cells on all cores (a row lists a texel once, so one box's rows write
+    // distinct marks; boxes in turn), then the marks between the lowest and highest marked texel
+    // read back in order 8 at a time (the near texels cluster), and left zero again.
+    std::vector<uint8_t> own;
+    std::vector<uint8_t>& is_near = marks && marks->size() == n ? *marks : own;
+    if (&is_near == &own) own.assign(n, 0);
+    std::atomic<uint32_t> lowest{UINT32_MAX}, highest{0};
+    auto mark = [&](uint32_t i, uint32_t& lo, uint32_t& hi) { is_near[i] = 1, lo = std::min(lo, i), hi = std::max(hi, i); };
+    auto keep_range = [&](uint32_t lo, uint32_t hi) {
+      for (uint32_t v = lowest.load(); lo < v && !lowest.compare_exchange_weak(v, lo);) {}
+      for (uint32_t v = highest.load(); hi > v && !highest.compare_exchange_weak(v, hi);) {}
+    };
+    std::vector<std::pair<uint32_t, uint32_t>> rows;
     for (size_t b = 0; b < boxes.size(); ++b) {
-      const auto& box_rows = rows[b];
-      for_each_chunk(box_rows.size(), [&](size_t first, size_t last) {
+      grid->candidate_rows(boxes[b], std::sqrt(radius_squared[b]), rows);
+      for_each_chunk(rows.size(), [&](size_t first, size_t last) {
+        uint32_t lo = UINT32_MAX, hi = 0;
         for (size_t r = first; r < last; ++r)
-          for (uint32_t k = box_rows[r].first; k < box_rows[r].second; ++k)
-            if (boxes[b].distance_squared(grid->entry_position(k)) <= radius_squared[b]) {
-              const uint32_t i = grid->entry(k);
-              if (!grid->is_displaced(i)) is_near[i] = 1;
-            }
-      }, 64);
+          for (uint32_t k = rows[r].first; k < rows[r].second; ++k)
+            if (boxes[b].distance_squared(grid->entry_position(k)) <= radius_squared[b])
+              if (const uint32_t i = grid->entry(k); !grid->is_displaced(i)) mark(i, lo, hi);
+        keep_range(lo, hi);
+      }, 256);
+      uint32_t lo = UINT32_MAX, hi = 0;
       for (uint32_t i : grid->displaced())
-        if (near_box(b, i)) is_near[i] = 1;
+        if (boxes[b].distance_squared(edited.gbuffer.texels[i].position) <= radius_squared[b]) mark(i, lo, hi);
+      keep_range(lo, hi);
     }
-    // Read back 8 marks at a time: the near texels cluster, most words are zero.
-    near.reserve(std::min(entries, n));
-    size_t i = 0;
-    for (; i + 8 <= n; i += 8) {
+    if (lowest.load() > highest.load()) return near;
+    size_t i = lowest.load();
+    const size_t stop = size_t(highest.load()) + 1;
+    for (; i + 8 <= stop; i += 8) {
       uint64_t word;
       std::memcpy(&word, &is_near[i], 8);
       if (word == 0) continue;
       for (size_t j = i; j < i + 8; ++j)
-        if (is_near[j]) near.push_back(uint32_t(j));
+        if (is_near[j]) near.push_back(uint32_t(j)), is_near[j] = 0;
     }
-    for (; i < n; ++i)
-      if (is_near[i]) near.push_back(uint32_t(i));
+    for (; i < stop; ++i)
+      if (is_near[i]) near.push_back(uint32_t(i)), is_near[i] = 0;
     return near;
   }
   for (size_t i = 0; i < edited.gbuffer.texels.size(); ++i) {

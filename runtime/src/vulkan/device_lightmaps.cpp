@@ -75,7 +75,7 @@ LightmapPublisher::LightmapPublisher(Context& context) : context_(context) {
     const VkResult r = vkCreateComputePipelines(d, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_);
     vkDestroyShaderModule(d, module, nullptr);
     check(r, "creating the pipeline of publish.comp");
-    counts_ = context.create_storage_buffer(8);
+    counts_ = context.create_buffer(8, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);  // read by the host, no download
     warm();
   } catch (...) {
     release();
@@ -123,7 +123,8 @@ void LightmapPublisher::write_set(const std::array<VkDescriptorBufferInfo, 13>& 
 }
 
 PublishedLightmap LightmapPublisher::publish(PublishMode mode, const TexelAccumulators& accumulation, const DeviceLightmap* previous,
-                                             const DeviceLightmap* base, std::shared_ptr<DeviceLightmap> out) {
+                                             const DeviceLightmap* base, std::shared_ptr<DeviceLightmap> out,
+                                             bool clear_accumulation) {
   if ((mode != PublishMode::Accumulation && !previous) || (mode == PublishMode::Change && !base))
     throw std::logic_error("LightmapPublisher::publish: the mode reads an estimate that was not given");
   for (const DeviceLightmap* e : {previous, base})
@@ -153,13 +154,22 @@ PublishedLightmap LightmapPublisher::publish(PublishMode mode, const TexelAccumu
   const PublishPush push{uint32_t(out->texels), uint32_t(out->layers), out->directional ? 1u : 0u, uint32_t(mode)};
   vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
   vkCmdDispatch(cmd, uint32_t((out->texels + 63) / 64), 1, 1);
-  barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-  barrier.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                       0, 1, &barrier, 0, nullptr, 0, nullptr);
+  barrier.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+  barrier.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT |
+                          VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_HOST_READ_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
+                       &barrier, 0, nullptr, 0, nullptr);
+  if (clear_accumulation) {
+    accumulation.clear(cmd);
+    barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
+                         1, &barrier, 0, nullptr, 0, nullptr);
+  }
   context_.submit_and_wait(cmd);
   uint32_t counts[2] = {0, 0};
-  context_.download(counts_, counts, sizeof(counts));
+  std::memcpy(counts, counts_.mapped(), sizeof(counts));  // host-coherent: visible once the submission is done
   result.single_sample_texels = counts[0];
   result.sampled_texels = counts[1];
   return result;

@@ -44,9 +44,12 @@ class LightmapPublisher {
 
   // out := the rule of `mode` over the accumulation, `previous` and `base` (null where the mode
   // reads none; same shape as `out`). Waits for the device; returns the counts of published texels
-  // with one sample and with two or more.
+  // with one sample and with two or more (read from host-visible memory: one submission in all).
+  // `clear_accumulation`: the accumulation's sums are cleared after the dispatch, in the same
+  // submission (an edit publishes what was shown, then starts again: LightmapDriver::start's
+  // clear is then not needed).
   PublishedLightmap publish(PublishMode mode, const TexelAccumulators& accumulation, const DeviceLightmap* previous,
-                            const DeviceLightmap* base, std::shared_ptr<DeviceLightmap> out);
+                            const DeviceLightmap* base, std::shared_ptr<DeviceLightmap> out, bool clear_accumulation = false);
   // Writes `estimate`'s sums, layers and sample counts into `to` (same texels and layers).
   void upload(const LightmapEstimate& estimate, DeviceLightmap& to);
 

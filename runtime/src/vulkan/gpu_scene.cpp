@@ -295,9 +295,23 @@ void GpuScene::update_moved_geometry(const LightingScene& edited, const Bvh4Link
 
 void GpuScene::set_changed_light_pairs(const LightingScene& edited, const std::vector<GpuPunctualLight>& pairs) {
   check_same_shape(edited);
+  check_supported_by_vulkan(edited);
   std::vector<GpuPunctualLight> records = edited.punctual_lights;
   records.insert(records.end(), pairs.begin(), pairs.end());
-  if (!records.empty()) upload_growing(punctual_lights_, records.data(), records.size() * sizeof(GpuPunctualLight));
+  using Write = Context::RangeWrite;
+  std::vector<Write> writes;
+  if (!records.empty()) {
+    grow(punctual_lights_, records.size() * sizeof(GpuPunctualLight));  // room for kMaxChangedLightPairs from the start
+    writes.push_back(Write::whole(punctual_lights_, records.data(), records.size() * sizeof(GpuPunctualLight)));
+  }
+  writes.push_back(Write::whole(punctual_cdf_, edited.punctual_cdf.data(), edited.punctual_cdf.size() * sizeof(double)));
+  context_.write_ranges(writes);
+}
+
+void GpuScene::update_punctual_lights(const LightingScene& edited) {
+  check_same_shape(edited);
+  check_supported_by_vulkan(edited);
+  upload_punctual(edited);
 }
 
 void GpuScene::update_environment(const LightingScene& edited) {

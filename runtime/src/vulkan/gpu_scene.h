@@ -37,7 +37,10 @@ class GpuScene {
   // The runtime's change estimate (path.h punctual_change_rays): after `edited`'s punctual lights,
   // `pairs` of records (each edited light as edited, then as it was at the base), the buffer grown
   // to fit. The kernels read them only when GpuParams::changed_light_pairs says so.
+  // The punctual records with `pairs` after them, and the punctual CDF, in one submission.
   void set_changed_light_pairs(const LightingScene& edited, const std::vector<GpuPunctualLight>& pairs);
+  // The punctual records and CDF alone, in one submission (edits of punctual lights).
+  void update_punctual_lights(const LightingScene& edited);
 
   // After set_geometry (lighting_scene.h): uploads the triangles, the BVH nodes (in this scene's
   // node layout) and per-slot vertex copies, then what update_materials and update_lights upload,

@@ -57,7 +57,7 @@ void import_strategy_sums(const std::vector<double>& sums, GuidingChoice& choice
 // probe bake took the buffer). bake()'s: the texels of `bake_runs` (a rank's own under a split),
 // their start points written straight into the staging memory, and on the work list.
 void LightmapDriver::prepare(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, Accumulation& a,
-                             const Runs* bake_runs, Accumulation* reuse) {
+                             const Runs* bake_runs, Accumulation* reuse, bool accumulation_cleared) {
   a.texel_count = gbuffer.texels.size();
   a.recorded = std::clamp(settings.recorded_bounces, 1, kMaxRecordedBounces);
   if (a.texel_count >= (1ull << 31)) throw std::runtime_error("Vulkan backend: too many texels");
@@ -87,7 +87,11 @@ void LightmapDriver::prepare(const TexelGBuffer& gbuffer, const IntegratorSettin
   Context& context = runner_.context();
   WavefrontBuffers& buffers = runner_.buffers();
   buffers.items.reserve(context, a.texel_count);
+  const VkBuffer sums_before[3] = {buffers.texels.sums.handle(), buffers.texels.bounce_sums.handle(), buffers.texels.samples.handle()};
   buffers.texels.reserve(context, a.texel_count, a.recorded, a.directional);
+  // Buffers that grew hold nothing yet: cleared whatever the caller cleared before.
+  const bool grew = sums_before[0] != buffers.texels.sums.handle() || sums_before[1] != buffers.texels.bounce_sums.handle() ||
+                    sums_before[2] != buffers.texels.samples.handle();
   buffers.results.reserve(context, a.max_work * a.result_bytes);
   runner_.bind_buffers();
   if (bake_runs) {
@@ -106,6 +110,7 @@ void LightmapDriver::prepare(const TexelGBuffer& gbuffer, const IntegratorSettin
   } else if (!reuse || buffers.items.owner != WorkItems::Owner::Texels) {
     upload_items(a);
   }
+  if (accumulation_cleared && !grew) return;
   VkCommandBuffer cmd = context.begin();
   buffers.texels.clear(cmd);
   context.submit_and_wait(cmd);
@@ -406,7 +411,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
 }
 
 void LightmapDriver::start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, uint32_t changed_light_pairs,
-                           bool texels_as_before) {
+                           bool texels_as_before, bool accumulation_cleared) {
   const auto start_time = Clock::now();
   std::optional<Accumulation> before = std::move(progressive_);
   progressive_.reset();
@@ -414,7 +419,7 @@ void LightmapDriver::start(const TexelGBuffer& gbuffer, const IntegratorSettings
   Accumulation a;
   const bool reuse = texels_as_before && before && before->texel_count == gbuffer.texels.size() &&
                      before->start_points.size() == gbuffer.texels.size();
-  prepare(gbuffer, settings, a, nullptr, reuse ? &*before : nullptr);
+  prepare(gbuffer, settings, a, nullptr, reuse ? &*before : nullptr, accumulation_cleared);
   a.params.changed_light_pairs = changed_light_pairs;
   a.seconds = std::chrono::duration<double>(Clock::now() - start_time).count();
   progressive_ = std::move(a);

@@ -39,8 +39,10 @@ class LightmapDriver {
   // edited punctual lights (GpuParams::changed_light_pairs; their records set on the scene first).
   // `texels_as_before`: the G-buffer's texels are those of the running accumulation (an edit that
   // moved none): their start points are not derived and uploaded again, only the sums cleared.
+  // `accumulation_cleared`: the sums were cleared since the last pass (LightmapPublisher::publish
+  // with clear_accumulation): not cleared again unless their buffers had to grow.
   void start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, uint32_t changed_light_pairs = 0,
-             bool texels_as_before = false);
+             bool texels_as_before = false, bool accumulation_cleared = false);
   // `samples` more per texel (sample indices continue where the last call ended); returns the rays traced.
   uint64_t add_samples(uint32_t samples);
   // The start points of `texels` taken from `gbuffer` again (an edit moved them), on the host and,
@@ -84,7 +86,7 @@ class LightmapDriver {
   using Runs = std::vector<std::pair<size_t, size_t>>;
   // `reuse`: an accumulation over the same texels whose start points and work list `a` takes.
   void prepare(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, Accumulation& a, const Runs* bake_runs = nullptr,
-               Accumulation* reuse = nullptr);
+               Accumulation* reuse = nullptr, bool accumulation_cleared = false);
   void upload_items(const Accumulation& a);
   void run_pass(Accumulation& a, uint32_t first, uint32_t pass);
   // What a read-back fills, made ahead of time (bake(): on a thread while the passes run): the

@@ -112,22 +112,24 @@ ProbeEstimate VulkanIntegrator::bake_probes(const std::vector<Vec3>& positions, 
   return impl_->probes.bake(positions, settings);
 }
 
-void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, bool texels_as_before) {
+void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, bool texels_as_before,
+                                         bool accumulation_cleared) {
   // The progressive accumulation (exitance-relight) adds samples in calls the caller sizes, with no
   // pass where a learned table could swap: guiding runs in bake() only.
   if (settings.guiding != GuidingMode::Off)
     throw std::runtime_error("Vulkan backend: guiding runs in whole bakes only, not in progressive accumulation (relight)");
-  impl_->lightmap.start(gbuffer, settings, 0, texels_as_before);
+  impl_->lightmap.start(gbuffer, settings, 0, texels_as_before, accumulation_cleared);
 }
 void VulkanIntegrator::start_progressive_change(const TexelGBuffer& gbuffer, const IntegratorSettings& settings,
                                                 const LightingScene& edited, const std::vector<GpuPunctualLight>& pairs,
-                                                bool texels_as_before) {
+                                                bool texels_as_before, bool accumulation_cleared) {
   if (settings.guiding != GuidingMode::Off)
     throw std::runtime_error("Vulkan backend: guiding runs in whole bakes only, not in progressive accumulation (relight)");
   if (pairs.empty() || pairs.size() % 2 != 0)
     throw std::invalid_argument("Vulkan backend: a change estimate needs pairs of light records (edited, base)");
   impl_->scene.set_changed_light_pairs(edited, pairs);
-  impl_->lightmap.start(gbuffer, settings, uint32_t(pairs.size() / 2), texels_as_before);
+  impl_->lightmap.set_guiding_scene(guiding_scene(edited, impl_->created_on));
+  impl_->lightmap.start(gbuffer, settings, uint32_t(pairs.size() / 2), texels_as_before, accumulation_cleared);
 }
 uint64_t VulkanIntegrator::add_samples(uint32_t samples) { return impl_->lightmap.add_samples(samples); }
 uint64_t VulkanIntegrator::add_samples_to(const std::vector<uint32_t>& texels, uint32_t first_sample, uint32_t samples) {
@@ -135,7 +137,8 @@ uint64_t VulkanIntegrator::add_samples_to(const std::vector<uint32_t>& texels, u
 }
 LightmapEstimate VulkanIntegrator::progressive_estimate() const { return impl_->lightmap.read(); }
 
-PublishedLightmap VulkanIntegrator::publish(PublishMode mode, const DeviceLightmap* previous, const DeviceLightmap* base) {
+PublishedLightmap VulkanIntegrator::publish(PublishMode mode, const DeviceLightmap* previous, const DeviceLightmap* base,
+                                            bool clear_accumulation) {
   const LightmapDriver::Shape shape = impl_->lightmap.shape();
   // An estimate of another shape (a whole run's, with other recorded layers) is nothing to keep.
   auto fits = [&](const DeviceLightmap* e) {
@@ -162,7 +165,7 @@ PublishedLightmap VulkanIntegrator::publish(PublishMode mode, const DeviceLightm
         }
     if (impl_->spare_lightmaps.size() < Impl::kSpareLightmaps) impl_->spare_lightmaps.push_back(out);
   }
-  return impl_->publisher->publish(mode, impl_->buffers.texels, previous, base, std::move(out));
+  return impl_->publisher->publish(mode, impl_->buffers.texels, previous, base, std::move(out), clear_accumulation);
 }
 
 std::shared_ptr<DeviceLightmap> VulkanIntegrator::upload_lightmap(const LightmapEstimate& estimate) {
@@ -185,6 +188,10 @@ void VulkanIntegrator::update_materials(const LightingScene& edited) {
 }
 void VulkanIntegrator::update_lights(const LightingScene& edited) {
   impl_->scene.update_lights(edited);
+  impl_->lightmap.set_guiding_scene(guiding_scene(edited, impl_->created_on));
+}
+void VulkanIntegrator::update_punctual_lights(const LightingScene& edited) {
+  impl_->scene.update_punctual_lights(edited);
   impl_->lightmap.set_guiding_scene(guiding_scene(edited, impl_->created_on));
 }
 void VulkanIntegrator::update_moved_geometry(const LightingScene& edited, const Bvh4Links& links,

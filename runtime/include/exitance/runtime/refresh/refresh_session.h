@@ -204,8 +204,9 @@ class RefreshSession {
   // `texels_as_before`: the G-buffer's texels are those of the accumulation's last start (no
   // instance moved): not uploaded again.
   void restart(bool texels_as_before);
-  // What texels publish now (published_lightmap), composed in device memory.
-  PublishedLightmap publish_on_device() const;
+  // What texels publish now (published_lightmap), composed in device memory; `clear_accumulation`:
+  // the accumulation's sums cleared in the same submission (apply_edits, which starts it again).
+  PublishedLightmap publish_on_device(bool clear_accumulation = false) const;
   std::unique_ptr<State> state_;
 };
 

@@ -27,8 +27,10 @@ struct ChangeBefore {
   std::vector<Vec3> light_positions;                            // every light's, before the edit
   std::vector<WorldBox> moved_boxes_before, moved_boxes_after;  // per effects.moved_instances
 };
+// `marks` (with a grid; may be null): a scratch of one zero byte per texel, left zero, so that an
+// edit neither allocates nor clears a megabyte (RefreshSession keeps one).
 std::vector<uint32_t> texels_near_change(const PersistedScene& edited, const ChangeBefore& before,
                                          const LightingScene& edited_lighting, const EditEffects& effects,
-                                         const TexelGrid* grid = nullptr);
+                                         const TexelGrid* grid = nullptr, std::vector<uint8_t>* marks = nullptr);
 
 }  // namespace exitance

@@ -134,19 +134,26 @@ class VulkanIntegrator final : public Integrator {
   // bake_probes in between does not. Throws as bake() does; std::logic_error before a start.
   // `texels_as_before`: `gbuffer`'s texels are those of the running accumulation (an edit that moved
   // no instance): they are not uploaded again, only the sums cleared.
-  void start_progressive(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, bool texels_as_before = false);
+  // `accumulation_cleared`: the last publish cleared the sums (publish(..., true)) and nothing ran
+  // since: no submission to clear them again.
+  void start_progressive(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, bool texels_as_before = false,
+                         bool accumulation_cleared = false);
   // A progressive accumulation of the change of E/pi from edited punctual lights (path.h
   // punctual_change_rays: the same paths, each vertex adding an edited light's direct light as edited
   // minus as it was; no emission, no sky). `edited`: the scene as update_lights last uploaded it;
   // `pairs`: per edited light its record in `edited` then its record at the base (at least one
-  // pair). Otherwise as start_progressive; the next start_progressive estimates E/pi again.
+  // pair). Uploads `edited`'s punctual records, the pairs after them and the punctual CDF in one
+  // submission. Otherwise as start_progressive; the next start_progressive estimates E/pi again.
   void start_progressive_change(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, const LightingScene& edited,
-                                const std::vector<GpuPunctualLight>& pairs, bool texels_as_before = false);
+                                const std::vector<GpuPunctualLight>& pairs, bool texels_as_before = false,
+                                bool accumulation_cleared = false);
   // What texels publish now, composed on the device from the progressive accumulation and the
   // estimates given (null where `mode` reads none; shaped as the accumulation), into a new device
   // estimate; waits for the device (a dispatch, no read-back of the lightmap). std::logic_error
-  // before a start.
-  PublishedLightmap publish(PublishMode mode, const DeviceLightmap* previous, const DeviceLightmap* base);
+  // before a start. `clear_accumulation`: the accumulation's sums cleared in the same submission,
+  // for a start_progressive(..., accumulation_cleared = true) right after.
+  PublishedLightmap publish(PublishMode mode, const DeviceLightmap* previous, const DeviceLightmap* base,
+                            bool clear_accumulation = false);
   // A host estimate into device memory. publish() reads a previous estimate shaped otherwise than
   // the accumulation (texels, recorded layers, sh1) as none.
   std::shared_ptr<DeviceLightmap> upload_lightmap(const LightmapEstimate& estimate);
@@ -169,6 +176,9 @@ class VulkanIntegrator final : public Integrator {
   // std::runtime_error as create() for what the backend does not support.
   void update_materials(const LightingScene& edited);
   void update_lights(const LightingScene& edited);
+  // update_lights for edits of punctual lights alone: their records and CDF in one submission (the
+  // sky, and a sky image, are not uploaded again).
+  void update_punctual_lights(const LightingScene& edited);
   // After set_geometry (lighting_scene.h: moved instances, BVH refit, same triangles): uploads the
   // triangles, BVH nodes (float or quantized, as created) and leaf vertex copies, then what
   // update_materials and update_lights upload; no device or pipeline is created again (a buffer
