@@ -4,8 +4,10 @@
 # (light edits estimated as a change; docs/runtime.md) and restarted from nothing (--ignore-baked,
 # the behaviour before), each output's relMSE against two 4096-spp relights of the edited scene; with
 # REPS, first what the edit costs alone (`seconds.edits`, `edits.milliseconds`, waited submissions),
-# REPS one-frame runs per edit.
-# Env: BUNDLES (building city), EDITS (move double block), FRAMES (1 6 60), MODES (change restart), REPS (0).
+# REPS one-frame runs per edit; with COST_REPS, bench_edit_cost on each lit bundle (the edit and the
+# one undoing it in turn, COST_REPS rounds each, one sample refreshed after each edit).
+# Env: BUNDLES (building city), EDITS (move double block; sun is the courtyard's), FRAMES (1 6 60),
+# MODES (change restart), REPS (0), COST_REPS (0).
 # Writes $OUT/summary.txt.
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
@@ -25,8 +27,12 @@ import json; r=json.load(open('$1')); e=r['edits']; ms=[f['milliseconds'] for f 
 print('$2', 'edits_s %.4f'%r['seconds']['edits'], 'edit_ms', {k: round(v, 2) for k, v in e.get('milliseconds', {}).items()}, 'submissions', e.get('device_submissions'), 'moved_texels', e['moved_texels'], 'changed_lights', e['changed_lights'], 'frames', len(ms), 'frame_ms_sum %.1f max %.1f'%(sum(ms), max(ms)), 'over_17ms', sum(1 for m in ms if m > 17), 'spp', r['spp'], 'samples_added', [f['samples_added'] for f in r['frames']][:8])" >> $S
 }
 for e in ${EDITS:-move double block}; do
-  b=building; [ $e = block ] && b=city
+  b=building; [ $e = block ] && b=city; [ $e = sun ] && b=courtyard
   cp -r $W/base_$b.bake $W/base.bake.tmp && rm -rf $W/base.bake && mv $W/base.bake.tmp $W/base.bake
+  if [ ${COST_REPS:-0} -gt 0 ]; then
+    echo "bench_edit_cost $e:" >> $S
+    $W/bench_edit_cost $W/base.bake --edits $W/$e.json --edits-back $W/${e}_back.json --repeat $COST_REPS >> $S
+  fi
   for k in $(seq ${REPS:-0}); do  # the edit's cost alone, one frame, another seed each time
     $R $W/base.bake -o $W/cost.bake --edits $W/$e.json --spp 4096 --frames 1 --budget-ms 16 --seed $k --no-frame-errors --json > $W/cost.json
     report $W/cost.json ${e}_cost_$k

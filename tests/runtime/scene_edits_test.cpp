@@ -859,6 +859,28 @@ TEST(TexelsNearChange, TheGridFindsWhatAFullPassFinds) {
   const std::vector<uint32_t> full_block = texels_near_change(p, was, lighting, moved_effects);
   EXPECT_EQ(texels_near_change(p, was, lighting, moved_effects, &moved_grid), full_block);
   EXPECT_GT(full_block.size(), 20000u / 32);  // long enough for the marks path
+
+  // A low sun (14 degrees up, travelling +x): a box 3-4 m above the texels shades the texels about
+  // 13 m further along x, beyond the near radius, and those count too.
+  PunctualLight sun;
+  sun.type = PunctualLight::Type::Directional;
+  sun.direction = normalize(Vec3{0.97f, -0.243f, 0});
+  p.scene.lights.push_back(sun);
+  lighting.bounds_lo = {0, 0, 0}, lighting.bounds_hi = {40, 0.5f, 25};
+  was.moved_boxes_before = {WorldBox{{18, 3, 10}, {22, 4, 14}}};
+  was.moved_boxes_after = {WorldBox{{2, 3, 2}, {4, 4, 4}}};
+  const size_t shaded = p.gbuffer.texels.size();
+  LiveTexel in_shadow, beside;
+  in_shadow.position = {35.5f, 0.25f, 12}, beside.position = {35.5f, 0.25f, 20};
+  p.gbuffer.texels.push_back(in_shadow), p.gbuffer.texels.push_back(beside);
+  const TexelGrid sun_grid(p.gbuffer);
+  const std::vector<uint32_t> full_sun = texels_near_change(p, was, lighting, moved_effects);
+  EXPECT_TRUE(std::binary_search(full_sun.begin(), full_sun.end(), uint32_t(shaded)));
+  EXPECT_FALSE(std::binary_search(full_sun.begin(), full_sun.end(), uint32_t(shaded + 1)));
+  std::vector<uint8_t> marks(p.gbuffer.texels.size(), 0);
+  EXPECT_EQ(texels_near_change(p, was, lighting, moved_effects, &sun_grid, &marks), full_sun);
+  EXPECT_EQ(std::count(marks.begin(), marks.end(), uint8_t(0)), ptrdiff_t(marks.size()));  // left zero
+  EXPECT_EQ(texels_near_change(p, was, lighting, moved_effects, &sun_grid, &marks), full_sun);
 }
 
 }  // namespace
