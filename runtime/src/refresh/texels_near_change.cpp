@@ -135,34 +135,45 @@ std::vector<uint32_t> texels_near_change(const PersistedScene& edited, const Cha
   const size_t n = edited.gbuffer.texels.size();
   if (grid && grid->texel_count() == n) {
     // A mark per texel (the caller's zeroed scratch when given: an edit allocates and zeroes no
-    // megabyte), the rows of cells on all cores (a row lists a texel once, so one region's rows
-    // write distinct marks; regions in turn), then the marks between the lowest and highest marked
-    // texel read back in order 8 at a time (the near texels cluster), and left zero again.
+    // megabyte), the rows of cells on all cores, then the marks between the lowest and highest
+    // marked texel read back in order 8 at a time (the near texels cluster), and left zero again.
     std::vector<uint8_t> own;
     std::vector<uint8_t>& is_near = marks && marks->size() == n ? *marks : own;
     if (&is_near == &own) own.assign(n, 0);
     std::atomic<uint32_t> lowest{UINT32_MAX}, highest{0};
-    auto mark = [&](uint32_t i, uint32_t& lo, uint32_t& hi) { is_near[i] = 1, lo = std::min(lo, i), hi = std::max(hi, i); };
+    auto mark = [&](uint32_t i, uint32_t& lo, uint32_t& hi) {
+      std::atomic_ref<uint8_t>(is_near[i]).store(1, std::memory_order_relaxed);
+      lo = std::min(lo, i), hi = std::max(hi, i);
+    };
     auto keep_range = [&](uint32_t lo, uint32_t hi) {
       for (uint32_t v = lowest.load(); lo < v && !lowest.compare_exchange_weak(v, lo);) {}
       for (uint32_t v = highest.load(); hi > v && !highest.compare_exchange_weak(v, hi);) {}
     };
-    std::vector<std::pair<uint32_t, uint32_t>> rows;
-    for (const Region& region : regions) {
-      grid->candidate_rows(region.candidates, 0.0f, rows);
-      for_each_chunk(rows.size(), [&](size_t first, size_t last) {
-        uint32_t lo = UINT32_MAX, hi = 0;
-        for (size_t r = first; r < last; ++r)
-          for (uint32_t k = rows[r].first; k < rows[r].second; ++k)
-            if (region.holds(grid->entry_position(k)))
-              if (const uint32_t i = grid->entry(k); !grid->is_displaced(i)) mark(i, lo, hi);
-        keep_range(lo, hi);
-      }, 256);
-      uint32_t lo = UINT32_MAX, hi = 0;
-      for (uint32_t i : grid->displaced())
-        if (region.holds(edited.gbuffer.texels[i].position)) mark(i, lo, hi);
-      keep_range(lo, hi);
+    // Every region's rows in one pass on all cores (regions overlap: a mark is stored atomically).
+    struct Row {
+      uint32_t region, first, end;
+    };
+    std::vector<Row> rows;
+    std::vector<std::pair<uint32_t, uint32_t>> region_rows;
+    for (size_t r = 0; r < regions.size(); ++r) {
+      grid->candidate_rows(regions[r].candidates, 0.0f, region_rows);
+      for (const auto& [first, end] : region_rows) rows.push_back({uint32_t(r), first, end});
     }
+    for_each_chunk(rows.size(), [&](size_t first, size_t last) {
+      uint32_t lo = UINT32_MAX, hi = 0;
+      for (size_t r = first; r < last; ++r) {
+        const Region& region = regions[rows[r].region];
+        for (uint32_t k = rows[r].first; k < rows[r].end; ++k)
+          if (region.holds(grid->entry_position(k)))
+            if (const uint32_t i = grid->entry(k); !grid->is_displaced(i)) mark(i, lo, hi);
+      }
+      keep_range(lo, hi);
+    }, 256);
+    uint32_t lo = UINT32_MAX, hi = 0;
+    for (uint32_t i : grid->displaced())
+      if (std::any_of(regions.begin(), regions.end(), [&](const Region& region) { return region.holds(edited.gbuffer.texels[i].position); }))
+        mark(i, lo, hi);
+    keep_range(lo, hi);
     if (lowest.load() > highest.load()) return near;
     size_t i = lowest.load();
     const size_t stop = size_t(highest.load()) + 1;
