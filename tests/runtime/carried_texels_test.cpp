@@ -28,24 +28,14 @@
 #include "exitance/runtime/unocclude_texel.h"
 #include "exitance/runtime/world_box.h"
 
+#include "support/base64.h"
+
 namespace exitance {
 namespace {
 
 using json = nlohmann::json;
 
-std::string base64(const std::vector<unsigned char>& bytes) {
-  static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (size_t i = 0; i < bytes.size(); i += 3) {
-    const uint32_t b = uint32_t(bytes[i]) << 16 | (i + 1 < bytes.size() ? uint32_t(bytes[i + 1]) << 8 : 0) |
-                       (i + 2 < bytes.size() ? uint32_t(bytes[i + 2]) : 0);
-    out += table[(b >> 18) & 63];
-    out += table[(b >> 12) & 63];
-    out += i + 1 < bytes.size() ? table[(b >> 6) & 63] : '=';
-    out += i + 2 < bytes.size() ? table[b & 63] : '=';
-  }
-  return out;
-}
+using test::base64;
 
 struct Quad {
   Vec3 corner, u, v, normal;  // corner + s u + t v, s and t in [0, 1]

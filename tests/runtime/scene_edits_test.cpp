@@ -27,25 +27,15 @@
 #include "exitance/runtime/scene_file_conversion.h"
 #include "exitance/runtime/world_box.h"
 
+#include "support/base64.h"
+
 namespace exitance {
 namespace {
 
 using json = nlohmann::json;
 constexpr double kHalfUlp = 1.0 / (1 << 24);  // float's unit roundoff 2^-24
 
-std::string base64(const std::vector<unsigned char>& bytes) {
-  static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (size_t i = 0; i < bytes.size(); i += 3) {
-    const uint32_t b = uint32_t(bytes[i]) << 16 | (i + 1 < bytes.size() ? uint32_t(bytes[i + 1]) << 8 : 0) |
-                       (i + 2 < bytes.size() ? uint32_t(bytes[i + 2]) : 0);
-    out += table[(b >> 18) & 63];
-    out += table[(b >> 12) & 63];
-    out += i + 1 < bytes.size() ? table[(b >> 6) & 63] : '=';
-    out += i + 2 < bytes.size() ? table[b & 63] : '=';
-  }
-  return out;
-}
+using test::base64;
 
 // A unit quad (two triangles, +Z normals, TEXCOORD_1 = xy) used by every mesh node; a spot lamp
 // and a directional sun; a matrix node ("Group") above an emissive panel; two nodes named "Twin".

@@ -18,24 +18,14 @@
 #include "exitance/runtime/alpha_coverage.h"
 #include "exitance/runtime/material_eval.h"
 
+#include "support/base64.h"
+
 namespace exitance {
 namespace {
 
 using json = nlohmann::json;
 
-std::string base64(const std::vector<unsigned char>& bytes) {
-  static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (size_t i = 0; i < bytes.size(); i += 3) {
-    const uint32_t b = uint32_t(bytes[i]) << 16 | (i + 1 < bytes.size() ? uint32_t(bytes[i + 1]) << 8 : 0) |
-                       (i + 2 < bytes.size() ? uint32_t(bytes[i + 2]) : 0);
-    out += table[(b >> 18) & 63];
-    out += table[(b >> 12) & 63];
-    out += i + 1 < bytes.size() ? table[(b >> 6) & 63] : '=';
-    out += i + 2 < bytes.size() ? table[b & 63] : '=';
-  }
-  return out;
-}
+using test::base64;
 
 void append_floats(std::vector<unsigned char>& bytes, const std::vector<float>& values) {
   const size_t at = bytes.size();
