@@ -24,29 +24,11 @@ class TexelGrid {
   // Texel i moved (to `texel`): no longer found through its cell, visited by every query instead.
   void displace(uint32_t i, const LiveTexel& texel);
   size_t displaced_count() const { return displaced_.size(); }
-  // The texels of the cells that `box` grown by `margin` overlaps, and every displaced texel (a
-  // superset of those within `margin` of it), each once.
-  template <typename Visit>
-  void for_each_candidate(const WorldBox& box, float margin, Visit visit) const {
-    if (texels_.empty() || box.empty()) return;
-    for (uint32_t i : displaced_) visit(i);
-    int first[3], last[3];
-    for (int a = 0; a < 3; ++a) {
-      first[a] = cell_of(a, box.lo[a] - margin);
-      last[a] = cell_of(a, box.hi[a] + margin);
-    }
-    for (int z = first[2]; z <= last[2]; ++z)
-      for (int y = first[1]; y <= last[1]; ++y)
-        for (int x = first[0]; x <= last[0]; ++x) {
-          const size_t cell = (size_t(z) * size_t(cells_[1]) + size_t(y)) * size_t(cells_[0]) + size_t(x);
-          for (uint32_t k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k)
-            if (is_displaced_.empty() || !is_displaced_[texels_[k]]) visit(texels_[k]);
-        }
-  }
-  // The candidates of for_each_candidate as ranges of entries (entry(k) for k in [first, second)),
-  // one per row of cells, without the displaced texels (displaced(), which the caller visits too):
-  // for a query split across threads. A displaced texel is still listed in its row: skip it
-  // (is_displaced). Returns the number of entries the ranges hold.
+  // The texels of the cells that `box` grown by `margin` overlaps, as ranges of entries (entry(k)
+  // for k in [first, second)), one per row of cells: with displaced() (which every query visits
+  // too), a superset of the texels within `margin` of the box; rows split across threads. A
+  // displaced texel is still listed in its row: skip it (is_displaced). Returns the number of
+  // entries the ranges hold.
   size_t candidate_rows(const WorldBox& box, float margin, std::vector<std::pair<uint32_t, uint32_t>>& rows) const;
   uint32_t entry(size_t k) const { return texels_[k]; }
   // Where entry k's texel was at the build (its position now unless displaced): read in entry
