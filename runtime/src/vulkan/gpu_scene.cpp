@@ -227,9 +227,7 @@ void GpuScene::update_geometry(const LightingScene& edited) {
 }
 
 void GpuScene::update_lights(const LightingScene& edited) {
-  check_same_shape(edited);
-  check_supported_by_vulkan(edited);
-  upload_punctual(edited);
+  update_punctual_lights(edited);
   sky_ = edited.sky;
   update_environment(edited);
 }
