@@ -592,6 +592,14 @@ LightmapEstimate RefreshSession::published_lightmap() const {
   return estimate;
 }
 
+const DevicePageImages& RefreshSession::publish_page_images(int dilation_texels) {
+  State& s = *state_;
+  const PublishedLightmap published = publish_on_device();
+  return s.integrator->write_page_images(*published.lightmap, s.persisted.gbuffer, dilation_texels);
+}
+
+std::vector<float> RefreshSession::read_page_image(size_t page) const { return state_->integrator->read_page_image(page); }
+
 double RefreshSession::estimated_relative_mse(const LightmapEstimate& estimate) {
   double sum = 0;
   size_t count = 0;

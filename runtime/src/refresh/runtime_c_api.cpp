@@ -1,6 +1,7 @@
 // The C API over RefreshSession: every entry point catches every exception and turns it into an
 // ExitanceRuntimeError plus a thread-local message, so no C++ exception crosses into C.
 #include "exitance/runtime/exitance_runtime.h"
+#include "exitance/runtime/exitance_runtime_vulkan.h"
 
 #include <algorithm>
 #include <cmath>
@@ -71,6 +72,51 @@ void require(bool condition, const char* what) {
   if (!condition) throw std::invalid_argument(what);
 }
 
+// exitance_runtime_open and _open_on_device (`device` null: the runtime's own device).
+void open_runtime(const char* bundle, const ExitanceRuntimeOptions* options, const ExitanceRuntimeVulkanDevice* device,
+                  ExitanceRuntime** out_runtime) {
+  require(bundle != nullptr, "bundle is NULL");
+  require(out_runtime != nullptr, "out_runtime is NULL");
+  RefreshSessionOptions session_options;
+  if (options) {
+    session_options.device.device_index = options->device_index;
+    if (options->has_seed) session_options.seed = options->seed;
+  }
+  if (device) {
+    VulkanExternalDevice external;
+    external.instance = device->instance;
+    external.physical_device = device->physical_device;
+    external.device = device->device;
+    external.queue = device->queue;
+    external.queue_family = device->queue_family;
+    external.api_version = device->api_version;
+    external.enabled_features = device->enabled_features;
+    external.timeline_semaphore = device->timeline_semaphore != 0;
+    if (!external.instance || !external.physical_device || !external.device || !external.queue)
+      throw std::invalid_argument("device needs its instance, physical_device, device and queue");
+    session_options.device.external_device = external;
+  }
+  auto runtime = std::make_unique<ExitanceRuntime>();
+  if (!device && enumerate_vulkan_devices().empty()) throw NoDevice("no Vulkan device (no loader, driver or device)");
+  try {
+    runtime->session = RefreshSession::open(bundle, session_options);
+  } catch (const BundleInputError&) {
+    throw;
+  } catch (const std::invalid_argument&) {
+    throw;
+  } catch (const std::runtime_error& e) {
+    throw NoDevice(e.what());  // creating the backend: no usable device, or the scene needs what it lacks
+  }
+  runtime->pages = runtime->session->persisted().gbuffer.pages;
+  *out_runtime = runtime.release();
+}
+
+// How far read_page and the page images dilate colour into the gutter: as bake writes pages.
+int dilation_texels(const ExitanceRuntime* runtime) {
+  const formats::BakeSettings baked = runtime->session->manifest().settings.value_or(formats::BakeSettings{});
+  return std::max(2, int(baked.padding) * 2);
+}
+
 }  // namespace
 
 extern "C" {
@@ -78,25 +124,17 @@ extern "C" {
 ExitanceRuntimeError exitance_runtime_open(const char* bundle, const ExitanceRuntimeOptions* options,
                                            ExitanceRuntime** out_runtime) {
   if (out_runtime) *out_runtime = nullptr;
-  return guarded("exitance_runtime_open", [&] {
-    require(bundle != nullptr, "bundle is NULL");
-    require(out_runtime != nullptr, "out_runtime is NULL");
-    RefreshSessionOptions session_options;
-    if (options) {
-      session_options.device.device_index = options->device_index;
-      if (options->has_seed) session_options.seed = options->seed;
-    }
-    auto runtime = std::make_unique<ExitanceRuntime>();
-    if (enumerate_vulkan_devices().empty()) throw NoDevice("no Vulkan device (no loader, driver or device)");
-    try {
-      runtime->session = RefreshSession::open(bundle, session_options);
-    } catch (const BundleInputError&) {
-      throw;
-    } catch (const std::runtime_error& e) {
-      throw NoDevice(e.what());  // creating the backend: no usable device, or the scene needs what it lacks
-    }
-    runtime->pages = runtime->session->persisted().gbuffer.pages;
-    *out_runtime = runtime.release();
+  return guarded("exitance_runtime_open", [&] { open_runtime(bundle, options, nullptr, out_runtime); });
+}
+
+ExitanceRuntimeError exitance_runtime_open_on_device(const char* bundle, const ExitanceRuntimeOptions* options,
+                                                     const ExitanceRuntimeVulkanDevice* device,
+                                                     ExitanceRuntime** out_runtime) {
+  if (out_runtime) *out_runtime = nullptr;
+  return guarded("exitance_runtime_open_on_device", [&] {
+    require(device != nullptr, "device is NULL");
+    require(!options || options->device_index == -1, "options->device_index must be -1 on an engine's device");
+    open_runtime(bundle, options, device, out_runtime);
   });
 }
 
@@ -157,9 +195,8 @@ formats::LightmapImage assembled_page(const ExitanceRuntime* runtime, uint32_t p
     throw std::invalid_argument("page " + std::to_string(page) + " is " + std::to_string(info.width) + " x " +
                                 std::to_string(info.height) + ", not " + std::to_string(width) + " x " +
                                 std::to_string(height));
-  const formats::BakeSettings baked = runtime->session->manifest().settings.value_or(formats::BakeSettings{});
   AssemblyOptions assembly;
-  assembly.dilation_texels = std::max(2, int(baked.padding) * 2);
+  assembly.dilation_texels = dilation_texels(runtime);
   std::vector<formats::LightmapImage> pages =
       assemble_lightmap_pages(runtime->session->persisted().gbuffer, runtime->session->published_lightmap(), assembly);
   return std::move(pages.at(page));
@@ -192,6 +229,30 @@ ExitanceRuntimeError exitance_runtime_read_page_channel(ExitanceRuntime* runtime
                                   " (it has " + names + ")");
     }
     std::copy(found->second.begin(), found->second.end(), out_values);
+  });
+}
+
+ExitanceRuntimeError exitance_runtime_vulkan_device(const ExitanceRuntime* runtime, ExitanceRuntimeVulkanDevice* out_device) {
+  return guarded("exitance_runtime_vulkan_device", [&] {
+    require(runtime != nullptr && out_device != nullptr, "runtime or out_device is NULL");
+    const VulkanExternalDevice d = runtime->session->integrator().vulkan_device();
+    *out_device = {d.instance, d.physical_device, d.device, d.queue, d.queue_family, d.api_version, d.enabled_features,
+                   d.timeline_semaphore ? 1 : 0};
+  });
+}
+
+ExitanceRuntimeError exitance_runtime_publish_page_images(ExitanceRuntime* runtime, ExitanceRuntimePageImage* out_images,
+                                                          uint32_t image_count, ExitanceRuntimeImagesReady* out_ready) {
+  return guarded("exitance_runtime_publish_page_images", [&] {
+    require(runtime != nullptr && out_images != nullptr, "runtime or out_images is NULL");
+    if (image_count < runtime->pages.size())
+      throw std::invalid_argument("image_count is " + std::to_string(image_count) + ", the bundle has " +
+                                  std::to_string(runtime->pages.size()) + " pages");
+    const DevicePageImages& images = runtime->session->publish_page_images(dilation_texels(runtime));
+    for (size_t p = 0; p < images.pages.size(); ++p)
+      out_images[p] = {images.pages[p].image, images.pages[p].view, images.format, images.layout, images.pages[p].width,
+                       images.pages[p].height};
+    if (out_ready) *out_ready = {images.ready, images.ready_value, images.queue_family};
   });
 }
 

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "exitance_spirv/publish.h"
 
@@ -34,64 +35,12 @@ void set_estimate(std::array<VkDescriptorBufferInfo, kBindings>& infos, uint32_t
 
 }  // namespace
 
-LightmapPublisher::LightmapPublisher(Context& context) : context_(context) {
-  VkDevice d = context.device();
-  try {
-    std::array<VkDescriptorSetLayoutBinding, kBindings> bindings{};
-    for (uint32_t i = 0; i < kBindings; ++i) bindings[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
-    VkDescriptorSetLayoutCreateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-    set_info.bindingCount = kBindings;
-    set_info.pBindings = bindings.data();
-    check(vkCreateDescriptorSetLayout(d, &set_info, nullptr, &set_layout_), "vkCreateDescriptorSetLayout (publish)");
-    VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(PublishPush)};
-    VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-    layout_info.setLayoutCount = 1;
-    layout_info.pSetLayouts = &set_layout_;
-    layout_info.pushConstantRangeCount = 1;
-    layout_info.pPushConstantRanges = &range;
-    check(vkCreatePipelineLayout(d, &layout_info, nullptr, &layout_), "vkCreatePipelineLayout (publish)");
-    VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindings};
-    VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-    pool_info.maxSets = 1;
-    pool_info.poolSizeCount = 1;
-    pool_info.pPoolSizes = &pool_size;
-    check(vkCreateDescriptorPool(d, &pool_info, nullptr, &pool_), "vkCreateDescriptorPool (publish)");
-    VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-    alloc.descriptorPool = pool_;
-    alloc.descriptorSetCount = 1;
-    alloc.pSetLayouts = &set_layout_;
-    check(vkAllocateDescriptorSets(d, &alloc, &set_), "vkAllocateDescriptorSets (publish)");
-    VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    module_info.codeSize = sizeof(spirv_publish);
-    module_info.pCode = spirv_publish;
-    VkShaderModule module;
-    check(vkCreateShaderModule(d, &module_info, nullptr, &module), "vkCreateShaderModule (publish)");
-    VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-    info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-    info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    info.stage.module = module;
-    info.stage.pName = "main";
-    info.layout = layout_;
-    const VkResult r = vkCreateComputePipelines(d, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_);
-    vkDestroyShaderModule(d, module, nullptr);
-    check(r, "creating the pipeline of publish.comp");
-    counts_ = context.create_buffer(8, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);  // read by the host, no download
-    warm();
-  } catch (...) {
-    release();
-    throw;
-  }
-}
-
-LightmapPublisher::~LightmapPublisher() { release(); }
-
-void LightmapPublisher::release() {
-  if (context_.hung()) return;  // a running submission may still use them (Context::cleanup)
-  VkDevice d = context_.device();
-  if (pipeline_) vkDestroyPipeline(d, std::exchange(pipeline_, VK_NULL_HANDLE), nullptr);
-  if (pool_) vkDestroyDescriptorPool(d, std::exchange(pool_, VK_NULL_HANDLE), nullptr);
-  if (layout_) vkDestroyPipelineLayout(d, std::exchange(layout_, VK_NULL_HANDLE), nullptr);
-  if (set_layout_) vkDestroyDescriptorSetLayout(d, std::exchange(set_layout_, VK_NULL_HANDLE), nullptr);
+LightmapPublisher::LightmapPublisher(Context& context)
+    : context_(context),
+      kernel_(context, std::vector<VkDescriptorType>(kBindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER), sizeof(PublishPush),
+              spirv_publish, sizeof(spirv_publish), 1, "publish.comp") {
+  counts_ = context.create_buffer(8, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);  // read by the host, no download
+  warm();
 }
 
 // One dispatch over no texels, so drivers that compile a pipeline at its first dispatch (lavapipe)
@@ -101,10 +50,9 @@ void LightmapPublisher::warm() {
   for (VkDescriptorBufferInfo& info : infos) info = {counts_.handle(), 0, VK_WHOLE_SIZE};
   write_set(infos);
   VkCommandBuffer cmd = context_.begin();
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
-  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set_, 0, nullptr);
+  kernel_.bind(cmd);
   const PublishPush push{0, 1, 0, 0};
-  vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+  kernel_.push(cmd, &push, sizeof(push));
   vkCmdDispatch(cmd, 1, 1, 1);
   context_.submit_and_wait(cmd);
 }
@@ -113,7 +61,7 @@ void LightmapPublisher::write_set(const std::array<VkDescriptorBufferInfo, 13>& 
   std::array<VkWriteDescriptorSet, kBindings> writes{};
   for (uint32_t i = 0; i < kBindings; ++i) {
     writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    writes[i].dstSet = set_;
+    writes[i].dstSet = kernel_.set();
     writes[i].dstBinding = i;
     writes[i].descriptorCount = 1;
     writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
@@ -149,10 +97,9 @@ PublishedLightmap LightmapPublisher::publish(PublishMode mode, const TexelAccumu
   barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
   vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
-  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set_, 0, nullptr);
+  kernel_.bind(cmd);
   const PublishPush push{uint32_t(out->texels), uint32_t(out->layers), out->directional ? 1u : 0u, uint32_t(mode)};
-  vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+  kernel_.push(cmd, &push, sizeof(push));
   vkCmdDispatch(cmd, uint32_t((out->texels + 63) / 64), 1, 1);
   barrier.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
   barrier.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT |

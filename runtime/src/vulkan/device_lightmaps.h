@@ -10,6 +10,7 @@
 
 #include "exitance/runtime/core/estimates.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
+#include "compute_kernel.h"
 #include "vulkan_context.h"
 #include "wavefront_buffers.h"
 
@@ -38,7 +39,6 @@ constexpr size_t device_lightmap_bytes_per_texel(int layers, bool directional) {
 class LightmapPublisher {
  public:
   explicit LightmapPublisher(Context& context);
-  ~LightmapPublisher();
   LightmapPublisher(const LightmapPublisher&) = delete;
   LightmapPublisher& operator=(const LightmapPublisher&) = delete;
 
@@ -56,13 +56,8 @@ class LightmapPublisher {
  private:
   void warm();
   void write_set(const std::array<VkDescriptorBufferInfo, 13>& infos);
-  void release();
   Context& context_;
-  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
-  VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  VkDescriptorPool pool_ = VK_NULL_HANDLE;
-  VkDescriptorSet set_ = VK_NULL_HANDLE;
-  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  ComputeKernel kernel_;
   Buffer counts_;
 };
 

@@ -191,7 +191,15 @@ void Context::create_own_device(const VulkanDeviceOptions& options) {
   queue_info.queueCount = 1;
   queue_info.pQueuePriorities = &priority;
   const VkPhysicalDeviceFeatures features = vulkan_required_features();
+  // Timeline semaphores where the device has them: an engine sampling the page images waits on one.
+  VkPhysicalDeviceVulkan12Features supported12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  VkPhysicalDeviceFeatures2 supported{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  supported.pNext = &supported12;
+  vkGetPhysicalDeviceFeatures2(physical_, &supported);
+  VkPhysicalDeviceVulkan12Features enabled12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  enabled12.timelineSemaphore = supported12.timelineSemaphore;
   VkDeviceCreateInfo device_info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  device_info.pNext = &enabled12;
   device_info.queueCreateInfoCount = 1;
   device_info.pQueueCreateInfos = &queue_info;
   device_info.pEnabledFeatures = &features;
@@ -200,6 +208,8 @@ void Context::create_own_device(const VulkanDeviceOptions& options) {
     check(vkCreateDevice(physical_, &device_info, nullptr, &device_), "vkCreateDevice");
   }
   vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+  enabled_features_ = features;
+  timeline_semaphores_ = enabled12.timelineSemaphore == VK_TRUE;
 }
 
 void Context::adopt(const VulkanExternalDevice& external) {
@@ -213,6 +223,8 @@ void Context::adopt(const VulkanExternalDevice& external) {
   device_ = external.device;
   queue_ = external.queue;
   queue_family_ = external.queue_family;
+  enabled_features_ = external.enabled_features;
+  timeline_semaphores_ = external.timeline_semaphore;
   uint32_t count = 0;
   std::vector<VkPhysicalDevice> devices;
   {
@@ -289,6 +301,15 @@ uint32_t Context::find_memory_type(uint32_t bits, VkMemoryPropertyFlags required
   throw std::runtime_error("Vulkan: no suitable memory type");
 }
 
+VkDeviceMemory Context::allocate_device_local(const VkMemoryRequirements& requirements, const char* what) {
+  VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  alloc.allocationSize = requirements.size;
+  alloc.memoryTypeIndex = find_memory_type(requirements.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  check(vkAllocateMemory(device_, &alloc, nullptr, &memory), what);
+  return memory;
+}
+
 Buffer& Buffer::operator=(Buffer&& other) noexcept {
   if (this == &other) return *this;
   release();
@@ -353,10 +374,26 @@ VkCommandBuffer Context::begin() {
 }
 
 void Context::submit_and_wait(VkCommandBuffer cmd, double timeout_seconds) {
+  submit_and_wait(cmd, timeout_seconds, VK_NULL_HANDLE, 0);
+}
+
+void Context::submit_and_wait(VkCommandBuffer cmd, VkSemaphore signal, uint64_t value) {
+  submit_and_wait(cmd, 0, signal, value);
+}
+
+void Context::submit_and_wait(VkCommandBuffer cmd, double timeout_seconds, VkSemaphore signal, uint64_t value) {
   check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
   VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   submit.commandBufferCount = 1;
   submit.pCommandBuffers = &cmd;
+  VkTimelineSemaphoreSubmitInfo timeline{VK_STRUCTURE_TYPE_TIMELINE_SEMAPHORE_SUBMIT_INFO};
+  if (signal) {
+    timeline.signalSemaphoreValueCount = 1;
+    timeline.pSignalSemaphoreValues = &value;
+    submit.pNext = &timeline;
+    submit.signalSemaphoreCount = 1;
+    submit.pSignalSemaphores = &signal;
+  }
   check(vkResetFences(device_, 1, &fence_), "vkResetFences");
   VkResult r = vkQueueSubmit(queue_, 1, &submit, fence_);
   if (r == VK_ERROR_DEVICE_LOST) fail("Vulkan device lost (vkQueueSubmit)");

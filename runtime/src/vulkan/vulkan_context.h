@@ -84,6 +84,16 @@ class Context {
   const VkPhysicalDeviceMemoryProperties& memory_properties() const { return memory_properties_; }
   bool timestamps() const { return timestamp_valid_bits_ > 0; }
   bool adopted() const { return !owns_device_; }
+  // The handles an engine sharing the device needs (exitance_runtime_vulkan.h).
+  VkInstance instance() const { return instance_; }
+  VkPhysicalDevice physical_device() const { return physical_; }
+  VkQueue queue() const { return queue_; }
+  uint32_t queue_family() const { return queue_family_; }
+  VkPhysicalDeviceFeatures enabled_features() const { return enabled_features_; }
+  // Whether timeline semaphores were enabled (own device: when supported; adopted: as the engine says).
+  bool timeline_semaphores() const { return timeline_semaphores_; }
+  // Device-local memory for `requirements` (an image's), freed by the caller with vkFreeMemory.
+  VkDeviceMemory allocate_device_local(const VkMemoryRequirements& requirements, const char* what);
 
   Buffer create_buffer(VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible);
   // A device-local storage buffer; throws when `size` exceeds the device's maxStorageBufferRange.
@@ -122,6 +132,8 @@ class Context {
   // VulkanDeviceFailure on timeout or device loss.
   // `timeout_seconds` > 0 replaces the fence timeout for this submission (kernel compilation).
   void submit_and_wait(VkCommandBuffer cmd, double timeout_seconds = 0);
+  // The same, also signalling timeline semaphore `signal` to `value` when the submission completes.
+  void submit_and_wait(VkCommandBuffer cmd, VkSemaphore signal, uint64_t value);
   bool lost() const { return lost_; }
   // Submissions waited for so far and the host time spent waiting (what an edit's few small
   // uploads cost is mostly these round trips: exitance-relight --json edits.device).
@@ -144,6 +156,7 @@ class Context {
   void create_submission_objects();
   void cleanup();
   void destroy(Buffer& buffer);
+  void submit_and_wait(VkCommandBuffer cmd, double timeout_seconds, VkSemaphore signal, uint64_t value);
   uint32_t find_memory_type(uint32_t bits, VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred) const;
 
   VulkanDeviceOptions options_;
@@ -158,6 +171,8 @@ class Context {
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
   uint32_t queue_family_ = 0;
+  VkPhysicalDeviceFeatures enabled_features_{};
+  bool timeline_semaphores_ = false;
   uint32_t timestamp_valid_bits_ = 0;
   VkCommandPool pool_ = VK_NULL_HANDLE;
   VkCommandBuffer cmd_ = VK_NULL_HANDLE;

@@ -13,6 +13,7 @@
 #include "exitance/runtime/core/per_bounce_bake.h"
 #include "gpu_scene.h"
 #include "kernel_launches.h"
+#include "lightmap_page_images.h"
 #include "lightmap_driver.h"
 #include "probe_driver.h"
 #include "traversal_benchmark.h"
@@ -49,6 +50,7 @@ struct VulkanIntegrator::Impl {
   LightmapDriver lightmap;
   ProbeDriver probes;
   std::optional<LightmapPublisher> publisher;  // made at the first publish or upload
+  std::unique_ptr<LightmapPageImages> page_images;  // made at the first write_page_images
   // Device estimates publish() wrote, reused once their holders let go of them (an edit replaces
   // the previous estimate: at 1 M texels ~100 MB not allocated again).
   std::vector<std::shared_ptr<DeviceLightmap>> spare_lightmaps;
@@ -180,6 +182,34 @@ std::shared_ptr<DeviceLightmap> VulkanIntegrator::upload_lightmap(const Lightmap
 }
 
 LightmapEstimate VulkanIntegrator::read_lightmap(const DeviceLightmap& lightmap) const { return impl_->lightmap.read(lightmap); }
+
+const DevicePageImages& VulkanIntegrator::write_page_images(const DeviceLightmap& lightmap, const TexelGBuffer& gbuffer,
+                                                            int dilation_texels) {
+  if (!impl_->page_images || !impl_->page_images->fits(gbuffer, dilation_texels)) {
+    impl_->page_images.reset();
+    impl_->page_images = std::make_unique<LightmapPageImages>(impl_->context, gbuffer, dilation_texels);
+  }
+  return impl_->page_images->write(lightmap);
+}
+
+std::vector<float> VulkanIntegrator::read_page_image(size_t page) const {
+  if (!impl_->page_images) throw std::logic_error("VulkanIntegrator::read_page_image before write_page_images");
+  return impl_->page_images->read_back(page);
+}
+
+VulkanExternalDevice VulkanIntegrator::vulkan_device() const {
+  const Context& c = impl_->context;
+  VulkanExternalDevice d;
+  d.instance = c.instance();
+  d.physical_device = c.physical_device();
+  d.device = c.device();
+  d.queue = c.queue();
+  d.queue_family = c.queue_family();
+  d.api_version = VK_API_VERSION_1_2;  // what the runtime's own instance asks for; an adopted one's is at least that
+  d.enabled_features = c.enabled_features();
+  d.timeline_semaphore = c.timeline_semaphores();
+  return d;
+}
 uint32_t VulkanIntegrator::progressive_samples() const { return impl_->lightmap.samples_done(); }
 
 void VulkanIntegrator::update_materials(const LightingScene& edited) {

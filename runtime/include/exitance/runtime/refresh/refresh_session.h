@@ -172,6 +172,12 @@ class RefreshSession {
   // fewer than 2 refreshed samples, and a texel no change reaches keeps its value. A whole run
   // (bake_per_bounce, bake_guided, bake_path) is shown wherever it has samples.
   LightmapEstimate published_lightmap() const;
+  // What published_lightmap() holds, written into one RGBA32F device image per atlas page (E/pi,
+  // coverage in A, gutters dilated `dilation_texels` deep: the values assemble_lightmap_pages gives,
+  // bit for bit), with no read-back; the images stay the same objects between calls.
+  const DevicePageImages& publish_page_images(int dilation_texels);
+  // Page `page` of the last publish_page_images read back: RGBA floats, row 0 at the top.
+  std::vector<float> read_page_image(size_t page) const;
   // Samples every texel has since the last edit or restart.
   uint32_t samples_per_texel() const;
   // The texels the last edit prioritized (G-buffer indices); empty when it was not local.

@@ -25,6 +25,9 @@ struct VulkanExternalDevice {
   // The features `device` was created with (VkDeviceCreateInfo::pEnabledFeatures, or
   // VkPhysicalDeviceFeatures2::features): at least those of vulkan_required_features().
   VkPhysicalDeviceFeatures enabled_features{};
+  // Whether the device was created with VkPhysicalDeviceVulkan12Features::timelineSemaphore: then
+  // the lightmap page images an engine samples come with a timeline semaphore to wait on.
+  bool timeline_semaphore = false;
 };
 
 // What a device must be created with for the backend: shaderInt64 and shaderFloat64 (the kernels'

@@ -15,6 +15,7 @@
 #include "exitance/runtime/core/lighting_scene.h"
 #include "exitance/runtime/texel_gbuffer.h"
 #include "exitance/runtime/vulkan/vulkan_device_failure.h"
+#include "exitance/runtime/vulkan/device_page_images.h"
 #include "exitance/runtime/vulkan/vulkan_external_device.h"
 
 namespace exitance {
@@ -157,6 +158,15 @@ class VulkanIntegrator final : public Integrator {
   // A host estimate into device memory. publish() reads a previous estimate shaped otherwise than
   // the accumulation (texels, recorded layers, sh1) as none.
   std::shared_ptr<DeviceLightmap> upload_lightmap(const LightmapEstimate& estimate);
+  // Writes `lightmap` (a published estimate of `gbuffer`'s texels) into one RGBA32F device image per
+  // page, gutters dilated `dilation_texels` deep as assemble_lightmap_pages does (the same values
+  // bit for bit), after every command submitted to the queue before; waits (bounded). The images
+  // are made at the first call (and again only if the pages change) and kept until destruction.
+  const DevicePageImages& write_page_images(const DeviceLightmap& lightmap, const TexelGBuffer& gbuffer, int dilation_texels);
+  // Page `page` of the last write_page_images read back: RGBA floats, row 0 at the top.
+  std::vector<float> read_page_image(size_t page) const;
+  // The device this integrator runs on (its own, or the adopted one): what an engine sharing it needs.
+  VulkanExternalDevice vulkan_device() const;
   // A device estimate read back, with the progressive accumulation's rays, seconds and counters.
   LightmapEstimate read_lightmap(const DeviceLightmap& lightmap) const;
   uint64_t add_samples(uint32_t samples);

@@ -1,0 +1,82 @@
+/* Exitance runtime, Vulkan interop (C99): the runtime on an engine's own Vulkan device, and the
+ * lightmap pages it publishes as device images the engine samples, with the semaphore to wait on
+ * (docs/runtime.md, "Results on the device"). samples/engine_sample renders a scene with them.
+ *
+ *   ExitanceRuntimeVulkanDevice device = {instance, physical, vk_device, queue, family,
+ *                                         VK_API_VERSION_1_2, enabled_features, 1};
+ *   exitance_runtime_open_on_device("scene.bake", NULL, &device, &rt);
+ *   ...
+ *   exitance_runtime_refresh(rt, 16.0, 0, NULL);
+ *   ExitanceRuntimePageImage pages[8];
+ *   ExitanceRuntimeImagesReady ready;
+ *   exitance_runtime_publish_page_images(rt, pages, 8, &ready);
+ *   // submit the frame waiting on ready.semaphore >= ready.value (VkTimelineSemaphoreSubmitInfo),
+ *   // sampling pages[p].view in layout pages[p].layout
+ */
+#ifndef EXITANCE_RUNTIME_VULKAN_H
+#define EXITANCE_RUNTIME_VULKAN_H
+
+#include <vulkan/vulkan.h>
+
+#include "exitance_runtime.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* An engine's device, adopted by the runtime (it creates no instance or device and destroys none).
+ * The engine keeps them alive until exitance_runtime_release, and does not use `queue` from
+ * another thread during a runtime call (vkQueueSubmit needs the queue externally synchronised). */
+typedef struct ExitanceRuntimeVulkanDevice {
+  VkInstance instance;
+  VkPhysicalDevice physical_device;
+  VkDevice device;
+  VkQueue queue;         /* of `queue_family`, which supports compute; the runtime submits here */
+  uint32_t queue_family;
+  uint32_t api_version;  /* VkApplicationInfo::apiVersion of the instance: 1.2 or later */
+  VkPhysicalDeviceFeatures enabled_features; /* what the device was created with: shaderInt64, shaderFloat64 at least */
+  int32_t timeline_semaphore; /* 1: created with VkPhysicalDeviceVulkan12Features::timelineSemaphore */
+} ExitanceRuntimeVulkanDevice;
+
+/* exitance_runtime_open on the engine's device. options->device_index must be -1 (the device is
+ * the engine's); a device that lacks what the runtime needs is EXITANCE_RUNTIME_NO_DEVICE naming it. */
+ExitanceRuntimeError exitance_runtime_open_on_device(const char* bundle, const ExitanceRuntimeOptions* options,
+                                                     const ExitanceRuntimeVulkanDevice* device,
+                                                     ExitanceRuntime** out_runtime);
+
+/* The device the runtime runs on: the adopted one, or the one it created (whose queue family
+ * supports compute; an engine rendering on it checks the family for graphics itself). */
+ExitanceRuntimeError exitance_runtime_vulkan_device(const ExitanceRuntime* runtime, ExitanceRuntimeVulkanDevice* out_device);
+
+/* One lightmap page in device memory. */
+typedef struct ExitanceRuntimePageImage {
+  VkImage image;
+  VkImageView view;     /* 2D, the whole image */
+  VkFormat format;      /* VK_FORMAT_R32G32B32A32_SFLOAT: E/pi in R, G, B; the texel coverage in A */
+  VkImageLayout layout; /* VK_IMAGE_LAYOUT_GENERAL, always: sample it in this layout */
+  uint32_t width;
+  uint32_t height;
+} ExitanceRuntimePageImage;
+
+/* When the images may be read. */
+typedef struct ExitanceRuntimeImagesReady {
+  VkSemaphore semaphore; /* timeline semaphore; VK_NULL_HANDLE on a device without timeline semaphores */
+  uint64_t value;        /* wait until the semaphore reaches it before reading the images */
+  uint32_t queue_family; /* the images are owned by this family (VK_SHARING_MODE_EXCLUSIVE) */
+} ExitanceRuntimeImagesReady;
+
+/* Writes what the runtime publishes now into one device image per page (the values read_page
+ * returns: E/pi, gutters dilated the same way) and describes them in out_images[0 .. page_count-1];
+ * image_count must be at least exitance_runtime_page_count. The images and views are the same on
+ * every call and valid until exitance_runtime_release; only this call writes them, on the
+ * runtime's queue, after every command submitted to that queue before it (so an engine's reads
+ * submitted to the same queue finish first; reads on another queue must be finished by the
+ * engine). No host read-back. out_ready may be NULL. */
+ExitanceRuntimeError exitance_runtime_publish_page_images(ExitanceRuntime* runtime, ExitanceRuntimePageImage* out_images,
+                                                          uint32_t image_count, ExitanceRuntimeImagesReady* out_ready);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* EXITANCE_RUNTIME_VULKAN_H */
