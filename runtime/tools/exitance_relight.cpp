@@ -40,6 +40,9 @@ int main(int argc, char** argv) {
   bool no_frame_errors = false, ignore_baked = false;
   app.add_flag("--ignore-baked", ignore_baked,
                "start every texel from nothing instead of from the bundle's baked lightmap (which is shown until refreshed samples are better, and which light edits are estimated as a change from)");
+  app.add_flag("--page-images", options.page_images,
+               "with --frames: after each frame, write the lightmap pages into the device images an engine samples "
+               "(exitance_runtime_publish_page_images) and report its milliseconds per frame");
   app.add_flag("--no-frame-errors", no_frame_errors,
                "with --frames: no per-frame error (it reads the lightmap back between frames, which idles the GPU)");
   app.add_option("--integrator", options.integrator,

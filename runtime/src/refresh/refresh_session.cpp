@@ -598,6 +598,11 @@ const DevicePageImages& RefreshSession::publish_page_images(int dilation_texels)
   return s.integrator->write_page_images(*published.lightmap, s.persisted.gbuffer, dilation_texels);
 }
 
+int RefreshSession::page_dilation_texels() const {
+  const formats::BakeSettings baked = state_->manifest.settings.value_or(formats::BakeSettings{});
+  return std::max(2, int(baked.padding) * 2);
+}
+
 std::vector<float> RefreshSession::read_page_image(size_t page) const { return state_->integrator->read_page_image(page); }
 
 double RefreshSession::estimated_relative_mse(const LightmapEstimate& estimate) {

@@ -59,7 +59,7 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   stage("write");
   AssemblyOptions assembly;
   assembly.bounce_layers = manifest.has_bounce_layers();
-  assembly.dilation_texels = std::max(2, int(baked.padding) * 2);
+  assembly.dilation_texels = session.page_dilation_texels();
   std::vector<formats::LightmapImage> pages = assemble_lightmap_pages(persisted.gbuffer, estimate, assembly);
   // Seams stitched as `bake` stitched them (seam_stage.h), or only measured where it ran --seams off.
   stage("seams");

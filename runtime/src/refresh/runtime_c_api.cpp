@@ -111,11 +111,7 @@ void open_runtime(const char* bundle, const ExitanceRuntimeOptions* options, con
   *out_runtime = runtime.release();
 }
 
-// How far read_page and the page images dilate colour into the gutter: as bake writes pages.
-int dilation_texels(const ExitanceRuntime* runtime) {
-  const formats::BakeSettings baked = runtime->session->manifest().settings.value_or(formats::BakeSettings{});
-  return std::max(2, int(baked.padding) * 2);
-}
+int dilation_texels(const ExitanceRuntime* runtime) { return runtime->session->page_dilation_texels(); }
 
 }  // namespace
 

@@ -32,6 +32,8 @@ json relight_bundle(const RelightOptions& options) {
   const bool per_bounce = options.integrator == "bounces";
   if (!per_bounce && options.integrator != "path")
     throw RelightInputError("--integrator " + options.integrator + ": expected path or bounces");
+  if (options.page_images && options.frames == 0)
+    throw RelightInputError("--page-images reports per frame: it needs --frames");
   if (per_bounce && (options.frames > 0 || options.frame_budget_ms > 0))
     throw RelightInputError("--integrator bounces runs the whole lightmap at once: --frames and --budget-ms need --integrator path");
   if (options.guiding == "auto")
@@ -158,6 +160,11 @@ json relight_bundle(const RelightOptions& options) {
       // Per-frame figures cost a read-back of the sums, outside the frame's time.
       json entry = {{"frame", frame}, {"milliseconds", r.milliseconds}, {"rays", r.rays},
                     {"samples_added", r.samples_added}, {"samples_per_texel", r.samples_per_texel}};
+      if (options.page_images) {  // what an engine's frame adds to hand the pages over on the device
+        const auto images_start = Clock::now();
+        session->publish_page_images(session->page_dilation_texels());
+        entry["page_images_milliseconds"] = std::chrono::duration<double, std::milli>(Clock::now() - images_start).count();
+      }
       const LightmapEstimate now = options.frame_errors ? session->refreshed_lightmap() : LightmapEstimate{};
       if (options.frame_errors) {
         const double error = RefreshSession::estimated_relative_mse(now);

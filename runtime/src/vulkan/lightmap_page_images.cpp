@@ -88,6 +88,12 @@ LightmapPageImages::LightmapPageImages(Context& context, const TexelGBuffer& gbu
     images_.format = kFormat;
     images_.layout = VK_IMAGE_LAYOUT_GENERAL;
     images_.queue_family = context.queue_family();
+    // Shared by every queue family of the device, so an engine reading them on another family
+    // needs no ownership transfer (only the semaphore wait).
+    uint32_t family_count = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(context.physical_device(), &family_count, nullptr);
+    std::vector<uint32_t> families(family_count);
+    for (uint32_t f = 0; f < family_count; ++f) families[f] = f;
     for (const AtlasPage& page : gbuffer.pages) {
       DevicePageImage image;
       image.width = uint32_t(page.width);
@@ -101,7 +107,8 @@ LightmapPageImages::LightmapPageImages(Context& context, const TexelGBuffer& gbu
       info.samples = VK_SAMPLE_COUNT_1_BIT;
       info.tiling = VK_IMAGE_TILING_OPTIMAL;
       info.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-      info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+      info.sharingMode = family_count > 1 ? VK_SHARING_MODE_CONCURRENT : VK_SHARING_MODE_EXCLUSIVE;
+      if (family_count > 1) info.queueFamilyIndexCount = family_count, info.pQueueFamilyIndices = families.data();
       info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
       check(vkCreateImage(d, &info, nullptr, &image.image), "vkCreateImage (a lightmap page)");
       images_.pages.push_back(image);

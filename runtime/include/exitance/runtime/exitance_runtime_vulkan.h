@@ -62,11 +62,14 @@ typedef struct ExitanceRuntimePageImage {
 typedef struct ExitanceRuntimeImagesReady {
   VkSemaphore semaphore; /* timeline semaphore; VK_NULL_HANDLE on a device without timeline semaphores */
   uint64_t value;        /* wait until the semaphore reaches it before reading the images */
-  uint32_t queue_family; /* the images are owned by this family (VK_SHARING_MODE_EXCLUSIVE) */
+  uint32_t queue_family; /* the family the runtime writes them on; the images are shared by every
+                            family of the device (VK_SHARING_MODE_CONCURRENT): no ownership transfer */
 } ExitanceRuntimeImagesReady;
 
 /* Writes what the runtime publishes now into one device image per page (the values read_page
- * returns: E/pi, gutters dilated the same way) and describes them in out_images[0 .. page_count-1];
+ * returns: E/pi, gutters dilated the same way; at open the bundle's baked lightmap when it was baked
+ * with at least 16 samples per texel, else 0 until refreshed) and describes them in
+ * out_images[0 .. page_count-1];
  * image_count must be at least exitance_runtime_page_count. The images and views are the same on
  * every call and valid until exitance_runtime_release; only this call writes them, on the
  * runtime's queue, after every command submitted to that queue before it (so an engine's reads

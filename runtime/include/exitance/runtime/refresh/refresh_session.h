@@ -176,6 +176,9 @@ class RefreshSession {
   // coverage in A, gutters dilated `dilation_texels` deep: the values assemble_lightmap_pages gives,
   // bit for bit), with no read-back; the images stay the same objects between calls.
   const DevicePageImages& publish_page_images(int dilation_texels);
+  // How deep pages dilate colour into the gutter, as bake writes them: twice the bake's chart
+  // padding, at least 2 (read_page, the page images and write_refreshed_bundle use it).
+  int page_dilation_texels() const;
   // Page `page` of the last publish_page_images read back: RGBA floats, row 0 at the top.
   std::vector<float> read_page_image(size_t page) const;
   // Samples every texel has since the last edit or restart.

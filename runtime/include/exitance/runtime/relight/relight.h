@@ -27,6 +27,7 @@ struct RelightOptions {
   double frame_budget_ms = 0;      // > 0: each frame (refresh call)
   uint32_t frames = 0;             // > 0: at most this many frames
   bool from_baked = true;          // start from the bundle's baked lightmap (RefreshSessionOptions::start_from_baked)
+  bool page_images = false;        // with frames: after each frame, the page images an engine samples written (publish_page_images), timed
   bool frame_errors = true;        // with frames: each frame's estimated error (a read-back of the sums between frames)
   std::optional<uint64_t> seed;    // default: the bake's
   int device_index = -1;           // Vulkan device; -1 = prefer a discrete GPU

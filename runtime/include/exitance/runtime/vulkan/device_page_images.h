@@ -20,7 +20,7 @@ struct DevicePageImages {
   VkImageLayout layout = VK_IMAGE_LAYOUT_GENERAL;   // always
   VkSemaphore ready = VK_NULL_HANDLE;  // timeline semaphore (none on a device without them)
   uint64_t ready_value = 0;            // reached when the last write is done
-  uint32_t queue_family = 0;           // owner of the images (exclusive sharing)
+  uint32_t queue_family = 0;           // the family they are written on (shared by every family: concurrent)
 };
 
 }  // namespace exitance
