@@ -44,6 +44,10 @@ struct RefreshSession::State {
     double last_work = 0, last_ms = 0;  // texel-samples and milliseconds of the last pass
     double fixed_ms = 0, ms_per_work = 0;
     bool fitted = false, explored = false;
+    // Not measured on this list yet: the cost is the last list's, a prior (a texel-sample costs
+    // about the same in any list), used with kPriorShare of the time left.
+    bool prior = false;
+    static constexpr double kPriorShare = 0.75;
     void add(double work, double ms) {
       if (last_work > 0 && work != last_work) {
         const double slope = (ms - last_ms) / (work - last_work), intercept = ms - slope * work;
@@ -51,11 +55,19 @@ struct RefreshSession::State {
       }
       if (!fitted) fixed_ms = 0, ms_per_work = ms / work;
       last_work = work, last_ms = ms;
+      prior = false;
     }
     // Samples of `texels` that fit in `remaining` ms; 0 when none.
     double fitting(double remaining, size_t texels) const {
       const double per_sample = ms_per_work * double(texels);
-      return per_sample > 0 ? std::floor((remaining - fixed_ms) / per_sample) : 1.0;
+      const double usable = prior ? kPriorShare * remaining : remaining;
+      return per_sample > 0 ? std::floor((usable - fixed_ms) / per_sample) : 1.0;
+    }
+    // A model for another list of `list_texels`, starting from this one's cost as its prior.
+    PassCost for_list(size_t list_texels) const {
+      PassCost next{list_texels};
+      if (ms_per_work > 0) next.fixed_ms = fixed_ms, next.ms_per_work = ms_per_work, next.prior = true;
+      return next;
     }
   } pass_cost;
   uint32_t priority_samples = 16;
@@ -447,10 +459,13 @@ RefreshReport RefreshSession::refresh(const RefreshBudget& budget) {
       const double remaining = budget.milliseconds - elapsed_ms();
       if (remaining <= 0) break;
       if (s.pass_cost.texels != list->size()) {
-        // A list not measured yet: its first pass (one sample) only at the start of a call, where
-        // the whole budget is left for it.
-        if (report.rays > 0) break;
-        s.pass_cost = State::PassCost{list->size()};
+        // A list not measured yet (the texels near an edit, then the others): sized from the last
+        // list's cost per texel-sample with a margin, so the texels near an edit get several
+        // samples in the call right after it, not one (the publishing rule needs 2 for a change,
+        // 8 for a restart). With nothing measured at all, one sample, and only at the start of a
+        // call, where the whole budget is left for it.
+        if (!(s.pass_cost.ms_per_work > 0) && report.rays > 0) break;
+        s.pass_cost = s.pass_cost.for_list(list->size());
       }
       double fitting = s.pass_cost.fitting(remaining, list->size());
       // A long budget (a whole relight under --time) is not spent in one pass sized by a model fitted
