@@ -379,6 +379,17 @@ void Context::submit_and_wait(VkCommandBuffer cmd, double timeout_seconds) {
 
 void Context::submit_and_wait(VkCommandBuffer cmd, VkSemaphore signal, uint64_t value) {
   submit_and_wait(cmd, 0, signal, value);
+  VkSemaphoreWaitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
+  wait.semaphoreCount = 1;
+  wait.pSemaphores = &signal;
+  wait.pValues = &value;
+  const VkResult r = vkWaitSemaphores(device_, &wait, uint64_t(std::max(0.001, options_.fence_timeout_seconds) * 1e9));
+  if (r == VK_TIMEOUT) {
+    hung_ = true;
+    fail("Vulkan timeline semaphore did not reach its value within the fence timeout");
+  }
+  if (r == VK_ERROR_DEVICE_LOST) fail("Vulkan device lost (vkWaitSemaphores)");
+  check(r, "vkWaitSemaphores");
 }
 
 void Context::submit_and_wait(VkCommandBuffer cmd, double timeout_seconds, VkSemaphore signal, uint64_t value) {

@@ -132,7 +132,8 @@ class Context {
   // VulkanDeviceFailure on timeout or device loss.
   // `timeout_seconds` > 0 replaces the fence timeout for this submission (kernel compilation).
   void submit_and_wait(VkCommandBuffer cmd, double timeout_seconds = 0);
-  // The same, also signalling timeline semaphore `signal` to `value` when the submission completes.
+  // The same, also signalling timeline semaphore `signal` to `value`, and waiting (bounded alike)
+  // until the semaphore shows it too (lavapipe was seen to signal the fence first).
   void submit_and_wait(VkCommandBuffer cmd, VkSemaphore signal, uint64_t value);
   bool lost() const { return lost_; }
   // Submissions waited for so far and the host time spent waiting (what an edit's few small
