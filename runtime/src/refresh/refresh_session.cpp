@@ -44,16 +44,24 @@ struct RefreshSession::State {
     double last_work = 0, last_ms = 0;  // texel-samples and milliseconds of the last pass
     double fixed_ms = 0, ms_per_work = 0;
     bool fitted = false, explored = false;
-    // Not measured on this list yet: the cost is the last list's, a prior (a texel-sample costs
-    // about the same in any list), used with kPriorShare of the time left.
+    // Not measured on this list yet: the cost is the last list's, a prior, whose passes get
+    // kPriorShare of the time left (a list's texels can cost more per sample than the last list's:
+    // the texels near an edit are not a random subset).
     bool prior = false;
-    static constexpr double kPriorShare = 0.75;
+    static constexpr double kPriorShare = 0.6;
+    // The last list's fitted fixed part (a pass's drain and submissions, whichever its texels):
+    // until this list has two pass sizes, its one measurement gives the part per texel-sample
+    // beyond it (without, that part also carries the fixed cost, and the next pass is sized small).
+    double known_fixed_ms = 0;
     void add(double work, double ms) {
       if (last_work > 0 && work != last_work) {
         const double slope = (ms - last_ms) / (work - last_work), intercept = ms - slope * work;
         if (slope > 0 && intercept >= 0) fixed_ms = intercept, ms_per_work = slope, fitted = true;
       }
-      if (!fitted) fixed_ms = 0, ms_per_work = ms / work;
+      if (!fitted) {
+        fixed_ms = ms > 2 * known_fixed_ms ? known_fixed_ms : 0;
+        ms_per_work = (ms - fixed_ms) / work;
+      }
       last_work = work, last_ms = ms;
       prior = false;
     }
@@ -67,6 +75,8 @@ struct RefreshSession::State {
     PassCost for_list(size_t list_texels) const {
       PassCost next{list_texels};
       if (ms_per_work > 0) next.fixed_ms = fixed_ms, next.ms_per_work = ms_per_work, next.prior = true;
+      if (fitted) next.known_fixed_ms = fixed_ms;
+      else next.known_fixed_ms = known_fixed_ms;
       return next;
     }
   } pass_cost;
@@ -459,11 +469,10 @@ RefreshReport RefreshSession::refresh(const RefreshBudget& budget) {
       const double remaining = budget.milliseconds - elapsed_ms();
       if (remaining <= 0) break;
       if (s.pass_cost.texels != list->size()) {
-        // A list not measured yet (the texels near an edit, then the others): sized from the last
-        // list's cost per texel-sample with a margin, so the texels near an edit get several
-        // samples in the call right after it, not one (the publishing rule needs 2 for a change,
-        // 8 for a restart). With nothing measured at all, one sample, and only at the start of a
-        // call, where the whole budget is left for it.
+        // A list not measured yet (the texels near an edit, then the others) is sized from the
+        // last list's cost and starts within the call (before, a call ended at a list switch and
+        // left its budget unused, and the list's first pass was one sample); with nothing
+        // measured at all, one sample, only at the start of a call, where the whole budget is left.
         if (!(s.pass_cost.ms_per_work > 0) && report.rays > 0) break;
         s.pass_cost = s.pass_cost.for_list(list->size());
       }
