@@ -3,7 +3,8 @@
 # Installs the runtime component of BUILD_DIR into WORK_DIR/prefix (exitance-relight, the shared
 # libexitance_runtime and the few shared libraries they need) and checks that the folder is
 # relocatable and links nothing of the offline stage: no Embree, TBB, OpenImageIO, OpenVDB, CGAL;
-# the shared library uses the system's libstdc++ (no static C++ runtime inside a .so).
+# the shared library uses the system's libstdc++ (no static C++ runtime inside a .so); a C program
+# builds against the installed headers and library.
 set -euo pipefail
 build_dir=$1 work=$2 cmake=$3
 forbidden='libembree|libtbb|libOpenImageIO|libopenvdb|libCGAL|libtinygltf|libssl|libcrypto'
@@ -36,6 +37,22 @@ for binary in "$tool" "$library"; do
 done
 readelf -d "$library" | grep NEEDED | grep -q 'libstdc++' \
   || { echo "FAIL: libexitance_runtime.so does not use the shared libstdc++"; exit 1; }
+
+# An engine's C program compiles against the installed headers and links the installed library.
+cat >"$work/engine.c" <<'C'
+#include <stdio.h>
+#include "exitance/runtime/exitance_runtime.h"
+#include "exitance/runtime/exitance_runtime_vulkan.h"
+int main(int argc, char** argv) {
+  ExitanceRuntime* rt = NULL;
+  ExitanceRuntimeError e = exitance_runtime_open_on_device(argv[1], NULL, NULL, &rt);
+  printf("%d %s\n", (int)e, exitance_runtime_last_error_message());
+  return e == EXITANCE_RUNTIME_INVALID_ARGUMENT && rt == NULL ? 0 : 1;
+}
+C
+cc -std=c99 -pedantic-errors -I"$work/moved/include" "$work/engine.c" -L"$(dirname "$library")" -lexitance_runtime \
+   -Wl,-rpath,"$(dirname "$library")" -o "$work/engine" || { echo "FAIL: a C program does not build against the installed runtime"; exit 1; }
+"$work/engine" "$work/no-such-bundle" || { echo "FAIL: the installed runtime's C API"; exit 1; }
 
 env -i "$tool" --help >/dev/null || { echo "FAIL: exitance-relight --help"; exit 1; }
 set +e
