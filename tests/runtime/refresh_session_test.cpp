@@ -80,6 +80,38 @@ TEST(RefreshSession, FramesAddUpToTheBakesSamplesBitForBit) {
   expect_same_sums(progressive, baked);
 }
 
+// Budgets smaller than one sample of the lightmap: each call refreshes part of the texels, the next
+// goes on where it stopped, and after the calls that add up to N samples of every texel the sums
+// equal a bake's N samples bit for bit (each texel took its samples in order).
+TEST(RefreshSession, CallsShorterThanASampleAddUpToTheBakesSamples) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  auto session = RefreshSession::open(baked_bundle().string());
+  const uint64_t texels = session->persisted().gbuffer.texels.size();
+  ASSERT_GT(texels, 8u);
+  const uint64_t third = (texels + 2) / 3;  // three calls per sample, the last one shorter
+  RefreshReport r = session->refresh({0, 0, third});
+  EXPECT_EQ(r.samples_per_texel, 0u);  // a third of the texels have one sample
+  EXPECT_GT(r.rays, 0u);
+  EXPECT_EQ(session->lightmap().texels[0].samples, 1u);
+  EXPECT_EQ(session->lightmap().texels[texels - 1].samples, 0u);
+  r = session->refresh({0, 0, third});
+  r = session->refresh({0, 0, texels - 2 * third});
+  EXPECT_EQ(r.samples_per_texel, 1u);
+  for (const TexelAccumulator& t : session->lightmap().texels) ASSERT_EQ(t.samples, 1u);
+  EXPECT_EQ(r.samples_added, 1u);
+  r = session->refresh({0, 0, texels + third});  // one whole sample, then a third of the next
+  EXPECT_EQ(r.samples_per_texel, 2u);
+  r = session->refresh({0, 2, 10 * texels});  // the cap counts whole samples: 2 reached, nothing added
+  EXPECT_EQ(r.samples_per_texel, 2u);
+  r = session->refresh({0, 0, 2 * texels - third});  // what is left of the third sample, then a whole fourth
+  EXPECT_EQ(r.samples_per_texel, 4u);
+  const LightmapEstimate progressive = session->lightmap();
+  for (const TexelAccumulator& t : progressive.texels) ASSERT_EQ(t.samples, 4u);
+  IntegratorSettings settings = session->settings();
+  settings.spp = 4;
+  expect_same_sums(progressive, session->integrator().bake(session->persisted().gbuffer, settings));
+}
+
 TEST(RefreshSession, RestartDropsEverySample) {
   if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
   auto session = RefreshSession::open(baked_bundle().string());

@@ -99,6 +99,9 @@ struct RefreshSession::State {
   EditTimings edit_timings;
   OpenTimings open_timings;
   uint32_t near_samples = 0, far_samples = 0, all_samples = 0;
+  // Texels [0, partial) of the list being refreshed have one sample more than its count: a sample
+  // of the list under way, in passes over parts of it (refresh(): a budget shorter than a sample).
+  size_t partial = 0;
   // What texels showed before the last edit (published_lightmap keeps it until the refreshed
   // estimate is better; published_estimate.h); at open, the bundle's baked lightmap. In device
   // memory (VulkanIntegrator::publish composes what is published there); shared with `base` when a
@@ -125,6 +128,7 @@ struct RefreshSession::State {
     near_texels.clear();
     far_texels.clear();
     near_samples = far_samples = all_samples = 0;
+    partial = 0;
   }
 };
 
@@ -409,6 +413,9 @@ uint32_t RefreshSession::samples_per_texel() const {
   return s.all_samples;
 }
 
+// The fewest texels a pass over part of a list takes (refresh(), below): smaller ones are mostly
+// their fixed cost.
+constexpr size_t kLeastPartTexels = 4096;
 // Budgets above this (ms) are spent in passes of at most half of what is left (refresh(), below).
 constexpr double kHalvingAboveMs = 50;
 
@@ -457,10 +464,17 @@ RefreshReport RefreshSession::refresh(const RefreshBudget& budget) {
     }
     if (*count >= limit) break;
     uint32_t pass = limit - *count;
+    // A pass is `pass` whole samples of the list or, with `part` > 0, one sample of its texels
+    // [s.partial, s.partial + part): when less than one sample of the list fits the budget, or one
+    // is under way (each texel still takes its samples in order, as in a bake; a list is left only
+    // once its sample is complete).
+    size_t part = s.partial > 0 ? list->size() - s.partial : 0;
     if (budget.texel_samples > 0) {
-      const uint64_t fitting = (budget.texel_samples - std::min(budget.texel_samples, used)) / list->size();
-      if (fitting == 0) break;
-      pass = uint32_t(std::min<uint64_t>(pass, fitting));
+      const uint64_t left = budget.texel_samples - std::min(budget.texel_samples, used);
+      if (left == 0) break;
+      if (part > 0) part = size_t(std::min<uint64_t>(part, left));
+      else if (left < list->size()) part = size_t(left);
+      else pass = uint32_t(std::min<uint64_t>(pass, left / list->size()));
     }
     if (budget.milliseconds > 0) {
       // Passes sized from the measured pass cost, so the call ends near its budget; the first
@@ -483,21 +497,45 @@ RefreshReport RefreshSession::refresh(const RefreshBudget& budget) {
       // nearer the final size and only the last, short pass relies on it.
       if (remaining > kHalvingAboveMs && fitting >= 2)
         fitting = std::max(1.0, std::min(fitting, s.pass_cost.fitting(0.5 * remaining, list->size())));
-      if (!s.pass_cost.fitted && !s.pass_cost.explored && s.pass_cost.last_work > 0 && fitting >= 1 &&
+      if (part == 0 && !s.pass_cost.fitted && !s.pass_cost.explored && s.pass_cost.last_work > 0 && fitting >= 1 &&
           remaining >= 1.25 * s.pass_cost.last_ms) {
         fitting += 1;
         s.pass_cost.explored = true;
       }
-      if (fitting < 1 && report.rays > 0) break;  // the next sample would overrun the budget
-      pass = uint32_t(std::clamp(fitting, 1.0, double(pass)));
+      if (part > 0 || (fitting < 1 && s.pass_cost.ms_per_work > 0)) {
+        // One sample of as many of the list's texels as fit (a frame shorter than one sample of
+        // the lightmap: lavapipe, or a budget of a millisecond or two on a GPU), at least
+        // kLeastPartTexels, and that only as a call's first pass (a call adds at least one).
+        if (part == 0) part = list->size();
+        const double usable = (s.pass_cost.prior ? State::PassCost::kPriorShare : 1.0) * remaining - s.pass_cost.fixed_ms;
+        const double fit = std::floor(usable / s.pass_cost.ms_per_work);
+        const size_t least = std::min(part, kLeastPartTexels);
+        if (fit < double(least)) {
+          if (report.rays > 0) break;
+          part = least;
+        } else if (fit < double(part)) {
+          part = size_t(fit);
+        }
+      } else {
+        pass = uint32_t(std::clamp(fitting, 1.0, double(pass)));
+      }
     }
     const auto pass_start = Clock::now();
-    report.rays += integrator.add_samples_to(*list, *count, pass);
-    used += uint64_t(pass) * list->size();
-    *count += pass;
+    double work = 0;
+    if (part > 0) {
+      const std::vector<uint32_t> texels(list->begin() + std::ptrdiff_t(s.partial), list->begin() + std::ptrdiff_t(s.partial + part));
+      report.rays += integrator.add_samples_to(texels, *count, 1);
+      s.partial += part;
+      if (s.partial == list->size()) s.partial = 0, ++*count;
+      work = double(part);
+    } else {
+      report.rays += integrator.add_samples_to(*list, *count, pass);
+      *count += pass;
+      work = double(pass) * double(list->size());
+    }
+    used += uint64_t(work);
     if (list == &s.near_texels) report.prioritized_texels = uint32_t(list->size());
-    s.pass_cost.add(double(pass) * double(list->size()),
-                    std::chrono::duration<double, std::milli>(Clock::now() - pass_start).count());
+    s.pass_cost.add(work, std::chrono::duration<double, std::milli>(Clock::now() - pass_start).count());
     if (budget.milliseconds > 0 && elapsed_ms() >= budget.milliseconds) break;
   }
   report.samples_per_texel = samples_per_texel();

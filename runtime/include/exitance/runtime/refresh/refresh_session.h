@@ -64,7 +64,9 @@ struct RefreshBudget {
   double milliseconds = 0;             // wall-clock time of the call; 0 = no time limit
   uint32_t max_samples_per_texel = 0;  // cap on the accumulated samples; 0 = no cap
   // Work of the call in texel-samples (a pass of n samples over m texels is n * m); 0 = no limit.
-  // Unlike milliseconds, deterministic: the same calls give the same results on any machine.
+  // Unlike milliseconds, deterministic: the same calls give the same results on any machine. Less
+  // than one sample of the texels refreshed is one sample of that many of them (the next call goes
+  // on from there), as a millisecond budget shorter than one sample is.
   uint64_t texel_samples = 0;
 };
 
