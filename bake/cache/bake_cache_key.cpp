@@ -12,11 +12,11 @@ namespace {
 // Not hashed: work_share (how many processes lit a bake does not change its bits: issue 15),
 // guiding_octree (the bake's own octree, from the hashed voxel options), the inspect callbacks and
 // budget_clock (the time budget's clock; the budget itself is hashed).
-static_assert(sizeof(IntegratorSettings) == 280, "IntegratorSettings changed: hash the new field in bake_cache_key");
+static_assert(sizeof(IntegratorSettings) == 288, "IntegratorSettings changed: hash the new field in bake_cache_key");
 static_assert(sizeof(AtlasSettings) == 24, "AtlasSettings changed: hash the new field in bake_cache_key");
 // Not hashed: input and output paths (the input's name and bytes are), cache_directory and
 // write_gltf (where results go does not change them), progress.
-static_assert(sizeof(BakeOptions) == 584, "BakeOptions changed: hash the new field in bake_cache_key (or say why not)");
+static_assert(sizeof(BakeOptions) == 592, "BakeOptions changed: hash the new field in bake_cache_key (or say why not)");
 static_assert(sizeof(ImportOptions) == 8, "ImportOptions changed: hash the new field in bake_cache_key");
 static_assert(sizeof(Material) == 168, "Material changed: hash the new field in bake_cache_key");
 static_assert(sizeof(PunctualLight) == 88, "PunctualLight changed: hash the new field in bake_cache_key");
@@ -72,7 +72,7 @@ void hash_options(Sha256Stream& h, const BakeOptions& o) {
   h.value(l.integrator), h.value(l.spp), h.value(l.time_budget_seconds), h.value(l.target_relative_error);
   h.value(l.max_bounces), h.value(l.seed), h.value(l.recorded_bounces), h.value(l.russian_roulette_start);
   h.value(l.safety_bounce_cap), h.value(l.sampling_strategy), h.value(l.sampler), h.value(l.guiding), h.value(l.guiding_mix);
-  h.value(l.trace_first_bounce);
+  h.value(l.trace_first_bounce), h.value(l.light_layers);
   h.value(o.integrator_auto), h.value(o.emitter_guiding_auto), h.value(o.guiding_auto_given);
   h.value(l.directional);
   h.value(l.guiding_grid_cells), h.value(l.adaptive), h.value(o.adaptive_request);

@@ -33,7 +33,7 @@ std::vector<T> scatter_per_texel(const std::vector<T>& traced, const std::vector
 // A new per-texel field of LightmapEstimate (estimates.h) must be added below: the copy at the top
 // carries every other field over unchanged, which for a per-texel vector would leave it indexed by
 // traced texel. The static_assert is there to make a new field fail the build here until it is.
-static_assert(sizeof(LightmapEstimate) == 368,  // guiding_*, emitter_guiding: per region and scene, not per texel
+static_assert(sizeof(LightmapEstimate) == 392,  // guiding_*, emitter_guiding: per region and scene, not per texel
               "LightmapEstimate changed: scatter its new per-texel fields in expand_lightmap_estimate, then update "
               "this size");
 
@@ -50,10 +50,13 @@ LightmapEstimate expand_lightmap_estimate(LightmapEstimate traced, const std::ve
   std::vector<double> bounces =
       scatter_per_texel(traced.bounces, full_index, all, size_t(traced.recorded_bounces), "bounces");
   std::vector<double> sh1 = scatter_per_texel(traced.sh1, full_index, all, 1, "sh1");  // [texel][axis][rgb]: 9 elements
+  std::vector<double> light_sums =
+      scatter_per_texel(traced.light_sums, full_index, all, size_t(traced.light_layers), "light_sums");
   LightmapEstimate full = std::move(traced);  // the fields that are not per texel
   full.texels = std::move(texels);
   full.bounces = std::move(bounces);
   full.sh1 = std::move(sh1);
+  full.light_sums = std::move(light_sums);
   return full;
 }
 

@@ -37,9 +37,15 @@ int main(int argc, char** argv) {
   app.add_option("--budget-ms", options.frame_budget_ms, "bound each frame (refresh call) to this many milliseconds")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--frames", options.frames, "refresh at most this many frames; the report lists each frame's time and error");
-  bool no_frame_errors = false, ignore_baked = false;
+  bool no_frame_errors = false, ignore_baked = false, no_light_layers = false;
+  app.add_flag("--no-light-layers", no_light_layers,
+               "keep no estimate per light layer (24 bytes per layer and texel); an edit that only scales lights "
+               "(intensity, colour, emission, a constant sky) then restarts instead of scaling their layers with 0 rays");
   app.add_flag("--ignore-baked", ignore_baked,
                "start every texel from nothing instead of from the bundle's baked lightmap (which is shown until refreshed samples are better, and which light edits are estimated as a change from)");
+  app.add_option("--spp-before-edits", options.samples_before_edits,
+                 "with --edits: refresh this many samples per texel before applying them (a session that has been "
+                 "running when the edit comes; benchmarks)");
   app.add_flag("--page-images", options.page_images,
                "with --frames: after each frame, write the lightmap pages into the device images an engine samples "
                "(exitance_runtime_publish_page_images) and report its milliseconds per frame");
@@ -91,6 +97,7 @@ int main(int argc, char** argv) {
   options.spp = spp;
   options.frame_errors = !no_frame_errors;
   options.from_baked = !ignore_baked;
+  options.light_layers = !no_light_layers;
   options.seed = seed;
   const char* validation = std::getenv("EXITANCE_VULKAN_VALIDATION");
   options.validation = validation && std::string(validation) == "1";

@@ -113,6 +113,20 @@ void add_auto_cost(uint work, uint slot, uint count) {
   if ((params.guiding & kGuidingAutoRecord) != 0u && count > 0u) results[auto_cost_index(work) + slot] += float(count);
 }
 
+// Light layers (GpuParams::light_layers, light_layers.h): per work item L rgb sums after every
+// other section of the batch's results; a contribution adds to its light's layer as well as to its
+// bounce slot (one writer: the path's own item).
+void add_light_result(uint work, uint layer, vec3 value) {
+  if (params.light_layers == 0u) return;
+  uint i = params.batch_work_total * params.light_result_words + (work * params.light_layers + min(layer, params.light_layers - 1u)) * 3u;
+  results[i] += value.x;
+  results[i + 1u] += value.y;
+  results[i + 2u] += value.z;
+}
+
+// The light layer of an emitting triangle: its material's (GpuMaterial::emission.w).
+uint emitter_light_layer(uint tri) { return uint(materials[floatBitsToUint(triangles[tri].p0_material.w)].emission.w); }
+
 // A contribution of path p: its E/pi slot, and on a directional texel batch its L1 through the
 // path's first continuation (path.h sh1_direction_factor).
 void add_path_result(uint p, uint work, uint depth, vec3 value) {

@@ -2,6 +2,7 @@
 // next-event estimation, continuation sampling and hit shading as the CPU reference, with the rays
 // they ask for queued to the connect and extend stages instead of traced at once.
 #include "exitance/common/path.h"
+#include "exitance/common/light_layers.h"
 #include "guide.glsl"
 
 PathLimits path_limits() {
@@ -28,6 +29,11 @@ uint connect_shadow_rays(uint p, inout uint steps) {
     vec4 ray = shadow_rays[slot].direction_length;
     if (trace_any(origin, ray.xyz, ray.w, steps)) continue;
     add_result(work, depth, contribution.xyz);
+    if (params.light_layers != 0u) {
+      // Slot 0: the area sample (layer in the low half of path_ray_o.w), 1: the punctual light (high half), 2: the sky.
+      uint layers = floatBitsToUint(path_ray_o[p].w);
+      add_light_result(work, k == 0u ? (layers & 0xFFFFu) : k == 1u ? (layers >> 16u) : kSkyLightLayer, contribution.xyz);
+    }
     if (params.directional != 0u) {
       // The texel's own next-event samples carry their shadow ray's direction; deeper ones the first continuation's.
       vec3 factor = path_throughput[sh1_factor_index(p)].xyz;
@@ -70,7 +76,14 @@ uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rn
     environment = no_shadow_ray();
     punctual_change_rays(x, throughput, params.punctual_count, params.changed_light_pairs, rng, punctual_light, area);
   } else {
-    next_event_estimation(x, origin, throughput, guide, rng, area, punctual_light, environment);
+    EmitterLearning sources;
+    next_event_estimation(x, origin, throughput, guide, emitter_guide_none(), rng, area, punctual_light, environment, sources);
+    if (params.light_layers != 0u) {
+      // Which layers the shadow rays' light goes to, read back by connect_shadow_rays.
+      uint area_layer = sources.area_triangle != kEmitterPatchNone ? emitter_light_layer(sources.area_triangle) : 0u;
+      uint punctual_layer = sources.punctual_index != kEmitterPatchNone ? punctual_light_layer(sources.punctual_index, params.punctual_layers) : 0u;
+      path_ray_o[p].w = uintBitsToFloat(area_layer | (punctual_layer << 16u));
+    }
   }
   uint first = p * params.shadow_slots;
   shadow_rays[first] = area;

@@ -56,7 +56,12 @@ void main() {
     bool finite = !(any(isnan(total)) || any(isinf(total)));
     if (directional)
       for (uint k = 0u; k < 9u; ++k) finite = finite && !isnan(results[sh1_result_index(w) + k]) && !isinf(results[sh1_result_index(w) + k]);
-    if (!finite) { ++nonfinite; continue; }
+    if (!finite) {
+      ++nonfinite;
+      // The light layers' loop below skips this sample by its NaN.
+      for (uint l = 0u; l < params.light_layers; ++l) results[params.batch_work_total * params.light_result_words + (w * params.light_layers + l) * 3u] = uintBitsToFloat(0x7FC00000u);
+      continue;
+    }
     if (directional)
       for (uint k = 0u; k < 9u; ++k) sh1[k] += double(results[sh1_result_index(w) + k]);
     if ((params.guiding & kGuidingAutoRecord) != 0u) record_auto_sample(texel, params.batch_sample_begin + s, w, total);
@@ -75,6 +80,18 @@ void main() {
     for (uint c = 0u; c < 3u; ++c) acc_bounce[(k * params.item_count_total + texel) * 3u + c] = layer[k][c];
   if (directional)
     for (uint k = 0u; k < 9u; ++k) acc_total[sh1_sum_index(texel) + k] = sh1[k];
+  // Light layers (light_layers.h): after the bounce layers in the same sums, layer by layer, each
+  // adding the texel's samples in order (a sample dropped above reads NaN here).
+  for (uint l = 0u; l < params.light_layers; ++l) {
+    uint at = ((K + l) * params.item_count_total + texel) * 3u;
+    dvec3 light = dvec3(acc_bounce[at], acc_bounce[at + 1u], acc_bounce[at + 2u]);
+    for (uint s = 0u; s < params.batch_sample_count; ++s) {
+      uint r = params.batch_work_total * params.light_result_words + ((s * n + j) * params.light_layers + l) * 3u;
+      vec3 v = vec3(results[r], results[r + 1u], results[r + 2u]);
+      if (!isnan(v.x)) light += dvec3(v);
+    }
+    acc_bounce[at] = light.x, acc_bounce[at + 1u] = light.y, acc_bounce[at + 2u] = light.z;
+  }
   acc_samples[texel] += samples;
   // Per-bounce layer passes record no bounce layers: the first slot counts back faces instead.
   if ((params.bounce_flags & kBouncePass) != 0u) acc_bounce[texel * 3u] += double(back_faces);

@@ -60,12 +60,19 @@ void main() {
     results[e + 2u] = albedo.z;
   } else if (tri == kInvalid) {
     // The change estimate (params.changed_light_pairs, path.h) adds no sky: it did not change.
-    if (params.changed_light_pairs == 0u) add_path_result(p, work, depth, throughput * escaped_radiance(wi, tp.w));
+    if (params.changed_light_pairs == 0u) {
+      vec3 sky = throughput * escaped_radiance(wi, tp.w);
+      add_path_result(p, work, depth, sky);
+      add_light_result(work, kSkyLightLayer, sky);
+    }
   } else {
     int bounce = kProbeMode ? int(depth) - 1 : int(depth);  // the vertex's bounce as the texel estimator counts it
     HitResult h = shade_continuation_hit(tri, hit.x, hit.z, hit.w, wi, tp.w, throughput, bounce, path_limits(), rng);
     // Only emitters add: a read-modify-write of the result slot per hit cost the H200 14 % of this stage.
-    if (h.radiance != vec3(0.0) && params.changed_light_pairs == 0u) add_path_result(p, work, depth, h.radiance);
+    if (h.radiance != vec3(0.0) && params.changed_light_pairs == 0u) {
+      add_path_result(p, work, depth, h.radiance);
+      add_light_result(work, emitter_light_layer(tri), h.radiance);
+    }
     continues = h.continues;
     throughput = h.throughput;
     x = h.next;

@@ -4,7 +4,8 @@
 // reference run on the scene a fresh bake of the edited glTF wrote. Per region (instance x 8x8
 // atlas texels, over the texels both G-buffers have) and channel, a z-test with the two estimates'
 // variances of the mean; |z| < 4.5 everywhere (about 1 false alarm in 10^5 tests per region).
-// Also: an edit drops every accumulated sample; a bad edit leaves the session as it was.
+// Also: an edit drops every accumulated sample unless it only scales lights (light layers: their
+// layers are scaled and every sample kept); a bad edit leaves the session as it was.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -89,6 +90,7 @@ struct EditCase {
   std::string sky_before, sky_after;  // bake --sky
   json edits;                         // EDITS.json
   std::function<void(json&)> edit_gltf;
+  bool scales = false;                // the edits only scale lights (light layers scaled, samples kept)
 };
 
 // The z-test of the header. Returns the number of regions compared.
@@ -148,11 +150,14 @@ void check_edit(const EditCase& c) {
   session->refresh({0, 8});
   const LightmapEstimate pre_edit = session->published_lightmap();
   const EditEffects effects = session->apply_edits(parse_scene_edits(c.edits.dump(), c.label + ".json"));
-  for (const TexelAccumulator& t : session->lightmap().texels) ASSERT_EQ(t.samples, 0u);  // nothing pre-edit kept
+  // Edits that only scale lights keep the 8 samples, their light layers scaled; the others keep none.
+  const bool scaled = session->last_edit_timings().scaled_light_layers;
+  EXPECT_EQ(scaled, c.scales);
+  for (const TexelAccumulator& t : session->lightmap().texels) ASSERT_EQ(t.samples, scaled ? 8u : 0u);
   session->refresh({0, 48});
-  // Light edits are estimated as a change from the 8 pre-edit samples; the others from nothing.
+  // Other light edits are estimated as a change from the 8 pre-edit samples; the rest from nothing.
   const LightmapEstimate gpu = session->refreshed_lightmap();
-  EXPECT_EQ(session->changed_lights() > 0, !effects.lights.empty() && !effects.sky && effects.materials.empty() &&
+  EXPECT_EQ(session->changed_lights() > 0, !scaled && !effects.lights.empty() && !effects.sky && effects.materials.empty() &&
                                                effects.moved_instances.empty());
 
   // The fresh bake of the edited glTF, lit by the CPU reference from its scene.bin.
@@ -189,13 +194,14 @@ TEST(RefreshEdits, LightIntensityAndColourEqualAFreshBake) {
                 json& sun = g["extensions"]["KHR_lights_punctual"]["lights"][0];
                 sun["intensity"] = 6.0;
                 sun["color"] = {0.6, 0.8, 1.0};
-              }});
+              },
+              true});
 }
 
 TEST(RefreshEdits, SkyEqualsAFreshBake) {
   if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
   check_edit({"sky", "courtyard", "0.3,0.4,0.5", "0.8,0.5,0.2", {{"edits", {{{"sky", {0.8, 0.5, 0.2}}}}}},
-              [](json&) {}});
+              [](json&) {}, true});
 }
 
 TEST(RefreshEdits, EmissionTurnedOnFromZeroEqualsAFreshBake) {

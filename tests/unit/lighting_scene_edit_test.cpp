@@ -1,5 +1,7 @@
 // Runtime edits of a LightingScene (set_material, set_punctual_light) must leave it exactly as
-// build_lighting_scene would build it from the edited Scene: records, CDFs, per-triangle area pdfs.
+// build_lighting_scene would build it from the edited Scene: records, CDFs, per-triangle area pdfs;
+// except the light layers, which stay as laid out when the scene was built (a layer's sums are its
+// light's), where a rebuild lays them out for the edited emitters.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -17,7 +19,10 @@ bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
 }
 
-void expect_same(const LightingScene& edited, const LightingScene& rebuilt) {
+void expect_same(const LightingScene& edited, LightingScene rebuilt) {
+  // The rebuilt scene with the edited one's light layers (emission.w), as its layout kept them.
+  ASSERT_EQ(edited.materials.size(), rebuilt.materials.size());
+  for (size_t i = 0; i < rebuilt.materials.size(); ++i) rebuilt.materials[i].emission.w = edited.materials[i].emission.w;
   EXPECT_TRUE(same_bytes(edited.triangles, rebuilt.triangles));
   EXPECT_TRUE(same_bytes(edited.materials, rebuilt.materials));
   EXPECT_TRUE(same_bytes(edited.punctual_lights, rebuilt.punctual_lights));
@@ -59,6 +64,11 @@ TEST(LightingSceneEdit, SetMaterialMatchesARebuild) {
     EXPECT_EQ(edited.source->materials[index].base_color.x, 0.9f);
   }
   EXPECT_EQ(edited.emitter_count(), 4u);  // the receiver's two triangles and the large quad's
+  // Laid out when built (materials 1 and 2 emissive): sky, 2 punctual, 2 emissive, 1 for later
+  // emitters, which material 0 (made emissive above) uses; material 1 (made black) keeps its layer.
+  EXPECT_EQ(edited.light_layer_count, 6u);
+  EXPECT_EQ(edited.material_light_layers, (std::vector<uint32_t>{5, 3, 4}));
+  for (size_t i = 0; i < 3; ++i) EXPECT_EQ(edited.materials[i].emission.w, float(edited.material_light_layers[i]));
   EXPECT_EQ(original_source->materials[1].emission.x, 2.0f) << "the shared source Scene must not change";
   EXPECT_THROW(set_material(edited, 3, Material{}), std::out_of_range);
 }

@@ -1,5 +1,7 @@
 #include "exitance/runtime/core/lighting_scene.h"
 
+#include "exitance/common/light_layers.h"
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -196,7 +198,27 @@ LightingScene build_lighting_scene(std::shared_ptr<const Scene> source, Bvh4 bvh
 
   lighting.sky = scene.sky.constant;
   if (scene.sky.has_environment()) lighting.environment = EnvironmentSampler(scene.sky.environment);
+  lay_out_light_layers(lighting, kDefaultLightLayerLimit);
   return lighting;
+}
+
+void lay_out_light_layers(LightingScene& lighting, uint32_t limit) {
+  if (limit == 0) throw std::invalid_argument("lay_out_light_layers: the limit must be at least 1");
+  lighting.punctual_light_layers = std::min<uint32_t>(lighting.punctual_count(), limit);
+  const uint32_t first_material_layer = 1 + lighting.punctual_light_layers;
+  uint32_t emissive = 0;
+  for (const GpuMaterial& m : lighting.materials) emissive += m.emission.x > 0 || m.emission.y > 0 || m.emission.z > 0;
+  const uint32_t material_layers = std::min(emissive, limit);
+  const uint32_t later = first_material_layer + material_layers;  // materials made emissive by an edit
+  lighting.light_layer_count = later + 1;
+  lighting.material_light_layers.assign(lighting.materials.size(), later);
+  uint32_t k = 0;
+  for (size_t i = 0; i < lighting.materials.size(); ++i) {
+    const GpuMaterial& m = lighting.materials[i];
+    if (m.emission.x > 0 || m.emission.y > 0 || m.emission.z > 0)
+      lighting.material_light_layers[i] = first_material_layer + std::min(k++, material_layers - 1);
+    lighting.materials[i].emission.w = float(lighting.material_light_layers[i]);
+  }
 }
 
 void set_geometry(LightingScene& lighting, std::shared_ptr<const Scene> edited) {
@@ -210,7 +232,13 @@ void set_geometry(LightingScene& lighting, std::shared_ptr<const Scene> edited) 
   const std::vector<Vec3>* fitted_to =
       lighting.source && lighting.source->positions.size() == edited->positions.size() ? &lighting.source->positions : nullptr;
   if (!bvh.nodes.empty()) refit_bvh4(bvh, edited->positions, fitted_to);
+  // The layers stay as they were laid out (a layer's sums are its light's).
+  const uint32_t punctual_layers = lighting.punctual_light_layers, layer_count = lighting.light_layer_count;
+  std::vector<uint32_t> material_layers = std::move(lighting.material_light_layers);
   lighting = build_lighting_scene(std::move(edited), std::move(bvh));
+  lighting.punctual_light_layers = punctual_layers, lighting.light_layer_count = layer_count;
+  lighting.material_light_layers = std::move(material_layers);
+  for (size_t i = 0; i < lighting.materials.size(); ++i) lighting.materials[i].emission.w = float(lighting.material_light_layers[i]);
 }
 
 void set_material(LightingScene& lighting, uint32_t index, const Material& material) {
@@ -236,7 +264,10 @@ void refresh_materials_from_source(LightingScene& lighting, const std::vector<ui
   const Scene& scene = *lighting.source;
   check_source_indices("refresh_materials_from_source", "material", scene.materials.size(), lighting.materials.size(), materials);
   if (materials.empty()) return;
-  for (uint32_t m : materials) lighting.materials[m] = material_record(scene.materials[m]);
+  for (uint32_t m : materials) {
+    lighting.materials[m] = material_record(scene.materials[m]);
+    lighting.materials[m].emission.w = float(lighting.material_light_layers[m]);  // its layer stays
+  }
   lighting.textured = !scene.vertex_color.empty();
   for (const Material& m : scene.materials) lighting.textured = lighting.textured || varies_per_point(m);
   build_emitter_distribution(lighting);

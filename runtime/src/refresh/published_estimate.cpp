@@ -7,8 +7,9 @@ namespace exitance {
 namespace {
 
 void check_shapes(const LightmapEstimate& a, const LightmapEstimate& b, const char* call) {
-  if (a.texels.size() != b.texels.size() || a.recorded_bounces != b.recorded_bounces || a.has_sh1() != b.has_sh1())
-    throw std::invalid_argument(std::string(call) + ": the estimates differ in texels, recorded bounces or sh1 layers");
+  if (a.texels.size() != b.texels.size() || a.recorded_bounces != b.recorded_bounces || a.has_sh1() != b.has_sh1() ||
+      a.light_layers != b.light_layers)
+    throw std::invalid_argument(std::string(call) + ": the estimates differ in texels, recorded bounces, light layers or sh1 layers");
 }
 
 double channel_sum(const Vec3& v) { return double(v[0]) + double(v[1]) + double(v[2]); }
@@ -19,6 +20,8 @@ void copy_texel(const LightmapEstimate& from, LightmapEstimate& to, size_t i) {
   to.texels[i] = from.texels[i];
   for (int k = 0; k < from.recorded_bounces; ++k)
     for (size_t c = 0; c < 3; ++c) to.bounces[(size_t(k) * n + i) * 3 + c] = from.bounces[(size_t(k) * n + i) * 3 + c];
+  for (int k = 0; k < from.light_layers; ++k)
+    for (size_t c = 0; c < 3; ++c) to.light_sums[(size_t(k) * n + i) * 3 + c] = from.light_sums[(size_t(k) * n + i) * 3 + c];
   if (from.has_sh1())
     for (size_t k = 0; k < 9; ++k) to.sh1[i * 9 + k] = from.sh1[i * 9 + k];
 }
@@ -62,6 +65,11 @@ LightmapEstimate add_change(const LightmapEstimate& base, const LightmapEstimate
       for (size_t c = 0; c < 3; ++c) {
         const size_t at = (size_t(k) * n + i) * 3 + c;
         sum.bounces[at] = m * (base.bounces[at] / b.samples + change.bounces[at] / d.samples);
+      }
+    for (int k = 0; k < base.light_layers; ++k)
+      for (size_t c = 0; c < 3; ++c) {
+        const size_t at = (size_t(k) * n + i) * 3 + c;
+        sum.light_sums[at] = m * (base.light_sums[at] / b.samples + change.light_sums[at] / d.samples);
       }
     if (base.has_sh1())
       for (size_t k = 0; k < 9; ++k) sum.sh1[i * 9 + k] = m * (base.sh1[i * 9 + k] / b.samples + change.sh1[i * 9 + k] / d.samples);

@@ -15,6 +15,7 @@
 #include "exitance/formats/scene_file.h"
 #include "exitance/formats/svo_file.h"
 #include "exitance/runtime/refresh/baked_lightmap.h"
+#include "exitance/runtime/refresh/light_layer_edits.h"
 #include "exitance/runtime/refresh/published_estimate.h"
 #include "exitance/runtime/refresh/texel_grid.h"
 #include "exitance/runtime/refresh/texels_near_change.h"
@@ -211,6 +212,7 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   settings.russian_roulette_start = baked.russian_roulette_start;
   settings.safety_bounce_cap = baked.safety_bounce_cap;
   settings.sampler = baked.sampler == "independent" ? kSamplerIndependent : kSamplerSobol;
+  settings.light_layers = options.light_layers;
   // A bundle baked with directional layers is refreshed with them (the same estimator, path.h).
   if (baked.directional == "sh1") settings.directional = DirectionalMode::Sh1;
 
@@ -235,7 +237,13 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
     try {
       std::optional<LightmapEstimate> baked = read_baked_lightmap(
           bundle_folder, manifest, state->persisted.gbuffer, std::clamp(settings.recorded_bounces, 1, int(kMaxRecordedLayers)));
-      if (baked) state->previous = state->integrator->upload_lightmap(*baked);
+      if (baked) {
+        // Shaped as the accumulation; the bundle holds no light layers, so they stay 0 (no split: an
+        // edit that scales lights scales these texels as the accumulation's split says).
+        baked->light_layers = state->integrator->light_layers();
+        baked->light_sums.assign(size_t(baked->light_layers) * baked->texels.size() * 3, 0.0);
+        state->previous = state->integrator->upload_lightmap(*baked);
+      }
       state->started_from_baked = state->previous != nullptr;
     } catch (const std::runtime_error& e) {
       throw BundleInputError(e.what());
@@ -245,6 +253,7 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   // The publishing pipeline made (on lavapipe compiled) and a published estimate's device memory
   // allocated here, not in the first edit (which reuses it).
   state->integrator->publish(PublishMode::Accumulation, nullptr, nullptr);
+  if (settings.light_layers) state->integrator->prepare_light_layer_scaling();  // not inside the first edit
   timings.publish = since();
   return std::unique_ptr<RefreshSession>(new RefreshSession(std::move(state)));
 }
@@ -266,6 +275,8 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   const uint64_t submissions_before = s.integrator->waited_submissions();
   const double wait_before = s.integrator->wait_seconds();
   const std::vector<GpuPunctualLight> lights_before = s.lighting->punctual_lights;
+  const std::optional<LightsBefore> layer_lights_before =
+      s.settings.light_layers ? std::optional<LightsBefore>(exitance::lights_before(*s.lighting)) : std::nullopt;
   ChangeBefore was;
   for (const PunctualLight& light : s.persisted.scene.lights) was.light_positions.push_back(light.position);
   // Validated and computed on copies of the small parts, then committed in place (the session's
@@ -300,6 +311,19 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
     }
   }
   timings.scene = since(lap);
+  // Edits that only scaled lights' emission: their layers scaled where the estimates are, 0 rays,
+  // every sample kept (light_layer_edits.h).
+  if (layer_lights_before) {
+    const std::optional<std::vector<Vec4>> factors = light_layer_factors(*layer_lights_before, lighting, effects);
+    if (factors && scale_light_layers(*factors, punctual_only)) {
+      timings.restart = since(lap);
+      timings.scaled_light_layers = true;
+      timings.device_submissions = s.integrator->waited_submissions() - submissions_before;
+      timings.device_wait = (s.integrator->wait_seconds() - wait_before) * 1e3;
+      s.edit_timings = timings;
+      return effects;
+    }
+  }
   if (effects.geometry_changed()) {
     // Moved texels leave their grid cells; the unocclude step again near the moved bounds (as a
     // fresh bake would place the texels); the start points of every texel that moved, uploaded.
@@ -388,6 +412,29 @@ void RefreshSession::end_change_estimate() {
   s.base.reset();
   s.base_lights.clear();
   s.changed_lights = 0;
+}
+
+bool RefreshSession::scale_light_layers(const std::vector<Vec4>& factors, bool punctual_only) {
+  State& s = *state_;
+  // A change estimate under way accumulates a change of direct light, not split by light; a
+  // per-bounce run keeps no light layers.
+  if (s.base) return false;
+  if (s.per_bounce && (!s.whole_run_path || s.per_bounce->light_layers != int(factors.size()))) return false;
+  if (!s.per_bounce && s.integrator->light_layers() != int(factors.size())) return false;
+  // Edits of punctual lights alone left their upload to the accumulation's restart (apply_edits).
+  if (punctual_only) s.integrator->update_punctual_lights(*s.lighting);
+  if (s.per_bounce) {
+    // A whole run's result (on the host) becomes what is shown, scaled below; the accumulation
+    // starts again behind it (its texel buffers were the run's).
+    s.previous = publish_on_device().lightmap;
+    s.clear_accumulation();
+    s.integrator->start_progressive(s.persisted.gbuffer, s.settings, false);
+  }
+  std::vector<const DeviceLightmap*> estimates;
+  if (s.previous) estimates.push_back(s.previous.get());
+  s.integrator->scale_light_layers(factors, estimates);
+  s.last_edit_near.clear();
+  return true;
 }
 
 void RefreshSession::restart() { restart(false); }
@@ -641,7 +688,7 @@ LightmapEstimate RefreshSession::published_lightmap() const {
   if (!s.previous) return estimate;
   const LightmapEstimate previous = s.integrator->read_lightmap(*s.previous);
   if (previous.texels.size() != estimate.texels.size() || previous.recorded_bounces != estimate.recorded_bounces ||
-      previous.has_sh1() != estimate.has_sh1())
+      previous.has_sh1() != estimate.has_sh1() || previous.light_layers != estimate.light_layers)
     return estimate;
   // A whole run (bake_per_bounce, bake_guided, bake_path) is a bake: shown wherever it has samples.
   const size_t n = estimate.texels.size();
@@ -650,6 +697,8 @@ LightmapEstimate RefreshSession::published_lightmap() const {
     estimate.texels[i] = previous.texels[i];
     for (int k = 0; k < estimate.recorded_bounces; ++k)
       for (int c = 0; c < 3; ++c) estimate.bounces[(size_t(k) * n + i) * 3 + size_t(c)] = previous.bounces[(size_t(k) * n + i) * 3 + size_t(c)];
+    for (int k = 0; k < estimate.light_layers; ++k)
+      for (int c = 0; c < 3; ++c) estimate.light_sums[(size_t(k) * n + i) * 3 + size_t(c)] = previous.light_sums[(size_t(k) * n + i) * 3 + size_t(c)];
   }
   return estimate;
 }

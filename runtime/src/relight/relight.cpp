@@ -34,6 +34,8 @@ json relight_bundle(const RelightOptions& options) {
     throw RelightInputError("--integrator " + options.integrator + ": expected path or bounces");
   if (options.page_images && options.frames == 0)
     throw RelightInputError("--page-images reports per frame: it needs --frames");
+  if (options.samples_before_edits > 0 && options.edits_file.empty())
+    throw RelightInputError("--spp-before-edits refreshes before the edits: it needs --edits");
   if (per_bounce && (options.frames > 0 || options.frame_budget_ms > 0))
     throw RelightInputError("--integrator bounces runs the whole lightmap at once: --frames and --budget-ms need --integrator path");
   if (options.guiding == "auto")
@@ -61,6 +63,7 @@ json relight_bundle(const RelightOptions& options) {
   RefreshSessionOptions session_options;
   session_options.seed = options.seed;
   session_options.start_from_baked = options.from_baked;
+  session_options.light_layers = options.light_layers;
   session_options.device.device_index = options.device_index;
   session_options.device.validation = options.validation;
   session_options.device.collect_stage_statistics = options.stage_statistics;
@@ -79,6 +82,12 @@ json relight_bundle(const RelightOptions& options) {
                            {"publish", opened.publish}};
 
   json edits_report;
+  if (options.samples_before_edits > 0) {  // a session that has been refreshing when the edit comes
+    report("refreshing before the edits", 0, 0);
+    const RefreshReport before = session->refresh({0, options.samples_before_edits});
+    seconds["before_edits"] = clock.lap();
+    edits_report["samples_before"] = before.samples_per_texel;
+  }
   if (!options.edits_file.empty()) {
     report("edits", 0, 0);
     std::ifstream in(options.edits_file, std::ios::binary);
@@ -87,7 +96,7 @@ json relight_bundle(const RelightOptions& options) {
     try {
       const std::vector<SceneEdit> edits = parse_scene_edits(text, options.edits_file);
       const EditEffects effects = session->apply_edits(edits);
-      edits_report = {{"file", fs::absolute(options.edits_file).lexically_normal().string()},
+      edits_report.update({{"file", fs::absolute(options.edits_file).lexically_normal().string()},
                       {"edits", edits.size()},
                       {"moved_instances", effects.moved_instances},
                       {"moved_texels", effects.moved_texels},
@@ -95,8 +104,10 @@ json relight_bundle(const RelightOptions& options) {
                       {"materials", effects.materials},
                       {"sky", effects.sky},
                       // punctual lights whose change from the pre-edit lighting is estimated (0: restarted)
-                      {"changed_lights", session->changed_lights()}};
+                      {"changed_lights", session->changed_lights()}});
       const EditTimings& t = session->last_edit_timings();
+      // true: the edits only scaled lights, whose layers were scaled with 0 rays (no sample dropped)
+      edits_report["scaled_light_layers"] = t.scaled_light_layers;
       edits_report["milliseconds"] = {{"scene", t.scene}, {"near_texels", t.near_texels}, {"publish", t.publish}, {"restart", t.restart},
                                       {"device_wait", t.device_wait}};
       edits_report["device_submissions"] = t.device_submissions;
@@ -199,6 +210,8 @@ json relight_bundle(const RelightOptions& options) {
   run["integrator"] = per_bounce ? "bounces" : "path";
   if (guided) run["guiding"] = options.guiding;
   run["spp"] = session->samples_per_texel();
+  // Light layers kept per texel (docs/runtime.md "Light layers"; 0: --no-light-layers or a whole run)
+  run["light_layers"] = session->integrator().light_layers();
   run["time_budget_seconds"] = options.time_budget_seconds;
   if (options.frame_budget_ms > 0) run["frame_budget_ms"] = options.frame_budget_ms;
   run["lighting_seconds"] = lighting_seconds;

@@ -11,12 +11,13 @@
 
 namespace exitance {
 
-DeviceLightmap::DeviceLightmap(vulkan::Context& context, size_t texel_count, int layer_count, bool is_directional)
-    : sums(context), texels(texel_count), layers(layer_count), directional(is_directional) {
-  sums.reserve(context, texels, layers, directional);
+DeviceLightmap::DeviceLightmap(vulkan::Context& context, size_t texel_count, int layer_count, bool is_directional,
+                               int light_layer_count)
+    : sums(context), texels(texel_count), layers(layer_count), directional(is_directional), light_layers(light_layer_count) {
+  sums.reserve(context, texels, layers + light_layers, directional);
 }
 
-size_t DeviceLightmap::bytes() const { return texels * vulkan::device_lightmap_bytes_per_texel(layers, directional); }
+size_t DeviceLightmap::bytes() const { return texels * vulkan::device_lightmap_bytes_per_texel(layers + light_layers, directional); }
 
 namespace vulkan {
 namespace {
@@ -76,7 +77,7 @@ PublishedLightmap LightmapPublisher::publish(PublishMode mode, const TexelAccumu
   if ((mode != PublishMode::Accumulation && !previous) || (mode == PublishMode::Change && !base))
     throw std::logic_error("LightmapPublisher::publish: the mode reads an estimate that was not given");
   for (const DeviceLightmap* e : {previous, base})
-    if (e && (e->texels != out->texels || e->layers != out->layers || e->directional != out->directional))
+    if (e && (e->texels != out->texels || e->layers != out->layers || e->directional != out->directional || e->light_layers != out->light_layers))
       throw std::logic_error("LightmapPublisher::publish: the estimates differ in texels, layers or L1 sums");
   PublishedLightmap result;
   result.lightmap = out;
@@ -98,7 +99,7 @@ PublishedLightmap LightmapPublisher::publish(PublishMode mode, const TexelAccumu
   vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
   kernel_.bind(cmd);
-  const PublishPush push{uint32_t(out->texels), uint32_t(out->layers), out->directional ? 1u : 0u, uint32_t(mode)};
+  const PublishPush push{uint32_t(out->texels), uint32_t(out->layers + out->light_layers), out->directional ? 1u : 0u, uint32_t(mode)};
   kernel_.push(cmd, &push, sizeof(push));
   vkCmdDispatch(cmd, uint32_t((out->texels + 63) / 64), 1, 1);
   barrier.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
@@ -124,9 +125,11 @@ PublishedLightmap LightmapPublisher::publish(PublishMode mode, const TexelAccumu
 
 void LightmapPublisher::upload(const LightmapEstimate& estimate, DeviceLightmap& to) {
   const size_t n = estimate.texels.size();
-  if (n != to.texels || estimate.recorded_bounces != to.layers || estimate.has_sh1() != to.directional)
-    throw std::invalid_argument("upload_lightmap: the estimate differs from the accumulation in texels, recorded bounces or sh1 layers");
+  if (n != to.texels || estimate.recorded_bounces != to.layers || estimate.has_sh1() != to.directional || estimate.light_layers != to.light_layers)
+    throw std::invalid_argument("upload_lightmap: the estimate differs from the accumulation in texels, recorded bounces, light layers or sh1 layers");
   if (n == 0) return;
+  if (estimate.bounces.size() != size_t(to.layers) * n * 3 || estimate.light_sums.size() != size_t(to.light_layers) * n * 3)
+    throw std::invalid_argument("upload_lightmap: the estimate's layer sums are not sized for its texels");
   const size_t sum_doubles = n * 6 + (to.directional ? n * 9 : 0);
   context_.write_ranges(to.sums.sums, {{0, sum_doubles * 8}}, [&](char* staging) {
     double* sums = reinterpret_cast<double*>(staging);
@@ -134,7 +137,10 @@ void LightmapPublisher::upload(const LightmapEstimate& estimate, DeviceLightmap&
       for (int c = 0; c < 3; ++c) sums[i * 6 + size_t(c)] = estimate.texels[i].total[c], sums[i * 6 + 3 + size_t(c)] = estimate.texels[i].total_squared[c];
     if (to.directional) std::memcpy(sums + n * 6, estimate.sh1.data(), n * 9 * 8);
   });
-  context_.upload(to.sums.bounce_sums, estimate.bounces.data(), estimate.bounces.size() * 8);
+  context_.write_ranges(to.sums.bounce_sums, {{0, (estimate.bounces.size() + estimate.light_sums.size()) * 8}}, [&](char* staging) {
+    std::memcpy(staging, estimate.bounces.data(), estimate.bounces.size() * 8);
+    if (!estimate.light_sums.empty()) std::memcpy(staging + estimate.bounces.size() * 8, estimate.light_sums.data(), estimate.light_sums.size() * 8);
+  });
   context_.write_ranges(to.sums.samples, {{0, n * 4}}, [&](char* staging) {
     uint32_t* samples = reinterpret_cast<uint32_t*>(staging);
     for (size_t i = 0; i < n; ++i) samples[i] = estimate.texels[i].samples;

@@ -17,14 +17,16 @@
 namespace exitance {
 
 // Per texel: 6 doubles of sums (+ 9 of L1 when directional), 3 doubles per recorded layer, the
-// sample count (LightmapEstimate's fields, layer 0 being the direct light).
+// sample count (LightmapEstimate's fields, layer 0 being the direct light). The light layers' sums
+// follow the recorded layers' in the same buffer ([layers + light layer][texel][rgb]).
 class DeviceLightmap {
  public:
-  DeviceLightmap(vulkan::Context& context, size_t texels, int layers, bool directional);
+  DeviceLightmap(vulkan::Context& context, size_t texels, int layers, bool directional, int light_layers = 0);
   vulkan::TexelAccumulators sums;
   size_t texels = 0;
   int layers = 1;
   bool directional = false;
+  int light_layers = 0;
   size_t bytes() const;
 };
 

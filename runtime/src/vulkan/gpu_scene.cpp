@@ -107,6 +107,8 @@ GpuScene::GpuScene(Context& context, const LightingScene& scene, bool quantized_
       triangle_count_(scene.triangles.size()),
       material_count_(scene.materials.size()),
       punctual_count_(scene.punctual_count()),
+      light_layer_count_(scene.light_layer_count),
+      punctual_light_layers_(scene.punctual_light_layers),
       sky_(scene.sky),
       bounds_lo_(scene.bounds_lo),
       bounds_hi_(scene.bounds_hi),

@@ -64,6 +64,9 @@ class GpuScene {
   Vec3 bounds_hi() const { return bounds_hi_; }
   uint32_t emitter_count() const { return uint32_t(emitters_.size()); }
   uint32_t punctual_count() const { return punctual_count_; }
+  // The scene's light layers as laid out when it was built (LightingScene; fixed through edits).
+  uint32_t light_layer_count() const { return light_layer_count_; }
+  uint32_t punctual_light_layers() const { return punctual_light_layers_; }
   uint32_t surface_flags() const { return surface_flags_; }  // kSurface* (gpu_layout.h)
   uint32_t environment_width() const { return environment_width_; }  // 0: constant sky
   uint32_t environment_height() const { return environment_height_; }
@@ -101,6 +104,7 @@ class GpuScene {
   std::vector<uint32_t> emitters_;  // uploaded emitter triangles: their records change with the next edit
   size_t triangle_count_ = 0, material_count_ = 0;
   uint32_t punctual_count_ = 0;
+  uint32_t light_layer_count_ = 1, punctual_light_layers_ = 0;
   Vec3 sky_{0, 0, 0}, bounds_lo_{0, 0, 0}, bounds_hi_{0, 0, 0};
   float extent_ = 1.0f;
   uint32_t environment_width_ = 0, environment_height_ = 0;  // 0: constant sky

@@ -66,6 +66,11 @@ void LightmapDriver::prepare(const TexelGBuffer& gbuffer, const IntegratorSettin
   a.directional = settings.directional == DirectionalMode::Sh1;
   a.result_bytes = size_t(a.recorded + 1) * 12 + (a.directional ? 36 : 0);  // + 9 floats of L1 (sh1_result_index)
   if (settings.guiding == GuidingMode::Auto) a.result_bytes += kAutoCostWords * 4;  // bindings.glsl auto_cost_index
+  // Light layers: L rgb floats per work item after the rest (bindings.glsl add_light_result).
+  // (A rank's share of a split bake keeps none: the runtime's edits scale them, in one process.)
+  a.light_layers = settings.light_layers && !distributed(settings.work_share) ? int(runner_.scene().light_layer_count()) : 0;
+  const size_t words_before_light_layers = a.result_bytes / 4;
+  a.result_bytes += size_t(a.light_layers) * 12;
   a.max_work = runner_.work_items_per_batch(a.result_bytes);
   a.work_list.clear();
   if (reuse) {
@@ -82,13 +87,16 @@ void LightmapDriver::prepare(const TexelGBuffer& gbuffer, const IntegratorSettin
   }
   a.params = runner_.bake_params(settings, uint32_t(a.recorded), uint32_t(a.texel_count));
   a.params.directional = a.directional ? 1u : 0u;
+  a.params.light_layers = uint32_t(a.light_layers);
+  a.params.punctual_layers = runner_.scene().punctual_light_layers();
+  a.params.light_result_words = uint32_t(words_before_light_layers);
   if (a.texel_count == 0) return;
 
   Context& context = runner_.context();
   WavefrontBuffers& buffers = runner_.buffers();
   buffers.items.reserve(context, a.texel_count);
   const VkBuffer sums_before[3] = {buffers.texels.sums.handle(), buffers.texels.bounce_sums.handle(), buffers.texels.samples.handle()};
-  buffers.texels.reserve(context, a.texel_count, a.recorded, a.directional);
+  buffers.texels.reserve(context, a.texel_count, a.recorded + a.light_layers, a.directional);
   // Buffers that grew hold nothing yet: cleared whatever the caller cleared before.
   const bool grew = sums_before[0] != buffers.texels.sums.handle() || sums_before[1] != buffers.texels.bounce_sums.handle() ||
                     sums_before[2] != buffers.texels.samples.handle();
@@ -133,20 +141,22 @@ void LightmapDriver::run_pass(Accumulation& a, uint32_t first, uint32_t pass) {
   }
 }
 
-LightmapEstimate LightmapDriver::sized_estimate(size_t texels, int recorded, bool directional) {
+LightmapEstimate LightmapDriver::sized_estimate(size_t texels, int recorded, bool directional, int light_layers) {
   LightmapEstimate estimate;
   estimate.recorded_bounces = recorded;
   estimate.texels.resize(texels);
   estimate.bounces.assign(size_t(recorded) * texels * 3, 0.0);
+  estimate.light_layers = light_layers;
+  estimate.light_sums.assign(size_t(light_layers) * texels * 3, 0.0);
   if (directional) estimate.sh1.assign(texels * 9, 0.0);
   return estimate;
 }
 
 LightmapDriver::ReadBackSpace LightmapDriver::read_back_space(size_t host_texels, size_t read_texels, int recorded,
-                                                              bool directional) {
+                                                              bool directional, int light_layers) {
   ReadBackSpace space;
-  space.estimate = sized_estimate(host_texels, recorded, directional);
-  const size_t largest = read_texels * std::max<size_t>({size_t(recorded) * 24, 48, directional ? 72u : 0u});
+  space.estimate = sized_estimate(host_texels, recorded, directional, light_layers);
+  const size_t largest = read_texels * std::max<size_t>({size_t(recorded) * 24, size_t(light_layers) * 24, 48, directional ? 72u : 0u});
   if (largest > 0) space.staging = runner_.context().create_buffer(largest, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
   return space;
 }
@@ -167,7 +177,7 @@ LightmapEstimate LightmapDriver::download(const Accumulation& a, const Runs* onl
   }
   LightmapEstimate estimate = space.estimate.texels.size() == host_texels && !space.estimate.texels.empty()
                                   ? std::move(space.estimate)
-                                  : sized_estimate(host_texels, a.recorded, a.directional);
+                                  : sized_estimate(host_texels, a.recorded, a.directional, a.light_layers);
   const Buffer* staging = space.staging.handle() ? &space.staging : nullptr;
   if (texel_count > 0) {
     Context& context = runner_.context();
@@ -195,6 +205,14 @@ LightmapEstimate LightmapDriver::download(const Accumulation& a, const Runs* onl
     context.read_back_ranges(sums.bounce_sums, layers, [&](const char* bytes) {
       place(reinterpret_cast<char*>(estimate.bounces.data()), 24, a.recorded, bytes);
     }, staging);
+    if (a.light_layers > 0) {  // after the recorded layers in the same buffer
+      std::vector<ByteRange> lights;
+      for (int k = 0; k < a.light_layers; ++k)
+        for (const ByteRange& r : ranges(24, size_t(a.recorded + k) * texel_count * 24)) lights.push_back(r);
+      context.read_back_ranges(sums.bounce_sums, lights, [&](const char* bytes) {
+        place(reinterpret_cast<char*>(estimate.light_sums.data()), 24, a.light_layers, bytes);
+      }, staging);
+    }
     context.read_back_ranges(sums.sums, ranges(48, 0), [&](const char* bytes) {
       const double* sums = reinterpret_cast<const double*>(bytes);
       for (size_t k = 0; k < runs.size(); ++k)
@@ -331,7 +349,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   const bool whole_here = !share || share->rank() == 0;
   std::future<ReadBackSpace> space = std::async(std::launch::async, &LightmapDriver::read_back_space, this,
                                                 whole_here ? a.texel_count : a.work_list.size(), a.work_list.size(), a.recorded,
-                                                a.directional);
+                                                a.directional, a.light_layers);
   uint32_t first = 0, pass = 0;
   while ((share || !a.work_list.empty()) && passes.next_pass(first, pass)) {
     const auto pass_start = Clock::now();
@@ -421,8 +439,26 @@ void LightmapDriver::start(const TexelGBuffer& gbuffer, const IntegratorSettings
                      before->start_points.size() == gbuffer.texels.size();
   prepare(gbuffer, settings, a, nullptr, reuse ? &*before : nullptr, accumulation_cleared);
   a.params.changed_light_pairs = changed_light_pairs;
+  // A change estimate's contributions are differences of direct light, not split by light: its light
+  // layers stay 0 (what it publishes then has no split, scale_light_layers.comp).
+  if (changed_light_pairs > 0) a.params.light_layers = 0;
   a.seconds = std::chrono::duration<double>(Clock::now() - start_time).count();
   progressive_ = std::move(a);
+}
+
+void LightmapDriver::scene_changed() {
+  if (!progressive_) return;
+  GpuParams& p = progressive_->params;
+  const GpuParams scene = runner_.bake_params(IntegratorSettings{}, p.recorded, p.item_count_total);
+  p.sky = scene.sky;
+  p.scene_extent = scene.scene_extent;
+  p.emitter_count = scene.emitter_count;
+  p.punctual_count = scene.punctual_count;
+  p.surface_flags = scene.surface_flags;
+  p.environment_width = scene.environment_width;
+  p.environment_height = scene.environment_height;
+  p.shadow_slots = scene.shadow_slots;
+  p.traversal_steps = scene.traversal_steps;
 }
 
 void LightmapDriver::update_texels(const TexelGBuffer& gbuffer, const std::vector<uint32_t>& texels) {
@@ -496,13 +532,14 @@ LightmapEstimate LightmapDriver::read(const DeviceLightmap& lightmap) {
   if (progressive_) a.totals = progressive_->totals, a.seconds = progressive_->seconds;
   a.texel_count = lightmap.texels;
   a.recorded = lightmap.layers;
+  a.light_layers = lightmap.light_layers;
   a.directional = lightmap.directional;
   return download(a, nullptr, {}, false, &lightmap.sums);
 }
 
 LightmapDriver::Shape LightmapDriver::shape() const {
   if (!progressive_) throw std::logic_error("Vulkan backend: publishing before start_progressive");
-  return {progressive_->texel_count, progressive_->recorded, progressive_->directional};
+  return {progressive_->texel_count, progressive_->recorded, progressive_->directional, progressive_->light_layers};
 }
 
 }  // namespace exitance::vulkan

@@ -43,6 +43,9 @@ class LightmapDriver {
   // with clear_accumulation): not cleared again unless their buffers had to grow.
   void start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, uint32_t changed_light_pairs = 0,
              bool texels_as_before = false, bool accumulation_cleared = false);
+  // The scene's lights changed under a running accumulation (an edit that only scaled them): the
+  // parameters the kernels take from the scene (the constant sky, counts) read again.
+  void scene_changed();
   // `samples` more per texel (sample indices continue where the last call ended); returns the rays traced.
   uint64_t add_samples(uint32_t samples);
   // The start points of `texels` taken from `gbuffer` again (an edit moved them), on the host and,
@@ -60,6 +63,7 @@ class LightmapDriver {
     size_t texels = 0;
     int layers = 1;
     bool directional = false;
+    int light_layers = 0;
   };
   Shape shape() const;
   bool started() const { return progressive_.has_value(); }
@@ -74,6 +78,7 @@ class LightmapDriver {
     std::vector<uint32_t> work_list;
     size_t texel_count = 0;
     int recorded = 1;
+    int light_layers = 0;  // IntegratorSettings::light_layers: the scene's light layers, else 0
     size_t result_bytes = 0;
     bool directional = false;  // DirectionalMode::Sh1: L1 results and sums too
     size_t max_work = 0;
@@ -97,8 +102,8 @@ class LightmapDriver {
     LightmapEstimate estimate;
     Buffer staging;
   };
-  static LightmapEstimate sized_estimate(size_t texels, int recorded, bool directional);
-  ReadBackSpace read_back_space(size_t host_texels, size_t read_texels, int recorded, bool directional);
+  static LightmapEstimate sized_estimate(size_t texels, int recorded, bool directional, int light_layers = 0);
+  ReadBackSpace read_back_space(size_t host_texels, size_t read_texels, int recorded, bool directional, int light_layers = 0);
   // The sums read back into `space` (sized here when it does not fit); `only`: just these runs
   // [first, end) of texels (a rank's own), in place among all texels (the others' left zero) or,
   // `packed`, run after run in arrays of the runs' texels alone; null: every texel.

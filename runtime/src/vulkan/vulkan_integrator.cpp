@@ -9,6 +9,7 @@
 
 #include "bounce_layer_driver.h"
 #include "device_lightmaps.h"
+#include "light_layer_scaling.h"
 #include "exitance/runtime/core/grid_guiding_cache.h"
 #include "exitance/runtime/core/per_bounce_bake.h"
 #include "gpu_scene.h"
@@ -50,6 +51,7 @@ struct VulkanIntegrator::Impl {
   LightmapDriver lightmap;
   ProbeDriver probes;
   std::optional<LightmapPublisher> publisher;  // made at the first publish or upload
+  std::optional<LightLayerScaler> scaler;      // made at the first scaling edit
   std::unique_ptr<LightmapPageImages> page_images;  // made at the first write_page_images
   // Device estimates publish() wrote, reused once their holders let go of them (an edit replaces
   // the previous estimate: at 1 M texels ~100 MB not allocated again).
@@ -144,7 +146,8 @@ PublishedLightmap VulkanIntegrator::publish(PublishMode mode, const DeviceLightm
   const LightmapDriver::Shape shape = impl_->lightmap.shape();
   // An estimate of another shape (a whole run's, with other recorded layers) is nothing to keep.
   auto fits = [&](const DeviceLightmap* e) {
-    return e && e->texels == shape.texels && e->layers == shape.layers && e->directional == shape.directional;
+    return e && e->texels == shape.texels && e->layers == shape.layers && e->directional == shape.directional &&
+           e->light_layers == shape.light_layers;
   };
   if (mode == PublishMode::Change && !(fits(base) && fits(previous)))
     throw std::logic_error("VulkanIntegrator::publish: a change estimate's base and previous must be shaped as the accumulation");
@@ -153,12 +156,12 @@ PublishedLightmap VulkanIntegrator::publish(PublishMode mode, const DeviceLightm
   std::shared_ptr<DeviceLightmap> out;
   for (const std::shared_ptr<DeviceLightmap>& spare : impl_->spare_lightmaps)
     if (spare.use_count() == 1 && spare->texels == shape.texels && spare->layers == shape.layers &&
-        spare->directional == shape.directional) {
+        spare->directional == shape.directional && spare->light_layers == shape.light_layers) {
       out = spare;
       break;
     }
   if (!out) {
-    out = std::make_shared<DeviceLightmap>(impl_->context, shape.texels, shape.layers, shape.directional);
+    out = std::make_shared<DeviceLightmap>(impl_->context, shape.texels, shape.layers, shape.directional, shape.light_layers);
     if (impl_->spare_lightmaps.size() >= Impl::kSpareLightmaps)  // of another shape, or all in use: the oldest free one goes
       for (auto it = impl_->spare_lightmaps.begin(); it != impl_->spare_lightmaps.end(); ++it)
         if (it->use_count() == 1) {
@@ -172,13 +175,35 @@ PublishedLightmap VulkanIntegrator::publish(PublishMode mode, const DeviceLightm
 
 std::shared_ptr<DeviceLightmap> VulkanIntegrator::upload_lightmap(const LightmapEstimate& estimate) {
   if (!impl_->publisher) impl_->publisher.emplace(impl_->context);
-  auto lightmap = std::make_shared<DeviceLightmap>(impl_->context, estimate.texels.size(), estimate.recorded_bounces, estimate.has_sh1());
+  auto lightmap = std::make_shared<DeviceLightmap>(impl_->context, estimate.texels.size(), estimate.recorded_bounces, estimate.has_sh1(),
+                                                   estimate.light_layers);
   impl_->publisher->upload(estimate, *lightmap);
   // Kept among the spares: when the caller lets it go (the first edit replaces the baked lightmap),
   // a later publish reuses its memory instead of it being freed inside the edit (freeing ~100 MB
   // of device memory costs milliseconds).
   if (impl_->spare_lightmaps.size() < Impl::kSpareLightmaps) impl_->spare_lightmaps.push_back(lightmap);
   return lightmap;
+}
+
+int VulkanIntegrator::light_layers() const { return impl_->lightmap.started() ? impl_->lightmap.shape().light_layers : 0; }
+
+void VulkanIntegrator::prepare_light_layer_scaling() {
+  if (!impl_->scaler) impl_->scaler.emplace(impl_->context);
+}
+
+void VulkanIntegrator::scale_light_layers(const std::vector<Vec4>& factors, const std::vector<const DeviceLightmap*>& estimates) {
+  const LightmapDriver::Shape shape = impl_->lightmap.shape();
+  const ScaledEstimate accumulation{&impl_->buffers.texels, shape.texels, shape.layers, shape.light_layers, shape.directional};
+  std::vector<ScaledEstimate> scaled;
+  for (const DeviceLightmap* e : estimates) {
+    if (!e || e->texels != shape.texels || e->layers != shape.layers || e->light_layers != shape.light_layers ||
+        e->directional != shape.directional)
+      throw std::logic_error("VulkanIntegrator::scale_light_layers: an estimate not shaped as the accumulation");
+    scaled.push_back({&e->sums, e->texels, e->layers, e->light_layers, e->directional});
+  }
+  if (!impl_->scaler) impl_->scaler.emplace(impl_->context);
+  impl_->scaler->scale(factors, accumulation, scaled);
+  impl_->lightmap.scene_changed();  // the passes to come light the edited scene (its sky colour)
 }
 
 LightmapEstimate VulkanIntegrator::read_lightmap(const DeviceLightmap& lightmap) const { return impl_->lightmap.read(lightmap); }

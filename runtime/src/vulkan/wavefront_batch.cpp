@@ -6,7 +6,7 @@
 namespace exitance::vulkan {
 namespace {
 
-static_assert(sizeof(GpuParams) == 176);  // 168 bytes of fields, padded to Vec4 alignment
+static_assert(sizeof(GpuParams) == 192);  // 192 bytes of fields (a multiple of Vec4 alignment)
 static_assert(sizeof(GpuSurfacePoint) == 48 && sizeof(ShadowRay) == 32);
 
 uint64_t stat64(const uint32_t* c, uint32_t slot) { return uint64_t(c[slot]) | (uint64_t(c[slot + 1]) << 32); }

@@ -19,7 +19,7 @@ struct GpuTriangle {
 // A material's constant factors: all an untextured scene reads.
 struct GpuMaterial {
   vec4 albedo_double_sided;  // xyz diffuse albedo (material.h); w 1 when double sided
-  vec4 emission;             // xyz emitted radiance; w 0
+  vec4 emission;             // xyz emitted radiance; w its light layer (light_layers.h), a whole number
 };
 
 // What a material needs where it varies per point (scenes with GpuParams::surface_flags &
@@ -122,6 +122,11 @@ struct GpuParams {
                            // constant, so one compiled kernel serves every scene's BVH)
   uint changed_light_pairs;  // texel batches: 0 = the estimator; n > 0 = the change of direct light from n edited
                              // punctual lights (path.h punctual_change_rays), pairs of records after the scene's own
+  uint light_layers;         // texel path batches: 0 = none; L > 0 = also sum each contribution into its light
+                             // layer (light_layers.h), L layers of rgb per work item after every other slot
+  uint punctual_layers;      // light layers of punctual lights (light_layers.h punctual_light_layer)
+  uint light_result_words;   // result words per work item before the light layers' section (bindings.glsl)
+  uint pad_light_layers;
 };
 
 // The most edited punctual lights a change estimate carries (GpuParams::changed_light_pairs; the

@@ -217,6 +217,10 @@ struct EmitterLearning {
   float value;
   uint punctual_light;  // kEmitterPatchNone: no punctual tables or no sample
   float punctual_value; // luminance(I falloff cos / pi) / probability
+  // Where the shadow rays' light comes from (light layers, light_layers.h), whether guided or not:
+  // the area sample's triangle and the punctual light chosen (kEmitterPatchNone: no sample).
+  uint area_triangle;
+  uint punctual_index;
 };
 
 EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, vec3 throughput, GuideVertex guide,
@@ -230,6 +234,8 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
   learning.value = 0.0f;
   learning.punctual_light = kEmitterPatchNone;
   learning.punctual_value = 0.0f;
+  learning.area_triangle = kEmitterPatchNone;
+  learning.punctual_index = kEmitterPatchNone;
   uint emitters = scene_emitter_count(SCENE_ALONE_ARG);
   if (emitters > 0u) {
     float u_choose = sample_1d(rng);
@@ -238,6 +244,7 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
     vec2 bary = point.barycentrics;
     uint patch_index = point.patch_index;
     uint tri = scene_emitter_triangle(SCENE_ARG point.emitter);
+    learning.area_triangle = tri;
     vec3 p0 = scene_triangle_vertex(SCENE_ARG tri, 0u);
     vec3 p1 = scene_triangle_vertex(SCENE_ARG tri, 1u);
     vec3 p2 = scene_triangle_vertex(SCENE_ARG tri, 2u);
@@ -278,6 +285,7 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
     float u_choose = sample_1d(rng);
     float probability;
     uint light_index = punctual_mixture_sample(scene_punctual_cdf(SCENE_ALONE_ARG), punctual, emitter_guide, u_choose, probability);
+    learning.punctual_index = light_index;
     float value = punctual_light_ray(scene_punctual_light(SCENE_ARG light_index), x, throughput, probability, punctual_ray);
     if (punctual_ray.contribution_state.w != kShadowNone && emitter_guide.punctual_count > 0u) {
       learning.punctual_light = light_index;

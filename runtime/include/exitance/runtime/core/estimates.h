@@ -46,6 +46,10 @@ struct LightmapEstimate {
   std::vector<TexelAccumulator> texels;
   std::vector<double> bounces;  // [bounce][texel][rgb] flattened: (k * texel_count + i) * 3 + c
   int recorded_bounces = 0;
+  // Light layers (IntegratorSettings::light_layers; exitance/common/light_layers.h): per layer the
+  // sums of E/pi of that light alone, [layer][texel][rgb] as `bounces`; they add up to the total.
+  int light_layers = 0;
+  std::vector<double> light_sums;
   uint64_t rays = 0;
   double seconds = 0;
   uint64_t nonfinite_samples = 0;  // samples discarded because they were NaN/Inf (should stay 0)

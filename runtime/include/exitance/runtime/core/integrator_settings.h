@@ -55,6 +55,9 @@ struct IntegratorSettings {
   int max_bounces = -1;            // diffuse bounces after the first hit; -1 = until Russian roulette
   uint64_t seed = 0;
   int recorded_bounces = 4;        // layers bounce0 (= direct) .. bounce<K-1> kept separately
+  // Vulkan path mode: also keep E/pi per light layer (exitance/common/light_layers.h; the runtime's
+  // refresh scales a layer when only its light's emission changed). 24 bytes per layer and texel.
+  bool light_layers = false;
   int russian_roulette_start = 3;  // first bounce at which roulette may end a path
   int safety_bounce_cap = 4096;    // never reached by paths of albedo < 0.998 in practice; documented
   uint32_t sampling_strategy = 0;  // continuation directions: kStrategyCosine (path.h)

@@ -29,6 +29,13 @@ struct LightingScene {
   float extent = 1.0f;                       // largest side of the bounds: the scale of ray-offset floors
   bool textured = false;  // materials vary per point (textures, MASK/BLEND, COLOR_0): CPU reference only
   Bvh4 bvh;
+  // Light layers (exitance/common/light_layers.h), laid out once when the scene is built and kept
+  // through edits (a layer's sums stay its light's): the sky, punctual_light_layers for the punctual
+  // lights, one per material emissive then (up to the limit), one for materials made emissive later.
+  // Each material's layer is in its record's emission.w too.
+  uint32_t punctual_light_layers = 0;
+  uint32_t light_layer_count = 1;
+  std::vector<uint32_t> material_light_layers;
 
   uint32_t emitter_count() const { return uint32_t(emitter_triangles.size()); }
   uint32_t punctual_count() const { return uint32_t(punctual_lights.size()); }
@@ -40,6 +47,12 @@ struct LightingScene {
 // scene's bounding sphere). An empty BVH is allowed (the CPU reference traces with Embree's own);
 // throws std::invalid_argument when the BVH references a triangle the scene does not have.
 LightingScene build_lighting_scene(std::shared_ptr<const Scene> scene, Bvh4 bvh);
+
+// The light layers of `scene`'s lights and emissive materials, at most `limit` per kind (beyond it
+// the last layer of the kind is shared): sets punctual_light_layers, light_layer_count,
+// material_light_layers and the records' emission.w. build_lighting_scene lays them out with the
+// default limit (kDefaultLightLayerLimit).
+void lay_out_light_layers(LightingScene& scene, uint32_t limit);
 
 // After geometry moved (an instance transform edit, refresh/scene_edits.h): `edited` is the source
 // scene with the same triangles (count, order, materials, instances) at new positions, and

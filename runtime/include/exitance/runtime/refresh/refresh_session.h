@@ -52,6 +52,11 @@ struct RefreshSessionOptions {
   // until refreshed samples are better (published_estimate.h), and the first light edit is estimated
   // as a change from it. false: every texel starts with nothing, as before issue 32.
   bool start_from_baked = true;
+  // Keep the estimate per light layer (exitance/common/light_layers.h; docs/runtime.md "Light
+  // layers"), so that an edit that only scales a light's emission (intensity, colour,
+  // emissiveFactor, emissiveStrength, a constant sky's colour) scales its layer with 0 rays and
+  // keeps every sample. Device memory: 24 bytes per layer and texel for each estimate kept.
+  bool light_layers = true;
 };
 
 // Edits that change at most this many punctual lights (counted against the base) are estimated as
@@ -84,7 +89,8 @@ struct EditTimings {
   double scene = 0;        // validating and applying the edits: host scene, lighting scene, device uploads
   double near_texels = 0;  // finding the texels near the change (texels_near_change.h)
   double publish = 0;      // keeping what texels showed, on the device (publish.comp)
-  double restart = 0;      // starting the accumulation again (a restart or a change estimate)
+  double restart = 0;      // starting the accumulation again (a restart or a change estimate), or scaling light layers
+  bool scaled_light_layers = false;  // the edit only scaled lights: their layers were scaled, no sample was dropped
   // Of all of the above: device submissions waited for, and the milliseconds spent waiting.
   uint64_t device_submissions = 0;
   double device_wait = 0;
@@ -218,6 +224,11 @@ class RefreshSession {
   // What texels publish now (published_lightmap), composed in device memory; `clear_accumulation`:
   // the accumulation's sums cleared in the same submission (apply_edits, which starts it again).
   PublishedLightmap publish_on_device(bool clear_accumulation = false) const;
+  // An edit that only scaled lights (light_layer_edits.h): the accumulation and previous scaled per
+  // layer with 0 rays, every sample kept (a previous texel without a split by light, as the baked
+  // lightmap's, in proportion to the accumulation's split there); false (nothing done) during a
+  // change estimate or after a per-bounce run, which keep no light layers.
+  bool scale_light_layers(const std::vector<Vec4>& factors, bool punctual_only);
   std::unique_ptr<State> state_;
 };
 

@@ -27,6 +27,8 @@ struct RelightOptions {
   double frame_budget_ms = 0;      // > 0: each frame (refresh call)
   uint32_t frames = 0;             // > 0: at most this many frames
   bool from_baked = true;          // start from the bundle's baked lightmap (RefreshSessionOptions::start_from_baked)
+  bool light_layers = true;        // keep the estimate per light layer (RefreshSessionOptions::light_layers)
+  uint32_t samples_before_edits = 0;  // > 0: refresh this many samples per texel before applying the edits
   bool page_images = false;        // with frames: after each frame, the page images an engine samples written (publish_page_images), timed
   bool frame_errors = true;        // with frames: each frame's estimated error (a read-back of the sums between frames)
   std::optional<uint64_t> seed;    // default: the bake's

@@ -1,0 +1,46 @@
+#!/bin/bash
+# Runs on the GPU machine (bench/light_layers_gpu_pack.sh packs what it needs): the building at 12
+# texels/m lit to 4096 spp as the shipped bundle, then one point light's intensity doubled
+# (bench/refresh_double_light.json) and refreshed frame by frame: right at open (the bundle holds no
+# light layers: the baked texels follow the accumulation's split, which has no samples yet) and in a
+# session that has refreshed WARM samples per texel first (a game running when the edit comes),
+# with light layers (scaled, 0 rays) and without (--no-light-layers: a change estimate), each
+# output's relMSE against two 4096-spp relights of the edited scene; the light move with and without
+# layers (their cost per frame); bench_edit_cost on the lit bundle (the edit and the one undoing it
+# in turn, COST_REPS rounds).
+# Env: WARM (256), FRAMES (1 6), COST_REPS (9). Writes $OUT/summary.txt.
+set -e
+for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
+export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+W=/tmp/w; mkdir -p $W && tar -C $W -xJf .replay/light_layers.txz
+R=$W/runtime/bin/exitance-relight
+export LD_LIBRARY_PATH=$W/runtime/lib
+S=$OUT/summary.txt
+$R --list-devices > $S
+$R $W/building.bake -o $W/base.bake --spp 4096 --seed 7 --no-frame-errors --json > $W/base.json
+python3 -c "import json; r=json.load(open('$W/base.json')); print('base', r['spp'], 'spp', r['seconds'], 'light_layers', r['light_layers'])" >> $S
+report() {  # $1 the run's JSON, $2 its label
+  python3 -c "
+import json; r=json.load(open('$1')); e=r['edits']; ms=[f['milliseconds'] for f in r['frames']]
+print('$2', 'edits_s %.5f'%r['seconds']['edits'], 'edit_ms', {k: round(v, 3) for k, v in e.get('milliseconds', {}).items()}, 'scaled', e.get('scaled_light_layers'), 'changed_lights', e['changed_lights'], 'samples_before', e.get('samples_before', 0), 'frames', len(ms), 'frame_ms', [round(m, 1) for m in ms], 'spp', r['spp'], 'light_layers', r['light_layers'])" >> $S
+}
+for e in double move; do
+  for s in 101 202; do $R $W/base.bake -o $W/ref_${e}_$s.bake --edits $W/$e.json --spp 4096 --seed $s --ignore-baked --no-light-layers --json > /dev/null; done
+  list=""
+  for f in ${FRAMES:-1 6}; do
+    for mode in open warm open_nolayers warm_nolayers; do
+      [ $e = move ] && [ ${mode#warm} != $mode ] && continue
+      flags=""; [ ${mode#warm} != $mode ] && flags="--spp-before-edits ${WARM:-256}"
+      [ ${mode%nolayers} != $mode ] && flags="$flags --no-light-layers"
+      o=${e}_${mode}_$f
+      $R $W/base.bake -o $W/$o.bake --edits $W/$e.json --spp 4096 --frames $f --budget-ms 16 --seed 3 --no-frame-errors $flags --json > $W/$o.json
+      report $W/$o.json $o
+      list="$list $W/$o.bake"
+    done
+  done
+  echo "relMSE $e (unrefreshed = base.bake):" >> $S
+  $W/bench_bundle_rel_mse $W/ref_${e}_101.bake $W/ref_${e}_202.bake $W/base.bake $list >> $S
+done
+echo "bench_edit_cost double (light layers on by default):" >> $S
+$W/bench_edit_cost $W/base.bake --edits $W/double.json --edits-back $W/double_back.json --repeat ${COST_REPS:-9} >> $S
+cat $S

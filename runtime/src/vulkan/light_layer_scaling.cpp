@@ -1,0 +1,103 @@
+#include "light_layer_scaling.h"
+
+#include <array>
+#include <cstring>
+#include <stdexcept>
+
+#include "exitance_spirv/scale_light_layers.h"
+
+namespace exitance::vulkan {
+namespace {
+
+struct ScalePush {
+  uint32_t texel_count, recorded, light_layers, directional, accumulation;
+};
+
+}  // namespace
+
+LightLayerScaler::LightLayerScaler(Context& context)
+    : context_(context),
+      kernel_(context, std::vector<VkDescriptorType>(5, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER), sizeof(ScalePush), spirv_scale_light_layers,
+              sizeof(spirv_scale_light_layers), kSets, "scale_light_layers.comp") {
+  // One dispatch over no texels, so drivers that compile a pipeline at its first dispatch (lavapipe)
+  // do it here and not inside the first edit.
+  factors_ = context_.create_buffer(sizeof(Vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
+  std::array<VkDescriptorBufferInfo, 5> infos{};
+  std::array<VkWriteDescriptorSet, 5> writes{};
+  for (uint32_t b = 0; b < 5; ++b) {
+    infos[b] = {factors_.handle(), 0, VK_WHOLE_SIZE};
+    writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[b].dstSet = kernel_.set(0);
+    writes[b].dstBinding = b;
+    writes[b].descriptorCount = 1;
+    writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[b].pBufferInfo = &infos[b];
+  }
+  vkUpdateDescriptorSets(context_.device(), 5, writes.data(), 0, nullptr);
+  VkCommandBuffer cmd = context_.begin();
+  kernel_.bind(cmd, 0);
+  const ScalePush push{0, 1, 0, 0, 1};
+  kernel_.push(cmd, &push, sizeof(push));
+  vkCmdDispatch(cmd, 1, 1, 1);
+  context_.submit_and_wait(cmd);
+}
+
+void LightLayerScaler::scale(const std::vector<Vec4>& factors, const ScaledEstimate& accumulation, const std::vector<ScaledEstimate>& others) {
+  if (others.size() + 1 > kSets) throw std::logic_error("LightLayerScaler::scale: more estimates than descriptor sets");
+  std::vector<ScaledEstimate> estimates = others;
+  estimates.push_back(accumulation);  // last: the others read its sums from before
+  for (const ScaledEstimate& e : estimates)
+    if (!e.sums || size_t(e.light_layers) != factors.size() || e.texels != accumulation.texels || e.recorded != accumulation.recorded ||
+        e.directional != accumulation.directional)
+      throw std::logic_error("LightLayerScaler::scale: an estimate not shaped as the accumulation");
+  if (factors.empty() || accumulation.texels == 0) return;
+  const size_t bytes = factors.size() * sizeof(Vec4);
+  if (!factors_.handle() || factors_.size() < bytes) factors_ = context_.create_buffer(bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
+  std::memcpy(factors_.mapped(), factors.data(), bytes);  // host-coherent: visible to the submission below
+  for (uint32_t i = 0; i < estimates.size(); ++i) {
+    const std::array<VkDescriptorBufferInfo, 5> infos{{{estimates[i].sums->sums.handle(), 0, VK_WHOLE_SIZE},
+                                                       {estimates[i].sums->bounce_sums.handle(), 0, VK_WHOLE_SIZE},
+                                                       {factors_.handle(), 0, VK_WHOLE_SIZE},
+                                                       {accumulation.sums->sums.handle(), 0, VK_WHOLE_SIZE},
+                                                       {accumulation.sums->bounce_sums.handle(), 0, VK_WHOLE_SIZE}}};
+    std::array<VkWriteDescriptorSet, 5> writes{};
+    for (uint32_t b = 0; b < 5; ++b) {
+      writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+      writes[b].dstSet = kernel_.set(i);
+      writes[b].dstBinding = b;
+      writes[b].descriptorCount = 1;
+      writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      writes[b].pBufferInfo = &infos[b];
+    }
+    vkUpdateDescriptorSets(context_.device(), 5, writes.data(), 0, nullptr);
+  }
+  VkCommandBuffer cmd = context_.begin();
+  VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_HOST_WRITE_BIT;
+  barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_HOST_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
+  for (uint32_t i = 0; i < estimates.size(); ++i) {
+    const ScaledEstimate& e = estimates[i];
+    const bool last = i + 1 == estimates.size();
+    if (last && i > 0) {  // the others' reads of the accumulation before it changes
+      barrier.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+      barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+      vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0, nullptr, 0,
+                           nullptr);
+    }
+    kernel_.bind(cmd, i);
+    const ScalePush push{uint32_t(e.texels), uint32_t(e.recorded), uint32_t(e.light_layers), e.directional ? 1u : 0u, last ? 1u : 0u};
+    kernel_.push(cmd, &push, sizeof(push));
+    vkCmdDispatch(cmd, uint32_t((e.texels + 63) / 64), 1, 1);
+  }
+  barrier.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+  barrier.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT |
+                          VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_HOST_READ_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
+                       &barrier, 0, nullptr, 0, nullptr);
+  context_.submit_and_wait(cmd);
+}
+
+}  // namespace exitance::vulkan

@@ -1,0 +1,333 @@
+// Light layers (exitance/common/light_layers.h, docs/runtime.md "Light layers") on lavapipe: the
+// runtime's estimate kept per light adds up to the total, whose bits the layers leave alone; each
+// layer alone agrees with a refresh of the scene lit by that light only; an edit that only scales
+// lights scales their layers with 0 rays, exactly, keeps every sample and converges from there.
+// The scene: the courtyard under a sun and a sky, with a point lamp added and the low wall made
+// emissive, so there is a layer of every kind (sky, two punctual lights, an emissive material).
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "exitance/bake/command/bake_pipeline.h"
+#include "exitance/common/light_layers.h"
+#include "exitance/runtime/refresh/published_estimate.h"
+#include "exitance/runtime/refresh/refresh_session.h"
+#include "support/lightmap_comparison.h"
+#include "support/vulkan_device_available.h"
+
+namespace exitance {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using testing::has_vulkan_device;
+
+fs::path test_dir() {
+  static const fs::path dir = [] {
+    const fs::path d = fs::temp_directory_path() / ("exitance-light-layers-" + std::to_string(::getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+json& named(json& list, const std::string& name) {
+  for (json& item : list)
+    if (item.value("name", "") == name) return item;
+  throw std::runtime_error("no " + name);
+}
+
+// Which lights the courtyard variant keeps (the others off: 0 intensity, no emission, black sky).
+struct Lit {
+  bool sun = true, lamp = true, wall = true, sky = true;
+};
+
+// The courtyard with a lamp and an emissive low wall, baked (CPU; 1 sample where only scene.bin is
+// used, 16 where the session starts from the baked lightmap).
+fs::path courtyard_bundle(const std::string& name, Lit lit, uint32_t spp = 1) {
+  const fs::path dir = test_dir();
+  const fs::path bundle = dir / (name + ".bake");
+  if (fs::exists(bundle)) return bundle;
+  fs::copy_file(fs::path(EXITANCE_SAMPLE_DIR) / "courtyard.bin", dir / "courtyard.bin", fs::copy_options::overwrite_existing);
+  std::ifstream in(fs::path(EXITANCE_SAMPLE_DIR) / "courtyard.gltf");
+  json g = json::parse(in);
+  json& lights = g["extensions"]["KHR_lights_punctual"]["lights"];
+  if (!lit.sun) lights[0]["intensity"] = 0.0;
+  lights.push_back({{"name", "Lamp"}, {"type", "point"}, {"color", {1.0, 0.8, 0.6}}, {"intensity", lit.lamp ? 60.0 : 0.0}});
+  g["nodes"].push_back({{"name", "Lamp"}, {"translation", {-1.5, 2.5, 0.5}},
+                        {"extensions", {{"KHR_lights_punctual", {{"light", lights.size() - 1}}}}}});
+  g["scenes"][g.value("scene", 0)]["nodes"].push_back(g["nodes"].size() - 1);
+  if (lit.wall) named(g["materials"], "Stone")["emissiveFactor"] = {0.9, 0.5, 0.2};
+  const fs::path input = dir / (name + ".gltf");
+  std::ofstream(input) << g.dump();
+  BakeOptions options;
+  options.input = input.string();
+  options.output = bundle.string();
+  options.backend.name = "cpu";
+  options.atlas.texel_density = 1.0f;
+  options.lighting.spp = spp;
+  options.lighting.seed = 5;
+  options.probes_enabled = false;
+  options.svo_enabled = false;
+  options.sky = lit.sky ? "0.3,0.4,0.5" : "0,0,0";
+  Diagnostics diagnostics;
+  run_bake(options, diagnostics);
+  return bundle;
+}
+
+// Validation layer messages of every session (each test expects none).
+std::vector<std::string>& validation_messages() {
+  static std::vector<std::string> messages;
+  return messages;
+}
+
+RefreshSessionOptions validated_options(uint64_t seed) {
+  RefreshSessionOptions options;
+  options.seed = seed;
+  options.device.validation = true;
+  options.device.on_validation_message = [](const std::string& m) { validation_messages().push_back(m); };
+  return options;
+}
+
+void expect_no_validation_messages() {
+  for (const std::string& m : validation_messages()) ADD_FAILURE() << "validation: " << m;
+  validation_messages().clear();
+}
+
+std::unique_ptr<RefreshSession> open_session(const fs::path& bundle, uint64_t seed, bool layers) {
+  RefreshSessionOptions options = validated_options(seed);
+  options.light_layers = layers;
+  options.start_from_baked = false;  // nothing before the session's own samples
+  return RefreshSession::open(bundle.string(), options);
+}
+
+// Layer `layer` of `e` as an estimate of its own: the mean of texel i, with `variance[i]` as the
+// variance of that mean.
+LightmapEstimate layer_estimate(const LightmapEstimate& e, int layer, const std::vector<Vec3>& variance) {
+  LightmapEstimate out;
+  out.texels.resize(e.texels.size());
+  out.rays = e.rays;
+  const size_t n = e.texels.size();
+  for (size_t i = 0; i < n; ++i) {
+    const uint32_t samples = e.texels[i].samples;
+    double mean[3], v[3];
+    for (int c = 0; c < 3; ++c) {
+      mean[c] = samples ? e.light_sums[(size_t(layer) * n + i) * 3 + size_t(c)] / samples : 0.0;
+      v[c] = variance[i][c];
+    }
+    set_total_sums(out.texels[i], samples, mean, v);
+  }
+  return out;
+}
+
+TEST(LightLayers, AddUpToTheTotalWhoseBitsTheyLeaveAlone) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const fs::path bundle = courtyard_bundle("all-lights", {});
+  auto layered = open_session(bundle, 7, true);
+  auto plain = open_session(bundle, 7, false);
+  const LightingScene& scene = layered->lighting_scene();
+  ASSERT_EQ(scene.punctual_light_layers, 2u);
+  ASSERT_EQ(scene.light_layer_count, 5u);  // sky, sun, lamp, the wall, materials made emissive later
+  layered->refresh({0, 6});
+  plain->refresh({0, 6});
+  const LightmapEstimate a = layered->lightmap(), b = plain->lightmap();
+  ASSERT_EQ(a.light_layers, 5);
+  EXPECT_EQ(b.light_layers, 0);
+  ASSERT_EQ(a.texels.size(), b.texels.size());
+  const size_t n = a.texels.size();
+  size_t differing = 0, off_split = 0;
+  double layer_totals[5] = {0, 0, 0, 0, 0};
+  for (size_t i = 0; i < n; ++i) {
+    differing += a.texels[i].samples != b.texels[i].samples;
+    for (int c = 0; c < 3; ++c) {
+      differing += a.texels[i].total[c] != b.texels[i].total[c] || a.texels[i].total_squared[c] != b.texels[i].total_squared[c];
+      double sum = 0;
+      for (int l = 0; l < 5; ++l) {
+        const double v = a.light_sums[(size_t(l) * n + i) * 3 + size_t(c)];
+        EXPECT_GE(v, 0.0);
+        sum += v;
+        layer_totals[l] += v;
+      }
+      // The same float contributions added in another order: float rounding of each sample's sum.
+      off_split += std::fabs(sum - a.texels[i].total[c]) > 1e-5 * a.texels[i].total[c] + 1e-30;
+    }
+  }
+  EXPECT_EQ(differing, 0u);
+  EXPECT_EQ(a.bounces, b.bounces);
+  EXPECT_EQ(off_split, 0u);
+  for (int l = 0; l < 4; ++l) EXPECT_GT(layer_totals[l], 0.0) << "layer " << l;
+  EXPECT_EQ(layer_totals[4], 0.0);  // no material was made emissive
+  std::printf("[light layers] %zu texels; layer shares: sky %.3f sun %.3f lamp %.3f wall %.3f\n", n,
+              layer_totals[0] / (layer_totals[0] + layer_totals[1] + layer_totals[2] + layer_totals[3]),
+              layer_totals[1] / (layer_totals[0] + layer_totals[1] + layer_totals[2] + layer_totals[3]),
+              layer_totals[2] / (layer_totals[0] + layer_totals[1] + layer_totals[2] + layer_totals[3]),
+              layer_totals[3] / (layer_totals[0] + layer_totals[1] + layer_totals[2] + layer_totals[3]));
+  expect_no_validation_messages();
+}
+
+// Each layer, from two sessions of different seeds (their difference gives its variance), against a
+// session of the scene lit by that light alone: per region of 64 texels and channel, |z| < 4.
+TEST(LightLayers, EachLayerEqualsTheSceneLitByItsLightAlone) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  constexpr uint32_t kSamples = 32;
+  const fs::path bundle = courtyard_bundle("all-lights", {});
+  auto first = open_session(bundle, 11, true);
+  auto second = open_session(bundle, 12, true);
+  first->refresh({0, kSamples});
+  second->refresh({0, kSamples});
+  const LightmapEstimate a = first->lightmap(), b = second->lightmap();
+  const size_t n = a.texels.size();
+  struct Alone {
+    int layer;
+    const char* name;
+    Lit lit;
+  };
+  const Alone cases[] = {{int(kSkyLightLayer), "sky-alone", {false, false, false, true}},
+                         {int(punctual_light_layer(0, 2)), "sun-alone", {true, false, false, false}},
+                         {int(punctual_light_layer(1, 2)), "lamp-alone", {false, true, false, false}},
+                         {3, "wall-alone", {false, false, true, false}}};
+  for (const Alone& alone : cases) {
+    SCOPED_TRACE(alone.name);
+    std::vector<Vec3> variance(n);
+    LightmapEstimate mean_of_two = a;  // the two seeds' layer sums added: their mean over 2 x kSamples
+    for (size_t i = 0; i < n; ++i)
+      for (int c = 0; c < 3; ++c) {
+        const size_t at = (size_t(alone.layer) * n + i) * 3 + size_t(c);
+        const double ma = a.light_sums[at] / kSamples, mb = b.light_sums[at] / kSamples;
+        variance[i][c] = float((ma - mb) * (ma - mb) / 4);  // of (ma + mb) / 2
+        mean_of_two.light_sums[at] = (ma + mb) / 2 * kSamples;
+      }
+    const LightmapEstimate layer = layer_estimate(mean_of_two, alone.layer, variance);
+    auto only = open_session(courtyard_bundle(alone.name, alone.lit), 13, false);
+    only->refresh({0, kSamples});
+    const LightmapEstimate reference = only->lightmap();
+    ASSERT_EQ(reference.texels.size(), n);
+    testing::compare_estimates(layer, reference, 64, alone.name);
+  }
+  expect_no_validation_messages();
+}
+
+// An edit that only scales lights: 0 rays, every sample kept, each layer times its factor exactly,
+// the total by the change; then the refresh goes on from there and agrees with a session of the
+// edited scene.
+TEST(LightLayers, AScalingEditScalesLayersWithNoRay) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const fs::path bundle = courtyard_bundle("all-lights", {});
+  auto session = open_session(bundle, 21, true);
+  session->refresh({0, 8});
+  const LightmapEstimate before = session->lightmap();
+  const std::string edits = R"({"edits": [{"light": "Lamp", "intensity": 150.0, "color": [0.5, 0.8, 0.6]},
+                                          {"light": "Sun", "intensity": 0.0},
+                                          {"material": "Stone", "emissiveFactor": [0.45, 0.5, 0.1]},
+                                          {"sky": [0.6, 0.4, 0.25]}]})";
+  const EditEffects effects = session->apply_edits(parse_scene_edits(edits, "scaling.json"));
+  EXPECT_EQ(effects.lights.size(), 2u);
+  EXPECT_TRUE(session->last_edit_timings().scaled_light_layers);
+  const LightmapEstimate after = session->lightmap();
+  EXPECT_EQ(after.rays, before.rays);  // nothing traced
+  const size_t n = before.texels.size();
+  // Per layer and channel, the factor: sky, sun off, lamp (150/60 x colour change), wall.
+  const double factors[5][3] = {{2.0, 1.0, 0.5},
+                                {0.0, 0.0, 0.0},
+                                {150.0 / 60 * 0.5 / 1.0, 150.0 / 60 * 0.8 / 0.8, 150.0 / 60 * 0.6 / 0.6},
+                                {0.5, 1.0, 0.5},
+                                {1.0, 1.0, 1.0}};
+  size_t differing = 0;
+  for (size_t i = 0; i < n; ++i) {
+    ASSERT_EQ(after.texels[i].samples, 8u);
+    for (int c = 0; c < 3; ++c) {
+      double total = before.texels[i].total[c];
+      for (int l = 0; l < 5; ++l) {
+        const size_t at = (size_t(l) * n + i) * 3 + size_t(c);
+        // The device multiplies by the factor as a float (the edit's ratio of floats).
+        const double expected = before.light_sums[at] * double(float(factors[l][c]));
+        total += expected - before.light_sums[at];
+        differing += std::fabs(after.light_sums[at] - expected) > 1e-6 * expected;
+      }
+      EXPECT_NEAR(after.texels[i].total[c], std::max(total, 0.0), 1e-9 * before.texels[i].total[c] + 1e-12) << "texel " << i;
+    }
+  }
+  EXPECT_EQ(differing, 0u);
+
+  // The refresh continues from the 8 samples; 56 more agree with 64 of a session of the edited scene.
+  session->refresh({0, 64});
+  const LightmapEstimate refreshed = session->lightmap();
+  for (const TexelAccumulator& t : refreshed.texels) ASSERT_EQ(t.samples, 64u);
+  const fs::path edited = test_dir() / "edited.bake";
+  {
+    std::ifstream in(fs::path(EXITANCE_SAMPLE_DIR) / "courtyard.gltf");
+    json g = json::parse(in);
+    json& lights = g["extensions"]["KHR_lights_punctual"]["lights"];
+    lights[0]["intensity"] = 0.0;
+    lights.push_back({{"name", "Lamp"}, {"type", "point"}, {"color", {0.5, 0.8, 0.6}}, {"intensity", 150.0}});
+    g["nodes"].push_back({{"name", "Lamp"}, {"translation", {-1.5, 2.5, 0.5}},
+                          {"extensions", {{"KHR_lights_punctual", {{"light", lights.size() - 1}}}}}});
+    g["scenes"][g.value("scene", 0)]["nodes"].push_back(g["nodes"].size() - 1);
+    named(g["materials"], "Stone")["emissiveFactor"] = {0.45, 0.5, 0.1};
+    const fs::path input = test_dir() / "edited.gltf";
+    std::ofstream(input) << g.dump();
+    BakeOptions options;
+    options.input = input.string();
+    options.output = edited.string();
+    options.backend.name = "cpu";
+    options.atlas.texel_density = 1.0f;
+    options.lighting.spp = 1;
+    options.lighting.seed = 5;
+    options.probes_enabled = false;
+    options.svo_enabled = false;
+    options.sky = "0.6,0.4,0.25";
+    Diagnostics diagnostics;
+    run_bake(options, diagnostics);
+  }
+  auto fresh = open_session(edited, 33, false);
+  fresh->refresh({0, 64});
+  testing::compare_estimates(refreshed, fresh->lightmap(), 64, "scaled-then-refreshed");
+  expect_no_validation_messages();
+}
+
+// A previous estimate with no split by light (the baked lightmap at open): scaled by the
+// accumulation's split at each texel; an edit that is not a scaling drops the samples as before.
+TEST(LightLayers, TheBakedLightmapFollowsTheAccumulationsSplit) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const fs::path bundle = courtyard_bundle("all-lights-16spp", {}, 16);
+  RefreshSessionOptions options = validated_options(41);
+  auto session = RefreshSession::open(bundle.string(), options);  // from the baked lightmap
+  ASSERT_TRUE(session->started_from_baked());
+  session->refresh({0, 1});  // one sample: every texel still shows the baked value (publishing_rule.h)
+  const LightmapEstimate shown_before = session->published_lightmap();
+  const LightmapEstimate accumulated = session->lightmap();
+  session->apply_edits(parse_scene_edits(R"({"edits": [{"sky": [0.9, 1.2, 1.5]}]})", "sky.json"));
+  EXPECT_TRUE(session->last_edit_timings().scaled_light_layers);
+  const LightmapEstimate shown_after = session->published_lightmap();
+  const size_t n = accumulated.texels.size();
+  size_t checked = 0;
+  for (size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      if (shown_before.texels[i].total[c] == accumulated.texels[i].total[c]) continue;  // shows the accumulation
+      const double sky = accumulated.light_sums[i * 3 + size_t(c)], total = accumulated.texels[i].total[c];
+      if (!(total > 0)) continue;
+      const double ratio = (total + sky * (3.0 - 1.0)) / total;  // every sky channel x 3 (as floats: within 1e-6)
+      const double expected = shown_before.texels[i].total[c] * ratio;
+      EXPECT_NEAR(shown_after.texels[i].total[c], expected, 1e-6 * expected) << "texel " << i << " channel " << c;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 0u);
+  // A light turned is not a scaling: the accumulation restarts.
+  session->apply_edits(parse_scene_edits(R"({"edits": [{"node": "Lamp", "translation": [0.5, 2.5, 0.5]}]})", "move.json"));
+  EXPECT_FALSE(session->last_edit_timings().scaled_light_layers);
+  for (const TexelAccumulator& t : session->lightmap().texels) ASSERT_EQ(t.samples, 0u);
+  expect_no_validation_messages();
+}
+
+}  // namespace
+}  // namespace exitance
