@@ -5,7 +5,10 @@
 // the range of each phase for each direction. Profiling target for issue 32's edit costs (the
 // figures an engine sees come from exitance-relight --json's edits.milliseconds, which this matches).
 //
-//   bench_edit_cost BUNDLE --edits A.json --edits-back B.json [--repeat 9] [--samples 1]
+// `--samples-before N`: the session refreshes N samples per texel first (a session that has been
+// running; an edit that only scales lights is applied by scaling its light layers once it has 256).
+//
+//   bench_edit_cost BUNDLE --edits A.json --edits-back B.json [--repeat 9] [--samples 1] [--samples-before 0]
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -54,28 +57,33 @@ int main(int argc, char** argv) {
   CLI::App app{"apply_edits' cost per phase on a bundle (bench/results/refresh-gpu.md)"};
   std::string bundle, forth, back;
   int repeat = 9;
-  uint32_t samples = 1;
+  uint32_t samples = 1, samples_before = 0;
   app.add_option("bundle", bundle, "baked bundle folder")->required();
   app.add_option("--edits", forth, "edits applied first in each round")->required();
   app.add_option("--edits-back", back, "edits applied second (undoing the first)")->required();
   app.add_option("--repeat", repeat, "rounds")->check(CLI::PositiveNumber);
   app.add_option("--samples", samples, "samples per texel refreshed after each edit (0: none)");
+  app.add_option("--samples-before", samples_before, "samples per texel refreshed before the first edit");
   CLI11_PARSE(app, argc, argv);
   try {
     const std::vector<SceneEdit> a = read_edits(forth), b = read_edits(back);
     auto session = RefreshSession::open(bundle);
+    if (samples_before > 0) session->refresh(RefreshBudget{0, samples_before, 0});
     Phases there, home;
+    size_t scaled = 0;
     for (int r = 0; r < repeat; ++r) {
       for (int k = 0; k < 2; ++k) {
         const auto start = std::chrono::steady_clock::now();
         session->apply_edits(k == 0 ? a : b);
         const double ms = bench::seconds_since(start) * 1e3;
         (k == 0 ? there : home).add(ms, session->last_edit_timings());
+        scaled += session->last_edit_timings().scaled_light_layers;
         if (samples > 0) session->refresh(RefreshBudget{0, samples, 0});
       }
     }
     there.print(forth.c_str());
     home.print(back.c_str());
+    std::printf("edits applied by scaling light layers: %zu of %d\n", scaled, 2 * repeat);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_edit_cost: %s\n", e.what());
     return 2;

@@ -1,13 +1,14 @@
 #!/bin/bash
 # Runs on the GPU machine (bench/light_layers_gpu_pack.sh packs what it needs): the building at 12
 # texels/m lit to 4096 spp as the shipped bundle, then one point light's intensity doubled
-# (bench/refresh_double_light.json) and refreshed frame by frame: right at open (the bundle holds no
-# light layers: the baked texels follow the accumulation's split, which has no samples yet) and in a
-# session that has refreshed WARM samples per texel first (a game running when the edit comes),
-# with light layers (scaled, 0 rays) and without (--no-light-layers: a change estimate), each
+# (bench/refresh_double_light.json) and refreshed frame by frame: right at open ("open": the bundle
+# holds no light layers and the accumulation has no split yet, so the edit is a change estimate as
+# without layers) and in a session that has refreshed WARM samples per texel first ("warm": a game
+# running when the edit comes; the layers are scaled with 0 rays, the baked texels by the
+# accumulation's split), with light layers and without (--no-light-layers: a change estimate), each
 # output's relMSE against two 4096-spp relights of the edited scene; the light move with and without
-# layers (their cost per frame); bench_edit_cost on the lit bundle (the edit and the one undoing it
-# in turn, COST_REPS rounds).
+# layers; the whole-run throughput with and without layers (256 spp); bench_edit_cost on the lit
+# bundle after WARM samples (the edit and the one undoing it in turn, COST_REPS rounds).
 # Env: WARM (256), FRAMES (1 6), COST_REPS (9). Writes $OUT/summary.txt.
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
@@ -19,6 +20,11 @@ S=$OUT/summary.txt
 $R --list-devices > $S
 $R $W/building.bake -o $W/base.bake --spp 4096 --seed 7 --no-frame-errors --json > $W/base.json
 python3 -c "import json; r=json.load(open('$W/base.json')); print('base', r['spp'], 'spp', r['seconds'], 'light_layers', r['light_layers'])" >> $S
+for layers in on off; do
+  flag=""; [ $layers = off ] && flag=--no-light-layers
+  $R $W/building.bake -o $W/tp.bake --spp 256 --seed 9 --no-frame-errors $flag --json > $W/tp.json
+  python3 -c "import json; r=json.load(open('$W/tp.json')); print('whole run 256 spp, light layers $layers:', r['light_layers'], 'lighting_s %.3f'%r['lighting_seconds'], 'rays/s %.3g'%r['rays_per_second'])" >> $S
+done
 report() {  # $1 the run's JSON, $2 its label
   python3 -c "
 import json; r=json.load(open('$1')); e=r['edits']; ms=[f['milliseconds'] for f in r['frames']]
@@ -28,10 +34,11 @@ for e in double move; do
   for s in 101 202; do $R $W/base.bake -o $W/ref_${e}_$s.bake --edits $W/$e.json --spp 4096 --seed $s --ignore-baked --no-light-layers --json > /dev/null; done
   list=""
   for f in ${FRAMES:-1 6}; do
-    for mode in open warm open_nolayers warm_nolayers; do
-      [ $e = move ] && [ ${mode#warm} != $mode ] && continue
-      flags=""; [ ${mode#warm} != $mode ] && flags="--spp-before-edits ${WARM:-256}"
-      [ ${mode%nolayers} != $mode ] && flags="$flags --no-light-layers"
+    for mode in open warm open-nolayers warm-nolayers; do
+      flags=""
+      case $mode in warm*) flags="--spp-before-edits ${WARM:-256}";; esac
+      case $mode in *nolayers) flags="$flags --no-light-layers";; esac
+      case "$e/$mode" in move/warm*) continue;; esac
       o=${e}_${mode}_$f
       $R $W/base.bake -o $W/$o.bake --edits $W/$e.json --spp 4096 --frames $f --budget-ms 16 --seed 3 --no-frame-errors $flags --json > $W/$o.json
       report $W/$o.json $o
@@ -41,6 +48,6 @@ for e in double move; do
   echo "relMSE $e (unrefreshed = base.bake):" >> $S
   $W/bench_bundle_rel_mse $W/ref_${e}_101.bake $W/ref_${e}_202.bake $W/base.bake $list >> $S
 done
-echo "bench_edit_cost double (light layers on by default):" >> $S
-$W/bench_edit_cost $W/base.bake --edits $W/double.json --edits-back $W/double_back.json --repeat ${COST_REPS:-9} >> $S
+echo "bench_edit_cost double after ${WARM:-256} samples (light layers on by default):" >> $S
+$W/bench_edit_cost $W/base.bake --edits $W/double.json --edits-back $W/double_back.json --repeat ${COST_REPS:-9} --samples-before ${WARM:-256} >> $S
 cat $S

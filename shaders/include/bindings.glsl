@@ -113,12 +113,17 @@ void add_auto_cost(uint work, uint slot, uint count) {
   if ((params.guiding & kGuidingAutoRecord) != 0u && count > 0u) results[auto_cost_index(work) + slot] += float(count);
 }
 
-// Light layers (GpuParams::light_layers, light_layers.h): per work item L rgb sums after every
-// other section of the batch's results; a contribution adds to its light's layer as well as to its
+// Light layers (GpuParams::light_layers, light_layers.h): after every other section of the batch's
+// results, layer by layer, rgb per work item ([layer][work][rgb]: reduce.comp's texels read
+// neighbouring work items together); a contribution adds to its light's layer as well as to its
 // bounce slot (one writer: the path's own item).
+uint light_result_index(uint work, uint layer) {
+  return params.batch_work_total * params.light_result_words + (layer * params.batch_work_total + work) * 3u;
+}
+
 void add_light_result(uint work, uint layer, vec3 value) {
   if (params.light_layers == 0u) return;
-  uint i = params.batch_work_total * params.light_result_words + (work * params.light_layers + min(layer, params.light_layers - 1u)) * 3u;
+  uint i = light_result_index(work, min(layer, params.light_layers - 1u));
   results[i] += value.x;
   results[i + 1u] += value.y;
   results[i + 2u] += value.z;

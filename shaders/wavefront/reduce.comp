@@ -59,7 +59,7 @@ void main() {
     if (!finite) {
       ++nonfinite;
       // The light layers' loop below skips this sample by its NaN.
-      for (uint l = 0u; l < params.light_layers; ++l) results[params.batch_work_total * params.light_result_words + (w * params.light_layers + l) * 3u] = uintBitsToFloat(0x7FC00000u);
+      for (uint l = 0u; l < params.light_layers; ++l) results[light_result_index(w, l)] = uintBitsToFloat(0x7FC00000u);
       continue;
     }
     if (directional)
@@ -86,7 +86,7 @@ void main() {
     uint at = ((K + l) * params.item_count_total + texel) * 3u;
     dvec3 light = dvec3(acc_bounce[at], acc_bounce[at + 1u], acc_bounce[at + 2u]);
     for (uint s = 0u; s < params.batch_sample_count; ++s) {
-      uint r = params.batch_work_total * params.light_result_words + ((s * n + j) * params.light_layers + l) * 3u;
+      uint r = light_result_index(s * n + j, l);
       vec3 v = vec3(results[r], results[r + 1u], results[r + 2u]);
       if (!isnan(v.x)) light += dvec3(v);
     }

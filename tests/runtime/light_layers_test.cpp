@@ -295,11 +295,20 @@ TEST(LightLayers, AScalingEditScalesLayersWithNoRay) {
 }
 
 // A previous estimate with no split by light (the baked lightmap at open): scaled by the
-// accumulation's split at each texel; an edit that is not a scaling drops the samples as before.
+// accumulation's split at each texel once the accumulation has proportional_split_samples (before,
+// the edit takes the other paths); an edit that is not a scaling drops the samples as before.
 TEST(LightLayers, TheBakedLightmapFollowsTheAccumulationsSplit) {
   if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
   const fs::path bundle = courtyard_bundle("all-lights-16spp", {}, 16);
+  {
+    auto young = RefreshSession::open(bundle.string(), validated_options(41));  // 256 samples needed by default
+    young->refresh({0, 4});
+    young->apply_edits(parse_scene_edits(R"({"edits": [{"sky": [0.9, 1.2, 1.5]}]})", "sky.json"));
+    EXPECT_FALSE(young->last_edit_timings().scaled_light_layers);
+    for (const TexelAccumulator& t : young->lightmap().texels) ASSERT_EQ(t.samples, 0u);  // restarted
+  }
   RefreshSessionOptions options = validated_options(41);
+  options.proportional_split_samples = 1;
   auto session = RefreshSession::open(bundle.string(), options);  // from the baked lightmap
   ASSERT_TRUE(session->started_from_baked());
   session->refresh({0, 1});  // one sample: every texel still shows the baked value (publishing_rule.h)

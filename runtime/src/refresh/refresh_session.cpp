@@ -115,6 +115,10 @@ struct RefreshSession::State {
   std::vector<GpuPunctualLight> base_lights;
   uint32_t changed_lights = 0;
   bool started_from_baked = false;  // previous was the bundle's baked lightmap at open
+  // previous's light layers split its totals by light (false: the baked lightmap, whose bundle has
+  // none, a change estimate's result, or anything published from them); meaningless without previous.
+  bool previous_split_by_light = false;
+  uint32_t proportional_split_samples = 256;  // RefreshSessionOptions::proportional_split_samples
   // A bake_per_bounce(), bake_guided() or bake_path() result: lightmap() until the next restart, edit
   // or refresh.
   std::optional<LightmapEstimate> per_bounce;
@@ -225,6 +229,7 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   state->integrator = VulkanIntegrator::create(state->lighting, options.device);
   timings.device = since();
   state->priority_samples = options.priority_samples;
+  state->proportional_split_samples = options.proportional_split_samples;
   state->texel_grid = TexelGrid(state->persisted.gbuffer);
   state->near_marks.assign(state->persisted.gbuffer.texels.size(), 0);
   index_for_edits(*state);
@@ -367,6 +372,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   // submission (it starts again below) unless a whole run's result is published from the host.
   since(lap);
   const bool clears = !s.per_bounce;
+  const bool split = published_split_by_light();
   const PublishedLightmap published = publish_on_device(clears);
   timings.publish = since(lap);
   // A base needs variances: after opening without the baked lightmap and before any refresh, restart.
@@ -378,6 +384,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
     s.base_lights = lights_before;
   }
   s.previous = published.lightmap;
+  s.previous_split_by_light = split;
   const bool texels_as_before = true;  // moved texels' start points were uploaded above
   if (as_change) {
     s.clear_accumulation();
@@ -407,11 +414,26 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
 void RefreshSession::end_change_estimate() {
   State& s = *state_;
   if (!s.base) return;
-  // What the change estimate published is what texels show until refreshed again.
+  // What the change estimate published is what texels show until refreshed again (its change is
+  // not split by light).
   s.previous = publish_on_device().lightmap;
+  s.previous_split_by_light = false;
   s.base.reset();
   s.base_lights.clear();
   s.changed_lights = 0;
+}
+
+bool RefreshSession::published_split_by_light() const {
+  const State& s = *state_;
+  if (s.base) return false;  // a change estimate's change is not split by light
+  if (s.per_bounce) {  // a whole run, shown wherever it has samples, previous elsewhere
+    if (!s.whole_run_path || s.per_bounce->light_layers == 0) return false;
+    if (!s.previous || s.previous_split_by_light) return true;
+    for (const TexelAccumulator& t : s.per_bounce->texels)
+      if (t.samples == 0) return false;
+    return true;
+  }
+  return s.integrator->light_layers() > 0 && (!s.previous || s.previous_split_by_light);
 }
 
 bool RefreshSession::scale_light_layers(const std::vector<Vec4>& factors, bool punctual_only) {
@@ -421,18 +443,21 @@ bool RefreshSession::scale_light_layers(const std::vector<Vec4>& factors, bool p
   if (s.base) return false;
   if (s.per_bounce && (!s.whole_run_path || s.per_bounce->light_layers != int(factors.size()))) return false;
   if (!s.per_bounce && s.integrator->light_layers() != int(factors.size())) return false;
+  // Without a split of its own, what was shown is scaled by the accumulation's, which must have
+  // samples enough (after a whole run the accumulation starts again: none).
+  if (s.per_bounce && !published_split_by_light()) return false;
+  if (!s.per_bounce && s.previous && !s.previous_split_by_light && samples_per_texel() < s.proportional_split_samples) return false;
   // Edits of punctual lights alone left their upload to the accumulation's restart (apply_edits).
   if (punctual_only) s.integrator->update_punctual_lights(*s.lighting);
   if (s.per_bounce) {
     // A whole run's result (on the host) becomes what is shown, scaled below; the accumulation
     // starts again behind it (its texel buffers were the run's).
     s.previous = publish_on_device().lightmap;
+    s.previous_split_by_light = true;
     s.clear_accumulation();
     s.integrator->start_progressive(s.persisted.gbuffer, s.settings, false);
   }
-  std::vector<const DeviceLightmap*> estimates;
-  if (s.previous) estimates.push_back(s.previous.get());
-  s.integrator->scale_light_layers(factors, estimates);
+  s.integrator->scale_light_layers(factors, s.previous.get(), s.previous_split_by_light);
   s.last_edit_near.clear();
   return true;
 }

@@ -10,7 +10,7 @@ namespace exitance::vulkan {
 namespace {
 
 struct ScalePush {
-  uint32_t texel_count, recorded, light_layers, directional, accumulation;
+  uint32_t texel_count, recorded, scaled, directional, proportional;
 };
 
 }  // namespace
@@ -36,7 +36,7 @@ LightLayerScaler::LightLayerScaler(Context& context)
   vkUpdateDescriptorSets(context_.device(), 5, writes.data(), 0, nullptr);
   VkCommandBuffer cmd = context_.begin();
   kernel_.bind(cmd, 0);
-  const ScalePush push{0, 1, 0, 0, 1};
+  const ScalePush push{0, 1, 0, 0, 0};
   kernel_.push(cmd, &push, sizeof(push));
   vkCmdDispatch(cmd, 1, 1, 1);
   context_.submit_and_wait(cmd);
@@ -50,10 +50,14 @@ void LightLayerScaler::scale(const std::vector<Vec4>& factors, const ScaledEstim
     if (!e.sums || size_t(e.light_layers) != factors.size() || e.texels != accumulation.texels || e.recorded != accumulation.recorded ||
         e.directional != accumulation.directional)
       throw std::logic_error("LightLayerScaler::scale: an estimate not shaped as the accumulation");
-  if (factors.empty() || accumulation.texels == 0) return;
-  const size_t bytes = factors.size() * sizeof(Vec4);
+  // The scaled layers only, each as rgb and its layer index (the kernel's cost is per scaled layer).
+  std::vector<Vec4> scaled;
+  for (size_t l = 0; l < factors.size(); ++l)
+    if (factors[l].w != 0) scaled.push_back(Vec4(factors[l].x, factors[l].y, factors[l].z, float(l)));
+  if (scaled.empty() || accumulation.texels == 0) return;
+  const size_t bytes = scaled.size() * sizeof(Vec4);
   if (!factors_.handle() || factors_.size() < bytes) factors_ = context_.create_buffer(bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
-  std::memcpy(factors_.mapped(), factors.data(), bytes);  // host-coherent: visible to the submission below
+  std::memcpy(factors_.mapped(), scaled.data(), bytes);  // host-coherent: visible to the submission below
   for (uint32_t i = 0; i < estimates.size(); ++i) {
     const std::array<VkDescriptorBufferInfo, 5> infos{{{estimates[i].sums->sums.handle(), 0, VK_WHOLE_SIZE},
                                                        {estimates[i].sums->bounce_sums.handle(), 0, VK_WHOLE_SIZE},
@@ -87,7 +91,8 @@ void LightLayerScaler::scale(const std::vector<Vec4>& factors, const ScaledEstim
                            nullptr);
     }
     kernel_.bind(cmd, i);
-    const ScalePush push{uint32_t(e.texels), uint32_t(e.recorded), uint32_t(e.light_layers), e.directional ? 1u : 0u, last ? 1u : 0u};
+    const ScalePush push{uint32_t(e.texels), uint32_t(e.recorded), uint32_t(scaled.size()), e.directional ? 1u : 0u,
+                         !last && e.proportional ? 1u : 0u};
     kernel_.push(cmd, &push, sizeof(push));
     vkCmdDispatch(cmd, uint32_t((e.texels + 63) / 64), 1, 1);
   }

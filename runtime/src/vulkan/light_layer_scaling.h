@@ -19,14 +19,15 @@ struct ScaledEstimate {
   int recorded = 1;
   int light_layers = 0;
   bool directional = false;
+  bool proportional = false;  // its light layers do not split its totals: scaled by the accumulation's split
 };
 
 class LightLayerScaler {
  public:
   explicit LightLayerScaler(Context& context);
   // `factors`: per light layer, rgb and w = 1 where the layer is scaled (w = 0: kept). Every
-  // estimate must have factors.size() light layers; `others` (previous, ...) are scaled first, by
-  // the accumulation's split where theirs is missing, then the accumulation.
+  // estimate must have factors.size() light layers; `others` (previous, ...) are scaled first
+  // (exactly, or by the accumulation's split where they are `proportional`), then the accumulation.
   void scale(const std::vector<Vec4>& factors, const ScaledEstimate& accumulation, const std::vector<ScaledEstimate>& others);
 
  private:

@@ -191,15 +191,16 @@ void VulkanIntegrator::prepare_light_layer_scaling() {
   if (!impl_->scaler) impl_->scaler.emplace(impl_->context);
 }
 
-void VulkanIntegrator::scale_light_layers(const std::vector<Vec4>& factors, const std::vector<const DeviceLightmap*>& estimates) {
+void VulkanIntegrator::scale_light_layers(const std::vector<Vec4>& factors, const DeviceLightmap* previous, bool previous_split) {
   const LightmapDriver::Shape shape = impl_->lightmap.shape();
   const ScaledEstimate accumulation{&impl_->buffers.texels, shape.texels, shape.layers, shape.light_layers, shape.directional};
   std::vector<ScaledEstimate> scaled;
-  for (const DeviceLightmap* e : estimates) {
-    if (!e || e->texels != shape.texels || e->layers != shape.layers || e->light_layers != shape.light_layers ||
+  if (previous) {
+    const DeviceLightmap* e = previous;
+    if (e->texels != shape.texels || e->layers != shape.layers || e->light_layers != shape.light_layers ||
         e->directional != shape.directional)
       throw std::logic_error("VulkanIntegrator::scale_light_layers: an estimate not shaped as the accumulation");
-    scaled.push_back({&e->sums, e->texels, e->layers, e->light_layers, e->directional});
+    scaled.push_back({&e->sums, e->texels, e->layers, e->light_layers, e->directional, !previous_split});
   }
   if (!impl_->scaler) impl_->scaler.emplace(impl_->context);
   impl_->scaler->scale(factors, accumulation, scaled);

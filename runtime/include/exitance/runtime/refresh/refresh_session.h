@@ -57,6 +57,11 @@ struct RefreshSessionOptions {
   // emissiveFactor, emissiveStrength, a constant sky's colour) scales its layer with 0 rays and
   // keeps every sample. Device memory: 24 bytes per layer and texel for each estimate kept.
   bool light_layers = true;
+  // What texels showed before (at open: the baked lightmap, whose bundle holds no light layers) has
+  // no split by light until replaced by estimates that have one: a scaling edit scales it by the
+  // accumulation's split, once the accumulation has this many samples per texel (its split is
+  // noisy before); with fewer, such an edit takes the other paths (a change estimate, a restart).
+  uint32_t proportional_split_samples = 256;
 };
 
 // Edits that change at most this many punctual lights (counted against the base) are estimated as
@@ -224,10 +229,13 @@ class RefreshSession {
   // What texels publish now (published_lightmap), composed in device memory; `clear_accumulation`:
   // the accumulation's sums cleared in the same submission (apply_edits, which starts it again).
   PublishedLightmap publish_on_device(bool clear_accumulation = false) const;
+  // Whether what publish_on_device gives now has light layers that split its totals by light.
+  bool published_split_by_light() const;
   // An edit that only scaled lights (light_layer_edits.h): the accumulation and previous scaled per
-  // layer with 0 rays, every sample kept (a previous texel without a split by light, as the baked
-  // lightmap's, in proportion to the accumulation's split there); false (nothing done) during a
-  // change estimate or after a per-bounce run, which keep no light layers.
+  // layer with 0 rays, every sample kept (a previous estimate without a split by light, as the
+  // baked lightmap, in proportion to the accumulation's split); false (nothing done) during a change
+  // estimate, after a per-bounce run (no light layers), or while the accumulation is too young to
+  // scale an unsplit previous estimate (RefreshSessionOptions::proportional_split_samples).
   bool scale_light_layers(const std::vector<Vec4>& factors, bool punctual_only);
   std::unique_ptr<State> state_;
 };

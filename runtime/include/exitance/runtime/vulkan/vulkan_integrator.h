@@ -159,13 +159,15 @@ class VulkanIntegrator final : public Integrator {
   // the accumulation (texels, recorded layers, sh1) as none.
   std::shared_ptr<DeviceLightmap> upload_lightmap(const LightmapEstimate& estimate);
   // Light layers (IntegratorSettings::light_layers): the progressive accumulation's count (0: none),
-  // and an edit that only scaled lights' emission applied to it and to `estimates` (shaped as it),
-  // with 0 rays in one submission (shaders/wavefront/scale_light_layers.comp). `factors`: per light
-  // layer, rgb and w = 1 where scaled. std::logic_error before a start or for another shape.
+  // and an edit that only scaled lights' emission applied to it and to `previous` (shaped as it; null:
+  // none), with 0 rays in one submission (shaders/wavefront/scale_light_layers.comp): exactly where
+  // the light layers split the totals, and for a previous estimate whose layers do not
+  // (`previous_split` false) by the accumulation's split. `factors`: per light layer, rgb and w = 1
+  // where scaled. std::logic_error before a start or for another shape.
   int light_layers() const;
   // The scaling kernel made (on lavapipe compiled) now rather than inside the first scaling edit.
   void prepare_light_layer_scaling();
-  void scale_light_layers(const std::vector<Vec4>& factors, const std::vector<const DeviceLightmap*>& estimates);
+  void scale_light_layers(const std::vector<Vec4>& factors, const DeviceLightmap* previous, bool previous_split);
   // Writes `lightmap` (a published estimate of `gbuffer`'s texels) into one RGBA32F device image per
   // page, gutters dilated `dilation_texels` deep as assemble_lightmap_pages does (the same values
   // bit for bit), after every command submitted to the queue before; waits (bounded). The images
