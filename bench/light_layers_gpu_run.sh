@@ -7,9 +7,9 @@
 # running when the edit comes; the layers are scaled with 0 rays, the baked texels by the
 # accumulation's split), with light layers and without (--no-light-layers: a change estimate), each
 # output's relMSE against two 4096-spp relights of the edited scene; the light move with and without
-# layers; the whole-run throughput with and without layers (256 spp); bench_edit_cost on the lit
+# layers; the throughput with and without layers (one unbudgeted frame of 256 spp); bench_edit_cost on the lit
 # bundle after WARM samples (the edit and the one undoing it in turn, COST_REPS rounds).
-# Env: WARM (256), FRAMES (1 6), COST_REPS (9). Writes $OUT/summary.txt.
+# Env: WARM (256), FRAMES (1 6), EDITS (double move), COST_REPS (9). Writes $OUT/summary.txt.
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
 export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
@@ -22,15 +22,15 @@ $R $W/building.bake -o $W/base.bake --spp 4096 --seed 7 --no-frame-errors --json
 python3 -c "import json; r=json.load(open('$W/base.json')); print('base', r['spp'], 'spp', r['seconds'], 'light_layers', r['light_layers'])" >> $S
 for layers in on off; do
   flag=""; [ $layers = off ] && flag=--no-light-layers
-  $R $W/building.bake -o $W/tp.bake --spp 256 --seed 9 --no-frame-errors $flag --json > $W/tp.json
-  python3 -c "import json; r=json.load(open('$W/tp.json')); print('whole run 256 spp, light layers $layers:', r['light_layers'], 'lighting_s %.3f'%r['lighting_seconds'], 'rays/s %.3g'%r['rays_per_second'])" >> $S
+  $R $W/building.bake -o $W/tp.bake --spp 256 --frames 1 --seed 9 --no-frame-errors $flag --json > $W/tp.json
+  python3 -c "import json; r=json.load(open('$W/tp.json')); print('one frame of 256 spp, light layers $layers:', r['light_layers'], 'lighting_s %.3f'%r['lighting_seconds'], 'rays/s %.3g'%r['rays_per_second'])" >> $S
 done
 report() {  # $1 the run's JSON, $2 its label
   python3 -c "
 import json; r=json.load(open('$1')); e=r['edits']; ms=[f['milliseconds'] for f in r['frames']]
 print('$2', 'edits_s %.5f'%r['seconds']['edits'], 'edit_ms', {k: round(v, 3) for k, v in e.get('milliseconds', {}).items()}, 'scaled', e.get('scaled_light_layers'), 'changed_lights', e['changed_lights'], 'samples_before', e.get('samples_before', 0), 'frames', len(ms), 'frame_ms', [round(m, 1) for m in ms], 'spp', r['spp'], 'light_layers', r['light_layers'])" >> $S
 }
-for e in double move; do
+for e in ${EDITS:-double move}; do
   for s in 101 202; do $R $W/base.bake -o $W/ref_${e}_$s.bake --edits $W/$e.json --spp 4096 --seed $s --ignore-baked --no-light-layers --json > /dev/null; done
   list=""
   for f in ${FRAMES:-1 6}; do

@@ -6,8 +6,9 @@
 // after N samples in any number of calls the lightmap equals bake --backend vulkan's N samples
 // with the same seed (lightmap(); published_lightmap() also weighs the baked or pre-edit value).
 // restart() drops every accumulated sample (lightmap() keeps no value from before it); apply_edits
-// restarts, except after edits of punctual lights alone, which it estimates as a change from what
-// was shown (apply_edits below). After a local edit (a moved instance, a point or spot light, an
+// restarts, except after edits that only scale lights, which scale their light layers with 0 rays
+// and keep every sample, and after other edits of punctual lights alone, which it estimates as a
+// change from what was shown (apply_edits below; docs/runtime.md "Light layers"). After a local edit (a moved instance, a point or spot light, an
 // emissive material) the texels near it are refreshed first (priority_samples), then the others
 // until they catch up; each texel's samples are still a bake's samples 0..N-1. What a texel shows
 // (published_lightmap) is its value from before the edit (at open: the bundle's baked lightmap)
@@ -139,6 +140,10 @@ class RefreshSession {
   // the same paths with each vertex adding the edited lights' direct light as edited minus as it was
   // (path.h punctual_change_rays), so texels that no edited light reaches keep their value exactly.
   // lightmap() is then that change; refreshed_lightmap() is base + change.
+  //
+  // Before both: with light layers (RefreshSessionOptions::light_layers), edits that only scale
+  // lights' emission (refresh/light_layer_edits.h) scale the accumulation's and the previous
+  // estimate's light layers with 0 rays and keep every sample (last_edit_timings().scaled_light_layers).
   EditEffects apply_edits(const std::vector<SceneEdit>& edits);
   const EditTimings& last_edit_timings() const;
   const OpenTimings& open_timings() const;
