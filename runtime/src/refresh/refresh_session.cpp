@@ -373,7 +373,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   since(lap);
   const bool clears = !s.per_bounce;
   const bool split = published_split_by_light();
-  const PublishedLightmap published = publish_on_device(clears);
+  const PublishedLightmap published = publish_on_device(clears, split);
   timings.publish = since(lap);
   // A base needs variances: after opening without the baked lightmap and before any refresh, restart.
   const bool as_change = lights_only && !pairs.empty() && pairs.size() / 2 <= kMaxChangedLights &&
@@ -689,7 +689,7 @@ LightmapEstimate RefreshSession::refreshed_lightmap() const {
 uint32_t RefreshSession::changed_lights() const { return state_->changed_lights; }
 bool RefreshSession::started_from_baked() const { return state_->started_from_baked; }
 
-PublishedLightmap RefreshSession::publish_on_device(bool clear_accumulation) const {
+PublishedLightmap RefreshSession::publish_on_device(bool clear_accumulation, bool light_layers) const {
   const State& s = *state_;
   if (s.per_bounce) {  // a whole run's result is on the host
     const LightmapEstimate estimate = published_lightmap();
@@ -702,13 +702,20 @@ PublishedLightmap RefreshSession::publish_on_device(bool clear_accumulation) con
     return published;
   }
   if (s.base)
-    return s.integrator->publish(PublishMode::Change, s.previous ? s.previous.get() : s.base.get(), s.base.get(), clear_accumulation);
-  return s.integrator->publish(s.previous ? PublishMode::Restart : PublishMode::Accumulation, s.previous.get(), nullptr, clear_accumulation);
+    return s.integrator->publish(PublishMode::Change, s.previous ? s.previous.get() : s.base.get(), s.base.get(), clear_accumulation,
+                                 false);
+  return s.integrator->publish(s.previous ? PublishMode::Restart : PublishMode::Accumulation, s.previous.get(), nullptr, clear_accumulation,
+                               light_layers);
 }
 
 LightmapEstimate RefreshSession::published_lightmap() const {
   const State& s = *state_;
-  if (!s.per_bounce) return s.integrator->read_lightmap(*publish_on_device().lightmap);
+  if (!s.per_bounce) {
+    const bool split = published_split_by_light();
+    LightmapEstimate published = s.integrator->read_lightmap(*publish_on_device(false, split).lightmap);
+    if (!split) std::fill(published.light_sums.begin(), published.light_sums.end(), 0.0);  // not composed: no split by light
+    return published;
+  }
   LightmapEstimate estimate = *s.per_bounce;
   if (!s.previous) return estimate;
   const LightmapEstimate previous = s.integrator->read_lightmap(*s.previous);

@@ -73,7 +73,7 @@ void LightmapPublisher::write_set(const std::array<VkDescriptorBufferInfo, 13>& 
 
 PublishedLightmap LightmapPublisher::publish(PublishMode mode, const TexelAccumulators& accumulation, const DeviceLightmap* previous,
                                              const DeviceLightmap* base, std::shared_ptr<DeviceLightmap> out,
-                                             bool clear_accumulation) {
+                                             bool clear_accumulation, bool light_layers) {
   if ((mode != PublishMode::Accumulation && !previous) || (mode == PublishMode::Change && !base))
     throw std::logic_error("LightmapPublisher::publish: the mode reads an estimate that was not given");
   for (const DeviceLightmap* e : {previous, base})
@@ -99,7 +99,9 @@ PublishedLightmap LightmapPublisher::publish(PublishMode mode, const TexelAccumu
   vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
   kernel_.bind(cmd);
-  const PublishPush push{uint32_t(out->texels), uint32_t(out->layers + out->light_layers), out->directional ? 1u : 0u, uint32_t(mode)};
+  // The light layers follow the recorded ones: composing only the first `layers` leaves them out.
+  const PublishPush push{uint32_t(out->texels), uint32_t(out->layers + (light_layers ? out->light_layers : 0)),
+                         out->directional ? 1u : 0u, uint32_t(mode)};
   kernel_.push(cmd, &push, sizeof(push));
   vkCmdDispatch(cmd, uint32_t((out->texels + 63) / 64), 1, 1);
   barrier.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;

@@ -50,8 +50,11 @@ class LightmapPublisher {
   // `clear_accumulation`: the accumulation's sums are cleared after the dispatch, in the same
   // submission (an edit publishes what was shown, then starts again: LightmapDriver::start's
   // clear is then not needed).
+  // `light_layers`: the light layers are composed too; false leaves out's as they were (what is
+  // published then has no split by light to keep, and a publish copies every layer of every texel).
   PublishedLightmap publish(PublishMode mode, const TexelAccumulators& accumulation, const DeviceLightmap* previous,
-                            const DeviceLightmap* base, std::shared_ptr<DeviceLightmap> out, bool clear_accumulation = false);
+                            const DeviceLightmap* base, std::shared_ptr<DeviceLightmap> out, bool clear_accumulation = false,
+                            bool light_layers = true);
   // Writes `estimate`'s sums, layers and sample counts into `to` (same texels and layers).
   void upload(const LightmapEstimate& estimate, DeviceLightmap& to);
 

@@ -142,7 +142,7 @@ uint64_t VulkanIntegrator::add_samples_to(const std::vector<uint32_t>& texels, u
 LightmapEstimate VulkanIntegrator::progressive_estimate() const { return impl_->lightmap.read(); }
 
 PublishedLightmap VulkanIntegrator::publish(PublishMode mode, const DeviceLightmap* previous, const DeviceLightmap* base,
-                                            bool clear_accumulation) {
+                                            bool clear_accumulation, bool light_layers) {
   const LightmapDriver::Shape shape = impl_->lightmap.shape();
   // An estimate of another shape (a whole run's, with other recorded layers) is nothing to keep.
   auto fits = [&](const DeviceLightmap* e) {
@@ -170,7 +170,7 @@ PublishedLightmap VulkanIntegrator::publish(PublishMode mode, const DeviceLightm
         }
     if (impl_->spare_lightmaps.size() < Impl::kSpareLightmaps) impl_->spare_lightmaps.push_back(out);
   }
-  return impl_->publisher->publish(mode, impl_->buffers.texels, previous, base, std::move(out), clear_accumulation);
+  return impl_->publisher->publish(mode, impl_->buffers.texels, previous, base, std::move(out), clear_accumulation, light_layers);
 }
 
 std::shared_ptr<DeviceLightmap> VulkanIntegrator::upload_lightmap(const LightmapEstimate& estimate) {

@@ -233,7 +233,9 @@ class RefreshSession {
   void restart(bool texels_as_before);
   // What texels publish now (published_lightmap), composed in device memory; `clear_accumulation`:
   // the accumulation's sums cleared in the same submission (apply_edits, which starts it again).
-  PublishedLightmap publish_on_device(bool clear_accumulation = false) const;
+  // `light_layers`: compose the light layers too (where what is published has a split by light to
+  // keep: published_split_by_light()); page images and read-backs of totals need none.
+  PublishedLightmap publish_on_device(bool clear_accumulation = false, bool light_layers = false) const;
   // Whether what publish_on_device gives now has light layers that split its totals by light.
   bool published_split_by_light() const;
   // An edit that only scaled lights (light_layer_edits.h): the accumulation and previous scaled per

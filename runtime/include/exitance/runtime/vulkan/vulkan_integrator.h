@@ -153,8 +153,11 @@ class VulkanIntegrator final : public Integrator {
   // estimate; waits for the device (a dispatch, no read-back of the lightmap). std::logic_error
   // before a start. `clear_accumulation`: the accumulation's sums cleared in the same submission,
   // for a start_progressive(..., accumulation_cleared = true) right after.
+  // `light_layers` false: the published estimate's light layers are not composed (left as they were;
+  // what is published has no split by light worth keeping, and copying them costs a read and write
+  // of every layer of every texel).
   PublishedLightmap publish(PublishMode mode, const DeviceLightmap* previous, const DeviceLightmap* base,
-                            bool clear_accumulation = false);
+                            bool clear_accumulation = false, bool light_layers = true);
   // A host estimate into device memory. publish() reads a previous estimate shaped otherwise than
   // the accumulation (texels, recorded layers, sh1) as none.
   std::shared_ptr<DeviceLightmap> upload_lightmap(const LightmapEstimate& estimate);
