@@ -70,7 +70,11 @@ void exitance_runtime_release(ExitanceRuntime* runtime);
 ExitanceRuntimeError exitance_runtime_last_error(void);
 const char* exitance_runtime_last_error_message(void);
 
-/* Applies edits given as EDITS.json text (docs/edits.md) and restarts the accumulation. */
+/* Applies edits given as EDITS.json text (docs/edits.md), all or nothing. Edits that only scale
+ * lights (intensity, colour, emission, a constant sky) scale their light layers where the session
+ * can (docs/runtime.md, "Light layers"), with no ray traced and every sample kept; other edits of
+ * punctual lights are estimated as a change; the rest restart the accumulation. Texels show their
+ * pre-edit value until the refreshed one is better (docs/runtime.md, "How a refresh works"). */
 ExitanceRuntimeError exitance_runtime_apply_edits(ExitanceRuntime* runtime, const char* edits_json);
 
 /* Adds samples to every texel within `budget_ms` milliseconds (0 = no time limit) and up to
