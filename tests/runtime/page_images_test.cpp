@@ -300,7 +300,7 @@ TEST(RuntimePageImages, BadDevicesAreRefusedWithOneLine) {
   EXPECT_EQ(exitance_runtime_open_on_device(bundle().c_str(), nullptr, &no_float64, &rt), EXITANCE_RUNTIME_NO_DEVICE);
   EXPECT_NE(std::string(exitance_runtime_last_error_message()).find("shaderFloat64"), std::string::npos)
       << exitance_runtime_last_error_message();
-  const ExitanceRuntimeOptions with_index{0, 0, 0};
+  const ExitanceRuntimeOptions with_index{0, 0, 0, 0};
   const ExitanceRuntimeVulkanDevice device = engine.handed_over();
   EXPECT_EQ(exitance_runtime_open_on_device(bundle().c_str(), &with_index, &device, &rt), EXITANCE_RUNTIME_INVALID_ARGUMENT);
   EXPECT_EQ(rt, nullptr);

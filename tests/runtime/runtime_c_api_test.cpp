@@ -72,6 +72,10 @@ TEST(RuntimeCApi, ErrorsAreCodesWithOneLineMessages) {
   EXPECT_NE(message.find("missing.bake/manifest.json: cannot read the manifest"), std::string::npos) << message;
   EXPECT_EQ(message.find('\n'), std::string::npos);
   EXPECT_EQ(exitance_runtime_refresh(nullptr, 16, 0, nullptr), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+  const ExitanceRuntimeOptions bad_layers{-1, 0, 0, 2};
+  EXPECT_EQ(exitance_runtime_open(bundle().c_str(), &bad_layers, &rt), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+  EXPECT_EQ(rt, nullptr);
+  EXPECT_EQ(std::string(exitance_runtime_last_error_message()), "exitance_runtime_open: options->light_layers_off must be 0 or 1");
   exitance_runtime_release(nullptr);  // ignored
 }
 

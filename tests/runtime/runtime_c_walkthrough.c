@@ -25,6 +25,7 @@ int runtime_c_walkthrough(const char* bundle, const char* output, char* message,
   options.device_index = -1;
   options.has_seed = 1;
   options.seed = 7;
+  options.light_layers_off = 0;
   code = exitance_runtime_open(bundle, &options, &rt);
   if (code != EXITANCE_RUNTIME_OK) return fail(NULL, code, message, message_size);
   code = exitance_runtime_apply_edits(rt, "{\"edits\": [{\"material\": \"CeilingLight\", \"emissiveStrength\": 2.0}]}");

@@ -81,6 +81,8 @@ void open_runtime(const char* bundle, const ExitanceRuntimeOptions* options, con
   if (options) {
     session_options.device.device_index = options->device_index;
     if (options->has_seed) session_options.seed = options->seed;
+    require(options->light_layers_off == 0 || options->light_layers_off == 1, "options->light_layers_off must be 0 or 1");
+    session_options.light_layers = options->light_layers_off == 0;
   }
   if (device) {
     VulkanExternalDevice external;

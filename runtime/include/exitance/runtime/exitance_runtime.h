@@ -44,6 +44,10 @@ typedef struct ExitanceRuntimeOptions {
   int32_t device_index; /* Vulkan physical device; -1 = prefer a discrete GPU */
   int32_t has_seed;     /* 0: the bake's seed; 1: `seed` */
   uint64_t seed;
+  /* 0: keep the estimate per light layer (docs/runtime.md, "Light layers": 24 bytes per layer and
+   * texel in each estimate kept); 1: keep none (edits that only scale lights then restart or are
+   * estimated as a change). Set every field: the struct has no default. */
+  int32_t light_layers_off;
 } ExitanceRuntimeOptions;
 
 typedef struct ExitanceRefreshReport {
