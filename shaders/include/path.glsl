@@ -74,7 +74,11 @@ uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rn
   if (directional_texel) guide = with_uniform_component(guide, kDirectionalUniformProbability);
   if (params.changed_light_pairs > 0u) {  // the runtime's change estimate: the edited lights alone
     environment = no_shadow_ray();
-    punctual_change_rays(x, throughput, params.punctual_count, params.changed_light_pairs, rng, punctual_light, area);
+    uint pair;
+    punctual_change_rays(x, throughput, params.punctual_count, params.changed_light_pairs, rng, punctual_light, area, pair);
+    // Both of the pair's rays (slots 0 and 1) carry the edited light's change: its layer.
+    uint layer = params.changed_light_layers[pair];
+    if (params.light_layers != 0u) path_ray_o[p].w = uintBitsToFloat(layer | (layer << 16u));
   } else {
     EmitterLearning sources;
     next_event_estimation(x, origin, throughput, guide, emitter_guide_none(), rng, area, punctual_light, environment, sources);

@@ -338,5 +338,66 @@ TEST(LightLayers, TheBakedLightmapFollowsTheAccumulationsSplit) {
   expect_no_validation_messages();
 }
 
+// A moved lamp is a change estimate whose changes go to the lamp's layer alone: what it publishes
+// keeps a split by light, so once it ends, a scaling edit scales what is shown exactly, with no
+// accumulated sample needed.
+TEST(LightLayers, AChangeEstimateKeepsTheSplit) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const fs::path bundle = courtyard_bundle("all-lights", {});
+  auto session = open_session(bundle, 51, true);
+  session->refresh({0, 8});
+  session->apply_edits(parse_scene_edits(R"({"edits": [{"node": "Lamp", "translation": [0.5, 2.5, 0.5]}]})", "move.json"));
+  ASSERT_EQ(session->changed_lights(), 1u);
+  session->refresh({0, 8});
+  const int lamp = int(punctual_light_layer(1, 2));
+  // Layers add up to the total within float rounding of each sample's terms; a change's terms (edited
+  // minus base light) cancel, so their size is the texel's value (`scale`, an estimate of it), not the sum's.
+  auto check_split = [](const LightmapEstimate& e, const char* what, int only_layer, const LightmapEstimate* scale = nullptr) {
+    const size_t n = e.texels.size();
+    size_t off_split = 0, outside = 0;
+    for (size_t i = 0; i < n; ++i)
+      for (int c = 0; c < 3; ++c) {
+        double sum = 0, magnitude = std::fabs(e.texels[i].total[c]);
+        if (scale && scale->texels[i].samples > 0)
+          magnitude += std::fabs(scale->texels[i].total[c]) / scale->texels[i].samples * e.texels[i].samples;
+        for (int l = 0; l < e.light_layers; ++l) {
+          const double v = e.light_sums[(size_t(l) * n + i) * 3 + size_t(c)];
+          sum += v, magnitude += std::fabs(v);
+          outside += only_layer >= 0 && l != only_layer && v != 0;
+        }
+        if (std::fabs(sum - e.texels[i].total[c]) > 1e-5 * magnitude + 1e-30) {
+          ++off_split;
+          std::printf("%s: texel %zu channel %d layers %.9g total %.9g\n", what, i, c, sum, e.texels[i].total[c]);
+        }
+      }
+    EXPECT_EQ(off_split, 0u) << what;
+    EXPECT_EQ(outside, 0u) << what;
+  };
+  const LightmapEstimate change = session->lightmap();
+  const LightmapEstimate refreshed = session->refreshed_lightmap();
+  check_split(change, "the change", lamp, &refreshed);
+  double lamp_change = 0;
+  for (size_t i = 0; i < change.texels.size(); ++i) lamp_change += std::fabs(change.light_sums[(size_t(lamp) * change.texels.size() + i) * 3]);
+  EXPECT_GT(lamp_change, 0.0);
+  check_split(refreshed, "base + change", -1);
+
+  session->restart();  // the change estimate ends: what it published is what is shown, split by light
+  const LightmapEstimate shown_before = session->published_lightmap();
+  check_split(shown_before, "shown", -1);
+  session->apply_edits(parse_scene_edits(R"({"edits": [{"sky": [0.9, 1.2, 1.5]}]})", "sky.json"));
+  EXPECT_TRUE(session->last_edit_timings().scaled_light_layers);  // no sample needed: what is shown has its split
+  const LightmapEstimate shown_after = session->published_lightmap();
+  const size_t n = shown_before.texels.size();
+  size_t checked = 0;
+  for (size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double expected = shown_before.texels[i].total[c] + 2.0 * shown_before.light_sums[i * 3 + size_t(c)];  // sky x 3
+      EXPECT_NEAR(shown_after.texels[i].total[c], expected, 1e-6 * expected + 1e-12) << "texel " << i;
+      checked += expected > 0;
+    }
+  EXPECT_GT(checked, 0u);
+  expect_no_validation_messages();
+}
+
 }  // namespace
 }  // namespace exitance

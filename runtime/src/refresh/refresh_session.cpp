@@ -1,3 +1,4 @@
+#include "exitance/common/light_layers.h"
 #include "exitance/common/path_sampler.h"
 #include "exitance/runtime/refresh/refresh_session.h"
 
@@ -118,6 +119,7 @@ struct RefreshSession::State {
   // previous's light layers split its totals by light (false: the baked lightmap, whose bundle has
   // none, a change estimate's result, or anything published from them); meaningless without previous.
   bool previous_split_by_light = false;
+  bool base_split_by_light = false;  // the same for base (a change estimate's changes go to their lights' layers)
   uint32_t proportional_split_samples = 256;  // RefreshSessionOptions::proportional_split_samples
   // A bake_per_bounce(), bake_guided() or bake_path() result: lightmap() until the next restart, edit
   // or refresh.
@@ -382,13 +384,20 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   if (as_change && !s.base) {
     s.base = published.lightmap;
     s.base_lights = lights_before;
+    s.base_split_by_light = split;
   }
   s.previous = published.lightmap;
   s.previous_split_by_light = split;
   const bool texels_as_before = true;  // moved texels' start points were uploaded above
   if (as_change) {
     s.clear_accumulation();
-    s.integrator->start_progressive_change(s.persisted.gbuffer, s.settings, *s.lighting, pairs, texels_as_before, clears);
+    // Each pair's change goes to its light's layer (pairs are formed in light order above).
+    std::vector<uint32_t> pair_layers;
+    for (size_t i = 0; i < base_lights.size() && s.settings.light_layers; ++i)
+      if (std::memcmp(&base_lights[i], &lights_now[i], sizeof(GpuPunctualLight)) != 0)
+        pair_layers.push_back(punctual_light_layer(uint32_t(i), s.lighting->punctual_light_layers));
+    s.integrator->start_progressive_change(s.persisted.gbuffer, s.settings, *s.lighting, pairs, texels_as_before, clears,
+                                           pair_layers);
     s.changed_lights = uint32_t(pairs.size() / 2);
   } else {
     if (punctual_only) s.integrator->update_punctual_lights(lighting);
@@ -414,10 +423,10 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
 void RefreshSession::end_change_estimate() {
   State& s = *state_;
   if (!s.base) return;
-  // What the change estimate published is what texels show until refreshed again (its change is
-  // not split by light).
-  s.previous = publish_on_device().lightmap;
-  s.previous_split_by_light = false;
+  // What the change estimate published is what texels show until refreshed again.
+  const bool split = published_split_by_light();
+  s.previous = publish_on_device(false, split).lightmap;
+  s.previous_split_by_light = split;
   s.base.reset();
   s.base_lights.clear();
   s.changed_lights = 0;
@@ -425,7 +434,9 @@ void RefreshSession::end_change_estimate() {
 
 bool RefreshSession::published_split_by_light() const {
   const State& s = *state_;
-  if (s.base) return false;  // a change estimate's change is not split by light
+  // A change estimate's changes are split by light (GpuParams::changed_light_layers): base + change
+  // is split where base and what was shown are.
+  if (s.base) return s.integrator->light_layers() > 0 && s.base_split_by_light && s.previous_split_by_light;
   if (s.per_bounce) {  // a whole run, shown wherever it has samples, previous elsewhere
     if (!s.whole_run_path || s.per_bounce->light_layers == 0) return false;
     if (!s.previous || s.previous_split_by_light) return true;
@@ -438,8 +449,9 @@ bool RefreshSession::published_split_by_light() const {
 
 bool RefreshSession::scale_light_layers(const std::vector<Vec4>& factors, bool punctual_only) {
   State& s = *state_;
-  // A change estimate under way accumulates a change of direct light, not split by light; a
-  // per-bounce run keeps no light layers.
+  // During a change estimate, an edited light's change is estimated against its record at the base,
+  // which a scaled layer would not match: such edits stay pairs of the change estimate. A per-bounce
+  // run keeps no light layers.
   if (s.base) return false;
   if (s.per_bounce && (!s.whole_run_path || s.per_bounce->light_layers != int(factors.size()))) return false;
   if (!s.per_bounce && s.integrator->light_layers() != int(factors.size())) return false;
@@ -703,7 +715,7 @@ PublishedLightmap RefreshSession::publish_on_device(bool clear_accumulation, boo
   }
   if (s.base)
     return s.integrator->publish(PublishMode::Change, s.previous ? s.previous.get() : s.base.get(), s.base.get(), clear_accumulation,
-                                 false);
+                                 light_layers);
   return s.integrator->publish(s.previous ? PublishMode::Restart : PublishMode::Accumulation, s.previous.get(), nullptr, clear_accumulation,
                                light_layers);
 }

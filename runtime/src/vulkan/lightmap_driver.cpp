@@ -429,7 +429,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
 }
 
 void LightmapDriver::start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, uint32_t changed_light_pairs,
-                           bool texels_as_before, bool accumulation_cleared) {
+                           bool texels_as_before, bool accumulation_cleared, const std::vector<uint32_t>& changed_light_layers) {
   const auto start_time = Clock::now();
   std::optional<Accumulation> before = std::move(progressive_);
   progressive_.reset();
@@ -439,9 +439,9 @@ void LightmapDriver::start(const TexelGBuffer& gbuffer, const IntegratorSettings
                      before->start_points.size() == gbuffer.texels.size();
   prepare(gbuffer, settings, a, nullptr, reuse ? &*before : nullptr, accumulation_cleared);
   a.params.changed_light_pairs = changed_light_pairs;
-  // A change estimate's contributions are differences of direct light, not split by light: its light
-  // layers stay 0 (what it publishes then has no split, scale_light_layers.comp).
-  if (changed_light_pairs > 0) a.params.light_layers = 0;
+  // A change estimate's contributions go to the edited lights' layers (GpuParams::changed_light_layers).
+  for (size_t k = 0; k < kMaxChangedLightPairs; ++k)
+    a.params.changed_light_layers[k] = k < changed_light_layers.size() ? changed_light_layers[k] : 0;
   a.seconds = std::chrono::duration<double>(Clock::now() - start_time).count();
   progressive_ = std::move(a);
 }

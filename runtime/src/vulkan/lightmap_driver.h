@@ -41,8 +41,9 @@ class LightmapDriver {
   // moved none): their start points are not derived and uploaded again, only the sums cleared.
   // `accumulation_cleared`: the sums were cleared since the last pass (LightmapPublisher::publish
   // with clear_accumulation): not cleared again unless their buffers had to grow.
+  // `changed_light_layers`: the light layer of each changed light (light layers on).
   void start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, uint32_t changed_light_pairs = 0,
-             bool texels_as_before = false, bool accumulation_cleared = false);
+             bool texels_as_before = false, bool accumulation_cleared = false, const std::vector<uint32_t>& changed_light_layers = {});
   // The scene's lights changed under a running accumulation (an edit that only scaled them): the
   // parameters the kernels take from the scene (the constant sky, counts) read again.
   void scene_changed();

@@ -126,14 +126,16 @@ void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const Inte
 }
 void VulkanIntegrator::start_progressive_change(const TexelGBuffer& gbuffer, const IntegratorSettings& settings,
                                                 const LightingScene& edited, const std::vector<GpuPunctualLight>& pairs,
-                                                bool texels_as_before, bool accumulation_cleared) {
+                                                bool texels_as_before, bool accumulation_cleared, const std::vector<uint32_t>& pair_layers) {
   if (settings.guiding != GuidingMode::Off)
     throw std::runtime_error("Vulkan backend: guiding runs in whole bakes only, not in progressive accumulation (relight)");
   if (pairs.empty() || pairs.size() % 2 != 0)
     throw std::invalid_argument("Vulkan backend: a change estimate needs pairs of light records (edited, base)");
   impl_->scene.set_changed_light_pairs(edited, pairs);
   impl_->lightmap.set_guiding_scene(guiding_scene(edited, impl_->created_on));
-  impl_->lightmap.start(gbuffer, settings, uint32_t(pairs.size() / 2), texels_as_before, accumulation_cleared);
+  if (pairs.size() / 2 > kMaxChangedLightPairs || (!pair_layers.empty() && pair_layers.size() != pairs.size() / 2))
+    throw std::invalid_argument("Vulkan backend: at most kMaxChangedLightPairs pairs, each with its light layer");
+  impl_->lightmap.start(gbuffer, settings, uint32_t(pairs.size() / 2), texels_as_before, accumulation_cleared, pair_layers);
 }
 uint64_t VulkanIntegrator::add_samples(uint32_t samples) { return impl_->lightmap.add_samples(samples); }
 uint64_t VulkanIntegrator::add_samples_to(const std::vector<uint32_t>& texels, uint32_t first_sample, uint32_t samples) {

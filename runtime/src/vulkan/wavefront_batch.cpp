@@ -6,7 +6,8 @@
 namespace exitance::vulkan {
 namespace {
 
-static_assert(sizeof(GpuParams) == 192);  // 192 bytes of fields (a multiple of Vec4 alignment)
+static_assert(sizeof(GpuParams) == 224);  // 224 bytes of fields (a multiple of Vec4 alignment)
+static_assert(sizeof(GpuParams::changed_light_layers) / sizeof(uint32_t) == kMaxChangedLightPairs);
 static_assert(sizeof(GpuSurfacePoint) == 48 && sizeof(ShadowRay) == 32);
 
 uint64_t stat64(const uint32_t* c, uint32_t slot) { return uint64_t(c[slot]) | (uint64_t(c[slot + 1]) << 32); }

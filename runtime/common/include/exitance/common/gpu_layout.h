@@ -127,6 +127,8 @@ struct GpuParams {
   uint punctual_layers;      // light layers of punctual lights (light_layers.h punctual_light_layer)
   uint light_result_words;   // result words per work item before the light layers' section (bindings.glsl)
   uint pad_light_layers;
+  // A change estimate with light layers: pair k's change goes to layer changed_light_layers[k].
+  uint changed_light_layers[8];  // kMaxChangedLightPairs
 };
 
 // The most edited punctual lights a change estimate carries (GpuParams::changed_light_pairs; the

@@ -321,11 +321,13 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
 // shadow-ray origin and path, so where neither version reaches a vertex the change is exactly 0.
 // Emission and the sky add nothing (they did not change). Pair k's records are punctual lights
 // first + 2k (as edited) and first + 2k + 1 (at the base), after the scene's own; one pair per vertex,
-// chosen uniformly (a random number only when there are several).
+// chosen uniformly (a random number only when there are several), reported in `pair`.
 EXITANCE_FN void punctual_change_rays(SCENE_PARAM SurfacePoint x, vec3 throughput, uint first, uint pairs,
-                                      INOUT(PathSampler) rng, OUT(ShadowRay) edited_ray, OUT(ShadowRay) base_ray) {
+                                      INOUT(PathSampler) rng, OUT(ShadowRay) edited_ray, OUT(ShadowRay) base_ray,
+                                      OUT(uint) pair) {
   uint k = 0u;
   if (pairs > 1u) k = min(uint(sample_1d(rng) * float(pairs)), pairs - 1u);
+  pair = k;
   float probability = 1.0f / float(pairs);
   punctual_light_ray(scene_punctual_light(SCENE_ARG first + 2u * k), x, throughput, probability, edited_ray);
   punctual_light_ray(scene_punctual_light(SCENE_ARG first + 2u * k + 1u), x, -throughput, probability, base_ray);

@@ -145,9 +145,10 @@ class VulkanIntegrator final : public Integrator {
   // `pairs`: per edited light its record in `edited` then its record at the base (at least one
   // pair). Uploads `edited`'s punctual records, the pairs after them and the punctual CDF in one
   // submission. Otherwise as start_progressive; the next start_progressive estimates E/pi again.
+  // `pair_layers`: with light layers, each pair's light layer, where its change is summed.
   void start_progressive_change(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, const LightingScene& edited,
                                 const std::vector<GpuPunctualLight>& pairs, bool texels_as_before = false,
-                                bool accumulation_cleared = false);
+                                bool accumulation_cleared = false, const std::vector<uint32_t>& pair_layers = {});
   // What texels publish now, composed on the device from the progressive accumulation and the
   // estimates given (null where `mode` reads none; shaped as the accumulation), into a new device
   // estimate; waits for the device (a dispatch, no read-back of the lightmap). std::logic_error
