@@ -79,6 +79,19 @@ void ComputeKernel::bind(VkCommandBuffer cmd, uint32_t index) const {
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &sets_.at(index), 0, nullptr);
 }
 
+void ComputeKernel::write_buffers(uint32_t index, const VkDescriptorBufferInfo* buffers, uint32_t count) const {
+  std::vector<VkWriteDescriptorSet> writes(count);
+  for (uint32_t b = 0; b < count; ++b) {
+    writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[b].dstSet = set(index);
+    writes[b].dstBinding = b;
+    writes[b].descriptorCount = 1;
+    writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[b].pBufferInfo = &buffers[b];
+  }
+  vkUpdateDescriptorSets(context_.device(), count, writes.data(), 0, nullptr);
+}
+
 void ComputeKernel::push(VkCommandBuffer cmd, const void* data, uint32_t bytes) const {
   vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, bytes, data);
 }

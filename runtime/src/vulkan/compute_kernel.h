@@ -26,6 +26,8 @@ class ComputeKernel {
   // Binds the pipeline and set `index` on `cmd`.
   void bind(VkCommandBuffer cmd, uint32_t index = 0) const;
   void push(VkCommandBuffer cmd, const void* data, uint32_t bytes) const;
+  // Points bindings 0 .. count - 1 of set `index` (storage buffers) at `buffers`.
+  void write_buffers(uint32_t index, const VkDescriptorBufferInfo* buffers, uint32_t count) const;
 
  private:
   void release();

@@ -58,18 +58,7 @@ void LightmapPublisher::warm() {
   context_.submit_and_wait(cmd);
 }
 
-void LightmapPublisher::write_set(const std::array<VkDescriptorBufferInfo, 13>& infos) {
-  std::array<VkWriteDescriptorSet, kBindings> writes{};
-  for (uint32_t i = 0; i < kBindings; ++i) {
-    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    writes[i].dstSet = kernel_.set();
-    writes[i].dstBinding = i;
-    writes[i].descriptorCount = 1;
-    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[i].pBufferInfo = &infos[i];
-  }
-  vkUpdateDescriptorSets(context_.device(), kBindings, writes.data(), 0, nullptr);
-}
+void LightmapPublisher::write_set(const std::array<VkDescriptorBufferInfo, 13>& infos) { kernel_.write_buffers(0, infos.data(), kBindings); }
 
 PublishedLightmap LightmapPublisher::publish(PublishMode mode, const TexelAccumulators& accumulation, const DeviceLightmap* previous,
                                              const DeviceLightmap* base, std::shared_ptr<DeviceLightmap> out,

@@ -23,17 +23,8 @@ LightLayerScaler::LightLayerScaler(Context& context)
   // do it here and not inside the first edit.
   factors_ = context_.create_buffer(sizeof(Vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
   std::array<VkDescriptorBufferInfo, 5> infos{};
-  std::array<VkWriteDescriptorSet, 5> writes{};
-  for (uint32_t b = 0; b < 5; ++b) {
-    infos[b] = {factors_.handle(), 0, VK_WHOLE_SIZE};
-    writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    writes[b].dstSet = kernel_.set(0);
-    writes[b].dstBinding = b;
-    writes[b].descriptorCount = 1;
-    writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[b].pBufferInfo = &infos[b];
-  }
-  vkUpdateDescriptorSets(context_.device(), 5, writes.data(), 0, nullptr);
+  infos.fill({factors_.handle(), 0, VK_WHOLE_SIZE});
+  kernel_.write_buffers(0, infos.data(), 5);
   VkCommandBuffer cmd = context_.begin();
   kernel_.bind(cmd, 0);
   const ScalePush push{0, 1, 0, 0, 0};
@@ -64,16 +55,7 @@ void LightLayerScaler::scale(const std::vector<Vec4>& factors, const ScaledEstim
                                                        {factors_.handle(), 0, VK_WHOLE_SIZE},
                                                        {accumulation.sums->sums.handle(), 0, VK_WHOLE_SIZE},
                                                        {accumulation.sums->bounce_sums.handle(), 0, VK_WHOLE_SIZE}}};
-    std::array<VkWriteDescriptorSet, 5> writes{};
-    for (uint32_t b = 0; b < 5; ++b) {
-      writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-      writes[b].dstSet = kernel_.set(i);
-      writes[b].dstBinding = b;
-      writes[b].descriptorCount = 1;
-      writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-      writes[b].pBufferInfo = &infos[b];
-    }
-    vkUpdateDescriptorSets(context_.device(), 5, writes.data(), 0, nullptr);
+    kernel_.write_buffers(i, infos.data(), 5);
   }
   VkCommandBuffer cmd = context_.begin();
   VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
