@@ -348,6 +348,20 @@ BakeSettings parse_settings(const FieldReader& r, const json& j) {
   return s;
 }
 
+LightLayersInfo parse_light_layers(const FieldReader& r, const json& j, size_t page_count) {
+  const std::string where = "light_layers";
+  LightLayersInfo layers;
+  layers.count = uint32_t(r.unsigned_integer(r.member(j, where, "count"), where + ".count", 1, kMaxManifestLightLayers));
+  layers.punctual = uint32_t(r.unsigned_integer(r.member(j, where, "punctual"), where + ".punctual", 0, layers.count - 1));
+  const json& files = r.array(r.member(j, where, "files"), where + ".files", page_count);
+  for (size_t p = 0; p < files.size(); ++p) {
+    layers.files.push_back(r.bundle_file(files[p], where + ".files[" + std::to_string(p) + "]"));
+    for (size_t q = 0; q < p; ++q)
+      if (layers.files[q] == layers.files[p]) r.fail(where + ".files[" + std::to_string(p) + "]", "\"" + layers.files[p] + "\" is listed twice");
+  }
+  return layers;
+}
+
 // A free-form block, kept as text.
 std::string object_text(const FieldReader& r, const json& j, const std::string& where) {
   if (!j.is_object()) r.fail(where, std::string("expected an object, got ") + j.type_name());
@@ -394,6 +408,7 @@ BundleManifest parse_bundle_manifest(std::string_view json_text, const std::stri
   if (root.contains("svo") && !root["svo"].is_null()) manifest.svo = parse_svo(r, root["svo"]);
   if (root.contains("scene")) manifest.scene = parse_scene(r, root["scene"]);
   if (root.contains("preview")) manifest.preview = parse_preview(r, root["preview"], manifest.pages.size());
+  if (root.contains("light_layers")) manifest.light_layers = parse_light_layers(r, root["light_layers"], manifest.pages.size());
   if (root.contains("input")) manifest.input = parse_input(r, root["input"]);
   if (root.contains("settings")) manifest.settings = parse_settings(r, root["settings"]);
   if (root.contains("stats")) manifest.stats_json = object_text(r, root["stats"], "stats");

@@ -121,6 +121,11 @@ std::string write_bundle_manifest(const BundleManifest& m) {
       root["scene"] = {{"file", m.scene->file}, {"format_version", m.scene->format_version}, {"bytes", m.scene->bytes}};
   }
   if (m.preview) root["preview"] = preview_json(*m.preview);
+  if (m.light_layers)
+    root["light_layers"] = {{"count", m.light_layers->count},
+                            {"punctual", m.light_layers->punctual},
+                            {"files", m.light_layers->files},
+                            {"units", "irradiance_over_pi"}};
   if (!m.stats_json.empty()) root["stats"] = free_form(m.stats_json, "stats");
   if (!m.relight_json.empty()) root["relight"] = free_form(m.relight_json, "relight");
 

@@ -41,6 +41,9 @@ int main(int argc, char** argv) {
   app.add_flag("--no-light-layers", no_light_layers,
                "keep no estimate per light layer (24 bytes per layer and texel); an edit that only scales lights "
                "(intensity, colour, emission, a constant sky) then restarts instead of scaling their layers with 0 rays");
+  app.add_flag("--light-layers", options.whole_run_light_layers,
+               "keep light layers in a whole run too (they are kept with --frames, --budget-ms or --spp-before-edits), "
+               "so the bundle written holds them: a session opening it scales a light's layer from its first frame");
   app.add_flag("--ignore-baked", ignore_baked,
                "start every texel from nothing instead of from the bundle's baked lightmap (which is shown until refreshed samples are better, and which light edits are estimated as a change from)");
   app.add_option("--spp-before-edits", options.samples_before_edits,

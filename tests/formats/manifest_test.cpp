@@ -266,5 +266,41 @@ TEST(BundleManifest, PreviewRoundTripsAndIsCheckedByName) {
   }
 }
 
+json light_layers_block() {
+  return {{"count", 5}, {"punctual", 2}, {"files", {"light-layers-0.exr", "light-layers-1.exr"}}, {"units", "irradiance_over_pi"}};
+}
+
+TEST(BundleManifest, LightLayersRoundTripAndAreCheckedByName) {
+  json j = full_manifest();
+  j["light_layers"] = light_layers_block();
+  const Manifest first = parse(j);
+  ASSERT_TRUE(first.light_layers.has_value());
+  EXPECT_EQ(first.light_layers->count, 5u);
+  EXPECT_EQ(first.light_layers->punctual, 2u);
+  ASSERT_EQ(first.light_layers->files.size(), 2u);
+  EXPECT_EQ(first.light_layers->files[1], "light-layers-1.exr");
+  const std::string written = formats::write_bundle_manifest(first);
+  EXPECT_EQ(formats::write_bundle_manifest(parse_manifest(written, "written")), written);
+  EXPECT_FALSE(parse(full_manifest()).light_layers.has_value());
+
+  const std::pair<void (*)(json&), const char*> refused[] = {
+      {[](json& l) { l["count"] = 0; }, "light_layers.count: 0 is outside 1..256"},
+      {[](json& l) { l["count"] = 257; }, "light_layers.count: 257 is outside 1..256"},
+      {[](json& l) { l["punctual"] = 5; }, "light_layers.punctual: 5 is outside 0..4"},
+      {[](json& l) { l.erase("punctual"); }, "light_layers.punctual: missing"},
+      {[](json& l) { l["files"].erase(1); }, "light_layers.files: expected 2 elements, got 1"},
+      {[](json& l) { l["files"][1] = "light-layers-0.exr"; }, "light_layers.files[1]: \"light-layers-0.exr\" is listed twice"},
+      {[](json& l) { l["files"][0] = "/tmp/x.exr"; }, "light_layers.files[0]: \"/tmp/x.exr\" is not a path relative to the bundle"},
+      {[](json& l) { l = "all"; }, "light_layers: expected an object, got string"},
+  };
+  for (const auto& [edit, message] : refused) {
+    SCOPED_TRACE(message);
+    json bad = full_manifest();
+    bad["light_layers"] = light_layers_block();
+    edit(bad["light_layers"]);
+    expect_format_error([&] { parse(bad); }, message);
+  }
+}
+
 }  // namespace
 }  // namespace exitance::loader

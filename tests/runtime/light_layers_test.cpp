@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -20,6 +21,10 @@
 #include "exitance/common/light_layers.h"
 #include "exitance/runtime/refresh/published_estimate.h"
 #include "exitance/runtime/refresh/refresh_session.h"
+#include "exitance/runtime/refresh/refreshed_bundle.h"
+#include "exitance/formats/bundle_manifest.h"
+#include "exitance/formats/lightmap_exr.h"
+#include "exitance/runtime/bundle/light_layer_pages.h"
 #include "support/lightmap_comparison.h"
 #include "support/vulkan_device_available.h"
 
@@ -396,6 +401,132 @@ TEST(LightLayers, AChangeEstimateKeepsTheSplit) {
       checked += expected > 0;
     }
   EXPECT_GT(checked, 0u);
+  expect_no_validation_messages();
+}
+
+}  // namespace
+}  // namespace exitance
+
+namespace exitance {
+namespace {
+
+formats::BundleManifest read_manifest(const fs::path& bundle) {
+  std::ifstream in(bundle / "manifest.json");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return formats::parse_bundle_manifest(text, (bundle / "manifest.json").string());
+}
+
+// A bundle written from a session with light layers holds them (docs/bundle.md "Light layers"); a
+// session that opens it starts from its lightmap split by light, so a scaling edit right after
+// open scales each texel's layer exactly, with no sample refreshed.
+TEST(LightLayers, ABundleKeepsTheSplitForTheNextSession) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const fs::path written = test_dir() / "written-with-layers.bake";
+  LightmapEstimate shown_when_written;
+  uint32_t layer_count = 0;
+  {
+    auto session = open_session(courtyard_bundle("all-lights", {}), 61, true);
+    session->refresh({0, 32});
+    shown_when_written = session->published_lightmap();
+    layer_count = session->lighting_scene().light_layer_count;
+    const json report = write_refreshed_bundle(*session, written.string(), json::object());
+    EXPECT_TRUE(report["light_layers"]["written"].get<bool>()) << report["light_layers"].dump();
+  }
+  const formats::BundleManifest manifest = read_manifest(written);
+  ASSERT_TRUE(manifest.light_layers.has_value());
+  EXPECT_EQ(manifest.light_layers->count, layer_count);
+  EXPECT_EQ(manifest.light_layers->punctual, 2u);
+  ASSERT_EQ(manifest.light_layers->files.size(), manifest.pages.size());
+
+  auto session = RefreshSession::open(written.string(), validated_options(62));
+  ASSERT_TRUE(session->started_from_baked());
+  const LightmapEstimate opened = session->published_lightmap();
+  const size_t n = opened.texels.size();
+  ASSERT_EQ(opened.light_layers, int(layer_count));
+  // Each layer as written (float32 means; the baked start gives every texel the same sample count).
+  size_t lit = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (!opened.texels[i].samples) continue;
+    for (int k = 0; k < opened.light_layers; ++k)
+      for (int c = 0; c < 3; ++c) {
+        const size_t at = (size_t(k) * n + i) * 3 + size_t(c);
+        const double was = shown_when_written.light_sums[at] / shown_when_written.texels[i].samples;
+        const double now = opened.light_sums[at] / opened.texels[i].samples;
+        EXPECT_NEAR(now, was, 1e-6 * std::fabs(was) + 1e-30) << "texel " << i << " layer " << k << " channel " << c;
+        lit += was != 0;
+      }
+  }
+  EXPECT_GT(lit, n);  // several layers light most texels
+  session->apply_edits(parse_scene_edits(R"({"edits": [{"sky": [0.9, 1.2, 1.5]}]})", "sky.json"));
+  EXPECT_TRUE(session->last_edit_timings().scaled_light_layers);  // at open, with no sample of its own
+  const LightmapEstimate scaled = session->published_lightmap();
+  size_t checked = 0;
+  for (size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double expected = opened.texels[i].total[c] + 2.0 * opened.light_sums[i * 3 + size_t(c)];  // sky x 3
+      EXPECT_NEAR(scaled.texels[i].total[c], expected, 1e-6 * std::fabs(expected) + 1e-12) << "texel " << i;
+      checked += expected > 0;
+    }
+  EXPECT_GT(checked, 0u);
+  expect_no_validation_messages();
+}
+
+// A bundle whose layers do not fit its scene, or whose layer file is damaged, is refused with one
+// line naming the file and the problem; a session that keeps no layers opens it as any other.
+TEST(LightLayers, BadLayersInABundleAreRefused) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const fs::path source = test_dir() / "layers-source.bake";
+  if (!fs::exists(source)) {
+    auto session = open_session(courtyard_bundle("all-lights", {}), 71, true);
+    session->refresh({0, 16});
+    write_refreshed_bundle(*session, source.string(), json::object());
+  }
+  auto damaged = [&](const std::string& name, const std::function<void(const fs::path&)>& damage) {
+    const fs::path copy = test_dir() / (name + ".bake");
+    fs::remove_all(copy);
+    fs::copy(source, copy, fs::copy_options::recursive);
+    damage(copy);
+    return copy;
+  };
+  auto expect_refused = [&](const fs::path& bundle, const std::string& needle) {
+    try {
+      RefreshSession::open(bundle.string(), validated_options(72));
+      ADD_FAILURE() << bundle << " opened";
+    } catch (const BundleInputError& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find(needle), std::string::npos) << message;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+  };
+  const fs::path miscounted = damaged("layers-miscounted", [](const fs::path& b) {
+    std::ifstream in(b / "manifest.json");
+    json m = json::parse(in);
+    m["light_layers"]["count"] = m["light_layers"]["count"].get<int>() + 1;
+    std::ofstream(b / "manifest.json") << m.dump(2);
+  });
+  expect_refused(miscounted, "manifest.json: light_layers: ");
+  const fs::path stray = damaged("layers-stray-channel", [](const fs::path& b) {
+    formats::LightmapImage image = formats::read_lightmap_exr((b / "light-layers-0.exr").string());
+    image.channels["layer1.A"] = image.channels.begin()->second;
+    formats::write_lightmap_exr((b / "light-layers-0.exr").string(), image);
+  });
+  expect_refused(stray, "light-layers-0.exr: channel \"layer1.A\" is not a light layer");
+  const fs::path partial = damaged("layers-partial", [](const fs::path& b) {
+    formats::LightmapImage image = formats::read_lightmap_exr((b / "light-layers-0.exr").string());
+    image.channels.erase(light_layer_channel(0, 1));
+    formats::write_lightmap_exr((b / "light-layers-0.exr").string(), image);
+  });
+  expect_refused(partial, "light-layers-0.exr: layer 0 has 2 of its R, G, B channels");
+  const fs::path nonfinite = damaged("layers-nonfinite", [](const fs::path& b) {
+    formats::LightmapImage image = formats::read_lightmap_exr((b / "light-layers-0.exr").string());
+    for (float& v : image.channels[light_layer_channel(0, 2)]) v = NAN;
+    formats::write_lightmap_exr((b / "light-layers-0.exr").string(), image);
+  });
+  expect_refused(nonfinite, "light-layers-0.exr: channel \"layer0.B\" at pixel (");
+  // Without light layers the session reads none of them.
+  RefreshSessionOptions options = validated_options(73);
+  options.light_layers = false;
+  EXPECT_TRUE(RefreshSession::open(nonfinite.string(), options)->started_from_baked());
   expect_no_validation_messages();
 }
 

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "exitance/formats/lightmap_exr.h"
+#include "exitance/runtime/bundle/light_layer_pages.h"
 #include "exitance/runtime/refresh/published_estimate.h"
 
 namespace exitance {
@@ -16,7 +17,9 @@ namespace exitance {
 namespace fs = std::filesystem;
 
 std::optional<LightmapEstimate> read_baked_lightmap(const std::string& bundle, const formats::BundleManifest& manifest,
-                                                    const TexelGBuffer& gbuffer, int recorded_bounces) {
+                                                    const TexelGBuffer& gbuffer, int recorded_bounces,
+                                                    BakedLightLayers light_layers, bool* has_light_layers) {
+  if (has_light_layers) *has_light_layers = false;
   // A relit bundle's pages are described by its "relight" report, a baked one's by "stats".
   const std::string& described = manifest.relight_json.empty() ? manifest.stats_json : manifest.relight_json;
   if (manifest.pages.empty() || manifest.pages.size() != gbuffer.pages.size() || described.empty()) return std::nullopt;
@@ -56,8 +59,26 @@ std::optional<LightmapEstimate> read_baked_lightmap(const std::string& bundle, c
     page[7] = valid == image.channels.end() ? nullptr : valid->second.data();
   }
 
+  // The bundle's light layers, checked against the layout the session's scene has.
+  std::vector<float> layer_means;
+  const bool read_layers = light_layers.count > 0 && manifest.light_layers.has_value();
+  if (read_layers) {
+    const formats::LightLayersInfo& info = *manifest.light_layers;
+    const std::string where = (fs::path(bundle) / "manifest.json").string() + ": light_layers";
+    if (info.count != light_layers.count || info.punctual != light_layers.punctual)
+      throw std::runtime_error(where + ": " + std::to_string(info.count) + " layers, " + std::to_string(info.punctual) +
+                               " of them punctual lights', but scene.bin's lights and emissive materials make " +
+                               std::to_string(light_layers.count) + ", " + std::to_string(light_layers.punctual) +
+                               " punctual (docs/bundle.md \"Light layers\")");
+    std::vector<std::string> files;
+    for (const std::string& file : info.files) files.push_back((fs::path(bundle) / file).string());
+    layer_means = read_light_layer_pages(files, gbuffer, info.count);
+  }
+
   LightmapEstimate estimate;
   const size_t n = gbuffer.texels.size();
+  estimate.light_layers = int(light_layers.count);
+  estimate.light_sums.assign(size_t(light_layers.count) * n * 3, 0.0);
   estimate.recorded_bounces = recorded_bounces;
   estimate.texels.resize(n);
   estimate.bounces.assign(size_t(recorded_bounces) * n * 3, 0.0);
@@ -89,7 +110,11 @@ std::optional<LightmapEstimate> read_baked_lightmap(const std::string& bundle, c
       estimate.bounces[i * 3 + size_t(c)] = double(m) * direct[c];
       if (recorded_bounces > 1) estimate.bounces[(n + i) * 3 + size_t(c)] = double(m) * (double(total[c]) - direct[c]);
     }
+    if (read_layers)
+      for (size_t k = 0; k < light_layers.count; ++k)
+        for (size_t c = 0; c < 3; ++c) estimate.light_sums[(k * n + i) * 3 + c] = double(m) * layer_means[(k * n + i) * 3 + c];
   }
+  if (has_light_layers) *has_light_layers = read_layers;
   return estimate;
 }
 

@@ -242,14 +242,18 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   timings.texels = since();
   if (options.start_from_baked) {
     try {
-      std::optional<LightmapEstimate> baked = read_baked_lightmap(
-          bundle_folder, manifest, state->persisted.gbuffer, std::clamp(settings.recorded_bounces, 1, int(kMaxRecordedLayers)));
+      // Shaped as the accumulation, with the bundle's light layers where it has them; without, they
+      // stay 0 (no split: an edit that scales lights scales these texels as the accumulation's split says).
+      BakedLightLayers layers;
+      if (state->integrator->light_layers() > 0)
+        layers = {uint32_t(state->integrator->light_layers()), state->lighting->punctual_light_layers};
+      bool baked_layers = false;
+      std::optional<LightmapEstimate> baked =
+          read_baked_lightmap(bundle_folder, manifest, state->persisted.gbuffer,
+                              std::clamp(settings.recorded_bounces, 1, int(kMaxRecordedLayers)), layers, &baked_layers);
       if (baked) {
-        // Shaped as the accumulation; the bundle holds no light layers, so they stay 0 (no split: an
-        // edit that scales lights scales these texels as the accumulation's split says).
-        baked->light_layers = state->integrator->light_layers();
-        baked->light_sums.assign(size_t(baked->light_layers) * baked->texels.size() * 3, 0.0);
         state->previous = state->integrator->upload_lightmap(*baked);
+        state->previous_split_by_light = baked_layers;
       }
       state->started_from_baked = state->previous != nullptr;
     } catch (const std::runtime_error& e) {
@@ -745,6 +749,33 @@ LightmapEstimate RefreshSession::published_lightmap() const {
       for (int c = 0; c < 3; ++c) estimate.light_sums[(size_t(k) * n + i) * 3 + size_t(c)] = previous.light_sums[(size_t(k) * n + i) * 3 + size_t(c)];
   }
   return estimate;
+}
+
+std::optional<LightmapEstimate> RefreshSession::published_lightmap_by_light() const {
+  const State& s = *state_;
+  const bool layers = s.per_bounce ? s.per_bounce->light_layers > 0 : s.integrator->light_layers() > 0;
+  if (!layers) return std::nullopt;
+  if (published_split_by_light()) return published_lightmap();
+  // Only the progressive accumulation, not during a change estimate, with samples enough to split by.
+  if (s.per_bounce || s.base || samples_per_texel() < s.proportional_split_samples) return std::nullopt;
+  LightmapEstimate published = published_lightmap();
+  const LightmapEstimate accumulation = lightmap();
+  const size_t n = published.texels.size();
+  if (accumulation.texels.size() != n || accumulation.light_layers != published.light_layers) return std::nullopt;
+  const int layer_count = published.light_layers;
+  for (size_t i = 0; i < n; ++i) {
+    const TexelAccumulator& shown = published.texels[i];
+    const TexelAccumulator& acc = accumulation.texels[i];
+    for (int c = 0; c < 3; ++c) {
+      // The shown total's sums split as the accumulation's mean is split (same samples or not).
+      const double total = acc.total[c];
+      for (int k = 0; k < layer_count; ++k) {
+        const double part = total != 0 ? accumulation.light_sums[(size_t(k) * n + i) * 3 + size_t(c)] / total : (k == 0 ? 1.0 : 0.0);
+        published.light_sums[(size_t(k) * n + i) * 3 + size_t(c)] = shown.total[c] * part;
+      }
+    }
+  }
+  return published;
 }
 
 const DevicePageImages& RefreshSession::publish_page_images(int dilation_texels) {

@@ -12,10 +12,12 @@
 #include "exitance/formats/scene_file.h"
 #include "exitance/formats/svo_file.h"
 #include "exitance/runtime/bundle/bundle_directory.h"
+#include "exitance/runtime/bundle/light_layer_pages.h"
 #include "exitance/runtime/bundle/lightmap_assembly.h"
 #include "exitance/runtime/bundle/probe_results.h"
 #include "exitance/runtime/bundle/seam_stage.h"
 #include "exitance/runtime/bundle/texel_exitance.h"
+#include "exitance/runtime/refresh/bundle_light_layers.h"
 #include "exitance/runtime/stage_clock.h"
 
 namespace exitance {
@@ -33,7 +35,11 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   const fs::path bundle(session.bundle());
   formats::BundleManifest manifest = session.manifest();
   const formats::BakeSettings baked = manifest.settings.value_or(formats::BakeSettings{});
-  const LightmapEstimate estimate = session.published_lightmap();
+  // With light layers split by light where the session has them (docs/bundle.md "Light layers").
+  std::optional<LightmapEstimate> by_light = session.published_lightmap_by_light();
+  const bool layers_split = by_light.has_value();
+  const LightmapEstimate estimate = by_light ? std::move(*by_light) : session.published_lightmap();
+  by_light.reset();
 
   PersistedScene persisted = session.persisted();
   ProbeEstimate probe_estimate;
@@ -66,6 +72,24 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   const json seams = stitch_bundle_seams(pages, persisted.scene, persisted.atlas, assembly.dilation_texels,
                                          bundle_stitches_seams(manifest.stats_json));
   stage("write");
+  // Light layers (docs/bundle.md "Light layers"), where what is published keeps a split by light.
+  std::vector<formats::LightmapImage> layer_pages;
+  manifest.light_layers.reset();
+  std::string light_layers_skipped = estimate.light_layers == 0 ? "the session keeps no light layers" : "";
+  if (estimate.light_layers > 0 && !layers_split)
+    light_layers_skipped = "what is published has no split by light (the baked lightmap without layers and too few refreshed samples to split it by)";
+  if (light_layers_skipped.empty()) {
+    const std::optional<BundleLightLayers> layout = bundle_light_layers(session.lighting_scene());
+    if (!layout) {
+      light_layers_skipped = "the edited lights share layers differently from the layout scene.bin gets";
+    } else {
+      layer_pages = assemble_light_layer_pages(persisted.gbuffer, estimate, layout->bundle_layer);
+      formats::LightLayersInfo& info = manifest.light_layers.emplace();
+      info.count = layout->count;
+      info.punctual = layout->punctual;
+      for (size_t p = 0; p < layer_pages.size(); ++p) info.files.push_back("light-layers-" + std::to_string(p) + ".exr");
+    }
+  }
   // The pages as assembled now, under the file names the manifest gave them.
   if (pages.size() != manifest.pages.size())
     throw BundleInputError((bundle / "manifest.json").string() + ": pages: " + std::to_string(manifest.pages.size()) +
@@ -106,6 +130,8 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   }
   report["nonfinite_samples"] = estimate.nonfinite_samples + probe_estimate.nonfinite_samples;
   report["seams"] = seams;
+  report["light_layers"] = manifest.light_layers ? json{{"count", manifest.light_layers->count}, {"written", true}}
+                                                 : json{{"written", false}, {"why_not", light_layers_skipped}};
 
   manifest.generator = "exitance-relight 0.1.0";
   formats::BakeSettings& settings = manifest.settings.emplace(baked);
@@ -131,6 +157,8 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
     write_bundle_atomically(out, [&](const fs::path& dir) {
       for (size_t p = 0; p < pages.size(); ++p)
         formats::write_lightmap_exr((dir / manifest.pages[p].file).string(), pages[p]);
+      for (size_t p = 0; p < layer_pages.size(); ++p)
+        formats::write_lightmap_exr((dir / manifest.light_layers->files[p]).string(), layer_pages[p]);
       if (has_probes) formats::write_probes_file((dir / manifest.probes->file).string(), persisted.probes);
       if (svo) formats::write_svo_file((dir / manifest.svo->file).string(), *svo);
       std::ofstream scene_out(dir / manifest.scene->file, std::ios::binary);

@@ -64,10 +64,12 @@ json relight_bundle(const RelightOptions& options) {
   session_options.seed = options.seed;
   session_options.start_from_baked = options.from_baked;
   // Light layers serve edits that come while frames refresh; a whole run after the edits (no
-  // --frames, --budget-ms or --spp-before-edits) would only pay for them (25 % of its rays/s on
-  // the H200 at 22 layers: bench/results/light-layers.md).
-  session_options.light_layers =
-      options.light_layers && (options.frames > 0 || options.frame_budget_ms > 0 || options.samples_before_edits > 0);
+  // --frames, --budget-ms or --spp-before-edits) pays for them (11 % of its rays/s on the H200 at 22
+  // layers: bench/results/light-layers.md) only to write them into the bundle (--light-layers).
+  if (options.whole_run_light_layers && !options.light_layers)
+    throw RelightInputError("--light-layers and --no-light-layers contradict each other");
+  session_options.light_layers = options.light_layers && (options.whole_run_light_layers || options.frames > 0 ||
+                                                          options.frame_budget_ms > 0 || options.samples_before_edits > 0);
   session_options.device.device_index = options.device_index;
   session_options.device.validation = options.validation;
   session_options.device.collect_stage_statistics = options.stage_statistics;

@@ -86,6 +86,19 @@ struct PreviewInfo {
   std::string views_skipped;  // why there are no views (no scene.bin), or ""
 };
 
+// "light_layers" (docs/bundle.md "Light layers"): E/pi split by the light it came from, for the
+// runtime (an edit that only scales a light scales its layer). One OpenEXR file per page with
+// channels "layer<k>.R/G/B" for the layers k that light some texel of the page (absent: 0). The
+// layers are laid out as scene.bin lays them out when opened (exitance/common/light_layers.h): 0 the
+// sky, 1..punctual the punctual lights, then the emissive materials; the runtime checks `count` and
+// `punctual` against that layout.
+constexpr uint32_t kMaxManifestLightLayers = 256;
+struct LightLayersInfo {
+  uint32_t count = 0;     // 1..kMaxManifestLightLayers
+  uint32_t punctual = 0;  // below count
+  std::vector<std::string> files;  // one per page, in page order
+};
+
 // The input the bundle was baked from.
 struct InputInfo {
   std::string file;    // file name without folders
@@ -133,6 +146,7 @@ struct BundleManifest {
   std::optional<SvoInfo> svo;
   std::optional<SceneFileInfo> scene;
   std::optional<PreviewInfo> preview;
+  std::optional<LightLayersInfo> light_layers;
   std::string stats_json;    // "stats": a JSON object as text, "" when absent
   std::string relight_json;  // "relight": a JSON object as text, "" when absent
 

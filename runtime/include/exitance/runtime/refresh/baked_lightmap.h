@@ -23,7 +23,18 @@ constexpr uint32_t kBakedStartMinimumSamples = 16;
 // and its error floor from relight.error.floor), or pages without R, G, B, direct.R/G/B and error.Y. Throws
 // std::runtime_error naming the file when a listed page cannot be read or does not match the
 // G-buffer's page size.
+//
+// Light layers (docs/bundle.md "Light layers"): with `light_layers` > 0 (the count the session's
+// scene lays out, `punctual_light_layers` of them punctual), the estimate has that many layers: the
+// bundle's (their means times the same sample count) when its manifest lists them, else all 0
+// (`has_light_layers` tells which). Throws std::runtime_error naming the manifest field when the
+// bundle's layer counts differ from the session's, and (light_layer_pages.h) for a bad layer file.
+struct BakedLightLayers {
+  uint32_t count = 0;  // 0: not read (the session keeps no light layers)
+  uint32_t punctual = 0;
+};
 std::optional<LightmapEstimate> read_baked_lightmap(const std::string& bundle, const formats::BundleManifest& manifest,
-                                                    const TexelGBuffer& gbuffer, int recorded_bounces);
+                                                    const TexelGBuffer& gbuffer, int recorded_bounces,
+                                                    BakedLightLayers light_layers = {}, bool* has_light_layers = nullptr);
 
 }  // namespace exitance

@@ -190,6 +190,13 @@ class RefreshSession {
   // fewer than 2 refreshed samples, and a texel no change reaches keeps its value. A whole run
   // (bake_per_bounce, bake_guided, bake_path) is shown wherever it has samples.
   LightmapEstimate published_lightmap() const;
+  // published_lightmap() with light layers that add up to its totals, for write_refreshed_bundle:
+  // exact where what is published keeps a split by light; texels that show an estimate without one
+  // (the baked lightmap of a bundle without layers) split in proportion to the accumulation's split
+  // per channel (a channel the accumulation has 0 of goes to the sky's layer), once the accumulation
+  // has RefreshSessionOptions::proportional_split_samples. nullopt without light layers, during a
+  // change estimate whose base has no split, or before that many samples.
+  std::optional<LightmapEstimate> published_lightmap_by_light() const;
   // What published_lightmap() holds, written into one RGBA32F device image per atlas page (E/pi,
   // coverage in A, gutters dilated `dilation_texels` deep: the values assemble_lightmap_pages gives,
   // bit for bit), with no read-back; the images stay the same objects between calls.

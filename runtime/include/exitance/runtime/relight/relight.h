@@ -28,6 +28,9 @@ struct RelightOptions {
   uint32_t frames = 0;             // > 0: at most this many frames
   bool from_baked = true;          // start from the bundle's baked lightmap (RefreshSessionOptions::start_from_baked)
   bool light_layers = true;        // keep the estimate per light layer (RefreshSessionOptions::light_layers)
+  // Keep them in a whole run too (no --frames, --budget-ms or --spp-before-edits), so that the bundle
+  // written holds them (docs/bundle.md "Light layers"); off: a whole run only pays for them.
+  bool whole_run_light_layers = false;
   uint32_t samples_before_edits = 0;  // > 0: refresh this many samples per texel before applying the edits
   bool page_images = false;        // with frames: after each frame, the page images an engine samples written (publish_page_images), timed
   bool frame_errors = true;        // with frames: each frame's estimated error (a read-back of the sums between frames)
