@@ -430,7 +430,7 @@ TEST(LightLayers, ABundleKeepsTheSplitForTheNextSession) {
     shown_when_written = session->published_lightmap();
     layer_count = session->lighting_scene().light_layer_count;
     const json report = write_refreshed_bundle(*session, written.string(), json::object());
-    EXPECT_TRUE(report["light_layers"]["written"].get<bool>()) << report["light_layers"].dump();
+    EXPECT_TRUE(report["bundle_light_layers"]["written"].get<bool>()) << report["bundle_light_layers"].dump();
   }
   const formats::BundleManifest manifest = read_manifest(written);
   ASSERT_TRUE(manifest.light_layers.has_value());

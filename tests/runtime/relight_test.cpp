@@ -419,6 +419,16 @@ TEST(Relight, BadScenesAreOneLineAndExitTwo) {
   EXPECT_EQ(std::count(errors.begin(), errors.end(), '\n'), 1) << errors;
   EXPECT_NE(errors.find("svo.bin"), std::string::npos) << errors;
   EXPECT_FALSE(fs::exists(guided_out)) << "partial output";
+  // Light layers kept in a whole run (so the bundle holds them) and refused together with none.
+  EXPECT_EQ(run_relight(f.baked.string() + " -o " + guided_out.string() + " --light-layers --no-light-layers --spp 1", errors), 2);
+  EXPECT_EQ(std::count(errors.begin(), errors.end(), '\n'), 1) << errors;
+  EXPECT_NE(errors.find("--light-layers and --no-light-layers"), std::string::npos) << errors;
+  EXPECT_FALSE(fs::exists(guided_out)) << "partial output";
+  const fs::path layered = f.dir / "layered.bake";
+  ASSERT_EQ(run_relight(f.baked.string() + " -o " + layered.string() + " --light-layers --spp 2", errors), 0) << errors;
+  const nlohmann::json written = nlohmann::json::parse(file_bytes(layered / "manifest.json"));
+  ASSERT_TRUE(written.contains("light_layers")) << written["relight"]["bundle_light_layers"].dump();
+  EXPECT_TRUE(fs::exists(layered / written["light_layers"]["files"][0].get<std::string>()));
 }
 
 // A submission past the fence timeout (EXITANCE_VULKAN_FENCE_TIMEOUT, here 1 ms) ends the run

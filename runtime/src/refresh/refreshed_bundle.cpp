@@ -130,7 +130,7 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   }
   report["nonfinite_samples"] = estimate.nonfinite_samples + probe_estimate.nonfinite_samples;
   report["seams"] = seams;
-  report["light_layers"] = manifest.light_layers ? json{{"count", manifest.light_layers->count}, {"written", true}}
+  report["bundle_light_layers"] = manifest.light_layers ? json{{"count", manifest.light_layers->count}, {"written", true}}
                                                  : json{{"written", false}, {"why_not", light_layers_skipped}};
 
   manifest.generator = "exitance-relight 0.1.0";
