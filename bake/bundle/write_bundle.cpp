@@ -14,7 +14,9 @@
 #include "exitance/formats/probes_file.h"
 #include "exitance/formats/svo_file.h"
 #include "exitance/runtime/bundle/bundle_directory.h"
+#include "exitance/runtime/bundle/light_layer_pages.h"
 #include "exitance/runtime/bundle/lightmap_assembly.h"
+#include "exitance/common/light_layers.h"
 
 namespace exitance {
 
@@ -61,6 +63,18 @@ WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::jso
       stitch_bundle_seams(pages, results.scene, results.layout, assembly.dilation_texels, options.stitch_seams);
   formats::BundleManifest manifest = build_bundle_manifest(
       results, pages, results.input_sha256, seconds, diagnostics.warnings.size(), options);
+  // Light layers (--light-layers; docs/bundle.md "Light layers"): the bake's layout is the one its
+  // scene.bin gets when opened, layer for layer.
+  std::vector<formats::LightmapImage> layer_pages;
+  if (results.lightmap.light_layers > 0) {
+    std::vector<uint32_t> same(size_t(results.lightmap.light_layers));
+    for (size_t k = 0; k < same.size(); ++k) same[k] = uint32_t(k);
+    layer_pages = assemble_light_layer_pages(results.gbuffer, results.lightmap, same);
+    formats::LightLayersInfo& info = manifest.light_layers.emplace();
+    info.count = uint32_t(results.lightmap.light_layers);
+    info.punctual = std::min<uint32_t>(uint32_t(results.scene.lights.size()), kDefaultLightLayerLimit);
+    for (size_t p = 0; p < layer_pages.size(); ++p) info.files.push_back("light-layers-" + std::to_string(p) + ".exr");
+  }
   {
     nlohmann::json stats = nlohmann::json::parse(manifest.stats_json);
     stats["seams"] = seams;
@@ -73,6 +87,8 @@ WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::jso
   write_bundle_atomically(out, [&](const fs::path& dir) {
     for (size_t p = 0; p < pages.size(); ++p)
       formats::write_lightmap_exr((dir / ("lightmap-" + std::to_string(p) + ".exr")).string(), pages[p]);
+    for (size_t p = 0; p < layer_pages.size(); ++p)
+      formats::write_lightmap_exr((dir / manifest.light_layers->files[p]).string(), layer_pages[p]);
     if (results.probes) formats::write_probes_file((dir / "probes.bin").string(), results.probes->grid);
     if (!results.scene_file.bytes.empty()) {
       std::ofstream scene_out(dir / "scene.bin", std::ios::binary);

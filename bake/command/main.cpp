@@ -52,6 +52,7 @@ std::string refused_under_mpirun(const exitance::BakeOptions& options, const std
   if (guiding == "grid" || guiding == "svo")
     return "--guiding " + guiding + ": guiding runs in one process only, not under mpirun";
   if (options.lighting.emitter_guiding) return "--emitter-guiding on: guiding runs in one process only, not under mpirun";
+  if (options.lighting.light_layers) return "--light-layers: light layers are kept in one process only, not under mpirun";
   if (integrator == "path" && options.lighting.target_relative_error > 0 && options.backend.name == "cpu")
     return "--target-error: on the CPU backend with --integrator path it plans each texel's samples in one process; "
            "under mpirun use --integrator bounces";
@@ -133,6 +134,9 @@ int main(int argc, char** argv) {
                  "SVO leaves per axis: a power of two 2..4096, auto (leaves about 4 texels wide) or none");
   app.add_option("--directional", directional,
                  "sh1: also write L1 SH directional layers sh1.x.R .. sh1.z.B (docs/bundle.md; path tracing)");
+  app.add_flag("--light-layers", options.lighting.light_layers,
+               "also write E/pi split by light (light-layers-<page>.exr, docs/bundle.md \"Light layers\"), so that the "
+               "runtime scales a light's layer with no ray from the moment it opens the bundle; path tracing only");
   app.add_option("--guiding", guiding,
                  "auto (default: path tracing on the CPU backend measures guided (grid) against unguided samples "
                  "during a pilot and keeps guiding per region where it pays; on Vulkan only when given (its pilot "
@@ -281,6 +285,10 @@ int main(int argc, char** argv) {
       return 2;
     }
     options.lighting.directional = exitance::DirectionalMode::Sh1;
+  }
+  if (options.lighting.light_layers && integrator == "bounces") {
+    std::cerr << "bake: error: --light-layers are kept by path tracing: they need --integrator path (or auto)\n";
+    return 2;
   }
   if (guiding == "grid" || guiding == "svo") {
     if (integrator == "bounces") {

@@ -38,6 +38,8 @@ TEST(BakeGuidingOptions, ContradictionsAreOneLineAndExit2) {
       {"--guiding svo --integrator bounces", "--guiding svo guides path tracing"},
       {"--guiding grid --integrator bounces", "--guiding grid guides path tracing"},
       {"--emitter-guiding on --backend vulkan", "--emitter-guiding on: implemented on the CPU backend only"},
+      // Not guiding, but refused the same way (docs/bundle.md "Light layers").
+      {"--light-layers --integrator bounces", "--light-layers are kept by path tracing: they need --integrator path"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.options);

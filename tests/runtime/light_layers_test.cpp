@@ -58,7 +58,8 @@ struct Lit {
 
 // The courtyard with a lamp and an emissive low wall, baked (CPU; 1 sample where only scene.bin is
 // used, 16 where the session starts from the baked lightmap).
-fs::path courtyard_bundle(const std::string& name, Lit lit, uint32_t spp = 1) {
+fs::path courtyard_bundle(const std::string& name, Lit lit, uint32_t spp = 1,
+                          const std::function<void(BakeOptions&)>& tweak = {}) {
   const fs::path dir = test_dir();
   const fs::path bundle = dir / (name + ".bake");
   if (fs::exists(bundle)) return bundle;
@@ -84,6 +85,7 @@ fs::path courtyard_bundle(const std::string& name, Lit lit, uint32_t spp = 1) {
   options.probes_enabled = false;
   options.svo_enabled = false;
   options.sky = lit.sky ? "0.3,0.4,0.5" : "0,0,0";
+  if (tweak) tweak(options);
   Diagnostics diagnostics;
   run_bake(options, diagnostics);
   return bundle;
@@ -527,6 +529,68 @@ TEST(LightLayers, BadLayersInABundleAreRefused) {
   RefreshSessionOptions options = validated_options(73);
   options.light_layers = false;
   EXPECT_TRUE(RefreshSession::open(nonfinite.string(), options)->started_from_baked());
+  expect_no_validation_messages();
+}
+
+// bake --light-layers on the CPU backend (Embree path tracing, the same attribution as the Vulkan
+// wavefront): the layers it writes add up to the written E/pi, a session opens them as its split,
+// and each agrees per 64-texel region with the Vulkan session's layer of the same light.
+TEST(LightLayers, TheCpuBakeWritesLayersThatAgreeWithVulkan) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  constexpr uint32_t kSamples = 32;
+  LightmapEstimate baked[2], refreshed[2];
+  for (int run = 0; run < 2; ++run) {
+    const fs::path bundle = courtyard_bundle("cpu-layers-" + std::to_string(run), {}, kSamples, [run](BakeOptions& o) {
+      o.lighting.light_layers = true;
+      o.lighting.integrator = IntegratorMode::Path;
+      o.lighting.seed = 81 + uint64_t(run);
+      o.stitch_seams = false;        // R, G, B as estimated, so that the layers add up to them
+      o.skip_sealed_texels = false;  // every texel traced, as the session traces them
+    });
+    const formats::BundleManifest manifest = read_manifest(bundle);
+    ASSERT_TRUE(manifest.light_layers.has_value());
+    auto opened = RefreshSession::open(bundle.string(), validated_options(90 + uint64_t(run)));
+    ASSERT_TRUE(opened->started_from_baked());
+    baked[run] = opened->published_lightmap();
+    auto session = open_session(courtyard_bundle("all-lights", {}), 85 + uint64_t(run), true);
+    session->refresh({0, kSamples});
+    refreshed[run] = session->lightmap();
+    ASSERT_EQ(baked[run].light_layers, refreshed[run].light_layers);
+  }
+  const size_t n = baked[0].texels.size();
+  ASSERT_EQ(refreshed[0].texels.size(), n);
+  size_t split = 0;
+  for (size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) {
+      double sum = 0, magnitude = 0;
+      int lit_by = 0;
+      for (int k = 0; k < baked[0].light_layers; ++k) {
+        const double v = baked[0].light_sums[(size_t(k) * n + i) * 3 + size_t(c)];
+        sum += v, magnitude += std::fabs(v), lit_by += v != 0;
+      }
+      EXPECT_NEAR(sum, baked[0].texels[i].total[c], 1e-5 * magnitude + 1e-12) << "texel " << i << " channel " << c;
+      split += lit_by >= 2;
+    }
+  EXPECT_GT(split, n);  // most texels' light comes from several layers
+  // Per layer, the mean of two seeds with the variance their difference gives, CPU against Vulkan.
+  auto layer_of_two = [n](const LightmapEstimate (&two)[2], int layer) {
+    std::vector<Vec3> variance(n);
+    LightmapEstimate mean = two[0];
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t samples = two[0].texels[i].samples;
+      for (int c = 0; c < 3; ++c) {
+        const size_t at = (size_t(layer) * n + i) * 3 + size_t(c);
+        const double ma = samples ? two[0].light_sums[at] / samples : 0.0, mb = samples ? two[1].light_sums[at] / samples : 0.0;
+        variance[i][c] = float((ma - mb) * (ma - mb) / 4);
+        mean.light_sums[at] = (ma + mb) / 2 * samples;
+      }
+    }
+    return layer_estimate(mean, layer, variance);
+  };
+  for (int layer = 0; layer < baked[0].light_layers; ++layer) {
+    const std::string name = "cpu layer " + std::to_string(layer);
+    testing::compare_estimates(layer_of_two(refreshed, layer), layer_of_two(baked, layer), 64, name.c_str());
+  }
   expect_no_validation_messages();
 }
 

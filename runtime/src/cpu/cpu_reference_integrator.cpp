@@ -21,6 +21,7 @@
 #include "exitance/runtime/core/svo_guiding_fields.h"
 #include "exitance/runtime/core/scene_access.h"
 #include "exitance/common/guide_learning.h"  // after scene_access.h: path.h reads its accessors
+#include "exitance/common/light_layers.h"
 #include "exitance/runtime/core/work_share.h"
 #include "exitance/runtime/embree_scene.h"
 
@@ -54,6 +55,12 @@ struct PathContributions {
   Vec3 first_factor{0, 0, 0};
   // The path's L1 coefficient along `axis` (RGB).
   Vec3 sh1(int axis) const { return texel_nee_sh1[axis] + (total() - texel_nee) * first_factor[axis]; }
+  // Light layers (light_layers.h; IntegratorSettings::light_layers): per layer the path's E/pi from
+  // that light, attributed as the Vulkan wavefront does (path.glsl, shade.comp); null: not kept.
+  Vec3* by_light = nullptr;
+  void add_light(uint32_t layer, Vec3 value) {
+    if (by_light) by_light[layer] += value;
+  }
 };
 
 // After a pass split over ranks: every rank's texels' sums (and their rays, the next split's cost)
@@ -86,10 +93,12 @@ struct CpuReferenceIntegrator::Impl {
   // Traces the shadow rays of one vertex; returns what the unoccluded ones carry. With `sh1` (a
   // directional texel's own vertex), also adds their L1 estimates there.
   // `arrived`: whether each ray arrived (unoccluded).
+  // `each`: what each ray carries (0 where it was occluded or not traced).
   Vec3 connect(const ShadowRay (&rays)[3], Vec3 origin, uint64_t& traced, const SurfacePoint& x,
-               Vec3* sh1 = nullptr, bool (*arrived)[3] = nullptr) const {
+               Vec3* sh1 = nullptr, bool (*arrived)[3] = nullptr, Vec3 (*each)[3] = nullptr) const {
     Vec3 sum{0, 0, 0};
     if (arrived) (*arrived)[0] = (*arrived)[1] = (*arrived)[2] = false;
+    if (each) (*each)[0] = (*each)[1] = (*each)[2] = Vec3{0, 0, 0};
     for (const ShadowRay& r : rays) {
       const float state = r.contribution_state.w;
       if (state == kShadowNone) continue;
@@ -99,6 +108,7 @@ struct CpuReferenceIntegrator::Impl {
       if (!embree->occluded(origin, d, r.direction_length.w)) {
         const Vec3 c{r.contribution_state.x, r.contribution_state.y, r.contribution_state.z};
         if (arrived) (*arrived)[&r - rays] = true;
+        if (each) (*each)[&r - rays] = c;
         sum += c;
         if (sh1) {
           const Vec3 f = sh1_direction_factor(x, d);
@@ -107,6 +117,12 @@ struct CpuReferenceIntegrator::Impl {
       }
     }
     return sum;
+  }
+
+  // The light layer of an emissive triangle: its material's (emission.w, lay_out_light_layers).
+  uint32_t emitter_light_layer(uint32_t triangle) const {
+    const LightingScene& s = scene();
+    return uint32_t(s.materials[floatBitsToUint(s.triangles[triangle].p0_material.w)].emission.w);
   }
 
   // What a guided vertex's continuation ray saw, as the learning target of its bin (luminance of
@@ -177,7 +193,16 @@ struct CpuReferenceIntegrator::Impl {
       EmitterLearning learning;
       next_event_estimation(s, x, origin, throughput, g, eg, rng, shadow[0], shadow[1], shadow[2], learning);
       bool arrived[3];
-      const Vec3 direct = connect(shadow, origin, rays, x, directional_texel ? out.texel_nee_sh1 : nullptr, &arrived);
+      Vec3 each[3];
+      const Vec3 direct = connect(shadow, origin, rays, x, directional_texel ? out.texel_nee_sh1 : nullptr, &arrived,
+                                  out.by_light ? &each : nullptr);
+      if (out.by_light) {  // the area sample's emitter, the punctual light chosen, the sky
+        out.add_light(learning.area_triangle != kEmitterPatchNone ? emitter_light_layer(learning.area_triangle) : kSkyLightLayer, each[0]);
+        out.add_light(learning.punctual_index != kEmitterPatchNone ? punctual_light_layer(learning.punctual_index, s.punctual_light_layers)
+                                                                     : kSkyLightLayer,
+                      each[1]);
+        out.add_light(kSkyLightLayer, each[2]);
+      }
       if (site.learns)
         emitter_guiding.cache->learn_arrived(site, learning.patch_index, learning.value, arrived[0], learning.punctual_light,
                                              learning.punctual_value, arrived[1]);
@@ -191,12 +216,16 @@ struct CpuReferenceIntegrator::Impl {
       const Hit hit = embree->intersect(origin, d.direction, INFINITY);
       guide.observe(record, g, d.direction, hit);
       if (!hit.found) {
-        out.add(bounce, ray_throughput * escaped_radiance(s, d.direction, d.pdf));
+        const Vec3 sky = ray_throughput * escaped_radiance(s, d.direction, d.pdf);
+        out.add(bounce, sky);
+        out.add_light(kSkyLightLayer, sky);
         return;
       }
       const HitResult h = shade_continuation_hit(s, hit.triangle, hit.distance, hit.b1, hit.b2, d.direction, d.pdf,
                                                  ray_throughput, bounce, limits, eg, rng);
       out.add(bounce, h.radiance);
+      if (out.by_light && (h.radiance.x != 0 || h.radiance.y != 0 || h.radiance.z != 0))
+        out.add_light(emitter_light_layer(hit.triangle), h.radiance);
       if (!h.continues) return;
       throughput = h.throughput;
       x = h.next;
@@ -265,6 +294,9 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   estimate.bounces.assign(size_t(estimate.recorded_bounces) * texel_count * 3, 0.0);
   const bool directional = settings.directional == DirectionalMode::Sh1;
   if (directional) estimate.sh1.assign(texel_count * 9, 0.0);
+  // Light layers: not gathered over ranks (as on Vulkan, LightmapDriver), so one process only.
+  estimate.light_layers = settings.light_layers && !share ? int(impl_->lighting->light_layer_count) : 0;
+  estimate.light_sums.assign(size_t(estimate.light_layers) * texel_count * 3, 0.0);
   tbb::combinable<uint64_t> rays_per_thread([] { return uint64_t(0); });
   tbb::combinable<uint64_t> nonfinite_per_thread([] { return uint64_t(0); });
   tbb::combinable<uint64_t> guided_per_thread([] { return uint64_t(0); });
@@ -349,6 +381,12 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     contributions = PathContributions{};
     contributions.recorded = estimate.recorded_bounces;
     contributions.directional = directional;
+    // This thread's per-layer scratch, cleared for each sample.
+    thread_local std::vector<Vec3> by_light;
+    if (estimate.light_layers > 0) {
+      by_light.assign(size_t(estimate.light_layers), Vec3{0, 0, 0});
+      contributions.by_light = by_light.data();
+    }
     const uint64_t rays_before = rays, guided_before = guided_vertices;
     EmitterGuidingCache* emitter_cache = emitter_guide && emitter_guide->active() ? emitter_guide.get() : nullptr;
     const EmitterGuiding emitter_guiding{emitter_cache, emitter_cache ? EmitterGuidingCache::learning(s)
@@ -382,6 +420,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     if (directional)
       for (int axis = 0; axis < 3; ++axis)
         for (int c = 0; c < 3; ++c) estimate.sh1[(i * 3 + size_t(axis)) * 3 + size_t(c)] += l1[axis][c];
+    for (int k = 0; k < estimate.light_layers; ++k)
+      for (int c = 0; c < 3; ++c) estimate.light_sums[(size_t(k) * texel_count + i) * 3 + size_t(c)] += by_light[size_t(k)][c];
     ++acc.samples;
     if (choice && !choice->decided())
       choice->record(i, s, guided_sample, luminance(total), rays - rays_before, guided_vertices - guided_before);
