@@ -123,6 +123,7 @@ int main(int argc, char** argv) {
  "instances": [{"node": 0, "name": "Floor", "mesh": 0, "page": 0, "scale_offset": [0.25, 0.25, 0.0, 0.5], "rect": [0, 0, 4, 4]}],
  "probes": {"file": "probes.bin", "origin": [0, 0, 0], "spacing": [1, 1, 1], "counts": [8, 4, 8], "sh_order": 2},
  "svo": {"file": "svo.bin", "bounds": [[0, 0, 0], [8, 8, 8]], "depth": 8},
+ "light_layers": {"count": 5, "punctual": 2, "files": ["light-layers-0.exr"], "units": "irradiance_over_pi"},
  "stats": {"seconds": {"import": 0.1}, "rays": 0}})");
   write_text(dir / "manifest" / "minimal.json", R"({"format_version": 1, "pages": [], "instances": []})");
   // EDITS.json on the sample scene's names (docs/edits.md): every kind of edit.

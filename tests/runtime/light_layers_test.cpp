@@ -594,5 +594,19 @@ TEST(LightLayers, TheCpuBakeWritesLayersThatAgreeWithVulkan) {
   expect_no_validation_messages();
 }
 
+// The layer files' channel names: exactly "layer<k>.R/G/B", k in decimal without leading zeros.
+TEST(LightLayers, ChannelNamesAreParsedStrictly) {
+  for (uint32_t k : {0u, 7u, 129u})
+    for (int c = 0; c < 3; ++c) {
+      const std::optional<LightLayerChannel> parsed = parse_light_layer_channel(light_layer_channel(k, c));
+      ASSERT_TRUE(parsed.has_value());
+      EXPECT_EQ(parsed->layer, k);
+      EXPECT_EQ(parsed->channel, c);
+    }
+  for (const char* bad : {"layer01.R", "layer1.A", "layerX.R", "layer.R", "layer1R", "layer-1.R", "layer1234567.R", "Layer1.R",
+                          "layer1.RR", "R", ""})
+    EXPECT_FALSE(parse_light_layer_channel(bad).has_value()) << bad;
+}
+
 }  // namespace
 }  // namespace exitance
