@@ -13,6 +13,8 @@
 #include <optional>
 
 #include "exitance/formats/format_error.h"
+#include "exitance/formats/probes_file.h"
+#include "exitance/runtime/bundle/probe_results.h"
 #include "exitance/formats/scene_file.h"
 #include "exitance/formats/svo_file.h"
 #include "exitance/runtime/refresh/baked_lightmap.h"
@@ -121,6 +123,17 @@ struct RefreshSession::State {
   bool previous_split_by_light = false;
   bool base_split_by_light = false;  // the same for base (a change estimate's changes go to their lights' layers)
   uint32_t proportional_split_samples = 256;  // RefreshSessionOptions::proportional_split_samples
+  // Refreshed probes (RefreshSessionOptions::refresh_probes; docs/runtime.md "Probes"): per refreshed
+  // probe its index in persisted.probes and what it showed before (at open the bundle's probes.bin),
+  // shown until the refreshed estimate has probe_switch_samples; the bake's probe_spp as the target;
+  // the measured milliseconds per probe sample that size a call's batch.
+  std::vector<size_t> probe_grid_index;
+  std::vector<std::array<float, 27>> previous_probes;
+  uint32_t probe_switch_samples = 0;
+  uint32_t probe_target = 0;
+  float probe_dering = 0;
+  double probe_budget_share = 0.25;
+  double probe_ms_per_sample = 0;
   // A bake_per_bounce(), bake_guided() or bake_path() result: lightmap() until the next restart, edit
   // or refresh.
   std::optional<LightmapEstimate> per_bounce;
@@ -239,6 +252,38 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   for (size_t i = 0; i < state->all_texels.size(); ++i) state->all_texels[i] = uint32_t(i);
   timings.indices = since();
   state->integrator->start_progressive(state->persisted.gbuffer, settings);
+  if (options.refresh_probes && state->persisted.has_probe_grid() && manifest.probes) {
+    if (!(options.probe_budget_share > 0 && options.probe_budget_share <= 1))
+      throw std::invalid_argument("RefreshSessionOptions::probe_budget_share must be in (0, 1]");
+    std::vector<Vec3> positions;
+    const std::vector<formats::ProbeRecord>& probes = state->persisted.probes.probes;
+    for (size_t i = 0; i < probes.size(); ++i)
+      if (formats::probe_is_usable(probes[i])) {
+        positions.push_back({probes[i].position[0], probes[i].position[1], probes[i].position[2]});
+        state->probe_grid_index.push_back(i);
+      }
+    state->probe_target = std::max(1u, baked.probe_spp);
+    state->probe_dering = baked.probe_dering_window;
+    state->probe_budget_share = options.probe_budget_share;
+    // What they show until refreshed: the bundle's probes.bin, as many samples as the bake gave
+    // them (none when the bundle has lost it: then the refreshed estimate from its first set).
+    state->previous_probes.assign(positions.size(), std::array<float, 27>{});
+    state->probe_switch_samples = 0;
+    const fs::path probes_file = bundle / manifest.probes->file;
+    if (fs::exists(probes_file)) {
+      try {
+        const formats::ProbeGrid baked_probes = formats::read_probes_file(probes_file.string());
+        if (baked_probes.probes.size() != probes.size())
+          throw BundleInputError(probes_file.string() + ": " + std::to_string(baked_probes.probes.size()) +
+                                 " probes, but scene.bin's probe grid has " + std::to_string(probes.size()));
+        for (size_t k = 0; k < positions.size(); ++k) state->previous_probes[k] = baked_probes.probes[state->probe_grid_index[k]].sh;
+        state->probe_switch_samples = state->probe_target;
+      } catch (const formats::FormatError& e) {
+        throw BundleInputError(e.what());
+      }
+    }
+    state->integrator->start_probe_refresh(positions);
+  }
   timings.texels = since();
   if (options.start_from_baked) {
     try {
@@ -294,6 +339,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   // lighting scene reads persisted.scene itself); nothing below throws for bad input.
   InPlaceEdits in_place = apply_scene_edits_in_place(s.persisted, edits, &s.instance_texels);
   const EditEffects& effects = in_place.effects;
+  restart_probes();
   // Edits of punctual lights alone upload the lights after the publish below, in the submission
   // that starts the accumulation again (start_progressive_change) or in one of their own.
   const bool punctual_only = !effects.geometry_changed() && effects.materials.empty() && !effects.sky && !effects.lights.empty();
@@ -424,6 +470,45 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   return effects;
 }
 
+void RefreshSession::restart_probes() {
+  State& s = *state_;
+  if (s.probe_grid_index.empty()) return;
+  // What each probe shows now is what it shows until its refreshed estimate of the edited scene has
+  // one stratified set (or the bake's probe_spp, if fewer).
+  const uint32_t switch_samples = std::min(s.probe_target, kProbeStratifiedSetSize);
+  if (s.integrator->probe_refresh_samples() > 0) {
+    const formats::ProbeGrid shown = published_probes();
+    for (size_t k = 0; k < s.probe_grid_index.size(); ++k) s.previous_probes[k] = shown.probes[s.probe_grid_index[k]].sh;
+  }
+  s.probe_switch_samples = switch_samples;
+  s.integrator->clear_probe_refresh();
+}
+
+formats::ProbeGrid RefreshSession::published_probes() const {
+  const State& s = *state_;
+  if (s.probe_grid_index.empty()) return {};
+  formats::ProbeGrid grid = s.persisted.probes;
+  for (size_t k = 0; k < s.probe_grid_index.size(); ++k) grid.probes[s.probe_grid_index[k]].sh = s.previous_probes[k];
+  if (s.integrator->probe_refresh_samples() == 0 && s.probe_switch_samples > 0) return grid;
+  // The probes whose refreshed estimate has the samples the rule asks, as probes.bin stores them.
+  const ProbeEstimate refreshed = s.integrator->probe_refresh_estimate();
+  std::vector<size_t> shown;
+  ProbeEstimate subset;
+  for (size_t k = 0; k < s.probe_grid_index.size(); ++k) {
+    if (refreshed.samples[k] == 0 || refreshed.samples[k] < s.probe_switch_samples) continue;
+    shown.push_back(s.probe_grid_index[k]);
+    subset.sh_sum.push_back(refreshed.sh_sum[k]);
+    subset.samples.push_back(refreshed.samples[k]);
+    subset.backface_hits.push_back(refreshed.backface_hits[k]);
+  }
+  store_probe_radiance(grid, shown, subset, s.probe_dering);
+  return grid;
+}
+
+uint32_t RefreshSession::probe_samples() const {
+  return state_->probe_grid_index.empty() ? 0 : state_->integrator->probe_refresh_samples();
+}
+
 void RefreshSession::end_change_estimate() {
   State& s = *state_;
   if (!s.base) return;
@@ -520,6 +605,21 @@ RefreshReport RefreshSession::refresh(const RefreshBudget& budget) {
   const uint32_t cap = budget.max_samples_per_texel ? budget.max_samples_per_texel : std::numeric_limits<uint32_t>::max();
   RefreshReport report;
   auto elapsed_ms = [&] { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); };
+  // Probes first (a frame's budget: the lightmap's passes are sized from what is left): a stratified
+  // set for as many of the next probes as fit their share of the budget, by the measured cost.
+  if (budget.milliseconds > 0 && !s.probe_grid_index.empty() && integrator.probe_refresh_samples() < s.probe_target) {
+    const uint32_t set = std::min(kProbeStratifiedSetSize, s.probe_target);
+    const double share = s.probe_budget_share * budget.milliseconds;
+    // Unmeasured: 16 probes, to measure; at least one probe a call, so probes always progress.
+    const size_t fitting = s.probe_ms_per_sample > 0 ? std::max<size_t>(1, size_t(share / (s.probe_ms_per_sample * set))) : 16;
+    const auto probes_start = Clock::now();
+    size_t refreshed = 0;
+    report.probe_rays = integrator.refresh_probe_set(s.settings, s.probe_target, fitting, &refreshed);
+    report.probes_refreshed = uint32_t(refreshed);
+    const double ms = std::chrono::duration<double, std::milli>(Clock::now() - probes_start).count();
+    if (refreshed > 0) s.probe_ms_per_sample = ms / (double(refreshed) * set);
+  }
+  report.probe_samples = s.probe_grid_index.empty() ? 0 : integrator.probe_refresh_samples();
   const uint32_t samples_before = samples_per_texel();
   uint64_t used = 0;  // texel-samples
   for (;;) {

@@ -230,6 +230,29 @@ ExitanceRuntimeError exitance_runtime_read_page_channel(ExitanceRuntime* runtime
   });
 }
 
+ExitanceRuntimeError exitance_runtime_probe_count(const ExitanceRuntime* runtime, uint32_t* out_count) {
+  return guarded("exitance_runtime_probe_count", [&] {
+    require(runtime != nullptr && out_count != nullptr, "runtime or out_count is NULL");
+    const PersistedScene& persisted = runtime->session->persisted();
+    *out_count = persisted.has_probe_grid() && runtime->session->manifest().probes ? uint32_t(persisted.probes.probes.size()) : 0u;
+  });
+}
+
+ExitanceRuntimeError exitance_runtime_read_probes(ExitanceRuntime* runtime, float* out_sh, uint32_t count, uint32_t* out_samples) {
+  return guarded("exitance_runtime_read_probes", [&] {
+    require(runtime != nullptr && (out_sh != nullptr || count == 0), "runtime or out_sh is NULL");
+    const formats::ProbeGrid grid = runtime->session->published_probes();
+    if (count != grid.probes.size())
+      throw std::invalid_argument("count " + std::to_string(count) + " is not the bundle's " + std::to_string(grid.probes.size()) +
+                                  " probes (exitance_runtime_probe_count)");
+    for (size_t i = 0; i < grid.probes.size(); ++i) {
+      const bool used = formats::probe_is_usable(grid.probes[i]);
+      for (size_t k = 0; k < 27; ++k) out_sh[i * 27 + k] = used ? grid.probes[i].sh[k] : 0.0f;
+    }
+    if (out_samples) *out_samples = runtime->session->probe_samples();
+  });
+}
+
 ExitanceRuntimeError exitance_runtime_vulkan_device(const ExitanceRuntime* runtime, ExitanceRuntimeVulkanDevice* out_device) {
   return guarded("exitance_runtime_vulkan_device", [&] {
     require(runtime != nullptr && out_device != nullptr, "runtime or out_device is NULL");

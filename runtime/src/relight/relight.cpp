@@ -70,6 +70,8 @@ json relight_bundle(const RelightOptions& options) {
     throw RelightInputError("--light-layers and --no-light-layers contradict each other");
   session_options.light_layers = options.light_layers && (options.whole_run_light_layers || options.frames > 0 ||
                                                           options.frame_budget_ms > 0 || options.samples_before_edits > 0);
+  // Probes are refreshed in frames (a whole run bakes them once, for the bundle it writes).
+  session_options.refresh_probes = options.frames > 0 || options.frame_budget_ms > 0;
   session_options.device.device_index = options.device_index;
   session_options.device.validation = options.validation;
   session_options.device.collect_stage_statistics = options.stage_statistics;
@@ -181,6 +183,8 @@ json relight_bundle(const RelightOptions& options) {
       // Per-frame figures cost a read-back of the sums, outside the frame's time.
       json entry = {{"frame", frame}, {"milliseconds", r.milliseconds}, {"rays", r.rays},
                     {"samples_added", r.samples_added}, {"samples_per_texel", r.samples_per_texel}};
+      if (r.probes_refreshed > 0 || r.probe_samples > 0)
+        entry["probes"] = {{"refreshed", r.probes_refreshed}, {"rays", r.probe_rays}, {"samples", r.probe_samples}};
       if (options.page_images) {  // what an engine's frame adds to hand the pages over on the device
         const auto images_start = Clock::now();
         session->publish_page_images(session->page_dilation_texels());

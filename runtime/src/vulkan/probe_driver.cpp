@@ -9,13 +9,6 @@
 #include "exitance/runtime/core/work_share.h"
 
 namespace exitance::vulkan {
-namespace {
-
-// Per work item: 2 result slots (12 bytes each), then albedo and direction (24 bytes).
-constexpr size_t kProbeResultBytes = 48;
-
-}  // namespace
-
 // Start points with the position only, and the work list: the probes [first, end) in order.
 void ProbeDriver::upload_probes(const std::vector<Vec3>& positions, size_t first, size_t end) {
   Context& context = runner_.context();

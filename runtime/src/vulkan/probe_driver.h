@@ -11,6 +11,9 @@
 
 namespace exitance::vulkan {
 
+// Per probe work item: 2 result slots (12 bytes each), then albedo and direction (24 bytes).
+inline constexpr size_t kProbeResultBytes = 48;
+
 class ProbeDriver {
  public:
   explicit ProbeDriver(WavefrontBatchRunner& runner) : runner_(runner) {}

@@ -17,6 +17,7 @@
 #include "lightmap_page_images.h"
 #include "lightmap_driver.h"
 #include "probe_driver.h"
+#include "probe_refresh.h"
 #include "traversal_benchmark.h"
 #include "vulkan_context.h"
 #include "wavefront_batch.h"
@@ -50,6 +51,7 @@ struct VulkanIntegrator::Impl {
   WavefrontBatchRunner runner;
   LightmapDriver lightmap;
   ProbeDriver probes;
+  ProbeRefresh probe_refresh;
   std::optional<LightmapPublisher> publisher;  // made at the first publish or upload
   std::optional<LightLayerScaler> scaler;      // made at the first scaling edit
   std::unique_ptr<LightmapPageImages> page_images;  // made at the first write_page_images
@@ -73,6 +75,7 @@ struct VulkanIntegrator::Impl {
         runner(context, scene, kernels, buffers, statistics, sizes, options.collect_stage_statistics),
         lightmap(runner),
         probes(runner),
+        probe_refresh(runner),
         source(lighting.source),
         created_on(std::move(lighting_ptr)) {
     runner.bind_buffers();
@@ -115,6 +118,15 @@ ProbeEstimate VulkanIntegrator::bake_probes(const std::vector<Vec3>& positions, 
     throw std::invalid_argument("Vulkan backend: probes with spp 0 need a time budget");
   return impl_->probes.bake(positions, settings);
 }
+
+void VulkanIntegrator::start_probe_refresh(const std::vector<Vec3>& positions) { impl_->probe_refresh.start(positions); }
+void VulkanIntegrator::clear_probe_refresh() { impl_->probe_refresh.clear(); }
+uint64_t VulkanIntegrator::refresh_probe_set(const IntegratorSettings& settings, uint32_t target_samples, size_t max_probes,
+                                             size_t* refreshed) {
+  return impl_->probe_refresh.add_set(settings, target_samples, max_probes, refreshed);
+}
+ProbeEstimate VulkanIntegrator::probe_refresh_estimate() const { return impl_->probe_refresh.read(); }
+uint32_t VulkanIntegrator::probe_refresh_samples() const { return impl_->probe_refresh.least_samples(); }
 
 void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, bool texels_as_before,
                                          bool accumulation_cleared) {

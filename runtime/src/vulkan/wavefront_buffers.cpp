@@ -120,7 +120,9 @@ WavefrontBuffers::WavefrontBuffers(Context& context, uint32_t path_count)
       items(context),
       results(context),
       texels(context),
-      probes(context) {}
+      probes(context),
+      refresh_probe_items(context),
+      refresh_probe_sums(context) {}
 
 void WavefrontBuffers::bind(DescriptorWrites& writes) const {
   control.bind(writes);
@@ -128,10 +130,10 @@ void WavefrontBuffers::bind(DescriptorWrites& writes) const {
   rays.bind(writes);
   shadows.bind(writes);
   dispatches.bind(writes);
-  items.bind(writes);
+  (probe_refresh_bound ? refresh_probe_items : items).bind(writes);
   results.bind(writes);
   texels.bind(writes);
-  probes.bind(writes);
+  (probe_refresh_bound ? refresh_probe_sums : probes).bind(writes);
 }
 
 }  // namespace exitance::vulkan

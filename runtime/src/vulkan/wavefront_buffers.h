@@ -143,6 +143,12 @@ struct WavefrontBuffers {
   SampleResults results;
   TexelAccumulators texels;
   ProbeAccumulators probes;
+  // The runtime's progressive probes (probe_refresh.h): their own items and sums, so that refreshing
+  // them between lightmap passes neither uploads the texels' start points again nor touches a
+  // whole-run probe bake's sums. Bound instead of `items` and `probes` while `probe_refresh_bound`.
+  WorkItems refresh_probe_items;
+  ProbeAccumulators refresh_probe_sums;
+  bool probe_refresh_bound = false;
 
   WavefrontBuffers(Context& context, uint32_t path_count);
   void bind(DescriptorWrites& writes) const;

@@ -107,6 +107,16 @@ ExitanceRuntimeError exitance_runtime_read_page(ExitanceRuntime* runtime, uint32
 ExitanceRuntimeError exitance_runtime_read_page_channel(ExitanceRuntime* runtime, uint32_t page, const char* channel,
                                                         float* out_values, uint32_t width, uint32_t height);
 
+/* Light probes as they show now, refreshed in the frames of exitance_runtime_refresh (docs/runtime.md
+ * "Probes"): the bundle's probe grid in probes.bin's order (docs/bundle.md), 27 floats per probe, the
+ * L2 SH of incident radiance (coefficient i, channel c at [i * 3 + c]; 0 for probes not in use).
+ * out_count: the grid's probes, 0 when the bundle has none. `count` must equal it; out_sh holds
+ * 27 * count floats. out_samples (may be NULL): the fewest refreshed samples of a probe since the
+ * last edit. Reads the probes back from the device. */
+ExitanceRuntimeError exitance_runtime_probe_count(const ExitanceRuntime* runtime, uint32_t* out_count);
+ExitanceRuntimeError exitance_runtime_read_probes(ExitanceRuntime* runtime, float* out_sh, uint32_t count,
+                                                  uint32_t* out_samples);
+
 /* Writes the refreshed bundle (lightmaps, probes, voxel exitance, the edited scene.bin) to
  * `output_folder` atomically; the loader (exitance_loader.h) opens it. */
 ExitanceRuntimeError exitance_runtime_write_bundle(ExitanceRuntime* runtime, const char* output_folder);

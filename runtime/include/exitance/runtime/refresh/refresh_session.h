@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "exitance/formats/bundle_manifest.h"
+#include "exitance/formats/probe_grid.h"
 #include "exitance/formats/scene_file.h"
 #include "exitance/formats/sparse_voxel_octree.h"
 #include "exitance/runtime/core/estimates.h"
@@ -63,6 +64,12 @@ struct RefreshSessionOptions {
   // accumulation's split, once the accumulation has this many samples per texel (its split is
   // noisy before); with fewer, such an edit takes the other paths (a change estimate, a restart).
   uint32_t proportional_split_samples = 256;
+  // Refresh the bundle's light probes in the same frames (docs/runtime.md "Probes"): each refresh
+  // call with a time budget gives the next batch of probes a stratified set of samples (at most
+  // `probe_budget_share` of the budget, from the measured cost), up to the bake's probe_spp, and
+  // every edit starts them again; published_probes() shows them. Off: probes stay as baked.
+  bool refresh_probes = true;
+  double probe_budget_share = 0.25;
 };
 
 // Edits that change at most this many punctual lights (counted against the base) are estimated as
@@ -88,6 +95,9 @@ struct RefreshReport {
   uint32_t samples_per_texel = 0;   // every texel has at least this many since the last edit or restart
   uint32_t prioritized_texels = 0;  // texels near the last edit that this call refreshed first (0: none)
   bool capped = false;              // the sample cap is reached: further calls add nothing
+  uint64_t probe_rays = 0;          // this call's probe samples' rays (not in `rays`)
+  uint32_t probes_refreshed = 0;    // probes that got a stratified set this call
+  uint32_t probe_samples = 0;       // every probe has at least this many since the last edit (or open)
 };
 
 // Where the last RefreshSession::apply_edits call spent its time, in milliseconds (benchmarks).
@@ -216,8 +226,17 @@ class RefreshSession {
   // estimates r^2 without the noise m^2 carries). Texels with fewer than 2 samples are left out;
   // infinity when no texel has 2.
   static double estimated_relative_mse(const LightmapEstimate& estimate);
-  // The probes' incident radiance (usable probes of the grid, in grid order) with `spp` rays each.
+  // The probes' incident radiance (usable probes of the grid, in grid order) with `spp` rays each:
+  // a whole run of its own (write_refreshed_bundle), not the refreshed probes below.
   ProbeEstimate probe_estimate(uint32_t spp);
+  // The probe grid as probes.bin stores it (docs/bundle.md), with what the probes show now: per
+  // usable probe, the refreshed estimate once it has the samples the publishing rule asks
+  // (docs/runtime.md "Probes": after an edit, one stratified set or the bake's probe_spp if fewer;
+  // at open, as many as the bundle's own), else what it showed before (at open the bundle's
+  // probes.bin). Empty (no probes) when the bundle has no probe grid. A read-back of the probes' sums.
+  formats::ProbeGrid published_probes() const;
+  // Probes refreshed since the last edit (or open), and the fewest samples one of them has.
+  uint32_t probe_samples() const;
 
   const std::string& bundle() const;
   const formats::BundleManifest& manifest() const;
@@ -235,6 +254,8 @@ class RefreshSession {
  private:
   explicit RefreshSession(std::unique_ptr<State> state);
   void end_change_estimate();
+  // An edit: what probes show is kept as what they showed before, and their refresh starts again.
+  void restart_probes();
   // `texels_as_before`: the G-buffer's texels are those of the accumulation's last start (no
   // instance moved): not uploaded again.
   void restart(bool texels_as_before);

@@ -126,6 +126,20 @@ class VulkanIntegrator final : public Integrator {
   ProbeEstimate bake_probes(const std::vector<Vec3>& positions, const IntegratorSettings& settings) const override;
   std::string backend_name() const override { return "vulkan"; }
 
+  // Progressive probes kept on the device (the runtime's refresh; vulkan/probe_refresh.h): the same
+  // estimator and random streams as bake_probes, a stratified set (kProbeStratifiedSetSize samples)
+  // of the next batch of probes per refresh_probe_set call, round robin, up to `target_samples` each,
+  // so that N samples of a probe are bake_probes' N samples with the same seed. Their own buffers:
+  // bake_probes and the lightmap's accumulation do not disturb them, nor they those. start clears
+  // the sums; clear_probe_refresh clears them again (an edit). Settings used as by bake_probes.
+  void start_probe_refresh(const std::vector<Vec3>& positions);
+  void clear_probe_refresh();
+  // At most `max_probes` probes (0: as many as one batch holds); `refreshed`: how many got their set.
+  uint64_t refresh_probe_set(const IntegratorSettings& settings, uint32_t target_samples, size_t max_probes = 0,
+                             size_t* refreshed = nullptr);
+  ProbeEstimate probe_refresh_estimate() const;  // a read-back
+  uint32_t probe_refresh_samples() const;         // the fewest samples of a probe
+
   // Progressive accumulation kept on the device between calls (the runtime's refresh). start
   // uploads the texels and clears their sums; add_samples adds `samples` to every texel, sample
   // indices continuing from the last call (so N samples in any number of calls are bake()'s N

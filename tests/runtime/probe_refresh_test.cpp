@@ -1,0 +1,155 @@
+// The runtime's refreshed light probes (docs/runtime.md "Probes", vulkan/probe_refresh.h) on
+// lavapipe with validation: refreshed in the frames of RefreshSession::refresh, a stratified set of
+// a batch of probes per call, they add up to the whole-run probe bake with the same seed (the same
+// paths, summed in the same order); an edit keeps what probes showed until their refreshed estimate
+// of the edited scene has its set, which then equals a whole-run bake of the edited scene. The C API
+// reads them.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "exitance/bake/command/bake_pipeline.h"
+#include "exitance/formats/probe_grid.h"
+#include "exitance/runtime/bundle/probe_results.h"
+#include "exitance/runtime/exitance_runtime.h"
+#include "exitance/runtime/refresh/refresh_session.h"
+#include "support/vulkan_device_available.h"
+
+namespace exitance {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::has_vulkan_device;
+
+constexpr uint32_t kProbeSpp = 64;  // one stratified set (kProbeStratifiedSetSize is 256)
+
+// The Cornell room with a coarse probe grid, its probes baked at kProbeSpp on the CPU.
+fs::path probe_bundle() {
+  static const fs::path bundle = [] {
+    const fs::path dir = fs::temp_directory_path() / ("exitance-probe-refresh-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    BakeOptions options;
+    options.input = (fs::path(EXITANCE_SAMPLE_DIR) / "cornell_room.gltf").string();
+    options.output = (dir / "cornell.bake").string();
+    options.backend.name = "cpu";
+    options.atlas.texel_density = 2.0f;
+    options.lighting.spp = 4;
+    options.lighting.seed = 3;
+    options.probe_spacing = 1.0f;
+    options.probe_spp = kProbeSpp;
+    options.svo_enabled = false;
+    Diagnostics diagnostics;
+    run_bake(options, diagnostics);
+    return fs::path(options.output);
+  }();
+  return bundle;
+}
+
+std::vector<std::string>& validation_messages() {
+  static std::vector<std::string> messages;
+  return messages;
+}
+
+std::unique_ptr<RefreshSession> open_session(uint64_t seed) {
+  RefreshSessionOptions options;
+  options.seed = seed;
+  options.device.validation = true;
+  options.device.on_validation_message = [](const std::string& m) { validation_messages().push_back(m); };
+  return RefreshSession::open(probe_bundle().string(), options);
+}
+
+// Frames of a generous budget until every probe has kProbeSpp refreshed samples.
+void refresh_probes(RefreshSession& session) {
+  for (int frame = 0; frame < 200 && session.probe_samples() < kProbeSpp; ++frame) {
+    RefreshBudget budget;
+    budget.milliseconds = 2000;
+    budget.max_samples_per_texel = 1;  // the lightmap's part stays small
+    const RefreshReport report = session.refresh(budget);
+    EXPECT_GT(report.probes_refreshed, 0u) << "frame " << frame;
+  }
+  ASSERT_EQ(session.probe_samples(), kProbeSpp);
+}
+
+// The grid a whole-run probe bake of the session's scene gives, as probes.bin stores it.
+formats::ProbeGrid whole_run_probes(RefreshSession& session) {
+  formats::ProbeGrid grid = session.persisted().probes;
+  std::vector<size_t> traced;
+  for (size_t i = 0; i < grid.probes.size(); ++i)
+    if (formats::probe_is_usable(grid.probes[i])) traced.push_back(i);
+  store_probe_radiance(grid, traced, session.probe_estimate(kProbeSpp), 0.0f);
+  return grid;
+}
+
+void expect_same_probes(const formats::ProbeGrid& a, const formats::ProbeGrid& b, const char* what) {
+  ASSERT_EQ(a.probes.size(), b.probes.size()) << what;
+  size_t lit = 0;
+  for (size_t i = 0; i < a.probes.size(); ++i)
+    for (size_t k = 0; k < 27; ++k) {
+      EXPECT_NEAR(a.probes[i].sh[k], b.probes[i].sh[k], 1e-6f * std::fabs(b.probes[i].sh[k]) + 1e-9f)
+          << what << ": probe " << i << " coefficient " << k;
+      lit += b.probes[i].sh[k] != 0;
+    }
+  EXPECT_GT(lit, a.probes.size()) << what;
+}
+
+TEST(ProbeRefresh, FramesAddUpToTheWholeRunBake) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  auto session = open_session(21);
+  const formats::ProbeGrid at_open = session->published_probes();
+  ASSERT_FALSE(at_open.probes.empty());
+  refresh_probes(*session);
+  expect_same_probes(session->published_probes(), whole_run_probes(*session), "refreshed at open");
+  // At open the refreshed probes replaced the bundle's only at as many samples as it has: not before.
+  for (const std::string& m : validation_messages()) ADD_FAILURE() << "validation: " << m;
+  validation_messages().clear();
+}
+
+TEST(ProbeRefresh, AnEditShowsThePreviousProbesUntilTheirSetIsDone) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  auto session = open_session(22);
+  refresh_probes(*session);
+  const formats::ProbeGrid before = session->published_probes();
+  session->apply_edits(parse_scene_edits(R"({"edits": [{"material": "CeilingLight", "emissiveFactor": [0.6, 0.85, 1.0]}]})", "bluer.json"));
+  EXPECT_EQ(session->probe_samples(), 0u);
+  expect_same_probes(session->published_probes(), before, "right after the edit");
+  // A frame that refreshes one probe: it alone shows the edited scene.
+  RefreshBudget small;
+  small.milliseconds = 1e-3;
+  small.max_samples_per_texel = 1;
+  session->refresh(small);
+  refresh_probes(*session);
+  const formats::ProbeGrid after = session->published_probes();
+  expect_same_probes(after, whole_run_probes(*session), "refreshed after the edit");
+  double changed = 0;
+  for (size_t i = 0; i < after.probes.size(); ++i) changed += std::fabs(after.probes[i].sh[0] - before.probes[i].sh[0]);
+  EXPECT_GT(changed, 0.0);
+
+  // The C API reads the same grid; a wrong count is one line and changes nothing.
+  ExitanceRuntime* runtime = nullptr;
+  ASSERT_EQ(exitance_runtime_open(probe_bundle().string().c_str(), nullptr, &runtime), EXITANCE_RUNTIME_OK);
+  uint32_t count = 0;
+  ASSERT_EQ(exitance_runtime_probe_count(runtime, &count), EXITANCE_RUNTIME_OK);
+  EXPECT_EQ(count, uint32_t(after.probes.size()));
+  std::vector<float> sh(size_t(count) * 27, -1.0f);
+  EXPECT_EQ(exitance_runtime_read_probes(runtime, sh.data(), count + 1, nullptr), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(exitance_runtime_last_error_message()).find("probe_count"), std::string::npos) << exitance_runtime_last_error_message();
+  EXPECT_EQ(sh[0], -1.0f);
+  uint32_t samples = 99;
+  ASSERT_EQ(exitance_runtime_read_probes(runtime, sh.data(), count, &samples), EXITANCE_RUNTIME_OK);
+  EXPECT_EQ(samples, 0u);  // nothing refreshed yet: the bundle's probes
+  size_t nonzero = 0;
+  for (float v : sh) nonzero += v != 0;
+  EXPECT_GT(nonzero, size_t(count));
+  exitance_runtime_release(runtime);
+  for (const std::string& m : validation_messages()) ADD_FAILURE() << "validation: " << m;
+  validation_messages().clear();
+}
+
+}  // namespace
+}  // namespace exitance
