@@ -1,0 +1,24 @@
+#!/bin/bash
+# Here (the build machine): the building at 12 texels/m with its probes (864 in the grid, 695 in
+# use, 512 spp each on the CPU; 1 spp of lightmap: the GPU run lights it itself), the runtime
+# folder, bench_edit_cost and the intensity edit and its undoing, into .replay/probe_refresh.txz for
+# bench/probe_refresh_gpu_run.sh.
+#   bash bench/probe_refresh_gpu_pack.sh BUILD_DIR [BAKED_BUILDING_WITH_PROBES]
+set -e
+build=${1:-build}
+work=$(mktemp -d)
+building=${2:-}
+[ -n "$building" ] || { building=$work/building.bake;
+  $build/bake/bake $build/samples/building.gltf -o $building --texel-density 12 --backend cpu --spp 1 \
+    --voxel-resolution none --no-cache > /dev/null; }
+mkdir -p $work/pack/building.bake
+cp $building/{manifest.json,scene.bin,probes.bin} $work/pack/building.bake/
+cmake --install $build --component runtime --prefix $work/pack/runtime > /dev/null
+cp $build/bench/bench_edit_cost $work/pack/
+cp bench/refresh_double_light.json $work/pack/double.json
+cp bench/refresh_double_light_back.json $work/pack/double_back.json
+mkdir -p .replay
+tar -C $work/pack -cf - . | xz -2 -T2 > .replay/probe_refresh.txz
+cp bench/probe_refresh_gpu_run.sh .replay/
+rm -rf $work
+ls -la .replay/probe_refresh.txz
