@@ -15,6 +15,10 @@
 
 #include "exitance/bake/command/bake_pipeline.h"
 #include "exitance/formats/probe_grid.h"
+#include "exitance/formats/svo_file.h"
+#include "exitance/runtime/refresh/refreshed_bundle.h"
+
+#include <nlohmann/json.hpp>
 #include "exitance/runtime/bundle/probe_results.h"
 #include "exitance/runtime/exitance_runtime.h"
 #include "exitance/runtime/refresh/refresh_session.h"
@@ -43,7 +47,7 @@ fs::path probe_bundle() {
     options.lighting.seed = 3;
     options.probe_spacing = 1.0f;
     options.probe_spp = kProbeSpp;
-    options.svo_enabled = false;
+    options.voxel_resolution = 16;
     Diagnostics diagnostics;
     run_bake(options, diagnostics);
     return fs::path(options.output);
@@ -149,6 +153,31 @@ TEST(ProbeRefresh, AnEditShowsThePreviousProbesUntilTheirSetIsDone) {
   exitance_runtime_release(runtime);
   for (const std::string& m : validation_messages()) ADD_FAILURE() << "validation: " << m;
   validation_messages().clear();
+}
+
+// The voxel exitance of what texels show, read without writing a bundle: what write_refreshed_bundle
+// writes into svo.bin, before and after an edit.
+TEST(ProbeRefresh, VoxelExitanceIsReadableBetweenBundles) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  auto session = open_session(23);
+  session->apply_edits(parse_scene_edits(R"({"edits": [{"material": "CeilingLight", "emissiveFactor": [0.6, 0.85, 1.0]}]})", "bluer.json"));
+  RefreshBudget budget;
+  budget.max_samples_per_texel = 8;
+  session->refresh(budget);
+  const std::optional<formats::SparseVoxelOctree> shown = session->published_voxel_exitance();
+  ASSERT_TRUE(shown.has_value());
+  const fs::path out = probe_bundle().parent_path() / "voxels.bake";
+  write_refreshed_bundle(*session, out.string(), nlohmann::json::object());
+  const formats::SparseVoxelOctree written = formats::read_svo_file((out / "svo.bin").string());
+  ASSERT_EQ(shown->nodes.size(), written.nodes.size());
+  EXPECT_EQ(shown->exitance_scale, written.exitance_scale);
+  size_t lit = 0;
+  for (size_t i = 0; i < written.nodes.size(); ++i)
+    for (size_t k = 0; k < 6; ++k) {
+      EXPECT_EQ(shown->nodes[i].exitance[k], written.nodes[i].exitance[k]) << "node " << i << " side " << k;
+      lit += written.nodes[i].exitance[k] != 0;
+    }
+  EXPECT_GT(lit, 0u);
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "exitance/formats/format_error.h"
 #include "exitance/formats/probes_file.h"
 #include "exitance/runtime/bundle/probe_results.h"
+#include "exitance/runtime/bundle/texel_exitance.h"
 #include "exitance/formats/scene_file.h"
 #include "exitance/formats/svo_file.h"
 #include "exitance/runtime/refresh/baked_lightmap.h"
@@ -503,6 +504,14 @@ formats::ProbeGrid RefreshSession::published_probes() const {
   }
   store_probe_radiance(grid, shown, subset, s.probe_dering);
   return grid;
+}
+
+std::optional<formats::SparseVoxelOctree> RefreshSession::published_voxel_exitance() const {
+  const State& s = *state_;
+  if (!s.svo) return std::nullopt;
+  formats::SparseVoxelOctree svo = *s.svo;
+  fill_svo_exitance(svo, s.persisted.scene, s.persisted.gbuffer, published_lightmap());
+  return svo;
 }
 
 uint32_t RefreshSession::probe_samples() const {

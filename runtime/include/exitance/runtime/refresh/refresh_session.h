@@ -13,8 +13,8 @@
 // until they catch up; each texel's samples are still a bake's samples 0..N-1. What a texel shows
 // (published_lightmap) is its value from before the edit (at open: the bundle's baked lightmap)
 // until the refreshed estimate has the lower estimated error (refresh/published_estimate.h).
-// Probes and voxel exitance are computed on request (probe_estimate, fill_svo_exitance), not per
-// frame yet.
+// Probes are refreshed in the same calls (published_probes; docs/runtime.md "Probes"); the voxel
+// exitance is computed from what texels show, on request (published_voxel_exitance).
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -237,6 +237,11 @@ class RefreshSession {
   formats::ProbeGrid published_probes() const;
   // Probes refreshed since the last edit (or open), and the fewest samples one of them has.
   uint32_t probe_samples() const;
+  // The bundle's sparse voxel octree with the radiant exitance of what texels show now
+  // (published_lightmap; fill_svo_exitance, as write_refreshed_bundle writes svo.bin), without
+  // writing a bundle; nullopt when the bundle has no svo.bin. A read-back and a host pass over the
+  // texels (0.1 s at 1 M texels on the H200's host: bench/results/host-stages.md).
+  std::optional<formats::SparseVoxelOctree> published_voxel_exitance() const;
 
   const std::string& bundle() const;
   const formats::BundleManifest& manifest() const;
