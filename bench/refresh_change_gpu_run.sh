@@ -6,8 +6,11 @@
 # REPS, first what the edit costs alone (`seconds.edits`, `edits.milliseconds`, waited submissions),
 # REPS one-frame runs per edit; with COST_REPS, bench_edit_cost on each lit bundle (the edit and the
 # one undoing it in turn, COST_REPS rounds each, one sample refreshed after each edit).
+# Mode "warm": the session refreshes WARM (16) samples per texel in 16 ms frames before the edit, as an
+# engine's session has when an edit comes (its passes are measured: the first frame after the edit
+# is sized, not a one-sample measurement).
 # Env: BUNDLES (building city), EDITS (move double block; sun is the courtyard's), FRAMES (1 6 60),
-# MODES (change restart), REPS (0), COST_REPS (0).
+# MODES (change restart warm), REPS (0), COST_REPS (0), WARM (16).
 # Writes $OUT/summary.txt.
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
@@ -41,7 +44,8 @@ for e in ${EDITS:-move double block}; do
   list=""
   for f in ${FRAMES:-1 6 60}; do
     for mode in ${MODES:-change restart}; do
-      flag=""; [ $mode = restart ] && flag=--ignore-baked
+      flag=""
+      case $mode in restart) flag=--ignore-baked;; warm) flag="--spp-before-edits ${WARM:-16}";; esac
       o=${e}_${mode}_$f
       $R $W/base.bake -o $W/$o.bake --edits $W/$e.json --spp 4096 --frames $f --budget-ms 16 --seed 3 --no-frame-errors $flag --json > $W/$o.json
       report $W/$o.json $o
