@@ -59,9 +59,19 @@ struct RefreshSession::State {
     // beyond it (without, that part also carries the fixed cost, and the next pass is sized small).
     double known_fixed_ms = 0;
     void add(double work, double ms) {
+      bool refitted = false;
       if (last_work > 0 && work != last_work) {
         const double slope = (ms - last_ms) / (work - last_work), intercept = ms - slope * work;
-        if (slope > 0 && intercept >= 0) fixed_ms = intercept, ms_per_work = slope, fitted = true;
+        if (slope > 0 && intercept >= 0) fixed_ms = intercept, ms_per_work = slope, fitted = refitted = true;
+      }
+      if (fitted && !refitted) {
+        // No new slope (the same size again, or two sizes that give none): the fit is moved through
+        // this pass, so that a fit from two noisy passes (a process's first passes, at low clocks)
+        // does not hold for as long as the sizes repeat (it held the courtyard's frames after a sun
+        // edit at 2 samples where 14 fit).
+        const double intercept = ms - ms_per_work * work;
+        if (intercept >= 0) fixed_ms = intercept;
+        else fixed_ms = 0, ms_per_work = ms / work;
       }
       if (!fitted) {
         fixed_ms = ms > 2 * known_fixed_ms ? known_fixed_ms : 0;
