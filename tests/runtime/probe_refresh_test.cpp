@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -150,6 +151,22 @@ TEST(ProbeRefresh, AnEditShowsThePreviousProbesUntilTheirSetIsDone) {
   size_t nonzero = 0;
   for (float v : sh) nonzero += v != 0;
   EXPECT_GT(nonzero, size_t(count));
+  // The probes' share of a frame: outside [0, 1] refused in one line; 0 refreshes none.
+  EXPECT_EQ(exitance_runtime_set_probe_budget_share(runtime, 1.5), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(exitance_runtime_last_error_message()).find("not in [0, 1]"), std::string::npos);
+  EXPECT_EQ(exitance_runtime_set_probe_budget_share(runtime, NAN), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+  ASSERT_EQ(exitance_runtime_set_probe_budget_share(runtime, 0.0), EXITANCE_RUNTIME_OK);
+  ExitanceRefreshReport frame;
+  ASSERT_EQ(exitance_runtime_refresh(runtime, 500.0, 1, &frame), EXITANCE_RUNTIME_OK);
+  ASSERT_EQ(exitance_runtime_read_probes(runtime, sh.data(), count, &samples), EXITANCE_RUNTIME_OK);
+  EXPECT_EQ(samples, 0u);
+  ASSERT_EQ(exitance_runtime_set_probe_budget_share(runtime, 1.0), EXITANCE_RUNTIME_OK);
+  const std::vector<float> baked = sh;
+  ASSERT_EQ(exitance_runtime_refresh(runtime, 500.0, 1, &frame), EXITANCE_RUNTIME_OK);
+  ASSERT_EQ(exitance_runtime_read_probes(runtime, sh.data(), count, &samples), EXITANCE_RUNTIME_OK);
+  size_t replaced = 0;  // probes whose set is done show the refreshed estimate (the bundle's was baked on the CPU)
+  for (size_t i = 0; i < count; ++i) replaced += std::memcmp(&sh[i * 27], &baked[i * 27], 27 * sizeof(float)) != 0;
+  EXPECT_GT(replaced, 0u);
   exitance_runtime_release(runtime);
   for (const std::string& m : validation_messages()) ADD_FAILURE() << "validation: " << m;
   validation_messages().clear();
@@ -178,6 +195,26 @@ TEST(ProbeRefresh, VoxelExitanceIsReadableBetweenBundles) {
       lit += written.nodes[i].exitance[k] != 0;
     }
   EXPECT_GT(lit, 0u);
+}
+
+// An edit while only some probes show their refreshed estimate keeps exactly what each showed.
+TEST(ProbeRefresh, AnEditKeepsWhatEachProbeShowed) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  auto session = open_session(24);
+  const formats::ProbeGrid baked = session->published_probes();
+  RefreshBudget budget;
+  budget.milliseconds = 2000;
+  budget.max_samples_per_texel = 1;
+  const RefreshReport frame = session->refresh(budget);  // the first batch: 16 probes, unmeasured
+  ASSERT_GT(frame.probes_refreshed, 0u);
+  ASSERT_EQ(session->probe_samples(), 0u) << "every probe refreshed: the test needs a partial batch";
+  const formats::ProbeGrid shown = session->published_probes();
+  size_t replaced = 0;
+  for (size_t i = 0; i < shown.probes.size(); ++i) replaced += shown.probes[i].sh != baked.probes[i].sh;
+  EXPECT_EQ(replaced, size_t(frame.probes_refreshed));
+  session->apply_edits(parse_scene_edits(R"({"edits": [{"material": "CeilingLight", "emissiveFactor": [0.6, 0.85, 1.0]}]})", "bluer.json"));
+  const formats::ProbeGrid kept = session->published_probes();
+  for (size_t i = 0; i < kept.probes.size(); ++i) EXPECT_EQ(kept.probes[i].sh, shown.probes[i].sh) << "probe " << i;
 }
 
 }  // namespace

@@ -487,7 +487,7 @@ void RefreshSession::restart_probes() {
   // What each probe shows now is what it shows until its refreshed estimate of the edited scene has
   // one stratified set (or the bake's probe_spp, if fewer).
   const uint32_t switch_samples = std::min(s.probe_target, kProbeStratifiedSetSize);
-  if (s.integrator->probe_refresh_samples() > 0) {
+  if (s.integrator->probe_refresh_most_samples() > 0) {  // some probe may show its refreshed estimate
     const formats::ProbeGrid shown = published_probes();
     for (size_t k = 0; k < s.probe_grid_index.size(); ++k) s.previous_probes[k] = shown.probes[s.probe_grid_index[k]].sh;
   }
@@ -500,7 +500,7 @@ formats::ProbeGrid RefreshSession::published_probes() const {
   if (s.probe_grid_index.empty()) return {};
   formats::ProbeGrid grid = s.persisted.probes;
   for (size_t k = 0; k < s.probe_grid_index.size(); ++k) grid.probes[s.probe_grid_index[k]].sh = s.previous_probes[k];
-  if (s.integrator->probe_refresh_samples() == 0 && s.probe_switch_samples > 0) return grid;
+  if (s.integrator->probe_refresh_most_samples() < std::max(1u, s.probe_switch_samples)) return grid;  // none refreshed enough
   // The probes whose refreshed estimate has the samples the rule asks, as probes.bin stores them.
   const ProbeEstimate refreshed = s.integrator->probe_refresh_estimate();
   std::vector<size_t> shown;
@@ -522,6 +522,12 @@ std::optional<formats::SparseVoxelOctree> RefreshSession::published_voxel_exitan
   formats::SparseVoxelOctree svo = *s.svo;
   fill_svo_exitance(svo, s.persisted.scene, s.persisted.gbuffer, published_lightmap());
   return svo;
+}
+
+void RefreshSession::set_probe_budget_share(double share) {
+  if (!(share >= 0 && share <= 1))
+    throw std::invalid_argument("probe budget share " + std::to_string(share) + " is not in [0, 1]");
+  state_->probe_budget_share = share;
 }
 
 uint32_t RefreshSession::probe_samples() const {
@@ -626,7 +632,8 @@ RefreshReport RefreshSession::refresh(const RefreshBudget& budget) {
   auto elapsed_ms = [&] { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); };
   // Probes first (a frame's budget: the lightmap's passes are sized from what is left): a stratified
   // set for as many of the next probes as fit their share of the budget, by the measured cost.
-  if (budget.milliseconds > 0 && !s.probe_grid_index.empty() && integrator.probe_refresh_samples() < s.probe_target) {
+  if (budget.milliseconds > 0 && s.probe_budget_share > 0 && !s.probe_grid_index.empty() &&
+      integrator.probe_refresh_samples() < s.probe_target) {
     const uint32_t set = std::min(kProbeStratifiedSetSize, s.probe_target);
     const double share = s.probe_budget_share * budget.milliseconds;
     // Unmeasured: 16 probes, to measure; at least one probe a call, so probes always progress.

@@ -253,6 +253,14 @@ ExitanceRuntimeError exitance_runtime_read_probes(ExitanceRuntime* runtime, floa
   });
 }
 
+ExitanceRuntimeError exitance_runtime_set_probe_budget_share(ExitanceRuntime* runtime, double share) {
+  return guarded("exitance_runtime_set_probe_budget_share", [&] {
+    require(runtime != nullptr, "runtime is NULL");
+    require(share >= 0 && share <= 1, "share is not in [0, 1]");
+    runtime->session->set_probe_budget_share(share);
+  });
+}
+
 ExitanceRuntimeError exitance_runtime_vulkan_device(const ExitanceRuntime* runtime, ExitanceRuntimeVulkanDevice* out_device) {
   return guarded("exitance_runtime_vulkan_device", [&] {
     require(runtime != nullptr && out_device != nullptr, "runtime or out_device is NULL");

@@ -108,6 +108,10 @@ ProbeEstimate ProbeRefresh::read() const {
   return estimate;
 }
 
+uint32_t ProbeRefresh::most_samples() const {
+  return samples_.empty() ? 0 : *std::max_element(samples_.begin(), samples_.end());
+}
+
 uint32_t ProbeRefresh::least_samples() const {
   return samples_.empty() ? 0 : *std::min_element(samples_.begin(), samples_.end());
 }

@@ -31,6 +31,8 @@ class ProbeRefresh {
   size_t probe_count() const { return samples_.size(); }
   // The fewest samples of a probe (every probe has whole sets).
   uint32_t least_samples() const;
+  // The most samples of a probe (0: none refreshed since the last start or clear).
+  uint32_t most_samples() const;
 
  private:
   WavefrontBatchRunner& runner_;

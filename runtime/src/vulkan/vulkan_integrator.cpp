@@ -127,6 +127,7 @@ uint64_t VulkanIntegrator::refresh_probe_set(const IntegratorSettings& settings,
 }
 ProbeEstimate VulkanIntegrator::probe_refresh_estimate() const { return impl_->probe_refresh.read(); }
 uint32_t VulkanIntegrator::probe_refresh_samples() const { return impl_->probe_refresh.least_samples(); }
+uint32_t VulkanIntegrator::probe_refresh_most_samples() const { return impl_->probe_refresh.most_samples(); }
 
 void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, bool texels_as_before,
                                          bool accumulation_cleared) {

@@ -116,6 +116,10 @@ ExitanceRuntimeError exitance_runtime_read_page_channel(ExitanceRuntime* runtime
 ExitanceRuntimeError exitance_runtime_probe_count(const ExitanceRuntime* runtime, uint32_t* out_count);
 ExitanceRuntimeError exitance_runtime_read_probes(ExitanceRuntime* runtime, float* out_sh, uint32_t count,
                                                   uint32_t* out_samples);
+/* The share of each exitance_runtime_refresh call's time budget the probes get, in [0, 1] (default
+ * 0.25); 0 refreshes no probe (each keeps showing what it shows). Outside [0, 1] or NaN:
+ * EXITANCE_RUNTIME_INVALID_ARGUMENT, nothing changed. */
+ExitanceRuntimeError exitance_runtime_set_probe_budget_share(ExitanceRuntime* runtime, double share);
 
 /* Writes the refreshed bundle (lightmaps, probes, voxel exitance, the edited scene.bin) to
  * `output_folder` atomically; the loader (exitance_loader.h) opens it. */

@@ -237,6 +237,10 @@ class RefreshSession {
   formats::ProbeGrid published_probes() const;
   // Probes refreshed since the last edit (or open), and the fewest samples one of them has.
   uint32_t probe_samples() const;
+  // The share of each refresh call's time budget the probes get from now on (RefreshSessionOptions::
+  // probe_budget_share), in [0, 1]; 0: no probe is refreshed (each keeps showing what it shows).
+  // Throws std::invalid_argument outside [0, 1] (nothing changed).
+  void set_probe_budget_share(double share);
   // The bundle's sparse voxel octree with the radiant exitance of what texels show now
   // (published_lightmap; fill_svo_exitance, as write_refreshed_bundle writes svo.bin), without
   // writing a bundle; nullopt when the bundle has no svo.bin. A read-back and a host pass over the

@@ -139,6 +139,7 @@ class VulkanIntegrator final : public Integrator {
                              size_t* refreshed = nullptr);
   ProbeEstimate probe_refresh_estimate() const;  // a read-back
   uint32_t probe_refresh_samples() const;         // the fewest samples of a probe
+  uint32_t probe_refresh_most_samples() const;    // the most (0: none refreshed)
 
   // Progressive accumulation kept on the device between calls (the runtime's refresh). start
   // uploads the texels and clears their sums; add_samples adds `samples` to every texel, sample
