@@ -9,16 +9,34 @@
 #include "exitance/runtime/core/work_share.h"
 
 namespace exitance::vulkan {
+void upload_probe_items(Context& context, WorkItems& items, const std::vector<Vec3>& positions, size_t first, size_t end) {
+  std::vector<GpuSurfacePoint> records(positions.size());
+  for (size_t i = 0; i < positions.size(); ++i) records[i].position = Vec4(positions[i], 0.0f);
+  context.upload(items.start_points, records.data(), records.size() * sizeof(GpuSurfacePoint));
+  std::vector<uint32_t> order(end - first);
+  for (size_t i = first; i < end; ++i) order[i - first] = uint32_t(i);
+  if (!order.empty()) context.upload(items.batch_items, order.data(), order.size() * 4);
+}
+
+void read_probe_sums(Context& context, const ProbeAccumulators& accumulators, ProbeEstimate& estimate) {
+  const size_t count = estimate.sh_sum.size();
+  if (count == 0) return;
+  std::vector<double> sums(count * 27);
+  std::vector<uint32_t> counts(count * 2);
+  context.download(accumulators.sh_sums, sums.data(), sums.size() * 8);
+  context.download(accumulators.counts, counts.data(), counts.size() * 4);
+  for (size_t i = 0; i < count; ++i) {
+    std::copy(sums.begin() + std::ptrdiff_t(i * 27), sums.begin() + std::ptrdiff_t(i * 27 + 27), estimate.sh_sum[i].begin());
+    estimate.samples[i] = counts[i * 2];
+    estimate.backface_hits[i] = counts[i * 2 + 1];
+  }
+}
+
 // Start points with the position only, and the work list: the probes [first, end) in order.
 void ProbeDriver::upload_probes(const std::vector<Vec3>& positions, size_t first, size_t end) {
   Context& context = runner_.context();
   WavefrontBuffers& buffers = runner_.buffers();
-  std::vector<GpuSurfacePoint> records(positions.size());
-  for (size_t i = 0; i < positions.size(); ++i) records[i].position = Vec4(positions[i], 0.0f);
-  context.upload(buffers.items.start_points, records.data(), records.size() * sizeof(GpuSurfacePoint));
-  std::vector<uint32_t> order(end - first);
-  for (size_t i = first; i < end; ++i) order[i - first] = uint32_t(i);
-  if (!order.empty()) context.upload(buffers.items.batch_items, order.data(), order.size() * 4);
+  upload_probe_items(context, buffers.items, positions, first, end);
   buffers.items.owner = WorkItems::Owner::Probes;
   VkCommandBuffer cmd = context.begin();
   buffers.probes.clear(cmd);
@@ -77,15 +95,7 @@ ProbeEstimate ProbeDriver::bake(const std::vector<Vec3>& positions, const Integr
     passes.finish_pass(totals.rays());
   }
 
-  std::vector<double> sums(probe_count * 27);
-  std::vector<uint32_t> counts(probe_count * 2);
-  context.download(buffers.probes.sh_sums, sums.data(), sums.size() * 8);
-  context.download(buffers.probes.counts, counts.data(), counts.size() * 4);
-  for (size_t i = 0; i < probe_count; ++i) {
-    std::copy(sums.begin() + std::ptrdiff_t(i * 27), sums.begin() + std::ptrdiff_t(i * 27 + 27), estimate.sh_sum[i].begin());
-    estimate.samples[i] = counts[i * 2];
-    estimate.backface_hits[i] = counts[i * 2 + 1];
-  }
+  read_probe_sums(context, buffers.probes, estimate);
   estimate.rays = totals.rays();
   estimate.nonfinite_samples = totals.nonfinite;
   estimate.seconds = std::chrono::duration<double>(Clock::now() - start).count();

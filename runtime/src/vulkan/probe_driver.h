@@ -14,6 +14,12 @@ namespace exitance::vulkan {
 // Per probe work item: 2 result slots (12 bytes each), then albedo and direction (24 bytes).
 inline constexpr size_t kProbeResultBytes = 48;
 
+// The probes' start points (position only) and the work list of probes [first, end), in order.
+void upload_probe_items(Context& context, WorkItems& items, const std::vector<Vec3>& positions, size_t first, size_t end);
+// `sums`' SH sums, sample counts and back-face counts into `estimate`'s vectors, which hold one
+// entry per probe already (a read-back).
+void read_probe_sums(Context& context, const ProbeAccumulators& sums, ProbeEstimate& estimate);
+
 class ProbeDriver {
  public:
   explicit ProbeDriver(WavefrontBatchRunner& runner) : runner_(runner) {}

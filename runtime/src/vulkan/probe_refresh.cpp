@@ -38,12 +38,7 @@ void ProbeRefresh::start(const std::vector<Vec3>& positions) {
   if (positions.empty()) return;
   buffers.refresh_probe_items.reserve(context, positions.size());
   buffers.refresh_probe_sums.reserve(context, positions.size());
-  std::vector<GpuSurfacePoint> records(positions.size());
-  for (size_t i = 0; i < positions.size(); ++i) records[i].position = Vec4(positions[i], 0.0f);
-  context.upload(buffers.refresh_probe_items.start_points, records.data(), records.size() * sizeof(GpuSurfacePoint));
-  std::vector<uint32_t> order(positions.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = uint32_t(i);
-  context.upload(buffers.refresh_probe_items.batch_items, order.data(), order.size() * 4);
+  upload_probe_items(context, buffers.refresh_probe_items, positions, 0, positions.size());
   clear();
 }
 
@@ -93,18 +88,7 @@ ProbeEstimate ProbeRefresh::read() const {
   estimate.sh_sum.assign(count, std::array<double, 27>{});
   estimate.samples.assign(count, 0);
   estimate.backface_hits.assign(count, 0);
-  if (count == 0) return estimate;
-  Context& context = runner_.context();
-  const WavefrontBuffers& buffers = runner_.buffers();
-  std::vector<double> sums(count * 27);
-  std::vector<uint32_t> counts(count * 2);
-  context.download(buffers.refresh_probe_sums.sh_sums, sums.data(), sums.size() * 8);
-  context.download(buffers.refresh_probe_sums.counts, counts.data(), counts.size() * 4);
-  for (size_t i = 0; i < count; ++i) {
-    std::copy(sums.begin() + std::ptrdiff_t(i * 27), sums.begin() + std::ptrdiff_t(i * 27 + 27), estimate.sh_sum[i].begin());
-    estimate.samples[i] = counts[i * 2];
-    estimate.backface_hits[i] = counts[i * 2 + 1];
-  }
+  read_probe_sums(runner_.context(), runner_.buffers().refresh_probe_sums, estimate);
   return estimate;
 }
 
