@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "exitance/runtime/bundle/lightmap_assembly.h"
 #include "exitance/runtime/core/parallel_chunks.h"
 
 namespace exitance {
@@ -94,12 +95,8 @@ std::vector<float> read_light_layer_pages(const std::vector<std::string>& files,
   std::vector<formats::LightmapImage> pages;
   std::vector<std::vector<std::array<const float*, 3>>> layers(files.size());
   for (size_t p = 0; p < files.size(); ++p) {
-    pages.push_back(formats::read_lightmap_exr(files[p]));
+    pages.push_back(read_atlas_page(files[p], gbuffer, p));
     const formats::LightmapImage& image = pages.back();
-    if (image.width != gbuffer.pages[p].width || image.height != gbuffer.pages[p].height)
-      throw std::runtime_error(files[p] + ": " + std::to_string(image.width) + "x" + std::to_string(image.height) +
-                               " pixels, but scene.bin's atlas page " + std::to_string(p) + " has " +
-                               std::to_string(gbuffer.pages[p].width) + "x" + std::to_string(gbuffer.pages[p].height));
     layers[p].assign(layer_count, {nullptr, nullptr, nullptr});
     for (const auto& [name, pixels] : image.channels) {
       const std::optional<LightLayerChannel> parsed = parse_light_layer_channel(name);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <utility>
@@ -80,6 +81,16 @@ void dilate_into(int width, int height, std::vector<uint8_t> filled, const std::
         },
         1);
   }
+}
+
+formats::LightmapImage read_atlas_page(const std::string& path, const TexelGBuffer& gbuffer, size_t page) {
+  formats::LightmapImage image = formats::read_lightmap_exr(path);
+  const AtlasPage& atlas = gbuffer.pages.at(page);
+  if (image.width != atlas.width || image.height != atlas.height)
+    throw std::runtime_error(path + ": " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                             " pixels, but scene.bin's atlas page " + std::to_string(page) + " has " +
+                             std::to_string(atlas.width) + "x" + std::to_string(atlas.height));
+  return image;
 }
 
 std::vector<formats::LightmapImage> assemble_lightmap_pages(const TexelGBuffer& gbuffer, const LightmapEstimate& estimate,

@@ -10,6 +10,7 @@
 
 #include "exitance/formats/lightmap_exr.h"
 #include "exitance/runtime/bundle/light_layer_pages.h"
+#include "exitance/runtime/bundle/lightmap_assembly.h"
 #include "exitance/runtime/refresh/published_estimate.h"
 
 namespace exitance {
@@ -43,12 +44,8 @@ std::optional<LightmapEstimate> read_baked_lightmap(const std::string& bundle, c
   std::vector<std::array<const float*, 8>> channels;
   for (size_t p = 0; p < manifest.pages.size(); ++p) {
     const std::string path = (fs::path(bundle) / manifest.pages[p].file).string();
-    pages.push_back(formats::read_lightmap_exr(path));
+    pages.push_back(read_atlas_page(path, gbuffer, p));
     const formats::LightmapImage& image = pages.back();
-    if (image.width != gbuffer.pages[p].width || image.height != gbuffer.pages[p].height)
-      throw std::runtime_error(path + ": " + std::to_string(image.width) + "x" + std::to_string(image.height) +
-                               " pixels, but scene.bin's atlas page " + std::to_string(p) + " has " +
-                               std::to_string(gbuffer.pages[p].width) + "x" + std::to_string(gbuffer.pages[p].height));
     std::array<const float*, 8>& page = channels.emplace_back();
     for (size_t k = 0; k < 7; ++k) {
       const auto found = image.channels.find(needed[k]);

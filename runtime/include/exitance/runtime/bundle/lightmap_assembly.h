@@ -5,6 +5,7 @@
 // from their neighbours.
 #pragma once
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "exitance/formats/lightmap_exr.h"
@@ -25,6 +26,10 @@ struct AssemblyOptions {
 std::vector<formats::LightmapImage> assemble_lightmap_pages(const TexelGBuffer& gbuffer, const LightmapEstimate& estimate,
                                                             const AssemblyOptions& options,
                                                             const std::vector<uint8_t>& untraced = {});
+
+// A page file of a bundle (lightmap or light layers) read back as atlas page `page` of `gbuffer`:
+// throws std::runtime_error naming `path` when it cannot be read or its size is not the page's.
+formats::LightmapImage read_atlas_page(const std::string& path, const TexelGBuffer& gbuffer, size_t page);
 
 // Fills texels whose coverage is 0 with the mean of already-filled 8-neighbours, `passes` rings deep.
 void dilate_into_gutter(int width, int height, const std::vector<float>& coverage, std::vector<float*> channels,
