@@ -72,7 +72,7 @@ WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::jso
     layer_pages = assemble_light_layer_pages(results.gbuffer, results.lightmap, same);
     formats::LightLayersInfo& info = manifest.light_layers.emplace();
     info.count = uint32_t(results.lightmap.light_layers);
-    info.punctual = std::min<uint32_t>(uint32_t(results.scene.lights.size()), kDefaultLightLayerLimit);
+    info.punctual = punctual_light_layer_count(uint32_t(results.scene.lights.size()), kDefaultLightLayerLimit);
     for (size_t p = 0; p < layer_pages.size(); ++p) info.files.push_back("light-layers-" + std::to_string(p) + ".exr");
   }
   {

@@ -204,7 +204,7 @@ LightingScene build_lighting_scene(std::shared_ptr<const Scene> source, Bvh4 bvh
 
 void lay_out_light_layers(LightingScene& lighting, uint32_t limit) {
   if (limit == 0) throw std::invalid_argument("lay_out_light_layers: the limit must be at least 1");
-  lighting.punctual_light_layers = std::min<uint32_t>(lighting.punctual_count(), limit);
+  lighting.punctual_light_layers = punctual_light_layer_count(lighting.punctual_count(), limit);
   const uint32_t first_material_layer = 1 + lighting.punctual_light_layers;
   uint32_t emissive = 0;
   for (const GpuMaterial& m : lighting.materials) emissive += m.emission.x > 0 || m.emission.y > 0 || m.emission.z > 0;

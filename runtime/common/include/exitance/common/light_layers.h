@@ -15,6 +15,9 @@ const uint kSkyLightLayer = 0u;
 // Default limit of layers per kind (punctual lights, emissive materials): 64 each.
 const uint kDefaultLightLayerLimit = 64u;
 
+// How many layers `lights` punctual lights get with at most `limit` per kind.
+EXITANCE_FN uint punctual_light_layer_count(uint lights, uint limit) { return min(lights, limit); }
+
 // The layer of punctual light `light` with `punctual_layers` layers for punctual lights.
 EXITANCE_FN uint punctual_light_layer(uint light, uint punctual_layers) {
   return 1u + min(light, punctual_layers - 1u);
