@@ -6,8 +6,6 @@
 // reads them.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -23,6 +21,7 @@
 #include "exitance/runtime/bundle/probe_results.h"
 #include "exitance/runtime/exitance_runtime.h"
 #include "exitance/runtime/refresh/refresh_session.h"
+#include "support/fresh_temp_dir.h"
 #include "support/vulkan_device_available.h"
 
 namespace exitance {
@@ -36,9 +35,7 @@ constexpr uint32_t kProbeSpp = 64;  // one stratified set (kProbeStratifiedSetSi
 // The Cornell room with a coarse probe grid, its probes baked at kProbeSpp on the CPU.
 fs::path probe_bundle() {
   static const fs::path bundle = [] {
-    const fs::path dir = fs::temp_directory_path() / ("exitance-probe-refresh-" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const fs::path dir = testing::fresh_temp_dir("probe-refresh");
     BakeOptions options;
     options.input = (fs::path(EXITANCE_SAMPLE_DIR) / "cornell_room.gltf").string();
     options.output = (dir / "cornell.bake").string();

@@ -4,8 +4,6 @@
 // it, and a damaged file is one error naming the file and the problem (run under ASan+UBSan in CI).
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -14,6 +12,7 @@
 
 #include "exitance/formats/lightmap_exr.h"
 #include "exitance/runtime/bundle/light_layer_pages.h"
+#include "support/fresh_temp_dir.h"
 
 namespace exitance {
 namespace {
@@ -50,12 +49,7 @@ struct Fixture {
 };
 
 fs::path temp_dir() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::temp_directory_path() / ("exitance-light-layer-pages-" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-  }();
+  static const fs::path dir = testing::fresh_temp_dir("light-layer-pages");
   return dir;
 }
 
