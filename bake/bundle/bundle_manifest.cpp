@@ -204,6 +204,12 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
   stats["coplanar_texels"] = results.geometry.coplanar_texels;
   stats["enclosed_lights"] = results.geometry.enclosed_lights;
   stats["nonfinite_samples"] = estimate.nonfinite_samples;
+  // What the automatic choices decided (--integrator, --guiding, --emitter-guiding auto), so a
+  // report says which estimator lit this scene; "auto" guiding's per-region choice is "guiding".
+  const char* guiding_names[] = {"off", "grid", "svo", "auto"};
+  stats["lighting"] = {{"integrator", options.lighting.integrator == IntegratorMode::Bounces ? "bounces" : "path"},
+                       {"guiding", guiding_names[int(options.lighting.guiding)]},
+                       {"emitter_guiding", options.lighting.emitter_guiding}};
   if (estimate.guiding_auto) stats["guiding"] = guiding_auto_json(estimate, results.backend.backend_name());
   if (estimate.emitter_guiding.records > 0) {
     const LightmapEstimate::EmitterGuidingReport& e = estimate.emitter_guiding;

@@ -8,7 +8,8 @@ IntegratorMode automatic_integrator(const BakeOptions& options, const Integrator
   if (backend.backend_name() != "cpu") return IntegratorMode::Path;
   if (options.lighting.directional != DirectionalMode::Off) return IntegratorMode::Path;
   if (options.lighting.light_layers) return IntegratorMode::Path;  // the per-bounce passes keep no split by light
-  if (options.lighting.guiding == GuidingMode::Grid) return IntegratorMode::Path;  // auto does not ask for it
+  // A guide the user names guides path tracing, so auto picks it (auto guiding does not ask for it).
+  if (options.lighting.guiding == GuidingMode::Grid || options.lighting.guiding == GuidingMode::Svo) return IntegratorMode::Path;
   if (options.adaptive_request == AdaptiveRequest::On) return IntegratorMode::Path;
   return IntegratorMode::Bounces;
 }

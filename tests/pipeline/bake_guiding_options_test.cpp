@@ -11,6 +11,8 @@
 #include <iterator>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "support/fresh_temp_dir.h"
 
 namespace exitance {
@@ -52,6 +54,34 @@ TEST(BakeGuidingOptions, ContradictionsAreOneLineAndExit2) {
     EXPECT_EQ(message.rfind("bake: error: ", 0), 0u) << message;
     EXPECT_NE(message.find(c.expected), std::string::npos) << message;
     EXPECT_FALSE(fs::exists(out));
+  }
+  fs::remove_all(dir);
+}
+
+// A guide the user names guides path tracing, so --integrator auto (the CPU's default would be the
+// per-bounce mode) picks path tracing for it, and the report says what was chosen.
+TEST(BakeGuidingOptions, ANamedGuideMakesAutoChoosePathTracing) {
+  const fs::path dir = testing::fresh_temp_dir("guiding-choice");
+  const struct {
+    const char* options;
+    const char* integrator;
+    const char* guiding;
+  } cases[] = {
+      {"--guiding svo", "path", "svo"},
+      {"--guiding grid", "path", "grid"},
+      {"--guiding off", "bounces", "off"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.options);
+    const fs::path out = dir / "out.bake", report = dir / "report.json";
+    ASSERT_EQ(run(std::string(EXITANCE_BAKE) + " " + EXITANCE_SAMPLE_DIR +
+                  "/cornell_room.gltf --no-cache --backend cpu --spp 1 --texel-density 2 --probes none " + c.options +
+                  " -o " + out.string() + " --json >" + report.string() + " 2>/dev/null"),
+              0);
+    const nlohmann::json stats = nlohmann::json::parse(read_text(report));
+    EXPECT_EQ(stats.at("lighting").at("integrator"), c.integrator);
+    EXPECT_EQ(stats.at("lighting").at("guiding"), c.guiding);
+    fs::remove_all(out);
   }
   fs::remove_all(dir);
 }
