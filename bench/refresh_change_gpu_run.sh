@@ -10,7 +10,9 @@
 # engine's session has when an edit comes (its passes are measured: the first frame after the edit
 # is sized, not a one-sample measurement).
 # Env: BUNDLES (building city), EDITS (move double block; sun is the courtyard's), FRAMES (1 6 60),
-# MODES (change restart warm), REPS (0), COST_REPS (0), WARM (16).
+# MODES (change restart warm), REPS (0), COST_REPS (0), WARM (16), RUNTIMES (runtime: the packed
+# runtime folders whose exitance-relight refreshes the frames, e.g. "runtime runtime_before"; the
+# converged bases and references come from the first).
 # Writes $OUT/summary.txt.
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
@@ -46,10 +48,13 @@ for e in ${EDITS:-move double block}; do
     for mode in ${MODES:-change restart}; do
       flag=""
       case $mode in restart) flag=--ignore-baked;; warm) flag="--spp-before-edits ${WARM:-16}";; esac
-      o=${e}_${mode}_$f
-      $R $W/base.bake -o $W/$o.bake --edits $W/$e.json --spp 4096 --frames $f --budget-ms 16 --seed 3 --no-frame-errors $flag --json > $W/$o.json
-      report $W/$o.json $o
-      list="$list $W/$o.bake"
+      for v in ${RUNTIMES:-runtime}; do
+        o=${e}_${mode}_$f; [ "$v" = runtime ] || o=${o}_$v
+        LD_LIBRARY_PATH=$W/$v/lib $W/$v/bin/exitance-relight $W/base.bake -o $W/$o.bake --edits $W/$e.json --spp 4096 --frames $f \
+            --budget-ms 16 --seed 3 --no-frame-errors $flag --json > $W/$o.json
+        report $W/$o.json $o
+        list="$list $W/$o.bake"
+      done
     done
   done
   echo "relMSE $e (unrefreshed = base.bake):" >> $S

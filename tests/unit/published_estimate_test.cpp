@@ -43,17 +43,19 @@ TEST(PublishedEstimate, AddChangeAddsMeansLayersAndVariances) {
   EXPECT_THROW(add_change(base, texel({1, 2}, 3)), std::invalid_argument);
 }
 
-TEST(PublishedEstimate, AChangeIsPublishedOnlyWithTwoSamplesAndWhereItIsSignificant) {
+TEST(PublishedEstimate, AChangeIsShownWithTwoSamplesWhereShowingItHasTheLowerEstimatedError) {
   const LightmapEstimate previous = texel({5, 5, 5, 5}), base = texel({1, 3, 2, 2});
   // One sample of the change: what the texel showed before the edit, bit for bit.
   EXPECT_EQ(publish_change(previous, base, texel({9})).texels[0].total[0], previous.texels[0].total[0]);
-  // Mean 2, V = 1 per channel: 3 * 4 <= 9 * 3 * 1, within 3 standard errors: the base exactly.
-  EXPECT_EQ(publish_change(previous, base, texel({1, 3})).texels[0].total[0], base.texels[0].total[0]);
-  // Mean 5 from 2 samples, V = 1: a variance from 2 samples widens 3 standard errors to 235.8
-  // (significance_for_samples): 75 < 235.8^2 * 3, the base.
-  EXPECT_EQ(publish_change(previous, base, texel({4, 6})).texels[0].total[0], base.texels[0].total[0]);
-  // Mean 5 from 8 samples, V = 1/7: 75 > 4.53^2 * 3 / 7 = 8.8, significant: base + change.
-  EXPECT_NEAR(publish_change(previous, base, texel({4, 6, 4, 6, 4, 6, 4, 6})).mean_total(0)[0], 7.0, 1e-6);
+  // Mean 0.5, V = 2.25 per channel: 3 * 0.25 <= 2 * 3 * 2.25: the base exactly.
+  EXPECT_EQ(publish_change(previous, base, texel({-1, 2})).texels[0].total[0], base.texels[0].total[0]);
+  // Mean 2 from 2 samples, V = 1: 3 * 4 > 2 * 3 * 1, base + change.
+  EXPECT_NEAR(publish_change(previous, base, texel({1, 3})).mean_total(0)[0], 4.0, 1e-6);
+  // One spike among n samples has |d|^2 = V_d, whatever n: never shown; two are (mean 3, V = 3:
+  // 27 > 2 * 9).
+  EXPECT_EQ(publish_change(previous, base, texel({0, 0, 0, 6})).texels[0].total[0], base.texels[0].total[0]);
+  EXPECT_EQ(publish_change(previous, base, texel({0, 0, 0, 0, 0, 0, 0, 0, 0, 6})).texels[0].total[0], base.texels[0].total[0]);
+  EXPECT_NEAR(publish_change(previous, base, texel({0, 0, 6, 6})).mean_total(0)[0], 5.0, 1e-6);
   // A change exactly 0 (no edited light reaches the texel): the base exactly.
   EXPECT_EQ(publish_change(previous, base, texel({0, 0, 0})).texels[0].total[1], base.texels[0].total[1]);
 }

@@ -34,9 +34,9 @@ LightmapEstimate add_change(const LightmapEstimate& base, const LightmapEstimate
 bool can_be_change_base(const LightmapEstimate& estimate);
 
 // After a light edit estimated as a change from `base`: per texel, `previous` (what it showed before
-// the edit) while the change has fewer than 2 samples, then base + change where the change is
-// significant (|d|^2 > kSignificance^2 V_d summed over channels: the rule above, with kept = base
-// and D = d sharing the base), else base.
+// the edit) while the change has fewer than 2 samples, then base + change where showing it has the
+// lower estimated error (|d|^2 > kChangeShownAbove V_d summed over channels, publishing_rule.h),
+// else base.
 LightmapEstimate publish_change(const LightmapEstimate& previous, const LightmapEstimate& base, const LightmapEstimate& change);
 
 // After any other edit (or none, from a bundle's baked lighting): `refreshed` is accumulated from
