@@ -210,6 +210,11 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
   stats["lighting"] = {{"integrator", options.lighting.integrator == IntegratorMode::Bounces ? "bounces" : "path"},
                        {"guiding", guiding_names[int(options.lighting.guiding)]},
                        {"emitter_guiding", options.lighting.emitter_guiding}};
+  if (results.denoise)
+    stats["denoise"] = {{"radius", options.denoise_radius},
+                        {"texels", results.denoise->texels},
+                        {"mean_neighbours", results.denoise->mean_neighbours},
+                        {"seconds", results.denoise->seconds}};
   if (estimate.guiding_auto) stats["guiding"] = guiding_auto_json(estimate, results.backend.backend_name());
   if (estimate.emitter_guiding.records > 0) {
     const LightmapEstimate::EmitterGuidingReport& e = estimate.emitter_guiding;

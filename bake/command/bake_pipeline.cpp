@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "exitance/bake/bundle/write_bundle.h"
+#include "exitance/runtime/bundle/indirect_denoise.h"
 #include "exitance/bake/cache/bake_cache_key.h"
 #include "exitance/bake/cache/bundle_cache.h"
 #include "exitance/bake/cache/sha256_stream.h"
@@ -211,11 +212,19 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
     if (budget > 0) lighting_options.lighting.time_budget_seconds = std::max(1e-3, budget - probe_lighting->seconds);
   }
   if (share) fail_here_if_asked(*share);
-  const LightmapEstimate lightmap =
+  LightmapEstimate lightmap =
       clock.time("lighting", [&] {
         return lighting_stage(*backend, gbuffer, options.skip_sealed_texels ? &sealed : nullptr, lighting_options,
                               diagnostics);
       });
+  std::optional<IndirectDenoiseReport> denoised;
+  if (options.denoise && writer) {
+    options.announce_stage("denoise");
+    denoised.emplace();
+    lightmap = clock.time("denoise", [&] {
+      return denoise_indirect(lightmap, gbuffer, IndirectDenoiseSettings{.radius = options.denoise_radius}, &*denoised);
+    });
+  }
   std::optional<json> distribution;
   if (options.lighting.work_share) distribution = distribution_json(gather_rank_work(*options.lighting.work_share));
   if (!writer) return json{{"rank", share->rank()}};
@@ -238,7 +247,8 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                             .sealed = &sealed,
                             .sealed_skipped = options.skip_sealed_texels,
                             .stage_cache = cache ? &stages.outcomes() : nullptr,
-                            .distribution = distribution ? &*distribution : nullptr};
+                            .distribution = distribution ? &*distribution : nullptr,
+                            .denoise = denoised ? &*denoised : nullptr};
   if (options.preview && scene_file.bytes.empty())
     diagnostics.warn("--preview: no views, only the lightmap pages: the bundle has no scene.bin (" +
                      scene_file.skipped + ")");

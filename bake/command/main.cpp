@@ -137,6 +137,11 @@ int main(int argc, char** argv) {
   app.add_flag("--light-layers", options.lighting.light_layers,
                "also write E/pi split by light (light-layers-<page>.exr, docs/bundle.md \"Light layers\"), so that the "
                "runtime scales a light's layer with no ray from the moment it opens the bundle; path tracing only");
+  app.add_flag("--denoise", options.denoise,
+               "filter the indirect light in texture space after lighting (an edge-stopping average over atlas "
+               "neighbours on the same surface; biased, off by default: docs/cli.md, bench/results/denoise.md)");
+  app.add_option("--denoise-radius", options.denoise_radius, "--denoise window radius in texels (default 3)")
+      ->check(CLI::Range(1, 16));
   app.add_option("--guiding", guiding,
                  "auto (default: path tracing on the CPU backend measures guided (grid) against unguided samples "
                  "during a pilot and keeps guiding per region where it pays; on Vulkan only when given (its pilot "
@@ -190,8 +195,13 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return e.get_exit_code() == 0 ? 0 : (code == 0 ? 0 : 2);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    // One line like every other refusal (CLI11's own print adds "Run with --help").
+    std::string message = e.what();
+    for (char& c : message)
+      if (c == '\n') c = ' ';
+    std::cerr << "bake: error: " << message << "\n";
+    return 2;
   }
   // A time budget or a target error ends the run itself: no sample cap unless --spp asks for one.
   if (spp_option->count() == 0 && (options.lighting.time_budget_seconds > 0 || options.lighting.target_relative_error > 0))
@@ -285,6 +295,16 @@ int main(int argc, char** argv) {
       return 2;
     }
     options.lighting.directional = exitance::DirectionalMode::Sh1;
+  }
+  if (options.denoise && options.lighting.light_layers) {
+    std::cerr << "bake: error: --denoise filters the indirect light, which --light-layers do not keep apart from the direct: "
+                 "bake with one of them\n";
+    return 2;
+  }
+  if (options.denoise && options.lighting.directional != exitance::DirectionalMode::Off) {
+    std::cerr << "bake: error: --denoise filters the indirect light, which --directional sh1 does not keep apart from the "
+                 "direct: bake with one of them\n";
+    return 2;
   }
   if (options.lighting.light_layers && integrator == "bounces") {
     std::cerr << "bake: error: --light-layers are kept by path tracing: they need --integrator path (or auto)\n";

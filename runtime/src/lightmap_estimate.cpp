@@ -9,6 +9,15 @@
 
 namespace exitance {
 
+void set_total_sums(TexelAccumulator& texel, uint32_t samples, const double mean[3], const double variance_of_mean[3]) {
+  const double n = samples;
+  texel.samples = samples;
+  for (int c = 0; c < 3; ++c) {
+    texel.total[c] = n * mean[c];
+    texel.total_squared[c] = n * mean[c] * mean[c] + n * (n - 1) * variance_of_mean[c];
+  }
+}
+
 Vec3 LightmapEstimate::mean_total(size_t texel) const {
   const TexelAccumulator& a = texels[texel];
   if (a.samples == 0) return {0, 0, 0};

@@ -84,8 +84,13 @@ int main(int argc, char** argv) {
     }
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return e.get_exit_code() == 0 ? 0 : (code == 0 ? 0 : 2);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    // One line like every other refusal (CLI11's own print adds "Run with --help").
+    std::string message = e.what();
+    for (char& c : message)
+      if (c == '\n') c = ' ';
+    std::cerr << "exitance-relight: error: " << message << "\n";
+    return 2;
   }
   if (!share.empty()) {
     int rank = -1, ranks = 0;

@@ -42,6 +42,9 @@ TEST(BakeGuidingOptions, ContradictionsAreOneLineAndExit2) {
       {"--emitter-guiding on --backend vulkan", "--emitter-guiding on: implemented on the CPU backend only"},
       // Not guiding, but refused the same way (docs/bundle.md "Light layers").
       {"--light-layers --integrator bounces", "--light-layers are kept by path tracing: they need --integrator path"},
+      {"--denoise --light-layers", "--denoise filters the indirect light, which --light-layers do not keep apart"},
+      {"--denoise --directional sh1", "--denoise filters the indirect light, which --directional sh1 does not keep apart"},
+      {"--denoise --denoise-radius 0", "--denoise-radius"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.options);

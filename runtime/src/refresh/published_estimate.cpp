@@ -28,15 +28,6 @@ void copy_texel(const LightmapEstimate& from, LightmapEstimate& to, size_t i) {
 
 }  // namespace
 
-void set_total_sums(TexelAccumulator& texel, uint32_t samples, const double mean[3], const double variance_of_mean[3]) {
-  const double n = samples;
-  texel.samples = samples;
-  for (int c = 0; c < 3; ++c) {
-    texel.total[c] = n * mean[c];
-    texel.total_squared[c] = n * mean[c] * mean[c] + n * (n - 1) * variance_of_mean[c];
-  }
-}
-
 LightmapEstimate add_change(const LightmapEstimate& base, const LightmapEstimate& change) {
   check_shapes(base, change, "add_change");
   LightmapEstimate sum = base;

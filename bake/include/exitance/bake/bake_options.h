@@ -57,6 +57,10 @@ struct BakeOptions {
   bool preview = false;
   // --seams stitch|off: least-squares seam stitching of the lightmap pages (runtime/src/bundle/seam_*.cpp).
   bool stitch_seams = true;
+  // --denoise [--denoise-radius R]: the texture-space filter of the indirect light after the
+  // lighting stage (runtime/bundle/indirect_denoise.h); biased, so off by default.
+  bool denoise = false;
+  int denoise_radius = 3;
   uint32_t preview_size = 512;
   // The bundle cache (bake/cache/bundle_cache.h): a folder, or empty for none. Empty by default
   // here; the bake command defaults to .exitance-cache beside OUT (--cache DIR, --no-cache).

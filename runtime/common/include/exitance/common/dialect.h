@@ -59,6 +59,7 @@ inline double clamp(double x, double lo, double hi) { return min(max(x, lo), hi)
 inline float acos(float a) { return std::acos(a); }
 inline float floor(float a) { return std::floor(a); }
 inline float cos(float a) { return std::cos(a); }
+inline float exp(float a) { return std::exp(a); }
 inline float sin(float a) { return std::sin(a); }
 // GLSL's two-argument atan is C's atan2.
 inline float atan(float y, float x) { return std::atan2(y, x); }

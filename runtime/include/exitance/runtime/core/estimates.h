@@ -42,6 +42,12 @@ struct BounceGatherStatistics {
   bool tail_completed = false;     // the geometric tail B_k r / (1 - r) was added to the last layer
 };
 
+// Sums over `samples` samples (at least 2) whose mean is `mean` and whose variance of the mean is
+// `variance_of_mean`, per channel: total = n mean, total_squared = n mean^2 + n (n - 1) V, so
+// LightmapEstimate::mean_total and variance_of_mean give them back (a composite estimate: the
+// runtime's base + change, a filtered texel). The direct sums are left alone.
+void set_total_sums(TexelAccumulator& texel, uint32_t samples, const double mean[3], const double variance_of_mean[3]);
+
 struct LightmapEstimate {
   std::vector<TexelAccumulator> texels;
   std::vector<double> bounces;  // [bounce][texel][rgb] flattened: (k * texel_count + i) * 3 + c

@@ -16,11 +16,6 @@
 
 namespace exitance {
 
-// Sums over `samples` samples (at least 2) whose mean is `mean` and whose variance of the mean is
-// `variance_of_mean`, per channel: total = n mean, total_squared = n mean^2 + n (n - 1) V, so
-// LightmapEstimate::mean_total and variance_of_mean give them back. The direct sums are left alone.
-void set_total_sums(TexelAccumulator& texel, uint32_t samples, const double mean[3], const double variance_of_mean[3]);
-
 // base + change per texel (the change estimate of RefreshSession's light edits, path.h
 // punctual_change_rays, is an unbiased estimate of E/pi(edited) - E/pi(base)): means and every
 // layer add, variances of the mean add (the two are independent), the sample count is the sum.

@@ -17,6 +17,7 @@
 #include "exitance/bake/voxelize/svo_build.h"
 #include "exitance/formats/bundle_manifest.h"
 #include "exitance/formats/lightmap_exr.h"
+#include "exitance/runtime/bundle/indirect_denoise.h"
 #include "exitance/runtime/core/estimates.h"
 #include "exitance/runtime/core/integrator.h"
 #include "exitance/runtime/scene.h"
@@ -52,6 +53,7 @@ struct BakeResults {
   const nlohmann::json* stage_cache = nullptr;  // --cache: {stage: "reused" | "computed"} (stats.cache.stages)
   // Under mpirun: {"ranks": N, "rank_work": [...]} (stats.ranks, stats.rank_work); null: one process.
   const nlohmann::json* distribution = nullptr;
+  const IndirectDenoiseReport* denoise = nullptr;  // --denoise: what the filter did; null: not asked
 };
 
 // The manifest (formats/bundle_manifest.h) of the bake: `pages`: the assembled lightmap pages (the manifest lists their channels). `input_sha256`: the
