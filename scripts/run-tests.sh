@@ -49,7 +49,7 @@ cmake --build build-asan -j"$jobs" --target bake stress_tests geometry_warning_t
   lighting_scene_edit_tests scene_edits_tests radiance_vdb_tests scene_file_tests exitance-relight \
   exitance_runtime exitance_loader bundle_cache_tests lightmap_uv_generation_tests adaptive_sampling_plan_tests guiding_auto_strategy_tests \
   stage_cache_keys_tests texture_sampling_tests per_bounce_budget_tests unocclude_tests \
-  seam_detection_tests view_materials_tests bake_guiding_options_tests work_share_split_tests bvh4_spatial_split_tests light_layer_pages_tests \
+  seam_detection_tests view_materials_tests bake_guiding_options_tests work_share_split_tests bvh4_spatial_split_tests light_layer_pages_tests indirect_denoise_tests \
   exitance-view
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0"
