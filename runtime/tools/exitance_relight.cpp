@@ -44,6 +44,12 @@ int main(int argc, char** argv) {
   app.add_flag("--light-layers", options.whole_run_light_layers,
                "keep light layers in a whole run too (they are kept with --frames, --budget-ms or --spp-before-edits), "
                "so the bundle written holds them: a session opening it scales a light's layer from its first frame");
+  bool denoise = false;
+  int denoise_radius = 3;
+  app.add_flag("--denoise", denoise,
+               "filter the written lightmap's indirect light in texture space (as bake --denoise; biased, off by "
+               "default; the bundle then holds no light layers; what frames publish is not filtered)");
+  app.add_option("--denoise-radius", denoise_radius, "--denoise window radius in texels (default 3)")->check(CLI::Range(1, 16));
   app.add_flag("--ignore-baked", ignore_baked,
                "start every texel from nothing instead of from the bundle's baked lightmap (which is shown until refreshed samples are better, and which light edits are estimated as a change from)");
   app.add_option("--spp-before-edits", options.samples_before_edits,
@@ -106,6 +112,7 @@ int main(int argc, char** argv) {
   options.frame_errors = !no_frame_errors;
   options.from_baked = !ignore_baked;
   options.light_layers = !no_light_layers;
+  options.denoise_radius = denoise ? denoise_radius : 0;
   options.seed = seed;
   const char* validation = std::getenv("EXITANCE_VULKAN_VALIDATION");
   options.validation = validation && std::string(validation) == "1";

@@ -429,6 +429,17 @@ TEST(Relight, BadScenesAreOneLineAndExitTwo) {
   const nlohmann::json written = nlohmann::json::parse(file_bytes(layered / "manifest.json"));
   ASSERT_TRUE(written.contains("light_layers")) << written["relight"]["bundle_light_layers"].dump();
   EXPECT_TRUE(fs::exists(layered / written["light_layers"]["files"][0].get<std::string>()));
+  // --denoise filters the indirect light, which light layers do not keep apart: refused with them;
+  // alone it writes the filtered pages and says so.
+  EXPECT_EQ(run_relight(f.baked.string() + " -o " + guided_out.string() + " --light-layers --denoise --spp 1", errors), 2);
+  EXPECT_EQ(std::count(errors.begin(), errors.end(), '\n'), 1) << errors;
+  EXPECT_NE(errors.find("--denoise"), std::string::npos) << errors;
+  EXPECT_FALSE(fs::exists(guided_out)) << "partial output";
+  const fs::path denoised = f.dir / "denoised.bake";
+  ASSERT_EQ(run_relight(f.baked.string() + " -o " + denoised.string() + " --denoise --spp 2", errors), 0) << errors;
+  const nlohmann::json filtered = nlohmann::json::parse(file_bytes(denoised / "manifest.json"));
+  EXPECT_GT(filtered["relight"]["denoise"]["texels"].get<uint64_t>(), 0u) << filtered["relight"].dump();
+  EXPECT_FALSE(filtered.contains("light_layers"));
 }
 
 // A submission past the fence timeout (EXITANCE_VULKAN_FENCE_TIMEOUT, here 1 ms) ends the run

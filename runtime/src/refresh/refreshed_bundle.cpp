@@ -1,5 +1,7 @@
 #include "exitance/runtime/refresh/refreshed_bundle.h"
 
+#include "exitance/runtime/bundle/indirect_denoise.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -26,7 +28,8 @@ namespace fs = std::filesystem;
 using json = nlohmann::json;
 
 json write_refreshed_bundle(RefreshSession& session, const std::string& output, json report,
-                            const StageProgress& progress, const std::function<void()>& check_before_write) {
+                            const StageProgress& progress, const std::function<void()>& check_before_write,
+                            int denoise_radius) {
   StageClock clock;
   json seconds = json::object();
   auto stage = [&](const char* name) {
@@ -36,12 +39,25 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   formats::BundleManifest manifest = session.manifest();
   const formats::BakeSettings baked = manifest.settings.value_or(formats::BakeSettings{});
   // With light layers split by light where the session has them (docs/bundle.md "Light layers").
-  std::optional<LightmapEstimate> by_light = session.published_lightmap_by_light();
+  // Not when the indirect light is filtered: light layers hold no split into direct and indirect.
+  std::optional<LightmapEstimate> by_light = denoise_radius > 0 ? std::nullopt : session.published_lightmap_by_light();
   const bool layers_split = by_light.has_value();
-  const LightmapEstimate estimate = by_light ? std::move(*by_light) : session.published_lightmap();
+  LightmapEstimate estimate = by_light ? std::move(*by_light) : session.published_lightmap();
   by_light.reset();
 
   PersistedScene persisted = session.persisted();
+  std::optional<IndirectDenoiseReport> denoised;
+  if (denoise_radius > 0) {
+    stage("denoise");
+    if (estimate.has_sh1())
+      throw BundleInputError((bundle / "manifest.json").string() +
+                             ": --denoise: the bundle has L1 (sh1) layers, which are not split into direct and indirect light");
+    estimate.light_layers = 0;
+    estimate.light_sums.clear();
+    denoised.emplace();
+    estimate = denoise_indirect(estimate, persisted.gbuffer, IndirectDenoiseSettings{.radius = denoise_radius}, &*denoised);
+    seconds["denoise"] = clock.lap();
+  }
   ProbeEstimate probe_estimate;
   const bool has_probes = persisted.has_probe_grid() && manifest.probes.has_value();
   if (has_probes) {
@@ -76,6 +92,7 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   std::vector<formats::LightmapImage> layer_pages;
   manifest.light_layers.reset();
   std::string light_layers_skipped = estimate.light_layers == 0 ? "the session keeps no light layers" : "";
+  if (denoised) light_layers_skipped = "--denoise: light layers are not split into direct and indirect light";
   if (estimate.light_layers > 0 && !layers_split)
     light_layers_skipped = "what is published has no split by light (the baked lightmap without layers and too few refreshed samples to split it by)";
   if (light_layers_skipped.empty()) {
@@ -130,6 +147,11 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   }
   report["nonfinite_samples"] = estimate.nonfinite_samples + probe_estimate.nonfinite_samples;
   report["seams"] = seams;
+  if (denoised)
+    report["denoise"] = {{"radius", denoise_radius},
+                         {"texels", denoised->texels},
+                         {"mean_neighbours", denoised->mean_neighbours},
+                         {"seconds", denoised->seconds}};
   report["bundle_light_layers"] = manifest.light_layers ? json{{"count", manifest.light_layers->count}, {"written", true}}
                                                  : json{{"written", false}, {"why_not", light_layers_skipped}};
 

@@ -68,6 +68,8 @@ json relight_bundle(const RelightOptions& options) {
   // layers: bench/results/light-layers.md) only to write them into the bundle (--light-layers).
   if (options.whole_run_light_layers && !options.light_layers)
     throw RelightInputError("--light-layers and --no-light-layers contradict each other");
+  if (options.whole_run_light_layers && options.denoise_radius > 0)
+    throw RelightInputError("--denoise filters the indirect light, which --light-layers do not keep apart from the direct: relight with one of them");
   session_options.light_layers = options.light_layers && (options.whole_run_light_layers || options.frames > 0 ||
                                                           options.frame_budget_ms > 0 || options.samples_before_edits > 0);
   // Probes are refreshed in frames (a whole run bakes them once, for the bundle it writes).
@@ -83,6 +85,9 @@ json relight_bundle(const RelightOptions& options) {
   if (options.guiding == "svo" && !session->svo())
     throw RelightInputError(options.bundle + ": --guiding svo reads the bundle's svo.bin, which it has none of (baked with --voxel-resolution none)");
   const formats::BakeSettings baked = session->manifest().settings.value_or(formats::BakeSettings{});
+  if (options.denoise_radius > 0 && baked.directional != "off")
+    throw RelightInputError(options.bundle + ": --denoise: the bundle has L1 (" + baked.directional +
+                            ") layers, which are not split into direct and indirect light");
   seconds["load"] = clock.lap();
   const OpenTimings& opened = session->open_timings();
   seconds["load_split"] = {{"read", opened.read},     {"lighting_scene", opened.lighting_scene}, {"device", opened.device},
@@ -243,7 +248,7 @@ json relight_bundle(const RelightOptions& options) {
     return run;
   }
   json written = write_refreshed_bundle(*session, out.string(), run, options.progress,
-                                        [&] { validation->throw_if_any(); });
+                                        [&] { validation->throw_if_any(); }, options.denoise_radius);
   for (auto& [stage, value] : written["seconds"].items()) seconds[stage] = value;
   written["seconds"] = seconds;
   if (options.frames > 0) written["frames"] = frames;
