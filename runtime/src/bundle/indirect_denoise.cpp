@@ -61,8 +61,13 @@ LightmapEstimate denoise_indirect(const LightmapEstimate& estimate, const TexelG
           const uint32_t j = texel_at[page_first[t.page] + size_t(y) * size_t(page.width) + size_t(x)];
           if (j == kNone || estimate.texels[j].samples == 0) continue;
           const LiveTexel& u = gbuffer.texels[j];
-          const double w = texture_space_filter_weight(t.position, t.geometric_normal, t.world_texel_size, u.position,
-                                                       u.geometric_normal, dx, dy, r);
+          double w = texture_space_filter_weight(t.position, t.geometric_normal, t.world_texel_size, u.position,
+                                                 u.geometric_normal, dx, dy, r);
+          if (w <= 0) continue;
+          float difference = 0, variances = 0;
+          for (int c = 0; c < 3; ++c)
+            difference += (indirect[j][c] - indirect[i][c]) * (indirect[j][c] - indirect[i][c]), variances += variance[i][c] + variance[j][c];
+          w *= texture_space_filter_range_weight(difference, variances);
           if (w <= 0) continue;
           ++my_neighbours;
           weight_sum += w;

@@ -34,5 +34,19 @@ EXITANCE_FN float texture_space_filter_weight(vec3 position, vec3 normal, float 
   return exp(-float(dx * dx + dy * dy) / (2.0f * sigma * sigma));
 }
 
+// Standard deviations of two texels' difference at which the range weight below is exp(-1/2).
+const float kFilterRangeSigmas = 2.0f;
+
+// The value's edge stop: neighbours whose indirect light differs from the texel's by more than their
+// noise explains weigh less, exp(-|x_j - x_i|^2 / (2 k^2 (V_i + V_j))) with k kFilterRangeSigmas,
+// squares and variances of the mean summed over the channels. Geometry cannot see an occluder
+// resting on a surface (a box on a floor): the floor under it is black, its neighbours lit, all on
+// one plane; their difference is many standard errors, so no light leaks in. Two exact values
+// (no variance) mix only if equal.
+EXITANCE_FN float texture_space_filter_range_weight(float difference_squared, float variance_sum) {
+  if (!(variance_sum > 0.0f)) return difference_squared > 0.0f ? 0.0f : 1.0f;
+  return exp(-difference_squared / (2.0f * kFilterRangeSigmas * kFilterRangeSigmas * variance_sum));
+}
+
 EXITANCE_NAMESPACE_END
 #endif
