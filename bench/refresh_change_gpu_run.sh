@@ -6,6 +6,8 @@
 # REPS, first what the edit costs alone (`seconds.edits`, `edits.milliseconds`, waited submissions),
 # REPS one-frame runs per edit; with COST_REPS, bench_edit_cost on each lit bundle (the edit and the
 # one undoing it in turn, COST_REPS rounds each, one sample refreshed after each edit).
+# Mode "warmdn": "warm", and the bundle written filtered by --denoise (bench/results/denoise.md): what a
+# device filter on the published pages would show.
 # Mode "warm": the session refreshes WARM (16) samples per texel in 16 ms frames before the edit, as an
 # engine's session has when an edit comes (its passes are measured: the first frame after the edit
 # is sized, not a one-sample measurement).
@@ -47,7 +49,11 @@ for e in ${EDITS:-move double block}; do
   for f in ${FRAMES:-1 6 60}; do
     for mode in ${MODES:-change restart}; do
       flag=""
-      case $mode in restart) flag=--ignore-baked;; warm) flag="--spp-before-edits ${WARM:-16}";; esac
+      case $mode in
+        restart) flag=--ignore-baked;;
+        warm) flag="--spp-before-edits ${WARM:-16}";;
+        warmdn) flag="--spp-before-edits ${WARM:-16} --denoise";;  # what was published, filtered when written
+      esac
       for v in ${RUNTIMES:-runtime}; do
         o=${e}_${mode}_$f; [ "$v" = runtime ] || o=${o}_$v
         LD_LIBRARY_PATH=$W/$v/lib $W/$v/bin/exitance-relight $W/base.bake -o $W/$o.bake --edits $W/$e.json --spp 4096 --frames $f \
