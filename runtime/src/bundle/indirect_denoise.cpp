@@ -35,25 +35,28 @@ LightmapEstimate denoise_indirect(const LightmapEstimate& estimate, const TexelG
 
   // Each texel's indirect mean (total minus direct) per channel, and its variance of the mean.
   std::vector<Vec3> indirect(n), variance(n);
-  for (size_t i = 0; i < n; ++i) {
-    const TexelAccumulator& a = estimate.texels[i];
-    if (a.samples == 0) continue;
-    for (int c = 0; c < 3; ++c) indirect[i][c] = float((a.total[c] - a.direct[c]) / a.samples);
-    variance[i] = estimate.variance_of_mean(i);
-  }
+  for_each_chunk(n, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const TexelAccumulator& a = estimate.texels[i];
+      if (a.samples == 0) continue;
+      for (int c = 0; c < 3; ++c) indirect[i][c] = float((a.total[c] - a.direct[c]) / a.samples);
+      variance[i] = estimate.variance_of_mean(i);
+    }
+  });
 
   LightmapEstimate out = estimate;
   const int r = settings.radius, layers = estimate.recorded_bounces;
   std::atomic<uint64_t> filtered{0}, neighbours{0};
   for_each_chunk(n, [&](size_t begin, size_t end) {
     uint64_t my_filtered = 0, my_neighbours = 0;
+    std::vector<double> layer_sum(size_t(layers) * 3);  // one per chunk, not per texel (no allocation in the loop)
     for (size_t i = begin; i < end; ++i) {
       const TexelAccumulator& a = estimate.texels[i];
       if (a.samples == 0) continue;
       const LiveTexel& t = gbuffer.texels[i];
       const AtlasPage& page = gbuffer.pages[t.page];
       double weight_sum = 0, sum[3] = {0, 0, 0}, variance_sum[3] = {0, 0, 0};
-      std::vector<double> layer_sum(size_t(layers) * 3, 0.0);
+      std::fill(layer_sum.begin(), layer_sum.end(), 0.0);
       for (int dy = -r; dy <= r; ++dy)
         for (int dx = -r; dx <= r; ++dx) {
           const int x = int(t.x) + dx, y = int(t.y) + dy;
