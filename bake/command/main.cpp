@@ -17,15 +17,12 @@
 #include "exitance/bake/input_error.h"
 #include "exitance/common/path_sampler.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
+#include "exitance/runtime/tools/command_line_errors.h"
 #include "exitance/runtime/tools/progress_bar.h"
 
-namespace {
+using exitance::one_line;
 
-std::string one_line(std::string text) {
-  for (char& c : text)
-    if (c == '\n' || c == '\r') c = ' ';
-  return text;
-}
+namespace {
 
 void print_warnings(const exitance::Diagnostics& diagnostics) {
   for (const std::string& w : diagnostics.warnings) std::cerr << "bake: warning: " << one_line(w) << "\n";
@@ -195,13 +192,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);  // --help
-    // One line like every other refusal (CLI11's own print adds "Run with --help").
-    std::string message = e.what();
-    for (char& c : message)
-      if (c == '\n') c = ' ';
-    std::cerr << "bake: error: " << message << "\n";
-    return 2;
+    return exitance::exit_for_option_error(app, e, "bake");
   }
   // A time budget or a target error ends the run itself: no sample cap unless --spp asks for one.
   if (spp_option->count() == 0 && (options.lighting.time_budget_seconds > 0 || options.lighting.target_relative_error > 0))

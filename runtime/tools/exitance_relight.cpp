@@ -9,18 +9,11 @@
 #include <optional>
 
 #include "exitance/runtime/relight/relight.h"
+#include "exitance/runtime/tools/command_line_errors.h"
 #include "exitance/runtime/tools/progress_bar.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 
-namespace {
-
-std::string one_line(std::string text) {
-  for (char& c : text)
-    if (c == '\n' || c == '\r') c = ' ';
-  return text;
-}
-
-}  // namespace
+using exitance::one_line;
 
 int main(int argc, char** argv) {
   CLI::App app{"exitance-relight: re-light a baked bundle from its scene.bin on the GPU"};
@@ -90,13 +83,7 @@ int main(int argc, char** argv) {
     }
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);  // --help
-    // One line like every other refusal (CLI11's own print adds "Run with --help").
-    std::string message = e.what();
-    for (char& c : message)
-      if (c == '\n') c = ' ';
-    std::cerr << "exitance-relight: error: " << message << "\n";
-    return 2;
+    return exitance::exit_for_option_error(app, e, "exitance-relight");
   }
   if (!share.empty()) {
     int rank = -1, ranks = 0;

@@ -22,20 +22,16 @@
 #include "exitance/runtime/view/view_input_error.h"
 #include "exitance/runtime/view/view_render.h"
 #include "exitance/runtime/view/view_scene.h"
+#include "exitance/runtime/tools/command_line_errors.h"
 
 namespace {
 
+using exitance::one_line;
 using exitance::Vec3;
 using exitance::view::ViewInputError;
 
 constexpr int kMaxImageSide = 16384;
 constexpr int kMaxSamplesPerAxis = 16;
-
-std::string one_line(std::string text) {
-  for (char& c : text)
-    if (c == '\n' || c == '\r') c = ' ';
-  return text;
-}
 
 std::vector<std::string> split_commas(const std::string& text) {
   std::vector<std::string> parts{""};
@@ -221,11 +217,8 @@ int main(int argc, char** argv) {
   app.add_option("-o,--out", cl.output, "output image: FILE.exr (linear) or FILE.png (tone-mapped, sRGB)")->required();
   try {
     app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << "exitance-view: error: " << one_line(e.what()) << "\n";
-    return 2;
+    return exitance::exit_for_option_error(app, e, "exitance-view");
   }
   try {
     using Clock = std::chrono::steady_clock;
