@@ -287,14 +287,10 @@ int main(int argc, char** argv) {
     }
     options.lighting.directional = exitance::DirectionalMode::Sh1;
   }
-  if (options.denoise && options.lighting.light_layers) {
-    std::cerr << "bake: error: --denoise filters the indirect light, which --light-layers do not keep apart from the direct: "
-                 "bake with one of them\n";
-    return 2;
-  }
-  if (options.denoise && options.lighting.directional != exitance::DirectionalMode::Off) {
-    std::cerr << "bake: error: --denoise filters the indirect light, which --directional sh1 does not keep apart from the "
-                 "direct: bake with one of them\n";
+  if (options.denoise && (options.lighting.light_layers || options.lighting.directional != exitance::DirectionalMode::Off)) {
+    std::cerr << "bake: error: --denoise filters the indirect light, which "
+              << (options.lighting.light_layers ? "--light-layers do" : "--directional sh1 does")
+              << " not keep apart from the direct: bake with one of them\n";
     return 2;
   }
   if (options.lighting.light_layers && integrator == "bounces") {

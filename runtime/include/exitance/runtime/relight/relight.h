@@ -33,10 +33,10 @@ struct RelightOptions {
   bool whole_run_light_layers = false;
   uint32_t samples_before_edits = 0;  // > 0: refresh this many samples per texel before applying the edits
   bool page_images = false;        // with frames: after each frame, the page images an engine samples written (publish_page_images), timed
-  bool frame_errors = true;
+  bool frame_errors = true;        // with frames: each frame's estimated error (a read-back of the sums between frames)
   // > 0: --denoise [--denoise-radius]: the written lightmap's indirect light filtered in texture
   // space with this radius (bundle/indirect_denoise.h; what frames publish is not filtered).
-  int denoise_radius = 0;        // with frames: each frame's estimated error (a read-back of the sums between frames)
+  int denoise_radius = 0;
   std::optional<uint64_t> seed;    // default: the bake's
   int device_index = -1;           // Vulkan device; -1 = prefer a discrete GPU
   bool validation = false;         // Vulkan validation layers; any message fails the relight
