@@ -6,8 +6,10 @@
 # REPS, first what the edit costs alone (`seconds.edits`, `edits.milliseconds`, waited submissions),
 # REPS one-frame runs per edit; with COST_REPS, bench_edit_cost on each lit bundle (the edit and the
 # one undoing it in turn, COST_REPS rounds each, one sample refreshed after each edit).
-# Mode "warmdn": "warm", and the bundle written filtered by --denoise (bench/results/denoise.md): what a
-# device filter on the published pages would show.
+# Mode "warmdn": "warm" with --denoise (the runtime's device filter of the indirect light: every frame's
+# page images and the written bundle show the filtered light; bench/results/denoise.md) and
+# --page-images (each frame's page images written and timed, the filter included). Mode "warmpi":
+# "warm" with --page-images alone, the same frames unfiltered.
 # Mode "warm": the session refreshes WARM (16) samples per texel in 16 ms frames before the edit, as an
 # engine's session has when an edit comes (its passes are measured: the first frame after the edit
 # is sized, not a one-sample measurement).
@@ -31,7 +33,9 @@ done
 report() {  # $1 the run's JSON, $2 its label
   python3 -c "
 import json; r=json.load(open('$1')); e=r['edits']; ms=[f['milliseconds'] for f in r['frames']]
-print('$2', 'edits_s %.4f'%r['seconds']['edits'], 'edit_ms', {k: round(v, 2) for k, v in e.get('milliseconds', {}).items()}, 'submissions', e.get('device_submissions'), 'moved_texels', e['moved_texels'], 'changed_lights', e['changed_lights'], 'frames', len(ms), 'frame_ms_sum %.1f max %.1f'%(sum(ms), max(ms)), 'over_17ms', sum(1 for m in ms if m > 17), 'spp', r['spp'], 'samples_added', [f['samples_added'] for f in r['frames']][:8])" >> $S
+pi=[f['page_images_milliseconds'] for f in r['frames'] if 'page_images_milliseconds' in f]
+dn=r.get('denoise')
+print('$2', ('page_images_ms max %.3f'%max(pi)) if pi else '', ('denoise_s %.4f mean_neighbours %.1f'%(dn['seconds'], dn['mean_neighbours'])) if dn else '', 'edits_s %.4f'%r['seconds']['edits'], 'edit_ms', {k: round(v, 2) for k, v in e.get('milliseconds', {}).items()}, 'submissions', e.get('device_submissions'), 'moved_texels', e['moved_texels'], 'changed_lights', e['changed_lights'], 'frames', len(ms), 'frame_ms_sum %.1f max %.1f'%(sum(ms), max(ms)), 'over_17ms', sum(1 for m in ms if m > 17), 'spp', r['spp'], 'samples_added', [f['samples_added'] for f in r['frames']][:8])" >> $S
 }
 for e in ${EDITS:-move double block}; do
   b=building; [ $e = block ] && b=city; [ $e = sun ] && b=courtyard
@@ -52,7 +56,8 @@ for e in ${EDITS:-move double block}; do
       case $mode in
         restart) flag=--ignore-baked;;
         warm) flag="--spp-before-edits ${WARM:-16}";;
-        warmdn) flag="--spp-before-edits ${WARM:-16} --denoise";;  # what was published, filtered when written
+        warmpi) flag="--spp-before-edits ${WARM:-16} --page-images";;
+        warmdn) flag="--spp-before-edits ${WARM:-16} --page-images --denoise";;
       esac
       for v in ${RUNTIMES:-runtime}; do
         o=${e}_${mode}_$f; [ "$v" = runtime ] || o=${o}_$v

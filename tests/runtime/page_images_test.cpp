@@ -269,6 +269,34 @@ TEST(RuntimePageImages, EqualReadPageOnTheEnginesDevice) {
   ASSERT_EQ(exitance_runtime_refresh(rt, 0, 8, &report), EXITANCE_RUNTIME_OK);
   expect_images_equal_read_page(rt, engine, "after a moved box and 8 samples");
 
+  // With the indirect light filtered on the device: the images still equal read_page (both show the
+  // filtered estimate), which is no longer what was shown unfiltered.
+  ExitanceRuntimePageInfo info{};
+  ASSERT_EQ(exitance_runtime_page_info(rt, 0, &info), EXITANCE_RUNTIME_OK);
+  std::vector<float> unfiltered(size_t(info.width) * info.height * 3), filtered(unfiltered.size());
+  ASSERT_EQ(exitance_runtime_read_page(rt, 0, unfiltered.data(), info.width, info.height), EXITANCE_RUNTIME_OK);
+  ASSERT_EQ(exitance_runtime_set_denoise_radius(rt, 3), EXITANCE_RUNTIME_OK) << exitance_runtime_last_error_message();
+  expect_images_equal_read_page(rt, engine, "filtered, radius 3");
+  ASSERT_EQ(exitance_runtime_read_page(rt, 0, filtered.data(), info.width, info.height), EXITANCE_RUNTIME_OK);
+  size_t changed = 0;
+  for (size_t i = 0; i < filtered.size(); ++i) changed += filtered[i] != unfiltered[i];
+  EXPECT_GT(changed, filtered.size() / 4) << "the filter changed too few values of page 0";
+  for (int32_t bad : {-1, 17}) {
+    EXPECT_EQ(exitance_runtime_set_denoise_radius(rt, bad), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+    const std::string message = exitance_runtime_last_error_message();
+    EXPECT_NE(message.find("exitance_runtime_set_denoise_radius"), std::string::npos) << message;
+    EXPECT_NE(message.find("is not 0 (off) to 16"), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos);
+  }
+  EXPECT_EQ(exitance_runtime_set_denoise_radius(nullptr, 3), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+  // The bad calls changed nothing: still filtered with radius 3; 0 turns it off again.
+  std::vector<float> again(filtered.size());
+  ASSERT_EQ(exitance_runtime_read_page(rt, 0, again.data(), info.width, info.height), EXITANCE_RUNTIME_OK);
+  EXPECT_EQ(again, filtered);
+  ASSERT_EQ(exitance_runtime_set_denoise_radius(rt, 0), EXITANCE_RUNTIME_OK);
+  ASSERT_EQ(exitance_runtime_read_page(rt, 0, again.data(), info.width, info.height), EXITANCE_RUNTIME_OK);
+  EXPECT_EQ(again, unfiltered);
+
   // Bad calls: one line naming the call and the problem; the images stay as they were.
   const uint32_t pages = exitance_runtime_page_count(rt);
   std::vector<ExitanceRuntimePageImage> images(pages + 1);

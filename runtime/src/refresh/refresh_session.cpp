@@ -148,6 +148,7 @@ struct RefreshSession::State {
   float probe_dering = 0;
   double probe_budget_share = 0.25;
   double probe_ms_per_sample = 0;
+  int denoise_radius = 0;  // set_denoise_radius: 0, or the filter's window radius in texels
   // A bake_per_bounce(), bake_guided() or bake_path() result: lightmap() until the next restart, edit
   // or refresh.
   std::optional<LightmapEstimate> per_bounce;
@@ -167,6 +168,12 @@ struct RefreshSession::State {
 };
 
 namespace {
+
+void check_denoise_radius(int radius, const IntegratorSettings& settings, const std::string& what) {
+  if (radius < 0 || radius > 16) throw std::invalid_argument(what + ": radius " + std::to_string(radius) + " is not 0 (off) to 16");
+  if (radius > 0 && settings.directional != DirectionalMode::Off)
+    throw std::invalid_argument(what + ": the bundle has L1 (sh1) layers, which are not split into direct and indirect light");
+}
 
 // The session's scene as a lighting scene's source: persisted.scene itself, not owned (the
 // session outlives its lighting scenes and integrator, State keeps it at one address).
@@ -266,6 +273,8 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   for (size_t i = 0; i < state->all_texels.size(); ++i) state->all_texels[i] = uint32_t(i);
   timings.indices = since();
   state->integrator->start_progressive(state->persisted.gbuffer, settings);
+  check_denoise_radius(options.denoise_radius, settings, "RefreshSessionOptions::denoise_radius");
+  state->denoise_radius = options.denoise_radius;
   if (options.refresh_probes && state->persisted.has_probe_grid() && manifest.probes) {
     if (!(options.probe_budget_share > 0 && options.probe_budget_share <= 1))
       throw std::invalid_argument("RefreshSessionOptions::probe_budget_share must be in (0, 1]");
@@ -525,8 +534,27 @@ std::optional<formats::SparseVoxelOctree> RefreshSession::published_voxel_exitan
   const State& s = *state_;
   if (!s.svo) return std::nullopt;
   formats::SparseVoxelOctree svo = *s.svo;
-  fill_svo_exitance(svo, s.persisted.scene, s.persisted.gbuffer, published_lightmap());
+  fill_svo_exitance(svo, s.persisted.scene, s.persisted.gbuffer, shown_lightmap());
   return svo;
+}
+
+void RefreshSession::set_denoise_radius(int radius) {
+  check_denoise_radius(radius, state_->settings, "set_denoise_radius");
+  state_->denoise_radius = radius;
+}
+
+int RefreshSession::denoise_radius() const { return state_->denoise_radius; }
+
+std::shared_ptr<DeviceLightmap> RefreshSession::shown_on_device(DeviceDenoiseCounts* counts) const {
+  const State& s = *state_;
+  const PublishedLightmap published = publish_on_device();
+  if (s.denoise_radius == 0) return published.lightmap;
+  return s.integrator->denoise_indirect(*published.lightmap, s.persisted.gbuffer, s.denoise_radius, counts);
+}
+
+LightmapEstimate RefreshSession::shown_lightmap(DeviceDenoiseCounts* counts) const {
+  if (state_->denoise_radius == 0) return published_lightmap();
+  return state_->integrator->read_lightmap(*shown_on_device(counts));
 }
 
 void RefreshSession::set_probe_budget_share(double share) {
@@ -912,8 +940,7 @@ std::optional<LightmapEstimate> RefreshSession::published_lightmap_by_light() co
 
 const DevicePageImages& RefreshSession::publish_page_images(int dilation_texels) {
   State& s = *state_;
-  const PublishedLightmap published = publish_on_device();
-  return s.integrator->write_page_images(*published.lightmap, s.persisted.gbuffer, dilation_texels);
+  return s.integrator->write_page_images(*shown_on_device(), s.persisted.gbuffer, dilation_texels);
 }
 
 int RefreshSession::page_dilation_texels() const {

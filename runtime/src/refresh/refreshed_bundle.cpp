@@ -1,7 +1,5 @@
 #include "exitance/runtime/refresh/refreshed_bundle.h"
 
-#include "exitance/runtime/bundle/indirect_denoise.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -28,8 +26,7 @@ namespace fs = std::filesystem;
 using json = nlohmann::json;
 
 json write_refreshed_bundle(RefreshSession& session, const std::string& output, json report,
-                            const StageProgress& progress, const std::function<void()>& check_before_write,
-                            int denoise_radius) {
+                            const StageProgress& progress, const std::function<void()>& check_before_write) {
   StageClock clock;
   json seconds = json::object();
   auto stage = [&](const char* name) {
@@ -40,24 +37,23 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   const formats::BakeSettings baked = manifest.settings.value_or(formats::BakeSettings{});
   // With light layers split by light where the session has them (docs/bundle.md "Light layers").
   // Not when the indirect light is filtered: light layers hold no split into direct and indirect.
+  const int denoise_radius = session.denoise_radius();
   std::optional<LightmapEstimate> by_light = denoise_radius > 0 ? std::nullopt : session.published_lightmap_by_light();
   const bool layers_split = by_light.has_value();
-  LightmapEstimate estimate = by_light ? std::move(*by_light) : session.published_lightmap();
+  std::optional<DeviceDenoiseCounts> denoised;
+  LightmapEstimate estimate;
+  if (by_light) {
+    estimate = std::move(*by_light);
+  } else if (denoise_radius > 0) {
+    stage("denoise");
+    estimate = session.shown_lightmap(&denoised.emplace());
+    seconds["denoise"] = clock.lap();
+  } else {
+    estimate = session.published_lightmap();
+  }
   by_light.reset();
 
   PersistedScene persisted = session.persisted();
-  std::optional<IndirectDenoiseReport> denoised;
-  if (denoise_radius > 0) {
-    stage("denoise");
-    if (estimate.has_sh1())
-      throw BundleInputError((bundle / "manifest.json").string() +
-                             ": --denoise: the bundle has L1 (sh1) layers, which are not split into direct and indirect light");
-    estimate.light_layers = 0;
-    estimate.light_sums.clear();
-    denoised.emplace();
-    estimate = denoise_indirect(estimate, persisted.gbuffer, IndirectDenoiseSettings{.radius = denoise_radius}, &*denoised);
-    seconds["denoise"] = clock.lap();
-  }
   ProbeEstimate probe_estimate;
   const bool has_probes = persisted.has_probe_grid() && manifest.probes.has_value();
   if (has_probes) {
@@ -150,8 +146,8 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   if (denoised)
     report["denoise"] = {{"radius", denoise_radius},
                          {"texels", denoised->texels},
-                         {"mean_neighbours", denoised->mean_neighbours},
-                         {"seconds", denoised->seconds}};
+                         {"mean_neighbours", denoised->texels > 0 ? double(denoised->neighbours) / double(denoised->texels) : 0.0},
+                         {"seconds", seconds["denoise"]}};
   report["bundle_light_layers"] = manifest.light_layers ? json{{"count", manifest.light_layers->count}, {"written", true}}
                                                  : json{{"written", false}, {"why_not", light_layers_skipped}};
 

@@ -183,7 +183,7 @@ ExitanceRuntimeError exitance_runtime_page_info(const ExitanceRuntime* runtime, 
 
 namespace {
 
-// Page `page` of the runtime's published lightmap as bake would write it, after checking the
+// Page `page` of what the runtime shows (shown_lightmap) as bake would write it, after checking the
 // caller's size (one error naming the page and both sizes).
 formats::LightmapImage assembled_page(const ExitanceRuntime* runtime, uint32_t page, uint32_t width, uint32_t height) {
   if (page >= runtime->pages.size())
@@ -196,7 +196,7 @@ formats::LightmapImage assembled_page(const ExitanceRuntime* runtime, uint32_t p
   AssemblyOptions assembly;
   assembly.dilation_texels = dilation_texels(runtime);
   std::vector<formats::LightmapImage> pages =
-      assemble_lightmap_pages(runtime->session->persisted().gbuffer, runtime->session->published_lightmap(), assembly);
+      assemble_lightmap_pages(runtime->session->persisted().gbuffer, runtime->session->shown_lightmap(), assembly);
   return std::move(pages.at(page));
 }
 
@@ -258,6 +258,13 @@ ExitanceRuntimeError exitance_runtime_set_probe_budget_share(ExitanceRuntime* ru
     require(runtime != nullptr, "runtime is NULL");
     require(share >= 0 && share <= 1, "share is not in [0, 1]");
     runtime->session->set_probe_budget_share(share);
+  });
+}
+
+ExitanceRuntimeError exitance_runtime_set_denoise_radius(ExitanceRuntime* runtime, int32_t radius) {
+  return guarded("exitance_runtime_set_denoise_radius", [&] {
+    require(runtime != nullptr, "runtime is NULL");
+    runtime->session->set_denoise_radius(radius);
   });
 }
 

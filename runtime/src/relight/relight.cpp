@@ -88,6 +88,8 @@ json relight_bundle(const RelightOptions& options) {
   if (options.denoise_radius > 0 && baked.directional != "off")
     throw RelightInputError(options.bundle + ": --denoise: the bundle has L1 (" + baked.directional +
                             ") layers, which are not split into direct and indirect light");
+  // Frames then show the filtered light too (page images), as an engine's session would.
+  session->set_denoise_radius(options.denoise_radius);
   seconds["load"] = clock.lap();
   const OpenTimings& opened = session->open_timings();
   seconds["load_split"] = {{"read", opened.read},     {"lighting_scene", opened.lighting_scene}, {"device", opened.device},
@@ -248,7 +250,7 @@ json relight_bundle(const RelightOptions& options) {
     return run;
   }
   json written = write_refreshed_bundle(*session, out.string(), run, options.progress,
-                                        [&] { validation->throw_if_any(); }, options.denoise_radius);
+                                        [&] { validation->throw_if_any(); });
   for (auto& [stage, value] : written["seconds"].items()) seconds[stage] = value;
   written["seconds"] = seconds;
   if (options.frames > 0) written["frames"] = frames;

@@ -14,6 +14,7 @@
 #include "exitance/runtime/core/per_bounce_bake.h"
 #include "gpu_scene.h"
 #include "kernel_launches.h"
+#include "indirect_denoiser.h"
 #include "lightmap_page_images.h"
 #include "lightmap_driver.h"
 #include "probe_driver.h"
@@ -55,6 +56,9 @@ struct VulkanIntegrator::Impl {
   std::optional<LightmapPublisher> publisher;  // made at the first publish or upload
   std::optional<LightLayerScaler> scaler;      // made at the first scaling edit
   std::unique_ptr<LightmapPageImages> page_images;  // made at the first write_page_images
+  std::unique_ptr<IndirectDenoiser> denoiser;        // made at the first denoise_indirect
+  bool denoiser_stale = false;                       // a start with other texels since it was made
+  std::shared_ptr<DeviceLightmap> denoised;          // denoise_indirect's output, reused once let go
   // Device estimates publish() wrote, reused once their holders let go of them (an edit replaces
   // the previous estimate: at 1 M texels ~100 MB not allocated again).
   std::vector<std::shared_ptr<DeviceLightmap>> spare_lightmaps;
@@ -136,6 +140,7 @@ void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const Inte
   if (settings.guiding != GuidingMode::Off)
     throw std::runtime_error("Vulkan backend: guiding runs in whole bakes only, not in progressive accumulation (relight)");
   impl_->lightmap.start(gbuffer, settings, 0, texels_as_before, accumulation_cleared);
+  impl_->denoiser_stale |= !texels_as_before;
 }
 void VulkanIntegrator::start_progressive_change(const TexelGBuffer& gbuffer, const IntegratorSettings& settings,
                                                 const LightingScene& edited, const std::vector<GpuPunctualLight>& pairs,
@@ -149,6 +154,7 @@ void VulkanIntegrator::start_progressive_change(const TexelGBuffer& gbuffer, con
   if (pairs.size() / 2 > kMaxChangedLightPairs || (!pair_layers.empty() && pair_layers.size() != pairs.size() / 2))
     throw std::invalid_argument("Vulkan backend: at most kMaxChangedLightPairs pairs, each with its light layer");
   impl_->lightmap.start(gbuffer, settings, uint32_t(pairs.size() / 2), texels_as_before, accumulation_cleared, pair_layers);
+  impl_->denoiser_stale |= !texels_as_before;
 }
 uint64_t VulkanIntegrator::add_samples(uint32_t samples) { return impl_->lightmap.add_samples(samples); }
 uint64_t VulkanIntegrator::add_samples_to(const std::vector<uint32_t>& texels, uint32_t first_sample, uint32_t samples) {
@@ -233,6 +239,27 @@ const DevicePageImages& VulkanIntegrator::write_page_images(const DeviceLightmap
   return impl_->page_images->write(lightmap);
 }
 
+std::shared_ptr<DeviceLightmap> VulkanIntegrator::denoise_indirect(const DeviceLightmap& published, const TexelGBuffer& gbuffer,
+                                                                  int radius, DeviceDenoiseCounts* counts) {
+  if (radius < 1 || radius > 16) throw std::invalid_argument("denoise_indirect: radius " + std::to_string(radius) + " is not 1 to 16");
+  if (published.directional)
+    throw std::invalid_argument("denoise_indirect: the estimate has L1 sums, which are not split into direct and indirect light");
+  if (published.texels != gbuffer.texels.size())
+    throw std::invalid_argument("denoise_indirect: the estimate has " + std::to_string(published.texels) + " texels, the G-buffer " +
+                                std::to_string(gbuffer.texels.size()));
+  if (!impl_->denoiser || impl_->denoiser_stale || !impl_->denoiser->fits(gbuffer)) {
+    impl_->denoiser.reset();
+    impl_->denoiser = std::make_unique<IndirectDenoiser>(impl_->context, gbuffer);
+    impl_->denoiser_stale = false;
+  }
+  std::shared_ptr<DeviceLightmap>& out = impl_->denoised;
+  if (!out || out.use_count() > 1 || out->texels != published.texels || out->layers != published.layers)
+    out = std::make_shared<DeviceLightmap>(impl_->context, published.texels, published.layers, false, 0);
+  const DeviceDenoiseCounts filtered = impl_->denoiser->filter(published, *out, radius);
+  if (counts) *counts = filtered;
+  return out;
+}
+
 std::vector<float> VulkanIntegrator::read_page_image(size_t page) const {
   if (!impl_->page_images) throw std::logic_error("VulkanIntegrator::read_page_image before write_page_images");
   return impl_->page_images->read_back(page);
@@ -274,6 +301,7 @@ void VulkanIntegrator::update_moved_geometry(const LightingScene& edited, const 
 }
 void VulkanIntegrator::update_texels(const TexelGBuffer& gbuffer, const std::vector<uint32_t>& texels) {
   impl_->lightmap.update_texels(gbuffer, texels);
+  if (impl_->denoiser && !impl_->denoiser_stale) impl_->denoiser->update_texels(gbuffer, texels);
 }
 void VulkanIntegrator::update_geometry(const LightingScene& edited) {
   impl_->scene.update_geometry(edited);

@@ -121,6 +121,15 @@ ExitanceRuntimeError exitance_runtime_read_probes(ExitanceRuntime* runtime, floa
  * EXITANCE_RUNTIME_INVALID_ARGUMENT, nothing changed. */
 ExitanceRuntimeError exitance_runtime_set_probe_budget_share(ExitanceRuntime* runtime, double share);
 
+/* The texture-space filter of the indirect light (docs/runtime.md "Filtered indirect light"): with a
+ * radius of 1 to 16 texels, what read_page, read_page_channel, the page images and write_bundle show
+ * has each texel's indirect light averaged over atlas neighbours on the same surface (on the device,
+ * below a millisecond per million texels on an H200: bench/results/denoise.md); its direct light,
+ * and what the refresh keeps and replaces, are unchanged. 0 (the default) turns it off. A radius
+ * outside 0 to 16, or a radius > 0 on a bundle baked with --directional sh1:
+ * EXITANCE_RUNTIME_INVALID_ARGUMENT, nothing changed. */
+ExitanceRuntimeError exitance_runtime_set_denoise_radius(ExitanceRuntime* runtime, int32_t radius);
+
 /* Writes the refreshed bundle (lightmaps, probes, voxel exitance, the edited scene.bin) to
  * `output_folder` atomically; the loader (exitance_loader.h) opens it. */
 ExitanceRuntimeError exitance_runtime_write_bundle(ExitanceRuntime* runtime, const char* output_folder);

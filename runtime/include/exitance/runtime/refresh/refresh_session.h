@@ -70,6 +70,9 @@ struct RefreshSessionOptions {
   // every edit starts them again; published_probes() shows them. Off: probes stay as baked.
   bool refresh_probes = true;
   double probe_budget_share = 0.25;
+  // Filter the indirect light of what is shown in texture space, with this window radius in texels
+  // (1 to 16; 0: off, the default): RefreshSession::set_denoise_radius.
+  int denoise_radius = 0;
 };
 
 // Edits that change at most this many punctual lights (counted against the base) are estimated as
@@ -207,7 +210,21 @@ class RefreshSession {
   // has RefreshSessionOptions::proportional_split_samples. nullopt without light layers, during a
   // change estimate whose base has no split, or before that many samples.
   std::optional<LightmapEstimate> published_lightmap_by_light() const;
-  // What published_lightmap() holds, written into one RGBA32F device image per atlas page (E/pi,
+  // The texture-space filter of the indirect light (docs/runtime.md "Filtered indirect light"): from
+  // now on what is shown (shown_lightmap: read_page, the page images, published_voxel_exitance,
+  // write_refreshed_bundle) has each texel's indirect light averaged over atlas neighbours on the
+  // same surface within `radius` texels (bundle/indirect_denoise.h's filter, run on the device), its
+  // direct light as estimated; 0 turns it off. What texels publish (published_lightmap) and every
+  // rule that keeps or replaces it are unchanged: the filter only shapes what is shown. Throws
+  // std::invalid_argument (nothing changed) for a radius outside 0 to 16 and, for a radius > 0, on a
+  // bundle baked with L1 layers (not split into direct and indirect light).
+  void set_denoise_radius(int radius);
+  int denoise_radius() const;
+  // What an engine sees: published_lightmap() with its indirect light filtered where a denoise radius
+  // is set (then without L1 sums or light layers), else published_lightmap() itself. `counts`: what
+  // the filter did (left alone when it is off).
+  LightmapEstimate shown_lightmap(DeviceDenoiseCounts* counts = nullptr) const;
+  // What shown_lightmap() holds, written into one RGBA32F device image per atlas page (E/pi,
   // coverage in A, gutters dilated `dilation_texels` deep: the values assemble_lightmap_pages gives,
   // bit for bit), with no read-back; the images stay the same objects between calls.
   const DevicePageImages& publish_page_images(int dilation_texels);
@@ -242,7 +259,7 @@ class RefreshSession {
   // Throws std::invalid_argument outside [0, 1] (nothing changed).
   void set_probe_budget_share(double share);
   // The bundle's sparse voxel octree with the radiant exitance of what texels show now
-  // (published_lightmap; fill_svo_exitance, as write_refreshed_bundle writes svo.bin), without
+  // (shown_lightmap; fill_svo_exitance, as write_refreshed_bundle writes svo.bin), without
   // writing a bundle; nullopt when the bundle has no svo.bin. A read-back and a host pass over the
   // texels (0.1 s at 1 M texels on the H200's host: bench/results/host-stages.md).
   std::optional<formats::SparseVoxelOctree> published_voxel_exitance() const;
@@ -273,6 +290,8 @@ class RefreshSession {
   // `light_layers`: compose the light layers too (where what is published has a split by light to
   // keep: published_split_by_light()); page images and read-backs of totals need none.
   PublishedLightmap publish_on_device(bool clear_accumulation = false, bool light_layers = false) const;
+  // publish_on_device(), then filtered on the device where a denoise radius is set.
+  std::shared_ptr<DeviceLightmap> shown_on_device(DeviceDenoiseCounts* counts = nullptr) const;
   // Whether what publish_on_device gives now has light layers that split its totals by light.
   bool published_split_by_light() const;
   // An edit that only scaled lights (light_layer_edits.h): the accumulation and previous scaled per

@@ -30,12 +30,12 @@ using StageProgress = std::function<void(const std::string&, double, uint64_t)>;
 // device fails.
 // `check_before_write` runs after all computing and before the first file is written (a caller's
 // last chance to refuse, e.g. on validation-layer messages).
-// `denoise_radius` > 0: the written lightmap's indirect light filtered in texture space
-// (bundle/indirect_denoise.h, exitance-relight --denoise); the bundle then holds no light layers
-// (they are not split into direct and indirect light), and a session with L1 sums is refused
-// (BundleInputError). The session itself is not changed.
+// The lightmap written is what the session shows (RefreshSession::shown_lightmap): with a denoise
+// radius set, its indirect light filtered in texture space on the device (exitance-relight
+// --denoise); the bundle then holds no light layers (they are not split into direct and indirect
+// light) and the entry gets "denoise" (radius, texels, mean_neighbours, seconds).
 nlohmann::json write_refreshed_bundle(RefreshSession& session, const std::string& output, nlohmann::json report,
                                       const StageProgress& progress = {},
-                                      const std::function<void()>& check_before_write = {}, int denoise_radius = 0);
+                                      const std::function<void()>& check_before_write = {});
 
 }  // namespace exitance

@@ -35,7 +35,7 @@ struct RelightOptions {
   bool page_images = false;        // with frames: after each frame, the page images an engine samples written (publish_page_images), timed
   bool frame_errors = true;        // with frames: each frame's estimated error (a read-back of the sums between frames)
   // > 0: --denoise [--denoise-radius]: the written lightmap's indirect light filtered in texture
-  // space with this radius (bundle/indirect_denoise.h; what frames publish is not filtered).
+  // space with this radius (RefreshSession::set_denoise_radius: what frames show is filtered too).
   int denoise_radius = 0;
   std::optional<uint64_t> seed;    // default: the bake's
   int device_index = -1;           // Vulkan device; -1 = prefer a discrete GPU

@@ -100,6 +100,13 @@ struct PublishedLightmap {
   uint64_t sampled_texels = 0;        // with two or more
 };
 
+// What VulkanIntegrator::denoise_indirect filtered: texels with samples, and the neighbours with a
+// weight > 0 summed over them (each texel itself included).
+struct DeviceDenoiseCounts {
+  uint64_t texels = 0;
+  uint64_t neighbours = 0;
+};
+
 class VulkanIntegrator final : public Integrator {
  public:
   // Uploads the scene (its BVH4 as built by the offline stage or read from scene.bin). Throws
@@ -187,6 +194,15 @@ class VulkanIntegrator final : public Integrator {
   // The scaling kernel made (on lavapipe compiled) now rather than inside the first scaling edit.
   void prepare_light_layer_scaling();
   void scale_light_layers(const std::vector<Vec4>& factors, const DeviceLightmap* previous, bool previous_split);
+  // `published` (an estimate of `gbuffer`'s texels) with its indirect light filtered in texture space
+  // on the device (bundle/indirect_denoise.h's filter: the same weights and arithmetic, equal up to
+  // the rounding of exp and sqrt; shaders/wavefront/denoise_indirect.comp), into a device estimate
+  // with its texels and recorded layers and no L1 sums or light layers. What the filter reads of the
+  // G-buffer is uploaded at the first call and again after a start with other texels;
+  // update_texels patches it. One submission, waited for. std::invalid_argument for a radius outside
+  // 1 to 16 or an estimate with L1 sums (not split into direct and indirect light).
+  std::shared_ptr<DeviceLightmap> denoise_indirect(const DeviceLightmap& published, const TexelGBuffer& gbuffer, int radius,
+                                                   DeviceDenoiseCounts* counts = nullptr);
   // Writes `lightmap` (a published estimate of `gbuffer`'s texels) into one RGBA32F device image per
   // page, gutters dilated `dilation_texels` deep as assemble_lightmap_pages does (the same values
   // bit for bit), after every command submitted to the queue before; waits (bounded). The images
