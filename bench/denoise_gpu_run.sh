@@ -1,7 +1,8 @@
 #!/bin/bash
 # Runs on the GPU machine: exitance-relight with and without --denoise (bundle/indirect_denoise.h)
 # on the bundles that bench/refresh_change_gpu_pack.sh packs (SCENES="building courtyard": the
-# building at 12 texels/m, the courtyard at 28), path tracing from nothing (--ignore-baked) at
+# building at 12 texels/m, the courtyard at 28; with SCENES="ajar_room thin_walls city" the door-gap
+# room at 64, thin_walls at 128 and the open city at 1.5), path tracing from nothing (--ignore-baked) at
 # SPPS samples per texel, each output's relMSE against two 4096-spp relights (seeds 101, 202):
 # the filter's error and bias on the GPU's own estimates at 1 M texels, and its host time there.
 #   here: SCENES="building courtyard" bash bench/refresh_change_gpu_pack.sh build
@@ -24,7 +25,7 @@ for b in ${BUNDLES:-building courtyard}; do
       $R $W/$b.bake -o $W/$o.bake --spp $n --seed 3 --ignore-baked --no-light-layers $flag --json > $W/$o.json
       python3 -c "
 import json; r=json.load(open('$W/$o.json')); s=r['seconds']
-print('$o', 'lighting_s %.3f'%s['lighting'], 'denoise_s', s.get('denoise'), 'write_s %.3f'%s['write'], 'texels', r['live_texels'], 'denoise', r.get('denoise'))" >> $S
+print('$o', 'load_s %.2f device_s %.2f'%(s['load'], s['load_split']['device']), 'lighting_s %.3f'%s['lighting'], 'denoise_s', s.get('denoise'), 'write_s %.3f'%s['write'], 'texels', r['live_texels'], 'denoise', r.get('denoise'))" >> $S
       list="$list $W/$o.bake"
     done
   done

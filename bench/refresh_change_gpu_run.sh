@@ -35,7 +35,7 @@ report() {  # $1 the run's JSON, $2 its label
 import json; r=json.load(open('$1')); e=r['edits']; ms=[f['milliseconds'] for f in r['frames']]
 pi=[f['page_images_milliseconds'] for f in r['frames'] if 'page_images_milliseconds' in f]
 dn=r.get('denoise')
-print('$2', ('page_images_ms max %.3f'%max(pi)) if pi else '', ('denoise_s %.4f mean_neighbours %.1f'%(dn['seconds'], dn['mean_neighbours'])) if dn else '', 'edits_s %.4f'%r['seconds']['edits'], 'edit_ms', {k: round(v, 2) for k, v in e.get('milliseconds', {}).items()}, 'submissions', e.get('device_submissions'), 'moved_texels', e['moved_texels'], 'changed_lights', e['changed_lights'], 'frames', len(ms), 'frame_ms_sum %.1f max %.1f'%(sum(ms), max(ms)), 'over_17ms', sum(1 for m in ms if m > 17), 'spp', r['spp'], 'samples_added', [f['samples_added'] for f in r['frames']][:8])" >> $S
+print('$2', 'load_s %.2f device_s %.2f'%(r['seconds']['load'], r['seconds']['load_split']['device']), ('page_images_ms first %.1f then %s'%(pi[0], sorted(round(x, 3) for x in pi[1:]))) if pi else '', ('denoise_s %.4f mean_neighbours %.1f'%(dn['seconds'], dn['mean_neighbours'])) if dn else '', 'edits_s %.4f'%r['seconds']['edits'], 'edit_ms', {k: round(v, 2) for k, v in e.get('milliseconds', {}).items()}, 'submissions', e.get('device_submissions'), 'moved_texels', e['moved_texels'], 'changed_lights', e['changed_lights'], 'frames', len(ms), 'frame_ms_sum %.1f max %.1f'%(sum(ms), max(ms)), 'over_17ms', sum(1 for m in ms if m > 17), 'spp', r['spp'], 'samples_added', [f['samples_added'] for f in r['frames']][:8])" >> $S
 }
 for e in ${EDITS:-move double block}; do
   b=building; [ $e = block ] && b=city; [ $e = sun ] && b=courtyard

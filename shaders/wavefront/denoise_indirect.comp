@@ -34,6 +34,7 @@ layout(push_constant) uniform Push {
   uint layers;  // recorded layers (layer 0: the direct light)
   int radius;
   uint pass;
+  uint totals_only;  // 1: only the sums and sample counts are written (all the page images read)
 } push;
 
 const uint kNone = 0xffffffffu;
@@ -58,7 +59,8 @@ void write_indirect(uint t) {
 void copy_texel(uint t) {
   uint N = push.texel_count;
   for (uint k = 0u; k < 6u; ++k) out_sums[t * 6u + k] = in_sums[t * 6u + k];
-  for (uint l = 0u; l < push.layers; ++l)
+  uint layers = push.totals_only != 0u ? 0u : push.layers;
+  for (uint l = 0u; l < layers; ++l)
     for (uint c = 0u; c < 3u; ++c) out_layers[(l * N + t) * 3u + c] = in_layers[(l * N + t) * 3u + c];
   out_samples[t] = in_samples[t];
 }
@@ -86,7 +88,8 @@ uint filter_texel(uint t) {
   int r = push.radius;
   uint neighbours = 0u;
 
-  for (uint first = 1u; first == 1u || first < push.layers; first += kLayersPerWindow) {
+  uint layers = push.totals_only != 0u ? 1u : push.layers;
+  for (uint first = 1u; first == 1u || first < layers; first += kLayersPerWindow) {
     bool totals = first == 1u;
     double weight_sum = 0.0lf;
     dvec3 sum = dvec3(0.0lf), variance_sum = dvec3(0.0lf);
@@ -117,11 +120,14 @@ uint filter_texel(uint t) {
             variance_sum[c] += w * w * double(other_variance[c]);
           }
         }
-        double samples_j = double(in_samples[j]);
+        if (first >= layers) continue;
+        // indirect_denoise.cpp divides each term by the samples; one reciprocal per neighbour here
+        // (a double division is many instructions on a GPU; the results differ in the last bit).
+        double per_sample = w / double(in_samples[j]);
         for (uint q = 0u; q < kLayersPerWindow; ++q) {
           uint k = first + q;
-          if (k >= push.layers) break;
-          for (uint c = 0u; c < 3u; ++c) layer_sum[q][c] += w * in_layers[(k * N + j) * 3u + c] / samples_j;
+          if (k >= layers) break;
+          for (uint c = 0u; c < 3u; ++c) layer_sum[q][c] += per_sample * in_layers[(k * N + j) * 3u + c];
         }
       }
     // The texel itself always has weight 1 (same surface, offset 0), so weight_sum >= 1.
@@ -131,11 +137,11 @@ uint filter_texel(uint t) {
         double variance_of_mean = variance_sum[c] / (weight_sum * weight_sum);
         out_sums[t * 6u + c] = d * mean;  // set_total_sums
         out_sums[t * 6u + 3u + c] = d * mean * mean + d * (d - 1.0lf) * variance_of_mean;
-        out_layers[t * 3u + c] = in_layers[t * 3u + c];  // the direct light, kept
+        if (push.totals_only == 0u) out_layers[t * 3u + c] = in_layers[t * 3u + c];  // the direct light, kept
       }
     for (uint q = 0u; q < kLayersPerWindow; ++q) {
       uint k = first + q;
-      if (k >= push.layers) break;
+      if (k >= layers) break;
       for (uint c = 0u; c < 3u; ++c) out_layers[(k * N + t) * 3u + c] = d * layer_sum[q][c] / weight_sum;
     }
   }

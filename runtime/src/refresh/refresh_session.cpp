@@ -545,11 +545,11 @@ void RefreshSession::set_denoise_radius(int radius) {
 
 int RefreshSession::denoise_radius() const { return state_->denoise_radius; }
 
-std::shared_ptr<DeviceLightmap> RefreshSession::shown_on_device(DeviceDenoiseCounts* counts) const {
+std::shared_ptr<DeviceLightmap> RefreshSession::shown_on_device(DeviceDenoiseCounts* counts, bool totals_only) const {
   const State& s = *state_;
   const PublishedLightmap published = publish_on_device();
   if (s.denoise_radius == 0) return published.lightmap;
-  return s.integrator->denoise_indirect(*published.lightmap, s.persisted.gbuffer, s.denoise_radius, counts);
+  return s.integrator->denoise_indirect(*published.lightmap, s.persisted.gbuffer, s.denoise_radius, counts, totals_only);
 }
 
 LightmapEstimate RefreshSession::shown_lightmap(DeviceDenoiseCounts* counts) const {
@@ -940,7 +940,7 @@ std::optional<LightmapEstimate> RefreshSession::published_lightmap_by_light() co
 
 const DevicePageImages& RefreshSession::publish_page_images(int dilation_texels) {
   State& s = *state_;
-  return s.integrator->write_page_images(*shown_on_device(), s.persisted.gbuffer, dilation_texels);
+  return s.integrator->write_page_images(*shown_on_device(nullptr, true), s.persisted.gbuffer, dilation_texels);
 }
 
 int RefreshSession::page_dilation_texels() const {

@@ -18,7 +18,7 @@ constexpr size_t kRecordFloats = 8;  // [position, texel size], [normal, 0]
 struct DenoisePush {
   uint32_t texel_count, layers;
   int32_t radius;
-  uint32_t pass;
+  uint32_t pass, totals_only;
 };
 
 void write_record(float* r, const LiveTexel& t) {
@@ -89,7 +89,7 @@ void IndirectDenoiser::update_texels(const TexelGBuffer& gbuffer, const std::vec
   context_.upload_ranges(records_buffer_, records_.data(), byte_ranges(record_runs(sorted, kRecord), kRecord));
 }
 
-DeviceDenoiseCounts IndirectDenoiser::filter(const DeviceLightmap& in, DeviceLightmap& out, int radius) {
+DeviceDenoiseCounts IndirectDenoiser::filter(const DeviceLightmap& in, DeviceLightmap& out, int radius, bool totals_only) {
   if (radius < 1 || radius > 16) throw std::invalid_argument("IndirectDenoiser: radius " + std::to_string(radius) + " is not 1 to 16");
   if (in.texels != texels_ || out.texels != texels_ || out.layers != in.layers || out.directional || out.light_layers != 0)
     throw std::invalid_argument("IndirectDenoiser: the estimates are not shaped for the G-buffer's texels and layers");
@@ -121,7 +121,7 @@ DeviceDenoiseCounts IndirectDenoiser::filter(const DeviceLightmap& in, DeviceLig
   kernel_.bind(cmd);
   const uint32_t groups = uint32_t((texels_ + 63) / 64);
   for (uint32_t pass = 0; pass < 2; ++pass) {
-    const DenoisePush push{uint32_t(texels_), uint32_t(in.layers), radius, pass};
+    const DenoisePush push{uint32_t(texels_), uint32_t(in.layers), radius, pass, totals_only ? 1u : 0u};
     kernel_.push(cmd, &push, sizeof(push));
     vkCmdDispatch(cmd, groups, 1, 1);
     barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;

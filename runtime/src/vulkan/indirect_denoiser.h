@@ -32,7 +32,9 @@ class IndirectDenoiser {
   // sample counts kept. `out` has `in`'s texels and recorded layers and neither L1 sums nor light
   // layers (they are not split into direct and indirect light); `in`'s are not read. One
   // submission, waited for (bounded). std::invalid_argument for another shape or radius.
-  DeviceDenoiseCounts filter(const DeviceLightmap& in, DeviceLightmap& out, int radius);
+  // `totals_only`: only the sums and sample counts written (what page images read; out's layers are
+  // left as they were), at about half the cost with the default four recorded layers.
+  DeviceDenoiseCounts filter(const DeviceLightmap& in, DeviceLightmap& out, int radius, bool totals_only = false);
 
  private:
   Context& context_;

@@ -240,7 +240,7 @@ const DevicePageImages& VulkanIntegrator::write_page_images(const DeviceLightmap
 }
 
 std::shared_ptr<DeviceLightmap> VulkanIntegrator::denoise_indirect(const DeviceLightmap& published, const TexelGBuffer& gbuffer,
-                                                                  int radius, DeviceDenoiseCounts* counts) {
+                                                                  int radius, DeviceDenoiseCounts* counts, bool totals_only) {
   if (radius < 1 || radius > 16) throw std::invalid_argument("denoise_indirect: radius " + std::to_string(radius) + " is not 1 to 16");
   if (published.directional)
     throw std::invalid_argument("denoise_indirect: the estimate has L1 sums, which are not split into direct and indirect light");
@@ -255,7 +255,7 @@ std::shared_ptr<DeviceLightmap> VulkanIntegrator::denoise_indirect(const DeviceL
   std::shared_ptr<DeviceLightmap>& out = impl_->denoised;
   if (!out || out.use_count() > 1 || out->texels != published.texels || out->layers != published.layers)
     out = std::make_shared<DeviceLightmap>(impl_->context, published.texels, published.layers, false, 0);
-  const DeviceDenoiseCounts filtered = impl_->denoiser->filter(published, *out, radius);
+  const DeviceDenoiseCounts filtered = impl_->denoiser->filter(published, *out, radius, totals_only);
   if (counts) *counts = filtered;
   return out;
 }

@@ -290,8 +290,9 @@ class RefreshSession {
   // `light_layers`: compose the light layers too (where what is published has a split by light to
   // keep: published_split_by_light()); page images and read-backs of totals need none.
   PublishedLightmap publish_on_device(bool clear_accumulation = false, bool light_layers = false) const;
-  // publish_on_device(), then filtered on the device where a denoise radius is set.
-  std::shared_ptr<DeviceLightmap> shown_on_device(DeviceDenoiseCounts* counts = nullptr) const;
+  // publish_on_device(), then filtered on the device where a denoise radius is set (`totals_only`:
+  // the filtered estimate's layers not written, for the page images).
+  std::shared_ptr<DeviceLightmap> shown_on_device(DeviceDenoiseCounts* counts = nullptr, bool totals_only = false) const;
   // Whether what publish_on_device gives now has light layers that split its totals by light.
   bool published_split_by_light() const;
   // An edit that only scaled lights (light_layer_edits.h): the accumulation and previous scaled per

@@ -201,8 +201,10 @@ class VulkanIntegrator final : public Integrator {
   // G-buffer is uploaded at the first call and again after a start with other texels;
   // update_texels patches it. One submission, waited for. std::invalid_argument for a radius outside
   // 1 to 16 or an estimate with L1 sums (not split into direct and indirect light).
+  // `totals_only`: only the totals and sample counts are written (all write_page_images reads); the
+  // result's layers are then not those of the filtered estimate.
   std::shared_ptr<DeviceLightmap> denoise_indirect(const DeviceLightmap& published, const TexelGBuffer& gbuffer, int radius,
-                                                   DeviceDenoiseCounts* counts = nullptr);
+                                                   DeviceDenoiseCounts* counts = nullptr, bool totals_only = false);
   // Writes `lightmap` (a published estimate of `gbuffer`'s texels) into one RGBA32F device image per
   // page, gutters dilated `dilation_texels` deep as assemble_lightmap_pages does (the same values
   // bit for bit), after every command submitted to the queue before; waits (bounded). The images
