@@ -192,6 +192,40 @@ TEST(ProbeRefresh, VoxelExitanceIsReadableBetweenBundles) {
       lit += written.nodes[i].exitance[k] != 0;
     }
   EXPECT_GT(lit, 0u);
+
+  // The C API: the same values as the svo.bin its write_bundle writes (half floats times the scale);
+  // a wrong count is one line and writes nothing.
+  ExitanceRuntime* runtime = nullptr;
+  ASSERT_EQ(exitance_runtime_open(probe_bundle().string().c_str(), nullptr, &runtime), EXITANCE_RUNTIME_OK);
+  ASSERT_EQ(exitance_runtime_apply_edits(runtime, R"({"edits": [{"material": "CeilingLight", "emissiveFactor": [0.6, 0.85, 1.0]}]})"),
+            EXITANCE_RUNTIME_OK);
+  ExitanceRefreshReport frame;
+  ASSERT_EQ(exitance_runtime_refresh(runtime, 0, 4, &frame), EXITANCE_RUNTIME_OK);
+  uint32_t count = 0;
+  ASSERT_EQ(exitance_runtime_voxel_count(runtime, &count), EXITANCE_RUNTIME_OK);
+  ASSERT_EQ(count, uint32_t(written.nodes.size()));
+  std::vector<float> exitance(size_t(count) * 6, -1.0f);
+  EXPECT_EQ(exitance_runtime_read_voxel_exitance(runtime, exitance.data(), count - 1), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+  const std::string message = exitance_runtime_last_error_message();
+  EXPECT_NE(message.find("exitance_runtime_read_voxel_exitance: count"), std::string::npos) << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos);
+  EXPECT_EQ(exitance[0], -1.0f);
+  EXPECT_EQ(exitance_runtime_read_voxel_exitance(runtime, nullptr, count), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+  ASSERT_EQ(exitance_runtime_read_voxel_exitance(runtime, exitance.data(), count), EXITANCE_RUNTIME_OK);
+  const fs::path from_c = probe_bundle().parent_path() / "voxels-c.bake";
+  ASSERT_EQ(exitance_runtime_write_bundle(runtime, from_c.string().c_str()), EXITANCE_RUNTIME_OK) << exitance_runtime_last_error_message();
+  const formats::SparseVoxelOctree c_written = formats::read_svo_file((from_c / "svo.bin").string());
+  ASSERT_EQ(c_written.nodes.size(), size_t(count));
+  size_t differing = 0, nonzero = 0;
+  for (size_t i = 0; i < c_written.nodes.size(); ++i)
+    for (size_t k = 0; k < 6; ++k) {
+      const float value = formats::half_to_float(c_written.nodes[i].exitance[k]) * c_written.exitance_scale;
+      differing += exitance[i * 6 + k] != value;
+      nonzero += value != 0;
+    }
+  EXPECT_EQ(differing, 0u);
+  EXPECT_GT(nonzero, 0u);
+  exitance_runtime_release(runtime);
 }
 
 // An edit while only some probes show their refreshed estimate keeps exactly what each showed.

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "exitance/formats/format_error.h"
+#include "exitance/formats/sparse_voxel_octree.h"
 #include "exitance/runtime/bundle/lightmap_assembly.h"
 #include "exitance/runtime/refresh/refresh_session.h"
 #include "exitance/runtime/refresh/refreshed_bundle.h"
@@ -258,6 +259,30 @@ ExitanceRuntimeError exitance_runtime_set_probe_budget_share(ExitanceRuntime* ru
     require(runtime != nullptr, "runtime is NULL");
     require(share >= 0 && share <= 1, "share is not in [0, 1]");
     runtime->session->set_probe_budget_share(share);
+  });
+}
+
+ExitanceRuntimeError exitance_runtime_voxel_count(const ExitanceRuntime* runtime, uint32_t* out_count) {
+  return guarded("exitance_runtime_voxel_count", [&] {
+    require(runtime != nullptr && out_count != nullptr, "runtime or out_count is NULL");
+    const formats::SparseVoxelOctree* svo = runtime->session->svo();
+    *out_count = svo ? uint32_t(svo->nodes.size()) : 0u;
+  });
+}
+
+ExitanceRuntimeError exitance_runtime_read_voxel_exitance(ExitanceRuntime* runtime, float* out_exitance, uint32_t count) {
+  return guarded("exitance_runtime_read_voxel_exitance", [&] {
+    require(runtime != nullptr && (out_exitance != nullptr || count == 0), "runtime or out_exitance is NULL");
+    const formats::SparseVoxelOctree* bundled = runtime->session->svo();
+    const size_t nodes = bundled ? bundled->nodes.size() : 0;
+    if (count != nodes)
+      throw std::invalid_argument("count " + std::to_string(count) + " is not the bundle's " + std::to_string(nodes) +
+                                  " octree nodes (exitance_runtime_voxel_count)");
+    if (nodes == 0) return;
+    const std::optional<formats::SparseVoxelOctree> shown = runtime->session->published_voxel_exitance();
+    for (size_t i = 0; i < nodes; ++i)
+      for (size_t k = 0; k < 6; ++k)
+        out_exitance[i * 6 + k] = formats::half_to_float(shown->nodes[i].exitance[k]) * shown->exitance_scale;
   });
 }
 

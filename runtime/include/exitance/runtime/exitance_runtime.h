@@ -121,6 +121,17 @@ ExitanceRuntimeError exitance_runtime_read_probes(ExitanceRuntime* runtime, floa
  * EXITANCE_RUNTIME_INVALID_ARGUMENT, nothing changed. */
 ExitanceRuntimeError exitance_runtime_set_probe_budget_share(ExitanceRuntime* runtime, double share);
 
+/* The sparse voxel octree's radiant exitance as the runtime shows it now (docs/runtime.md "Voxel
+ * exitance"): per node of the bundle's svo.bin, in its order (breadth-first, formats/svo_format.md; the
+ * loader (exitance_loader.h) reads the structure), 6 floats: front RGB then back RGB, M = pi L_o in
+ * W/m^2 scene units, exactly what exitance_runtime_write_bundle would write into svo.bin (half
+ * floats times its scale) from what the runtime shows (filtered where a denoise radius is set).
+ * out_count: the octree's nodes, 0 when the bundle has no svo.bin. `count` must equal it; out_exitance
+ * holds 6 * count floats. A read-back of the lightmap and a host pass over the texels (~0.1 s at 1 M
+ * texels on the H200's host): not a per-frame call. */
+ExitanceRuntimeError exitance_runtime_voxel_count(const ExitanceRuntime* runtime, uint32_t* out_count);
+ExitanceRuntimeError exitance_runtime_read_voxel_exitance(ExitanceRuntime* runtime, float* out_exitance, uint32_t count);
+
 /* The texture-space filter of the indirect light (docs/runtime.md "Filtered indirect light"): with a
  * radius of 1 to 16 texels, what read_page, read_page_channel, the page images and write_bundle show
  * has each texel's indirect light averaged over atlas neighbours on the same surface (on the device,
