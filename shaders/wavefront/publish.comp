@@ -119,8 +119,9 @@ void main() {
     vec3 k = mean_total(kFromPrevious, t), f = mean_total(kFromAccumulation, t);
     double difference = 0.0lf;
     for (uint c = 0u; c < 3u; ++c) difference += (double(f[c]) - double(k[c])) * (double(f[c]) - double(k[c]));
+    bool all_zero = acc_sums[t * 6u] == 0.0lf && acc_sums[t * 6u + 1u] == 0.0lf && acc_sums[t * 6u + 2u] == 0.0lf;
     uint choice = publish_after_restart(prev_samples[t], acc_samples[t], difference, variance_sum(kFromPrevious, t),
-                                        variance_sum(kFromAccumulation, t));
+                                        variance_sum(kFromAccumulation, t), all_zero);
     uint from = choice == kPublishPrevious ? kFromPrevious : kFromAccumulation;
     copy_texel(from, t);
     published_samples = samples_of(from, t);

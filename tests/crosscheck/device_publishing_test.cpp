@@ -124,5 +124,41 @@ TEST(DevicePublishing, EqualsTheHostRuleTexelForTexel) {
   EXPECT_GT(refreshed_texels, 0u);
 }
 
+// A texel an edit covered: every refreshed sample 0 (publishing_rule.h's run of zeros). The box is
+// black with a small one-sided emitter under its ceiling facing down, so the ceiling's texels see
+// nothing lit and get exactly 0; the kept estimate shows them lit (as before an edit that covered
+// them). Device and host choose alike, and the run of zeros replaces the kept value.
+TEST(DevicePublishing, ACoveredTexelEqualsTheHostRule) {
+  const Vec3 black{0, 0, 0};
+  const Vec3 emission[6] = {black, black, black, black, black, black};
+  const testing::AtlasScene box = testing::atlas_box(0.0f, emission, 6, 0.3f, Vec3{4, 4, 4});
+  CREATE_VULKAN_OR_SKIP(vk, box.scene);
+  vk->start_progressive(box.gbuffer, settings(5, 1));
+  vk->add_samples(16);
+  LightmapEstimate previous = vk->progressive_estimate();
+  size_t ceiling = 0;
+  for (size_t i = 0; i < previous.texels.size(); ++i) {
+    TexelAccumulator& t = previous.texels[i];
+    if (box.gbuffer.texels[i].instance != 1) continue;
+    ASSERT_EQ(t.total[0], 0.0) << "a ceiling texel saw light: the test needs them dark";
+    // Mean 0.3, per-sample variance 0.05 per channel: nine zeros are improbable unchanged (at most
+    // (0.15 / 0.42)^9 = 1e-4), while the 3-sigma test alone keeps the value (0.27 < 4.27^2 x 0.026).
+    for (int c = 0; c < 3; ++c) t.total[c] = t.samples * 0.3, t.total_squared[c] = t.samples * (0.09 + 0.05 * 15.0 / 16.0);
+    ++ceiling;
+  }
+  ASSERT_GT(ceiling, 10u);
+  vk->start_progressive(box.gbuffer, settings(9, 1));
+  const std::shared_ptr<DeviceLightmap> previous_on_device = vk->upload_lightmap(previous);
+  vk->add_samples(9);
+  const LightmapEstimate accumulation = vk->progressive_estimate();
+  const LightmapEstimate host = publish_restart(previous, accumulation);
+  const PublishedLightmap restart = vk->publish(PublishMode::Restart, previous_on_device.get(), nullptr);
+  expect_same_estimate(vk->read_lightmap(*restart.lightmap), host, "restart over covered texels");
+  size_t covered_shown = 0;
+  for (size_t i = 0; i < host.texels.size(); ++i)
+    covered_shown += box.gbuffer.texels[i].instance == 1 && host.texels[i].samples == 9 && host.texels[i].total[0] == 0.0;
+  EXPECT_EQ(covered_shown, ceiling) << "every covered texel shows its 9 zeros";
+}
+
 }  // namespace
 }  // namespace exitance

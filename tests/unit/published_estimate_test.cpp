@@ -103,5 +103,30 @@ TEST(PublishedEstimate, ARestartKeepsThePreviousValueUntilTheRefreshedOneIsMoreP
   EXPECT_NEAR(publish_restart(previous, texel({9, 11, 9, 11, 9, 11, 9, 11})).mean_total(0)[0], 10.0, 1e-6);
 }
 
+// A texel the edit covered: every refreshed sample exactly 0. Under "nothing changed" a sample of
+// the kept value (non-negative, mean K, per-sample variance s^2 summed over the channels) is 0 with
+// probability at most s^2 / (s^2 + |K|^2), so n zeros have at most its n-th power.
+TEST(PublishedEstimate, ARestartShowsACoveredTexelOnceItsRunOfZerosIsImprobableUnchanged) {
+  const std::initializer_list<double> zeros8 = {0, 0, 0, 0, 0, 0, 0, 0};
+  // Kept: 16 samples of 1 and 3 (mean 2, s^2 = 3 x 16/15 = 3.2, |K|^2 = 12): a zero has probability
+  // at most 0.21, eight of them 3.9e-6 < 0.0027: refreshed. The 3-sigma test alone keeps it
+  // (12 < 4.53^2 x (1/5 + 2/5) = 12.3).
+  const LightmapEstimate sixteen = texel({1, 3, 1, 3, 1, 3, 1, 3, 1, 3, 1, 3, 1, 3, 1, 3});
+  EXPECT_EQ(publish_restart(sixteen, texel(zeros8)).texels[0].samples, 8u);
+  EXPECT_EQ(publish_restart(sixteen, texel(zeros8)).texels[0].total[0], 0.0);
+  // Eight samples of 0 but one (0.01): not a run of zeros, and not significant: kept.
+  EXPECT_EQ(publish_restart(sixteen, texel({0, 0, 0, 0, 0, 0, 0, 0.01})).texels[0].total[0], sixteen.texels[0].total[0]);
+  // Kept samples that are often 0 (0, 0, 0, 4: mean 1, s^2 = 3 x 3.2 = 9.6, |K|^2 = 3): a zero has
+  // probability at most 0.76 unchanged, eight of them 0.11: kept; 24 of them 0.0015: refreshed.
+  const LightmapEstimate often_dark = texel({0, 0, 0, 4, 0, 0, 0, 4, 0, 0, 0, 4, 0, 0, 0, 4});
+  EXPECT_EQ(publish_restart(often_dark, texel(zeros8)).texels[0].total[0], often_dark.texels[0].total[0]);
+  LightmapEstimate zeros24 = texel(zeros8);
+  zeros24.texels[0].samples = 24;
+  EXPECT_EQ(publish_restart(often_dark, zeros24).texels[0].samples, 24u);
+  // A kept value of 0 stays whatever the zeros (nothing to replace).
+  const LightmapEstimate dark = texel({0, 0, 0, 0});
+  EXPECT_EQ(publish_restart(dark, texel(zeros8)).texels[0].samples, 4u);
+}
+
 }  // namespace
 }  // namespace exitance

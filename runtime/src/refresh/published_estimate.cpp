@@ -99,9 +99,11 @@ LightmapEstimate publish_restart(const LightmapEstimate& previous, const Lightma
     const Vec3 k = previous.mean_total(i), f = refreshed.mean_total(i);
     double difference = 0;
     for (int c = 0; c < 3; ++c) difference += (double(f[c]) - k[c]) * (double(f[c]) - k[c]);
+    const TexelAccumulator& r = refreshed.texels[i];
+    const bool all_zero = r.total[0] == 0 && r.total[1] == 0 && r.total[2] == 0;
     const uint32_t choice =
-        publish_after_restart(previous.texels[i].samples, refreshed.texels[i].samples, difference,
-                              channel_sum(previous.variance_of_mean(i)), channel_sum(refreshed.variance_of_mean(i)));
+        publish_after_restart(previous.texels[i].samples, r.samples, difference, channel_sum(previous.variance_of_mean(i)),
+                              channel_sum(refreshed.variance_of_mean(i)), all_zero);
     if (choice == kPublishPrevious) copy_texel(previous, published, i);
   }
   return published;
