@@ -9,7 +9,8 @@
 # Mode "warmdn": "warm" with --denoise (the runtime's device filter of the indirect light: every frame's
 # page images and the written bundle show the filtered light; bench/results/denoise.md) and
 # --page-images (each frame's page images written and timed, the filter included). Mode "warmpi":
-# "warm" with --page-images alone, the same frames unfiltered.
+# "warm" with --page-images alone, the same frames unfiltered. Modes "warmp32", "changep32": "warm"
+# and "change" with --priority-samples 32 (the texels near a local edit get 32 samples first, not 16).
 # Mode "warm": the session refreshes WARM (16) samples per texel in 16 ms frames before the edit, as an
 # engine's session has when an edit comes (its passes are measured: the first frame after the edit
 # is sized, not a one-sample measurement).
@@ -57,6 +58,8 @@ for e in ${EDITS:-move double block}; do
         restart) flag=--ignore-baked;;
         warm) flag="--spp-before-edits ${WARM:-16}";;
         warmpi) flag="--spp-before-edits ${WARM:-16} --page-images";;
+        warmp32) flag="--spp-before-edits ${WARM:-16} --priority-samples 32";;
+        changep32) flag="--priority-samples 32";;
         warmdn) flag="--spp-before-edits ${WARM:-16} --page-images --denoise";;
       esac
       for v in ${RUNTIMES:-runtime}; do

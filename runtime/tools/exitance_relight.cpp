@@ -40,14 +40,18 @@ int main(int argc, char** argv) {
   bool denoise = false;
   int denoise_radius = 3;
   app.add_flag("--denoise", denoise,
-               "filter the written lightmap's indirect light in texture space (as bake --denoise; biased, off by "
-               "default; the bundle then holds no light layers; what frames publish is not filtered)");
+               "filter the indirect light of what the session shows in texture space, on the device (as bake "
+               "--denoise; biased, off by default): the written lightmap and each frame's page images; the bundle "
+               "then holds no light layers");
   app.add_option("--denoise-radius", denoise_radius, "--denoise window radius in texels (default 3)")->check(CLI::Range(1, 16));
   app.add_flag("--ignore-baked", ignore_baked,
                "start every texel from nothing instead of from the bundle's baked lightmap (which is shown until refreshed samples are better, and which light edits are estimated as a change from)");
   app.add_option("--spp-before-edits", options.samples_before_edits,
                  "with --edits: refresh this many samples per texel before applying them (a session that has been "
                  "running when the edit comes; benchmarks)");
+  app.add_option("--priority-samples", options.priority_samples,
+                 "after a local edit, the samples per texel the texels near it get before the others get any "
+                 "(default 32; 0: every pass takes every texel)");
   app.add_flag("--page-images", options.page_images,
                "with --frames: after each frame, write the lightmap pages into the device images an engine samples "
                "(exitance_runtime_publish_page_images) and report its milliseconds per frame");

@@ -98,7 +98,7 @@ struct RefreshSession::State {
       return next;
     }
   } pass_cost;
-  uint32_t priority_samples = 16;
+  uint32_t priority_samples = 32;
   // The accumulation since the last edit, as lists of texels with their sample counts: after a
   // local edit, the texels near it first (until priority_samples), then the others until they
   // catch up, then all together. Each list's texels share one count, so sample indices stay those

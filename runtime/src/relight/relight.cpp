@@ -63,6 +63,7 @@ json relight_bundle(const RelightOptions& options) {
   RefreshSessionOptions session_options;
   session_options.seed = options.seed;
   session_options.start_from_baked = options.from_baked;
+  session_options.priority_samples = options.priority_samples;
   // Light layers serve edits that come while frames refresh; a whole run after the edits (no
   // --frames, --budget-ms or --spp-before-edits) pays for them (11 % of its rays/s on the H200 at 22
   // layers: bench/results/light-layers.md) only to write them into the bundle (--light-layers).

@@ -31,6 +31,7 @@ struct RelightOptions {
   // Keep them in a whole run too (no --frames, --budget-ms or --spp-before-edits), so that the bundle
   // written holds them (docs/bundle.md "Light layers"); off: a whole run only pays for them.
   bool whole_run_light_layers = false;
+  uint32_t priority_samples = 32;  // RefreshSessionOptions::priority_samples (--priority-samples)
   uint32_t samples_before_edits = 0;  // > 0: refresh this many samples per texel before applying the edits
   bool page_images = false;        // with frames: after each frame, the page images an engine samples written (publish_page_images), timed
   bool frame_errors = true;        // with frames: each frame's estimated error (a read-back of the sums between frames)
