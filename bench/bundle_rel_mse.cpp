@@ -8,6 +8,9 @@
 // what remains is the TEST's error against the converged answer, bias included.
 // --by-reference K: also, per TEST, where its error is: the texels in K bins of equal count by the
 // reference's mean over the channels, each bin's mean reference and share of the TEST's raw sum.
+// --worst N: also, per TEST, its N texels of largest error (page, column, row, reference and TEST
+// channel means, share of the raw sum) and how few texels hold half its raw sum: a
+// few texels far off (a lit value where the reference is black) can dominate relMSE.
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -23,22 +26,29 @@
 namespace fs = std::filesystem;
 
 int main(int argc, char** argv) {
-  int bins = 0;
-  if (argc >= 3 && std::string(argv[1]) == "--by-reference") {
-    bins = std::atoi(argv[2]);
-    if (bins < 1 || bins > 100) {
-      std::fprintf(stderr, "bench_bundle_rel_mse: --by-reference: K must be 1 to 100, got '%s'\n", argv[2]);
+  int bins = 0, worst = 0;
+  while (argc >= 3 && (std::string(argv[1]) == "--by-reference" || std::string(argv[1]) == "--worst")) {
+    const bool by_reference = std::string(argv[1]) == "--by-reference";
+    const int value = std::atoi(argv[2]);
+    if (value < 1 || value > (by_reference ? 100 : 10000)) {
+      std::fprintf(stderr, "bench_bundle_rel_mse: %s: must be 1 to %d, got '%s'\n", argv[1], by_reference ? 100 : 10000, argv[2]);
       return 2;
     }
+    (by_reference ? bins : worst) = value;
     argv += 2, argc -= 2;
   }
   if (argc < 4) {
-    std::fprintf(stderr, "usage: bench_bundle_rel_mse [--by-reference K] REF_A.bake REF_B.bake TEST.bake [TEST.bake ...]\n");
+    std::fprintf(stderr, "usage: bench_bundle_rel_mse [--by-reference K] [--worst N] REF_A.bake REF_B.bake TEST.bake [TEST.bake ...]\n");
     return 2;
   }
   try {
     // Per compared texel: the reference's channel mean, and per TEST its weighted squared error.
     std::vector<double> reference_of_texel;
+    struct Where {
+      uint32_t page, x, y;
+    };
+    std::vector<Where> where_of_texel;
+    std::vector<std::vector<double>> test_of_texel(size_t(argc - 3));  // --worst: each TEST's channel mean
     std::vector<std::vector<double>> error_of_texel(size_t(argc - 3));
     std::vector<std::string> pages;
     for (const auto& entry : fs::directory_iterator(argv[1])) {
@@ -50,7 +60,8 @@ int main(int argc, char** argv) {
     double noise = 0;
     std::vector<double> sums(size_t(argc - 3), 0.0);
     size_t texels = 0;
-    for (const std::string& page : pages) {
+    for (size_t page_index = 0; page_index < pages.size(); ++page_index) {
+      const std::string& page = pages[page_index];
       const exitance::formats::LightmapImage a = exitance::formats::read_lightmap_exr((fs::path(argv[1]) / page).string());
       const exitance::formats::LightmapImage b = exitance::formats::read_lightmap_exr((fs::path(argv[2]) / page).string());
       std::vector<exitance::formats::LightmapImage> tests;
@@ -60,7 +71,7 @@ int main(int argc, char** argv) {
         if (!(a.channels.at("A")[i] >= 1.0f) || !(a.channels.at("valid")[i] > 0)) continue;
         ++texels;
         double reference_mean = 0;
-        std::vector<double> texel_error(tests.size(), 0.0);
+        std::vector<double> texel_error(tests.size(), 0.0), texel_value(tests.size(), 0.0);
         for (const char* c : channels) {
           const double va = a.channels.at(c)[i], vb = b.channels.at(c).at(i), r = 0.5 * (va + vb);
           const double w = rel_mse_weight(r);
@@ -70,11 +81,16 @@ int main(int argc, char** argv) {
             const double x = tests[t].channels.at(c).at(i);
             sums[t] += (x - r) * (x - r) * w;
             texel_error[t] += (x - r) * (x - r) * w;
+            texel_value[t] += x / 3;
           }
         }
-        if (bins > 0) {
+        if (bins > 0 || worst > 0) {
           reference_of_texel.push_back(reference_mean);
           for (size_t t = 0; t < tests.size(); ++t) error_of_texel[t].push_back(texel_error[t]);
+        }
+        if (worst > 0) {
+          where_of_texel.push_back({uint32_t(page_index), uint32_t(i % size_t(a.width)), uint32_t(i / size_t(a.width))});
+          for (size_t t = 0; t < tests.size(); ++t) test_of_texel[t].push_back(texel_value[t]);
         }
       }
     }
@@ -97,6 +113,20 @@ int main(int argc, char** argv) {
         }
         std::printf("\n");
       }
+    }
+    for (size_t t = 0; worst > 0 && t < sums.size() && texels > 0; ++t) {
+      std::vector<size_t> order(texels);
+      std::iota(order.begin(), order.end(), size_t(0));
+      std::sort(order.begin(), order.end(), [&](size_t x, size_t y) { return error_of_texel[t][x] > error_of_texel[t][y]; });
+      size_t half = 0;
+      for (double held = 0; half < texels && held < 0.5 * sums[t]; ++half) held += error_of_texel[t][order[half]];
+      std::printf("%s: %zu texels hold half the raw sum; worst (page x y: reference, test, share):", argv[t + 3], half);
+      for (size_t j = 0; j < std::min(texels, size_t(worst)); ++j) {
+        const size_t k = order[j];
+        std::printf(" [%s %u %u: %.4g %.4g %.4f]", pages[where_of_texel[k].page].c_str(), where_of_texel[k].x, where_of_texel[k].y,
+                    reference_of_texel[k], test_of_texel[t][k], sums[t] > 0 ? error_of_texel[t][k] / sums[t] : 0.0);
+      }
+      std::printf("\n");
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_bundle_rel_mse: %s\n", e.what());
