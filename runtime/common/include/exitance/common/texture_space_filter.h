@@ -43,9 +43,15 @@ const float kFilterRangeSigmas = 2.0f;
 // resting on a surface (a box on a floor): the floor under it is black, its neighbours lit, all on
 // one plane; their difference is many standard errors, so no light leaks in. Two exact values
 // (no variance) mix only if equal.
+// Beyond this exponent the weight is 0: exp(-80) = 1.8e-35 is still a normal float, so the host and a
+// device that flushes denormals to zero (lavapipe may) take the same neighbours.
+const float kFilterRangeCutoff = 80.0f;
+
 EXITANCE_FN float texture_space_filter_range_weight(float difference_squared, float variance_sum) {
   if (!(variance_sum > 0.0f)) return difference_squared > 0.0f ? 0.0f : 1.0f;
-  return exp(-difference_squared / (2.0f * kFilterRangeSigmas * kFilterRangeSigmas * variance_sum));
+  float exponent = difference_squared / (2.0f * kFilterRangeSigmas * kFilterRangeSigmas * variance_sum);
+  if (exponent > kFilterRangeCutoff) return 0.0f;
+  return exp(-exponent);
 }
 
 EXITANCE_NAMESPACE_END
