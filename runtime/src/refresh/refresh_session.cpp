@@ -255,6 +255,7 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   settings.light_layers = options.light_layers;
   // A bundle baked with directional layers is refreshed with them (the same estimator, path.h).
   if (baked.directional == "sh1") settings.directional = DirectionalMode::Sh1;
+  check_denoise_radius(options.denoise_radius, settings, "RefreshSessionOptions::denoise_radius");  // before the device is made
 
   try {
     state->lighting = std::make_shared<LightingScene>(build_lighting_scene(scene_of(*state), to_bvh4(state->persisted.bvh)));
@@ -273,7 +274,6 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   for (size_t i = 0; i < state->all_texels.size(); ++i) state->all_texels[i] = uint32_t(i);
   timings.indices = since();
   state->integrator->start_progressive(state->persisted.gbuffer, settings);
-  check_denoise_radius(options.denoise_radius, settings, "RefreshSessionOptions::denoise_radius");
   state->denoise_radius = options.denoise_radius;
   if (options.refresh_probes && state->persisted.has_probe_grid() && manifest.probes) {
     if (!(options.probe_budget_share > 0 && options.probe_budget_share <= 1))

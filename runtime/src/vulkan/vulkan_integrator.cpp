@@ -244,6 +244,8 @@ std::shared_ptr<DeviceLightmap> VulkanIntegrator::denoise_indirect(const DeviceL
   if (radius < 1 || radius > 16) throw std::invalid_argument("denoise_indirect: radius " + std::to_string(radius) + " is not 1 to 16");
   if (published.directional)
     throw std::invalid_argument("denoise_indirect: the estimate has L1 sums, which are not split into direct and indirect light");
+  if (published.layers < 1)
+    throw std::invalid_argument("denoise_indirect: the estimate records no direct light (layer 0) to keep apart from the indirect");
   if (published.texels != gbuffer.texels.size())
     throw std::invalid_argument("denoise_indirect: the estimate has " + std::to_string(published.texels) + " texels, the G-buffer " +
                                 std::to_string(gbuffer.texels.size()));
