@@ -39,4 +39,9 @@ class ComputeKernel {
   VkPipeline pipeline_ = VK_NULL_HANDLE;
 };
 
+// Records the zeroing of `counters` (a kernel's host-visible counts of what it did) and a barrier
+// that makes it, and every transfer or compute write recorded before, visible to the compute
+// shaders recorded next (publish.comp, denoise_indirect.comp).
+void clear_counters_before_compute(VkCommandBuffer cmd, const Buffer& counters);
+
 }  // namespace exitance::vulkan

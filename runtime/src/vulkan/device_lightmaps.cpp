@@ -81,18 +81,14 @@ PublishedLightmap LightmapPublisher::publish(PublishMode mode, const TexelAccumu
   write_set(infos);
 
   VkCommandBuffer cmd = context_.begin();
-  vkCmdFillBuffer(cmd, counts_.handle(), 0, VK_WHOLE_SIZE, 0);
-  VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-  barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
+  clear_counters_before_compute(cmd, counts_);
   kernel_.bind(cmd);
   // The light layers follow the recorded ones: composing only the first `layers` leaves them out.
   const PublishPush push{uint32_t(out->texels), uint32_t(out->layers + (light_layers ? out->light_layers : 0)),
                          out->directional ? 1u : 0u, uint32_t(mode)};
   kernel_.push(cmd, &push, sizeof(push));
   vkCmdDispatch(cmd, uint32_t((out->texels + 63) / 64), 1, 1);
+  VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   barrier.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
   barrier.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT |
                           VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_HOST_READ_BIT;

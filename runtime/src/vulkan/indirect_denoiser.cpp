@@ -90,7 +90,6 @@ void IndirectDenoiser::update_texels(const TexelGBuffer& gbuffer, const std::vec
 }
 
 DeviceDenoiseCounts IndirectDenoiser::filter(const DeviceLightmap& in, DeviceLightmap& out, int radius, bool totals_only) {
-  if (radius < 1 || radius > 16) throw std::invalid_argument("IndirectDenoiser: radius " + std::to_string(radius) + " is not 1 to 16");
   if (in.texels != texels_ || out.texels != texels_ || out.layers != in.layers || out.directional || out.light_layers != 0)
     throw std::invalid_argument("IndirectDenoiser: the estimates are not shaped for the G-buffer's texels and layers");
   DeviceDenoiseCounts counts;
@@ -112,14 +111,10 @@ DeviceDenoiseCounts IndirectDenoiser::filter(const DeviceLightmap& in, DeviceLig
   kernel_.write_buffers(0, infos.data(), kBindings);
 
   VkCommandBuffer cmd = context_.begin();
-  vkCmdFillBuffer(cmd, counts_.handle(), 0, VK_WHOLE_SIZE, 0);
-  VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-  barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
+  clear_counters_before_compute(cmd, counts_);
   kernel_.bind(cmd);
   const uint32_t groups = uint32_t((texels_ + 63) / 64);
+  VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   for (uint32_t pass = 0; pass < 2; ++pass) {
     const DenoisePush push{uint32_t(texels_), uint32_t(in.layers), radius, pass, totals_only ? 1u : 0u};
     kernel_.push(cmd, &push, sizeof(push));
