@@ -16,6 +16,7 @@
 #include "exitance/bake/distributed/mpi_work_share.h"
 #include "exitance/bake/input_error.h"
 #include "exitance/common/path_sampler.h"
+#include "exitance/common/texture_space_filter.h"
 #include "exitance/runtime/vulkan/vulkan_integrator.h"
 #include "exitance/runtime/tools/command_line_errors.h"
 #include "exitance/runtime/tools/progress_bar.h"
@@ -138,7 +139,7 @@ int main(int argc, char** argv) {
                "filter the indirect light in texture space after lighting (an edge-stopping average over atlas "
                "neighbours on the same surface; biased, off by default: docs/cli.md, bench/results/denoise.md)");
   app.add_option("--denoise-radius", options.denoise_radius, "--denoise window radius in texels (default 3)")
-      ->check(CLI::Range(1, 16));
+      ->check(CLI::Range(1, exitance::kFilterMaxRadius));
   app.add_option("--guiding", guiding,
                  "auto (default: path tracing on the CPU backend measures guided (grid) against unguided samples "
                  "during a pilot and keeps guiding per region where it pays; on Vulkan only when given (its pilot "

@@ -8,6 +8,7 @@
 #include <iostream>
 #include <optional>
 
+#include "exitance/common/texture_space_filter.h"
 #include "exitance/runtime/relight/relight.h"
 #include "exitance/runtime/tools/command_line_errors.h"
 #include "exitance/runtime/tools/progress_bar.h"
@@ -43,7 +44,7 @@ int main(int argc, char** argv) {
                "filter the indirect light of what the session shows in texture space, on the device (as bake "
                "--denoise; biased, off by default): the written lightmap and each frame's page images; the bundle "
                "then holds no light layers");
-  app.add_option("--denoise-radius", denoise_radius, "--denoise window radius in texels (default 3)")->check(CLI::Range(1, 16));
+  app.add_option("--denoise-radius", denoise_radius, "--denoise window radius in texels (default 3)")->check(CLI::Range(1, exitance::kFilterMaxRadius));
   app.add_flag("--ignore-baked", ignore_baked,
                "start every texel from nothing instead of from the bundle's baked lightmap (which is shown until refreshed samples are better, and which light edits are estimated as a change from)");
   app.add_option("--spp-before-edits", options.samples_before_edits,

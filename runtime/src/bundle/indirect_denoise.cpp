@@ -19,8 +19,9 @@ LightmapEstimate denoise_indirect(const LightmapEstimate& estimate, const TexelG
                                 " texels, the G-buffer " + std::to_string(n));
   if (estimate.light_layers > 0 || estimate.has_sh1())
     throw std::invalid_argument("denoise_indirect: light layers and L1 sums are not split into direct and indirect light");
-  if (settings.radius < 1 || settings.radius > 16)
-    throw std::invalid_argument("denoise_indirect: radius " + std::to_string(settings.radius) + " is not 1 to 16");
+  if (settings.radius < 1 || settings.radius > kFilterMaxRadius)
+    throw std::invalid_argument("denoise_indirect: radius " + std::to_string(settings.radius) + " is not 1 to " +
+                                std::to_string(kFilterMaxRadius));
 
   // Per page pixel, its live texel (or none): the neighbours of a texel are found by atlas offset.
   std::vector<size_t> page_first(gbuffer.pages.size() + 1, 0);

@@ -1,5 +1,6 @@
 #include "exitance/common/light_layers.h"
 #include "exitance/common/path_sampler.h"
+#include "exitance/common/texture_space_filter.h"
 #include "exitance/runtime/refresh/refresh_session.h"
 
 #include <algorithm>
@@ -170,7 +171,8 @@ struct RefreshSession::State {
 namespace {
 
 void check_denoise_radius(int radius, const IntegratorSettings& settings, const std::string& what) {
-  if (radius < 0 || radius > 16) throw std::invalid_argument(what + ": radius " + std::to_string(radius) + " is not 0 (off) to 16");
+  if (radius < 0 || radius > kFilterMaxRadius)
+    throw std::invalid_argument(what + ": radius " + std::to_string(radius) + " is not 0 (off) to " + std::to_string(kFilterMaxRadius));
   if (radius > 0 && settings.directional != DirectionalMode::Off)
     throw std::invalid_argument(what + ": the bundle has L1 (sh1) layers, which are not split into direct and indirect light");
 }

@@ -31,7 +31,8 @@ class IndirectDenoiser {
   // variance, layer 0 (the direct light) kept, layers 1 and up filtered with the same weights,
   // sample counts kept. `out` has `in`'s texels and recorded layers and neither L1 sums nor light
   // layers (they are not split into direct and indirect light); `in`'s are not read. One
-  // submission, waited for (bounded). std::invalid_argument for another shape or radius.
+  // submission, waited for (bounded). std::invalid_argument for another shape; the radius is
+  // VulkanIntegrator::denoise_indirect's to check.
   // `totals_only`: only the sums and sample counts written (what page images read; out's layers are
   // left as they were), at about half the cost with the default four recorded layers.
   DeviceDenoiseCounts filter(const DeviceLightmap& in, DeviceLightmap& out, int radius, bool totals_only = false);

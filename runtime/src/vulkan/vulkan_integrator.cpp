@@ -14,6 +14,7 @@
 #include "exitance/runtime/core/per_bounce_bake.h"
 #include "gpu_scene.h"
 #include "kernel_launches.h"
+#include "exitance/common/texture_space_filter.h"
 #include "indirect_denoiser.h"
 #include "lightmap_page_images.h"
 #include "lightmap_driver.h"
@@ -241,7 +242,8 @@ const DevicePageImages& VulkanIntegrator::write_page_images(const DeviceLightmap
 
 std::shared_ptr<DeviceLightmap> VulkanIntegrator::denoise_indirect(const DeviceLightmap& published, const TexelGBuffer& gbuffer,
                                                                   int radius, DeviceDenoiseCounts* counts, bool totals_only) {
-  if (radius < 1 || radius > 16) throw std::invalid_argument("denoise_indirect: radius " + std::to_string(radius) + " is not 1 to 16");
+  if (radius < 1 || radius > kFilterMaxRadius)
+    throw std::invalid_argument("denoise_indirect: radius " + std::to_string(radius) + " is not 1 to " + std::to_string(kFilterMaxRadius));
   if (published.directional)
     throw std::invalid_argument("denoise_indirect: the estimate has L1 sums, which are not split into direct and indirect light");
   if (published.layers < 1)

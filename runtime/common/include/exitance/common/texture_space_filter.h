@@ -11,6 +11,10 @@
 #include "exitance/common/dialect.h"
 EXITANCE_NAMESPACE_BEGIN
 
+// The largest window radius in texels (a (2 r + 1)^2 window): bake, exitance-relight and the runtime
+// accept 1 to this.
+const int kFilterMaxRadius = 16;
+
 // Normals of the same surface: cosine of the angle between them at least this (about 18 degrees).
 const float kFilterNormalCosine = 0.95f;
 // The neighbour's distance from the texel's plane, in the texel's world size, at most this.
