@@ -34,7 +34,6 @@ IndirectDenoiser::IndirectDenoiser(Context& context, const TexelGBuffer& gbuffer
       kernel_(context, std::vector<VkDescriptorType>(kBindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER), sizeof(DenoisePush),
               spirv_denoise_indirect, sizeof(spirv_denoise_indirect), 1, "denoise_indirect.comp") {
   const size_t n = texels_;
-  records_.resize(n * kRecordFloats);
   std::vector<uint32_t> where(n * 2), pages, pixels;
   for (const AtlasPage& page : gbuffer.pages) {
     if (page.width >= 65536 || page.height >= 65536)
@@ -46,13 +45,12 @@ IndirectDenoiser::IndirectDenoiser(Context& context, const TexelGBuffer& gbuffer
   }
   for (size_t i = 0; i < n; ++i) {
     const LiveTexel& t = gbuffer.texels[i];
-    write_record(&records_[i * kRecordFloats], t);
     where[i * 2] = t.page;
     where[i * 2 + 1] = t.x | (t.y << 16);
     pixels[pages[size_t(t.page) * 4] + size_t(t.y) * size_t(gbuffer.pages[t.page].width) + t.x] = uint32_t(i);
   }
   // Empty buffers are 16 bytes: a descriptor needs a buffer.
-  records_buffer_ = context.create_storage_buffer(std::max<size_t>(records_.size() * 4, 16));
+  records_buffer_ = context.create_storage_buffer(std::max<size_t>(n * kRecordFloats * 4, 16));
   where_ = context.create_storage_buffer(std::max<size_t>(where.size() * 4, 16));
   pages_ = context.create_storage_buffer(std::max<size_t>(pages.size() * 4, 16));
   pixels_ = context.create_storage_buffer(std::max<size_t>(pixels.size() * 4, 16));
@@ -60,7 +58,9 @@ IndirectDenoiser::IndirectDenoiser(Context& context, const TexelGBuffer& gbuffer
   counts_ = context.create_buffer(8, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
   std::vector<Context::RangeWrite> writes;
   if (n > 0) {
-    writes.push_back(Context::RangeWrite::whole(records_buffer_, records_.data(), records_.size() * 4));
+    writes.push_back({&records_buffer_, {{0, n * kRecordFloats * 4}}, [&](char* staging) {
+                        for (size_t i = 0; i < n; ++i) write_record(reinterpret_cast<float*>(staging) + i * kRecordFloats, gbuffer.texels[i]);
+                      }});
     writes.push_back(Context::RangeWrite::whole(where_, where.data(), where.size() * 4));
   }
   if (!pages.empty()) writes.push_back(Context::RangeWrite::whole(pages_, pages.data(), pages.size() * 4));
@@ -80,13 +80,18 @@ void IndirectDenoiser::update_texels(const TexelGBuffer& gbuffer, const std::vec
   for (uint32_t i : texels)
     if (i >= texels_ || i >= gbuffer.texels.size())
       throw std::out_of_range("IndirectDenoiser: texel " + std::to_string(i) + " of " + std::to_string(texels_));
-  // A moved texel keeps its atlas place (same G-buffer layout): only its world record changes.
-  for (uint32_t i : texels) write_record(&records_[size_t(i) * kRecordFloats], gbuffer.texels[i]);
+  // A moved texel keeps its atlas place (same G-buffer layout): only its world record changes. The
+  // runs' records are written from the G-buffer, the unchanged ones in joined gaps as they are.
   std::vector<uint32_t> sorted = texels;
   std::sort(sorted.begin(), sorted.end());
   sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
   constexpr size_t kRecord = kRecordFloats * 4;
-  context_.upload_ranges(records_buffer_, records_.data(), byte_ranges(record_runs(sorted, kRecord), kRecord));
+  const std::vector<std::pair<uint32_t, uint32_t>> runs = record_runs(sorted, kRecord);
+  context_.write_ranges(records_buffer_, byte_ranges(runs, kRecord), [&](char* staging) {
+    float* out = reinterpret_cast<float*>(staging);
+    for (const auto& [first, end] : runs)
+      for (uint32_t i = first; i < end; ++i, out += kRecordFloats) write_record(out, gbuffer.texels[i]);
+  });
 }
 
 DeviceDenoiseCounts IndirectDenoiser::filter(const DeviceLightmap& in, DeviceLightmap& out, int radius, bool totals_only) {

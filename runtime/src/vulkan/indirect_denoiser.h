@@ -41,7 +41,6 @@ class IndirectDenoiser {
   Context& context_;
   size_t texels_ = 0;
   std::vector<uint32_t> page_sizes_;  // [width, height] per page
-  std::vector<float> records_;        // host mirror of texel_records: 8 floats per texel
   Buffer records_buffer_, where_, pages_, pixels_, indirect_, counts_;
   ComputeKernel kernel_;
 };
