@@ -95,6 +95,13 @@ ShRgb ProbeEstimate::mean(size_t probe) const {
   return sh;
 }
 
+double ProbeEstimate::l0_variance_of_mean(size_t probe) const {
+  if (probe >= l0_square_sum.size()) return 0;
+  double variance = 0;
+  for (size_t c = 0; c < 3; ++c) variance += variance_of_mean_from_sums(sh_sum[probe][c], l0_square_sum[probe][c], samples[probe]);
+  return variance;
+}
+
 Vec3 ProbeEstimate::mean_axis_irradiance_over_pi(size_t probe, int axis) const {
   if (probe >= axis_irradiance_sum.size() || samples[probe] == 0) return {0, 0, 0};
   const auto& a = axis_irradiance_sum[probe];

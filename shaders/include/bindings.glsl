@@ -39,7 +39,9 @@ layout(std430, set = 0, binding = kBindingResults) buffer ResultBuffer { float r
 layout(std430, set = 0, binding = kBindingTexelSums) buffer AccumulatorBuffer { double acc_total[]; };  // [texel][total rgb, squared rgb]
 layout(std430, set = 0, binding = kBindingBounceSums) buffer BounceAccumulatorBuffer { double acc_bounce[]; };  // [k][texel][rgb]
 layout(std430, set = 0, binding = kBindingTexelSamples) buffer SampleCountBuffer { uint acc_samples[]; };
-layout(std430, set = 0, binding = kBindingProbeShSums) buffer ProbeShBuffer { double acc_probe_sh[]; };  // [probe][coefficient][rgb]
+// [probe][coefficient][rgb], then [probe][rgb] squared L0 terms, then [light layer][probe][coefficient][rgb]
+// (reduce_probes.comp; params.item_count_total probes)
+layout(std430, set = 0, binding = kBindingProbeShSums) buffer ProbeShBuffer { double acc_probe_sh[]; };
 // Per-bounce layer passes: the layers' atlas caches, in the probe SH sums' binding (gpu_layout.h kBindingBounceCache).
 layout(std430, set = 0, binding = kBindingBounceCache) readonly buffer BounceCacheBuffer { float bounce_cache[]; };
 // Path guiding: its header, locator, front, CDF and back sections, in the same binding (gpu_layout.h
@@ -69,14 +71,16 @@ uint queue_append(uint counter_slot) {
 
 // Texels: per work item, slots 0..K of E/pi by bounce. Probes (K = 1): slot 0 the radiance met by the
 // probe ray (sky or emission), slot 1 the path estimate of E/pi at its hit, then after all the
-// batch's slots, per work item, the hit's albedo (x < 0: back face) and the ray direction.
+// batch's slots, per work item, kProbeExtraWords: the hit's albedo (x < 0: back face), the ray
+// direction, and 1 + the light layer of what slot 0 met (0: nothing; probe light layers, reduce_probes).
 uint result_index(uint work, uint slot) { return (work * (params.recorded + 1u) + slot) * 3u; }
 
 // Per-bounce layer passes (one result slot, recorded = 0): per work item a flag, 1 when the texel's
 // continuation ray met a single-sided back face (layer 0), after the batch's slots.
 uint bounce_back_face_index(uint work) { return params.batch_work_total * 3u + work; }
 
-uint probe_extra_index(uint work) { return params.batch_work_total * 6u + work * 6u; }
+const uint kProbeExtraWords = 7u;  // runtime/src/vulkan/probe_driver.h kProbeResultBytes
+uint probe_extra_index(uint work) { return params.batch_work_total * 6u + work * kProbeExtraWords; }
 
 void add_result(uint work, uint depth, vec3 value) {
   uint i = result_index(work, min(depth, params.recorded));

@@ -45,11 +45,16 @@ void main() {
     next_depth = kBounceDirectRay;
   } else if (kProbeMode && depth == 0u) {
     vec3 albedo = vec3(0.0);
+    uint met_layer = 0u;  // 1 + the light layer of slot 0's radiance (0: none)
     if (tri == kInvalid) {
       add_result(work, 0u, scene_sky_radiance(wi));
+      met_layer = kSkyLightLayer + 1u;
     } else {
       ProbeHit h = shade_probe_hit(tri, hit.z, hit.w, wi);
-      if (h.radiance != vec3(0.0)) add_result(work, 0u, h.radiance);
+      if (h.radiance != vec3(0.0)) {
+        add_result(work, 0u, h.radiance);
+        met_layer = emitter_light_layer(tri) + 1u;
+      }
       albedo = h.back_face ? vec3(-1.0) : h.albedo;
       continues = h.continues;
       x = h.next;
@@ -58,6 +63,7 @@ void main() {
     results[e] = albedo.x;
     results[e + 1u] = albedo.y;
     results[e + 2u] = albedo.z;
+    results[e + 6u] = float(met_layer);
   } else if (tri == kInvalid) {
     // The change estimate (params.changed_light_pairs, path.h) adds no sky: it did not change.
     if (params.changed_light_pairs == 0u) {

@@ -16,6 +16,7 @@
 #include "exitance/formats/format_error.h"
 #include "exitance/formats/probes_file.h"
 #include "exitance/runtime/bundle/probe_results.h"
+#include "published_probes.h"
 #include "exitance/runtime/bundle/texel_exitance.h"
 #include "exitance/formats/scene_file.h"
 #include "exitance/formats/svo_file.h"
@@ -140,15 +141,17 @@ struct RefreshSession::State {
   uint32_t proportional_split_samples = 256;  // RefreshSessionOptions::proportional_split_samples
   // Refreshed probes (RefreshSessionOptions::refresh_probes; docs/runtime.md "Probes"): per refreshed
   // probe its index in persisted.probes and what it showed before (at open the bundle's probes.bin),
-  // shown until the refreshed estimate has probe_switch_samples; the bake's probe_spp as the target;
-  // the measured milliseconds per probe sample that size a call's batch.
+  // shown until the refreshed estimate is the better by the publishing rule (published_probes.h;
+  // where the kept value's variance is unknown, until it has probe_switch_samples); the bake's
+  // probe_spp as the target; the last full batch and its time, which size a call's batch.
   std::vector<size_t> probe_grid_index;
-  std::vector<std::array<float, 27>> previous_probes;
+  std::vector<KeptProbe> previous_probes;
   uint32_t probe_switch_samples = 0;
   uint32_t probe_target = 0;
   float probe_dering = 0;
   double probe_budget_share = 0.25;
-  double probe_ms_per_sample = 0;
+  size_t probe_last_batch = 0;    // probes in the last full batch of a call, and its milliseconds
+  double probe_last_batch_ms = 0;
   int denoise_radius = 0;  // set_denoise_radius: 0, or the filter's window radius in texels
   // A bake_per_bounce(), bake_guided() or bake_path() result: lightmap() until the next restart, edit
   // or refresh.
@@ -292,7 +295,7 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
     state->probe_budget_share = options.probe_budget_share;
     // What they show until refreshed: the bundle's probes.bin, as many samples as the bake gave
     // them (none when the bundle has lost it: then the refreshed estimate from its first set).
-    state->previous_probes.assign(positions.size(), std::array<float, 27>{});
+    state->previous_probes.assign(positions.size(), KeptProbe{});
     state->probe_switch_samples = 0;
     const fs::path probes_file = bundle / manifest.probes->file;
     if (fs::exists(probes_file)) {
@@ -301,13 +304,15 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
         if (baked_probes.probes.size() != probes.size())
           throw BundleInputError(probes_file.string() + ": " + std::to_string(baked_probes.probes.size()) +
                                  " probes, but scene.bin's probe grid has " + std::to_string(probes.size()));
-        for (size_t k = 0; k < positions.size(); ++k) state->previous_probes[k] = baked_probes.probes[state->probe_grid_index[k]].sh;
+        for (size_t k = 0; k < positions.size(); ++k)
+          state->previous_probes[k] = {baked_probes.probes[state->probe_grid_index[k]].sh, state->probe_target, -1.0};
         state->probe_switch_samples = state->probe_target;
       } catch (const formats::FormatError& e) {
         throw BundleInputError(e.what());
       }
     }
-    state->integrator->start_probe_refresh(positions);
+    // Kept per light layer as the texels are, so that an edit scaling lights scales them too.
+    state->integrator->start_probe_refresh(positions, settings.light_layers ? int(state->lighting->light_layer_count) : 0);
   }
   timings.texels = since();
   if (options.start_from_baked) {
@@ -364,7 +369,6 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   // lighting scene reads persisted.scene itself); nothing below throws for bad input.
   InPlaceEdits in_place = apply_scene_edits_in_place(s.persisted, edits, &s.instance_texels);
   const EditEffects& effects = in_place.effects;
-  restart_probes();
   // Edits of punctual lights alone upload the lights after the publish below, in the submission
   // that starts the accumulation again (start_progressive_change) or in one of their own.
   const bool punctual_only = !effects.geometry_changed() && effects.materials.empty() && !effects.sky && !effects.lights.empty();
@@ -400,6 +404,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   if (layer_lights_before) {
     const std::optional<std::vector<Vec4>> factors = light_layer_factors(*layer_lights_before, lighting, effects);
     if (factors && scale_light_layers(*factors, punctual_only)) {
+      scale_probes(*factors);
       timings.restart = since(lap);
       timings.scaled_light_layers = true;
       timings.device_submissions = s.integrator->waited_submissions() - submissions_before;
@@ -407,6 +412,20 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
       s.edit_timings = timings;
       return effects;
     }
+  }
+  {
+    // Probes start again, those nearest a local change first (a light moved, an instance moved);
+    // after a change everywhere (the sun, the sky, a material) in their own order.
+    std::vector<Vec3> points;
+    bool global = effects.sky || !effects.materials.empty();
+    for (uint32_t i : effects.lights) {
+      if (s.persisted.scene.lights[i].type == PunctualLight::Type::Directional) global = true;
+      points.push_back(was.light_positions[i]);
+      points.push_back(s.persisted.scene.lights[i].position);
+    }
+    std::vector<WorldBox> boxes = in_place.moved_boxes_before;
+    boxes.insert(boxes.end(), in_place.moved_boxes_after.begin(), in_place.moved_boxes_after.end());
+    restart_probes(global ? std::vector<Vec3>{} : points, global ? std::vector<WorldBox>{} : boxes);
   }
   if (effects.geometry_changed()) {
     // Moved texels leave their grid cells; the unocclude step again near the moved bounds (as a
@@ -497,32 +516,64 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   return effects;
 }
 
-void RefreshSession::restart_probes() {
+void RefreshSession::restart_probes(const std::vector<Vec3>& near_points, const std::vector<WorldBox>& near_boxes) {
   State& s = *state_;
   if (s.probe_grid_index.empty()) return;
-  // What each probe shows now is what it shows until its refreshed estimate of the edited scene has
-  // one stratified set (or the bake's probe_spp, if fewer).
+  // What each probe shows now is what it shows until its refreshed estimate of the edited scene is
+  // the better by the publishing rule (or, where what it shows has no known variance, until that
+  // estimate has one stratified set or the bake's probe_spp, if fewer).
   const uint32_t switch_samples = std::min(s.probe_target, kProbeStratifiedSetSize);
   if (s.integrator->probe_refresh_most_samples() > 0) {  // some probe may show its refreshed estimate
-    const formats::ProbeGrid shown = published_probes();
-    for (size_t k = 0; k < s.probe_grid_index.size(); ++k) s.previous_probes[k] = shown.probes[s.probe_grid_index[k]].sh;
+    std::vector<bool> refreshed_shown;
+    const ProbeEstimate refreshed = s.integrator->probe_refresh_estimate();
+    const formats::ProbeGrid shown = published_probes(refreshed, &refreshed_shown);
+    for (size_t k = 0; k < s.probe_grid_index.size(); ++k)
+      if (refreshed_shown[k])
+        s.previous_probes[k] = {shown.probes[s.probe_grid_index[k]].sh, refreshed.samples[k], refreshed.l0_variance_of_mean(k)};
   }
   s.probe_switch_samples = switch_samples;
-  s.integrator->clear_probe_refresh();
+  std::vector<Vec3> positions;
+  if (!near_points.empty() || !near_boxes.empty())
+    for (size_t i : s.probe_grid_index) {
+      const formats::ProbeRecord& r = s.persisted.probes.probes[i];
+      positions.push_back({r.position[0], r.position[1], r.position[2]});
+    }
+  s.integrator->clear_probe_refresh(probes_nearest_first(positions, near_points, near_boxes));
+}
+
+void RefreshSession::scale_probes(const std::vector<Vec4>& factors) {
+  State& s = *state_;
+  if (s.probe_grid_index.empty()) return;
+  if (s.integrator->probe_refresh_light_layers() != int(factors.size())) return restart_probes();
+  // What probes showed before the last edit, scaled by their refreshed estimate's split (a read-back
+  // of each scaled layer), then the refreshed sums themselves on the device: every sample kept.
+  if (s.integrator->probe_refresh_most_samples() > 0)
+    for (size_t l = 0; l < factors.size(); ++l)
+      if (factors[l].w != 0)
+        scale_kept_probes(s.previous_probes, s.integrator->probe_refresh_layer(int(l)), Vec4(factors[l].x, factors[l].y, factors[l].z, 0),
+                          s.probe_dering);
+  s.integrator->scale_probe_layers(factors);
 }
 
 formats::ProbeGrid RefreshSession::published_probes() const {
   const State& s = *state_;
   if (s.probe_grid_index.empty()) return {};
+  if (s.integrator->probe_refresh_most_samples() == 0) return published_probes(ProbeEstimate{}, nullptr);
+  return published_probes(s.integrator->probe_refresh_estimate(), nullptr);
+}
+
+formats::ProbeGrid RefreshSession::published_probes(const ProbeEstimate& refreshed, std::vector<bool>* refreshed_shown) const {
+  const State& s = *state_;
   formats::ProbeGrid grid = s.persisted.probes;
-  for (size_t k = 0; k < s.probe_grid_index.size(); ++k) grid.probes[s.probe_grid_index[k]].sh = s.previous_probes[k];
-  if (s.integrator->probe_refresh_most_samples() < std::max(1u, s.probe_switch_samples)) return grid;  // none refreshed enough
-  // The probes whose refreshed estimate has the samples the rule asks, as probes.bin stores them.
-  const ProbeEstimate refreshed = s.integrator->probe_refresh_estimate();
+  if (refreshed_shown) refreshed_shown->assign(s.probe_grid_index.size(), false);
+  for (size_t k = 0; k < s.probe_grid_index.size(); ++k) grid.probes[s.probe_grid_index[k]].sh = s.previous_probes[k].sh;
+  if (refreshed.samples.size() != s.probe_grid_index.size()) return grid;  // none refreshed
+  // The probes whose refreshed estimate the publishing rule prefers, as probes.bin stores them.
   std::vector<size_t> shown;
   ProbeEstimate subset;
   for (size_t k = 0; k < s.probe_grid_index.size(); ++k) {
-    if (refreshed.samples[k] == 0 || refreshed.samples[k] < s.probe_switch_samples) continue;
+    if (!probe_shows_refreshed(s.previous_probes[k], refreshed, k, std::max(1u, s.probe_switch_samples))) continue;
+    if (refreshed_shown) (*refreshed_shown)[k] = true;
     shown.push_back(s.probe_grid_index[k]);
     subset.sh_sum.push_back(refreshed.sh_sum[k]);
     subset.samples.push_back(refreshed.samples[k]);
@@ -563,6 +614,32 @@ void RefreshSession::set_probe_budget_share(double share) {
   if (!(share >= 0 && share <= 1))
     throw std::invalid_argument("probe budget share " + std::to_string(share) + " is not in [0, 1]");
   state_->probe_budget_share = share;
+}
+
+bool RefreshSession::refreshes_probes() const { return !state_->probe_grid_index.empty(); }
+
+RefreshSession::ProbeErrors RefreshSession::probe_errors() const {
+  const State& s = *state_;
+  ProbeErrors errors;
+  errors.probes = uint32_t(s.probe_grid_index.size());
+  if (s.probe_grid_index.empty()) return errors;
+  const ProbeEstimate refreshed = s.integrator->probe_refresh_most_samples() > 0 ? s.integrator->probe_refresh_estimate() : ProbeEstimate{};
+  std::vector<bool> refreshed_shown;
+  const formats::ProbeGrid shown = published_probes(refreshed, &refreshed_shown);
+  double sum = 0;
+  for (size_t k = 0; k < s.probe_grid_index.size(); ++k) {
+    const bool fresh = refreshed_shown[k];
+    errors.showing_refreshed += fresh;
+    const double variance = fresh ? refreshed.l0_variance_of_mean(k) : s.previous_probes[k].variance;
+    if (variance < 0 || (fresh && refreshed.samples[k] < 2)) continue;
+    double signal = 0;
+    const std::array<float, 27>& sh = shown.probes[s.probe_grid_index[k]].sh;
+    for (size_t c = 0; c < 3; ++c) signal += double(sh[c]) * sh[c];
+    sum += variance / (std::max(0.0, signal - variance) + 1e-3);
+    ++errors.with_variance;
+  }
+  errors.estimated_relative_mse = errors.with_variance > 0 ? sum / errors.with_variance : NAN;
+  return errors;
 }
 
 uint32_t RefreshSession::probe_samples() const {
@@ -670,16 +747,23 @@ RefreshReport RefreshSession::refresh(const RefreshBudget& budget) {
   // set for as many of the next probes as fit their share of the budget, by the measured cost.
   if (budget.milliseconds > 0 && s.probe_budget_share > 0 && !s.probe_grid_index.empty() &&
       integrator.probe_refresh_samples() < s.probe_target) {
-    const uint32_t set = std::min(kProbeStratifiedSetSize, s.probe_target);
     const double share = s.probe_budget_share * budget.milliseconds;
-    // Unmeasured: 16 probes, to measure; at least one probe a call, so probes always progress.
-    const size_t fitting = s.probe_ms_per_sample > 0 ? std::max<size_t>(1, size_t(share / (s.probe_ms_per_sample * set))) : 16;
+    // The batch is scaled by share / the last batch's time (a batch costs a fixed part, its pass,
+    // plus a part per probe: this converges on the batch whose time is the share), rounded up so
+    // that it can grow from one probe, and by at most 2x either way a call, so that one slow batch
+    // (a first dispatch that compiled its pipeline) costs a few calls, not the session. Unmeasured:
+    // 16 probes; at least one probe a call, so probes always progress.
+    size_t fitting = 16;
+    if (s.probe_last_batch > 0 && s.probe_last_batch_ms > 0) {
+      const double scaled = std::ceil(double(s.probe_last_batch) * share / s.probe_last_batch_ms);
+      fitting = size_t(std::clamp(scaled, std::max(1.0, std::floor(s.probe_last_batch / 2.0)), 2.0 * double(s.probe_last_batch)));
+    }
     const auto probes_start = Clock::now();
     size_t refreshed = 0;
     report.probe_rays = integrator.refresh_probe_set(s.settings, s.probe_target, fitting, &refreshed);
     report.probes_refreshed = uint32_t(refreshed);
     const double ms = std::chrono::duration<double, std::milli>(Clock::now() - probes_start).count();
-    if (refreshed > 0) s.probe_ms_per_sample = ms / (double(refreshed) * set);
+    if (refreshed > 0) s.probe_last_batch = refreshed, s.probe_last_batch_ms = ms;
   }
   report.probe_samples = s.probe_grid_index.empty() ? 0 : integrator.probe_refresh_samples();
   const uint32_t samples_before = samples_per_texel();

@@ -58,11 +58,16 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   const bool has_probes = persisted.has_probe_grid() && manifest.probes.has_value();
   if (has_probes) {
     stage("probes");
-    std::vector<size_t> traced;
-    for (size_t i = 0; i < persisted.probes.probes.size(); ++i)
-      if (formats::probe_is_usable(persisted.probes.probes[i])) traced.push_back(i);
-    probe_estimate = session.probe_estimate(baked.probe_spp);
-    store_probe_radiance(persisted.probes, traced, probe_estimate, baked.probe_dering_window);
+    if (session.refreshes_probes()) {
+      // What the refreshed probes show, as the pages hold what texels show (docs/runtime.md "Probes").
+      persisted.probes = session.published_probes();
+    } else {
+      std::vector<size_t> traced;
+      for (size_t i = 0; i < persisted.probes.probes.size(); ++i)
+        if (formats::probe_is_usable(persisted.probes.probes[i])) traced.push_back(i);
+      probe_estimate = session.probe_estimate(baked.probe_spp);
+      store_probe_radiance(persisted.probes, traced, probe_estimate, baked.probe_dering_window);
+    }
     seconds["probes"] = clock.lap();
   }
 
@@ -119,7 +124,7 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   report["source_bundle"] = fs::absolute(bundle).lexically_normal().string();
   report["source_generator"] = manifest.generator;
   report["what"] = std::string(report.contains("edits") ? "scene.bin edited, then " : "") +
-                   "full relight from scene.bin: lightmaps, probes and voxel exitance recomputed; " +
+                   "full relight from scene.bin: lightmaps, probes and voxel exitance recomputed (probes as refreshed in frames, where they were); " +
                    (session.started_from_baked() ? "input lightmaps the starting state (shown until refreshed samples are better)"
                                                  : "input lightmaps not read");
   report["device"] = integrator.device_description();
@@ -127,6 +132,9 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   report["seed"] = session.settings().seed;
   report["rays"] = estimate.rays;
   report["probe_rays"] = probe_estimate.rays;
+  // "refreshed": probes.bin holds what the session's refreshed probes show; "whole run": a probe
+  // bake of its own at the bake's probe spp.
+  if (has_probes) report["probes_written"] = session.refreshes_probes() ? "refreshed" : "whole run";
   report["estimated_relative_error"] = estimate.mean_relative_standard_error();
   const double relative_mse = RefreshSession::estimated_relative_mse(estimate);
   report["estimated_relative_mse"] = std::isfinite(relative_mse) ? json(relative_mse) : json(nullptr);

@@ -102,9 +102,10 @@ json relight_bundle(const RelightOptions& options) {
     report("refreshing before the edits", 0, 0);
     // With a frame budget, in frames of that budget (the pass costs the frames after the edits use
     // are then measured on frames like them); else in one call.
+    // Frames go on while they add samples to texels or probes (a frame may spend its budget on probes alone).
     RefreshReport before;
     do before = session->refresh({options.frame_budget_ms, options.samples_before_edits});
-    while (options.frame_budget_ms > 0 && !before.capped && before.rays > 0);
+    while (options.frame_budget_ms > 0 && !before.capped && (before.rays > 0 || before.probe_rays > 0));
     seconds["before_edits"] = clock.lap();
     edits_report["samples_before"] = before.samples_per_texel;
   }
@@ -193,6 +194,12 @@ json relight_bundle(const RelightOptions& options) {
                     {"samples_added", r.samples_added}, {"samples_per_texel", r.samples_per_texel}};
       if (r.probes_refreshed > 0 || r.probe_samples > 0)
         entry["probes"] = {{"refreshed", r.probes_refreshed}, {"rays", r.probe_rays}, {"samples", r.probe_samples}};
+      if (options.frame_errors && session->refreshes_probes()) {
+        const RefreshSession::ProbeErrors p = session->probe_errors();
+        json& probes = entry["probes"];
+        probes["showing_refreshed"] = p.showing_refreshed;
+        probes["estimated_relative_mse"] = std::isfinite(p.estimated_relative_mse) ? json(p.estimated_relative_mse) : json(nullptr);
+      }
       if (options.page_images) {  // what an engine's frame adds to hand the pages over on the device
         const auto images_start = Clock::now();
         session->publish_page_images(session->page_dilation_texels());

@@ -18,18 +18,25 @@ void upload_probe_items(Context& context, WorkItems& items, const std::vector<Ve
   if (!order.empty()) context.upload(items.batch_items, order.data(), order.size() * 4);
 }
 
-void read_probe_sums(Context& context, const ProbeAccumulators& accumulators, ProbeEstimate& estimate) {
+void read_probe_sums(Context& context, const ProbeAccumulators& accumulators, ProbeEstimate& estimate, int light_layers) {
   const size_t count = estimate.sh_sum.size();
   if (count == 0) return;
-  std::vector<double> sums(count * 27);
+  // Totals and squares first in the buffer, then the layers: light_layers 0 reads the former alone.
+  std::vector<double> sums(size_t(ProbeAccumulators::sum_bytes(count, light_layers) / 8));
   std::vector<uint32_t> counts(count * 2);
   context.download(accumulators.sh_sums, sums.data(), sums.size() * 8);
   context.download(accumulators.counts, counts.data(), counts.size() * 4);
+  estimate.l0_square_sum.assign(count, {});
   for (size_t i = 0; i < count; ++i) {
     std::copy(sums.begin() + std::ptrdiff_t(i * 27), sums.begin() + std::ptrdiff_t(i * 27 + 27), estimate.sh_sum[i].begin());
+    for (size_t c = 0; c < 3; ++c) estimate.l0_square_sum[i][c] = sums[count * 27 + i * 3 + c];
     estimate.samples[i] = counts[i * 2];
     estimate.backface_hits[i] = counts[i * 2 + 1];
   }
+  estimate.light_layers = light_layers;
+  estimate.light_sh_sum.assign(count * size_t(light_layers), {});
+  const double* layers = sums.data() + count * ProbeAccumulators::kSumsPerProbe;
+  for (size_t k = 0; k < estimate.light_sh_sum.size(); ++k) std::copy(layers + k * 27, layers + k * 27 + 27, estimate.light_sh_sum[k].begin());
 }
 
 // Start points with the position only, and the work list: the probes [first, end) in order.

@@ -11,14 +11,16 @@
 
 namespace exitance::vulkan {
 
-// Per probe work item: 2 result slots (12 bytes each), then albedo and direction (24 bytes).
-inline constexpr size_t kProbeResultBytes = 48;
+// Per probe work item: 2 result slots (12 bytes each), then albedo, direction and the light layer
+// slot 0 met (28 bytes; bindings.glsl kProbeExtraWords); light layers add 12 bytes each after them.
+inline constexpr size_t kProbeResultBytes = 52;
+inline constexpr uint32_t kProbeResultWords = uint32_t(kProbeResultBytes / 4);
 
 // The probes' start points (position only) and the work list of probes [first, end), in order.
 void upload_probe_items(Context& context, WorkItems& items, const std::vector<Vec3>& positions, size_t first, size_t end);
-// `sums`' SH sums, sample counts and back-face counts into `estimate`'s vectors, which hold one
-// entry per probe already (a read-back).
-void read_probe_sums(Context& context, const ProbeAccumulators& sums, ProbeEstimate& estimate);
+// `sums`' SH sums, squared L0 sums, sample counts, back-face counts and `light_layers` layers into
+// `estimate`, whose sh_sum, samples and backface_hits hold one entry per probe already (a read-back).
+void read_probe_sums(Context& context, const ProbeAccumulators& sums, ProbeEstimate& estimate, int light_layers = 0);
 
 class ProbeDriver {
  public:

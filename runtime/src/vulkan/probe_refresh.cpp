@@ -1,12 +1,19 @@
 #include "probe_refresh.h"
 
 #include <algorithm>
+#include <array>
+#include <cstring>
 #include <stdexcept>
 
+#include "exitance_spirv/scale_probe_layers.h"
 #include "probe_driver.h"
 
 namespace exitance::vulkan {
 namespace {
+
+struct ScalePush {
+  uint32_t probe_count, scaled;
+};
 
 // Binds the refresh's items and sums for as long as it lives, then the bake's again (also when a
 // batch throws), so a lightmap pass after it finds its own buffers bound.
@@ -29,24 +36,114 @@ class ProbeRefreshBinding {
 
 }  // namespace
 
-void ProbeRefresh::start(const std::vector<Vec3>& positions) {
+ProbeRefresh::ProbeRefresh(WavefrontBatchRunner& runner) : runner_(runner) {}
+ProbeRefresh::~ProbeRefresh() = default;
+
+void ProbeRefresh::start(const std::vector<Vec3>& positions, int light_layers) {
   if (positions.size() >= (1ull << 31)) throw std::runtime_error("Vulkan backend: too many probes");
   Context& context = runner_.context();
   WavefrontBuffers& buffers = runner_.buffers();
   samples_.assign(positions.size(), 0);
   next_ = 0;
+  // Layers only where their sums fit one storage buffer binding and a batch holds a set's work.
+  const VkDeviceSize limit = context.properties().limits.maxStorageBufferRange;
+  light_layers_ = std::max(0, light_layers);
+  if (ProbeAccumulators::sum_bytes(positions.size(), light_layers_) > limit ||
+      VkDeviceSize(kProbeStratifiedSetSize) * (kProbeResultBytes + 12 * size_t(light_layers_)) > limit)
+    light_layers_ = 0;
   if (positions.empty()) return;
   buffers.refresh_probe_items.reserve(context, positions.size());
-  buffers.refresh_probe_sums.reserve(context, positions.size());
+  buffers.refresh_probe_sums.reserve(context, positions.size(), light_layers_);
   upload_probe_items(context, buffers.refresh_probe_items, positions, 0, positions.size());
+  order_.resize(positions.size());
+  for (size_t i = 0; i < order_.size(); ++i) order_[i] = uint32_t(i);
+  identity_order_ = true;
+  if (light_layers_ > 0 && !scaling_) {
+    scaling_ = std::make_unique<ComputeKernel>(context, std::vector<VkDescriptorType>(2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER),
+                                               uint32_t(sizeof(ScalePush)), spirv_scale_probe_layers,
+                                               sizeof(spirv_scale_probe_layers), 1, "scale_probe_layers.comp");
+    factors_ = context.create_buffer(sizeof(Vec4) * size_t(light_layers_), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
+    // One dispatch over no probe, so a driver that compiles at the first dispatch (lavapipe) does
+    // it here and not inside the first edit.
+    const std::array<VkDescriptorBufferInfo, 2> infos{{{buffers.refresh_probe_sums.sh_sums.handle(), 0, VK_WHOLE_SIZE},
+                                                       {factors_.handle(), 0, VK_WHOLE_SIZE}}};
+    scaling_->write_buffers(0, infos.data(), 2);
+    VkCommandBuffer cmd = context.begin();
+    scaling_->bind(cmd, 0);
+    const ScalePush push{0, 0};
+    scaling_->push(cmd, &push, sizeof(push));
+    vkCmdDispatch(cmd, 1, 1, 1);
+    context.submit_and_wait(cmd);
+  }
   clear();
 }
 
-void ProbeRefresh::clear() {
+void ProbeRefresh::scale_layers(const std::vector<Vec4>& factors) {
+  if (light_layers_ == 0 || factors.size() != size_t(light_layers_))
+    throw std::logic_error("ProbeRefresh::scale_layers: factors for " + std::to_string(factors.size()) + " layers, the probes keep " +
+                           std::to_string(light_layers_));
+  std::vector<Vec4> scaled;
+  for (size_t l = 0; l < factors.size(); ++l)
+    if (factors[l].w != 0) scaled.push_back(Vec4(factors[l].x, factors[l].y, factors[l].z, float(l)));
+  if (scaled.empty() || samples_.empty()) return;
+  Context& context = runner_.context();
+  std::memcpy(factors_.mapped(), scaled.data(), scaled.size() * sizeof(Vec4));  // host-coherent
+  // The sums buffer may have grown since the descriptor was written.
+  const std::array<VkDescriptorBufferInfo, 2> infos{{{runner_.buffers().refresh_probe_sums.sh_sums.handle(), 0, VK_WHOLE_SIZE},
+                                                     {factors_.handle(), 0, VK_WHOLE_SIZE}}};
+  scaling_->write_buffers(0, infos.data(), 2);
+  VkCommandBuffer cmd = context.begin();
+  VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_HOST_WRITE_BIT;
+  barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_HOST_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
+  scaling_->bind(cmd, 0);
+  const ScalePush push{uint32_t(samples_.size()), uint32_t(scaled.size())};
+  scaling_->push(cmd, &push, sizeof(push));
+  vkCmdDispatch(cmd, uint32_t((samples_.size() + 63) / 64), 1, 1);
+  barrier.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+  barrier.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT |
+                          VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_HOST_READ_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
+                       &barrier, 0, nullptr, 0, nullptr);
+  context.submit_and_wait(cmd);
+}
+
+ProbeEstimate ProbeRefresh::read_layer(int layer) const {
+  if (layer < 0 || layer >= light_layers_) throw std::logic_error("ProbeRefresh::read_layer: no layer " + std::to_string(layer));
+  const size_t count = samples_.size();
+  ProbeEstimate estimate;
+  estimate.sh_sum.assign(count, std::array<double, 27>{});
+  estimate.samples.assign(count, 0);
+  estimate.backface_hits.assign(count, 0);
+  if (count == 0) return estimate;
+  Context& context = runner_.context();
+  const ProbeAccumulators& sums = runner_.buffers().refresh_probe_sums;
+  std::vector<uint32_t> counts(count * 2);
+  context.download(sums.counts, counts.data(), counts.size() * 4);
+  context.download(sums.sh_sums, estimate.sh_sum.data(), count * 27 * 8,
+                   VkDeviceSize(count) * (ProbeAccumulators::kSumsPerProbe + 27 * size_t(layer)) * 8);
+  for (size_t i = 0; i < count; ++i) estimate.samples[i] = counts[i * 2], estimate.backface_hits[i] = counts[i * 2 + 1];
+  return estimate;
+}
+
+void ProbeRefresh::clear(const std::vector<uint32_t>& order) {
   std::fill(samples_.begin(), samples_.end(), 0u);
   next_ = 0;
   if (samples_.empty()) return;
   Context& context = runner_.context();
+  if (!order.empty() || !identity_order_) {
+    if (!order.empty() && order.size() != samples_.size()) throw std::logic_error("ProbeRefresh::clear: an order of another probe count");
+    order_ = order;
+    if (order_.empty()) {
+      order_.resize(samples_.size());
+      for (size_t i = 0; i < order_.size(); ++i) order_[i] = uint32_t(i);
+    }
+    identity_order_ = order.empty();
+    context.upload(runner_.buffers().refresh_probe_items.batch_items, order_.data(), order_.size() * 4);
+  }
   VkCommandBuffer cmd = context.begin();
   runner_.buffers().refresh_probe_sums.clear(cmd);
   context.submit_and_wait(cmd);
@@ -60,35 +157,39 @@ uint64_t ProbeRefresh::add_set(const IntegratorSettings& settings, uint32_t targ
   // Probes [next_, end) share one sample count (round robin): one batch of their next set (the last
   // one cut at the target, as a whole-run bake's last pass is).
   if (next_ >= count) next_ = 0;
-  const uint32_t first_sample = samples_[next_];
+  const uint32_t first_sample = samples_[order_[next_]];
   if (first_sample >= target_samples) return 0;  // round robin: the rest have as many
   const uint32_t set = std::min(kProbeStratifiedSetSize, target_samples - first_sample);
-  const size_t max_work = runner_.work_items_per_batch(kProbeResultBytes);
+  const size_t max_work = runner_.work_items_per_batch(kProbeResultBytes + 12 * size_t(light_layers_));
   size_t per_batch = std::max<size_t>(1, max_work / set);
   if (max_probes > 0) per_batch = std::min(per_batch, max_probes);
   const size_t end = std::min(count, next_ + per_batch);
   Context& context = runner_.context();
-  runner_.buffers().results.reserve(context, std::max<size_t>(max_work, size_t(set)) * kProbeResultBytes);
+  runner_.buffers().results.reserve(context, std::max<size_t>(max_work, size_t(set)) * (kProbeResultBytes + 12 * size_t(light_layers_)));
   GpuParams params = runner_.bake_params(settings, 1, uint32_t(count));
   params.probe_spp = target_samples;
+  params.light_layers = uint32_t(light_layers_);
+  params.punctual_layers = runner_.scene().punctual_light_layers();
+  params.light_result_words = kProbeResultWords;
+  const size_t result_bytes = kProbeResultBytes + 12 * size_t(light_layers_);
   BatchTotals totals;
   {
     const ProbeRefreshBinding bound(runner_);
-    runner_.run(params, {uint32_t(next_), uint32_t(end - next_), first_sample, set}, kProbeResultBytes, kProbeBatch, totals);
+    runner_.run(params, {uint32_t(next_), uint32_t(end - next_), first_sample, set}, result_bytes, kProbeBatch, totals);
   }
-  for (size_t i = next_; i < end; ++i) samples_[i] += set;
+  for (size_t i = next_; i < end; ++i) samples_[order_[i]] += set;
   if (refreshed) *refreshed = end - next_;
   next_ = end;
   return totals.rays();
 }
 
-ProbeEstimate ProbeRefresh::read() const {
+ProbeEstimate ProbeRefresh::read(bool with_layers) const {
   const size_t count = samples_.size();
   ProbeEstimate estimate;
   estimate.sh_sum.assign(count, std::array<double, 27>{});
   estimate.samples.assign(count, 0);
   estimate.backface_hits.assign(count, 0);
-  read_probe_sums(runner_.context(), runner_.buffers().refresh_probe_sums, estimate);
+  read_probe_sums(runner_.context(), runner_.buffers().refresh_probe_sums, estimate, with_layers ? light_layers_ : 0);
   return estimate;
 }
 

@@ -5,29 +5,50 @@
 // lightmap passes. Its items and sums are buffers of their own (WavefrontBuffers::refresh_probe_*),
 // bound only while its batches run: the texels' start points and a whole-run probe bake stay as
 // they are.
+//
+// Light layers (docs/runtime.md "Probes"): with `light_layers` > 0 each probe also keeps its SH sums
+// per light layer (light_layers.h; reduce_probes.comp), so that an edit that only scales lights'
+// emission scales them exactly with 0 rays (scale_layers, scale_probe_layers.comp) and every sample
+// is kept. Where the sums would pass the device's largest storage buffer, the probes keep no layers.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "exitance/runtime/core/estimates.h"
 #include "exitance/runtime/core/integrator_settings.h"
+#include "compute_kernel.h"
 #include "wavefront_batch.h"
 
 namespace exitance::vulkan {
 
 class ProbeRefresh {
  public:
-  explicit ProbeRefresh(WavefrontBatchRunner& runner) : runner_(runner) {}
-  // The probes refreshed from now on (their positions uploaded), their sums cleared.
-  void start(const std::vector<Vec3>& positions);
-  // Every probe's sums cleared (an edit changed the scene); the positions kept.
-  void clear();
+  explicit ProbeRefresh(WavefrontBatchRunner& runner);
+  ~ProbeRefresh();
+  // The probes refreshed from now on (their positions uploaded), their sums cleared; `light_layers`
+  // as the scene's (0: none).
+  void start(const std::vector<Vec3>& positions, int light_layers = 0);
+  int light_layers() const { return light_layers_; }
+  // An edit that only scaled lights: `factors` per light layer (rgb, w = 1 where scaled), as
+  // LightLayerScaler takes them; every probe's sums scaled on the device, one submission. The
+  // factors must have light_layers() entries.
+  void scale_layers(const std::vector<Vec4>& factors);
+  // The sums of light layer `layer` (sh_sum per probe), its totals, squared L0 sums and counts: a
+  // read-back of that layer alone.
+  ProbeEstimate read_layer(int layer) const;
+  // Every probe's sums cleared (an edit changed the scene); the positions kept. `order` (empty: the
+  // probes' own order): the order the round robin visits them in from now on, a permutation of the
+  // probes (the probes nearest a local edit first).
+  void clear(const std::vector<uint32_t>& order = {});
   // The next probes' next stratified set, round robin over the probes: as many probes as one batch
   // holds and at most `max_probes` (0: no limit), never past `target_samples` per probe. Returns the
   // rays traced (0 once every probe has its target); `refreshed`: how many probes got their set.
   uint64_t add_set(const IntegratorSettings& settings, uint32_t target_samples, size_t max_probes = 0,
                    size_t* refreshed = nullptr);
-  ProbeEstimate read() const;  // a read-back: waits for the device
+  // A read-back (waits for the device): totals, squared L0 sums and counts, and with `with_layers`
+  // every light layer's sums (27 doubles per probe and layer).
+  ProbeEstimate read(bool with_layers = false) const;
   size_t probe_count() const { return samples_.size(); }
   // The fewest samples of a probe (every probe has whole sets).
   uint32_t least_samples() const;
@@ -37,7 +58,12 @@ class ProbeRefresh {
  private:
   WavefrontBatchRunner& runner_;
   std::vector<uint32_t> samples_;  // per probe, as the device's counts (back faces included)
-  size_t next_ = 0;                // the probe the next set starts at
+  std::vector<uint32_t> order_;    // the round robin's order (the device's batch items)
+  bool identity_order_ = true;
+  size_t next_ = 0;                // the position in order_ the next set starts at
+  int light_layers_ = 0;
+  std::unique_ptr<ComputeKernel> scaling_;  // scale_probe_layers.comp, made at a start with layers
+  Buffer factors_;
 };
 
 }  // namespace exitance::vulkan

@@ -124,13 +124,18 @@ ProbeEstimate VulkanIntegrator::bake_probes(const std::vector<Vec3>& positions, 
   return impl_->probes.bake(positions, settings);
 }
 
-void VulkanIntegrator::start_probe_refresh(const std::vector<Vec3>& positions) { impl_->probe_refresh.start(positions); }
-void VulkanIntegrator::clear_probe_refresh() { impl_->probe_refresh.clear(); }
+void VulkanIntegrator::start_probe_refresh(const std::vector<Vec3>& positions, int light_layers) {
+  impl_->probe_refresh.start(positions, light_layers);
+}
+void VulkanIntegrator::clear_probe_refresh(const std::vector<uint32_t>& order) { impl_->probe_refresh.clear(order); }
+int VulkanIntegrator::probe_refresh_light_layers() const { return impl_->probe_refresh.light_layers(); }
+void VulkanIntegrator::scale_probe_layers(const std::vector<Vec4>& factors) { impl_->probe_refresh.scale_layers(factors); }
+ProbeEstimate VulkanIntegrator::probe_refresh_layer(int layer) const { return impl_->probe_refresh.read_layer(layer); }
 uint64_t VulkanIntegrator::refresh_probe_set(const IntegratorSettings& settings, uint32_t target_samples, size_t max_probes,
                                              size_t* refreshed) {
   return impl_->probe_refresh.add_set(settings, target_samples, max_probes, refreshed);
 }
-ProbeEstimate VulkanIntegrator::probe_refresh_estimate() const { return impl_->probe_refresh.read(); }
+ProbeEstimate VulkanIntegrator::probe_refresh_estimate(bool with_layers) const { return impl_->probe_refresh.read(with_layers); }
 uint32_t VulkanIntegrator::probe_refresh_samples() const { return impl_->probe_refresh.least_samples(); }
 uint32_t VulkanIntegrator::probe_refresh_most_samples() const { return impl_->probe_refresh.most_samples(); }
 

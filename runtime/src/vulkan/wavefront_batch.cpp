@@ -166,7 +166,9 @@ void WavefrontBatchRunner::run(GpuParams& params, BatchRange range, size_t resul
                     std::to_string(idle_iterations) + " iterations (the bounce cap allows " + std::to_string(stall_limit) + ")");
   }
   KernelLaunches reduce = launches(timed);
-  reduce.launch(kernels.reduce_name, kernels.reduce, groups_for(range.count));
+  // Probe batches reduce one thread per probe and slot: its totals, then each light layer (reduce_probes.comp).
+  const uint32_t reduce_threads = kernels.reduce == Kernel::ReduceProbes ? range.count * (1 + params.light_layers) : range.count;
+  reduce.launch(kernels.reduce_name, kernels.reduce, groups_for(reduce_threads));
   copy_counters(reduce);
   reduce.submit_and_wait();
   check_faults(kernels.reduce_name);

@@ -95,8 +95,8 @@ void TexelAccumulators::bind(DescriptorWrites& writes) const {
 ProbeAccumulators::ProbeAccumulators(Context& context)
     : sh_sums(context.create_storage_buffer(kPlaceholder)), counts(context.create_storage_buffer(kPlaceholder)) {}
 
-void ProbeAccumulators::reserve(Context& context, size_t probes) {
-  grow(context, sh_sums, probes * 27 * 8);
+void ProbeAccumulators::reserve(Context& context, size_t probes, int light_layers) {
+  grow(context, sh_sums, sum_bytes(probes, light_layers));
   grow(context, counts, probes * 2 * 4);
 }
 

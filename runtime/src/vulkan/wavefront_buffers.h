@@ -121,11 +121,15 @@ struct TexelAccumulators {
 
 // Per probe, over the bake's samples: L2 SH sums (doubles) and counts.
 struct ProbeAccumulators {
-  Buffer sh_sums;  // [probe][coefficient][rgb]
+  // [probe][coefficient][rgb], then [probe][rgb] sums of squared L0 terms, then per light layer
+  // [layer][probe][coefficient][rgb] (reduce_probes.comp; bindings.glsl acc_probe_sh)
+  Buffer sh_sums;
   Buffer counts;   // [probe][samples, back-face hits]
 
+  static constexpr size_t kSumsPerProbe = 30;  // 27 SH sums and 3 squared L0 sums
+  static VkDeviceSize sum_bytes(size_t probes, int light_layers) { return VkDeviceSize(probes) * (kSumsPerProbe + 27 * size_t(light_layers)) * 8; }
   explicit ProbeAccumulators(Context& context);
-  void reserve(Context& context, size_t probes);
+  void reserve(Context& context, size_t probes, int light_layers = 0);
   // Per-bounce lightmap bakes keep their layer caches in sh_sums (gpu_layout.h kBindingBounceCache).
   void reserve_bytes(Context& context, VkDeviceSize sh_sum_bytes);
   void clear(VkCommandBuffer cmd) const;

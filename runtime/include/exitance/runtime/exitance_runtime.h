@@ -112,7 +112,8 @@ ExitanceRuntimeError exitance_runtime_read_page_channel(ExitanceRuntime* runtime
  * L2 SH of incident radiance (coefficient i, channel c at [i * 3 + c]; 0 for probes not in use).
  * out_count: the grid's probes, 0 when the bundle has none. `count` must equal it; out_sh holds
  * 27 * count floats. out_samples (may be NULL): the fewest refreshed samples of a probe since the
- * last edit. Reads the probes back from the device. */
+ * last edit that restarted them (an edit that only scales lights scales them and keeps every
+ * sample). Reads the probes back from the device. */
 ExitanceRuntimeError exitance_runtime_probe_count(const ExitanceRuntime* runtime, uint32_t* out_count);
 ExitanceRuntimeError exitance_runtime_read_probes(ExitanceRuntime* runtime, float* out_sh, uint32_t count,
                                                   uint32_t* out_samples);
@@ -142,7 +143,8 @@ ExitanceRuntimeError exitance_runtime_read_voxel_exitance(ExitanceRuntime* runti
 ExitanceRuntimeError exitance_runtime_set_denoise_radius(ExitanceRuntime* runtime, int32_t radius);
 
 /* Writes the refreshed bundle (lightmaps, probes, voxel exitance, the edited scene.bin) to
- * `output_folder` atomically; the loader (exitance_loader.h) opens it. */
+ * `output_folder` atomically, as the runtime shows them (the probes as refreshed, where the runtime
+ * refreshes them); the loader (exitance_loader.h) opens it. */
 ExitanceRuntimeError exitance_runtime_write_bundle(ExitanceRuntime* runtime, const char* output_folder);
 
 #ifdef __cplusplus

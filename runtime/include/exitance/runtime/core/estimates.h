@@ -124,11 +124,22 @@ struct ProbeEstimate {
   std::vector<std::array<double, 18>> axis_irradiance_sum;
   std::vector<uint32_t> samples;         // per probe
   std::vector<uint32_t> backface_hits;   // per probe: rays that hit the back of a single-sided surface
+  // Per probe, Vulkan runs only (empty elsewhere): sum over samples of (L_c(w) * Y_0 * 4pi)^2, the
+  // squares of each sample's L0 term, for the probe's error estimate (l0_variance_of_mean).
+  std::vector<std::array<double, 3>> l0_square_sum;
+  // The runtime's refreshed probes with light layers (vulkan/probe_refresh.h; docs/runtime.md
+  // "Probes"): per layer and probe, sh_sum's part from that light, at [layer * probes + probe]; the
+  // layers sum to sh_sum. Empty when light_layers is 0.
+  int light_layers = 0;
+  std::vector<std::array<double, 27>> light_sh_sum;
   uint64_t rays = 0;
   double seconds = 0;
   uint64_t nonfinite_samples = 0;
 
   ShRgb mean(size_t probe) const;  // SH coefficients of incident radiance
+  // The variance of the mean of L0 summed over rgb, as variance_of_mean_from_sums (publishing_rule.h);
+  // 0 without l0_square_sum or below 2 samples.
+  double l0_variance_of_mean(size_t probe) const;
   Vec3 mean_axis_irradiance_over_pi(size_t probe, int axis) const;  // axis 0..5 as above; 0 when absent
 };
 

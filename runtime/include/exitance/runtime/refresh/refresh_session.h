@@ -25,6 +25,7 @@
 
 #include "exitance/formats/bundle_manifest.h"
 #include "exitance/formats/probe_grid.h"
+#include "exitance/runtime/world_box.h"
 #include "exitance/formats/scene_file.h"
 #include "exitance/formats/sparse_voxel_octree.h"
 #include "exitance/runtime/core/estimates.h"
@@ -68,8 +69,9 @@ struct RefreshSessionOptions {
   uint32_t proportional_split_samples = 256;
   // Refresh the bundle's light probes in the same frames (docs/runtime.md "Probes"): each refresh
   // call with a time budget gives the next batch of probes a stratified set of samples (at most
-  // `probe_budget_share` of the budget, from the measured cost), up to the bake's probe_spp, and
-  // every edit starts them again; published_probes() shows them. Off: probes stay as baked.
+  // `probe_budget_share` of the budget, from the measured cost), up to the bake's probe_spp; an edit
+  // that only scales lights scales their light layers (with light_layers), every other edit starts
+  // them again; published_probes() shows them. Off: probes stay as baked.
   bool refresh_probes = true;
   double probe_budget_share = 0.25;
   // Filter the indirect light of what is shown in texture space, with this window radius in texels
@@ -249,13 +251,25 @@ class RefreshSession {
   // a whole run of its own (write_refreshed_bundle), not the refreshed probes below.
   ProbeEstimate probe_estimate(uint32_t spp);
   // The probe grid as probes.bin stores it (docs/bundle.md), with what the probes show now: per
-  // usable probe, the refreshed estimate once it has the samples the publishing rule asks
-  // (docs/runtime.md "Probes": after an edit, one stratified set or the bake's probe_spp if fewer;
-  // at open, as many as the bundle's own), else what it showed before (at open the bundle's
-  // probes.bin). Empty (no probes) when the bundle has no probe grid. A read-back of the probes' sums.
+  // usable probe, the refreshed estimate where the publishing rule prefers it to what the probe
+  // showed before (docs/runtime.md "Probes"; published_probes.h), else that (at open the bundle's
+  // probes.bin, replaced at as many samples as it has). Empty (no probes) when the bundle has no
+  // probe grid. A read-back of the probes' sums.
   formats::ProbeGrid published_probes() const;
   // Probes refreshed since the last edit (or open), and the fewest samples one of them has.
   uint32_t probe_samples() const;
+  // Whether the session refreshes the bundle's probes (RefreshSessionOptions::refresh_probes, and
+  // the bundle has a probe grid and probes.bin's entry).
+  bool refreshes_probes() const;
+  // What the probes show, for a report: how many show their refreshed estimate, and the mean over
+  // the probes whose shown value has a known variance (refreshed, or kept from a refreshed
+  // estimate) of their L0's estimated relMSE, sum_c v_c / (sum_c max(0, m_c^2 - v_c) + 1e-3) as
+  // estimated_relative_mse does for texels (NaN when none has one). A read-back of the probes' sums.
+  struct ProbeErrors {
+    uint32_t probes = 0, showing_refreshed = 0, with_variance = 0;
+    double estimated_relative_mse = 0;
+  };
+  ProbeErrors probe_errors() const;
   // The share of each refresh call's time budget the probes get from now on (RefreshSessionOptions::
   // probe_budget_share), in [0, 1]; 0: no probe is refreshed (each keeps showing what it shows).
   // Throws std::invalid_argument outside [0, 1] (nothing changed).
@@ -282,8 +296,16 @@ class RefreshSession {
  private:
   explicit RefreshSession(std::unique_ptr<State> state);
   void end_change_estimate();
-  // An edit: what probes show is kept as what they showed before, and their refresh starts again.
-  void restart_probes();
+  // An edit: what probes show is kept as what they showed before, and their refresh starts again,
+  // nearest the points and boxes first (none: in the grid's order).
+  void restart_probes(const std::vector<Vec3>& near_points = {}, const std::vector<WorldBox>& near_boxes = {});
+  // An edit that only scaled lights (factors as scale_light_layers'): the probes' sums scaled per
+  // light layer on the device and what they showed before by their split, every sample kept;
+  // restart_probes() where the probes keep no light layers.
+  void scale_probes(const std::vector<Vec4>& factors);
+  // published_probes() from a read-back `refreshed` (empty: none refreshed); `refreshed_shown`, per
+  // refreshed probe, whether it shows its refreshed estimate.
+  formats::ProbeGrid published_probes(const ProbeEstimate& refreshed, std::vector<bool>* refreshed_shown) const;
   // `texels_as_before`: the G-buffer's texels are those of the accumulation's last start (no
   // instance moved): not uploaded again.
   void restart(bool texels_as_before);

@@ -139,12 +139,22 @@ class VulkanIntegrator final : public Integrator {
   // so that N samples of a probe are bake_probes' N samples with the same seed. Their own buffers:
   // bake_probes and the lightmap's accumulation do not disturb them, nor they those. start clears
   // the sums; clear_probe_refresh clears them again (an edit). Settings used as by bake_probes.
-  void start_probe_refresh(const std::vector<Vec3>& positions);
-  void clear_probe_refresh();
+  // `light_layers`: the scene's light layers, kept per probe too (0: none; fewer where they would
+  // not fit the device: probe_refresh_light_layers says).
+  void start_probe_refresh(const std::vector<Vec3>& positions, int light_layers = 0);
+  // `order`: the probes nearest a local edit first (ProbeRefresh::clear); empty: their own order.
+  void clear_probe_refresh(const std::vector<uint32_t>& order = {});
+  int probe_refresh_light_layers() const;
+  // An edit that only scaled lights (factors as scale_light_layers'): the probes' sums scaled on the
+  // device, 0 rays, every sample kept. Needs probe_refresh_light_layers() == factors.size().
+  void scale_probe_layers(const std::vector<Vec4>& factors);
+  // One light layer's sums per probe (with the probes' counts): a read-back of that layer alone.
+  ProbeEstimate probe_refresh_layer(int layer) const;
   // At most `max_probes` probes (0: as many as one batch holds); `refreshed`: how many got their set.
   uint64_t refresh_probe_set(const IntegratorSettings& settings, uint32_t target_samples, size_t max_probes = 0,
                              size_t* refreshed = nullptr);
-  ProbeEstimate probe_refresh_estimate() const;  // a read-back
+  // A read-back: totals, squared L0 sums and counts; with `with_layers`, the light layers' sums too.
+  ProbeEstimate probe_refresh_estimate(bool with_layers = false) const;
   uint32_t probe_refresh_samples() const;         // the fewest samples of a probe
   uint32_t probe_refresh_most_samples() const;    // the most (0: none refreshed)
 

@@ -1,0 +1,59 @@
+#include "published_probes.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "exitance/common/publishing_rule.h"
+#include "exitance/runtime/spherical_harmonics.h"
+
+namespace exitance {
+
+bool probe_shows_refreshed(const KeptProbe& kept, const ProbeEstimate& refreshed, size_t k, uint32_t switch_samples) {
+  const uint32_t n = refreshed.samples[k];
+  if (n == 0) return false;
+  if (kept.variance < 0 || k >= refreshed.l0_square_sum.size()) return n >= switch_samples;
+  double difference_squared = 0;
+  bool all_zero = true;
+  for (size_t c = 0; c < 3; ++c) {
+    const double d = refreshed.sh_sum[k][c] / n - double(kept.sh[c]);  // L0: the dering window keeps band 0
+    difference_squared += d * d;
+    all_zero = all_zero && refreshed.sh_sum[k][c] == 0 && refreshed.l0_square_sum[k][c] == 0;
+  }
+  return publish_after_restart(kept.samples, n, difference_squared, kept.variance, refreshed.l0_variance_of_mean(k), all_zero) ==
+         kPublishRefreshed;
+}
+
+void scale_kept_probes(std::vector<KeptProbe>& kept, const ProbeEstimate& layer, Vec4 factor, float dering_window) {
+  for (size_t k = 0; k < kept.size() && k < layer.samples.size(); ++k) {
+    if (layer.samples[k] == 0) continue;
+    ShRgb mean = layer.mean(k);
+    if (dering_window > 0) sh_apply_hanning_window(mean, dering_window);
+    KeptProbe& probe = kept[k];
+    const float f[3] = {factor.x, factor.y, factor.z};
+    double before = 0, after = 0;
+    for (size_t i = 0; i < 9; ++i)
+      for (size_t c = 0; c < 3; ++c) {
+        float& value = probe.sh[i * 3 + c];
+        const float scaled = value + (f[c] - 1.0f) * mean[i][int(c)];
+        if (i == 0) before += double(value) * value, after += double(scaled) * scaled;
+        value = i == 0 ? std::max(scaled, 0.0f) : scaled;  // L0 is a sum of non-negative radiance
+      }
+    if (probe.variance > 0) probe.variance = before > 0 ? probe.variance * after / before : probe.variance;
+  }
+}
+
+std::vector<uint32_t> probes_nearest_first(const std::vector<Vec3>& positions, const std::vector<Vec3>& points,
+                                           const std::vector<WorldBox>& boxes) {
+  if (points.empty() && boxes.empty()) return {};
+  std::vector<float> distance(positions.size(), INFINITY);
+  for (size_t k = 0; k < positions.size(); ++k) {
+    for (const Vec3& p : points) distance[k] = std::min(distance[k], dot(positions[k] - p, positions[k] - p));
+    for (const WorldBox& b : boxes) distance[k] = std::min(distance[k], b.distance_squared(positions[k]));
+  }
+  std::vector<uint32_t> order(positions.size());
+  for (size_t k = 0; k < order.size(); ++k) order[k] = uint32_t(k);
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return distance[a] < distance[b]; });
+  return order;
+}
+
+}  // namespace exitance
