@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 #include "exitance/runtime/bundle/probe_results.h"
 #include "exitance/runtime/exitance_runtime.h"
+#include "exitance/runtime/exitance_runtime_vulkan.h"
 #include "exitance/runtime/refresh/refresh_session.h"
 #include "exitance/runtime/world_box.h"
 #include "support/fresh_temp_dir.h"
@@ -290,6 +291,65 @@ TEST(ProbeRefresh, AnEditKeepsWhatEachProbeShowed) {
   session->apply_edits(parse_scene_edits(kBoxMoved, "box.json"));
   const formats::ProbeGrid kept = session->published_probes();
   for (size_t i = 0; i < kept.probes.size(); ++i) EXPECT_EQ(kept.probes[i].sh, shown.probes[i].sh) << "probe " << i;
+}
+
+// The probes as an engine reads them on the device (publish_probe_buffer, exitance_runtime_publish_probes):
+// the values published_probes() gives, bit for bit, at open, part way through a set, after a
+// restart (the box moved: some probes refreshed, others keeping what they showed), once refreshed,
+// and after an edit that scales a light.
+void expect_buffer_is_published(RefreshSession& session, const char* when) {
+  session.publish_probe_buffer();
+  const std::vector<float> buffer = session.read_probe_buffer();
+  const formats::ProbeGrid grid = session.published_probes();
+  ASSERT_EQ(buffer.size(), grid.probes.size() * 27) << when;
+  size_t differing = 0;
+  for (size_t i = 0; i < grid.probes.size(); ++i)
+    differing += std::memcmp(&buffer[i * 27], grid.probes[i].sh.data(), 27 * sizeof(float)) != 0;
+  EXPECT_EQ(differing, 0u) << when;
+}
+
+TEST(ProbeRefresh, TheDeviceBufferHoldsWhatProbesShow) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  auto session = open_session(26);
+  expect_buffer_is_published(*session, "at open");
+  RefreshBudget small;
+  small.milliseconds = 1e-3;
+  small.max_samples_per_texel = 1;
+  session->refresh(small);
+  expect_buffer_is_published(*session, "one batch refreshed");
+  refresh_probes(*session);
+  expect_buffer_is_published(*session, "refreshed");
+  session->apply_edits(parse_scene_edits(kBoxMoved, "box.json"));
+  expect_buffer_is_published(*session, "after the box moved");
+  session->refresh(small);
+  expect_buffer_is_published(*session, "after the box moved, one batch");
+  refresh_probes(*session);
+  expect_buffer_is_published(*session, "after the box moved, refreshed");
+  session->apply_edits(parse_scene_edits(R"({"edits": [{"material": "CeilingLight", "emissiveFactor": [0.6, 0.85, 1.0]}]})", "bluer.json"));
+  expect_buffer_is_published(*session, "after a scaling edit");
+  const DeviceProbeBuffer first = session->publish_probe_buffer();
+  const DeviceProbeBuffer again = session->publish_probe_buffer();
+  EXPECT_EQ(first.buffer, again.buffer);
+  EXPECT_EQ(first.size, VkDeviceSize(session->persisted().probes.probes.size()) * 108);
+  if (first.ready) EXPECT_EQ(again.ready_value, first.ready_value + 1);
+
+  // The C API hands the same over; NULL is one line and changes nothing.
+  ExitanceRuntime* runtime = nullptr;
+  ASSERT_EQ(exitance_runtime_open(probe_bundle().string().c_str(), nullptr, &runtime), EXITANCE_RUNTIME_OK);
+  ExitanceRuntimeProbeBuffer probes{};
+  ExitanceRuntimeImagesReady ready{};
+  EXPECT_EQ(exitance_runtime_publish_probes(runtime, nullptr, &ready), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(exitance_runtime_last_error_message()).find("exitance_runtime_publish_probes"), std::string::npos)
+      << exitance_runtime_last_error_message();
+  ASSERT_EQ(exitance_runtime_publish_probes(runtime, &probes, &ready), EXITANCE_RUNTIME_OK);
+  uint32_t count = 0;
+  ASSERT_EQ(exitance_runtime_probe_count(runtime, &count), EXITANCE_RUNTIME_OK);
+  EXPECT_NE(probes.buffer, VkBuffer(VK_NULL_HANDLE));
+  EXPECT_EQ(probes.probe_count, count);
+  EXPECT_EQ(probes.size, VkDeviceSize(count) * 108);
+  exitance_runtime_release(runtime);
+  for (const std::string& m : validation_messages()) ADD_FAILURE() << "validation: " << m;
+  validation_messages().clear();
 }
 
 // Light layers (docs/runtime.md "Probes"): each probe's sums split by light add up to its totals,

@@ -146,6 +146,7 @@ struct RefreshSession::State {
   // probe_spp as the target; the last full batch and its time, which size a call's batch.
   std::vector<size_t> probe_grid_index;
   std::vector<KeptProbe> previous_probes;
+  bool previous_probes_uploaded = false;  // publish_probe_buffer's copy of them is current
   uint32_t probe_switch_samples = 0;
   uint32_t probe_target = 0;
   float probe_dering = 0;
@@ -532,6 +533,7 @@ void RefreshSession::restart_probes(const std::vector<Vec3>& near_points, const 
         s.previous_probes[k] = {shown.probes[s.probe_grid_index[k]].sh, refreshed.samples[k], refreshed.l0_variance_of_mean(k)};
   }
   s.probe_switch_samples = switch_samples;
+  s.previous_probes_uploaded = false;
   std::vector<Vec3> positions;
   if (!near_points.empty() || !near_boxes.empty())
     for (size_t i : s.probe_grid_index) {
@@ -553,7 +555,38 @@ void RefreshSession::scale_probes(const std::vector<Vec4>& factors) {
         scale_kept_probes(s.previous_probes, s.integrator->probe_refresh_layer(int(l)), Vec4(factors[l].x, factors[l].y, factors[l].z, 0),
                           s.probe_dering);
   s.integrator->scale_probe_layers(factors);
+  s.previous_probes_uploaded = false;
 }
+
+const DeviceProbeBuffer& RefreshSession::publish_probe_buffer() {
+  State& s = *state_;
+  if (s.probe_grid_index.empty())
+    throw std::invalid_argument("the session refreshes no light probes (the bundle has none, or refresh_probes is off)");
+  std::vector<uint32_t> grid_index(s.probe_grid_index.begin(), s.probe_grid_index.end());
+  std::vector<double> kept;
+  if (!s.previous_probes_uploaded) {
+    kept.reserve(s.previous_probes.size() * 29);
+    for (const KeptProbe& k : s.previous_probes) {
+      for (float v : k.sh) kept.push_back(v);
+      kept.push_back(k.samples);
+      kept.push_back(k.variance);
+    }
+  }
+  // The dering window per band, as sh_apply_hanning_window computes it (store_probe_radiance).
+  std::array<float, 3> band_weight{1.0f, 1.0f, 1.0f};
+  if (s.probe_dering > 0)
+    for (int band = 0; band < 3; ++band) {
+      const float l = float(band);
+      band_weight[size_t(band)] = l < s.probe_dering ? 0.5f * (1.0f + std::cos(3.14159265358979f * l / s.probe_dering)) : 0.0f;
+    }
+  const DeviceProbeBuffer& buffer =
+      s.integrator->write_probe_buffer(s.persisted.probes.probes.size(), grid_index, s.previous_probes_uploaded ? nullptr : &kept,
+                                       std::max(1u, s.probe_switch_samples), band_weight);
+  s.previous_probes_uploaded = true;
+  return buffer;
+}
+
+std::vector<float> RefreshSession::read_probe_buffer() const { return state_->integrator->read_probe_buffer(); }
 
 formats::ProbeGrid RefreshSession::published_probes() const {
   const State& s = *state_;

@@ -317,6 +317,16 @@ ExitanceRuntimeError exitance_runtime_publish_page_images(ExitanceRuntime* runti
   });
 }
 
+ExitanceRuntimeError exitance_runtime_publish_probes(ExitanceRuntime* runtime, ExitanceRuntimeProbeBuffer* out_buffer,
+                                                     ExitanceRuntimeImagesReady* out_ready) {
+  return guarded("exitance_runtime_publish_probes", [&] {
+    require(runtime != nullptr && out_buffer != nullptr, "runtime or out_buffer is NULL");
+    const DeviceProbeBuffer& probes = runtime->session->publish_probe_buffer();
+    *out_buffer = {probes.buffer, probes.size, probes.probes};
+    if (out_ready) *out_ready = {probes.ready, probes.ready_value, probes.queue_family};
+  });
+}
+
 ExitanceRuntimeError exitance_runtime_write_bundle(ExitanceRuntime* runtime, const char* output_folder) {
   return guarded("exitance_runtime_write_bundle", [&] {
     require(runtime != nullptr && output_folder != nullptr, "runtime or output_folder is NULL");

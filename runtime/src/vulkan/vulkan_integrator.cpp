@@ -17,6 +17,7 @@
 #include "exitance/common/texture_space_filter.h"
 #include "indirect_denoiser.h"
 #include "lightmap_page_images.h"
+#include "probe_publishing.h"
 #include "lightmap_driver.h"
 #include "probe_driver.h"
 #include "probe_refresh.h"
@@ -57,6 +58,7 @@ struct VulkanIntegrator::Impl {
   std::optional<LightmapPublisher> publisher;  // made at the first publish or upload
   std::optional<LightLayerScaler> scaler;      // made at the first scaling edit
   std::unique_ptr<LightmapPageImages> page_images;  // made at the first write_page_images
+  std::unique_ptr<ProbePublisher> probe_publisher;  // made at the first write_probe_buffer
   std::unique_ptr<IndirectDenoiser> denoiser;        // made at the first denoise_indirect
   bool denoiser_stale = false;                       // a start with other texels since it was made
   std::shared_ptr<DeviceLightmap> denoised;          // denoise_indirect's output, reused once let go
@@ -235,6 +237,23 @@ void VulkanIntegrator::scale_light_layers(const std::vector<Vec4>& factors, cons
 }
 
 LightmapEstimate VulkanIntegrator::read_lightmap(const DeviceLightmap& lightmap) const { return impl_->lightmap.read(lightmap); }
+
+const DeviceProbeBuffer& VulkanIntegrator::write_probe_buffer(size_t grid_probes, const std::vector<uint32_t>& grid_index,
+                                                              const std::vector<double>* kept, uint32_t switch_samples,
+                                                              const std::array<float, 3>& band_weight) {
+  if (!impl_->probe_publisher || !impl_->probe_publisher->fits(grid_probes, grid_index)) {
+    if (!kept) throw std::logic_error("VulkanIntegrator::write_probe_buffer: the first write needs the kept values");
+    impl_->probe_publisher.reset();
+    impl_->probe_publisher = std::make_unique<ProbePublisher>(impl_->context, grid_probes, grid_index);
+  }
+  if (kept) impl_->probe_publisher->set_kept(*kept);
+  return impl_->probe_publisher->write(impl_->buffers.refresh_probe_sums, switch_samples, band_weight);
+}
+
+std::vector<float> VulkanIntegrator::read_probe_buffer() const {
+  if (!impl_->probe_publisher) throw std::logic_error("VulkanIntegrator::read_probe_buffer before write_probe_buffer");
+  return impl_->probe_publisher->read_back();
+}
 
 const DevicePageImages& VulkanIntegrator::write_page_images(const DeviceLightmap& lightmap, const TexelGBuffer& gbuffer,
                                                             int dilation_texels) {

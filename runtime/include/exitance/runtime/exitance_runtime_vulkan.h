@@ -1,6 +1,7 @@
 /* Exitance runtime, Vulkan interop (C99): the runtime on an engine's own Vulkan device, and the
  * lightmap pages it publishes as device images the engine samples, with the semaphore to wait on
- * (docs/runtime.md, "Results on the device"). samples/engine_sample renders a scene with them.
+ * (docs/runtime.md, "Results on the device"), and its light probes as a device buffer.
+ * samples/engine_sample renders a scene with the pages.
  *
  *   ExitanceRuntimeVulkanDevice device = {instance, physical, vk_device, queue, family,
  *                                         VK_API_VERSION_1_2, enabled_features, 1};
@@ -77,6 +78,24 @@ typedef struct ExitanceRuntimeImagesReady {
  * engine). No host read-back. out_ready may be NULL. */
 ExitanceRuntimeError exitance_runtime_publish_page_images(ExitanceRuntime* runtime, ExitanceRuntimePageImage* out_images,
                                                           uint32_t image_count, ExitanceRuntimeImagesReady* out_ready);
+
+/* The light probes as they show now, in device memory (docs/runtime.md "Probes"). */
+typedef struct ExitanceRuntimeProbeBuffer {
+  VkBuffer buffer;      /* 27 floats per probe of the bundle's grid, in probes.bin's order: the L2 SH of
+                           incident radiance, coefficient i, channel c at [i * 3 + c]; 0 for probes not in use */
+  VkDeviceSize size;    /* bytes (108 per probe) */
+  uint32_t probe_count; /* the grid's probes (exitance_runtime_probe_count) */
+} ExitanceRuntimeProbeBuffer;
+
+/* Writes what the probes show now (the values exitance_runtime_read_probes returns, bit for bit)
+ * into a device buffer and describes it in *out_buffer. The buffer is the same on every call and
+ * valid until exitance_runtime_release; only this call writes it, on the runtime's queue, after
+ * every command submitted to that queue before it; it is shared by every queue family of the device
+ * (VK_SHARING_MODE_CONCURRENT). Wait for out_ready (may be NULL) as for the page images. No host
+ * read-back. A bundle without probes, or a runtime that does not refresh them:
+ * EXITANCE_RUNTIME_INVALID_ARGUMENT, nothing changed. */
+ExitanceRuntimeError exitance_runtime_publish_probes(ExitanceRuntime* runtime, ExitanceRuntimeProbeBuffer* out_buffer,
+                                                     ExitanceRuntimeImagesReady* out_ready);
 
 #ifdef __cplusplus
 }

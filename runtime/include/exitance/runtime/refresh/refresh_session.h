@@ -25,6 +25,7 @@
 
 #include "exitance/formats/bundle_manifest.h"
 #include "exitance/formats/probe_grid.h"
+#include "exitance/runtime/vulkan/device_probe_buffer.h"
 #include "exitance/runtime/world_box.h"
 #include "exitance/formats/scene_file.h"
 #include "exitance/formats/sparse_voxel_octree.h"
@@ -258,6 +259,13 @@ class RefreshSession {
   formats::ProbeGrid published_probes() const;
   // Probes refreshed since the last edit (or open), and the fewest samples one of them has.
   uint32_t probe_samples() const;
+  // What the probes show (published_probes()'s values, bit for bit) written into a device buffer of
+  // 27 floats per probe of the grid, in probes.bin's order (0 for probes not in use), and the
+  // timeline semaphore value to wait on: no read-back (docs/runtime.md "Probes"). The buffer is the
+  // same on every call and lives as long as the session. std::invalid_argument when the session
+  // refreshes no probes (refreshes_probes()).
+  const DeviceProbeBuffer& publish_probe_buffer();
+  std::vector<float> read_probe_buffer() const;  // the last publish_probe_buffer read back (tests, tools)
   // Whether the session refreshes the bundle's probes (RefreshSessionOptions::refresh_probes, and
   // the bundle has a probe grid and probes.bin's entry).
   bool refreshes_probes() const;

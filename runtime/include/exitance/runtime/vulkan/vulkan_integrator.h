@@ -6,6 +6,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -16,6 +17,7 @@
 #include "exitance/runtime/texel_gbuffer.h"
 #include "exitance/runtime/vulkan/vulkan_device_failure.h"
 #include "exitance/runtime/vulkan/device_page_images.h"
+#include "exitance/runtime/vulkan/device_probe_buffer.h"
 #include "exitance/runtime/vulkan/vulkan_external_device.h"
 
 namespace exitance {
@@ -222,6 +224,14 @@ class VulkanIntegrator final : public Integrator {
   const DevicePageImages& write_page_images(const DeviceLightmap& lightmap, const TexelGBuffer& gbuffer, int dilation_texels);
   // Page `page` of the last write_page_images read back: RGBA floats, row 0 at the top.
   std::vector<float> read_page_image(size_t page) const;
+  // What the refreshed probes show, written into a device buffer of 27 floats per grid probe
+  // (vulkan/probe_publishing.h): `grid_index` per refreshed probe its grid slot; `kept` (when not
+  // null: uploaded first) kKeptWords per probe of what each showed before; the rest as
+  // RefreshSession::published_probes decides. One submission, waited for; no read-back.
+  const DeviceProbeBuffer& write_probe_buffer(size_t grid_probes, const std::vector<uint32_t>& grid_index,
+                                              const std::vector<double>* kept, uint32_t switch_samples,
+                                              const std::array<float, 3>& band_weight);
+  std::vector<float> read_probe_buffer() const;  // the last write_probe_buffer read back
   // The device this integrator runs on (its own, or the adopted one): what an engine sharing it needs.
   VulkanExternalDevice vulkan_device() const;
   // A device estimate read back, with the progressive accumulation's rays, seconds and counters.
