@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "exitance/bake/command/bake_pipeline.h"
+#include "exitance/formats/half_float.h"
 #include "exitance/formats/probe_grid.h"
 #include "exitance/formats/svo_file.h"
 #include "exitance/runtime/refresh/refreshed_bundle.h"
@@ -347,6 +348,59 @@ TEST(ProbeRefresh, TheDeviceBufferHoldsWhatProbesShow) {
   EXPECT_NE(probes.buffer, VkBuffer(VK_NULL_HANDLE));
   EXPECT_EQ(probes.probe_count, count);
   EXPECT_EQ(probes.size, VkDeviceSize(count) * 108);
+  exitance_runtime_release(runtime);
+  for (const std::string& m : validation_messages()) ADD_FAILURE() << "validation: " << m;
+  validation_messages().clear();
+}
+
+// The voxel exitance computed on the device (publish_voxel_exitance, exitance_runtime_publish_voxel_exitance)
+// against the host's (published_voxel_exitance, what svo.bin gets): equal up to svo.bin's half-float
+// encoding (11 significant bits: 2^-11 relative, below 2^-24 of the scale absolute) and the host's
+// running means in float (a few float roundings per level); lit and filled sides the same. At open,
+// after refreshing, after the box moved (texels deposit elsewhere) and after a scaling edit.
+void expect_device_voxels_are_shown(RefreshSession& session, const char* when) {
+  session.publish_voxel_exitance();
+  const std::vector<float> device = session.read_voxel_exitance();
+  const std::optional<formats::SparseVoxelOctree> host = session.published_voxel_exitance();
+  ASSERT_TRUE(host.has_value());
+  ASSERT_EQ(device.size(), host->nodes.size() * 6) << when;
+  size_t lit = 0, off = 0;
+  for (size_t i = 0; i < host->nodes.size(); ++i)
+    for (size_t k = 0; k < 6; ++k) {
+      const float h = formats::half_to_float(host->nodes[i].exitance[k]) * host->exitance_scale;
+      const float d = device[i * 6 + k];
+      off += !(std::fabs(d - h) <= 1e-3f * std::fabs(h) + 1e-7f * host->exitance_scale);
+      lit += h != 0;
+    }
+  EXPECT_EQ(off, 0u) << when;
+  EXPECT_GT(lit, host->nodes.size()) << when;
+}
+
+TEST(ProbeRefresh, TheDeviceVoxelExitanceIsWhatTexelsShow) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  auto session = open_session(27);
+  RefreshBudget budget;
+  budget.max_samples_per_texel = 4;
+  session->refresh(budget);
+  expect_device_voxels_are_shown(*session, "refreshed");
+  session->apply_edits(parse_scene_edits(kBoxMoved, "box.json"));
+  budget.max_samples_per_texel = 8;
+  session->refresh(budget);
+  expect_device_voxels_are_shown(*session, "after the box moved");
+  session->apply_edits(parse_scene_edits(R"({"edits": [{"material": "CeilingLight", "emissiveFactor": [0.6, 0.85, 1.0]}]})", "bluer.json"));
+  expect_device_voxels_are_shown(*session, "after a scaling edit");
+  const DeviceVoxelExitance first = session->publish_voxel_exitance();
+  EXPECT_EQ(first.size, VkDeviceSize(session->svo()->nodes.size()) * 24);
+
+  ExitanceRuntime* runtime = nullptr;
+  ASSERT_EQ(exitance_runtime_open(probe_bundle().string().c_str(), nullptr, &runtime), EXITANCE_RUNTIME_OK);
+  ExitanceRuntimeVoxelBuffer voxels{};
+  EXPECT_EQ(exitance_runtime_publish_voxel_exitance(runtime, nullptr, nullptr), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+  ASSERT_EQ(exitance_runtime_publish_voxel_exitance(runtime, &voxels, nullptr), EXITANCE_RUNTIME_OK);
+  uint32_t count = 0;
+  ASSERT_EQ(exitance_runtime_voxel_count(runtime, &count), EXITANCE_RUNTIME_OK);
+  EXPECT_EQ(voxels.node_count, count);
+  EXPECT_NE(voxels.buffer, VkBuffer(VK_NULL_HANDLE));
   exitance_runtime_release(runtime);
   for (const std::string& m : validation_messages()) ADD_FAILURE() << "validation: " << m;
   validation_messages().clear();

@@ -147,6 +147,7 @@ struct RefreshSession::State {
   std::vector<size_t> probe_grid_index;
   std::vector<KeptProbe> previous_probes;
   bool previous_probes_uploaded = false;  // publish_probe_buffer's copy of them is current
+  bool voxel_deposits_current = false;    // publish_voxel_exitance's deposits are the texels' as they are
   uint32_t probe_switch_samples = 0;
   uint32_t probe_target = 0;
   float probe_dering = 0;
@@ -370,6 +371,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   // lighting scene reads persisted.scene itself); nothing below throws for bad input.
   InPlaceEdits in_place = apply_scene_edits_in_place(s.persisted, edits, &s.instance_texels);
   const EditEffects& effects = in_place.effects;
+  if (effects.geometry_changed() || !effects.materials.empty()) s.voxel_deposits_current = false;  // texels moved, or their albedo or emission
   // Edits of punctual lights alone upload the lights after the publish below, in the submission
   // that starts the accumulation again (start_progressive_change) or in one of their own.
   const bool punctual_only = !effects.geometry_changed() && effects.materials.empty() && !effects.sky && !effects.lights.empty();
@@ -587,6 +589,18 @@ const DeviceProbeBuffer& RefreshSession::publish_probe_buffer() {
 }
 
 std::vector<float> RefreshSession::read_probe_buffer() const { return state_->integrator->read_probe_buffer(); }
+
+const DeviceVoxelExitance& RefreshSession::publish_voxel_exitance() {
+  State& s = *state_;
+  if (!s.svo) throw std::invalid_argument("the bundle has no svo.bin (baked with --voxel-resolution none)");
+  std::optional<VoxelDeposits> deposits;
+  if (!s.voxel_deposits_current) deposits = voxel_deposits(*s.svo, s.persisted.scene, s.persisted.gbuffer);
+  const DeviceVoxelExitance& out = s.integrator->write_voxel_exitance(*shown_on_device(nullptr, true), *s.svo, deposits ? &*deposits : nullptr);
+  s.voxel_deposits_current = true;
+  return out;
+}
+
+std::vector<float> RefreshSession::read_voxel_exitance() const { return state_->integrator->read_voxel_exitance(); }
 
 formats::ProbeGrid RefreshSession::published_probes() const {
   const State& s = *state_;

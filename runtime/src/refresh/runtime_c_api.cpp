@@ -327,6 +327,16 @@ ExitanceRuntimeError exitance_runtime_publish_probes(ExitanceRuntime* runtime, E
   });
 }
 
+ExitanceRuntimeError exitance_runtime_publish_voxel_exitance(ExitanceRuntime* runtime, ExitanceRuntimeVoxelBuffer* out_buffer,
+                                                             ExitanceRuntimeImagesReady* out_ready) {
+  return guarded("exitance_runtime_publish_voxel_exitance", [&] {
+    require(runtime != nullptr && out_buffer != nullptr, "runtime or out_buffer is NULL");
+    const DeviceVoxelExitance& voxels = runtime->session->publish_voxel_exitance();
+    *out_buffer = {voxels.buffer, voxels.size, voxels.nodes};
+    if (out_ready) *out_ready = {voxels.ready, voxels.ready_value, voxels.queue_family};
+  });
+}
+
 ExitanceRuntimeError exitance_runtime_write_bundle(ExitanceRuntime* runtime, const char* output_folder) {
   return guarded("exitance_runtime_write_bundle", [&] {
     require(runtime != nullptr && output_folder != nullptr, "runtime or output_folder is NULL");

@@ -18,6 +18,7 @@
 #include "indirect_denoiser.h"
 #include "lightmap_page_images.h"
 #include "probe_publishing.h"
+#include "voxel_exitance_publishing.h"
 #include "lightmap_driver.h"
 #include "probe_driver.h"
 #include "probe_refresh.h"
@@ -59,6 +60,7 @@ struct VulkanIntegrator::Impl {
   std::optional<LightLayerScaler> scaler;      // made at the first scaling edit
   std::unique_ptr<LightmapPageImages> page_images;  // made at the first write_page_images
   std::unique_ptr<ProbePublisher> probe_publisher;  // made at the first write_probe_buffer
+  std::unique_ptr<VoxelExitancePublisher> voxel_publisher;  // made at the first write_voxel_exitance
   std::unique_ptr<IndirectDenoiser> denoiser;        // made at the first denoise_indirect
   bool denoiser_stale = false;                       // a start with other texels since it was made
   std::shared_ptr<DeviceLightmap> denoised;          // denoise_indirect's output, reused once let go
@@ -248,6 +250,21 @@ const DeviceProbeBuffer& VulkanIntegrator::write_probe_buffer(size_t grid_probes
   }
   if (kept) impl_->probe_publisher->set_kept(*kept);
   return impl_->probe_publisher->write(impl_->buffers.refresh_probe_sums, switch_samples, band_weight);
+}
+
+const DeviceVoxelExitance& VulkanIntegrator::write_voxel_exitance(const DeviceLightmap& lightmap, const formats::SparseVoxelOctree& svo,
+                                                                 const VoxelDeposits* deposits) {
+  if (!impl_->voxel_publisher) {
+    if (!deposits) throw std::logic_error("VulkanIntegrator::write_voxel_exitance: the first write needs the deposits");
+    impl_->voxel_publisher = std::make_unique<VoxelExitancePublisher>(impl_->context, svo);
+  }
+  if (deposits) impl_->voxel_publisher->set_deposits(*deposits);
+  return impl_->voxel_publisher->write(lightmap);
+}
+
+std::vector<float> VulkanIntegrator::read_voxel_exitance() const {
+  if (!impl_->voxel_publisher) throw std::logic_error("VulkanIntegrator::read_voxel_exitance before write_voxel_exitance");
+  return impl_->voxel_publisher->read_back();
 }
 
 std::vector<float> VulkanIntegrator::read_probe_buffer() const {

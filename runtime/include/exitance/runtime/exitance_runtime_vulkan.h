@@ -1,6 +1,6 @@
 /* Exitance runtime, Vulkan interop (C99): the runtime on an engine's own Vulkan device, and the
  * lightmap pages it publishes as device images the engine samples, with the semaphore to wait on
- * (docs/runtime.md, "Results on the device"), and its light probes as a device buffer.
+ * (docs/runtime.md, "Results on the device"), and its light probes and voxel exitance as device buffers.
  * samples/engine_sample renders a scene with the pages.
  *
  *   ExitanceRuntimeVulkanDevice device = {instance, physical, vk_device, queue, family,
@@ -96,6 +96,25 @@ typedef struct ExitanceRuntimeProbeBuffer {
  * EXITANCE_RUNTIME_INVALID_ARGUMENT, nothing changed. */
 ExitanceRuntimeError exitance_runtime_publish_probes(ExitanceRuntime* runtime, ExitanceRuntimeProbeBuffer* out_buffer,
                                                      ExitanceRuntimeImagesReady* out_ready);
+
+/* The voxel exitance of what the runtime shows now, in device memory (docs/runtime.md "Voxel exitance"). */
+typedef struct ExitanceRuntimeVoxelBuffer {
+  VkBuffer buffer;      /* 6 floats per node of the bundle's svo.bin, in its order: front RGB, back RGB,
+                           M = pi L_o in W/m^2 scene units (exitance_runtime_read_voxel_exitance's
+                           values before their half-float encoding) */
+  VkDeviceSize size;    /* bytes (24 per node) */
+  uint32_t node_count;  /* exitance_runtime_voxel_count */
+} ExitanceRuntimeVoxelBuffer;
+
+/* Computes the voxel exitance on the device from what the runtime shows (filtered where a denoise
+ * radius is set) into a device buffer and describes it in *out_buffer: the same buffer on every call,
+ * valid until exitance_runtime_release, written only by this call on the runtime's queue after
+ * everything submitted to it before, shared by every queue family; wait for out_ready (may be NULL)
+ * as for the page images. No host read-back (after an edit that moved texels or changed materials,
+ * the next call works out on the host where texels deposit: ~0.1 s at 1 M texels). A bundle without
+ * svo.bin: EXITANCE_RUNTIME_INVALID_ARGUMENT, nothing changed. */
+ExitanceRuntimeError exitance_runtime_publish_voxel_exitance(ExitanceRuntime* runtime, ExitanceRuntimeVoxelBuffer* out_buffer,
+                                                             ExitanceRuntimeImagesReady* out_ready);
 
 #ifdef __cplusplus
 }

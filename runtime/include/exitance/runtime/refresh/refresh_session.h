@@ -26,6 +26,7 @@
 #include "exitance/formats/bundle_manifest.h"
 #include "exitance/formats/probe_grid.h"
 #include "exitance/runtime/vulkan/device_probe_buffer.h"
+#include "exitance/runtime/vulkan/device_voxel_exitance.h"
 #include "exitance/runtime/world_box.h"
 #include "exitance/formats/scene_file.h"
 #include "exitance/formats/sparse_voxel_octree.h"
@@ -266,6 +267,13 @@ class RefreshSession {
   // refreshes no probes (refreshes_probes()).
   const DeviceProbeBuffer& publish_probe_buffer();
   std::vector<float> read_probe_buffer() const;  // the last publish_probe_buffer read back (tests, tools)
+  // The voxel exitance of what texels show (published_voxel_exitance()'s values before their
+  // half-float encoding) computed on the device into a buffer of 6 floats per node of svo.bin, and
+  // the timeline semaphore value to wait on: no read-back (docs/runtime.md "Voxel exitance"). Where
+  // each texel deposits is worked out on the host at the first call and again after an edit moved
+  // texels or changed materials. std::invalid_argument when the bundle has no svo.bin.
+  const DeviceVoxelExitance& publish_voxel_exitance();
+  std::vector<float> read_voxel_exitance() const;  // the last publish_voxel_exitance read back (tests, tools)
   // Whether the session refreshes the bundle's probes (RefreshSessionOptions::refresh_probes, and
   // the bundle has a probe grid and probes.bin's entry).
   bool refreshes_probes() const;

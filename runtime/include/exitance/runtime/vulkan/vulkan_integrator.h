@@ -18,6 +18,8 @@
 #include "exitance/runtime/vulkan/vulkan_device_failure.h"
 #include "exitance/runtime/vulkan/device_page_images.h"
 #include "exitance/runtime/vulkan/device_probe_buffer.h"
+#include "exitance/runtime/vulkan/device_voxel_exitance.h"
+#include "exitance/runtime/bundle/texel_exitance.h"
 #include "exitance/runtime/vulkan/vulkan_external_device.h"
 
 namespace exitance {
@@ -232,6 +234,12 @@ class VulkanIntegrator final : public Integrator {
                                               const std::vector<double>* kept, uint32_t switch_samples,
                                               const std::array<float, 3>& band_weight);
   std::vector<float> read_probe_buffer() const;  // the last write_probe_buffer read back
+  // The voxel exitance of `lightmap` computed on the device into a buffer of 6 floats per node of
+  // `svo` (vulkan/voxel_exitance_publishing.h); `deposits` (when not null: uploaded first, and
+  // needed at the first call) where each texel deposits. One submission, waited for; no read-back.
+  const DeviceVoxelExitance& write_voxel_exitance(const DeviceLightmap& lightmap, const formats::SparseVoxelOctree& svo,
+                                                  const VoxelDeposits* deposits);
+  std::vector<float> read_voxel_exitance() const;  // the last write_voxel_exitance read back
   // The device this integrator runs on (its own, or the adopted one): what an engine sharing it needs.
   VulkanExternalDevice vulkan_device() const;
   // A device estimate read back, with the progressive accumulation's rays, seconds and counters.
