@@ -55,7 +55,8 @@ int main(int argc, char** argv) {
                  "(default 32; 0: every pass takes every texel)");
   app.add_flag("--page-images", options.page_images,
                "with --frames: after each frame, write the lightmap pages into the device images an engine samples "
-               "(exitance_runtime_publish_page_images) and report its milliseconds per frame");
+               "(exitance_runtime_publish_page_images), and the probes and voxel exitance into their device buffers "
+               "where the bundle has them, and report each call's milliseconds per frame");
   app.add_flag("--no-frame-errors", no_frame_errors,
                "with --frames: no per-frame error (it reads the lightmap back between frames, which idles the GPU)");
   app.add_option("--integrator", options.integrator,

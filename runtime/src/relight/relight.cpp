@@ -204,6 +204,17 @@ json relight_bundle(const RelightOptions& options) {
         const auto images_start = Clock::now();
         session->publish_page_images(session->page_dilation_texels());
         entry["page_images_milliseconds"] = std::chrono::duration<double, std::milli>(Clock::now() - images_start).count();
+        // The probes and the voxel exitance handed over on the device the same way, where the bundle has them.
+        if (session->refreshes_probes()) {
+          const auto probes_start = Clock::now();
+          session->publish_probe_buffer();
+          entry["probe_buffer_milliseconds"] = std::chrono::duration<double, std::milli>(Clock::now() - probes_start).count();
+        }
+        if (session->svo()) {
+          const auto voxels_start = Clock::now();
+          session->publish_voxel_exitance();
+          entry["voxel_exitance_milliseconds"] = std::chrono::duration<double, std::milli>(Clock::now() - voxels_start).count();
+        }
       }
       const LightmapEstimate now = options.frame_errors ? session->refreshed_lightmap() : LightmapEstimate{};
       if (options.frame_errors) {
