@@ -16,6 +16,7 @@
 #include "exitance/formats/lightmap_exr.h"
 #include "exitance/loader/exitance_loader.h"
 #include "exitance/runtime/exitance_runtime.h"
+#include "exitance/runtime/exitance_runtime_vulkan.h"
 
 extern "C" int runtime_c_walkthrough(const char* bundle, const char* output, char* message, size_t message_size);
 
@@ -150,6 +151,17 @@ TEST(RuntimeCApi, ReadPageChannelReturnsTheRefreshedDirectionalLayers) {
   ASSERT_EQ(exitance_runtime_read_page_channel(rt, 0, "sh1.y.G", sh1.data(), page.width, page.height), EXITANCE_RUNTIME_OK);
   const fs::path written = dir / "sh1-refreshed.bake";
   ASSERT_EQ(exitance_runtime_write_bundle(rt, written.c_str()), EXITANCE_RUNTIME_OK) << exitance_runtime_last_error_message();
+  // This bundle has neither probes nor svo.bin: their device buffers are one-line refusals.
+  ExitanceRuntimeProbeBuffer probes{};
+  EXPECT_EQ(exitance_runtime_publish_probes(rt, &probes, nullptr), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+  const std::string no_probes = exitance_runtime_last_error_message();
+  EXPECT_NE(no_probes.find("exitance_runtime_publish_probes: the session refreshes no light probes"), std::string::npos) << no_probes;
+  EXPECT_EQ(probes.buffer, VkBuffer(VK_NULL_HANDLE));
+  ExitanceRuntimeVoxelBuffer voxels{};
+  EXPECT_EQ(exitance_runtime_publish_voxel_exitance(rt, &voxels, nullptr), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+  const std::string no_svo = exitance_runtime_last_error_message();
+  EXPECT_NE(no_svo.find("exitance_runtime_publish_voxel_exitance: the bundle has no svo.bin"), std::string::npos) << no_svo;
+  EXPECT_EQ(no_svo.find('\n'), std::string::npos);
   exitance_runtime_release(rt);
   const exitance::formats::LightmapImage image = exitance::formats::read_lightmap_exr((written / "lightmap-0.exr").string());
   ASSERT_TRUE(image.channels.count("sh1.y.G"));
