@@ -294,6 +294,66 @@ TEST(ProbeRefresh, AnEditKeepsWhatEachProbeShowed) {
   for (size_t i = 0; i < kept.probes.size(); ++i) EXPECT_EQ(kept.probes[i].sh, shown.probes[i].sh) << "probe " << i;
 }
 
+// After a local edit the probes near it are refreshed to their target before the others get a sample
+// (probes that take two stratified sets: the publishing rule prefers a refreshed estimate with as
+// many samples as the value it kept, so the near probes need both sets first). The building at a
+// coarse density, one room's point light moved.
+TEST(ProbeRefresh, TheProbesNearALocalEditReachTheirTargetFirst) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  static const fs::path bundle = [] {
+    BakeOptions options;
+    options.input = (fs::path(EXITANCE_SAMPLE_DIR) / "building.gltf").string();
+    options.output = (probe_bundle().parent_path() / "building-probes.bake").string();
+    options.backend.name = "cpu";
+    options.atlas.texel_density = 0.5f;
+    options.lighting.spp = 1;
+    options.probe_spacing = 4.0f;
+    options.probe_spp = 2 * kProbeStratifiedSetSize;
+    options.voxel_resolution = 0;
+    Diagnostics diagnostics;
+    run_bake(options, diagnostics);
+    return fs::path(options.output);
+  }();
+  RefreshSessionOptions options;
+  options.seed = 28;
+  auto session = RefreshSession::open(bundle.string(), options);
+  const uint32_t target = 2 * kProbeStratifiedSetSize;
+  RefreshBudget frame;
+  frame.milliseconds = 5000;
+  frame.max_samples_per_texel = 1;
+  for (int k = 0; k < 400 && session->probe_samples() < target; ++k) session->refresh(frame);
+  ASSERT_EQ(session->probe_samples(), target);
+  const auto light_position = [&] {
+    for (const PunctualLight& light : session->persisted().scene.lights)
+      if (light.name == "Room_0_0_2_Point") return light.position;
+    ADD_FAILURE() << "no light Room_0_0_2_Point";
+    return Vec3{0, 0, 0};
+  };
+  const Vec3 before = light_position();
+  session->apply_edits(parse_scene_edits(R"({"edits": [{"node": "Room_0_0_2_Point", "translation": [4.2, 2.2, 12.0]}]})", "move.json"));
+  const Vec3 after = light_position();
+  std::vector<float> distance;
+  for (const formats::ProbeRecord& r : session->persisted().probes.probes)
+    if (formats::probe_is_usable(r)) {
+      const Vec3 p{r.position[0], r.position[1], r.position[2]};
+      distance.push_back(std::min(dot(p - before, p - before), dot(p - after, p - after)));
+    }
+  const size_t nearest = size_t(std::min_element(distance.begin(), distance.end()) - distance.begin());
+  const size_t farthest = size_t(std::max_element(distance.begin(), distance.end()) - distance.begin());
+  RefreshBudget small;
+  small.milliseconds = 1e-3;  // one batch of probes a call
+  small.max_samples_per_texel = 1;
+  ProbeEstimate now;
+  for (int k = 0; k < 400; ++k) {
+    session->refresh(small);
+    now = session->integrator().probe_refresh_estimate();
+    if (now.samples[nearest] >= target) break;
+  }
+  ASSERT_EQ(now.samples[nearest], target);
+  // Round robin over all probes would have given the farthest its first set before the nearest its second.
+  EXPECT_EQ(now.samples[farthest], 0u) << "farthest at " << std::sqrt(distance[farthest]) << " m of " << distance.size() << " probes";
+}
+
 // The probes as an engine reads them on the device (publish_probe_buffer, exitance_runtime_publish_probes):
 // the values published_probes() gives, bit for bit, at open, part way through a set, after a
 // restart (the box moved: some probes refreshed, others keeping what they showed), once refreshed,

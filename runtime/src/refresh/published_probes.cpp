@@ -43,16 +43,33 @@ void scale_kept_probes(std::vector<KeptProbe>& kept, const ProbeEstimate& layer,
 }
 
 std::vector<uint32_t> probes_nearest_first(const std::vector<Vec3>& positions, const std::vector<Vec3>& points,
-                                           const std::vector<WorldBox>& boxes) {
+                                           const std::vector<WorldBox>& boxes, float near_floor, size_t* near) {
+  if (near) *near = 0;
   if (points.empty() && boxes.empty()) return {};
   std::vector<float> distance(positions.size(), INFINITY);
+  std::vector<uint8_t> near_flag(positions.size(), 1);  // 0: near (sorted first)
   for (size_t k = 0; k < positions.size(); ++k) {
-    for (const Vec3& p : points) distance[k] = std::min(distance[k], dot(positions[k] - p, positions[k] - p));
-    for (const WorldBox& b : boxes) distance[k] = std::min(distance[k], b.distance_squared(positions[k]));
+    bool is_near = false;
+    for (const Vec3& p : points) {
+      const float d = dot(positions[k] - p, positions[k] - p);
+      distance[k] = std::min(distance[k], d);
+      is_near = is_near || d <= near_floor * near_floor;
+    }
+    for (const WorldBox& b : boxes) {
+      const float d = b.distance_squared(positions[k]);
+      const float r = std::max(2.0f * b.half_diagonal(), near_floor);
+      distance[k] = std::min(distance[k], d);
+      is_near = is_near || d <= r * r;
+    }
+    if (is_near && near) ++*near;
+    near_flag[k] = is_near ? 0 : 1;
   }
   std::vector<uint32_t> order(positions.size());
   for (size_t k = 0; k < order.size(); ++k) order[k] = uint32_t(k);
-  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return distance[a] < distance[b]; });
+  // The near probes first (the first *near of the order), each part nearest first.
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    return near_flag[a] != near_flag[b] ? near_flag[a] < near_flag[b] : distance[a] < distance[b];
+  });
   return order;
 }
 

@@ -35,8 +35,10 @@ void scale_kept_probes(std::vector<KeptProbe>& kept, const ProbeEstimate& layer,
 
 // The order to refresh probes in after an edit whose change is local: nearest first, by the distance
 // to the nearest of `points` (lights before and after a move) and `boxes` (moved instances' bounds
-// before and after); empty (the probes' own order) when there is neither.
+// before and after); empty (the probes' own order) when there is neither. `near` (may be null): how
+// many of them lie near the change, as texels_near_change counts texels near: within twice a box's
+// half-diagonal of it, and at least `near_floor` (a tenth of the scene's extent) of it or a point.
 std::vector<uint32_t> probes_nearest_first(const std::vector<Vec3>& positions, const std::vector<Vec3>& points,
-                                           const std::vector<WorldBox>& boxes);
+                                           const std::vector<WorldBox>& boxes, float near_floor = 0, size_t* near = nullptr);
 
 }  // namespace exitance

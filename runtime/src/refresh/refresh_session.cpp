@@ -542,7 +542,9 @@ void RefreshSession::restart_probes(const std::vector<Vec3>& near_points, const 
       const formats::ProbeRecord& r = s.persisted.probes.probes[i];
       positions.push_back({r.position[0], r.position[1], r.position[2]});
     }
-  s.integrator->clear_probe_refresh(probes_nearest_first(positions, near_points, near_boxes));
+  size_t near = 0;
+  const std::vector<uint32_t> order = probes_nearest_first(positions, near_points, near_boxes, 0.1f * s.lighting->extent, &near);
+  s.integrator->clear_probe_refresh(order, near);
 }
 
 void RefreshSession::scale_probes(const std::vector<Vec4>& factors) {

@@ -129,9 +129,10 @@ ProbeEstimate ProbeRefresh::read_layer(int layer) const {
   return estimate;
 }
 
-void ProbeRefresh::clear(const std::vector<uint32_t>& order) {
+void ProbeRefresh::clear(const std::vector<uint32_t>& order, size_t priority) {
   std::fill(samples_.begin(), samples_.end(), 0u);
   next_ = 0;
+  priority_ = order.empty() ? 0 : std::min(priority, order.size());
   if (samples_.empty()) return;
   Context& context = runner_.context();
   if (!order.empty() || !identity_order_) {
@@ -155,15 +156,22 @@ uint64_t ProbeRefresh::add_set(const IntegratorSettings& settings, uint32_t targ
   const size_t count = samples_.size();
   if (count == 0) return 0;
   // Probes [next_, end) share one sample count (round robin): one batch of their next set (the last
-  // one cut at the target, as a whole-run bake's last pass is).
-  if (next_ >= count) next_ = 0;
+  // one cut at the target, as a whole-run bake's last pass is). The priority probes first, round
+  // robin among themselves until the last of them (the fewest samples) has the target, then the others.
+  size_t lo = 0, hi = count;
+  if (priority_ > 0) {
+    if (samples_[order_[priority_ - 1]] < target_samples) hi = priority_;
+    else lo = priority_;
+  }
+  if (lo >= hi) return 0;
+  if (next_ < lo || next_ >= hi) next_ = lo;
   const uint32_t first_sample = samples_[order_[next_]];
   if (first_sample >= target_samples) return 0;  // round robin: the rest have as many
   const uint32_t set = std::min(kProbeStratifiedSetSize, target_samples - first_sample);
   const size_t max_work = runner_.work_items_per_batch(kProbeResultBytes + 12 * size_t(light_layers_));
   size_t per_batch = std::max<size_t>(1, max_work / set);
   if (max_probes > 0) per_batch = std::min(per_batch, max_probes);
-  const size_t end = std::min(count, next_ + per_batch);
+  const size_t end = std::min(hi, next_ + per_batch);
   Context& context = runner_.context();
   runner_.buffers().results.reserve(context, std::max<size_t>(max_work, size_t(set)) * (kProbeResultBytes + 12 * size_t(light_layers_)));
   GpuParams params = runner_.bake_params(settings, 1, uint32_t(count));

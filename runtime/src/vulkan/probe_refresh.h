@@ -39,8 +39,10 @@ class ProbeRefresh {
   ProbeEstimate read_layer(int layer) const;
   // Every probe's sums cleared (an edit changed the scene); the positions kept. `order` (empty: the
   // probes' own order): the order the round robin visits them in from now on, a permutation of the
-  // probes (the probes nearest a local edit first).
-  void clear(const std::vector<uint32_t>& order = {});
+  // probes (the probes nearest a local edit first); its first `priority` probes get every sample up
+  // to the target before the others get any (those near the edit: the publishing rule prefers a
+  // refreshed estimate with as many samples as the value it kept).
+  void clear(const std::vector<uint32_t>& order = {}, size_t priority = 0);
   // The next probes' next stratified set, round robin over the probes: as many probes as one batch
   // holds and at most `max_probes` (0: no limit), never past `target_samples` per probe. Returns the
   // rays traced (0 once every probe has its target); `refreshed`: how many probes got their set.
@@ -60,6 +62,7 @@ class ProbeRefresh {
   std::vector<uint32_t> samples_;  // per probe, as the device's counts (back faces included)
   std::vector<uint32_t> order_;    // the round robin's order (the device's batch items)
   bool identity_order_ = true;
+  size_t priority_ = 0;            // order_[0, priority_) first, to the target
   size_t next_ = 0;                // the position in order_ the next set starts at
   int light_layers_ = 0;
   std::unique_ptr<ComputeKernel> scaling_;  // scale_probe_layers.comp, made at a start with layers

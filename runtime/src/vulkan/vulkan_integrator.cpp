@@ -131,7 +131,9 @@ ProbeEstimate VulkanIntegrator::bake_probes(const std::vector<Vec3>& positions, 
 void VulkanIntegrator::start_probe_refresh(const std::vector<Vec3>& positions, int light_layers) {
   impl_->probe_refresh.start(positions, light_layers);
 }
-void VulkanIntegrator::clear_probe_refresh(const std::vector<uint32_t>& order) { impl_->probe_refresh.clear(order); }
+void VulkanIntegrator::clear_probe_refresh(const std::vector<uint32_t>& order, size_t priority) {
+  impl_->probe_refresh.clear(order, priority);
+}
 int VulkanIntegrator::probe_refresh_light_layers() const { return impl_->probe_refresh.light_layers(); }
 void VulkanIntegrator::scale_probe_layers(const std::vector<Vec4>& factors) { impl_->probe_refresh.scale_layers(factors); }
 ProbeEstimate VulkanIntegrator::probe_refresh_layer(int layer) const { return impl_->probe_refresh.read_layer(layer); }

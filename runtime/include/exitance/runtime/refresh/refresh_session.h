@@ -313,7 +313,7 @@ class RefreshSession {
   explicit RefreshSession(std::unique_ptr<State> state);
   void end_change_estimate();
   // An edit: what probes show is kept as what they showed before, and their refresh starts again,
-  // nearest the points and boxes first (none: in the grid's order).
+  // nearest the points and boxes first (none: in the grid's order), those near them to the target first.
   void restart_probes(const std::vector<Vec3>& near_points = {}, const std::vector<WorldBox>& near_boxes = {});
   // An edit that only scaled lights (factors as scale_light_layers'): the probes' sums scaled per
   // light layer on the device and what they showed before by their split, every sample kept;

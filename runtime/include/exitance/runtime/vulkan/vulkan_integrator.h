@@ -147,7 +147,7 @@ class VulkanIntegrator final : public Integrator {
   // not fit the device: probe_refresh_light_layers says).
   void start_probe_refresh(const std::vector<Vec3>& positions, int light_layers = 0);
   // `order`: the probes nearest a local edit first (ProbeRefresh::clear); empty: their own order.
-  void clear_probe_refresh(const std::vector<uint32_t>& order = {});
+  void clear_probe_refresh(const std::vector<uint32_t>& order = {}, size_t priority = 0);
   int probe_refresh_light_layers() const;
   // An edit that only scaled lights (factors as scale_light_layers'): the probes' sums scaled on the
   // device, 0 rays, every sample kept. Needs probe_refresh_light_layers() == factors.size().
