@@ -10,6 +10,7 @@
 
 #include "compute_kernel.h"
 #include "exitance/runtime/vulkan/device_probe_buffer.h"
+#include "shared_device_buffer.h"
 #include "vulkan_context.h"
 #include "wavefront_buffers.h"
 
@@ -20,7 +21,6 @@ class ProbePublisher {
   static constexpr size_t kKeptWords = 29;  // per probe: 27 SH values, samples, variance (< 0: unknown)
   // A buffer for `grid_probes` probes; `grid_index`: per refreshed probe its slot in the grid.
   ProbePublisher(Context& context, size_t grid_probes, const std::vector<uint32_t>& grid_index);
-  ~ProbePublisher();
   ProbePublisher(const ProbePublisher&) = delete;
   ProbePublisher& operator=(const ProbePublisher&) = delete;
 
@@ -30,15 +30,14 @@ class ProbePublisher {
   // Writes the buffer in one submission after everything submitted to the queue before it,
   // signals the semaphore and waits for it (bounded). `band_weight`: the dering window per band.
   const DeviceProbeBuffer& write(const ProbeAccumulators& sums, uint32_t switch_samples, const std::array<float, 3>& band_weight);
-  std::vector<float> read_back();  // for tests and tools
+  std::vector<float> read_back() const { return out_buffer_.read_back(); }  // for tests and tools
 
  private:
-  void release();
   Context& context_;
   size_t probes_;  // refreshed probes
   std::vector<uint32_t> grid_index_;
   Buffer kept_, index_;
-  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  SharedDeviceBuffer out_buffer_;
   DeviceProbeBuffer out_;
   ComputeKernel kernel_;
 };

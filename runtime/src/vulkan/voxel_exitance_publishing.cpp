@@ -1,10 +1,9 @@
 #include "voxel_exitance_publishing.h"
 
+#include <algorithm>
 #include <array>
 #include <bit>
-#include <cstring>
 #include <stdexcept>
-#include <utility>
 
 #include "exitance_spirv/publish_voxel_exitance.h"
 
@@ -21,64 +20,25 @@ constexpr uint32_t kGroup = 64;
 VoxelExitancePublisher::VoxelExitancePublisher(Context& context, const formats::SparseVoxelOctree& svo)
     : context_(context),
       level_begin_(svo.level_begin),
+      out_buffer_(context, VkDeviceSize(std::max<size_t>(svo.nodes.size(), 1)) * 24, "voxel exitance"),
       kernel_(context, std::vector<VkDescriptorType>(8, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER), uint32_t(sizeof(VoxelPush)),
               spirv_publish_voxel_exitance, sizeof(spirv_publish_voxel_exitance), 1, "publish_voxel_exitance.comp") {
   const size_t nodes = svo.nodes.size();
   if (nodes == 0 || level_begin_.size() != size_t(svo.depth) + 2) throw std::invalid_argument("VoxelExitancePublisher: an octree without its levels");
-  VkDevice d = context.device();
-  try {
-    std::vector<uint32_t> words(nodes * 4);
-    for (size_t i = 0; i < nodes; ++i) {
-      const formats::SvoNode& n = svo.nodes[i];
-      words[i * 4] = i == 0 ? 0u : n.parent;
-      words[i * 4 + 1] = n.first_child;
-      words[i * 4 + 2] = uint32_t(std::popcount(unsigned(n.child_mask)));
-    }
-    nodes_ = context.create_storage_buffer(words.size() * 4);
-    context.upload(nodes_, words.data(), words.size() * 4);
-    scratch_ = context.create_storage_buffer(nodes * 2 * 4 * 8);
-    state_ = context.create_storage_buffer(nodes * 2 * 4);
-    side_first_ = context.create_storage_buffer((2 * nodes + 1) * 4);
-    entries_ = context.create_storage_buffer(16);
-    out_.nodes = uint32_t(nodes);
-    out_.size = VkDeviceSize(nodes) * 24;
-    out_.queue_family = context.queue_family();
-    // Shared by every queue family of the device: no ownership transfer for an engine's reads.
-    uint32_t family_count = 0;
-    vkGetPhysicalDeviceQueueFamilyProperties(context.physical_device(), &family_count, nullptr);
-    std::vector<uint32_t> families(family_count);
-    for (uint32_t f = 0; f < family_count; ++f) families[f] = f;
-    VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-    info.size = out_.size;
-    info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-    info.sharingMode = family_count > 1 ? VK_SHARING_MODE_CONCURRENT : VK_SHARING_MODE_EXCLUSIVE;
-    if (family_count > 1) info.queueFamilyIndexCount = family_count, info.pQueueFamilyIndices = families.data();
-    check(vkCreateBuffer(d, &info, nullptr, &out_.buffer), "vkCreateBuffer (voxel exitance)");
-    VkMemoryRequirements requirements;
-    vkGetBufferMemoryRequirements(d, out_.buffer, &requirements);
-    memory_ = context.allocate_device_local(requirements, "allocating the voxel exitance buffer");
-    check(vkBindBufferMemory(d, out_.buffer, memory_, 0), "vkBindBufferMemory (voxel exitance)");
-    if (context.timeline_semaphores()) {
-      VkSemaphoreTypeCreateInfo type{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
-      type.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
-      VkSemaphoreCreateInfo semaphore{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-      semaphore.pNext = &type;
-      check(vkCreateSemaphore(d, &semaphore, nullptr, &out_.ready), "vkCreateSemaphore (voxel exitance ready)");
-    }
-  } catch (...) {
-    release();
-    throw;
+  std::vector<uint32_t> words(nodes * 4);
+  for (size_t i = 0; i < nodes; ++i) {
+    const formats::SvoNode& n = svo.nodes[i];
+    words[i * 4] = i == 0 ? 0u : n.parent;
+    words[i * 4 + 1] = n.first_child;
+    words[i * 4 + 2] = uint32_t(std::popcount(unsigned(n.child_mask)));
   }
-}
-
-VoxelExitancePublisher::~VoxelExitancePublisher() { release(); }
-
-void VoxelExitancePublisher::release() {
-  if (context_.hung()) return;  // a running submission may still use them (Context::cleanup)
-  VkDevice d = context_.device();
-  if (out_.buffer) vkDestroyBuffer(d, std::exchange(out_.buffer, VK_NULL_HANDLE), nullptr);
-  if (memory_) vkFreeMemory(d, std::exchange(memory_, VK_NULL_HANDLE), nullptr);
-  if (out_.ready) vkDestroySemaphore(d, std::exchange(out_.ready, VK_NULL_HANDLE), nullptr);
+  nodes_ = context.create_storage_buffer(words.size() * 4);
+  context.upload(nodes_, words.data(), words.size() * 4);
+  scratch_ = context.create_storage_buffer(nodes * 2 * 4 * 8);
+  state_ = context.create_storage_buffer(nodes * 2 * 4);
+  side_first_ = context.create_storage_buffer((2 * nodes + 1) * 4);
+  entries_ = context.create_storage_buffer(16);
+  out_ = {out_buffer_.buffer(), VkDeviceSize(nodes) * 24, uint32_t(nodes), out_buffer_.ready(), 0, context.queue_family()};
 }
 
 void VoxelExitancePublisher::set_deposits(const VoxelDeposits& deposits) {
@@ -149,25 +109,9 @@ const DeviceVoxelExitance& VoxelExitancePublisher::write(const DeviceLightmap& l
   done.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_UNIFORM_READ_BIT;
   vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &done, 0, nullptr, 0,
                        nullptr);
-  if (out_.ready) context_.submit_and_wait(cmd, out_.ready, out_.ready_value + 1);
-  else context_.submit_and_wait(cmd);
-  if (out_.ready) ++out_.ready_value;
+  out_buffer_.submit_write(cmd);
+  out_.ready_value = out_buffer_.ready_value();
   return out_;
-}
-
-std::vector<float> VoxelExitancePublisher::read_back() {
-  std::vector<float> values(size_t(out_.nodes) * 6);
-  Buffer staging = context_.create_buffer(values.size() * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
-  VkCommandBuffer cmd = context_.begin();
-  const VkBufferCopy region{0, 0, values.size() * 4};
-  vkCmdCopyBuffer(cmd, out_.buffer, staging.handle(), 1, &region);
-  VkMemoryBarrier host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-  host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &host, 0, nullptr, 0, nullptr);
-  context_.submit_and_wait(cmd);
-  std::memcpy(values.data(), staging.mapped(), values.size() * 4);
-  return values;
 }
 
 }  // namespace exitance::vulkan

@@ -11,6 +11,7 @@
 #include "exitance/formats/sparse_voxel_octree.h"
 #include "exitance/runtime/bundle/texel_exitance.h"
 #include "exitance/runtime/vulkan/device_voxel_exitance.h"
+#include "shared_device_buffer.h"
 #include "vulkan_context.h"
 
 namespace exitance::vulkan {
@@ -18,7 +19,6 @@ namespace exitance::vulkan {
 class VoxelExitancePublisher {
  public:
   VoxelExitancePublisher(Context& context, const formats::SparseVoxelOctree& svo);
-  ~VoxelExitancePublisher();
   VoxelExitancePublisher(const VoxelExitancePublisher&) = delete;
   VoxelExitancePublisher& operator=(const VoxelExitancePublisher&) = delete;
 
@@ -27,15 +27,14 @@ class VoxelExitancePublisher {
   // The voxel exitance of `lightmap` (a published estimate of the deposits' texels), in one
   // submission after everything submitted to the queue before it; waits (bounded).
   const DeviceVoxelExitance& write(const DeviceLightmap& lightmap);
-  std::vector<float> read_back();  // for tests and tools
+  std::vector<float> read_back() const { return out_buffer_.read_back(); }  // for tests and tools
 
  private:
-  void release();
   Context& context_;
   std::vector<uint32_t> level_begin_;
   Buffer side_first_, entries_, nodes_, scratch_, state_;
   bool deposits_set_ = false;
-  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  SharedDeviceBuffer out_buffer_;
   DeviceVoxelExitance out_;
   ComputeKernel kernel_;
 };
