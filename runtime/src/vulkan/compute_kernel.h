@@ -44,4 +44,12 @@ class ComputeKernel {
 // shaders recorded next (publish.comp, denoise_indirect.comp).
 void clear_counters_before_compute(VkCommandBuffer cmd, const Buffer& counters);
 
+// Records a barrier that makes every transfer, compute or host write before it visible to the
+// compute shaders recorded next (the small kernels that rewrite sums in place: scale_light_layers,
+// scale_probe_layers).
+void writes_visible_to_compute(VkCommandBuffer cmd);
+// Records a barrier after compute shaders: their reads and writes done before later transfers,
+// compute shaders and host reads (a download, the next pass, the host's mapped read).
+void compute_done_before_all(VkCommandBuffer cmd);
+
 }  // namespace exitance::vulkan

@@ -58,11 +58,8 @@ void LightLayerScaler::scale(const std::vector<Vec4>& factors, const ScaledEstim
     kernel_.write_buffers(i, infos.data(), 5);
   }
   VkCommandBuffer cmd = context_.begin();
+  writes_visible_to_compute(cmd);
   VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_HOST_WRITE_BIT;
-  barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_HOST_BIT,
-                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
   for (uint32_t i = 0; i < estimates.size(); ++i) {
     const ScaledEstimate& e = estimates[i];
     const bool last = i + 1 == estimates.size();
@@ -78,12 +75,7 @@ void LightLayerScaler::scale(const std::vector<Vec4>& factors, const ScaledEstim
     kernel_.push(cmd, &push, sizeof(push));
     vkCmdDispatch(cmd, uint32_t((e.texels + 63) / 64), 1, 1);
   }
-  barrier.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-  barrier.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT |
-                          VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_HOST_READ_BIT;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                       VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
-                       &barrier, 0, nullptr, 0, nullptr);
+  compute_done_before_all(cmd);
   context_.submit_and_wait(cmd);
 }
 

@@ -63,11 +63,6 @@ const DeviceProbeBuffer& ProbePublisher::write(const ProbeAccumulators& sums, ui
     kernel_.push(cmd, &push, sizeof(push));
     vkCmdDispatch(cmd, uint32_t((probes_ + 63) / 64), 1, 1);
   }
-  VkMemoryBarrier done{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  done.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-  done.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_UNIFORM_READ_BIT;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &done, 0, nullptr, 0,
-                       nullptr);
   out_buffer_.submit_write(cmd);
   out_.ready_value = out_buffer_.ready_value();
   return out_;

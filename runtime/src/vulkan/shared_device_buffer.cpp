@@ -47,6 +47,12 @@ void SharedDeviceBuffer::release() {
 }
 
 void SharedDeviceBuffer::submit_write(VkCommandBuffer cmd) {
+  // The kernels' writes visible to whatever reads the buffer next (an engine's shaders, a copy).
+  VkMemoryBarrier done{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  done.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+  done.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_UNIFORM_READ_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &done, 0, nullptr, 0,
+                       nullptr);
   if (ready_) {
     context_.submit_and_wait(cmd, ready_, ready_value_ + 1);
     ++ready_value_;

@@ -24,8 +24,8 @@ class SharedDeviceBuffer {
   VkDeviceSize size() const { return size_; }
   VkSemaphore ready() const { return ready_; }
   uint64_t ready_value() const { return ready_value_; }
-  // Submits `cmd` (the write, ending with its barriers), signals the semaphore to the next value and
-  // waits for it (bounded).
+  // Ends `cmd` (the compute write) with the barrier that makes it visible to any later read, submits
+  // it, signals the semaphore to the next value and waits for it (bounded).
   void submit_write(VkCommandBuffer cmd);
   std::vector<float> read_back() const;  // a copy through staging, for tests and tools
 

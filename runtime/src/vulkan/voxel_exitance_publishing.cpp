@@ -104,11 +104,6 @@ const DeviceVoxelExitance& VoxelExitancePublisher::write(const DeviceLightmap& l
   for (uint32_t l = depth; l-- > 0;) dispatch(1, level(l).first, level(l).second);
   dispatch(2, 0, out_.nodes);
   for (uint32_t l = 1; l <= depth; ++l) dispatch(3, level(l).first, level(l).second);
-  VkMemoryBarrier done{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  done.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-  done.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_UNIFORM_READ_BIT;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &done, 0, nullptr, 0,
-                       nullptr);
   out_buffer_.submit_write(cmd);
   out_.ready_value = out_buffer_.ready_value();
   return out_;
