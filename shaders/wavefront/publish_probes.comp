@@ -9,6 +9,7 @@
 // [i * 3 + c]. The same float operations as the host, so the buffer equals published_probes().
 layout(local_size_x = 64) in;
 #include "exitance/common/publishing_rule.h"
+#include "exitance/common/spherical_harmonics_basis.h"
 
 layout(std430, set = 0, binding = 0) readonly buffer Sums { double sums[]; };    // ProbeAccumulators: totals, squared L0, ...
 layout(std430, set = 0, binding = 1) readonly buffer Counts { uint counts[]; };  // [probe][samples, back faces]
@@ -22,38 +23,31 @@ layout(push_constant) uniform Push {
   float band_weight[3];  // the dering window per SH band (1 without dering)
 } push;
 
-uint band_of(uint coefficient) { return coefficient == 0u ? 0u : (coefficient < 4u ? 1u : 2u); }
 
 void main() {
   uint k = gl_GlobalInvocationID.x;
   if (k >= push.probe_count) return;
   uint n = counts[k * 2u];
   uint at = k * 29u;
-  bool refreshed = false;
+  double difference_squared = 0.0lf;
+  double variance = 0.0lf;
+  bool all_zero = true;
   if (n > 0u) {
-    double kept_variance = kept[at + 28u];
-    if (kept_variance < 0.0lf) {
-      refreshed = n >= push.switch_samples;
-    } else {
-      double difference_squared = 0.0lf;
-      double variance = 0.0lf;
-      bool all_zero = true;
-      uint squares_at = push.probe_count * 27u + k * 3u;
-      for (uint c = 0u; c < 3u; ++c) {
-        double d = sums[k * 27u + c] / double(n) - double(float(kept[at + c]));
-        difference_squared += d * d;
-        all_zero = all_zero && sums[k * 27u + c] == 0.0lf && sums[squares_at + c] == 0.0lf;
-        variance += double(variance_of_mean_from_sums(sums[k * 27u + c], sums[squares_at + c], n));
-      }
-      refreshed = publish_after_restart(uint(kept[at + 27u]), n, difference_squared, kept_variance, variance, all_zero) ==
-                  kPublishRefreshed;
+    uint squares_at = push.probe_count * 27u + k * 3u;
+    for (uint c = 0u; c < 3u; ++c) {
+      double d = sums[k * 27u + c] / double(n) - double(float(kept[at + c]));
+      difference_squared += d * d;
+      all_zero = all_zero && sums[k * 27u + c] == 0.0lf && sums[squares_at + c] == 0.0lf;
+      variance += double(variance_of_mean_from_sums(sums[k * 27u + c], sums[squares_at + c], n));
     }
   }
+  bool refreshed =
+      publish_probe_refreshed(n, push.switch_samples, uint(kept[at + 27u]), kept[at + 28u], difference_squared, variance, all_zero);
   uint out_at = grid_index[k] * 27u;
   for (uint i = 0u; i < 9u; ++i) {
     vec3 value;
     for (uint c = 0u; c < 3u; ++c)
-      value[c] = refreshed ? float(sums[k * 27u + i * 3u + c] / double(n)) * push.band_weight[band_of(i)] : float(kept[at + i * 3u + c]);
+      value[c] = refreshed ? float(sums[k * 27u + i * 3u + c] / double(n)) * push.band_weight[sh_band(int(i))] : float(kept[at + i * 3u + c]);
     if (refreshed && (any(isnan(value)) || any(isinf(value)))) value = vec3(0.0);
     for (uint c = 0u; c < 3u; ++c) out_sh[out_at + i * 3u + c] = value[c];
   }

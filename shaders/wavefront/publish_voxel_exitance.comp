@@ -10,7 +10,7 @@
 // (filled) where that has one. Output: [node][front rgb, back rgb], 0 where neither lit nor filled.
 layout(local_size_x = 64) in;
 
-const float kPi = 3.14159265358979323846f;
+#include "exitance/common/sampling.h"  // kPi, as texel_exitance.cpp's
 
 layout(std430, set = 0, binding = 0) readonly buffer Sums { double sums[]; };      // [texel][total rgb, squared rgb]
 layout(std430, set = 0, binding = 1) readonly buffer Samples { uint samples[]; };  // [texel]

@@ -10,8 +10,8 @@ namespace exitance {
 
 bool probe_shows_refreshed(const KeptProbe& kept, const ProbeEstimate& refreshed, size_t k, uint32_t switch_samples) {
   const uint32_t n = refreshed.samples[k];
-  if (n == 0) return false;
-  if (kept.variance < 0 || k >= refreshed.l0_square_sum.size()) return n >= switch_samples;
+  // Without squared sums (no variance to compare) as for a kept value of unknown variance.
+  if (n == 0 || k >= refreshed.l0_square_sum.size()) return publish_probe_refreshed(n, switch_samples, kept.samples, -1, 0, 0, false);
   double difference_squared = 0;
   bool all_zero = true;
   for (size_t c = 0; c < 3; ++c) {
@@ -19,8 +19,8 @@ bool probe_shows_refreshed(const KeptProbe& kept, const ProbeEstimate& refreshed
     difference_squared += d * d;
     all_zero = all_zero && refreshed.sh_sum[k][c] == 0 && refreshed.l0_square_sum[k][c] == 0;
   }
-  return publish_after_restart(kept.samples, n, difference_squared, kept.variance, refreshed.l0_variance_of_mean(k), all_zero) ==
-         kPublishRefreshed;
+  return publish_probe_refreshed(n, switch_samples, kept.samples, kept.variance, difference_squared, refreshed.l0_variance_of_mean(k),
+                                 all_zero);
 }
 
 void scale_kept_probes(std::vector<KeptProbe>& kept, const ProbeEstimate& layer, Vec4 factor, float dering_window) {

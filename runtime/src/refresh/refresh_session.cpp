@@ -17,6 +17,7 @@
 #include "exitance/formats/probes_file.h"
 #include "exitance/runtime/bundle/probe_results.h"
 #include "published_probes.h"
+#include "exitance/runtime/spherical_harmonics.h"
 #include "exitance/runtime/bundle/texel_exitance.h"
 #include "exitance/formats/scene_file.h"
 #include "exitance/formats/svo_file.h"
@@ -576,13 +577,10 @@ const DeviceProbeBuffer& RefreshSession::publish_probe_buffer() {
       kept.push_back(k.variance);
     }
   }
-  // The dering window per band, as sh_apply_hanning_window computes it (store_probe_radiance).
+  // The dering window per band, as store_probe_radiance applies it (none: 1).
   std::array<float, 3> band_weight{1.0f, 1.0f, 1.0f};
   if (s.probe_dering > 0)
-    for (int band = 0; band < 3; ++band) {
-      const float l = float(band);
-      band_weight[size_t(band)] = l < s.probe_dering ? 0.5f * (1.0f + std::cos(3.14159265358979f * l / s.probe_dering)) : 0.0f;
-    }
+    for (int band = 0; band < 3; ++band) band_weight[size_t(band)] = sh_hanning_band_weight(band, s.probe_dering);
   const DeviceProbeBuffer& buffer =
       s.integrator->write_probe_buffer(s.persisted.probes.probes.size(), grid_index, s.previous_probes_uploaded ? nullptr : &kept,
                                        std::max(1u, s.probe_switch_samples), band_weight);

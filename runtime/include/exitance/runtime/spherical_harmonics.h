@@ -41,12 +41,12 @@ inline Vec3 sh_irradiance_over_pi(const ShRgb& radiance, Vec3 n) {
 // Optional deringing: a Hanning window over the bands, w_l = (1 + cos(pi l / width)) / 2 for
 // l < width, 0 beyond. width = 3 keeps band 0, scales band 1 by 0.75 and band 2 by 0.25. Reduces
 // negative lobes around bright sources at the cost of blur.
+inline float sh_hanning_band_weight(int band, float width) {
+  const float l = float(band);
+  return l < width ? 0.5f * (1.0f + std::cos(3.14159265358979f * l / width)) : 0.0f;
+}
 inline void sh_apply_hanning_window(ShRgb& sh, float width) {
-  for (int i = 0; i < kShCoefficients; ++i) {
-    const float l = float(sh_band(i));
-    const float w = l < width ? 0.5f * (1.0f + std::cos(3.14159265358979f * l / width)) : 0.0f;
-    sh[i] = sh[i] * w;
-  }
+  for (int i = 0; i < kShCoefficients; ++i) sh[i] = sh[i] * sh_hanning_band_weight(sh_band(i), width);
 }
 
 }  // namespace exitance

@@ -105,6 +105,19 @@ EXITANCE_FN uint publish_after_restart(uint kept_samples, uint refreshed_samples
   return (more_precise || significant) ? kPublishRefreshed : kPublishPrevious;
 }
 
+// What a refreshed light probe shows (refresh/published_probes.h on the host, publish_probes.comp on
+// the device): its refreshed estimate of n samples rather than what it showed before the last edit
+// (kept_samples behind that, its L0 mean's variance summed over rgb; < 0 when unknown, as for the
+// bundle's probes.bin: then the refreshed estimate once it has switch_samples), by
+// publish_after_restart on the probe's L0 terms.
+EXITANCE_FN bool publish_probe_refreshed(uint n, uint switch_samples, uint kept_samples, double kept_variance,
+                                         double difference_squared, double refreshed_variance, bool refreshed_all_zero) {
+  if (n == 0u) return false;
+  if (kept_variance < 0.0) return n >= switch_samples;
+  return publish_after_restart(kept_samples, n, difference_squared, kept_variance, refreshed_variance, refreshed_all_zero) ==
+         kPublishRefreshed;
+}
+
 // A change estimate's d is shown where |d|^2 > kChangeShownAbove V_d. Showing base + d costs its
 // variance V_d; showing the base costs the true change squared, whose estimate from d is
 // |d|^2 - V_d: so 2 is where the estimated errors are equal. Unlike a restart's independent
