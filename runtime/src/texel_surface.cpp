@@ -87,11 +87,15 @@ float triangle_world_texel_size(const Scene& scene, uint32_t t, const InstanceRe
   return texel_area > 0 ? std::sqrt(world_area / texel_area) : 0.0f;
 }
 
-TexelSurface texel_surface(const Scene& scene, uint32_t t, float b1, float b2) {
+Vec3 texel_surface_position(const Scene& scene, uint32_t t, float b1, float b2) {
   const Vec3* pos = &scene.positions[size_t(t) * 3];
+  return pos[0] * (1 - b1 - b2) + pos[1] * b1 + pos[2] * b2;
+}
+
+TexelSurface texel_surface(const Scene& scene, uint32_t t, float b1, float b2) {
   const Vec3* nrm = &scene.normals[size_t(t) * 3];
   TexelSurface s;
-  s.position = pos[0] * (1 - b1 - b2) + pos[1] * b1 + pos[2] * b2;
+  s.position = texel_surface_position(scene, t, b1, b2);
   s.geometric_normal = triangle_normal(scene, t);
   Vec3 n = nrm[0] * (1 - b1 - b2) + nrm[1] * b1 + nrm[2] * b2;
   const float n_length = length(n);

@@ -63,6 +63,9 @@ ClippedPolygon clip_to_box(const Vec3 triangle[3], const WorldBox& box) {
 WorldBox carried_part_box(const Vec3 before[3], const Vec3 after[3], const WorldBox& box) {
   WorldBox whole;
   for (int k = 0; k < 3; ++k) whole.grow(after[k]);
+  // A triangle wholly inside the box (no spatial split cut it): the clip keeps its three corners,
+  // which carry to the moved corners, so its part is the whole moved triangle (most leaves).
+  if (box.contains(before[0], 0.0f) && box.contains(before[1], 0.0f) && box.contains(before[2], 0.0f)) return whole;
   const ClippedPolygon part = clip_to_box(before, box);
   auto point = [](const Vec3& v) { return Point{v.x, v.y, v.z}; };
   auto minus = [](const Point& a, const Point& b) { return Point{a[0] - b[0], a[1] - b[1], a[2] - b[2]}; };

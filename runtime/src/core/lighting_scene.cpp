@@ -74,61 +74,78 @@ double punctual_power(const PunctualLight& light, float radius) {
   }
 }
 
-void set_emitter_distribution(LightingScene& lighting, const std::vector<double>& powers);
+void set_emitter_distribution(LightingScene& lighting, const std::vector<double>& powers, std::vector<float> areas);
 
-// Area x luminance of the mean emission, x2 when double sided.
-double emitter_power(const Scene& scene, uint32_t t, double area) {
-  const Material& m = scene.materials[scene.triangle_material[t]];
-  Vec3 mean = m.emission;
-  if (m.emissive_texture.texture >= 0) mean = mean * texture_mean(scene.textures[size_t(m.emissive_texture.texture)]);
-  return area * double(luminance(mean)) * (m.double_sided ? 2.0 : 1.0);
+// Per material: the luminance of its mean emission, x2 when double sided (an emitter's power is
+// its area times this). Once per call: an emissive texture's mean reads the whole image.
+std::vector<double> emission_power_per_area(const Scene& scene) {
+  std::vector<double> out(scene.materials.size());
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    const Material& m = scene.materials[i];
+    Vec3 mean = m.emission;
+    if (m.emissive_texture.texture >= 0) mean = mean * texture_mean(scene.textures[size_t(m.emissive_texture.texture)]);
+    out[i] = double(luminance(mean)) * (m.double_sided ? 2.0 : 1.0);
+  }
+  return out;
 }
 
 // Emitters by power (area x luminance of the mean emission, x2 when double sided), and every
 // triangle's area density under that choice, which NEE's MIS needs at any hit on it.
 void build_emitter_distribution(LightingScene& lighting) {
   const Scene& scene = *lighting.source;
+  const std::vector<double> per_area = emission_power_per_area(scene);
   lighting.emitter_triangles.clear();
   for (GpuTriangle& g : lighting.triangles) g.p1_area_pdf.w = 0.0f;
   std::vector<double> powers;
+  std::vector<float> areas;
   for (uint32_t t = 0; t < scene.triangle_count(); ++t) {
     if (!is_emissive(scene, t)) continue;
-    const double area = triangle_area(scene, t);
-    const double power = emitter_power(scene, t, area);
+    const float area = triangle_area(scene, t);
+    const double power = double(area) * per_area[scene.triangle_material[t]];
     if (!(power > 0) || !(area > 0)) continue;  // zero-area or black emitters can never be hit usefully
     lighting.emitter_triangles.push_back(t);
     powers.push_back(power);
+    areas.push_back(area);
   }
-  set_emitter_distribution(lighting, powers);
+  set_emitter_distribution(lighting, powers, std::move(areas));
 }
 
 // After emitters moved (their areas may change by rounding or a scale, the set cannot: emission
 // is the material's, and a move that collapses a triangle is refused): the same distribution as
 // build_emitter_distribution from the emitters alone. False, nothing changed, when a listed
 // emitter no longer qualifies (build_emitter_distribution then).
-bool refresh_emitter_powers(LightingScene& lighting) {
+bool refresh_emitter_powers(LightingScene& lighting, const std::vector<uint32_t>& moved) {
   const Scene& scene = *lighting.source;
-  std::vector<double> powers;
-  powers.reserve(lighting.emitter_triangles.size());
-  for (uint32_t t : lighting.emitter_triangles) {
-    const double area = triangle_area(scene, t);
-    const double power = emitter_power(scene, t, area);
-    if (!(power > 0) || !(area > 0)) return false;
-    powers.push_back(power);
+  const std::vector<double> per_area = emission_power_per_area(scene);
+  const std::vector<uint32_t>& emitters = lighting.emitter_triangles;
+  std::vector<float> areas = lighting.emitter_areas;
+  if (areas.size() != emitters.size()) {
+    areas.resize(emitters.size());
+    for (size_t i = 0; i < emitters.size(); ++i) areas[i] = triangle_area(scene, emitters[i]);
+  } else {  // both ascend: the moved emitters' areas again, the others' are the same bits
+    for (size_t i = 0, k = 0; i < emitters.size() && k < moved.size();) {
+      if (emitters[i] < moved[k]) ++i;
+      else if (moved[k] < emitters[i]) ++k;
+      else areas[i++] = triangle_area(scene, moved[k++]);
+    }
   }
-  set_emitter_distribution(lighting, powers);
+  std::vector<double> powers(emitters.size());
+  for (size_t i = 0; i < emitters.size(); ++i) {
+    const double area = areas[i];
+    powers[i] = area * per_area[scene.triangle_material[emitters[i]]];
+    if (!(powers[i] > 0) || !(area > 0)) return false;
+  }
+  set_emitter_distribution(lighting, powers, std::move(areas));
   return true;
 }
 
 // The emitter CDF over `powers` (per lighting.emitter_triangles) and the emitters' area pdfs.
-void set_emitter_distribution(LightingScene& lighting, const std::vector<double>& powers) {
-  const Scene& scene = *lighting.source;
+void set_emitter_distribution(LightingScene& lighting, const std::vector<double>& powers, std::vector<float> areas) {
   const Distribution1D emitters(powers);
   lighting.emitter_cdf = padded_cdf(emitters);
-  for (size_t i = 0; i < lighting.emitter_triangles.size(); ++i) {
-    const uint32_t t = lighting.emitter_triangles[i];
-    lighting.triangles[t].p1_area_pdf.w = emitters.pmf(i) / triangle_area(scene, t);
-  }
+  for (size_t i = 0; i < lighting.emitter_triangles.size(); ++i)
+    lighting.triangles[lighting.emitter_triangles[i]].p1_area_pdf.w = emitters.pmf(i) / areas[i];
+  lighting.emitter_areas = std::move(areas);
 }
 
 // Punctual lights by power. An all-zero distribution never samples (pmf 0 -> probability 0).
@@ -297,7 +314,7 @@ MovedTrianglesRefresh refresh_moved_triangles_from_source(LightingScene& lightin
     lighting.bounds_lo = bounds.lo, lighting.bounds_hi = bounds.hi;
     lighting.extent = std::max(max_component(bounds.hi - bounds.lo), 1e-30f);
   }
-  if (emitter_moved && !refresh_emitter_powers(lighting)) build_emitter_distribution(lighting);  // areas follow the moved emitters
+  if (emitter_moved && !refresh_emitter_powers(lighting, moved)) build_emitter_distribution(lighting);  // areas follow the moved emitters
   build_punctual_distribution(lighting);                      // directional powers follow the bounds
   for (size_t l = 0; l < scene.lights.size() && l < lighting.punctual_lights.size(); ++l)
     lighting.punctual_lights[l] = punctual_record(scene.lights[l]);

@@ -1,6 +1,7 @@
 #include "moved_instances.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <optional>
@@ -38,47 +39,58 @@ std::vector<std::string> responsible_edits(const Scene& scene, const std::vector
   return out;
 }
 
-// Moves an instance's triangles (the slice) by `delta` (normals by its inverse transpose, renormalized).
-void move_triangles(MovedTriangles& m, const Instance& instance, const Matrix4d& delta, const std::string& where) {
-  const double det = determinant3(delta);
-  const bool mirrors = det < 0;  // the importer flips the winding of mirrored instances: so do we
-  for (uint32_t t = 0; t < m.count; ++t) {
-    Vec3* p = &m.positions[size_t(t) * 3];
-    Vec3* n = &m.normals[size_t(t) * 3];
-    for (int k = 0; k < 3; ++k) p[k] = transform_point(delta, p[k]);
-    if (mirrors) {
-      std::swap(p[1], p[2]);
-      std::swap(n[1], n[2]);
-      for (std::vector<Vec2>* uv : {&m.uv0, &m.lightmap_uv})
-        if (!uv->empty()) std::swap((*uv)[size_t(t) * 3 + 1], (*uv)[size_t(t) * 3 + 2]);
-      if (!m.vertex_color.empty()) {
-        std::swap(m.vertex_color[size_t(t) * 3 + 1], m.vertex_color[size_t(t) * 3 + 2]);
-        std::swap(m.vertex_alpha[size_t(t) * 3 + 1], m.vertex_alpha[size_t(t) * 3 + 2]);
-      }
-      if (!m.tangents.empty()) {
-        std::swap(m.tangents[size_t(t) * 3 + 1], m.tangents[size_t(t) * 3 + 2]);
-        std::swap(m.tangent_signs[size_t(t) * 3 + 1], m.tangent_signs[size_t(t) * 3 + 2]);
-      }
+// Moves one triangle of the slice by `delta`; false when the move collapses it.
+bool move_triangle(MovedTriangles& m, uint32_t t, const Matrix4d& delta, bool mirrors) {
+  Vec3* p = &m.positions[size_t(t) * 3];
+  Vec3* n = &m.normals[size_t(t) * 3];
+  for (int k = 0; k < 3; ++k) p[k] = transform_point(delta, p[k]);
+  if (mirrors) {
+    std::swap(p[1], p[2]);
+    std::swap(n[1], n[2]);
+    for (std::vector<Vec2>* uv : {&m.uv0, &m.lightmap_uv})
+      if (!uv->empty()) std::swap((*uv)[size_t(t) * 3 + 1], (*uv)[size_t(t) * 3 + 2]);
+    if (!m.vertex_color.empty()) {
+      std::swap(m.vertex_color[size_t(t) * 3 + 1], m.vertex_color[size_t(t) * 3 + 2]);
+      std::swap(m.vertex_alpha[size_t(t) * 3 + 1], m.vertex_alpha[size_t(t) * 3 + 2]);
     }
-    const Vec3 face = cross(p[1] - p[0], p[2] - p[0]);
-    const float face_length = length(face);
-    if (!(face_length > 0.0f) || !std::isfinite(face_length) || !is_finite(p[0]) || !is_finite(p[1]) || !is_finite(p[2]))
-      fail(where, "the transform collapses triangle " + std::to_string(m.first + t) + " of instance \"" + instance.name +
-                      "\" (zero area or not finite)");
-    for (int k = 0; k < 3; ++k) {
-      // Cofactor = det * inverse-transpose: its sign undone so the normal keeps its side.
-      const Vec3 v = transform_normal(delta, n[k]) * (mirrors ? -1.0f : 1.0f);
-      const float v_length = length(v);
-      const Vec3 moved_normal = v_length > 0.0f && std::isfinite(v_length) ? v / v_length : face / face_length;
-      if (!m.tangents.empty()) {  // normal-map frames move with the surface
-        const size_t c = size_t(t) * 3 + size_t(k);
-        const TangentFrame frame = transform_tangent_frame(delta, {m.tangents[c], m.tangent_signs[c]}, n[k], moved_normal);
-        m.tangents[c] = frame.tangent;
-        m.tangent_signs[c] = frame.sign;
-      }
-      n[k] = moved_normal;
+    if (!m.tangents.empty()) {
+      std::swap(m.tangents[size_t(t) * 3 + 1], m.tangents[size_t(t) * 3 + 2]);
+      std::swap(m.tangent_signs[size_t(t) * 3 + 1], m.tangent_signs[size_t(t) * 3 + 2]);
     }
   }
+  const Vec3 face = cross(p[1] - p[0], p[2] - p[0]);
+  const float face_length = length(face);
+  if (!(face_length > 0.0f) || !std::isfinite(face_length) || !is_finite(p[0]) || !is_finite(p[1]) || !is_finite(p[2]))
+    return false;
+  for (int k = 0; k < 3; ++k) {
+    // Cofactor = det * inverse-transpose: its sign undone so the normal keeps its side.
+    const Vec3 v = transform_normal(delta, n[k]) * (mirrors ? -1.0f : 1.0f);
+    const float v_length = length(v);
+    const Vec3 moved_normal = v_length > 0.0f && std::isfinite(v_length) ? v / v_length : face / face_length;
+    if (!m.tangents.empty()) {  // normal-map frames move with the surface
+      const size_t c = size_t(t) * 3 + size_t(k);
+      const TangentFrame frame = transform_tangent_frame(delta, {m.tangents[c], m.tangent_signs[c]}, n[k], moved_normal);
+      m.tangents[c] = frame.tangent;
+      m.tangent_signs[c] = frame.sign;
+    }
+    n[k] = moved_normal;
+  }
+  return true;
+}
+
+// Moves an instance's triangles (the slice) by `delta` (normals by its inverse transpose,
+// renormalized), on all cores; the first collapsed triangle is named.
+void move_triangles(MovedTriangles& m, const Instance& instance, const Matrix4d& delta, const std::string& where) {
+  const bool mirrors = determinant3(delta) < 0;  // the importer flips the winding of mirrored instances: so do we
+  std::atomic<uint32_t> first_collapsed{UINT32_MAX};
+  for_each_chunk(m.count, [&](size_t begin, size_t end) {
+    for (size_t t = begin; t < end; ++t)
+      if (!move_triangle(m, uint32_t(t), delta, mirrors))
+        for (uint32_t v = first_collapsed.load(); t < v && !first_collapsed.compare_exchange_weak(v, uint32_t(t));) {}
+  }, 1024);
+  if (first_collapsed.load() != UINT32_MAX)
+    fail(where, "the transform collapses triangle " + std::to_string(m.first + first_collapsed.load()) + " of instance \"" +
+                    instance.name + "\" (zero area or not finite)");
 }
 
 template <typename T>
@@ -97,7 +109,7 @@ void put_corners(std::vector<T>& all, const std::vector<T>& slice, uint32_t firs
 bool pushed_off_surface(const LiveTexel& texel, const Scene& scene, const InstanceRect& rect, const AtlasPage& page,
                         float& b1, float& b2) {
   texel_barycentrics(scene, rect, page.width, page.height, texel.triangle, texel.x, texel.y, b1, b2);
-  return !same_bits(texel_surface(scene, texel.triangle, b1, b2).position, texel.position);
+  return !same_bits(texel_surface_position(scene, texel.triangle, b1, b2), texel.position);
 }
 
 // A texel of a moved instance, re-derived on `next` as the rasterizer derives it (barycentrics

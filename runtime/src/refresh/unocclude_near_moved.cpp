@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -37,7 +38,7 @@ std::vector<uint32_t> unocclude_near_boxes(PersistedScene& edited, const std::ve
     float b1, b2;
     texel_barycentrics(edited.scene, edited.atlas.rects[texel.instance], page.width, page.height, texel.triangle,
                        texel.x, texel.y, b1, b2);
-    const Vec3 surface = texel_surface(edited.scene, texel.triangle, b1, b2).position;
+    const Vec3 surface = texel_surface_position(edited.scene, texel.triangle, b1, b2);
     if (!std::any_of(boxes.begin(), boxes.end(), [&](const WorldBox& b) { return b.contains(surface, reach); })) return false;
     texel.position = surface;
     unocclude_texel(texel, edited_lighting.extent, query);
@@ -58,13 +59,21 @@ std::vector<uint32_t> unocclude_near_boxes(PersistedScene& edited, const std::ve
     std::vector<uint32_t> candidates;
     const float margin = 2 * 0.75f * grid->largest_texel_size();
     auto within = [&](const Vec3& p) { return std::any_of(boxes.begin(), boxes.end(), [&](const WorldBox& b) { return b.contains(p, margin); }); };
-    std::vector<std::pair<uint32_t, uint32_t>> rows;
+    std::vector<std::pair<uint32_t, uint32_t>> rows, box_rows;
     for (const WorldBox& b : boxes) {
-      grid->candidate_rows(b, margin, rows);
-      for (const auto& [begin, end] : rows)
-        for (uint32_t k = begin; k < end; ++k)
-          if (within(grid->entry_position(k)) && !grid->is_displaced(grid->entry(k))) candidates.push_back(grid->entry(k));
+      grid->candidate_rows(b, margin, box_rows);
+      for (auto [begin, end] : box_rows)  // in pieces: a block's few rows hold ~100 000 entries
+        for (; begin < end; begin = std::min(end, begin + 4096)) rows.emplace_back(begin, std::min(end, begin + 4096));
     }
+    std::mutex merge;
+    for_each_chunk(rows.size(), [&](size_t first, size_t last) {  // the rows' texels on all cores
+      std::vector<uint32_t> found;
+      for (size_t r = first; r < last; ++r)
+        for (uint32_t k = rows[r].first; k < rows[r].second; ++k)
+          if (within(grid->entry_position(k)) && !grid->is_displaced(grid->entry(k))) found.push_back(grid->entry(k));
+      const std::lock_guard<std::mutex> lock(merge);
+      candidates.insert(candidates.end(), found.begin(), found.end());
+    }, 4);
     for (uint32_t i : grid->displaced())
       if (within(edited.gbuffer.texels[i].position)) candidates.push_back(i);
     std::sort(candidates.begin(), candidates.end());

@@ -441,8 +441,15 @@ struct StagingLease {
 
 const Buffer& Context::staging_for(VkDeviceSize size, Buffer& own, bool& leased) {
   leased = false;
-  if (size <= kSmallStagingBytes && !small_staging_busy_) {
-    if (!small_staging_.handle()) small_staging_ = create_buffer(kSmallStagingBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+  if (size <= kReusedStagingLimit && !small_staging_busy_) {
+    if (!small_staging_.handle() || small_staging_.size() < size) {
+      // Grown to the next power of two: a moved instance's edit writes a few megabytes each time, and
+      // a new host-visible buffer per edit costs its allocation and page faults (pinned on GPUs).
+      VkDeviceSize bytes = kSmallStagingBytes;
+      while (bytes < size) bytes *= 2;
+      small_staging_ = Buffer{};
+      small_staging_ = create_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+    }
     small_staging_busy_ = leased = true;
     return small_staging_;
   }

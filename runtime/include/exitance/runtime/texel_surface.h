@@ -44,5 +44,7 @@ struct TexelSurface {
   Vec3 position, geometric_normal, shading_normal, albedo;
 };
 TexelSurface texel_surface(const Scene& scene, uint32_t triangle, float b1, float b2);
+// texel_surface's position alone, the same bits (an edit's tests of where texels lie need no albedo).
+Vec3 texel_surface_position(const Scene& scene, uint32_t triangle, float b1, float b2);
 
 }  // namespace exitance

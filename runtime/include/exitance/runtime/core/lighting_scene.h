@@ -22,6 +22,7 @@ struct LightingScene {
   std::vector<GpuPunctualLight> punctual_lights;
   std::vector<uint32_t> emitter_triangles;   // emissive triangles NEE picks from, by power
   std::vector<double> emitter_cdf;           // emitter_triangles.size() + 1 entries (at least 2)
+  std::vector<float> emitter_areas;          // per emitter_triangles: an edit recomputes the moved ones only
   std::vector<double> punctual_cdf;          // punctual_lights.size() + 1 entries (at least 2), by power
   Vec3 sky{0, 0, 0};                         // constant sky radiance (when there is no environment map)
   EnvironmentSampler environment;            // enabled when the sky is an image
