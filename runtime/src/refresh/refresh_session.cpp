@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <iterator>
 #include <cstring>
 #include <limits>
@@ -380,6 +381,8 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   if (s.scene_file) s.stale_scene_file = std::move(s.scene_file);
   s.scene_file.reset();
   LightingScene& lighting = *s.lighting;
+  std::vector<uint32_t> moved_bvh_nodes;  // geometry edits: uploaded below, beside the texels' host work
+  bool moved_emitters = false;
   if (effects.geometry_changed()) {
     for (size_t j = 0; j < effects.moved_instances.size(); ++j) s.instance_boxes[effects.moved_instances[j]] = in_place.moved_boxes_after[j];
     WorldBox bounds = s.uninstanced_box;
@@ -389,9 +392,8 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
     for (uint32_t n : moved.bvh_nodes) std::memcpy(&s.persisted.bvh.nodes[n], &lighting.bvh.nodes[n], sizeof(Bvh4Node));
     if (!effects.materials.empty()) refresh_materials_from_source(lighting, effects.materials);
     if (effects.sky) refresh_lights_from_source(lighting, {}, true);
-    s.integrator->update_moved_geometry(lighting, s.bvh_links, in_place.moved_triangles, moved.bvh_nodes,
-                                        moved.emitters_changed || !effects.materials.empty());
-    if (effects.sky) s.integrator->update_lights(lighting);
+    moved_bvh_nodes = moved.bvh_nodes;
+    moved_emitters = moved.emitters_changed || !effects.materials.empty();
   } else {
     if (!effects.materials.empty()) {
       refresh_materials_from_source(lighting, effects.materials);
@@ -431,6 +433,17 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
     boxes.insert(boxes.end(), in_place.moved_boxes_after.begin(), in_place.moved_boxes_after.end());
     restart_probes(global ? std::vector<Vec3>{} : points, global ? std::vector<WorldBox>{} : boxes);
   }
+  // A geometry edit's upload (the refit nodes, the moved triangles' records, the emitters) runs on
+  // its own thread while this one moves texels and finds those near the change: the two read the
+  // lighting scene and write disjoint state, and nothing else here records device work until it is
+  // joined (the texels' upload below). Its errors are the device's, rethrown at the join.
+  std::future<void> geometry_upload;
+  if (effects.geometry_changed())
+    geometry_upload = std::async(std::launch::async, [&] {
+      s.integrator->update_moved_geometry(lighting, s.bvh_links, in_place.moved_triangles, moved_bvh_nodes, moved_emitters);
+      if (effects.sky) s.integrator->update_lights(lighting);
+    });
+  std::vector<uint32_t> changed_texels;
   if (effects.geometry_changed()) {
     // Moved texels leave their grid cells; the unocclude step again near the moved bounds (as a
     // fresh bake would place the texels); the start points of every texel that moved, uploaded.
@@ -445,16 +458,18 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
                                in_place.moved_boxes_before, s.instance_boxes, s.uninstanced_box);
     const std::vector<uint32_t> unoccluded = unocclude_near_boxes(s.persisted, boxes, lighting, &s.texel_grid, &carried);
     for (uint32_t i : unoccluded) s.texel_grid.displace(i, s.persisted.gbuffer.texels[i]);
-    std::vector<uint32_t> changed;
     std::set_union(in_place.moved_texels.begin(), in_place.moved_texels.end(), unoccluded.begin(), unoccluded.end(),
-                   std::back_inserter(changed));
-    s.integrator->update_texels(s.persisted.gbuffer, changed);
+                   std::back_inserter(changed_texels));
   }
   was.moved_boxes_before = in_place.moved_boxes_before;
   was.moved_boxes_after = in_place.moved_boxes_after;
   std::vector<uint32_t> near = texels_near_change(s.persisted, was, lighting, effects, &s.texel_grid, &s.near_marks);
   // Set-aside texels are visited by every query: past an eighth of them, the grid is built again.
   if (s.texel_grid.displaced_count() > s.persisted.gbuffer.texels.size() / 8) s.texel_grid = TexelGrid(s.persisted.gbuffer);
+  if (geometry_upload.valid()) {
+    geometry_upload.get();
+    s.integrator->update_texels(s.persisted.gbuffer, changed_texels);
+  }
   timings.near_texels = since(lap);
 
   // Edits of punctual lights alone are estimated as a change from what was published before them
