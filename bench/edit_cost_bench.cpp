@@ -34,9 +34,10 @@ std::vector<SceneEdit> read_edits(const std::string& path) {
 }
 
 struct Phases {
-  std::vector<double> total, scene, near_texels, publish, restart, wait, submissions;
+  std::vector<double> total, scene, texels, near_texels, uploads, publish, restart, wait, submissions;
   void add(double ms, const EditTimings& t) {
-    total.push_back(ms), scene.push_back(t.scene), near_texels.push_back(t.near_texels);
+    total.push_back(ms), scene.push_back(t.scene), texels.push_back(t.texels), near_texels.push_back(t.near_texels);
+    uploads.push_back(t.uploads);
     publish.push_back(t.publish), restart.push_back(t.restart), wait.push_back(t.device_wait);
     submissions.push_back(double(t.device_submissions));
   }
@@ -46,7 +47,8 @@ struct Phases {
       std::printf("  %-12s median %8.3f  min %8.3f  max %8.3f\n", what, bench::median(v), v.front(), v.back());
     };
     std::printf("%s (%zu edits)\n", name, total.size());
-    row("total ms", total), row("scene", scene), row("near_texels", near_texels), row("publish", publish);
+    row("total ms", total), row("scene", scene), row("texels", texels), row("near_texels", near_texels);
+    row("uploads", uploads), row("publish", publish);
     row("restart", restart), row("device_wait", wait), row("submissions", submissions);
   }
 };

@@ -433,6 +433,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
     boxes.insert(boxes.end(), in_place.moved_boxes_after.begin(), in_place.moved_boxes_after.end());
     restart_probes(global ? std::vector<Vec3>{} : points, global ? std::vector<WorldBox>{} : boxes);
   }
+  timings.scene += since(lap);
   // A geometry edit's upload (the refit nodes, the moved triangles' records, the emitters) runs on
   // its own thread while this one moves texels and finds those near the change: the two read the
   // lighting scene and write disjoint state, and nothing else here records device work until it is
@@ -461,16 +462,18 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
     std::set_union(in_place.moved_texels.begin(), in_place.moved_texels.end(), unoccluded.begin(), unoccluded.end(),
                    std::back_inserter(changed_texels));
   }
+  timings.texels = since(lap);
   was.moved_boxes_before = in_place.moved_boxes_before;
   was.moved_boxes_after = in_place.moved_boxes_after;
   std::vector<uint32_t> near = texels_near_change(s.persisted, was, lighting, effects, &s.texel_grid, &s.near_marks);
   // Set-aside texels are visited by every query: past an eighth of them, the grid is built again.
   if (s.texel_grid.displaced_count() > s.persisted.gbuffer.texels.size() / 8) s.texel_grid = TexelGrid(s.persisted.gbuffer);
+  timings.near_texels = since(lap);
   if (geometry_upload.valid()) {
     geometry_upload.get();
     s.integrator->update_texels(s.persisted.gbuffer, changed_texels);
   }
-  timings.near_texels = since(lap);
+  timings.uploads = since(lap);
 
   // Edits of punctual lights alone are estimated as a change from what was published before them
   // (path.h punctual_change_rays): the same paths, each vertex adding the edited lights' direct

@@ -129,7 +129,8 @@ json relight_bundle(const RelightOptions& options) {
       const EditTimings& t = session->last_edit_timings();
       // true: the edits only scaled lights, whose layers were scaled with 0 rays (no sample dropped)
       edits_report["scaled_light_layers"] = t.scaled_light_layers;
-      edits_report["milliseconds"] = {{"scene", t.scene}, {"near_texels", t.near_texels}, {"publish", t.publish}, {"restart", t.restart},
+      edits_report["milliseconds"] = {{"scene", t.scene},     {"texels", t.texels},   {"near_texels", t.near_texels},
+                                      {"uploads", t.uploads}, {"publish", t.publish}, {"restart", t.restart},
                                       {"device_wait", t.device_wait}};
       edits_report["device_submissions"] = t.device_submissions;
     } catch (const SceneEditError& e) {

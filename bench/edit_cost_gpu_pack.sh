@@ -1,0 +1,28 @@
+#!/bin/bash
+# Here (the build machine): packs what bench/edit_cost_gpu_run.sh needs into .replay/edit_cost.txz:
+# the open city at 1.5 texels/m (1.07 M texels; baked at 1 spp unless a bundle is given), the
+# runtime component, bench_edit_cost, the city block's edit and the one undoing it, and optionally a
+# second bench_edit_cost built from an earlier commit (BEFORE=path/to/bench_edit_cost) for an A/B on
+# the same host.
+#   bash bench/edit_cost_gpu_pack.sh BUILD_DIR [CITY_BUNDLE]
+set -e
+build=${1:-build}
+work=$(mktemp -d)
+city=${2:-}
+if [ -z "$city" ]; then
+  city=$work/city.bake
+  $build/bake/bake $build/samples/open_city.gltf -o $city --texel-density 1.5 --sky 0.5,0.6,0.8 --backend cpu --spp 1 \
+    --probes none --voxel-resolution none --no-cache > /dev/null
+fi
+mkdir -p $work/pack/city.bake
+cp $city/{manifest.json,scene.bin} $work/pack/city.bake/
+cmake --install $build --component runtime --prefix $work/pack/runtime > /dev/null
+cp $build/bench/bench_edit_cost $work/pack/
+[ -z "${BEFORE:-}" ] || cp "$BEFORE" $work/pack/bench_edit_cost_before
+cp bench/refresh_move_block.json $work/pack/block.json
+cp bench/refresh_move_block_back.json $work/pack/block_back.json
+mkdir -p .replay
+tar -C $work/pack -cf - . | xz -2 -T2 > .replay/edit_cost.txz
+cp bench/edit_cost_gpu_run.sh .replay/
+rm -rf $work
+ls -la .replay/edit_cost.txz

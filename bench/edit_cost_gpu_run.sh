@@ -1,0 +1,28 @@
+#!/bin/bash
+# Runs on the GPU machine (bench/edit_cost_gpu_pack.sh packs what it needs): what moving one block of
+# the open city costs the caller of apply_edits, per phase. bench_edit_cost moves the block and back
+# REPS rounds (one sample refreshed after each edit, SAMPLES_BEFORE per texel refreshed first); with a
+# packed earlier bench_edit_cost, both in turn (before, after, before, after). Then exitance-relight
+# with the block edit after WARM samples per texel in 16 ms frames, RELIGHTS times: `seconds.edits`
+# and `edits.milliseconds` as an engine's call sees them.
+# Env: REPS (9), SAMPLES_BEFORE (16), WARM (16), RELIGHTS (5). Writes $OUT/summary.txt.
+set -e
+for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
+export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+W=/tmp/w; mkdir -p $W && tar -C $W -xJf .replay/edit_cost.txz
+export LD_LIBRARY_PATH=$W/runtime/lib
+S=$OUT/summary.txt
+{ nproc; lscpu | grep -i "model name"; } > $S
+cost() { echo "== $1" >> $S; $W/$1 $W/city.bake --edits $W/block.json --edits-back $W/block_back.json --repeat ${REPS:-9} \
+  --samples 1 --samples-before ${SAMPLES_BEFORE:-16} >> $S 2>&1; }
+for round in 1 2; do
+  [ -x $W/bench_edit_cost_before ] && cost bench_edit_cost_before
+  cost bench_edit_cost
+done
+for k in $(seq ${RELIGHTS:-5}); do
+  $W/runtime/bin/exitance-relight $W/city.bake -o $W/out.bake --edits $W/block.json --spp-before-edits ${WARM:-16} \
+    --frames 1 --budget-ms 16 --seed $k --no-frame-errors --json > $W/relight.json
+  python3 -c "
+import json; r=json.load(open('$W/relight.json')); e=r['edits']
+print('relight $k edits_s %.4f'%r['seconds']['edits'], 'edit_ms', {k: round(v, 2) for k, v in e.get('milliseconds', {}).items()}, 'moved_texels', e['moved_texels'])" >> $S
+done
