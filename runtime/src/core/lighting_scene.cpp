@@ -2,6 +2,7 @@
 
 #include "exitance/common/light_layers.h"
 
+#include <atomic>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -10,6 +11,7 @@
 #include "exitance/common/punctual_light.h"
 #include "exitance/common/sampling.h"
 #include "exitance/runtime/core/bvh4_refit.h"
+#include "exitance/runtime/core/parallel_chunks.h"
 #include "exitance/runtime/distribution_1d.h"
 #include "exitance/runtime/material_eval.h"
 
@@ -130,11 +132,15 @@ bool refresh_emitter_powers(LightingScene& lighting, const std::vector<uint32_t>
     }
   }
   std::vector<double> powers(emitters.size());
-  for (size_t i = 0; i < emitters.size(); ++i) {
-    const double area = areas[i];
-    powers[i] = area * per_area[scene.triangle_material[emitters[i]]];
-    if (!(powers[i] > 0) || !(area > 0)) return false;
-  }
+  std::atomic<bool> qualify{true};
+  for_each_chunk(emitters.size(), [&](size_t first, size_t last) {  // a city holds tens of thousands of emitters
+    for (size_t i = first; i < last; ++i) {
+      const double area = areas[i];
+      powers[i] = area * per_area[scene.triangle_material[emitters[i]]];
+      if (!(powers[i] > 0) || !(area > 0)) qualify.store(false, std::memory_order_relaxed);
+    }
+  }, 4096);
+  if (!qualify.load()) return false;
   set_emitter_distribution(lighting, powers, std::move(areas));
   return true;
 }
@@ -143,8 +149,9 @@ bool refresh_emitter_powers(LightingScene& lighting, const std::vector<uint32_t>
 void set_emitter_distribution(LightingScene& lighting, const std::vector<double>& powers, std::vector<float> areas) {
   const Distribution1D emitters(powers);
   lighting.emitter_cdf = padded_cdf(emitters);
-  for (size_t i = 0; i < lighting.emitter_triangles.size(); ++i)
-    lighting.triangles[lighting.emitter_triangles[i]].p1_area_pdf.w = emitters.pmf(i) / areas[i];
+  for_each_chunk(lighting.emitter_triangles.size(), [&](size_t first, size_t last) {
+    for (size_t i = first; i < last; ++i) lighting.triangles[lighting.emitter_triangles[i]].p1_area_pdf.w = emitters.pmf(i) / areas[i];
+  }, 4096);
   lighting.emitter_areas = std::move(areas);
 }
 

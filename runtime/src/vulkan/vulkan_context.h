@@ -180,11 +180,13 @@ class Context {
   VkFence fence_ = VK_NULL_HANDLE;
   VulkanDeviceInfo info_;
   // Host-visible staging reused by uploads and read-backs (each waits for its copy, so one buffer
-  // serves them in turn): 256 KiB at first, grown to the largest transfer up to 16 MiB (an edit's
-  // lights or a moved instance's records allocate nothing); larger transfers get their own.
+  // serves them in turn): 4 MiB at first (a city block's move uploads ~3.6 MB: its triangles, leaf
+  // slots, nodes and every emitter's record), grown to the largest transfer up to 16 MiB, so an
+  // edit allocates nothing (a new pinned buffer cost the first edit its allocation); larger
+  // transfers get their own.
   Buffer small_staging_;
   bool small_staging_busy_ = false;
-  static constexpr VkDeviceSize kSmallStagingBytes = 256 * 1024;
+  static constexpr VkDeviceSize kSmallStagingBytes = 4 * 1024 * 1024;
   static constexpr VkDeviceSize kReusedStagingLimit = 16 * 1024 * 1024;
   // The reused staging when `size` fits and it is free (marked busy until `own` is released by the
   // caller's scope: see StagingLease in the .cpp), else a new buffer in `own`.
