@@ -243,7 +243,8 @@ std::vector<MovingTexel> moving_texels(const PlannedMoves& planned, const Scene&
   if (texel_start && texels_by_instance && texel_start->size() == before.instances.size() + 1) {
     for (uint32_t k : planned.instances)
       for (uint32_t e = (*texel_start)[k]; e < (*texel_start)[size_t(k) + 1]; ++e) visit((*texels_by_instance)[e]);
-    std::sort(out.begin(), out.end(), [](const MovingTexel& a, const MovingTexel& b) { return a.index < b.index; });
+    auto by_index = [](const MovingTexel& a, const MovingTexel& b) { return a.index < b.index; };
+    if (!std::is_sorted(out.begin(), out.end(), by_index)) std::sort(out.begin(), out.end(), by_index);  // one instance's ascend
   } else {
     for (size_t i = 0; i < gbuffer.texels.size(); ++i) visit(i);
   }
