@@ -212,11 +212,8 @@ InPlaceEdits apply_scene_edits_in_place(PersistedScene& persisted, const std::ve
   effects.moved_texels = texels.size();
   out.moved_deltas = planned.delta;
   for (size_t j = 0; j < planned.instances.size(); ++j) {
-    const refresh::MovedTriangles& m = planned.triangles[j];
-    out.moved_boxes_before.push_back(triangles_world_box(scene, m.first, m.count));
-    WorldBox after;
-    for (const Vec3& p : m.positions) after.grow(p);
-    out.moved_boxes_after.push_back(after);
+    out.moved_boxes_before.push_back(planned.triangles[j].box_before);
+    out.moved_boxes_after.push_back(planned.triangles[j].box_after);
   }
   // Triangles in the order the instances' ranges ascend (ranges do not overlap: one instance per triangle).
   std::vector<size_t> by_first(planned.triangles.size());

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <mutex>
 #include <cmath>
 #include <cstring>
 #include <optional>
@@ -83,10 +84,17 @@ bool move_triangle(MovedTriangles& m, uint32_t t, const Matrix4d& delta, bool mi
 void move_triangles(MovedTriangles& m, const Instance& instance, const Matrix4d& delta, const std::string& where) {
   const bool mirrors = determinant3(delta) < 0;  // the importer flips the winding of mirrored instances: so do we
   std::atomic<uint32_t> first_collapsed{UINT32_MAX};
+  std::mutex boxes;
   for_each_chunk(m.count, [&](size_t begin, size_t end) {
-    for (size_t t = begin; t < end; ++t)
+    WorldBox before, after;  // this chunk's (a union: the same bounds in any order)
+    for (size_t t = begin; t < end; ++t) {
+      for (size_t k = 0; k < 3; ++k) before.grow(m.positions[t * 3 + k]);
       if (!move_triangle(m, uint32_t(t), delta, mirrors))
         for (uint32_t v = first_collapsed.load(); t < v && !first_collapsed.compare_exchange_weak(v, uint32_t(t));) {}
+      for (size_t k = 0; k < 3; ++k) after.grow(m.positions[t * 3 + k]);
+    }
+    const std::lock_guard<std::mutex> lock(boxes);
+    m.box_before.grow(before), m.box_after.grow(after);
   }, 1024);
   if (first_collapsed.load() != UINT32_MAX)
     fail(where, "the transform collapses triangle " + std::to_string(m.first + first_collapsed.load()) + " of instance \"" +

@@ -5,6 +5,8 @@
 #include <utility>
 #include <vector>
 
+#include "exitance/runtime/world_box.h"
+
 #include "exitance/runtime/refresh/scene_edits.h"
 
 namespace exitance::refresh {
@@ -34,6 +36,7 @@ struct MovedTriangles {
   std::vector<Vec3> positions, normals, vertex_color, tangents;
   std::vector<Vec2> uv0, lightmap_uv;
   std::vector<float> vertex_alpha, tangent_signs;
+  WorldBox box_before, box_after;  // the triangles' bounds before and after the move (plan_moves)
   static MovedTriangles of(const Scene& scene, uint32_t first, uint32_t count);
   void write_into(Scene& scene) const;  // the arrays the scene has; cannot throw
 };
