@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "exitance/runtime/core/parallel_chunks.h"
+
 namespace exitance {
 
 TexelGrid::TexelGrid(const TexelGBuffer& gbuffer) {
@@ -25,14 +27,18 @@ TexelGrid::TexelGrid(const TexelGBuffer& gbuffer) {
   }
   lo_ = bounds.lo;
   const size_t cell_count = size_t(cells_[0]) * size_t(cells_[1]) * size_t(cells_[2]);
+  // Each texel's cell on all cores (an edit that displaced an eighth of the texels builds the grid
+  // again inside its call), counted and placed on one.
   std::vector<uint32_t> cell_of_texel(n);
+  for_each_chunk(n, [&](size_t first, size_t last) {
+    for (size_t i = first; i < last; ++i) {
+      const Vec3 p = gbuffer.texels[i].position;
+      cell_of_texel[i] = uint32_t((size_t(cell_of(2, p.z)) * size_t(cells_[1]) + size_t(cell_of(1, p.y))) * size_t(cells_[0]) +
+                                  size_t(cell_of(0, p.x)));
+    }
+  }, 65536);
   cell_start_.assign(cell_count + 1, 0);
-  for (size_t i = 0; i < n; ++i) {
-    const Vec3 p = gbuffer.texels[i].position;
-    const size_t c = (size_t(cell_of(2, p.z)) * size_t(cells_[1]) + size_t(cell_of(1, p.y))) * size_t(cells_[0]) + size_t(cell_of(0, p.x));
-    cell_of_texel[i] = uint32_t(c);
-    ++cell_start_[c + 1];
-  }
+  for (uint32_t c : cell_of_texel) ++cell_start_[size_t(c) + 1];
   for (size_t c = 0; c < cell_count; ++c) cell_start_[c + 1] += cell_start_[c];
   texels_.resize(n);
   positions_.resize(n);
@@ -42,6 +48,7 @@ TexelGrid::TexelGrid(const TexelGBuffer& gbuffer) {
     texels_[k] = uint32_t(i);
     positions_[k] = gbuffer.texels[i].position;
   }
+  is_displaced_.assign(n, 0);  // here, not at an edit's first displaced texel
 }
 
 void TexelGrid::displace(uint32_t i, const LiveTexel& texel) {

@@ -74,8 +74,14 @@ std::vector<uint32_t> unocclude_near_boxes(PersistedScene& edited, const std::ve
       const std::lock_guard<std::mutex> lock(merge);
       candidates.insert(candidates.end(), found.begin(), found.end());
     }, 4);
-    for (uint32_t i : grid->displaced())
-      if (within(edited.gbuffer.texels[i].position)) candidates.push_back(i);
+    const std::vector<uint32_t>& displaced = grid->displaced();  // up to an eighth of the texels
+    for_each_chunk(displaced.size(), [&](size_t first, size_t last) {
+      std::vector<uint32_t> found;
+      for (size_t k = first; k < last; ++k)
+        if (within(edited.gbuffer.texels[displaced[k]].position)) found.push_back(displaced[k]);
+      const std::lock_guard<std::mutex> lock(merge);
+      candidates.insert(candidates.end(), found.begin(), found.end());
+    }, 16384);
     std::sort(candidates.begin(), candidates.end());
     candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
     reconsider_all(candidates);

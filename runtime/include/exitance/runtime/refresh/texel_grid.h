@@ -46,7 +46,7 @@ class TexelGrid {
   std::vector<uint32_t> texels_;      // texel indices, by cell
   std::vector<Vec3> positions_;       // their positions at the build, by cell
   std::vector<uint32_t> displaced_;   // texels moved since the build
-  std::vector<uint8_t> is_displaced_;  // per texel (empty until one is)
+  std::vector<uint8_t> is_displaced_;  // per texel
   float largest_texel_size_ = 0;
 };
 
