@@ -227,6 +227,23 @@ TEST(RefreshEdits, InstanceMovedEqualsAFreshBake) {
               [&](json& g) { named(g["nodes"], "TallBox")["translation"] = moved; }});
 }
 
+// A moved instance, an emission turned on and the sky changed in one call: the moved geometry and
+// emitters are uploaded on a thread of their own while the call moves texels (refresh_session.cpp),
+// the sky's records with them; the refreshed lightmap agrees with a fresh bake of the edited glTF.
+TEST(RefreshEdits, AMoveWithAnEmissionAndASkyInOneCallEqualsAFreshBake) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const std::array<double, 3> moved{-0.55, 0.0, 0.2};
+  check_edit({"box-moved-glow-sky", "cornell_room", "0.2,0.3,0.4", "0.5,0.4,0.3",
+              {{"edits",
+                {{{"node", "TallBox"}, {"translation", moved}},
+                 {{"material", "Green"}, {"emissiveFactor", {0.1, 0.9, 0.2}}},
+                 {{"sky", {0.5, 0.4, 0.3}}}}}},
+              [&](json& g) {
+                named(g["nodes"], "TallBox")["translation"] = moved;
+                named(g["materials"], "Green")["emissiveFactor"] = {0.1, 0.9, 0.2};
+              }});
+}
+
 // A point light moved (and brighter) in one room of the building: estimated as a change from the
 // pre-edit estimate, which agrees with a fresh bake of the edited glTF, leaves every texel the light
 // reaches neither before nor after at its pre-edit value exactly, and is never published with fewer
