@@ -54,7 +54,6 @@ TexelGrid::TexelGrid(const TexelGBuffer& gbuffer) {
 void TexelGrid::displace(uint32_t i, const LiveTexel& texel) {
   if (i >= texels_.size()) return;
   largest_texel_size_ = std::max(largest_texel_size_, texel.world_texel_size);
-  if (is_displaced_.empty()) is_displaced_.assign(texels_.size(), 0);
   if (is_displaced_[i]) return;
   is_displaced_[i] = 1;
   displaced_.push_back(i);
@@ -73,7 +72,9 @@ size_t TexelGrid::candidate_rows(const WorldBox& box, float margin, std::vector<
     for (int y = first[1]; y <= last[1]; ++y) {
       const size_t row = (size_t(z) * size_t(cells_[1]) + size_t(y)) * size_t(cells_[0]);
       const uint32_t begin = cell_start_[row + size_t(first[0])], end = cell_start_[row + size_t(last[0]) + 1];
-      if (begin < end) rows.emplace_back(begin, end), entries += end - begin;
+      entries += end - begin;
+      for (uint32_t piece = begin; piece < end; piece = std::min(end, piece + kRowPiece))
+        rows.emplace_back(piece, std::min(end, piece + kRowPiece));
     }
   return entries;
 }

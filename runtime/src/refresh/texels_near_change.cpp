@@ -157,8 +157,7 @@ std::vector<uint32_t> texels_near_change(const PersistedScene& edited, const Cha
     std::vector<std::pair<uint32_t, uint32_t>> region_rows;
     for (size_t r = 0; r < regions.size(); ++r) {
       grid->candidate_rows(regions[r].candidates, 0.0f, region_rows);
-      for (auto [first, end] : region_rows)  // in pieces of at most 4096 entries: a few rows can hold most texels
-        for (; first < end; first = std::min(end, first + 4096)) rows.push_back({uint32_t(r), first, std::min(end, first + 4096)});
+      for (const auto& [first, end] : region_rows) rows.push_back({uint32_t(r), first, end});
     }
     for_each_chunk(rows.size(), [&](size_t first, size_t last) {
       uint32_t lo = UINT32_MAX, hi = 0;

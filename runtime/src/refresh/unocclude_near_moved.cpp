@@ -62,26 +62,26 @@ std::vector<uint32_t> unocclude_near_boxes(PersistedScene& edited, const std::ve
     std::vector<std::pair<uint32_t, uint32_t>> rows, box_rows;
     for (const WorldBox& b : boxes) {
       grid->candidate_rows(b, margin, box_rows);
-      for (auto [begin, end] : box_rows)  // in pieces: a block's few rows hold ~100 000 entries
-        for (; begin < end; begin = std::min(end, begin + 4096)) rows.emplace_back(begin, std::min(end, begin + 4096));
+      rows.insert(rows.end(), box_rows.begin(), box_rows.end());
     }
+    // Items [0, count) on all cores, each chunk's finds appended under the lock (sorted below).
     std::mutex merge;
-    for_each_chunk(rows.size(), [&](size_t first, size_t last) {  // the rows' texels on all cores
-      std::vector<uint32_t> found;
-      for (size_t r = first; r < last; ++r)
-        for (uint32_t k = rows[r].first; k < rows[r].second; ++k)
-          if (within(grid->entry_position(k)) && !grid->is_displaced(grid->entry(k))) found.push_back(grid->entry(k));
-      const std::lock_guard<std::mutex> lock(merge);
-      candidates.insert(candidates.end(), found.begin(), found.end());
-    }, 4);
+    auto gather = [&](size_t count, size_t min_chunk, const auto& find) {
+      for_each_chunk(count, [&](size_t first, size_t last) {
+        std::vector<uint32_t> found;
+        for (size_t k = first; k < last; ++k) find(k, found);
+        const std::lock_guard<std::mutex> lock(merge);
+        candidates.insert(candidates.end(), found.begin(), found.end());
+      }, min_chunk);
+    };
+    gather(rows.size(), 4, [&](size_t r, std::vector<uint32_t>& found) {  // the rows' texels
+      for (uint32_t k = rows[r].first; k < rows[r].second; ++k)
+        if (within(grid->entry_position(k)) && !grid->is_displaced(grid->entry(k))) found.push_back(grid->entry(k));
+    });
     const std::vector<uint32_t>& displaced = grid->displaced();  // up to an eighth of the texels
-    for_each_chunk(displaced.size(), [&](size_t first, size_t last) {
-      std::vector<uint32_t> found;
-      for (size_t k = first; k < last; ++k)
-        if (within(edited.gbuffer.texels[displaced[k]].position)) found.push_back(displaced[k]);
-      const std::lock_guard<std::mutex> lock(merge);
-      candidates.insert(candidates.end(), found.begin(), found.end());
-    }, 16384);
+    gather(displaced.size(), 16384, [&](size_t k, std::vector<uint32_t>& found) {
+      if (within(edited.gbuffer.texels[displaced[k]].position)) found.push_back(displaced[k]);
+    });
     std::sort(candidates.begin(), candidates.end());
     candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
     reconsider_all(candidates);

@@ -25,10 +25,12 @@ class TexelGrid {
   void displace(uint32_t i, const LiveTexel& texel);
   size_t displaced_count() const { return displaced_.size(); }
   // The texels of the cells that `box` grown by `margin` overlaps, as ranges of entries (entry(k)
-  // for k in [first, second)), one per row of cells: with displaced() (which every query visits
-  // too), a superset of the texels within `margin` of the box; rows split across threads. A
+  // for k in [first, second)): each row of cells in pieces of at most kRowPiece entries (a moved
+  // block's few rows hold ~100 000), so that callers split them across threads. With displaced()
+  // (which every query visits too), a superset of the texels within `margin` of the box. A
   // displaced texel is still listed in its row: skip it (is_displaced). Returns the number of
   // entries the ranges hold.
+  static constexpr uint32_t kRowPiece = 4096;
   size_t candidate_rows(const WorldBox& box, float margin, std::vector<std::pair<uint32_t, uint32_t>>& rows) const;
   uint32_t entry(size_t k) const { return texels_[k]; }
   // Where entry k's texel was at the build (its position now unless displaced): read in entry
