@@ -152,7 +152,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0f, 1.0f));
   std::string emitter_guiding = "auto";
   app.add_option("--emitter-guiding", emitter_guiding,
-                 "auto (default: on where the CPU backend bakes in one process) | on | off: next-event "
+                 "auto (default: on where the CPU backend bakes in one process) | on (CPU, or Vulkan path tracing) | off: next-event "
                  "estimation samples emitter patches and punctual lights from distributions learned per grid region, "
                  "mixed with the default choice by power (docs/lighting-core.md \"Emitter guiding\")")
       ->check(CLI::IsMember({"auto", "off", "on"}));
@@ -312,8 +312,15 @@ int main(int argc, char** argv) {
   // Resolved once the backend and integrator are known (automatic_integrator.h).
   if (guiding == "auto") options.lighting.guiding = exitance::GuidingMode::Auto;
   if (emitter_guiding == "on") {
-    if (options.backend.name == "vulkan") {
-      std::cerr << "bake: error: --emitter-guiding on: implemented on the CPU backend only (use --backend cpu)\n";
+    // The Vulkan backend guides path tracing's emitters (its automatic integrator is path tracing).
+    if (options.backend.name == "vulkan" && integrator == "bounces") {
+      std::cerr << "bake: error: --emitter-guiding on with --backend vulkan guides path tracing: it contradicts "
+                   "--integrator bounces (the CPU backend guides both)\n";
+      return 2;
+    }
+    if (options.backend.name == "vulkan" && guiding == "svo") {
+      std::cerr << "bake: error: --emitter-guiding on with --backend vulkan: --guiding svo beside it runs on the CPU "
+                   "backend only (use --guiding grid or --backend cpu)\n";
       return 2;
     }
     options.lighting.emitter_guiding = true;

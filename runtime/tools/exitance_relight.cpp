@@ -1,4 +1,4 @@
-// exitance-relight BUNDLE [-o OUT] [--edits EDITS.json] [--spp N] [--time S] [--budget-ms N] [--frames N] [--guiding off|grid|svo] [--seed N] [--device N] [--json] [--share R/N]
+// exitance-relight BUNDLE [-o OUT] [--edits EDITS.json] [--spp N] [--time S] [--budget-ms N] [--frames N] [--guiding off|grid|svo] [--emitter-guiding off|on] [--seed N] [--device N] [--json] [--share R/N]
 // Re-lights a baked bundle from its scene.bin on the GPU (runtime/src/relight). Links the runtime
 // library and nothing of the offline stage; runs where only a Vulkan driver exists.
 #include <CLI/CLI.hpp>
@@ -68,6 +68,11 @@ int main(int argc, char** argv) {
                  "svo.bin: the whole lightmap in one run; not with --frames, --budget-ms or --integrator bounces; auto is "
                  "refused: the measured choice runs in bake only)")
       ->check(CLI::IsMember({"off", "grid", "svo", "auto"}));
+  app.add_option("--emitter-guiding", options.emitter_guiding,
+                 "off (default) | on (next-event estimation guided by emitter distributions learned during the run, as "
+                 "bake --emitter-guiding on: the whole lightmap in one run; not with --frames, --budget-ms, --guiding or "
+                 "--integrator bounces)")
+      ->check(CLI::IsMember({"off", "on"}));
   app.add_option("--seed", seed, "random seed (default: the bake's); results are deterministic per seed and device");
   app.add_option("--device", options.device_index, "Vulkan device index (see --list-devices)")->check(CLI::NonNegativeNumber);
   app.add_flag("--list-devices", list_devices, "print the Vulkan devices and exit");

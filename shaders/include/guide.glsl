@@ -8,9 +8,9 @@
 
 float guide_float(uint word) { return uintBitsToFloat(guide_words[word]); }
 
-// kGuideLocatorGrid: GridGuidingCache::record_of (cell_index: NaN and below the origin go to cell 0).
-uint guide_grid_record(vec3 position, vec3 shading_normal) {
-  uint base = guide_words[kGuideLocatorOffset];
+// kGuideLocatorGrid: GridGuidingCache::record_of (cell_index: NaN and below the origin go to cell 0),
+// over the grid locator's words from `base` (grid guiding's locator section, or emitter guiding's).
+uint guide_grid_record_at(uint base, vec3 position, vec3 shading_normal) {
   vec3 lo = vec3(guide_float(base), guide_float(base + 1u), guide_float(base + 2u));
   float cell = guide_float(base + 3u);
   ivec3 dims = ivec3(guide_words[base + 4u], guide_words[base + 5u], guide_words[base + 6u]);
@@ -21,6 +21,9 @@ uint guide_grid_record(vec3 position, vec3 shading_normal) {
   }
   uint cell_index = uint((c.z * dims.y + c.y) * dims.x + c.x);
   return guide_words[base + kGuideGridWords + cell_index * kGuideNormalClasses + guide_normal_class(shading_normal)];
+}
+uint guide_grid_record(vec3 position, vec3 shading_normal) {
+  return guide_grid_record_at(guide_words[kGuideLocatorOffset], position, shading_normal);
 }
 
 // kGuideLocatorSvo: SvoGuidingFields::node_of (formats::svo_find_node's descent: the deepest node
@@ -88,6 +91,16 @@ uint guide_learning_key(uint record, GuideVertex g, vec3 direction) {
   return record * kGuideBins + guide_bin_of_local(local);
 }
 
+// A 64-bit fixed-point sum at words (lo, hi) from `word`: the low word's add, then the high word's
+// with the carry of the low one. Integers, so the sums do not depend on the order of the adds.
+void guide_add_fixed(uint word, uint64_t units_sum) {
+  uint lo = uint(units_sum & 0xFFFFFFFFul);
+  uint hi = uint(units_sum >> 32);
+  uint old = atomicAdd(guide_words[word], lo);
+  if (old + lo < old) hi += 1u;  // the low word wrapped
+  if (hi != 0u) atomicAdd(guide_words[word + 1u], hi);
+}
+
 // GridGuidingCache::learn: one target into the back table, a 64-bit fixed-point sum as two words
 // with the carry of the low word's add, and a count: integers, so the sums do not depend on order.
 void guide_learn(uint key, float target) {
@@ -95,11 +108,7 @@ void guide_learn(uint key, float target) {
   double units = packDouble2x32(uvec2(guide_words[kGuideFixedUnits], guide_words[kGuideFixedUnits + 1u]));
   uint64_t units_sum = guide_fixed_point(target, guide_float(kGuideFixedCap), units);
   uint b = guide_words[kGuideBackOffset] + key * kGuideBackWords;
-  uint lo = uint(units_sum & 0xFFFFFFFFul);
-  uint hi = uint(units_sum >> 32);
-  uint old = atomicAdd(guide_words[b], lo);
-  if (old + lo < old) hi += 1u;  // the low word wrapped
-  if (hi != 0u) atomicAdd(guide_words[b + 1u], hi);
+  guide_add_fixed(b, units_sum);
   atomicAdd(guide_words[b + 2u], 1u);
 }
 

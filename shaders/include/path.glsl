@@ -4,6 +4,7 @@
 #include "exitance/common/path.h"
 #include "exitance/common/light_layers.h"
 #include "guide.glsl"
+#include "emitter_guide.glsl"
 
 PathLimits path_limits() {
   PathLimits limits;
@@ -28,6 +29,7 @@ uint connect_shadow_rays(uint p, inout uint steps) {
     if (contribution.w != kShadowTrace) continue;
     vec4 ray = shadow_rays[slot].direction_length;
     if (trace_any(origin, ray.xyz, ray.w, steps)) continue;
+    if (params.emitter_guide != 0u) emitter_guide_learn_arrived(p, k);
     add_result(work, depth, contribution.xyz);
     if (params.light_layers != 0u) {
       // Slot 0: the area sample (layer in the low half of path_ray_o.w), 1: the punctual light (high half), 2: the sky.
@@ -81,7 +83,12 @@ uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rn
     if (params.light_layers != 0u) path_ray_o[p].w = uintBitsToFloat(layer | (layer << 16u));
   } else {
     EmitterLearning sources;
-    next_event_estimation(x, origin, throughput, guide, emitter_guide_none(), rng, area, punctual_light, environment, sources);
+    // Emitter guiding (emitter_guide.glsl): texel samples only, as on the CPU.
+    uint emitter_record = kGuideNoRecord;
+    bool emitter_learns = false;
+    EmitterGuide emitter = kProbeMode ? emitter_guide_none() : emitter_guide_site(p, x, emitter_record, emitter_learns);
+    next_event_estimation(x, origin, throughput, guide, emitter, rng, area, punctual_light, environment, sources);
+    if (!kProbeMode && params.emitter_guide != 0u) emitter_guide_keep(p, emitter_record, emitter_learns, sources);
     if (params.light_layers != 0u) {
       // Which layers the shadow rays' light goes to, read back by connect_shadow_rays.
       uint area_layer = sources.area_triangle != kEmitterPatchNone ? emitter_light_layer(sources.area_triangle) : 0u;

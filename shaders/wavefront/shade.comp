@@ -73,7 +73,9 @@ void main() {
     }
   } else {
     int bounce = kProbeMode ? int(depth) - 1 : int(depth);  // the vertex's bounce as the texel estimator counts it
-    HitResult h = shade_continuation_hit(tri, hit.x, hit.z, hit.w, wi, tp.w, throughput, bounce, path_limits(), rng);
+    // Emitter guiding: the hit's MIS weight reads the density of the mixture its vertex sampled.
+    EmitterGuide emitter = kProbeMode ? emitter_guide_none() : emitter_guide_of_path(p);
+    HitResult h = shade_continuation_hit(tri, hit.x, hit.z, hit.w, wi, tp.w, throughput, bounce, path_limits(), emitter, rng);
     // Only emitters add: a read-modify-write of the result slot per hit cost the H200 14 % of this stage.
     if (h.radiance != vec3(0.0) && params.changed_light_pairs == 0u) {
       add_path_result(p, work, depth, h.radiance);

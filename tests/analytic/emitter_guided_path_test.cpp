@@ -28,6 +28,7 @@
 #include "exitance/runtime/core/emitter_guiding_cache.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "support/atlas_box.h"
+#include "support/box_with_lights_outside.h"
 #include "support/identical_estimates.h"
 #include "support/independent_estimates.h"
 #include "support/region_and_furnace_checks.h"
@@ -229,31 +230,8 @@ IntegratorSettings settings(uint32_t spp, uint64_t seed, bool emitter_guiding) {
   return s;
 }
 
-// The unit box (albedo 0.5) lit inside by a 20 cm lamp under the ceiling (radiance 50) and a point
-// light (intensity 0.5), with an emitter 100x the lamp's power and a point light 100x brighter
-// outside above the closed ceiling: the default sampling by power sends 99 % of its shadow rays to
-// the lights outside, which never arrive.
-testing::AtlasScene box_with_lights_outside() {
-  const Vec3 black{0, 0, 0};
-  const Vec3 emission[6] = {black, black, black, black, black, black};
-  testing::AtlasScene box = testing::atlas_box(0.5f, emission, 8, 0.2f, {50, 50, 50});
-  // Outside: 1 m^2 facing down onto the ceiling's outer side at y = 1.5 (power 100x the lamp's).
-  testing::add_quad(box.scene, {0, 1.5f, 0}, {1, 0, 0}, {0, 0, 1}, testing::add_material(box.scene, {0, 0, 0}, {200, 200, 200}));
-  box.scene.instances.back().name = "outside_emitter";
-  PunctualLight inside;
-  inside.name = "inside";
-  inside.position = {0.3f, 0.5f, 0.6f};
-  inside.intensity = {0.5f, 0.5f, 0.5f};
-  PunctualLight outside = inside;
-  outside.name = "outside";
-  outside.position = {0.5f, 2.0f, 0.5f};
-  outside.intensity = {50, 50, 50};
-  box.scene.lights = {outside, inside};
-  return box;
-}
-
 TEST(EmitterGuiding, LearnsTheLightsARecordSees) {
-  const testing::AtlasScene box = box_with_lights_outside();
+  const testing::AtlasScene box = testing::box_with_lights_outside();
   const CpuReferenceIntegrator integrator(box.scene);
   IntegratorSettings s = settings(64, 1, true);
   size_t area_records = 0, punctual_records = 0, records = 0;
@@ -309,7 +287,7 @@ double sample_scene_agrees(const char* name, float density, uint32_t spp) {
 }
 
 TEST(EmitterGuiding, BoxWithLightsOutsideAgreesWithUnguided) {
-  const testing::AtlasScene box = box_with_lights_outside();
+  const testing::AtlasScene box = testing::box_with_lights_outside();
   EXPECT_LT(kZLimit * expect_regions_agree("box", box.scene, box.gbuffer, 64), kDetectableBias)
       << "the test could not see a 10 % bias";
 }
@@ -327,7 +305,7 @@ TEST(EmitterGuiding, BuildingAgreesWithUnguided) {
 }
 
 TEST(EmitterGuiding, BitIdenticalPerSeedAndThreadCount) {
-  const testing::AtlasScene box = box_with_lights_outside();
+  const testing::AtlasScene box = testing::box_with_lights_outside();
   const CpuReferenceIntegrator integrator(box.scene);
   const LightmapEstimate a = integrator.bake(box.gbuffer, settings(24, 7, true));
   const LightmapEstimate b = integrator.bake(box.gbuffer, settings(24, 7, true));
@@ -345,7 +323,7 @@ TEST(EmitterGuiding, BitIdenticalPerSeedAndThreadCount) {
 // B_1's traced ones at gather hits. Both layers are linear in those samples, so per region their
 // means agree with the unguided per-bounce mode's (two bounces, so no data-dependent tail length).
 TEST(EmitterGuiding, PerBounceLayersAgreeWithUnguided) {
-  const testing::AtlasScene box = box_with_lights_outside();
+  const testing::AtlasScene box = testing::box_with_lights_outside();
   const CpuReferenceIntegrator integrator(box.scene);
   std::map<uint32_t, std::vector<double>> guided[2], unguided[2];
   for (int seed = 0; seed < kSeeds; ++seed) {
@@ -373,7 +351,7 @@ TEST(EmitterGuiding, PerBounceLayersAgreeWithUnguided) {
 }
 
 TEST(EmitterGuiding, PerBounceBitIdenticalPerSeedAndThreadCount) {
-  const testing::AtlasScene box = box_with_lights_outside();
+  const testing::AtlasScene box = testing::box_with_lights_outside();
   const CpuReferenceIntegrator integrator(box.scene);
   IntegratorSettings s = settings(24, 7, true);
   s.integrator = IntegratorMode::Bounces;

@@ -162,8 +162,7 @@ EmitterGuidingCache::Site EmitterGuidingCache::vertex_site(EmitterGuidingCache* 
   s.record = cache->record_of(position, shading_normal);
   const EmitterGuide guide = cache->vertex(s.record);
   const bool sampling_learned = guide.guided_probability > 0 || guide.punctual_guided_probability > 0;
-  s.learns = s.record != kNoRecord &&
-             (learning == Learning::Everywhere || (learning == Learning::WhereSampled && sampling_learned));
+  s.learns = emitter_vertex_learns(uint(learning), s.record != kNoRecord, sampling_learned);
   if (s.learns || sampling_learned) s.guide = guide;
   return s;
 }
@@ -186,6 +185,18 @@ void EmitterGuidingCache::learn_punctual(uint32_t record, uint32_t light, float 
   if (record == kNoRecord || light >= punctual_count_ || !(value > 0)) return;
   punctual_back_[size_t(record) * punctual_count_ + light].fetch_add(guide_fixed_point(value, value_cap_, fixed_scale_),
                                                                      std::memory_order_relaxed);
+}
+
+void EmitterGuidingCache::import_learned(uint32_t record, uint32_t patch, uint64_t fixed_sum, uint32_t count) {
+  if (record >= record_count() || patch >= patch_count() || count == 0) return;
+  Accumulator& a = back_[size_t(record) * patch_count() + patch];
+  a.sum.fetch_add(fixed_sum, std::memory_order_relaxed);
+  a.count.fetch_add(count, std::memory_order_relaxed);
+}
+
+void EmitterGuidingCache::import_learned_punctual(uint32_t record, uint32_t light, uint64_t fixed_sum) {
+  if (record >= record_count() || light >= punctual_count_ || fixed_sum == 0) return;
+  punctual_back_[size_t(record) * punctual_count_ + light].fetch_add(fixed_sum, std::memory_order_relaxed);
 }
 
 void EmitterGuidingCache::swap() {

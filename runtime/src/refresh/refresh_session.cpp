@@ -990,7 +990,8 @@ LightmapEstimate RefreshSession::bake_guided(uint32_t spp, double time_budget_se
   return *s.per_bounce;
 }
 
-const LightmapEstimate& RefreshSession::bake_path(uint32_t spp, double time_budget_seconds, WorkShare* share) {
+const LightmapEstimate& RefreshSession::bake_path(uint32_t spp, double time_budget_seconds, WorkShare* share,
+                                                  bool emitter_guiding) {
   State& s = *state_;
   end_change_estimate();
   if (spp == 0 && !(time_budget_seconds > 0)) throw std::invalid_argument("path tracing in one run needs samples per texel or a time budget");
@@ -1000,6 +1001,7 @@ const LightmapEstimate& RefreshSession::bake_path(uint32_t spp, double time_budg
   settings.spp = spp;
   settings.time_budget_seconds = time_budget_seconds;
   settings.work_share = share;
+  settings.emitter_guiding = emitter_guiding;
   s.per_bounce = s.integrator->bake(s.persisted.gbuffer, settings);
   s.whole_run_path = true;
   s.whole_run_guided = false;

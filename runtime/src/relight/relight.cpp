@@ -46,16 +46,22 @@ json relight_bundle(const RelightOptions& options) {
   if (guided && per_bounce) throw RelightInputError("--guiding " + options.guiding + " guides path tracing: it needs --integrator path");
   if (guided && (options.frames > 0 || options.frame_budget_ms > 0))
     throw RelightInputError("--guiding " + options.guiding + " runs the whole lightmap at once: --frames and --budget-ms need --guiding off");
+  if (options.emitter_guiding != "off" && options.emitter_guiding != "on")
+    throw RelightInputError("--emitter-guiding " + options.emitter_guiding + ": expected off or on");
+  const bool emitter_guided = options.emitter_guiding == "on";
+  if (emitter_guided && (per_bounce || guided || options.frames > 0 || options.frame_budget_ms > 0))
+    throw RelightInputError("--emitter-guiding on guides path tracing of the whole lightmap in one run: it takes no "
+                            "--integrator bounces, --guiding, --frames or --budget-ms");
 
   const bool share = options.share_ranks > 0;
   if (share) {
     if (options.share_rank < 0 || options.share_rank >= options.share_ranks)
       throw RelightInputError("--share " + std::to_string(options.share_rank) + "/" + std::to_string(options.share_ranks) +
                               ": expected R/N with 0 <= R < N");
-    if (per_bounce || guided || options.frames > 0 || options.frame_budget_ms > 0 || options.time_budget_seconds > 0 ||
+    if (per_bounce || guided || emitter_guided || options.frames > 0 || options.frame_budget_ms > 0 || options.time_budget_seconds > 0 ||
         !options.edits_file.empty() || !options.output.empty() || !options.spp || *options.spp == 0)
       throw RelightInputError("--share measures one rank's share of path tracing at a fixed --spp: it takes no --integrator bounces, "
-                              "--guiding, --frames, --budget-ms, --time, --edits or -o (it writes nothing)");
+                              "--guiding, --emitter-guiding, --frames, --budget-ms, --time, --edits or -o (it writes nothing)");
   }
   const fs::path bundle(options.bundle);
   const fs::path out = options.output.empty() ? bundle : fs::path(options.output);
@@ -165,6 +171,17 @@ json relight_bundle(const RelightOptions& options) {
                                 options.guiding == "svo" ? GuidingMode::Svo : GuidingMode::Grid).rays;
     report("lighting", 1, rays);
   }
+  json emitter_guiding_report;
+  if (emitter_guided) {
+    report("lighting", 0, 0);
+    const LightmapEstimate& e = session->bake_path(spp, options.time_budget_seconds, nullptr, true);
+    rays = e.rays;
+    const LightmapEstimate::EmitterGuidingReport& g = e.emitter_guiding;
+    emitter_guiding_report = {{"records", g.records}, {"records_sampling_learned", g.records_sampling_learned},
+                              {"patches", g.patches}, {"punctual_lights", g.punctual_lights},
+                              {"memory_bytes", g.memory_bytes}, {"dropped", g.dropped}};
+    report("lighting", 1, rays);
+  }
   uint64_t share_texels = 0;
   double share_passes_seconds = 0;
   if (share) {
@@ -177,7 +194,7 @@ json relight_bundle(const RelightOptions& options) {
     share_texels = rank_alone.work.texel_samples / spp;
     report("lighting", 1, rays);
   }
-  for (uint32_t frame = 0; !per_bounce && !guided && !share && (options.frames == 0 || frame < options.frames); ++frame) {
+  for (uint32_t frame = 0; !per_bounce && !guided && !emitter_guided && !share && (options.frames == 0 || frame < options.frames); ++frame) {
     RefreshBudget budget;
     budget.max_samples_per_texel = spp;
     budget.milliseconds = options.frame_budget_ms;
@@ -250,6 +267,7 @@ json relight_bundle(const RelightOptions& options) {
   json run;
   run["integrator"] = per_bounce ? "bounces" : "path";
   if (guided) run["guiding"] = options.guiding;
+  if (emitter_guided) run["emitter_guiding"] = emitter_guiding_report;
   run["spp"] = session->samples_per_texel();
   // Light layers kept per texel (docs/runtime.md "Light layers"; 0: --no-light-layers or a whole run)
   run["light_layers"] = session->integrator().light_layers();

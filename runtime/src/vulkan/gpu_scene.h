@@ -63,6 +63,7 @@ class GpuScene {
   Vec3 bounds_lo() const { return bounds_lo_; }
   Vec3 bounds_hi() const { return bounds_hi_; }
   uint32_t emitter_count() const { return uint32_t(emitters_.size()); }
+  const std::vector<uint32_t>& emitter_triangles() const { return emitters_; }  // the emitter list, in CDF order
   uint32_t punctual_count() const { return punctual_count_; }
   // The scene's light layers as laid out when it was built (LightingScene; fixed through edits).
   uint32_t light_layer_count() const { return light_layer_count_; }

@@ -15,6 +15,7 @@
 #include "exitance/runtime/core/pass_scheduler.h"
 #include "exitance/runtime/core/work_share.h"
 #include "exitance/runtime/core/svo_guiding_fields.h"
+#include "emitter_guide_buffer.h"
 #include "guide_buffer.h"
 #include "svo_guide_buffer.h"
 
@@ -331,6 +332,46 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     svo_buffer.emplace(*svo_guide);
     svo_buffer->upload(runner_);
   }
+  // Emitter guiding (emitter_guide_buffer.h): the CPU reference's cache, its learning schedule and
+  // its fold between passes; its section follows the other guide's words in the guide buffer.
+  std::unique_ptr<EmitterGuidingCache> emitter_guide;
+  std::optional<EmitterGuideBuffer> emitter_buffer;
+  if (settings.emitter_guiding) {
+    if (share) throw std::invalid_argument("Vulkan backend: --emitter-guiding runs in one process only, not under mpirun with several ranks");
+    if (svo_guide)
+      throw std::invalid_argument("Vulkan backend: --emitter-guiding on with --guiding svo is implemented on the CPU backend only");
+    const std::shared_ptr<const LightingScene>& lighting = guiding_scene_.lighting;
+    if (!lighting) throw std::logic_error("Vulkan backend: emitter guiding without the integrator's scene");
+    // Its patch tables index the device's emitter list (their powers may differ after an emission
+    // edit: the mixture stays unbiased, as its densities read the device's CDF).
+    if (lighting->emitter_triangles != runner_.scene().emitter_triangles() || lighting->punctual_count() != a.params.punctual_count)
+      throw std::invalid_argument("Vulkan backend: --emitter-guiding on: the device's scene was edited since the integrator was made; "
+                                  "emitter guiding bakes the scene it was made on");
+    emitter_guide = EmitterGuidingCache::for_bake(*lighting, gbuffer, settings);
+  }
+  if (emitter_guide) {
+    Context& context = runner_.context();
+    WavefrontBuffers& buffers = runner_.buffers();
+    emitter_buffer.emplace(*emitter_guide, guide_buffer ? guide_buffer->bytes() / 4 : kGuideHeaderWords);
+    const size_t bytes = emitter_buffer->end_word() * 4;
+    if (uint64_t(bytes) > context.properties().limits.maxStorageBufferRange)
+      throw std::runtime_error("Vulkan backend: --emitter-guiding on: the guide buffer (" + std::to_string(bytes) +
+                               " bytes) passes the device's largest storage buffer (use fewer --guiding-grid-cells or "
+                               "--emitter-guiding-patches)");
+    bool rebind = buffers.paths.reserve_emitter_learning(context);
+    if (buffers.probes.sh_sums.size() < bytes) {
+      buffers.probes.reserve_bytes(context, bytes);  // a new buffer: the other guide's words again
+      rebind = true;
+      if (guide_buffer) guide_buffer->upload(runner_);
+    }
+    if (rebind) runner_.bind_buffers();
+    if (!guide_buffer) {  // no other guide: a header of zeros (no locator, no auto sections)
+      const std::vector<uint32_t> header(kGuideHeaderWords, 0u);
+      context.upload(buffers.probes.sh_sums, header.data(), header.size() * 4);
+    }
+    emitter_buffer->upload(runner_);
+    a.params.emitter_guide = emitter_buffer->params_offset();
+  }
   PassPolicy policy;
   // Untimed: as many samples per batch as fill the work items; a budget or target error: ramped passes.
   // Guided: ramped while learning, so the table swaps after the same samples as the CPU's (1, 2, 3,
@@ -341,6 +382,10 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   if (guide && !policy.ramp) policy.ramp = true, policy.ramp_below = choice ? choice->pilot() : GridGuidingCache::kLearningSamples;
   // SVO: ramped throughout, as on the CPU, so its rebuilds (1, 2, 4, ... spp) end passes of the same sizes.
   if (svo_guide) policy.ramp = true, policy.ramp_below = PassPolicy{}.ramp_below;
+  // Emitter guiding: ramped while every vertex learns, so its tables fold after the same samples as
+  // the CPU's; after that, untimed, passes as large as fill the work items (later samples learn
+  // only where a record samples what it learned, and fold after each pass).
+  if (emitter_guide && !policy.ramp) policy.ramp = true, policy.ramp_below = EmitterGuidingCache::kEveryLearningSamples;
   PassScheduler passes(settings, policy);
   // The estimate is hundreds of MB at millions of texels: a thread allocates it and touches its
   // pages, and makes the read-back's pinned staging buffer, while the host waits on the device's
@@ -369,6 +414,8 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
       if (share) share->work.texel_samples += uint64_t(a.work_list.size()) * pass;
     }
     if (learning) guide_buffer->fold_learning(runner_, *guide);  // this pass's learning is the next pass's table
+    if (emitter_buffer && a.params.emitter_guide != 0u && !emitter_buffer->fold_learning(runner_, *emitter_guide, first + pass))
+      a.params.emitter_guide = 0;  // no record gains: the default sampling from here, as on the CPU
     if (choice && !choice->decided() && first + pass >= choice->pilot()) {  // the pilot is complete on every texel
       import_strategy_sums(guide_buffer->download_auto_sums(runner_), *choice);
       choice->decide();
@@ -410,6 +457,10 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   }
   if (guide && settings.inspect_guiding) settings.inspect_guiding(*guide);
   if (svo_guide && settings.inspect_svo_guiding) settings.inspect_svo_guiding(*svo_guide);
+  if (emitter_guide) {
+    emitter_guide->report(estimate.emitter_guiding);
+    if (settings.inspect_emitter_guiding) settings.inspect_emitter_guiding(*emitter_guide);
+  }
   if (settings.work_share) settings.work_share->work.rays += estimate.rays;
   if (share) {
     // Rank 0 alone writes the bundle: the per-texel sums go to it, and the other ranks keep none.

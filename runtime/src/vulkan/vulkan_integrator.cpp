@@ -105,8 +105,6 @@ VulkanIntegrator::~VulkanIntegrator() = default;
 
 LightmapEstimate VulkanIntegrator::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const {
   if (settings.adaptive) throw std::runtime_error("Vulkan backend: --adaptive on is implemented on the CPU backend only (use --backend cpu)");
-  if (settings.emitter_guiding)
-    throw std::invalid_argument("Vulkan backend: --emitter-guiding on is implemented on the CPU backend only (use --backend cpu)");
   if (settings.spp == 0 && !(settings.time_budget_seconds > 0) && !(settings.target_relative_error > 0))
     throw std::invalid_argument("Vulkan backend: spp 0 needs a time budget or a target error");
   if (settings.integrator == IntegratorMode::Bounces) {
@@ -114,6 +112,9 @@ LightmapEstimate VulkanIntegrator::bake(const TexelGBuffer& gbuffer, const Integ
       throw std::invalid_argument("Vulkan backend: --directional sh1 applies to path tracing, not to --integrator bounces");
     if (settings.guiding != GuidingMode::Off)
       throw std::invalid_argument("Vulkan backend: guiding applies to path tracing, not to --integrator bounces");
+    if (settings.emitter_guiding)
+      throw std::invalid_argument("Vulkan backend: --emitter-guiding on applies to path tracing here (--integrator path); "
+                                  "the per-bounce mode guides its emitters on the CPU backend only");
     impl_->lightmap.end_progressive();  // the texel buffers are this bake's now
     impl_->runner.statistics().clear();
     vulkan::BounceLayerDriver layers(impl_->runner, impl_->source, gbuffer, settings);
@@ -149,7 +150,7 @@ void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const Inte
                                          bool accumulation_cleared) {
   // The progressive accumulation (exitance-relight) adds samples in calls the caller sizes, with no
   // pass where a learned table could swap: guiding runs in bake() only.
-  if (settings.guiding != GuidingMode::Off)
+  if (settings.guiding != GuidingMode::Off || settings.emitter_guiding)
     throw std::runtime_error("Vulkan backend: guiding runs in whole bakes only, not in progressive accumulation (relight)");
   impl_->lightmap.start(gbuffer, settings, 0, texels_as_before, accumulation_cleared);
   impl_->denoiser_stale |= !texels_as_before;
@@ -157,7 +158,7 @@ void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const Inte
 void VulkanIntegrator::start_progressive_change(const TexelGBuffer& gbuffer, const IntegratorSettings& settings,
                                                 const LightingScene& edited, const std::vector<GpuPunctualLight>& pairs,
                                                 bool texels_as_before, bool accumulation_cleared, const std::vector<uint32_t>& pair_layers) {
-  if (settings.guiding != GuidingMode::Off)
+  if (settings.guiding != GuidingMode::Off || settings.emitter_guiding)
     throw std::runtime_error("Vulkan backend: guiding runs in whole bakes only, not in progressive accumulation (relight)");
   if (pairs.empty() || pairs.size() % 2 != 0)
     throw std::invalid_argument("Vulkan backend: a change estimate needs pairs of light records (edited, base)");

@@ -30,7 +30,15 @@ PathStateBuffers::PathStateBuffers(Context& context, uint32_t paths)
       ray_origin(context.create_storage_buffer(size_t(paths) * 16)),
       ray_direction(context.create_storage_buffer(size_t(paths) * 16)),
       hit(context.create_storage_buffer(size_t(paths) * 16)),
-      shadow_rays(context.create_storage_buffer(size_t(paths) * kShadowRaysPerVertex * sizeof(ShadowRay))) {}
+      shadow_rays(context.create_storage_buffer(size_t(paths) * kShadowRaysPerVertex * sizeof(ShadowRay))),
+      paths(paths) {}
+
+bool PathStateBuffers::reserve_emitter_learning(Context& context) {
+  const VkDeviceSize bytes = VkDeviceSize(paths) * 4 * 16;
+  if (throughput.size() >= bytes) return false;
+  throughput = context.create_storage_buffer(bytes);
+  return true;
+}
 
 void PathStateBuffers::bind(DescriptorWrites& writes) const {
   writes.set(kBindingPathWork, work);

@@ -30,7 +30,8 @@ struct PathStateBuffers {
   Buffer work;           // work item of the batch, or kInvalid
   Buffer depth;          // vertices so far
   Buffer rng;            // PathSampler (path_sampler.h): four uints
-  Buffer throughput;     // rgb, pdf of the ray; then P more: the directional state (gpu_layout.h)
+  Buffer throughput;     // rgb, pdf of the ray; then P more: the directional state; then, with emitter
+                         // guiding, 2P more: what a vertex's next-event samples learn (gpu_layout.h)
   Buffer ray_origin;
   Buffer ray_direction;
   Buffer hit;            // t, triangle bits, b1, b2
@@ -38,6 +39,10 @@ struct PathStateBuffers {
 
   PathStateBuffers(Context& context, uint32_t paths);
   void bind(DescriptorWrites& writes) const;
+  // The throughput buffer with emitter guiding's 2P entries (a new buffer when it grows: rebind).
+  // Returns whether it grew.
+  bool reserve_emitter_learning(Context& context);
+  uint32_t paths = 0;
   static constexpr size_t kBytesPerPath = 4 + 4 + 16 + 16 + 16 + 16 + 16 + kShadowRaysPerVertex * sizeof(ShadowRay);
 };
 

@@ -126,7 +126,8 @@ struct GpuParams {
                              // layer (light_layers.h), L layers of rgb per work item after every other slot
   uint punctual_layers;      // light layers of punctual lights (light_layers.h punctual_light_layer)
   uint light_result_words;   // result words per work item before the light layers' section (bindings.glsl)
-  uint pad_light_layers;
+  uint emitter_guide;        // texel path batches: word offset of emitter guiding's section in the guide buffer
+                             // (kEmitterGuide* below); 0 = the default next-event sampling
   // A change estimate with light layers: pair k's change goes to layer changed_light_layers[k].
   uint changed_light_layers[8];  // kMaxChangedLightPairs
 };
@@ -248,6 +249,40 @@ const uint kGuideSvoWords = 8u;
 const uint kGuideFrontWords = 4u;
 const uint kGuideBackWords = 3u;
 const uint kGuideNoRecord = 0xFFFFFFFFu;
+// Emitter guiding (--emitter-guiding on; core/emitter_guiding_cache.h, common/guided_emitters.h;
+// docs/lighting-core.md "Emitter guiding on the Vulkan backend"): one more section of the guide
+// buffer, after any other guide's, at the word GpuParams::emitter_guide gives. Its first
+// kEmitterGuideHeaderWords words hold the word offsets of its tables and their sizes:
+//   locator   kGuideGridWords words as kGuideLocatorGrid's, then per (cell, normal class) its record
+//   tables    per emitter its first patch << 3 | level, per patch its first and end emitter, per scene
+//             triangle its emitter (guided_emitters.h EmitterGuide's tables)
+//   front     per record 2 floats: the area lights' and the punctual lights' guided probability
+//   cdf       per record patch_count + 1 floats; punctual cdf: per record punctual_count + 1 floats
+//   back      per record and patch kGuideBackWords (fixed-point sum lo, hi; count); punctual back: per
+//             record and light 2 words (sum lo, hi). Added to by integer atomics when a vertex that
+//             learns (EmitterGuidingCache::learning of its sample) sees its shadow ray arrive; read,
+//             folded (EmitterGuidingCache::import_learned + end_pass) and cleared between passes.
+// Per path, the vertex's emitter record and what its shadow rays learn wait in path_throughput
+// [2P + 2p] and [2P + 2p + 1] (record, patch, value, punctual light; punctual value, learns) from
+// next-event estimation to the connect stage, and the record until the continuation's hit is shaded
+// (its MIS weight reads the mixture's density).
+const uint kEmitterGuideLocator = 0u;
+const uint kEmitterGuideRecords = 1u;
+const uint kEmitterGuidePatches = 2u;
+const uint kEmitterGuidePunctual = 3u;
+const uint kEmitterGuideEmitterPatch = 4u;
+const uint kEmitterGuidePatchEmitters = 5u;
+const uint kEmitterGuideTriangleEmitter = 6u;
+const uint kEmitterGuideFront = 7u;
+const uint kEmitterGuideCdf = 8u;
+const uint kEmitterGuidePunctualCdf = 9u;
+const uint kEmitterGuideBack = 10u;
+const uint kEmitterGuidePunctualBack = 11u;
+const uint kEmitterGuideFixedUnits = 12u;  // + 13: the double's lo, hi words
+const uint kEmitterGuideFixedCap = 14u;
+const uint kEmitterGuideHeaderWords = 16u;
+const uint kEmitterGuideFrontWords = 2u;
+const uint kEmitterGuidePunctualBackWords = 2u;
 const uint kGuidingSample = 1u;         // GpuParams::guiding: vertices sample the front table's mixture
 const uint kGuidingLearn = 2u;          // and their continuation rays add to the back table
 const uint kGuidingCount = 4u;          // SVO locator: vertices count themselves per (node, class)

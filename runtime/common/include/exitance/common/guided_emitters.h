@@ -76,6 +76,24 @@ EXITANCE_FN EmitterGuide emitter_guide_none() {
   return g;
 }
 
+// Which vertices of a texel's sample `sample` teach the tables (both backends): every vertex in the
+// first kEmitterEveryLearningSamples; after them, one sample in kEmitterLaterLearningStride, at
+// vertices whose record samples a learned distribution (they keep improving it). Vertices that
+// neither learn nor sample a learned distribution take the default's code path
+// (EmitterGuidingCache::learning and vertex_site; emitter_guide.glsl).
+const uint kEmitterEveryLearningSamples = 64u;
+const uint kEmitterLaterLearningStride = 8u;
+const uint kEmitterLearnNone = 0u;
+const uint kEmitterLearnEverywhere = 1u;
+const uint kEmitterLearnWhereSampled = 2u;
+EXITANCE_FN uint emitter_learning_of_sample(uint sample_index) {
+  if (sample_index < kEmitterEveryLearningSamples) return kEmitterLearnEverywhere;
+  return sample_index % kEmitterLaterLearningStride == 0u ? kEmitterLearnWhereSampled : kEmitterLearnNone;
+}
+EXITANCE_FN bool emitter_vertex_learns(uint learning, bool has_record, bool sampling_learned) {
+  return has_record && (learning == kEmitterLearnEverywhere || (learning == kEmitterLearnWhereSampled && sampling_learned));
+}
+
 // ---- Sub-triangles: midpoint subdivision in barycentric space ----
 // A triangle with corners (A, B, C) has children 0: (A, AB, AC), 1: (AB, B, BC), 2: (AC, BC, C) and
 // 3: (BC, AC, AB) (the middle one, turned), where XY is the midpoint; sub-triangle s of level L is

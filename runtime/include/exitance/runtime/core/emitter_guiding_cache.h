@@ -79,13 +79,11 @@ class EmitterGuidingCache {
   // samples a learned distribution (they keep improving it). Vertices of records that sample by
   // default then take the default's code path: finding a sample's patch and learning it cost the
   // Cornell room, where every record's gain is small, 11 % of its time when every sample learned.
-  enum class Learning : uint8_t { None, Everywhere, WhereSampled };
-  static constexpr uint32_t kEveryLearningSamples = 64;
-  static constexpr uint32_t kLaterLearningStride = 8;
-  static Learning learning(uint32_t sample) {
-    if (sample < kEveryLearningSamples) return Learning::Everywhere;
-    return sample % kLaterLearningStride == 0 ? Learning::WhereSampled : Learning::None;
-  }
+  // The schedule is guided_emitters.h's emitter_learning_of_sample, shared with the kernels.
+  enum class Learning : uint8_t { None = kEmitterLearnNone, Everywhere = kEmitterLearnEverywhere, WhereSampled = kEmitterLearnWhereSampled };
+  static constexpr uint32_t kEveryLearningSamples = kEmitterEveryLearningSamples;
+  static constexpr uint32_t kLaterLearningStride = kEmitterLaterLearningStride;
+  static Learning learning(uint32_t sample) { return Learning(emitter_learning_of_sample(sample)); }
 
 
   uint32_t record_of(Vec3 position, Vec3 shading_normal) const;
@@ -110,6 +108,15 @@ class EmitterGuidingCache {
   void learn(uint32_t record, uint32_t patch, float value);
   // The same for punctual light `light`.
   void learn_punctual(uint32_t record, uint32_t light, float value);
+  // Sums another backend learned (the Vulkan kernels' fixed-point sums, guide_fixed_point with
+  // fixed_cap() and fixed_units()) into the back tables, as learn() would have added them; folded at
+  // the next swap(). Out-of-range indices are ignored.
+  void import_learned(uint32_t record, uint32_t patch, uint64_t fixed_sum, uint32_t count);
+  void import_learned_punctual(uint32_t record, uint32_t light, uint64_t fixed_sum);
+  double fixed_units() const { return fixed_scale_; }
+  float fixed_cap() const { return value_cap_; }
+  // Per scene triangle its emitter index (kEmitterPatchNone: none): EmitterGuide's triangle table.
+  const std::vector<uint32_t>& triangle_emitter() const { return triangle_emitter_; }
   // Between passes: folds the sums learned since the last swap into the front tables.
   void swap();
   // After a pass that brought texels to `samples` samples each: swap(), and past

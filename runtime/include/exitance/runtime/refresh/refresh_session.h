@@ -194,7 +194,10 @@ class RefreshSession {
   // texel. relight --share runs one rank's share alone, to measure how a split balances.
   // Returns the result lightmap() returns, by reference (valid until the next restart, edit or
   // refresh: a million texels' estimate is ~100 MB).
-  const LightmapEstimate& bake_path(uint32_t spp, double time_budget_seconds, WorkShare* share = nullptr);
+  // `emitter_guiding`: next-event estimation guided by emitter distributions learned during the run
+  // (bake --emitter-guiding on; one process only).
+  const LightmapEstimate& bake_path(uint32_t spp, double time_budget_seconds, WorkShare* share = nullptr,
+                                    bool emitter_guiding = false);
 
   // The lightmap accumulated since the last edit or restart (a read-back: it waits for the device);
   // after a light edit estimated as a change (changed_lights() > 0), that change.

@@ -50,6 +50,9 @@ struct RelightOptions {
   // grid|svo on the Vulkan backend; svo's octree is the bundle's svo.bin: no --frames or --budget-ms;
   // RefreshSession::bake_guided).
   std::string guiding = "off";
+  // "off" or "on": next-event estimation guided by emitter distributions learned during a whole run
+  // (bake --emitter-guiding on; path tracing of the whole lightmap in one run, as --guiding).
+  std::string emitter_guiding = "off";
   // > 0: --share R/N, a benchmark of one rank's share of a split bake: rank `share_rank` of
   // `share_ranks` (the texel range bake under mpirun gives it) by path tracing in one run
   // (RefreshSession::bake_path), alone on this device; needs --spp; writes no bundle (the other

@@ -1,0 +1,41 @@
+#!/bin/bash
+# Emitter guiding against the default next-event sampling on the GPU machine (issue 35, item 2),
+# through exitance-relight (--emitter-guiding on: one guided path-traced bake of the whole lightmap,
+# as bake --backend vulkan --emitter-guiding on; off: the progressive relight). Carry .gl and .replay;
+# .replay/eg.txz comes from bench/emitter_guiding_gpu_pack.sh. A two-seed 4096-spp unguided
+# reference (seeds 101, 202), then both modes at equal lighting time (TIMES seconds, --time) and at
+# equal samples (SPPS), each timed (lighting seconds, with the cache's build, learning and folds)
+# and compared with the reference (bench_bundle_rel_mse: relMSE, the reference's noise subtracted).
+#   bash .replay/emitter_guiding_gpu_run.sh       (env TIMES, SPPS; writes $OUT/summary.txt)
+set -e
+for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
+export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+W=/tmp/w; mkdir -p $W && tar -C $W -xJf .replay/eg.txz
+R=$W/rt/bin/exitance-relight
+S=$OUT/summary.txt
+nvidia-smi --query-gpu=name,driver_version --format=csv,noheader > $S
+B=$W/building.bake
+common="--ignore-baked --no-light-layers --json"
+$R $B -o $W/warm.bake --spp 4 --seed 1 $common > /dev/null                      # shader and driver caches
+$R $B -o $W/warm.bake --spp 4 --seed 1 --emitter-guiding on $common > /dev/null
+for s in 101 202; do $R $B -o $W/ref_$s.bake --spp 4096 --seed $s $common > /dev/null; done
+list=""
+run() {  # NAME ARGS...
+  local name=$1; shift
+  $R $B -o $W/$name.bake --seed 3 $common "$@" > $W/$name.json
+  python3 -c "
+import json; r=json.load(open('$W/$name.json'))
+print('$name', 'lighting_s %.3f'%r['lighting_seconds'], 'spp', r['samples_per_texel'], 'rays %.3g'%r['rays'], 'rays_per_s %.3g'%r['rays_per_second'], 'guide', r.get('emitter_guiding'))" >> $S
+  list="$list $W/$name.bake"
+}
+for t in ${TIMES:-0.25 1 4}; do
+  run off_t$t --time $t
+  run on_t$t --time $t --emitter-guiding on
+done
+for n in ${SPPS:-64 256}; do
+  run off_s$n --spp $n
+  run on_s$n --spp $n --emitter-guiding on
+done
+echo "relMSE:" >> $S
+$W/rt/bin/bench_bundle_rel_mse $W/ref_101.bake $W/ref_202.bake $list >> $S
+cat $S

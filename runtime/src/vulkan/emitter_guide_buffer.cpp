@@ -1,0 +1,112 @@
+#include "emitter_guide_buffer.h"
+
+#include <algorithm>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "guide_buffer.h"
+
+namespace exitance::vulkan {
+
+EmitterGuideBuffer::EmitterGuideBuffer(const EmitterGuidingCache& cache, size_t base)
+    : base_(std::max<size_t>(base, kGuideHeaderWords)),
+      records_(cache.record_count()),
+      patches_(cache.patch_count()),
+      punctual_(cache.punctual_count()) {
+  const GuideGridLocator& locator = cache.locator();
+  const EmitterPatches& patches = cache.patches();
+  const std::vector<uint32_t>& triangle_emitter = cache.triangle_emitter();
+  // Section-relative offsets, in the order of gpu_layout.h's description.
+  const size_t locator_at = kEmitterGuideHeaderWords;
+  const size_t emitter_patch_at = locator_at + kGuideGridWords + locator.record_index().size();
+  const size_t patch_emitters_at = emitter_patch_at + patches.emitter_patch.size();
+  const size_t triangle_emitter_at = patch_emitters_at + patches.patch_emitters.size();
+  front_ = triangle_emitter_at + triangle_emitter.size();
+  const size_t cdf_at = front_ + size_t(records_) * kEmitterGuideFrontWords;
+  const size_t punctual_cdf_at = cdf_at + (patches_ > 0 ? size_t(records_) * (patches_ + 1) : 0);
+  back_ = punctual_cdf_at + (punctual_ > 0 ? size_t(records_) * (punctual_ + 1) : 0);
+  const size_t punctual_back_at = back_ + size_t(records_) * patches_ * kGuideBackWords;
+  back_end_ = punctual_back_at + size_t(records_) * punctual_ * kEmitterGuidePunctualBackWords;
+  if (base_ + back_end_ >= (size_t(1) << 32))
+    throw std::runtime_error("Vulkan backend: --emitter-guiding on: " + std::to_string(records_) + " records of " +
+                             std::to_string(patches_) + " patches do not fit the guide buffer (use fewer --guiding-grid-cells)");
+  words_.assign(back_end_, 0u);
+  auto absolute = [&](size_t at) { return uint32_t(base_ + at); };
+  words_[kEmitterGuideLocator] = absolute(locator_at);
+  words_[kEmitterGuideRecords] = records_;
+  words_[kEmitterGuidePatches] = patches_;
+  words_[kEmitterGuidePunctual] = punctual_;
+  words_[kEmitterGuideEmitterPatch] = absolute(emitter_patch_at);
+  words_[kEmitterGuidePatchEmitters] = absolute(patch_emitters_at);
+  words_[kEmitterGuideTriangleEmitter] = absolute(triangle_emitter_at);
+  words_[kEmitterGuideFront] = absolute(front_);
+  words_[kEmitterGuideCdf] = absolute(cdf_at);
+  words_[kEmitterGuidePunctualCdf] = absolute(punctual_cdf_at);
+  words_[kEmitterGuideBack] = absolute(back_);
+  words_[kEmitterGuidePunctualBack] = absolute(punctual_back_at);
+  const double units = cache.fixed_units();
+  uint64_t units_bits;
+  std::memcpy(&units_bits, &units, 8);
+  words_[kEmitterGuideFixedUnits] = uint32_t(units_bits);
+  words_[kEmitterGuideFixedUnits + 1] = uint32_t(units_bits >> 32);
+  words_[kEmitterGuideFixedCap] = guide_float_bits(cache.fixed_cap());
+  // The locator: kGuideLocatorGrid's words (guide.glsl guide_grid_record_at).
+  const Vec3 origin = locator.origin();
+  for (int a = 0; a < 3; ++a) {
+    words_[locator_at + size_t(a)] = guide_float_bits(origin[a]);
+    words_[locator_at + 4 + size_t(a)] = uint32_t(locator.cells(a));
+  }
+  words_[locator_at + 3] = guide_float_bits(locator.cell_size());
+  std::copy(locator.record_index().begin(), locator.record_index().end(), words_.begin() + std::ptrdiff_t(locator_at + kGuideGridWords));
+  std::copy(patches.emitter_patch.begin(), patches.emitter_patch.end(), words_.begin() + std::ptrdiff_t(emitter_patch_at));
+  std::copy(patches.patch_emitters.begin(), patches.patch_emitters.end(), words_.begin() + std::ptrdiff_t(patch_emitters_at));
+  std::copy(triangle_emitter.begin(), triangle_emitter.end(), words_.begin() + std::ptrdiff_t(triangle_emitter_at));
+  pack_front(cache);
+}
+
+void EmitterGuideBuffer::pack_front(const EmitterGuidingCache& cache) {
+  const size_t cdf_at = words_[kEmitterGuideCdf] - base_, punctual_cdf_at = words_[kEmitterGuidePunctualCdf] - base_;
+  for (uint32_t r = 0; r < records_; ++r) {
+    const EmitterGuide g = cache.vertex(r);
+    uint32_t* f = &words_[front_ + size_t(r) * kEmitterGuideFrontWords];
+    f[0] = guide_float_bits(g.guided_probability);
+    f[1] = guide_float_bits(g.punctual_guided_probability);
+    if (patches_ > 0) std::memcpy(&words_[cdf_at + size_t(r) * (patches_ + 1)], g.cdf, (size_t(patches_) + 1) * 4);
+    if (punctual_ > 0)
+      std::memcpy(&words_[punctual_cdf_at + size_t(r) * (punctual_ + 1)], g.punctual_cdf, (size_t(punctual_) + 1) * 4);
+  }
+}
+
+void EmitterGuideBuffer::upload(WavefrontBatchRunner& runner) const {
+  Context& context = runner.context();
+  const Buffer& buffer = runner.buffers().probes.sh_sums;
+  if (buffer.size() < end_word() * 4) throw std::logic_error("EmitterGuideBuffer::upload: the guide buffer was not grown");
+  context.upload(buffer, words_.data(), words_.size() * 4, base_ * 4);
+}
+
+bool EmitterGuideBuffer::fold_learning(WavefrontBatchRunner& runner, EmitterGuidingCache& cache, uint32_t samples) {
+  Context& context = runner.context();
+  const Buffer& buffer = runner.buffers().probes.sh_sums;
+  if (back_end_ > back_) context.download(buffer, &words_[back_], (back_end_ - back_) * 4, (base_ + back_) * 4);
+  const size_t punctual_back_at = words_[kEmitterGuidePunctualBack] - base_;
+  for (uint32_t r = 0; r < records_; ++r) {
+    for (uint32_t k = 0; k < patches_; ++k) {
+      const uint32_t* w = &words_[back_ + (size_t(r) * patches_ + k) * kGuideBackWords];
+      if (w[2] != 0) cache.import_learned(r, k, uint64_t(w[0]) | (uint64_t(w[1]) << 32), w[2]);
+    }
+    for (uint32_t i = 0; i < punctual_; ++i) {
+      const uint32_t* w = &words_[punctual_back_at + (size_t(r) * punctual_ + i) * kEmitterGuidePunctualBackWords];
+      if (w[0] != 0 || w[1] != 0) cache.import_learned_punctual(r, i, uint64_t(w[0]) | (uint64_t(w[1]) << 32));
+    }
+  }
+  std::fill(words_.begin() + std::ptrdiff_t(back_), words_.end(), 0u);
+  cache.end_pass(samples);
+  if (!cache.active()) return false;
+  pack_front(cache);
+  // Front and CDFs with the new tables, the back sums at 0 for the next pass (adjacent sections).
+  context.upload(buffer, &words_[front_], (back_end_ - front_) * 4, (base_ + front_) * 4);
+  return true;
+}
+
+}  // namespace exitance::vulkan
