@@ -10,13 +10,14 @@ namespace {
 
 // A new field in one of these must be added to the key below; the sizes catch most additions.
 // Not hashed: work_share (how many processes lit a bake does not change its bits: issue 15),
-// guiding_octree (the bake's own octree, from the hashed voxel options), the inspect callbacks and
-// budget_clock (the time budget's clock; the budget itself is hashed).
-static_assert(sizeof(IntegratorSettings) == 288, "IntegratorSettings changed: hash the new field in bake_cache_key");
+// guiding_octree (the bake's own octree, from the hashed voxel options), the inspect callbacks,
+// budget_clock (the time budget's clock; the budget itself is hashed) and bounce_caches_on_host
+// (where the per-bounce caches are built: the same pages bit for bit).
+static_assert(sizeof(IntegratorSettings) == 320, "IntegratorSettings changed: hash the new field in bake_cache_key");
 static_assert(sizeof(AtlasSettings) == 24, "AtlasSettings changed: hash the new field in bake_cache_key");
 // Not hashed: input and output paths (the input's name and bytes are), cache_directory and
 // write_gltf (where results go does not change them), progress.
-static_assert(sizeof(BakeOptions) == 592, "BakeOptions changed: hash the new field in bake_cache_key (or say why not)");
+static_assert(sizeof(BakeOptions) == 624, "BakeOptions changed: hash the new field in bake_cache_key (or say why not)");
 static_assert(sizeof(ImportOptions) == 8, "ImportOptions changed: hash the new field in bake_cache_key");
 static_assert(sizeof(Material) == 168, "Material changed: hash the new field in bake_cache_key");
 static_assert(sizeof(PunctualLight) == 88, "PunctualLight changed: hash the new field in bake_cache_key");

@@ -68,6 +68,10 @@ int main(int argc, char** argv) {
                  "svo.bin: the whole lightmap in one run; not with --frames, --budget-ms or --integrator bounces; auto is "
                  "refused: the measured choice runs in bake only)")
       ->check(CLI::IsMember({"off", "grid", "svo", "auto"}));
+  app.add_option("--bounce-caches", options.bounce_caches,
+                 "device (default) | host: where --integrator bounces builds its layer caches (host: the earlier path, "
+                 "built on the CPU and uploaded between layers, for A/B timing; the same results bit for bit)")
+      ->check(CLI::IsMember({"device", "host"}));
   app.add_option("--emitter-guiding", options.emitter_guiding,
                  "off (default) | on (next-event estimation guided by emitter distributions learned during the run, as "
                  "bake --emitter-guiding on: the whole lightmap in one run; not with --frames, --budget-ms, --guiding or "

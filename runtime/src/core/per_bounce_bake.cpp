@@ -34,6 +34,7 @@
 #include <cmath>
 
 #include "exitance/common/bounce_gather.h"
+#include "exitance/common/gpu_layout.h"
 #include "exitance/runtime/core/bounce_tail.h"
 #include "exitance/runtime/core/partial_layer_pass.h"
 #include "exitance/runtime/core/pass_scheduler.h"
@@ -45,8 +46,8 @@ namespace {
 // B_0 .. B_256 at most; fewer when the layers' sums would pass ~2 GiB.
 constexpr int kMaxLayers = 257;
 constexpr size_t kLayerMemoryLimit = size_t(2) << 30;
-// Rings of gutter texels filled around charts: a bilinear footprint reaches one texel past a chart.
-constexpr int kCacheDilation = 2;
+// Rings of gutter texels filled around charts (gpu_layout.h: the device's builder fills as many).
+constexpr int kCacheDilation = int(kBounceCacheDilation);
 // What a time budget keeps aside for the work after the last layer pass, in tail estimates (of as
 // many layers): the assembly reads every layer of every texel once, as the tail does, and freeing
 // the layers and the caller's copy of the result (bake's expansion onto the sealed texels) cost
@@ -169,7 +170,10 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
     const double build_start = passes.elapsed_seconds();
     std::vector<Vec3> means(n);
     for (size_t i = 0; i < n; ++i) means[i] = layers[k].mean(i);
-    caches[k].build(gbuffer, means, valid, kCacheDilation);
+    if (estimator.builds_caches())
+      estimator.build_cache(k, means, valid);
+    else
+      caches[k].build(gbuffer, means, valid, kCacheDilation);
     ++cache_versions[k];
     cache_stale[k] = 0;
     cache_seconds[k] = passes.elapsed_seconds() - build_start;

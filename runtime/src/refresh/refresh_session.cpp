@@ -948,7 +948,7 @@ LightmapEstimate RefreshSession::lightmap() const {
   return state_->per_bounce ? *state_->per_bounce : state_->integrator->progressive_estimate();
 }
 
-LightmapEstimate RefreshSession::bake_per_bounce(uint32_t spp, double time_budget_seconds) {
+LightmapEstimate RefreshSession::bake_per_bounce(uint32_t spp, double time_budget_seconds, bool caches_on_host) {
   State& s = *state_;
   end_change_estimate();
   if (s.settings.directional != DirectionalMode::Off)
@@ -961,6 +961,7 @@ LightmapEstimate RefreshSession::bake_per_bounce(uint32_t spp, double time_budge
   settings.time_budget_seconds = time_budget_seconds;
   const formats::BakeSettings baked = s.manifest.settings.value_or(formats::BakeSettings{});
   settings.trace_first_bounce = baked.first_bounce != "cached";
+  settings.bounce_caches_on_host = caches_on_host;
   s.per_bounce = s.integrator->bake(s.persisted.gbuffer, settings);
   s.whole_run_path = s.whole_run_guided = false;
   return *s.per_bounce;

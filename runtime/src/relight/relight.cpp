@@ -46,6 +46,10 @@ json relight_bundle(const RelightOptions& options) {
   if (guided && per_bounce) throw RelightInputError("--guiding " + options.guiding + " guides path tracing: it needs --integrator path");
   if (guided && (options.frames > 0 || options.frame_budget_ms > 0))
     throw RelightInputError("--guiding " + options.guiding + " runs the whole lightmap at once: --frames and --budget-ms need --guiding off");
+  if (options.bounce_caches != "device" && options.bounce_caches != "host")
+    throw RelightInputError("--bounce-caches " + options.bounce_caches + ": expected device or host");
+  if (options.bounce_caches != "device" && !per_bounce)
+    throw RelightInputError("--bounce-caches " + options.bounce_caches + " places the per-bounce mode's caches: it needs --integrator bounces");
   if (options.emitter_guiding != "off" && options.emitter_guiding != "on")
     throw RelightInputError("--emitter-guiding " + options.emitter_guiding + ": expected off or on");
   const bool emitter_guided = options.emitter_guiding == "on";
@@ -159,7 +163,7 @@ json relight_bundle(const RelightOptions& options) {
   if (per_bounce) {
     report("lighting", 0, 0);
     try {
-      rays = session->bake_per_bounce(spp, options.time_budget_seconds).rays;
+      rays = session->bake_per_bounce(spp, options.time_budget_seconds, options.bounce_caches == "host").rays;
     } catch (const std::invalid_argument& e) {
       throw RelightInputError(options.bundle + ": " + e.what());
     }

@@ -1,10 +1,13 @@
 #include "bounce_layer_driver.h"
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
+
+#include "exitance_spirv/bounce_cache.h"
 
 namespace exitance::vulkan {
 namespace {
@@ -110,6 +113,9 @@ void BounceLayerDriver::upload_caches(size_t layers, const std::vector<BounceLay
   for (size_t k = 0; k < layers; ++k) {
     if (uploaded_versions_[k] == versions[k] && !whole) continue;
     caches[k].interleave(cache_words_, first_layer_word_ + k * layer_words_);
+    if (settings_.inspect_bounce_cache)
+      settings_.inspect_bounce_cache(k, std::vector<float>(cache_words_.begin() + std::ptrdiff_t(first_layer_word_ + k * layer_words_),
+                                                           cache_words_.begin() + std::ptrdiff_t(first_layer_word_ + (k + 1) * layer_words_)));
     if (!whole && layer_words_ > 0)
       context.upload(buffers.probes.sh_sums, &cache_words_[first_layer_word_ + k * layer_words_], layer_words_ * 4,
                      (first_layer_word_ + k * layer_words_) * 4);
@@ -118,13 +124,130 @@ void BounceLayerDriver::upload_caches(size_t layers, const std::vector<BounceLay
   if (whole) context.upload(buffers.probes.sh_sums, cache_words_.data(), words * 4);
 }
 
+void BounceLayerDriver::reserve_device_layers(size_t layers) {
+  Context& context = runner_.context();
+  WavefrontBuffers& buffers = runner_.buffers();
+  const size_t words = first_layer_word_ + std::max<size_t>(layers, 1) * layer_words_;
+  const size_t limit = size_t(context.properties().limits.maxStorageBufferRange);
+  if (words * 4 > limit)
+    throw std::runtime_error("Vulkan backend: --integrator bounces: " + std::to_string(layers) +
+                             " layer caches pass the device's largest storage buffer");
+  if (!tables_uploaded_) {  // this bake's header and tables (the buffer may hold another bake's data)
+    if (buffers.probes.sh_sums.size() < words * 4) {
+      buffers.probes.reserve_bytes(context, words * 4);
+      runner_.bind_buffers();
+    }
+    context.upload(buffers.probes.sh_sums, cache_words_.data(), first_layer_word_ * 4);
+    tables_uploaded_ = true;
+    return;
+  }
+  const VkDeviceSize held = buffers.probes.sh_sums.size();
+  if (held >= words * 4) return;
+  // Twice the layers at a time (a bake adds one layer per bounce), the layers built so far copied over.
+  const size_t grown = std::min(limit / 4, std::max(words, first_layer_word_ + 2 * std::max<size_t>(layers, 1) * layer_words_));
+  Buffer larger = context.create_storage_buffer(VkDeviceSize(grown) * 4);
+  VkCommandBuffer cmd = context.begin();
+  const VkBufferCopy region{0, 0, held};
+  vkCmdCopyBuffer(cmd, buffers.probes.sh_sums.handle(), larger.handle(), 1, &region);
+  context.submit_and_wait(cmd);
+  buffers.probes.sh_sums = std::move(larger);
+  runner_.bind_buffers();
+}
+
+void BounceLayerDriver::build_cache(size_t layer, const std::vector<Vec3>& means, const std::vector<uint8_t>& valid) {
+  Context& context = runner_.context();
+  const size_t texels = gbuffer_.texels.size();
+  if (means.size() != texels || (!valid.empty() && valid.size() != texels))
+    throw std::logic_error("BounceLayerDriver::build_cache: means or validity of another G-buffer");
+  reserve_device_layers(layer + 1);
+  if (!cache_kernel_) {
+    // Per live texel its page texel (BounceLayerCache::build skips texels off their page), position
+    // and geometric normal; per page its size and first page texel; a fill flag per page texel.
+    std::vector<uint32_t> first(gbuffer_.pages.size() + 1, 0);
+    std::vector<uint32_t> page_words;
+    for (size_t p = 0; p < gbuffer_.pages.size(); ++p) {
+      const AtlasPage& page = gbuffer_.pages[p];
+      first[p + 1] = first[p] + uint32_t(page.width) * uint32_t(page.height);
+      page_words.insert(page_words.end(), {uint32_t(page.width), uint32_t(page.height), first[p], 0u});
+    }
+    page_texels_ = first.back();
+    std::vector<uint32_t> words(std::max<size_t>(texels, 1) * 8, 0xFFFFFFFFu);
+    auto bits = [](float f) {
+      uint32_t u;
+      std::memcpy(&u, &f, 4);
+      return u;
+    };
+    for (size_t i = 0; i < texels; ++i) {
+      const LiveTexel& t = gbuffer_.texels[i];
+      uint32_t* w = &words[i * 8];
+      const bool on_page = t.page < gbuffer_.pages.size() && t.x < uint32_t(gbuffer_.pages[t.page].width) &&
+                           t.y < uint32_t(gbuffer_.pages[t.page].height);
+      w[0] = on_page ? first[t.page] + t.y * uint32_t(gbuffer_.pages[t.page].width) + t.x : 0xFFFFFFFFu;
+      const float values[6] = {t.position.x, t.position.y, t.position.z, t.geometric_normal.x, t.geometric_normal.y,
+                               t.geometric_normal.z};
+      for (int c = 0; c < 6; ++c) w[1 + c] = bits(values[c]);
+      w[7] = 0;
+    }
+    if (page_words.empty()) page_words.assign(4, 0u);
+    cache_texels_ = context.create_storage_buffer(words.size() * 4);
+    context.upload(cache_texels_, words.data(), words.size() * 4);
+    cache_pages_ = context.create_storage_buffer(page_words.size() * 4);
+    context.upload(cache_pages_, page_words.data(), page_words.size() * 4);
+    cache_means_ = context.create_storage_buffer(std::max<size_t>(texels, 1) * 16);
+    cache_flags_ = context.create_storage_buffer(std::max<size_t>(page_texels_, 1) * 4);
+    cache_kernel_ = std::make_unique<ComputeKernel>(context, std::vector<VkDescriptorType>(5, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER),
+                                                    uint32_t(5 * 4), spirv_bounce_cache, sizeof(spirv_bounce_cache), 1,
+                                                    "bounce_cache.comp");
+  }
+  std::vector<Vec4> packed(texels);
+  for (size_t i = 0; i < texels; ++i)
+    packed[i] = Vec4(means[i].x, means[i].y, means[i].z, valid.empty() || valid[i] ? 1.0f : 0.0f);
+  if (texels > 0) context.upload(cache_means_, packed.data(), packed.size() * sizeof(Vec4));
+  // The cache buffer may have grown since the descriptors were written.
+  const std::array<VkDescriptorBufferInfo, 5> infos{{{runner_.buffers().probes.sh_sums.handle(), 0, VK_WHOLE_SIZE},
+                                                     {cache_texels_.handle(), 0, VK_WHOLE_SIZE},
+                                                     {cache_means_.handle(), 0, VK_WHOLE_SIZE},
+                                                     {cache_flags_.handle(), 0, VK_WHOLE_SIZE},
+                                                     {cache_pages_.handle(), 0, VK_WHOLE_SIZE}}};
+  cache_kernel_->write_buffers(0, infos.data(), uint32_t(infos.size()));
+  struct Push {
+    uint32_t mode, layer_word, count, ring, page_count;
+  };
+  const uint32_t layer_word = uint32_t(first_layer_word_ + layer * layer_words_);
+  VkCommandBuffer cmd = context.begin();
+  writes_visible_to_compute(cmd);
+  cache_kernel_->bind(cmd, 0);
+  auto dispatch = [&](uint32_t mode, size_t count, uint32_t ring) {
+    if (count == 0) return;
+    const Push push{mode, layer_word, uint32_t(count), ring, uint32_t(gbuffer_.pages.size())};
+    cache_kernel_->push(cmd, &push, sizeof(push));
+    const size_t groups = (count + 63) / 64;
+    const uint32_t x = uint32_t(std::min<size_t>(groups, 65535));
+    vkCmdDispatch(cmd, x, uint32_t((groups + x - 1) / x), 1);
+    writes_visible_to_compute(cmd);
+  };
+  dispatch(0, page_texels_, 0);
+  dispatch(1, texels, 0);
+  for (uint32_t ring = 1; ring <= kBounceCacheDilation; ++ring) dispatch(2, page_texels_, ring);
+  compute_done_before_all(cmd);
+  context.submit_and_wait(cmd);
+  if (settings_.inspect_bounce_cache) {
+    std::vector<float> words(layer_words_);
+    if (!words.empty()) context.download(runner_.buffers().probes.sh_sums, words.data(), words.size() * 4, size_t(layer_word) * 4);
+    settings_.inspect_bounce_cache(layer, words);
+  }
+}
+
 void BounceLayerDriver::estimate(const BounceLayerPass& pass, const std::vector<BounceLayerCache>& caches,
                                  const std::vector<uint64_t>& cache_versions) {
   if (pass.samples == 0 || pass.end <= pass.begin) return;
   if (!prepared_) prepare();
   Context& context = runner_.context();
   WavefrontBuffers& buffers = runner_.buffers();
-  upload_caches(size_t(pass.layer), caches, cache_versions);
+  if (builds_caches())
+    reserve_device_layers(size_t(pass.layer));  // the layers below pass.layer were built there
+  else
+    upload_caches(size_t(pass.layer), caches, cache_versions);
   if (uint64_t(pass.first_sample) + pass.samples > std::numeric_limits<uint32_t>::max())
     throw std::invalid_argument("Vulkan backend: more than 2^32 - 1 samples per texel");
   const size_t texels = gbuffer_.texels.size();

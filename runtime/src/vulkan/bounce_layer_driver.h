@@ -11,6 +11,7 @@
 
 #include "exitance/runtime/core/per_bounce_bake.h"
 #include "exitance/runtime/scene.h"
+#include "compute_kernel.h"
 #include "wavefront_batch.h"
 
 namespace exitance::vulkan {
@@ -25,10 +26,17 @@ class BounceLayerDriver final : public BounceLayerEstimator {
   void estimate(const BounceLayerPass& pass, const std::vector<BounceLayerCache>& caches,
                 const std::vector<uint64_t>& cache_versions) override;
   BounceGatherCounts counts() const override;
+  // The layer caches are built on the device (bounce_cache.comp) from the means the host loop
+  // passes, unless settings.bounce_caches_on_host asks for the host's BounceLayerCache pages.
+  bool builds_caches() const override { return !settings_.bounce_caches_on_host; }
+  void build_cache(size_t layer, const std::vector<Vec3>& means, const std::vector<uint8_t>& valid) override;
 
  private:
   void prepare();
   void upload_caches(size_t layers, const std::vector<BounceLayerCache>& caches, const std::vector<uint64_t>& versions);
+  // The cache buffer with room for `layers` layers, its header and tables on the device; when it
+  // grows, what it held (the layers built so far) is copied into the larger one.
+  void reserve_device_layers(size_t layers);
 
   WavefrontBatchRunner& runner_;
   std::shared_ptr<const Scene> source_;
@@ -44,6 +52,11 @@ class BounceLayerDriver final : public BounceLayerEstimator {
   size_t layer_words_ = 0, first_layer_word_ = 0;
   std::vector<uint64_t> uploaded_versions_;     // per layer, the cache version on the device (0: none)
   std::vector<uint32_t> work_list_;
+  // Device-built caches (bounce_cache.comp): the kernel, per live texel its page texel, position and
+  // normal (uploaded once), the means of the layer being built, a fill flag per page texel, the pages.
+  std::unique_ptr<ComputeKernel> cache_kernel_;
+  Buffer cache_texels_, cache_means_, cache_flags_, cache_pages_;
+  size_t page_texels_ = 0;
 };
 
 }  // namespace exitance::vulkan

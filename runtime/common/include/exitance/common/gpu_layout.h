@@ -202,6 +202,7 @@ const uint kBounceCacheTriangleWords = 7u;
 const uint kBounceCacheInstanceWords = 5u;
 const uint kBounceCachePageWords = 3u;
 const uint kBounceCacheTexelWords = 10u;
+const uint kBounceCacheDilation = 2u;       // rings of gutter texels filled around charts (a bilinear footprint reaches one past)
 const uint kBouncePass = 1u;                // bounce_flags: this batch estimates layer bounce_layer
 const uint kBounceTraceFirst = 2u;          // at layer 0 a gather hit takes a direct-light sample, not the cache
 // Path guiding (--guiding grid, issue 11; docs/lighting-core.md "Grid guiding on the Vulkan

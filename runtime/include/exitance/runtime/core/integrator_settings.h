@@ -52,6 +52,9 @@ struct IntegratorSettings {
   // than reading the B_0 lightmap (false). Direct light carries the sharp shadows a texel-resolution
   // cache blurs; traced, the lookup's resolution bias only enters from B_2 on, through the smoother B_1.
   bool trace_first_bounce = true;
+  // Bounces mode on the Vulkan backend: build the layer caches on the host and upload them (the path
+  // before the device built them; the same pages bit for bit), for the equivalence test and benches.
+  bool bounce_caches_on_host = false;
   int max_bounces = -1;            // diffuse bounces after the first hit; -1 = until Russian roulette
   uint64_t seed = 0;
   int recorded_bounces = 4;        // layers bounce0 (= direct) .. bounce<K-1> kept separately
@@ -91,6 +94,9 @@ struct IntegratorSettings {
   std::function<void(const GridGuidingCache&)> inspect_guiding;
   std::function<void(const SvoGuidingFields&)> inspect_svo_guiding;  // the same for GuidingMode::Svo
   std::function<void(const EmitterGuidingCache&)> inspect_emitter_guiding;  // the same for emitter_guiding
+  // Bounces mode on the Vulkan backend: each layer cache's page words (kBounceCacheTexelWords per page
+  // texel, all pages) as the layer passes read them, after every build (tests: device against host).
+  std::function<void(size_t layer, const std::vector<float>& words)> inspect_bounce_cache;
   // This process's share of a bake split over processes (core/work_share.h; bake under mpirun); null:
   // the whole bake. Backends without it refuse more than one rank before lighting (bake does).
   WorkShare* work_share = nullptr;

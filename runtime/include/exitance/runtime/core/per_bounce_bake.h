@@ -48,6 +48,12 @@ class BounceLayerEstimator {
   virtual void estimate(const BounceLayerPass& pass, const std::vector<BounceLayerCache>& caches,
                         const std::vector<uint64_t>& cache_versions) = 0;
   virtual BounceGatherCounts counts() const = 0;
+  // Whether the estimator builds the layers' caches itself (the Vulkan backend, on the device):
+  // bake_per_bounce then calls build_cache with each layer's per-texel means and validity where it
+  // would build a BounceLayerCache on the host (whose `caches` entries then stay empty), at the
+  // same points of the schedule.
+  virtual bool builds_caches() const { return false; }
+  virtual void build_cache(size_t layer, const std::vector<Vec3>& means, const std::vector<uint8_t>& valid) {}
 };
 
 // E/pi at every live texel as the sum of the bounce layers B_0..B_K, each kept separately

@@ -177,7 +177,9 @@ class RefreshSession {
   // until the next restart, edit or refresh() call (which starts the progressive accumulation
   // again). Throws std::invalid_argument for a bundle with directional layers (per-bounce passes
   // estimate no L1) or without a bound.
-  LightmapEstimate bake_per_bounce(uint32_t spp, double time_budget_seconds);
+  // `caches_on_host`: the layer caches built on the host and uploaded (the path before the device
+  // built them; the same results bit for bit), for A/B timing.
+  LightmapEstimate bake_per_bounce(uint32_t spp, double time_budget_seconds, bool caches_on_host = false);
   // Whether lightmap() holds a bake_per_bounce() result.
   bool per_bounce() const;
   // The whole lightmap by grid-guided path tracing (--guiding grid, issue 11) on the session's

@@ -53,6 +53,9 @@ struct RelightOptions {
   // "off" or "on": next-event estimation guided by emitter distributions learned during a whole run
   // (bake --emitter-guiding on; path tracing of the whole lightmap in one run, as --guiding).
   std::string emitter_guiding = "off";
+  // With integrator "bounces": where the layer caches are built, "device" or "host" (the path before
+  // the device built them, for A/B timing; the same results bit for bit).
+  std::string bounce_caches = "device";
   // > 0: --share R/N, a benchmark of one rank's share of a split bake: rank `share_rank` of
   // `share_ranks` (the texel range bake under mpirun gives it) by path tracing in one run
   // (RefreshSession::bake_path), alone on this device; needs --spp; writes no bundle (the other
