@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "exitance/runtime/core/grid_guiding_cache.h"
+#include "exitance/runtime/core/parallel_chunks.h"
 #include "exitance/runtime/core/scene_access.h"
 #include "exitance/common/guide_learning.h"  // after scene_access.h: path.h reads its accessors
 
@@ -200,30 +201,36 @@ void EmitterGuidingCache::import_learned_punctual(uint32_t record, uint32_t ligh
 }
 
 void EmitterGuidingCache::swap() {
+  // Records are independent (each folds and rebuilds only its own rows): on all cores.
   const size_t patches = patch_count();
-  for (uint32_t r = 0; r < record_count(); ++r) {
-    bool changed = false;
-    for (size_t k = 0; k < patches; ++k) {
-      Accumulator& a = back_[size_t(r) * patches + k];
-      const uint32_t count = a.count.load(std::memory_order_relaxed);
-      if (count == 0) continue;
-      const uint64_t units = a.sum.load(std::memory_order_relaxed);
-      a.sum.store(0, std::memory_order_relaxed);
-      a.count.store(0, std::memory_order_relaxed);
-      learned_[size_t(r) * patches + k] += double(units) / fixed_scale_;
-      samples_[size_t(r) * patches + k] += count;
-      changed = true;
-    }
-    for (size_t i = 0; i < punctual_count_; ++i) {
-      std::atomic<uint64_t>& sum = punctual_back_[size_t(r) * punctual_count_ + i];
-      const uint64_t units = sum.load(std::memory_order_relaxed);
-      if (units == 0) continue;
-      sum.store(0, std::memory_order_relaxed);
-      punctual_learned_[size_t(r) * punctual_count_ + i] += double(units) / fixed_scale_;
-      changed = true;
-    }
-    if (changed) rebuild(r);
-  }
+  for_each_chunk(
+      record_count(),
+      [&](size_t first, size_t end) {
+        for (size_t r = first; r < end; ++r) {
+          bool changed = false;
+          for (size_t k = 0; k < patches; ++k) {
+            Accumulator& a = back_[r * patches + k];
+            const uint32_t count = a.count.load(std::memory_order_relaxed);
+            if (count == 0) continue;
+            const uint64_t units = a.sum.load(std::memory_order_relaxed);
+            a.sum.store(0, std::memory_order_relaxed);
+            a.count.store(0, std::memory_order_relaxed);
+            learned_[r * patches + k] += double(units) / fixed_scale_;
+            samples_[r * patches + k] += count;
+            changed = true;
+          }
+          for (size_t i = 0; i < punctual_count_; ++i) {
+            std::atomic<uint64_t>& sum = punctual_back_[r * punctual_count_ + i];
+            const uint64_t units = sum.load(std::memory_order_relaxed);
+            if (units == 0) continue;
+            sum.store(0, std::memory_order_relaxed);
+            punctual_learned_[r * punctual_count_ + i] += double(units) / fixed_scale_;
+            changed = true;
+          }
+          if (changed) rebuild(uint32_t(r));
+        }
+      },
+      16);
 }
 
 void EmitterGuidingCache::end_pass(uint32_t samples) {

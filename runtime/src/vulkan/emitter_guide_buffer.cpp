@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "exitance/runtime/core/parallel_chunks.h"
 #include "guide_buffer.h"
 
 namespace exitance::vulkan {
@@ -90,22 +91,34 @@ bool EmitterGuideBuffer::fold_learning(WavefrontBatchRunner& runner, EmitterGuid
   const Buffer& buffer = runner.buffers().probes.sh_sums;
   if (back_end_ > back_) context.download(buffer, &words_[back_], (back_end_ - back_) * 4, (base_ + back_) * 4);
   const size_t punctual_back_at = words_[kEmitterGuidePunctualBack] - base_;
-  for (uint32_t r = 0; r < records_; ++r) {
-    for (uint32_t k = 0; k < patches_; ++k) {
-      const uint32_t* w = &words_[back_ + (size_t(r) * patches_ + k) * kGuideBackWords];
-      if (w[2] != 0) cache.import_learned(r, k, uint64_t(w[0]) | (uint64_t(w[1]) << 32), w[2]);
-    }
-    for (uint32_t i = 0; i < punctual_; ++i) {
-      const uint32_t* w = &words_[punctual_back_at + (size_t(r) * punctual_ + i) * kEmitterGuidePunctualBackWords];
-      if (w[0] != 0 || w[1] != 0) cache.import_learned_punctual(r, i, uint64_t(w[0]) | (uint64_t(w[1]) << 32));
-    }
-  }
+  // Records on all cores (the cache's back tables add atomically; each record's rows are its own).
+  for_each_chunk(
+      records_,
+      [&](size_t first, size_t end) {
+        for (size_t r = first; r < end; ++r) {
+          for (uint32_t k = 0; k < patches_; ++k) {
+            const uint32_t* w = &words_[back_ + (r * patches_ + k) * kGuideBackWords];
+            if (w[2] != 0) cache.import_learned(uint32_t(r), k, uint64_t(w[0]) | (uint64_t(w[1]) << 32), w[2]);
+          }
+          for (uint32_t i = 0; i < punctual_; ++i) {
+            const uint32_t* w = &words_[punctual_back_at + (r * punctual_ + i) * kEmitterGuidePunctualBackWords];
+            if (w[0] != 0 || w[1] != 0) cache.import_learned_punctual(uint32_t(r), i, uint64_t(w[0]) | (uint64_t(w[1]) << 32));
+          }
+        }
+      },
+      16);
   std::fill(words_.begin() + std::ptrdiff_t(back_), words_.end(), 0u);
   cache.end_pass(samples);
+  // The back tables at 0 on the device too, for the next pass.
+  if (back_end_ > back_) {
+    VkCommandBuffer cmd = context.begin();
+    vkCmdFillBuffer(cmd, buffer.handle(), (base_ + back_) * 4, (back_end_ - back_) * 4, 0);
+    context.submit_and_wait(cmd);
+  }
   if (!cache.active()) return false;
   pack_front(cache);
-  // Front and CDFs with the new tables, the back sums at 0 for the next pass (adjacent sections).
-  context.upload(buffer, &words_[front_], (back_end_ - front_) * 4, (base_ + front_) * 4);
+  // Front and CDFs (adjacent sections) with the new tables.
+  context.upload(buffer, &words_[front_], (back_ - front_) * 4, (base_ + front_) * 4);
   return true;
 }
 
