@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "exitance/runtime/core/parallel_chunks.h"
 #include "exitance/runtime/core/scene_access.h"
 #include "exitance/common/guide_learning.h"  // after scene_access.h: path.h reads its accessors
 
@@ -91,25 +92,31 @@ void GridGuidingCache::import_learned(uint32_t record, uint32_t bin, uint64_t fi
 }
 
 void GridGuidingCache::swap() {
-  for (uint32_t r = 0; r < front_.size(); ++r) {
-    bool changed = false;
-    for (uint b = 0; b < kGuideBins; ++b) {
-      const size_t i = size_t(r) * kGuideBins + b;
-      BinAccumulator& a = back_[i];
-      const uint32_t count = a.count.load(std::memory_order_relaxed);
-      weight_[i] *= kCountDecay;
-      if (count == 0) continue;
-      const uint64_t sum = a.sum.load(std::memory_order_relaxed);
-      a.count.store(0, std::memory_order_relaxed);
-      a.sum.store(0, std::memory_order_relaxed);
-      const float mean = float(double(sum) / fixed_scale_ / double(count));
-      const float w = weight_[i] + float(count);
-      radiance_[i] += (mean - radiance_[i]) * (float(count) / w);
-      weight_[i] = w;
-      changed = true;
-    }
-    if (changed) rebuild(r);
-  }
+  // Records are independent (each folds and rebuilds only its own bins): on all cores.
+  for_each_chunk(
+      front_.size(),
+      [&](size_t first, size_t end) {
+        for (size_t r = first; r < end; ++r) {
+          bool changed = false;
+          for (uint b = 0; b < kGuideBins; ++b) {
+            const size_t i = r * kGuideBins + b;
+            BinAccumulator& a = back_[i];
+            const uint32_t count = a.count.load(std::memory_order_relaxed);
+            weight_[i] *= kCountDecay;
+            if (count == 0) continue;
+            const uint64_t sum = a.sum.load(std::memory_order_relaxed);
+            a.count.store(0, std::memory_order_relaxed);
+            a.sum.store(0, std::memory_order_relaxed);
+            const float mean = float(double(sum) / fixed_scale_ / double(count));
+            const float w = weight_[i] + float(count);
+            radiance_[i] += (mean - radiance_[i]) * (float(count) / w);
+            weight_[i] = w;
+            changed = true;
+          }
+          if (changed) rebuild(uint32_t(r));
+        }
+      },
+      64);
 }
 
 void GridGuidingCache::rebuild(uint32_t record) {

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "exitance/runtime/core/parallel_chunks.h"
+
 namespace exitance::vulkan {
 
 uint32_t guide_float_bits(float f) {
@@ -85,16 +87,25 @@ void GuideBuffer::fold_learning(WavefrontBatchRunner& runner, GridGuidingCache& 
   const size_t back_words = back_end_ - back_;
   if (back_words == 0) return;
   context.download(buffer, &words_[back_], back_words * 4, back_ * 4);
-  for (uint32_t r = 0; r < records_; ++r)
-    for (uint32_t b = 0; b < kGuideBins; ++b) {
-      const uint32_t* w = &words_[back_ + (size_t(r) * kGuideBins + b) * kGuideBackWords];
-      if (w[2] != 0) cache.import_learned(r, b, uint64_t(w[0]) | (uint64_t(w[1]) << 32), w[2]);
-    }
+  // Records on all cores (the cache's back table adds atomically; each record's bins are its own).
+  for_each_chunk(
+      records_,
+      [&](size_t first, size_t end) {
+        for (size_t r = first; r < end; ++r)
+          for (uint32_t b = 0; b < kGuideBins; ++b) {
+            const uint32_t* w = &words_[back_ + (r * kGuideBins + b) * kGuideBackWords];
+            if (w[2] != 0) cache.import_learned(uint32_t(r), b, uint64_t(w[0]) | (uint64_t(w[1]) << 32), w[2]);
+          }
+      },
+      64);
   std::fill(words_.begin() + std::ptrdiff_t(back_), words_.begin() + std::ptrdiff_t(back_end_), 0u);
   cache.swap();
   pack_front(cache);
-  // Front and CDFs (adjacent) with the new table, the back sums at 0 for the next pass.
-  context.upload(buffer, &words_[front_], (back_end_ - front_) * 4, front_ * 4);
+  // The back sums at 0 on the device for the next pass; front and CDFs (adjacent) with the new table.
+  VkCommandBuffer cmd = context.begin();
+  vkCmdFillBuffer(cmd, buffer.handle(), back_ * 4, back_words * 4, 0);
+  context.submit_and_wait(cmd);
+  context.upload(buffer, &words_[front_], (back_ - front_) * 4, front_ * 4);
 }
 
 void GuideBuffer::add_auto_sections(const std::vector<uint32_t>& texel_words, uint32_t pilot, uint32_t statistics_from) {
