@@ -312,12 +312,6 @@ int main(int argc, char** argv) {
   // Resolved once the backend and integrator are known (automatic_integrator.h).
   if (guiding == "auto") options.lighting.guiding = exitance::GuidingMode::Auto;
   if (emitter_guiding == "on") {
-    // The Vulkan backend guides path tracing's emitters (its automatic integrator is path tracing).
-    if (options.backend.name == "vulkan" && integrator == "bounces") {
-      std::cerr << "bake: error: --emitter-guiding on with --backend vulkan guides path tracing: it contradicts "
-                   "--integrator bounces (the CPU backend guides both)\n";
-      return 2;
-    }
     if (options.backend.name == "vulkan" && guiding == "svo") {
       std::cerr << "bake: error: --emitter-guiding on with --backend vulkan: --guiding svo beside it runs on the CPU "
                    "backend only (use --guiding grid or --backend cpu)\n";

@@ -115,7 +115,8 @@ BounceHit shade_bounce_hit(uint p, uint work, uint state, vec4 hit, vec3 wi, vec
     direct_only.max_bounces = 0;
     direct_only.rr_start = params.rr_start;
     direct_only.safety_cap = params.safety_cap;
-    HitResult h = shade_continuation_hit(tri, hit.x, hit.z, hit.w, wi, tp.w, throughput, 0, direct_only, rng);
+    // Emitter guiding: the MIS weight reads the density of the mixture the direct sample's vertex used.
+    HitResult h = shade_continuation_hit(tri, hit.x, hit.z, hit.w, wi, tp.w, throughput, 0, direct_only, emitter_guide_of_path(p), rng);
     if (h.radiance != vec3(0.0)) add_result(work, 0u, h.radiance);
     return r;
   }

@@ -39,7 +39,6 @@ TEST(BakeGuidingOptions, ContradictionsAreOneLineAndExit2) {
       {"--guiding svo --voxel-resolution none", "--guiding svo builds its fields from the voxel octree"},
       {"--guiding svo --integrator bounces", "--guiding svo guides path tracing"},
       {"--guiding grid --integrator bounces", "--guiding grid guides path tracing"},
-      {"--emitter-guiding on --backend vulkan --integrator bounces", "--emitter-guiding on with --backend vulkan guides path tracing"},
       {"--emitter-guiding on --backend vulkan --guiding svo", "--guiding svo beside it runs on the CPU backend only"},
       // Not guiding, but refused the same way (docs/bundle.md "Light layers").
       {"--light-layers --integrator bounces", "--light-layers are kept by path tracing: they need --integrator path"},

@@ -210,9 +210,12 @@ class CpuBounceLayerEstimator final : public BounceLayerEstimator {
     });
   }
 
-  // What emitter guiding's cache held at the end (nothing when it was off).
+  // What emitter guiding's cache held at the end (nothing when it was off), and settings'
+  // inspect_emitter_guiding called with it.
   void report(LightmapEstimate::EmitterGuidingReport& out) const {
-    if (emitter_guide_) emitter_guide_->report(out);
+    if (!emitter_guide_) return;
+    emitter_guide_->report(out);
+    if (settings_.inspect_emitter_guiding) settings_.inspect_emitter_guiding(*emitter_guide_);
   }
 
   BounceGatherCounts counts() const override {

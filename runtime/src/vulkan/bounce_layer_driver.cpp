@@ -23,9 +23,26 @@ float word_bits(uint32_t u) {
 
 }  // namespace
 
+BounceLayerDriver::~BounceLayerDriver() = default;
+
+void BounceLayerDriver::report(LightmapEstimate::EmitterGuidingReport& out) const {
+  if (!emitter_guide_) return;
+  emitter_guide_->report(out);
+  if (settings_.inspect_emitter_guiding) settings_.inspect_emitter_guiding(*emitter_guide_);
+}
+
 BounceLayerDriver::BounceLayerDriver(WavefrontBatchRunner& runner, std::shared_ptr<const Scene> source,
-                                     const TexelGBuffer& gbuffer, const IntegratorSettings& settings)
+                                     const TexelGBuffer& gbuffer, const IntegratorSettings& settings,
+                                     std::shared_ptr<const LightingScene> lighting)
     : runner_(runner), source_(std::move(source)), gbuffer_(gbuffer), settings_(settings) {
+  if (settings.emitter_guiding) {
+    if (!lighting) throw std::logic_error("Vulkan backend: emitter guiding in the per-bounce mode without the integrator's scene");
+    if (lighting->emitter_triangles != runner_.scene().emitter_triangles() ||
+        lighting->punctual_count() != runner_.scene().punctual_count())
+      throw std::invalid_argument("Vulkan backend: --emitter-guiding on: the device's scene was edited since the integrator was made; "
+                                  "emitter guiding bakes the scene it was made on");
+    emitter_guide_ = EmitterGuidingCache::for_bake(*lighting, gbuffer, settings);
+  }
   // The tables the lookup reads (bounce_pass.glsl bounce_cache_lookup), as BounceLayerCache::lookup
   // reads them on the CPU: each triangle's instance and lightmap UVs, each instance's rectangle.
   const size_t triangles = source_ && source_->triangle_instance.size() * 3 <= source_->lightmap_uv.size()
@@ -35,6 +52,10 @@ BounceLayerDriver::BounceLayerDriver(WavefrontBatchRunner& runner, std::shared_p
   const size_t instance_table = triangle_table + triangles * kBounceCacheTriangleWords;
   const size_t page_table = instance_table + instances * kBounceCacheInstanceWords;
   first_layer_word_ = page_table + pages * kBounceCachePageWords;
+  if (emitter_guide_) {  // emitter guiding's section between the tables and the layers: it never moves
+    emitter_buffer_ = std::make_unique<EmitterGuideBuffer>(*emitter_guide_, first_layer_word_);
+    first_layer_word_ = emitter_buffer_->end_word();
+  }
   size_t page_texels = 0;
   for (const AtlasPage& page : gbuffer_.pages) page_texels += size_t(page.width) * size_t(page.height);
   layer_words_ = page_texels * kBounceCacheTexelWords;
@@ -121,7 +142,18 @@ void BounceLayerDriver::upload_caches(size_t layers, const std::vector<BounceLay
                      (first_layer_word_ + k * layer_words_) * 4);
     uploaded_versions_[k] = versions[k];
   }
-  if (whole) context.upload(buffers.probes.sh_sums, cache_words_.data(), words * 4);
+  if (whole) {
+    context.upload(buffers.probes.sh_sums, cache_words_.data(), words * 4);
+    upload_emitter_section();
+  }
+}
+
+// Emitter guiding's section (its front tables as the cache holds them, back tables at 0) and the
+// path state's room for what a vertex learns, after a whole upload of the cache buffer.
+void BounceLayerDriver::upload_emitter_section() {
+  if (!emitter_buffer_) return;
+  if (runner_.buffers().paths.reserve_emitter_learning(runner_.context())) runner_.bind_buffers();
+  emitter_buffer_->upload(runner_);
 }
 
 void BounceLayerDriver::reserve_device_layers(size_t layers) {
@@ -138,6 +170,7 @@ void BounceLayerDriver::reserve_device_layers(size_t layers) {
       runner_.bind_buffers();
     }
     context.upload(buffers.probes.sh_sums, cache_words_.data(), first_layer_word_ * 4);
+    upload_emitter_section();
     tables_uploaded_ = true;
     return;
   }
@@ -244,10 +277,18 @@ void BounceLayerDriver::estimate(const BounceLayerPass& pass, const std::vector<
   if (!prepared_) prepare();
   Context& context = runner_.context();
   WavefrontBuffers& buffers = runner_.buffers();
+  // Emitter guiding: the previous passes' learning becomes this pass's front table (as the CPU's
+  // estimator), before any whole upload of the cache buffer could clear its back tables.
+  if (emitter_guide_ && learned_samples_ > 0 && emitter_guide_->active())
+    emitter_buffer_->fold_learning(runner_, *emitter_guide_, learned_samples_);
   if (builds_caches())
     reserve_device_layers(size_t(pass.layer));  // the layers below pass.layer were built there
   else
     upload_caches(size_t(pass.layer), caches, cache_versions);
+  if (emitter_guide_) {
+    learned_samples_ = std::max(learned_samples_, pass.first_sample + pass.samples);
+    params_.emitter_guide = emitter_guide_->active() ? emitter_buffer_->params_offset() : 0u;
+  }
   if (uint64_t(pass.first_sample) + pass.samples > std::numeric_limits<uint32_t>::max())
     throw std::invalid_argument("Vulkan backend: more than 2^32 - 1 samples per texel");
   const size_t texels = gbuffer_.texels.size();

@@ -9,9 +9,11 @@
 #include <memory>
 #include <vector>
 
+#include "exitance/runtime/core/emitter_guiding_cache.h"
 #include "exitance/runtime/core/per_bounce_bake.h"
 #include "exitance/runtime/scene.h"
 #include "compute_kernel.h"
+#include "emitter_guide_buffer.h"
 #include "wavefront_batch.h"
 
 namespace exitance::vulkan {
@@ -20,8 +22,14 @@ class BounceLayerDriver final : public BounceLayerEstimator {
  public:
   // `source`: the scene's triangles' instances and lightmap UVs (may be null: every gather hit is
   // then estimated on the fly).
+  // `lighting`: the scene the device holds, for emitter guiding's cache (settings.emitter_guiding;
+  // may be null otherwise).
   BounceLayerDriver(WavefrontBatchRunner& runner, std::shared_ptr<const Scene> source, const TexelGBuffer& gbuffer,
-                    const IntegratorSettings& settings);
+                    const IntegratorSettings& settings, std::shared_ptr<const LightingScene> lighting = nullptr);
+  ~BounceLayerDriver() override;
+  // What emitter guiding's cache held at the end (nothing when it was off), and settings'
+  // inspect_emitter_guiding called with it.
+  void report(LightmapEstimate::EmitterGuidingReport& out) const;
 
   void estimate(const BounceLayerPass& pass, const std::vector<BounceLayerCache>& caches,
                 const std::vector<uint64_t>& cache_versions) override;
@@ -37,6 +45,7 @@ class BounceLayerDriver final : public BounceLayerEstimator {
   // The cache buffer with room for `layers` layers, its header and tables on the device; when it
   // grows, what it held (the layers built so far) is copied into the larger one.
   void reserve_device_layers(size_t layers);
+  void upload_emitter_section();
 
   WavefrontBatchRunner& runner_;
   std::shared_ptr<const Scene> source_;
@@ -54,6 +63,12 @@ class BounceLayerDriver final : public BounceLayerEstimator {
   std::vector<uint32_t> work_list_;
   // Device-built caches (bounce_cache.comp): the kernel, per live texel its page texel, position and
   // normal (uploaded once), the means of the layer being built, a fill flag per page texel, the pages.
+  // Emitter guiding (emitter_guide_buffer.h) on the direct-light samples (B_0's, and B_1's traced
+  // ones at gather hits), one cache through all layers' passes, folded before each pass as the CPU's
+  // estimator does (cpu/cpu_bounce_integrator.cpp).
+  std::unique_ptr<EmitterGuidingCache> emitter_guide_;
+  std::unique_ptr<EmitterGuideBuffer> emitter_buffer_;
+  uint32_t learned_samples_ = 0;
   std::unique_ptr<ComputeKernel> cache_kernel_;
   Buffer cache_texels_, cache_means_, cache_flags_, cache_pages_;
   size_t page_texels_ = 0;

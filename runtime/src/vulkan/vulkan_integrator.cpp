@@ -112,13 +112,12 @@ LightmapEstimate VulkanIntegrator::bake(const TexelGBuffer& gbuffer, const Integ
       throw std::invalid_argument("Vulkan backend: --directional sh1 applies to path tracing, not to --integrator bounces");
     if (settings.guiding != GuidingMode::Off)
       throw std::invalid_argument("Vulkan backend: guiding applies to path tracing, not to --integrator bounces");
-    if (settings.emitter_guiding)
-      throw std::invalid_argument("Vulkan backend: --emitter-guiding on applies to path tracing here (--integrator path); "
-                                  "the per-bounce mode guides its emitters on the CPU backend only");
     impl_->lightmap.end_progressive();  // the texel buffers are this bake's now
     impl_->runner.statistics().clear();
-    vulkan::BounceLayerDriver layers(impl_->runner, impl_->source, gbuffer, settings);
-    return bake_per_bounce(gbuffer, settings, layers);
+    vulkan::BounceLayerDriver layers(impl_->runner, impl_->source, gbuffer, settings, impl_->created_on);
+    LightmapEstimate estimate = bake_per_bounce(gbuffer, settings, layers);
+    layers.report(estimate.emitter_guiding);
+    return estimate;
   }
   return impl_->lightmap.bake(gbuffer, settings);
 }
