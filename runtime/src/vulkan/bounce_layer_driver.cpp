@@ -8,6 +8,7 @@
 #include <string>
 
 #include "exitance_spirv/bounce_cache.h"
+#include "guide_buffer.h"
 
 namespace exitance::vulkan {
 namespace {
@@ -205,11 +206,6 @@ void BounceLayerDriver::build_cache(size_t layer, const std::vector<Vec3>& means
     }
     page_texels_ = first.back();
     std::vector<uint32_t> words(std::max<size_t>(texels, 1) * 8, 0xFFFFFFFFu);
-    auto bits = [](float f) {
-      uint32_t u;
-      std::memcpy(&u, &f, 4);
-      return u;
-    };
     for (size_t i = 0; i < texels; ++i) {
       const LiveTexel& t = gbuffer_.texels[i];
       uint32_t* w = &words[i * 8];
@@ -218,7 +214,7 @@ void BounceLayerDriver::build_cache(size_t layer, const std::vector<Vec3>& means
       w[0] = on_page ? first[t.page] + t.y * uint32_t(gbuffer_.pages[t.page].width) + t.x : 0xFFFFFFFFu;
       const float values[6] = {t.position.x, t.position.y, t.position.z, t.geometric_normal.x, t.geometric_normal.y,
                                t.geometric_normal.z};
-      for (int c = 0; c < 6; ++c) w[1 + c] = bits(values[c]);
+      for (int c = 0; c < 6; ++c) w[1 + c] = guide_float_bits(values[c]);
       w[7] = 0;
     }
     if (page_words.empty()) page_words.assign(4, 0u);
