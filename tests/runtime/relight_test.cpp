@@ -258,7 +258,8 @@ TEST(Relight, ReproducesAVulkanGuidedBakeBitForBit) {
 
 // Emitter guiding (--emitter-guiding on): a bundle baked emitter-guided on the Vulkan backend is
 // relit emitter-guided from scene.bin bit for bit (the same cache, passes, folds and seed); the
-// report says what the cache held; refused with --frames (not progressive) and with --guiding.
+// report says what the cache held; refused with --frames (not progressive), with --guiding and an
+// unknown value; after an edit that makes a material emissive, the cache is made for the edited emitters.
 TEST(Relight, ReproducesAVulkanEmitterGuidedBakeBitForBit) {
   if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
   const fs::path dir = fs::temp_directory_path() / ("exitance-relight-emitter-" + std::to_string(::getpid()));
@@ -310,6 +311,18 @@ TEST(Relight, ReproducesAVulkanEmitterGuidedBakeBitForBit) {
   options.emitter_guiding = "sometimes";
   EXPECT_THROW(relight_bundle(options), RelightInputError);
   EXPECT_FALSE(fs::exists(dir / "refused.bake"));
+  // After an edit that makes a material emissive, the guide is made for the edited emitters (the
+  // session edits its lighting scene in place, which the device and the cache both follow).
+  const fs::path edits = dir / "glow.json";
+  std::ofstream(edits) << R"({"edits": [{"material": "Wood", "emissiveFactor": [0.5, 0.4, 0.3]}]})";
+  options.emitter_guiding = "on";
+  options.edits_file = edits.string();
+  options.output = (dir / "glowing.bake").string();
+  const nlohmann::json glowing = relight_bundle(options);
+  ASSERT_TRUE(glowing.contains("emitter_guiding")) << glowing.dump();
+  EXPECT_GT(glowing["emitter_guiding"]["records_sampling_learned"].get<uint32_t>(), 0u);
+  EXPECT_NE(glowing["emitter_guiding"]["patches"], report["emitter_guiding"]["patches"]) << "patches of the edited emitters";
+  EXPECT_EQ(glowing["nonfinite_samples"].get<uint64_t>(), 0u);
   fs::remove_all(dir);
 }
 

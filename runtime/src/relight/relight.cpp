@@ -178,7 +178,13 @@ json relight_bundle(const RelightOptions& options) {
   json emitter_guiding_report;
   if (emitter_guided) {
     report("lighting", 0, 0);
-    const LightmapEstimate& e = session->bake_path(spp, options.time_budget_seconds, nullptr, true);
+    const LightmapEstimate* run = nullptr;
+    try {
+      run = &session->bake_path(spp, options.time_budget_seconds, nullptr, true);
+    } catch (const std::invalid_argument& e) {  // e.g. the edits changed the emitters the guide was made for
+      throw RelightInputError(options.bundle + ": " + e.what());
+    }
+    const LightmapEstimate& e = *run;
     rays = e.rays;
     const LightmapEstimate::EmitterGuidingReport& g = e.emitter_guiding;
     emitter_guiding_report = {{"records", g.records}, {"records_sampling_learned", g.records_sampling_learned},
