@@ -3,8 +3,11 @@
 # `cmake --install BUILD --component runtime`, with build/bench/bench_bundle_rel_mse copied into rt/bin,
 # and cornell.bake, building.bake, city.bake: manifest, probes.bin, scene.bin, svo.bin of CPU bakes).
 # Per scene: a two-seed 4096-spp path-traced reference, then path at 64/256/1024 spp and the
-# per-bounce mode at 16/64/256 spp, timed, and each one's relMSE against the reference.
-#   bash .replay/per_bounce_gpu_run.sh
+# per-bounce mode at 16/64/256 spp, timed, and each one's relMSE against the reference. With
+# CACHES="device host" the per-bounce runs are repeated with their layer caches built on the host
+# (exitance-relight --bounce-caches host, the earlier path; the same results bit for bit): the A/B of
+# building them on the device (docs/lighting-core.md "Per-bounce mode").
+#   bash .replay/per_bounce_gpu_run.sh        (env SCENES, CACHES)
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
 export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
@@ -24,10 +27,13 @@ for scene in ${SCENES:-cornell building city}; do
     echo "$scene path $spp spp: lighting $(field lighting_seconds /tmp/w/r.json) s, rays $(field rays /tmp/w/r.json)"
     tests="$tests /tmp/w/$scene-path$spp.bake"
   done
-  for spp in 16 64 256; do
-    $R $B -o /tmp/w/$scene-bounces$spp.bake --spp $spp --seed 1 --integrator bounces --json > /tmp/w/r.json
-    echo "$scene bounces $spp spp: lighting $(field lighting_seconds /tmp/w/r.json) s, rays $(field rays /tmp/w/r.json)"
-    tests="$tests /tmp/w/$scene-bounces$spp.bake"
+  for caches in ${CACHES:-device}; do
+    for spp in 16 64 256; do
+      $R $B -o /tmp/w/$scene-bounces$spp-$caches.bake --spp $spp --seed 1 --integrator bounces --bounce-caches $caches \
+        --json > /tmp/w/r.json
+      echo "$scene bounces ($caches caches) $spp spp: lighting $(field lighting_seconds /tmp/w/r.json) s, rays $(field rays /tmp/w/r.json)"
+      tests="$tests /tmp/w/$scene-bounces$spp-$caches.bake"
+    done
   done
   echo "$scene reference: $(field lighting_seconds /tmp/w/refA.json) s per 4096-spp run"
   LD_LIBRARY_PATH=/tmp/w/rt/lib /tmp/w/rt/bin/bench_bundle_rel_mse /tmp/w/$scene-refA.bake /tmp/w/$scene-refB.bake $tests | sed "s#/tmp/w/##"
