@@ -46,20 +46,8 @@ EmitterGuideBuffer::EmitterGuideBuffer(const EmitterGuidingCache& cache, size_t 
   words_[kEmitterGuidePunctualCdf] = absolute(punctual_cdf_at);
   words_[kEmitterGuideBack] = absolute(back_);
   words_[kEmitterGuidePunctualBack] = absolute(punctual_back_at);
-  const double units = cache.fixed_units();
-  uint64_t units_bits;
-  std::memcpy(&units_bits, &units, 8);
-  words_[kEmitterGuideFixedUnits] = uint32_t(units_bits);
-  words_[kEmitterGuideFixedUnits + 1] = uint32_t(units_bits >> 32);
-  words_[kEmitterGuideFixedCap] = guide_float_bits(cache.fixed_cap());
-  // The locator: kGuideLocatorGrid's words (guide.glsl guide_grid_record_at).
-  const Vec3 origin = locator.origin();
-  for (int a = 0; a < 3; ++a) {
-    words_[locator_at + size_t(a)] = guide_float_bits(origin[a]);
-    words_[locator_at + 4 + size_t(a)] = uint32_t(locator.cells(a));
-  }
-  words_[locator_at + 3] = guide_float_bits(locator.cell_size());
-  std::copy(locator.record_index().begin(), locator.record_index().end(), words_.begin() + std::ptrdiff_t(locator_at + kGuideGridWords));
+  pack_fixed_point(cache.fixed_units(), cache.fixed_cap(), &words_[kEmitterGuideFixedUnits]);
+  pack_grid_locator(locator, &words_[locator_at]);
   std::copy(patches.emitter_patch.begin(), patches.emitter_patch.end(), words_.begin() + std::ptrdiff_t(emitter_patch_at));
   std::copy(patches.patch_emitters.begin(), patches.patch_emitters.end(), words_.begin() + std::ptrdiff_t(patch_emitters_at));
   std::copy(triangle_emitter.begin(), triangle_emitter.end(), words_.begin() + std::ptrdiff_t(triangle_emitter_at));

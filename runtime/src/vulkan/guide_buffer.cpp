@@ -15,6 +15,28 @@ uint32_t guide_float_bits(float f) {
   return u;
 }
 
+static_assert(kGuideFixedCap == kGuideFixedUnits + 2 && kEmitterGuideFixedCap == kEmitterGuideFixedUnits + 2,
+              "pack_fixed_point writes the scale's two words, then the cap");
+
+void pack_grid_locator(const GuideGridLocator& locator, uint32_t* out) {
+  const Vec3 origin = locator.origin();
+  for (int a = 0; a < 3; ++a) {
+    out[a] = guide_float_bits(origin[a]);
+    out[4 + a] = uint32_t(locator.cells(a));
+  }
+  out[3] = guide_float_bits(locator.cell_size());
+  out[7] = 0;
+  std::copy(locator.record_index().begin(), locator.record_index().end(), out + kGuideGridWords);
+}
+
+void pack_fixed_point(double units, float cap, uint32_t* out) {
+  uint64_t units_bits;
+  std::memcpy(&units_bits, &units, 8);
+  out[0] = uint32_t(units_bits);
+  out[1] = uint32_t(units_bits >> 32);
+  out[2] = guide_float_bits(cap);
+}
+
 void upload_guide_words(WavefrontBatchRunner& runner, const std::vector<uint32_t>& words, const char* mode,
                         const char* remedy) {
   Context& context = runner.context();
@@ -49,19 +71,8 @@ GuideBuffer::GuideBuffer(const GridGuidingCache& cache) : records_(cache.record_
   words_[kGuideFrontOffset] = uint32_t(front_);
   words_[kGuideCdfOffset] = uint32_t(cdf_);
   words_[kGuideBackOffset] = uint32_t(back_);
-  const double units = cache.fixed_units();
-  uint64_t units_bits;
-  std::memcpy(&units_bits, &units, 8);
-  words_[kGuideFixedUnits] = uint32_t(units_bits);
-  words_[kGuideFixedUnits + 1] = uint32_t(units_bits >> 32);
-  words_[kGuideFixedCap] = guide_float_bits(cache.fixed_cap());
-  const Vec3 origin = cache.grid_origin();
-  for (int a = 0; a < 3; ++a) {
-    words_[locator + size_t(a)] = guide_float_bits(origin[a]);
-    words_[locator + 4 + size_t(a)] = uint32_t(cache.cells(a));
-  }
-  words_[locator + 3] = guide_float_bits(cache.cell_size());
-  std::memcpy(&words_[locator + kGuideGridWords], index.data(), index.size() * 4);
+  pack_fixed_point(cache.fixed_units(), cache.fixed_cap(), &words_[kGuideFixedUnits]);
+  pack_grid_locator(cache.locator(), &words_[locator]);
   pack_front(cache);
 }
 

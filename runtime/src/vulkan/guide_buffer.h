@@ -15,6 +15,13 @@ namespace exitance::vulkan {
 
 // A float's bits as one guide-buffer word.
 uint32_t guide_float_bits(float f);
+// A grid locator as kGuideLocatorGrid's words from `out` (kGuideGridWords: origin, cell size, cells;
+// then per (cell, normal class) its record): what guide.glsl guide_grid_record_at reads, for grid
+// guiding's section and emitter guiding's.
+void pack_grid_locator(const GuideGridLocator& locator, uint32_t* out);
+// common/guide_learning.h guide_fixed_point's scale (a double as lo, hi words) and target cap: the
+// three words from `out` (kGuideFixedUnits, kGuideFixedCap; kEmitterGuideFixedUnits, kEmitterGuideFixedCap).
+void pack_fixed_point(double units, float cap, uint32_t* out);
 // Every guide layout's words onto the device, in the guide binding (the probe SH sums' buffer, grown
 // and rebound when too small). `mode` and `remedy` complete the error when the device's largest
 // storage buffer is too small.

@@ -102,6 +102,7 @@ class GridGuidingCache {
 
   // The locator and the front table as a device copies them (runtime/src/vulkan/guide_buffer.cpp).
   Vec3 grid_origin() const { return locator_.origin(); }
+  const GuideGridLocator& locator() const { return locator_; }
   // Per (cell, class), cell (z * cells(1) + y) * cells(0) + x: its record or kNoRecord.
   const std::vector<uint32_t>& record_index() const { return locator_.record_index(); }
   double fixed_units() const { return fixed_scale_; }  // fixed-point units per unit of radiance
