@@ -32,6 +32,7 @@
 #include "support/identical_estimates.h"
 #include "support/independent_estimates.h"
 #include "support/region_and_furnace_checks.h"
+#include "support/region_runs.h"
 
 namespace exitance {
 namespace {
@@ -325,7 +326,7 @@ TEST(EmitterGuiding, BitIdenticalPerSeedAndThreadCount) {
 TEST(EmitterGuiding, PerBounceLayersAgreeWithUnguided) {
   const testing::AtlasScene box = testing::box_with_lights_outside();
   const CpuReferenceIntegrator integrator(box.scene);
-  std::map<uint32_t, std::vector<double>> guided[2], unguided[2];
+  testing::RegionRuns guided[2], unguided[2];
   for (int seed = 0; seed < kSeeds; ++seed) {
     for (bool on : {true, false}) {
       IntegratorSettings s = settings(256, uint64_t(seed) + (on ? 0 : 1000), on);
@@ -336,11 +337,7 @@ TEST(EmitterGuiding, PerBounceLayersAgreeWithUnguided) {
       if (on) {
         EXPECT_GT(e.emitter_guiding.records_sampling_learned, 0u);
       }
-      for (int layer = 0; layer < 2; ++layer) {
-        std::vector<double> texel(box.gbuffer.texels.size());
-        for (size_t i = 0; i < texel.size(); ++i) texel[i] = luminance(e.mean_bounce(layer, i));
-        for (auto& [region, m] : testing::region_means(box.gbuffer, texel)) (on ? guided : unguided)[layer][region].push_back(m);
-      }
+      for (int layer = 0; layer < 2; ++layer) testing::add_layer_regions(box.gbuffer, e, layer, (on ? guided : unguided)[layer]);
     }
   }
   for (int layer = 0; layer < 2; ++layer) {

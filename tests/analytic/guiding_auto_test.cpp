@@ -23,6 +23,7 @@
 #include "support/atlas_box.h"
 #include "support/identical_estimates.h"
 #include "support/independent_estimates.h"
+#include "support/prepared_sample.h"
 #include "support/region_and_furnace_checks.h"
 
 namespace exitance {
@@ -38,13 +39,6 @@ IntegratorSettings settings(uint32_t spp, uint64_t seed, GuidingMode guiding) {
   s.seed = seed;
   s.guiding = guiding;
   return s;
-}
-
-PreparedScene sample_scene(const char* name, float density) {
-  AtlasSettings atlas;
-  atlas.texel_density = density;
-  Diagnostics diagnostics;
-  return prepare_scene_for_lighting(std::string(EXITANCE_SAMPLE_DIR "/") + name + ".gltf", "", atlas, diagnostics);
 }
 
 // Auto against unguided, per region (instance), over kSeeds seeds each. Returns the median over
@@ -83,13 +77,13 @@ double expect_auto_agrees(const std::string& label, const PreparedScene& p, uint
 }
 
 TEST(GuidingAuto, CornellRoomAgreesWithUnguided) {
-  const PreparedScene p = sample_scene("cornell_room", 2);
+  const PreparedScene p = testing::prepared_sample("cornell_room", 2);
   const double se = expect_auto_agrees("cornell_room", p, 64);
   EXPECT_LT(kZLimit * se, kDetectableBias) << "the test could not see a 10 % bias";
 }
 
 TEST(GuidingAuto, AjarRoomAgreesWithUnguided) {
-  const PreparedScene p = sample_scene("ajar_room", 4);
+  const PreparedScene p = testing::prepared_sample("ajar_room", 4);
   const double se = expect_auto_agrees("ajar_room", p, 64);
   EXPECT_LT(kZLimit * se, kDetectableBias) << "the test could not see a 10 % bias";
 }
@@ -105,7 +99,7 @@ bool identical(const LightmapEstimate& a, const LightmapEstimate& b) {
 }
 
 TEST(GuidingAuto, ChoiceAndResultBitIdenticalPerSeedAndThreadCount) {
-  const PreparedScene p = sample_scene("ajar_room", 4);
+  const PreparedScene p = testing::prepared_sample("ajar_room", 4);
   const CpuReferenceIntegrator integrator(p.scene);
   const LightmapEstimate a = integrator.bake(p.gbuffer, settings(96, 7, GuidingMode::Auto));
   ASSERT_FALSE(a.guiding_regions.empty()) << "96 spp: the pilot (16) ends within the bake";

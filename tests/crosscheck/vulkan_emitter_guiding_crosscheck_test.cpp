@@ -24,6 +24,7 @@
 #include "support/box_with_lights_outside.h"
 #include "support/identical_estimates.h"
 #include "support/independent_estimates.h"
+#include "support/prepared_sample.h"
 #include "support/region_and_furnace_checks.h"
 #include "support/region_runs.h"
 #include "support/validated_vulkan_backend.h"
@@ -41,13 +42,6 @@ IntegratorSettings settings(uint32_t spp, uint64_t seed, bool emitter_guiding) {
   s.seed = seed;
   s.emitter_guiding = emitter_guiding;
   return s;
-}
-
-PreparedScene sample_scene(const char* name, float density) {
-  AtlasSettings atlas;
-  atlas.texel_density = density;
-  Diagnostics diagnostics;
-  return prepare_scene_for_lighting(std::string(EXITANCE_SAMPLE_DIR "/") + name + ".gltf", "", atlas, diagnostics);
 }
 
 // Per record the probabilities its learned distributions give the patches, then the punctual lights
@@ -75,31 +69,33 @@ double table_distance(const std::vector<std::vector<float>>& a, const std::vecto
 // rounding moves a value by a unit or sends a ray elsewhere. The tolerance is relative to the
 // tables' own noise, the distance between the CPU's tables of two seeds: a device that learned at
 // other vertices, other patches or other values would be about as far as that.
-TEST(VulkanEmitterGuiding, DeviceLearnsTheCpuTables) {
+// On the box, with settings `s` (its seed for both backends; the CPU's with seed + 1 for the noise).
+void expect_device_learns_the_cpu_tables(const std::string& label, IntegratorSettings s) {
   const testing::AtlasScene box = testing::box_with_lights_outside();
   CREATE_VULKAN_OR_SKIP(vk, box.scene);
   const CpuReferenceIntegrator cpu(box.scene);
   std::vector<std::vector<float>> device, host, other_seed;
-  IntegratorSettings s = settings(64, 5, true);
   s.inspect_emitter_guiding = [&](const EmitterGuidingCache& c) { device = learned_tables(c); };
   const LightmapEstimate d = vk->bake(box.gbuffer, s);
   s.inspect_emitter_guiding = [&](const EmitterGuidingCache& c) { host = learned_tables(c); };
   const LightmapEstimate h = cpu.bake(box.gbuffer, s);
-  s.seed = 6;
+  s.seed += 1;
   s.inspect_emitter_guiding = [&](const EmitterGuidingCache& c) { other_seed = learned_tables(c); };
   cpu.bake(box.gbuffer, s);
   ASSERT_EQ(device.size(), host.size());
   ASSERT_GT(device.size(), 0u);
   const double same = table_distance(device, host), noise = table_distance(host, other_seed);
-  std::printf("[vulkan emitter guided] tables: device vs CPU, one seed %.3g; CPU vs CPU, two seeds %.3g; records "
+  std::printf("[vulkan emitter guided] %s tables: device vs CPU, one seed %.3g; CPU vs CPU, two seeds %.3g; records "
               "sampling learned: device %u, CPU %u of %u\n",
-              same, noise, d.emitter_guiding.records_sampling_learned, h.emitter_guiding.records_sampling_learned,
-              d.emitter_guiding.records);
+              label.c_str(), same, noise, d.emitter_guiding.records_sampling_learned,
+              h.emitter_guiding.records_sampling_learned, d.emitter_guiding.records);
   EXPECT_GT(noise, 0.0);
   EXPECT_LE(same, 0.05 * noise);
   EXPECT_GT(d.emitter_guiding.records_sampling_learned, d.emitter_guiding.records / 2) << "guiding must engage";
   EXPECT_EQ(d.emitter_guiding.records_sampling_learned, h.emitter_guiding.records_sampling_learned);
 }
+
+TEST(VulkanEmitterGuiding, DeviceLearnsTheCpuTables) { expect_device_learns_the_cpu_tables("path", settings(64, 5, true)); }
 
 // The texels' luminance variance across runs, summed, over their squared means, summed: texels in
 // the dark (mostly 0, once in a while a little light) weigh by their light, not by 1/mean^2.
@@ -180,7 +176,7 @@ TEST(VulkanEmitterGuiding, BoxWithLightsOutsideAgreesAndLowersTheVariance) {
 }
 
 TEST(VulkanEmitterGuiding, BuildingAgreesAndLowersTheVariance) {
-  const PreparedScene p = sample_scene("building", 0.5f);
+  const PreparedScene p = testing::prepared_sample("building", 0.5f);
   double ratio = 0;
   expect_guided_agrees("building", p.scene, p.gbuffer, 64, false, ratio);
   // Measured 0.36; the CPU's relMSE at equal samples is 3.3x lower at 64 spp (bench/results/emitter-guiding.md).
@@ -191,7 +187,7 @@ TEST(VulkanEmitterGuiding, BuildingAgreesAndLowersTheVariance) {
 
 // Integer sums on the device and in the fold: the same seed gives the same tables and lightmap.
 TEST(VulkanEmitterGuiding, BitIdenticalPerSeed) {
-  const PreparedScene p = sample_scene("building", 0.5f);
+  const PreparedScene p = testing::prepared_sample("building", 0.5f);
   CREATE_VULKAN_OR_SKIP(vk, p.scene);
   std::vector<std::vector<std::vector<float>>> tables;
   IntegratorSettings s = settings(24, 7, true);
@@ -209,30 +205,10 @@ TEST(VulkanEmitterGuiding, BitIdenticalPerSeed) {
 // hits) with one cache through all layers' passes, folded before each pass, as the CPU's estimator
 // does: with one seed the device learns the CPU's tables (the same tolerance as in path mode).
 TEST(VulkanEmitterGuiding, PerBounceDeviceLearnsTheCpuTables) {
-  const testing::AtlasScene box = testing::box_with_lights_outside();
-  CREATE_VULKAN_OR_SKIP(vk, box.scene);
-  const CpuReferenceIntegrator cpu(box.scene);
-  std::vector<std::vector<float>> device, host, other_seed;
   IntegratorSettings s = settings(16, 5, true);
   s.integrator = IntegratorMode::Bounces;
   s.max_bounces = 2;
-  s.inspect_emitter_guiding = [&](const EmitterGuidingCache& c) { device = learned_tables(c); };
-  const LightmapEstimate d = vk->bake(box.gbuffer, s);
-  s.inspect_emitter_guiding = [&](const EmitterGuidingCache& c) { host = learned_tables(c); };
-  const LightmapEstimate h = cpu.bake(box.gbuffer, s);
-  s.seed = 6;
-  s.inspect_emitter_guiding = [&](const EmitterGuidingCache& c) { other_seed = learned_tables(c); };
-  cpu.bake(box.gbuffer, s);
-  ASSERT_EQ(device.size(), host.size());
-  ASSERT_GT(device.size(), 0u);
-  const double same = table_distance(device, host), noise = table_distance(host, other_seed);
-  std::printf("[vulkan emitter guided] per-bounce tables: device vs CPU, one seed %.3g; CPU vs CPU, two seeds %.3g; "
-              "records sampling learned: device %u, CPU %u of %u\n",
-              same, noise, d.emitter_guiding.records_sampling_learned, h.emitter_guiding.records_sampling_learned,
-              d.emitter_guiding.records);
-  EXPECT_GT(noise, 0.0);
-  EXPECT_LE(same, 0.05 * noise);
-  EXPECT_GT(d.emitter_guiding.records_sampling_learned, 0u) << "guiding must engage";
+  expect_device_learns_the_cpu_tables("per-bounce", s);
 }
 
 // Per region, the guided per-bounce layers B_0 and B_1 agree with the unguided ones (both layers are
@@ -251,11 +227,7 @@ TEST(VulkanEmitterGuiding, PerBounceLayersAgreeWithUnguided) {
       if (on) {
         EXPECT_GT(e.emitter_guiding.records_sampling_learned, 0u);
       }
-      for (int layer = 0; layer < 2; ++layer) {
-        std::vector<double> texel(box.gbuffer.texels.size());
-        for (size_t i = 0; i < texel.size(); ++i) texel[i] = luminance(e.mean_bounce(layer, i));
-        for (const auto& [region, m] : testing::region_means(box.gbuffer, texel)) (on ? guided : unguided)[layer][region].push_back(m);
-      }
+      for (int layer = 0; layer < 2; ++layer) testing::add_layer_regions(box.gbuffer, e, layer, (on ? guided : unguided)[layer]);
     }
   for (int layer = 0; layer < 2; ++layer) {
     const double se = testing::expect_regions_agree("vulkan emitter guided", "per-bounce B_" + std::to_string(layer),

@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 
 #include "exitance/bake/command/bake_pipeline.h"
@@ -154,6 +155,37 @@ TEST(Relight, ReproducesADirectionalBakeBitForBit) {
   fs::remove_all(dir);
 }
 
+// A Vulkan bake of sample `name` into `baked` for a relight to reproduce: `density` texels per metre,
+// `spp`, seed 9, no probes or octree, sealed texels traced; `lighting` sets the integrator and guides.
+void bake_to_relight(const char* name, const fs::path& baked, float density, uint32_t spp,
+                     const std::function<void(BakeOptions&)>& lighting) {
+  BakeOptions bake;
+  bake.input = std::string(EXITANCE_SAMPLE_DIR) + "/" + name + ".gltf";
+  bake.output = baked.string();
+  bake.backend.name = "vulkan";
+  lighting(bake);
+  bake.atlas.texel_density = density;
+  bake.lighting.spp = spp;
+  bake.lighting.seed = 9;
+  bake.probes_enabled = false;
+  bake.svo_enabled = false;
+  bake.skip_sealed_texels = false;
+  Diagnostics diagnostics;
+  run_bake(bake, diagnostics);
+}
+
+// Every EXR page of `baked` byte for byte the one the relight wrote into `relit`; returns how many.
+size_t expect_same_pages(const fs::path& baked, const fs::path& relit, const char* whose) {
+  size_t pages = 0;
+  for (const auto& entry : fs::directory_iterator(baked)) {
+    if (entry.path().extension() != ".exr") continue;
+    EXPECT_TRUE(file_bytes(entry.path()) == file_bytes(relit / entry.path().filename()))
+        << entry.path().filename() << " differs from " << whose;
+    ++pages;
+  }
+  return pages;
+}
+
 // The per-bounce mode (--integrator bounces): a bundle baked with it on the Vulkan backend is relit
 // with it from scene.bin, bit for bit (the same core loop, per-texel streams and seed); the manifest
 // records the integrator; --frames is refused with it, and a directional bundle cannot use it.
@@ -163,20 +195,10 @@ TEST(Relight, ReproducesAVulkanPerBounceBakeBitForBit) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path baked = dir / "bounces.bake", output = dir / "bounces-relit.bake";
-  BakeOptions bake;
-  bake.input = std::string(EXITANCE_SAMPLE_DIR) + "/cornell_room.gltf";
-  bake.output = baked.string();
-  bake.backend.name = "vulkan";
-  bake.lighting.integrator = IntegratorMode::Bounces;
-  bake.integrator_auto = false;
-  bake.atlas.texel_density = 4;
-  bake.lighting.spp = 4;
-  bake.lighting.seed = 9;
-  bake.probes_enabled = false;
-  bake.svo_enabled = false;
-  bake.skip_sealed_texels = false;
-  Diagnostics diagnostics;
-  run_bake(bake, diagnostics);
+  bake_to_relight("cornell_room", baked, 4, 4, [](BakeOptions& b) {
+    b.lighting.integrator = IntegratorMode::Bounces;
+    b.integrator_auto = false;
+  });
   RelightOptions options;
   options.bundle = baked.string();
   options.output = output.string();
@@ -188,14 +210,7 @@ TEST(Relight, ReproducesAVulkanPerBounceBakeBitForBit) {
   EXPECT_GT(report["rays"].get<uint64_t>(), 0u);
   const nlohmann::json manifest = nlohmann::json::parse(file_bytes(output / "manifest.json"));
   EXPECT_EQ(manifest["settings"]["integrator"], "bounces");
-  size_t pages = 0;
-  for (const auto& entry : fs::directory_iterator(baked)) {
-    if (entry.path().extension() != ".exr") continue;
-    EXPECT_TRUE(file_bytes(entry.path()) == file_bytes(output / entry.path().filename()))
-        << entry.path().filename() << " differs from the per-bounce bake's";
-    ++pages;
-  }
-  EXPECT_GE(pages, 1u);
+  EXPECT_GE(expect_same_pages(baked, output, "the per-bounce bake's"), 1u);
   // Not progressive: frames need path tracing.
   options.frames = 2;
   options.output = (dir / "refused.bake").string();
@@ -213,21 +228,11 @@ TEST(Relight, ReproducesAVulkanGuidedBakeBitForBit) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path baked = dir / "guided.bake", output = dir / "guided-relit.bake";
-  BakeOptions bake;
-  bake.input = std::string(EXITANCE_SAMPLE_DIR) + "/cornell_room.gltf";
-  bake.output = baked.string();
-  bake.backend.name = "vulkan";
-  bake.lighting.integrator = IntegratorMode::Path;
-  bake.lighting.guiding = GuidingMode::Grid;
-  bake.integrator_auto = false;
-  bake.atlas.texel_density = 4;
-  bake.lighting.spp = 12;
-  bake.lighting.seed = 9;
-  bake.probes_enabled = false;
-  bake.svo_enabled = false;
-  bake.skip_sealed_texels = false;
-  Diagnostics diagnostics;
-  run_bake(bake, diagnostics);
+  bake_to_relight("cornell_room", baked, 4, 12, [](BakeOptions& b) {
+    b.lighting.integrator = IntegratorMode::Path;
+    b.lighting.guiding = GuidingMode::Grid;
+    b.integrator_auto = false;
+  });
   RelightOptions options;
   options.bundle = baked.string();
   options.output = output.string();
@@ -238,14 +243,7 @@ TEST(Relight, ReproducesAVulkanGuidedBakeBitForBit) {
   EXPECT_EQ(report["integrator"], "path");
   EXPECT_EQ(report["guiding"], "grid");
   EXPECT_GT(report["rays"].get<uint64_t>(), 0u);
-  size_t pages = 0;
-  for (const auto& entry : fs::directory_iterator(baked)) {
-    if (entry.path().extension() != ".exr") continue;
-    EXPECT_TRUE(file_bytes(entry.path()) == file_bytes(output / entry.path().filename()))
-        << entry.path().filename() << " differs from the guided bake's";
-    ++pages;
-  }
-  EXPECT_GE(pages, 1u);
+  EXPECT_GE(expect_same_pages(baked, output, "the guided bake's"), 1u);
   options.output = (dir / "refused.bake").string();
   options.frames = 2;
   EXPECT_THROW(relight_bundle(options), RelightInputError);
@@ -266,23 +264,13 @@ TEST(Relight, ReproducesAVulkanEmitterGuidedBakeBitForBit) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path baked = dir / "guided.bake", output = dir / "guided-relit.bake";
-  BakeOptions bake;
-  bake.input = std::string(EXITANCE_SAMPLE_DIR) + "/building.gltf";
-  bake.output = baked.string();
-  bake.backend.name = "vulkan";
-  bake.lighting.integrator = IntegratorMode::Path;
-  bake.lighting.guiding = GuidingMode::Off;
-  bake.lighting.emitter_guiding = true;
-  bake.integrator_auto = false;
-  bake.emitter_guiding_auto = false;
-  bake.atlas.texel_density = 0.5f;
-  bake.lighting.spp = 12;
-  bake.lighting.seed = 9;
-  bake.probes_enabled = false;
-  bake.svo_enabled = false;
-  bake.skip_sealed_texels = false;
-  Diagnostics diagnostics;
-  run_bake(bake, diagnostics);
+  bake_to_relight("building", baked, 0.5f, 12, [](BakeOptions& b) {
+    b.lighting.integrator = IntegratorMode::Path;
+    b.lighting.guiding = GuidingMode::Off;
+    b.lighting.emitter_guiding = true;
+    b.integrator_auto = false;
+    b.emitter_guiding_auto = false;
+  });
   RelightOptions options;
   options.bundle = baked.string();
   options.output = output.string();
@@ -293,14 +281,7 @@ TEST(Relight, ReproducesAVulkanEmitterGuidedBakeBitForBit) {
   EXPECT_EQ(report["integrator"], "path");
   ASSERT_TRUE(report.contains("emitter_guiding")) << report.dump();
   EXPECT_GT(report["emitter_guiding"]["records_sampling_learned"].get<uint32_t>(), 0u);
-  size_t pages = 0;
-  for (const auto& entry : fs::directory_iterator(baked)) {
-    if (entry.path().extension() != ".exr") continue;
-    EXPECT_TRUE(file_bytes(entry.path()) == file_bytes(output / entry.path().filename()))
-        << entry.path().filename() << " differs from the emitter-guided bake's";
-    ++pages;
-  }
-  EXPECT_GE(pages, 1u);
+  EXPECT_GE(expect_same_pages(baked, output, "the emitter-guided bake's"), 1u);
   options.output = (dir / "refused.bake").string();
   options.frames = 2;
   EXPECT_THROW(relight_bundle(options), RelightInputError);

@@ -22,6 +22,13 @@ inline void add_regions(const TexelGBuffer& gbuffer, const LightmapEstimate& e, 
   for (const auto& entry : region_means(gbuffer, luminance_means(e))) runs[entry.first].push_back(entry.second);
 }
 
+// One run's per-region luminance means of bounce layer `layer` (LightmapEstimate::mean_bounce) appended to `runs`.
+inline void add_layer_regions(const TexelGBuffer& gbuffer, const LightmapEstimate& e, int layer, RegionRuns& runs) {
+  std::vector<double> texel(gbuffer.texels.size());
+  for (size_t i = 0; i < texel.size(); ++i) texel[i] = luminance(e.mean_bounce(layer, i));
+  for (const auto& entry : region_means(gbuffer, texel)) runs[entry.first].push_back(entry.second);
+}
+
 // Per region, the means of two sets of independent runs agree within `z_limit` (printed under
 // `prefix`). Returns the median over regions of the relative standard error of the difference.
 inline double expect_regions_agree(const char* prefix, const std::string& label, const RegionRuns& reference,
