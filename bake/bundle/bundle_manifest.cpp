@@ -10,6 +10,7 @@
 
 #include "exitance/common/path_sampler.h"
 #include "exitance/common/sampling.h"
+#include "exitance/runtime/bundle/emitter_guiding_report.h"
 #include "exitance/runtime/material_eval.h"
 
 namespace exitance {
@@ -216,15 +217,7 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
                         {"mean_neighbours", results.denoise->mean_neighbours},
                         {"seconds", results.denoise->seconds}};
   if (estimate.guiding_auto) stats["guiding"] = guiding_auto_json(estimate, results.backend.backend_name());
-  if (estimate.emitter_guiding.records > 0) {
-    const LightmapEstimate::EmitterGuidingReport& e = estimate.emitter_guiding;
-    stats["emitter_guiding"] = {{"records", e.records},
-                                {"records_sampling_learned", e.records_sampling_learned},
-                                {"patches", e.patches},
-                                {"punctual_lights", e.punctual_lights},
-                                {"memory_bytes", e.memory_bytes},
-                                {"dropped_after_learning", e.dropped}};
-  }
+  if (estimate.emitter_guiding.records > 0) stats["emitter_guiding"] = emitter_guiding_json(estimate.emitter_guiding);
   if (results.stage_cache) stats["cache"]["stages"] = *results.stage_cache;
   if (results.distribution)
     for (const auto& [key, value] : results.distribution->items()) stats[key] = value;

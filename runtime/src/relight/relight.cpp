@@ -9,6 +9,7 @@
 #include <limits>
 #include <memory>
 
+#include "exitance/runtime/bundle/emitter_guiding_report.h"
 #include "exitance/formats/bundle_manifest.h"
 #include "exitance/runtime/refresh/refreshed_bundle.h"
 #include "exitance/runtime/stage_clock.h"
@@ -184,12 +185,8 @@ json relight_bundle(const RelightOptions& options) {
     } catch (const std::invalid_argument& e) {  // e.g. the edits changed the emitters the guide was made for
       throw RelightInputError(options.bundle + ": " + e.what());
     }
-    const LightmapEstimate& e = *run;
-    rays = e.rays;
-    const LightmapEstimate::EmitterGuidingReport& g = e.emitter_guiding;
-    emitter_guiding_report = {{"records", g.records}, {"records_sampling_learned", g.records_sampling_learned},
-                              {"patches", g.patches}, {"punctual_lights", g.punctual_lights},
-                              {"memory_bytes", g.memory_bytes}, {"dropped", g.dropped}};
+    rays = run->rays;
+    emitter_guiding_report = emitter_guiding_json(run->emitter_guiding);
     report("lighting", 1, rays);
   }
   uint64_t share_texels = 0;

@@ -36,14 +36,7 @@ BounceLayerDriver::BounceLayerDriver(WavefrontBatchRunner& runner, std::shared_p
                                      const TexelGBuffer& gbuffer, const IntegratorSettings& settings,
                                      std::shared_ptr<const LightingScene> lighting)
     : runner_(runner), source_(std::move(source)), gbuffer_(gbuffer), settings_(settings) {
-  if (settings.emitter_guiding) {
-    if (!lighting) throw std::logic_error("Vulkan backend: emitter guiding in the per-bounce mode without the integrator's scene");
-    if (lighting->emitter_triangles != runner_.scene().emitter_triangles() ||
-        lighting->punctual_count() != runner_.scene().punctual_count())
-      throw std::invalid_argument("Vulkan backend: --emitter-guiding on: the device's scene was edited since the integrator was made; "
-                                  "emitter guiding bakes the scene it was made on");
-    emitter_guide_ = EmitterGuidingCache::for_bake(*lighting, gbuffer, settings);
-  }
+  emitter_guide_ = emitter_guide_for_device(lighting, runner_.scene(), gbuffer, settings);
   // The tables the lookup reads (bounce_pass.glsl bounce_cache_lookup), as BounceLayerCache::lookup
   // reads them on the CPU: each triangle's instance and lightmap UVs, each instance's rectangle.
   const size_t triangles = source_ && source_->triangle_instance.size() * 3 <= source_->lightmap_uv.size()

@@ -10,6 +10,19 @@
 
 namespace exitance::vulkan {
 
+std::unique_ptr<EmitterGuidingCache> emitter_guide_for_device(const std::shared_ptr<const LightingScene>& lighting,
+                                                              const GpuScene& device_scene, const TexelGBuffer& gbuffer,
+                                                              const IntegratorSettings& settings) {
+  if (!settings.emitter_guiding) return nullptr;
+  if (!lighting) throw std::logic_error("Vulkan backend: emitter guiding without the integrator's scene");
+  // Their powers may differ after an emission edit: the mixture stays unbiased, as its densities
+  // read the device's CDF.
+  if (lighting->emitter_triangles != device_scene.emitter_triangles() || lighting->punctual_count() != device_scene.punctual_count())
+    throw std::invalid_argument("Vulkan backend: --emitter-guiding on: the device's scene was edited since the integrator was made; "
+                                "emitter guiding bakes the scene it was made on");
+  return EmitterGuidingCache::for_bake(*lighting, gbuffer, settings);
+}
+
 EmitterGuideBuffer::EmitterGuideBuffer(const EmitterGuidingCache& cache, size_t base)
     : base_(std::max<size_t>(base, kGuideHeaderWords)),
       records_(cache.record_count()),

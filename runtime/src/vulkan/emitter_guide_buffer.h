@@ -7,12 +7,21 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "exitance/runtime/core/emitter_guiding_cache.h"
 #include "wavefront_batch.h"
 
 namespace exitance::vulkan {
+
+// The cache a Vulkan bake's settings ask for (EmitterGuidingCache::for_bake on `lighting`, the
+// scene the integrator holds), null when emitter guiding is off or there is nothing to guide;
+// refused in one line when `lighting` no longer lists the device's emitters and punctual lights
+// (its patch tables index the device's emitter list).
+std::unique_ptr<EmitterGuidingCache> emitter_guide_for_device(const std::shared_ptr<const LightingScene>& lighting,
+                                                              const GpuScene& device_scene, const TexelGBuffer& gbuffer,
+                                                              const IntegratorSettings& settings);
 
 class EmitterGuideBuffer {
  public:

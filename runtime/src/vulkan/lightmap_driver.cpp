@@ -340,14 +340,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     if (share) throw std::invalid_argument("Vulkan backend: --emitter-guiding runs in one process only, not under mpirun with several ranks");
     if (svo_guide)
       throw std::invalid_argument("Vulkan backend: --emitter-guiding on with --guiding svo is implemented on the CPU backend only");
-    const std::shared_ptr<const LightingScene>& lighting = guiding_scene_.lighting;
-    if (!lighting) throw std::logic_error("Vulkan backend: emitter guiding without the integrator's scene");
-    // Its patch tables index the device's emitter list (their powers may differ after an emission
-    // edit: the mixture stays unbiased, as its densities read the device's CDF).
-    if (lighting->emitter_triangles != runner_.scene().emitter_triangles() || lighting->punctual_count() != a.params.punctual_count)
-      throw std::invalid_argument("Vulkan backend: --emitter-guiding on: the device's scene was edited since the integrator was made; "
-                                  "emitter guiding bakes the scene it was made on");
-    emitter_guide = EmitterGuidingCache::for_bake(*lighting, gbuffer, settings);
+    emitter_guide = emitter_guide_for_device(guiding_scene_.lighting, runner_.scene(), gbuffer, settings);
   }
   if (emitter_guide) {
     Context& context = runner_.context();
