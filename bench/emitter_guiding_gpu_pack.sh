@@ -11,7 +11,10 @@ if [ -z "$2" ]; then
   $build/bake/bake $build/samples/building.gltf -o $bundle --backend cpu --integrator path --texel-density 12 \
     --spp 1 --probes none --voxel-resolution none --no-cache > /dev/null
 fi
-mkdir -p $work/pack/building.bake && cp $bundle/{manifest.json,scene.bin} $work/pack/building.bake/
+mkdir -p $work/pack/building.bake
+for f in manifest.json scene.bin probes.bin svo.bin; do  # a per-bounce pack's bundle has probes and the octree too
+  [ -f $bundle/$f ] && cp $bundle/$f $work/pack/building.bake/
+done
 cmake --install $build --component runtime --prefix $work/pack/rt > /dev/null
 cp $build/bench/bench_bundle_rel_mse $work/pack/rt/bin/
 mkdir -p .replay

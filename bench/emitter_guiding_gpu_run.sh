@@ -36,6 +36,15 @@ for n in ${SPPS:-64 256}; do
   run off_s$n --spp $n
   run on_s$n --spp $n --emitter-guiding on
 done
+# Per wavefront stage at 256 spp, unguided and guided (GPU seconds beside the lighting seconds: the
+# rest is the folds' host work and idle device).
+for mode in off on; do
+  $R $B -o $W/stages.bake --seed 3 --spp 256 --emitter-guiding $mode --stage-statistics $common > $W/stages.json
+  python3 -c "
+import json; r=json.load(open('$W/stages.json')); g=sum(s['gpu_seconds'] for s in r['stages'])
+print('stages $mode: lighting %.3f s, GPU stages %.3f s'%(r['lighting_seconds'], g))
+for s in r['stages']: print('  %-50s %.4f s  rays %.3g  lanes %.2f'%(s['stage'], s['gpu_seconds'], s['rays'], s['lane_efficiency']))" >> $S
+done
 echo "relMSE:" >> $S
-$W/rt/bin/bench_bundle_rel_mse $W/ref_101.bake $W/ref_202.bake $list >> $S
+LD_LIBRARY_PATH=$W/rt/lib $W/rt/bin/bench_bundle_rel_mse $W/ref_101.bake $W/ref_202.bake $list >> $S
 cat $S

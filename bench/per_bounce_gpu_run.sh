@@ -7,7 +7,9 @@
 # CACHES="device host" the per-bounce runs are repeated with their layer caches built on the host
 # (exitance-relight --bounce-caches host, the earlier path; the same results bit for bit): the A/B of
 # building them on the device (docs/lighting-core.md "Per-bounce mode").
-#   bash .replay/per_bounce_gpu_run.sh        (env SCENES, CACHES)
+# STAGES=1 adds one 64-spp per-bounce run with --stage-statistics per scene: each wavefront stage's
+# GPU seconds beside the run's lighting seconds (the rest is host work and idle device).
+#   bash .replay/per_bounce_gpu_run.sh        (env SCENES, CACHES, STAGES)
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
 export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
@@ -35,6 +37,13 @@ for scene in ${SCENES:-cornell building city}; do
       tests="$tests /tmp/w/$scene-bounces$spp-$caches.bake"
     done
   done
+  if [ -n "${STAGES:-}" ]; then
+    $R $B -o /tmp/w/stages.bake --spp 64 --seed 1 --integrator bounces --stage-statistics --json > /tmp/w/r.json
+    python3 -c "
+import json; r=json.load(open('/tmp/w/r.json')); g=sum(s['gpu_seconds'] for s in r['stages'])
+print('$scene bounces 64 spp, stages: lighting %.3f s, GPU stages %.3f s'%(r['lighting_seconds'], g))
+for s in r['stages']: print('  %-12s %.4f s  rays %.3g  lanes %.2f'%(s['stage'], s['gpu_seconds'], s['rays'], s['lane_efficiency']))"
+  fi
   echo "$scene reference: $(field lighting_seconds /tmp/w/refA.json) s per 4096-spp run"
   LD_LIBRARY_PATH=/tmp/w/rt/lib /tmp/w/rt/bin/bench_bundle_rel_mse /tmp/w/$scene-refA.bake /tmp/w/$scene-refB.bake $tests | sed "s#/tmp/w/##"
   rm -rf /tmp/w/$scene-*.bake

@@ -10,6 +10,7 @@
 
 #include "exitance/common/path_sampler.h"
 #include "exitance/common/sampling.h"
+#include "exitance/runtime/bundle/bounce_statistics_report.h"
 #include "exitance/runtime/bundle/emitter_guiding_report.h"
 #include "exitance/runtime/material_eval.h"
 
@@ -218,6 +219,8 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
                         {"seconds", results.denoise->seconds}};
   if (estimate.guiding_auto) stats["guiding"] = guiding_auto_json(estimate, results.backend.backend_name());
   if (estimate.emitter_guiding.records > 0) stats["emitter_guiding"] = emitter_guiding_json(estimate.emitter_guiding);
+  if (options.lighting.integrator == IntegratorMode::Bounces && !estimate.bounce_statistics.samples.empty())
+    stats["bounces"] = bounce_statistics_json(estimate.bounce_statistics);
   if (results.stage_cache) stats["cache"]["stages"] = *results.stage_cache;
   if (results.distribution)
     for (const auto& [key, value] : results.distribution->items()) stats[key] = value;

@@ -211,6 +211,15 @@ TEST(Relight, ReproducesAVulkanPerBounceBakeBitForBit) {
   const nlohmann::json manifest = nlohmann::json::parse(file_bytes(output / "manifest.json"));
   EXPECT_EQ(manifest["settings"]["integrator"], "bounces");
   EXPECT_GE(expect_same_pages(baked, output, "the per-bounce bake's"), 1u);
+  // The run's layers and host seconds are reported as the bake's manifest reports them.
+  const nlohmann::json& bounces = report["bounces"];
+  const nlohmann::json baked_manifest = nlohmann::json::parse(file_bytes(baked / "manifest.json"));
+  const nlohmann::json& baked_bounces = baked_manifest["stats"]["bounces"];
+  EXPECT_EQ(bounces["samples_per_layer"], baked_bounces["samples_per_layer"]);
+  EXPECT_EQ(bounces["samples_per_layer"].size(), bounces["bounces"].get<size_t>() + 1);
+  EXPECT_EQ(bounces["ratio"], baked_bounces["ratio"]);
+  EXPECT_GT(bounces["seconds"]["passes"].get<double>(), 0.0);
+  EXPECT_GT(bounces["seconds"]["caches"].get<double>(), 0.0) << "the layers above B_0 read caches";
   // Not progressive: frames need path tracing.
   options.frames = 2;
   options.output = (dir / "refused.bake").string();

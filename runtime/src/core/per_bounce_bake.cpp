@@ -30,6 +30,7 @@
 #include "exitance/runtime/core/per_bounce_bake.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 
@@ -37,6 +38,7 @@
 #include "exitance/common/gpu_layout.h"
 #include "exitance/runtime/core/bounce_tail.h"
 #include "exitance/runtime/core/partial_layer_pass.h"
+#include "exitance/runtime/core/parallel_chunks.h"
 #include "exitance/runtime/core/pass_scheduler.h"
 #include "exitance/runtime/core/work_share.h"
 
@@ -82,6 +84,19 @@ struct Layer {
   uint64_t texels_with_one_more() const { return uint64_t(std::count(one_more.begin(), one_more.end(), uint8_t(1))); }
 };
 
+// Texel i's total over the layers, and its variance (the layers' variances summed).
+Vec3 total_of(const std::vector<Layer>& layers, size_t i) {
+  Vec3 total{0, 0, 0};
+  for (const Layer& layer : layers) total += layer.mean(i);
+  return total;
+}
+Vec3 total_variance_of(const std::vector<Layer>& layers, size_t i) {
+  Vec3 variance{0, 0, 0};
+  for (const Layer& layer : layers)
+    for (int c = 0; c < 3; ++c) variance[c] += float(layer.variance_of_mean(i, c));
+  return variance;
+}
+
 double area_of(const LiveTexel& t) {
   const double s = t.world_texel_size;
   return s > 0 && std::isfinite(s) ? s * s : 1.0;
@@ -104,20 +119,19 @@ BounceTail tail_after(const std::vector<Layer>& layers, const TexelGBuffer& gbuf
                                      float(std::sqrt(layer.variance_of_mean(i, 2)))));
     return sd * sd;
   };
-  for (size_t i = 0; i < n; ++i) {
-    in.area[i] = area_of(gbuffer.texels[i]);
-    in.previous_bounce[i] = luminance(layers[last - 1].mean(i));
-    in.last_bounce[i] = luminance(layers[last].mean(i));
-    in.previous_bounce_variance[i] = luminance_variance(layers[last - 1], i);
-    in.last_bounce_variance[i] = luminance_variance(layers[last], i);
-    Vec3 total{0, 0, 0}, variance{0, 0, 0};
-    for (const Layer& layer : layers) {
-      total += layer.mean(i);
-      for (int c = 0; c < 3; ++c) variance[c] += float(layer.variance_of_mean(i, c));
+  // Each texel's inputs on its own (all cores: at 1 M texels and ten layers this was most of the
+  // host's time between the GPU's layer passes); the reduction stays serial, in texel order.
+  for_each_chunk(n, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      in.area[i] = area_of(gbuffer.texels[i]);
+      in.previous_bounce[i] = luminance(layers[last - 1].mean(i));
+      in.last_bounce[i] = luminance(layers[last].mean(i));
+      in.previous_bounce_variance[i] = luminance_variance(layers[last - 1], i);
+      in.last_bounce_variance[i] = luminance_variance(layers[last], i);
+      in.total[i] = luminance(total_of(layers, i));
+      in.total_variance[i] = luminance(total_variance_of(layers, i));
     }
-    in.total[i] = luminance(total);
-    in.total_variance[i] = luminance(variance);
-  }
+  }, 16384);
   return estimate_bounce_tail(in);
 }
 
@@ -166,10 +180,13 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
   auto assembly_seconds = [&] {
     return tail_layers > 0 ? kAfterLoopPerTail * tail_seconds * double(layers.size()) / double(tail_layers) : 0.0;
   };
+  BounceGatherStatistics::Seconds host;  // the loop's parts (estimates.h)
   auto build_cache = [&](size_t k) {
     const double build_start = passes.elapsed_seconds();
     std::vector<Vec3> means(n);
-    for (size_t i = 0; i < n; ++i) means[i] = layers[k].mean(i);
+    for_each_chunk(n, [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) means[i] = layers[k].mean(i);
+    });
     if (estimator.builds_caches())
       estimator.build_cache(k, means, valid);
     else
@@ -177,6 +194,7 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
     ++cache_versions[k];
     cache_stale[k] = 0;
     cache_seconds[k] = passes.elapsed_seconds() - build_start;
+    host.caches += cache_seconds[k];
   };
 
   // Split over processes (work_share.h): each layer pass estimates this rank's texels, then every
@@ -242,6 +260,7 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
       if (step.whole > 0) {
         pass.first_sample = layer.samples, pass.samples = step.whole;
         estimator.estimate(pass, caches, cache_versions);
+        host.passes += passes.elapsed_seconds() - layer_start;
         if (share) share->work.seconds += passes.elapsed_seconds() - layer_start;
         own_samples += uint64_t(own_end - own_begin) * step.whole;
       }
@@ -251,6 +270,7 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
         const double partial_start = passes.elapsed_seconds();
         pass.first_sample = layer.samples + step.whole, pass.samples = 1, pass.texels = &own;
         if (!own.empty()) estimator.estimate(pass, caches, cache_versions);
+        host.passes += passes.elapsed_seconds() - partial_start;
         if (share) share->work.seconds += passes.elapsed_seconds() - partial_start;
         own_samples += own.size();
         layer.one_more.resize(n);  // every rank marks every texel: the choice is by global index
@@ -270,7 +290,9 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
       layer.samples += step.whole;
       if (runs) cache_stale[t] = 1;
       if (t == 0 && runs) {  // texel validity changes every cache
-        for (size_t i = 0; i < n; ++i) valid[i] = 2 * layers[0].back_faces[i] <= layers[0].samples_at(i) ? 1 : 0;
+        for_each_chunk(n, [&](size_t begin, size_t end) {
+          for (size_t i = begin; i < end; ++i) valid[i] = 2 * layers[0].back_faces[i] <= layers[0].samples_at(i) ? 1 : 0;
+        });
         std::fill(cache_stale.begin(), cache_stale.end(), uint8_t(1));
       }
 
@@ -283,6 +305,7 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
           tail = tail_after(layers, gbuffer);
           tail_known = true;
           tail_seconds = passes.elapsed_seconds() - tail_start, tail_layers = layers.size();
+          host.tail += tail_seconds;
         }
         const bool tail_above_noise = k >= 1 && (!noise_known || !tail.below_noise);
         const bool more = forced ? int(layers.size()) < layer_cap
@@ -306,21 +329,21 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
     // At least 16 samples, as in path mode; a texel that stayed black with no variance (inside
     // geometry) has met any target (a relative error of 0/0 would never end the run).
     if (settings.target_relative_error > 0 && !wants_more && layers[0].samples >= 16) {
-      all_converged = true;
-      for (size_t i = 0; i < n && all_converged; ++i) {
-        Vec3 total{0, 0, 0}, variance{0, 0, 0};
-        for (const Layer& layer : layers) {
-          total += layer.mean(i);
-          for (int c = 0; c < 3; ++c) variance[c] += float(layer.variance_of_mean(i, c));
-        }
-        const float lum = luminance(total);
-        all_converged = std::sqrt(luminance(variance)) <= settings.target_relative_error * lum;
-      }
+      const double test_start = passes.elapsed_seconds();
+      std::atomic<bool> converged{true};
+      for_each_chunk(n, [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end && converged.load(std::memory_order_relaxed); ++i)
+          if (!(std::sqrt(luminance(total_variance_of(layers, i))) <= settings.target_relative_error * luminance(total_of(layers, i))))
+            converged.store(false, std::memory_order_relaxed);
+      }, 16384);
+      all_converged = converged.load();
+      host.tail += passes.elapsed_seconds() - test_start;
     }
     passes.finish_pass(counters().rays, all_converged);
   }
 
   // A layer started but never sampled (the budget ended first) is dropped.
+  const double assembly_start = passes.elapsed_seconds();
   while (layers.size() > 1 && layers.back().samples == 0) layers.pop_back();
   if (!tail_known && layers.size() >= 2) tail = tail_after(layers, gbuffer);
 
@@ -338,30 +361,32 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
   const int layer_count = int(layers.size());
   estimate.recorded_bounces = layer_count;
   estimate.bounces.resize(size_t(layer_count) * n * 3);  // every entry is written below
-  for (size_t i = 0; i < n; ++i) {
-    TexelAccumulator& acc = estimate.texels[i];
-    acc.samples = layers[0].samples_at(i);
-    const double n0 = acc.samples;
-    double total[3] = {0, 0, 0}, variance[3] = {0, 0, 0};
-    for (int k = 0; k < layer_count; ++k) {
-      const Layer& layer = layers[size_t(k)];
-      const Vec3 mean = layer.mean(i);
-      // The last recorded bounce carries the completed tail, so the bounces still sum to the total.
-      const double scale = k == layer_count - 1 ? 1.0 + tail_factor : 1.0;
+  for_each_chunk(n, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      TexelAccumulator& acc = estimate.texels[i];
+      acc.samples = layers[0].samples_at(i);
+      const double n0 = acc.samples;
+      double total[3] = {0, 0, 0}, variance[3] = {0, 0, 0};
+      for (int k = 0; k < layer_count; ++k) {
+        const Layer& layer = layers[size_t(k)];
+        const Vec3 mean = layer.mean(i);
+        // The last recorded bounce carries the completed tail, so the bounces still sum to the total.
+        const double scale = k == layer_count - 1 ? 1.0 + tail_factor : 1.0;
+        for (int c = 0; c < 3; ++c) {
+          // The layer's mean as a sum over the texel's B_0 samples, so mean_bounce() reads it back.
+          estimate.bounces[(size_t(k) * n + i) * 3 + size_t(c)] = n0 * scale * mean[c];
+          total[c] += scale * mean[c];
+          variance[c] += scale * scale * layer.variance_of_mean(i, c);
+        }
+      }
       for (int c = 0; c < 3; ++c) {
-        // The layer's mean as a sum over the texel's B_0 samples, so mean_bounce() reads it back.
-        estimate.bounces[(size_t(k) * n + i) * 3 + size_t(c)] = n0 * scale * mean[c];
-        total[c] += scale * mean[c];
-        variance[c] += scale * scale * layer.variance_of_mean(i, c);
+        acc.total[c] = n0 * total[c];
+        acc.direct[c] = n0 * layers[0].mean(i)[c];
+        // Chosen so variance_of_mean() returns the summed layer variances.
+        acc.total_squared[c] = n0 * total[c] * total[c] + (n0 >= 2 ? (n0 - 1) * n0 * variance[c] : 0.0);
       }
     }
-    for (int c = 0; c < 3; ++c) {
-      acc.total[c] = n0 * total[c];
-      acc.direct[c] = n0 * layers[0].mean(i)[c];
-      // Chosen so variance_of_mean() returns the summed layer variances.
-      acc.total_squared[c] = n0 * total[c] * total[c] + (n0 >= 2 ? (n0 - 1) * n0 * variance[c] : 0.0);
-    }
-  }
+  }, 16384);
   BounceGatherCounts c = counters();
   if (settings.work_share) {
     RankWork& work = settings.work_share->work;
@@ -391,6 +416,8 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
   stats.noise_rms = tail.noise_rms;
   stats.tail_below_noise = layer_count >= 2 && tail.below_noise;
   stats.tail_completed = complete_tail;
+  host.assembly = passes.elapsed_seconds() - assembly_start;
+  stats.seconds = host;
   estimate.rays = c.rays;
   estimate.nonfinite_samples = c.nonfinite;
   estimate.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

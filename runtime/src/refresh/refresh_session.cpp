@@ -948,7 +948,7 @@ LightmapEstimate RefreshSession::lightmap() const {
   return state_->per_bounce ? *state_->per_bounce : state_->integrator->progressive_estimate();
 }
 
-LightmapEstimate RefreshSession::bake_per_bounce(uint32_t spp, double time_budget_seconds, bool caches_on_host) {
+const LightmapEstimate& RefreshSession::bake_per_bounce(uint32_t spp, double time_budget_seconds, bool caches_on_host) {
   State& s = *state_;
   end_change_estimate();
   if (s.settings.directional != DirectionalMode::Off)
@@ -969,7 +969,7 @@ LightmapEstimate RefreshSession::bake_per_bounce(uint32_t spp, double time_budge
 
 bool RefreshSession::per_bounce() const { return state_->per_bounce.has_value() && !state_->whole_run_path; }
 
-LightmapEstimate RefreshSession::bake_guided(uint32_t spp, double time_budget_seconds, float guiding_mix, GuidingMode mode) {
+const LightmapEstimate& RefreshSession::bake_guided(uint32_t spp, double time_budget_seconds, float guiding_mix, GuidingMode mode) {
   State& s = *state_;
   end_change_estimate();
   if (spp == 0 && !(time_budget_seconds > 0))

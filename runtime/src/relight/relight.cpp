@@ -9,6 +9,7 @@
 #include <limits>
 #include <memory>
 
+#include "exitance/runtime/bundle/bounce_statistics_report.h"
 #include "exitance/runtime/bundle/emitter_guiding_report.h"
 #include "exitance/formats/bundle_manifest.h"
 #include "exitance/runtime/refresh/refreshed_bundle.h"
@@ -161,10 +162,13 @@ json relight_bundle(const RelightOptions& options) {
   const auto lighting_start = Clock::now();
   json frames = json::array();
   uint64_t rays = 0;
+  json bounces_report;  // the per-bounce mode's layers, stop and host seconds
   if (per_bounce) {
     report("lighting", 0, 0);
     try {
-      rays = session->bake_per_bounce(spp, options.time_budget_seconds, options.bounce_caches == "host").rays;
+      const LightmapEstimate& run = session->bake_per_bounce(spp, options.time_budget_seconds, options.bounce_caches == "host");
+      rays = run.rays;
+      bounces_report = bounce_statistics_json(run.bounce_statistics);
     } catch (const std::invalid_argument& e) {
       throw RelightInputError(options.bundle + ": " + e.what());
     }
@@ -275,6 +279,7 @@ json relight_bundle(const RelightOptions& options) {
   run["integrator"] = per_bounce ? "bounces" : "path";
   if (guided) run["guiding"] = options.guiding;
   if (emitter_guided) run["emitter_guiding"] = emitter_guiding_report;
+  if (per_bounce) run["bounces"] = bounces_report;
   run["spp"] = session->samples_per_texel();
   // Light layers kept per texel (docs/runtime.md "Light layers"; 0: --no-light-layers or a whole run)
   run["light_layers"] = session->integrator().light_layers();

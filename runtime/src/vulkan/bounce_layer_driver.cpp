@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "exitance/runtime/core/parallel_chunks.h"
 #include "exitance_spirv/bounce_cache.h"
 #include "guide_buffer.h"
 
@@ -221,10 +222,14 @@ void BounceLayerDriver::build_cache(size_t layer, const std::vector<Vec3>& means
                                                     uint32_t(5 * 4), spirv_bounce_cache, sizeof(spirv_bounce_cache), 1,
                                                     "bounce_cache.comp");
   }
-  std::vector<Vec4> packed(texels);
-  for (size_t i = 0; i < texels; ++i)
-    packed[i] = Vec4(means[i].x, means[i].y, means[i].z, valid.empty() || valid[i] ? 1.0f : 0.0f);
-  if (texels > 0) context.upload(cache_means_, packed.data(), packed.size() * sizeof(Vec4));
+  // Means and validity packed straight into the staging mapping, on all cores.
+  context.write_ranges(cache_means_, {{0, VkDeviceSize(texels) * sizeof(Vec4)}}, [&](char* mapped) {
+    Vec4* packed = reinterpret_cast<Vec4*>(mapped);
+    for_each_chunk(texels, [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i)
+        packed[i] = Vec4(means[i].x, means[i].y, means[i].z, valid.empty() || valid[i] ? 1.0f : 0.0f);
+    });
+  });
   // The cache buffer may have grown since the descriptors were written.
   const std::array<VkDescriptorBufferInfo, 5> infos{{{runner_.buffers().probes.sh_sums.handle(), 0, VK_WHOLE_SIZE},
                                                      {cache_texels_.handle(), 0, VK_WHOLE_SIZE},
@@ -310,19 +315,33 @@ void BounceLayerDriver::estimate(const BounceLayerPass& pass, const std::vector<
   }
   runner_.record_statistics(totals_, kTexelBatch);
 
-  // The pass's sums (texel order, doubles) onto the layer's; the back-face counts in the first bounce slot.
-  std::vector<double> sums(texels * 6), back_faces(texels * 3);
-  context.download(buffers.texels.sums, sums.data(), sums.size() * 8);
-  context.download(buffers.texels.bounce_sums, back_faces.data(), back_faces.size() * 8);
-  for (const uint32_t texel : work_list_) {
-    const size_t i = texel;
-    for (int c = 0; c < 3; ++c) {
-      pass.sum[i * 3 + size_t(c)] += sums[i * 6 + size_t(c)];
-      pass.sum_squared[i * 3 + size_t(c)] += sums[i * 6 + 3 + size_t(c)];
-    }
-    if (pass.back_faces) pass.back_faces[i] += uint32_t(back_faces[i * 3]);
-    if (pass.texel_rays) pass.texel_rays[i] = 0;  // not counted per texel on the device: an even split
-  }
+  // The pass's sums (texel order, doubles) onto the layer's, read from the pinned staging buffer
+  // kept for them (a new 48 MB one per pass at 1 M texels cost its allocation and page faults), each
+  // listed texel's own entries on all cores; the back-face counts in the first bounce slot, read
+  // back only where the pass counts them (B_0).
+  const VkDeviceSize sum_bytes = VkDeviceSize(texels) * 6 * 8;
+  if (sum_bytes > 0 && read_staging_.size() < sum_bytes)
+    read_staging_ = context.create_buffer(sum_bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+  context.read_back_ranges(buffers.texels.sums, {{0, sum_bytes}}, [&](const char* mapped) {
+    const double* sums = reinterpret_cast<const double*>(mapped);
+    for_each_chunk(work_list_.size(), [&](size_t begin, size_t end) {
+      for (size_t w = begin; w < end; ++w) {
+        const size_t i = work_list_[w];
+        for (int c = 0; c < 3; ++c) {
+          pass.sum[i * 3 + size_t(c)] += sums[i * 6 + size_t(c)];
+          pass.sum_squared[i * 3 + size_t(c)] += sums[i * 6 + 3 + size_t(c)];
+        }
+        if (pass.texel_rays) pass.texel_rays[i] = 0;  // not counted per texel on the device: an even split
+      }
+    });
+  }, &read_staging_);
+  if (pass.back_faces)
+    context.read_back_ranges(buffers.texels.bounce_sums, {{0, VkDeviceSize(texels) * 3 * 8}}, [&](const char* mapped) {
+      const double* counts = reinterpret_cast<const double*>(mapped);
+      for_each_chunk(work_list_.size(), [&](size_t begin, size_t end) {
+        for (size_t w = begin; w < end; ++w) pass.back_faces[work_list_[w]] += uint32_t(counts[size_t(work_list_[w]) * 3]);
+      });
+    }, &read_staging_);
 }
 
 BounceGatherCounts BounceLayerDriver::counts() const {

@@ -64,20 +64,25 @@ EmitterGuideBuffer::EmitterGuideBuffer(const EmitterGuidingCache& cache, size_t 
   std::copy(patches.emitter_patch.begin(), patches.emitter_patch.end(), words_.begin() + std::ptrdiff_t(emitter_patch_at));
   std::copy(patches.patch_emitters.begin(), patches.patch_emitters.end(), words_.begin() + std::ptrdiff_t(patch_emitters_at));
   std::copy(triangle_emitter.begin(), triangle_emitter.end(), words_.begin() + std::ptrdiff_t(triangle_emitter_at));
-  pack_front(cache);
+  pack_front(cache, &words_[front_]);
 }
 
-void EmitterGuideBuffer::pack_front(const EmitterGuidingCache& cache) {
-  const size_t cdf_at = words_[kEmitterGuideCdf] - base_, punctual_cdf_at = words_[kEmitterGuidePunctualCdf] - base_;
-  for (uint32_t r = 0; r < records_; ++r) {
-    const EmitterGuide g = cache.vertex(r);
-    uint32_t* f = &words_[front_ + size_t(r) * kEmitterGuideFrontWords];
-    f[0] = guide_float_bits(g.guided_probability);
-    f[1] = guide_float_bits(g.punctual_guided_probability);
-    if (patches_ > 0) std::memcpy(&words_[cdf_at + size_t(r) * (patches_ + 1)], g.cdf, (size_t(patches_) + 1) * 4);
-    if (punctual_ > 0)
-      std::memcpy(&words_[punctual_cdf_at + size_t(r) * (punctual_ + 1)], g.punctual_cdf, (size_t(punctual_) + 1) * 4);
-  }
+void EmitterGuideBuffer::pack_front(const EmitterGuidingCache& cache, uint32_t* at_front) const {
+  const size_t cdf_at = words_[kEmitterGuideCdf] - base_ - front_;
+  const size_t punctual_cdf_at = words_[kEmitterGuidePunctualCdf] - base_ - front_;
+  for_each_chunk(
+      records_,
+      [&](size_t first, size_t end) {
+        for (size_t r = first; r < end; ++r) {
+          const EmitterGuide g = cache.vertex(uint32_t(r));
+          uint32_t* f = at_front + r * kEmitterGuideFrontWords;
+          f[0] = guide_float_bits(g.guided_probability);
+          f[1] = guide_float_bits(g.punctual_guided_probability);
+          if (patches_ > 0) std::memcpy(at_front + cdf_at + r * (patches_ + 1), g.cdf, (size_t(patches_) + 1) * 4);
+          if (punctual_ > 0) std::memcpy(at_front + punctual_cdf_at + r * (punctual_ + 1), g.punctual_cdf, (size_t(punctual_) + 1) * 4);
+        }
+      },
+      64);
 }
 
 void EmitterGuideBuffer::upload(WavefrontBatchRunner& runner) const {
@@ -90,25 +95,30 @@ void EmitterGuideBuffer::upload(WavefrontBatchRunner& runner) const {
 bool EmitterGuideBuffer::fold_learning(WavefrontBatchRunner& runner, EmitterGuidingCache& cache, uint32_t samples) {
   Context& context = runner.context();
   const Buffer& buffer = runner.buffers().probes.sh_sums;
-  if (back_end_ > back_) context.download(buffer, &words_[back_], (back_end_ - back_) * 4, (base_ + back_) * 4);
+  const size_t staged_words = std::max(back_end_ - back_, back_ - front_);
+  if (staged_words > 0 && staging_.size() < staged_words * 4)
+    staging_ = context.create_buffer(staged_words * 4, VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
   const size_t punctual_back_at = words_[kEmitterGuidePunctualBack] - base_;
-  // Records on all cores (the cache's back tables add atomically; each record's rows are its own).
-  for_each_chunk(
-      records_,
-      [&](size_t first, size_t end) {
-        for (size_t r = first; r < end; ++r) {
-          for (uint32_t k = 0; k < patches_; ++k) {
-            const uint32_t* w = &words_[back_ + (r * patches_ + k) * kGuideBackWords];
-            if (w[2] != 0) cache.import_learned(uint32_t(r), k, uint64_t(w[0]) | (uint64_t(w[1]) << 32), w[2]);
+  // The back sums imported straight from the read-back's mapping, records on all cores (the cache's
+  // back tables add atomically; each record's rows are its own).
+  context.read_back_ranges(buffer, {{(base_ + back_) * 4, (back_end_ - back_) * 4}}, [&](const char* mapped) {
+    const uint32_t* back = reinterpret_cast<const uint32_t*>(mapped);  // section word back_ at 0
+    for_each_chunk(
+        records_,
+        [&](size_t first, size_t end) {
+          for (size_t r = first; r < end; ++r) {
+            for (uint32_t k = 0; k < patches_; ++k) {
+              const uint32_t* w = &back[(r * patches_ + k) * kGuideBackWords];
+              if (w[2] != 0) cache.import_learned(uint32_t(r), k, uint64_t(w[0]) | (uint64_t(w[1]) << 32), w[2]);
+            }
+            for (uint32_t i = 0; i < punctual_; ++i) {
+              const uint32_t* w = &back[punctual_back_at - back_ + (r * punctual_ + i) * kEmitterGuidePunctualBackWords];
+              if (w[0] != 0 || w[1] != 0) cache.import_learned_punctual(uint32_t(r), i, uint64_t(w[0]) | (uint64_t(w[1]) << 32));
+            }
           }
-          for (uint32_t i = 0; i < punctual_; ++i) {
-            const uint32_t* w = &words_[punctual_back_at + (r * punctual_ + i) * kEmitterGuidePunctualBackWords];
-            if (w[0] != 0 || w[1] != 0) cache.import_learned_punctual(uint32_t(r), i, uint64_t(w[0]) | (uint64_t(w[1]) << 32));
-          }
-        }
-      },
-      16);
-  std::fill(words_.begin() + std::ptrdiff_t(back_), words_.end(), 0u);
+        },
+        16);
+  }, &staging_);
   cache.end_pass(samples);
   // The back tables at 0 on the device too, for the next pass.
   if (back_end_ > back_) {
@@ -117,9 +127,11 @@ bool EmitterGuideBuffer::fold_learning(WavefrontBatchRunner& runner, EmitterGuid
     context.submit_and_wait(cmd);
   }
   if (!cache.active()) return false;
-  pack_front(cache);
-  // Front and CDFs (adjacent sections) with the new tables.
-  context.upload(buffer, &words_[front_], (back_ - front_) * 4, (base_ + front_) * 4);
+  // Front and CDFs (adjacent sections) with the new tables; words_ keeps them too, for a whole
+  // upload after the buffer grows (BounceLayerDriver's host-built caches).
+  pack_front(cache, &words_[front_]);
+  context.write_ranges(buffer, {{(base_ + front_) * 4, (back_ - front_) * 4}},
+                       [&](char* mapped) { std::memcpy(mapped, &words_[front_], (back_ - front_) * 4); }, &staging_);
   return true;
 }
 

@@ -42,12 +42,16 @@ class EmitterGuideBuffer {
   bool fold_learning(WavefrontBatchRunner& runner, EmitterGuidingCache& cache, uint32_t samples);
 
  private:
-  void pack_front(const EmitterGuidingCache& cache);
+  // The front tables and CDFs, words [front_, back_) of the section, written from `at_front` on.
+  void pack_front(const EmitterGuidingCache& cache, uint32_t* at_front) const;
 
   std::vector<uint32_t> words_;  // the section, word 0 = guide buffer word base_
   size_t base_ = 0;
   size_t front_ = 0, back_ = 0, back_end_ = 0;  // section-relative
   uint32_t records_ = 0, patches_ = 0, punctual_ = 0;
+  // Host-visible, kept for the folds' read-backs and uploads (tens of MB at a million texels: a new
+  // pinned buffer per fold cost its allocation and page faults).
+  Buffer staging_;
 };
 
 }  // namespace exitance::vulkan

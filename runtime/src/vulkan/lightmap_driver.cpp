@@ -376,9 +376,12 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   // SVO: ramped throughout, as on the CPU, so its rebuilds (1, 2, 4, ... spp) end passes of the same sizes.
   if (svo_guide) policy.ramp = true, policy.ramp_below = PassPolicy{}.ramp_below;
   // Emitter guiding: ramped while every vertex learns, so its tables fold after the same samples as
-  // the CPU's; after that, untimed, passes as large as fill the work items (later samples learn
-  // only where a record samples what it learned, and fold after each pass).
-  if (emitter_guide && !policy.ramp) policy.ramp = true, policy.ramp_below = EmitterGuidingCache::kEveryLearningSamples;
+  // the CPU's; after that passes as large as fill the work items, under a time budget too (later
+  // samples learn only where a record samples what it learned, and fold after each pass: a fold
+  // reads back and uploads tens of MB, and the budget's 16-sample passes paid one per 16 samples;
+  // the budget still cuts the last pass). With grid guiding beside it, grid's ramp applies.
+  if (emitter_guide && !guide) policy.ramp = true, policy.ramp_below = EmitterGuidingCache::kEveryLearningSamples;
+  else if (emitter_guide && !policy.ramp) policy.ramp = true, policy.ramp_below = EmitterGuidingCache::kEveryLearningSamples;
   PassScheduler passes(settings, policy);
   // The estimate is hundreds of MB at millions of texels: a thread allocates it and touches its
   // pages, and makes the read-back's pinned staging buffer, while the host waits on the device's

@@ -495,11 +495,12 @@ void Context::upload_ranges(const Buffer& dst, const void* data, const std::vect
   write_ranges({RangeWrite::mirrored(dst, data, ranges)});
 }
 
-void Context::write_ranges(const Buffer& dst, const std::vector<ByteRange>& ranges, const std::function<void(char*)>& write) {
-  write_ranges({RangeWrite{&dst, ranges, write}});
+void Context::write_ranges(const Buffer& dst, const std::vector<ByteRange>& ranges, const std::function<void(char*)>& write,
+                           const Buffer* staging) {
+  write_ranges({RangeWrite{&dst, ranges, write}}, staging);
 }
 
-void Context::write_ranges(const std::vector<RangeWrite>& writes) {
+void Context::write_ranges(const std::vector<RangeWrite>& writes, const Buffer* given_staging) {
   std::vector<std::vector<VkBufferCopy>> regions(writes.size());
   std::vector<VkDeviceSize> start(writes.size(), 0);
   VkDeviceSize total = 0;
@@ -513,7 +514,8 @@ void Context::write_ranges(const std::vector<RangeWrite>& writes) {
   if (total == 0) return;
   Buffer own;
   bool leased = false;
-  const Buffer& staging = staging_for(total, own, leased);
+  const Buffer& staging = given_staging && given_staging->mapped() && given_staging->size() >= total
+                              ? *given_staging : staging_for(total, own, leased);
   StagingLease lease{small_staging_busy_, leased};
   VkCommandBuffer cmd = begin();
   for (size_t w = 0; w < writes.size(); ++w) {

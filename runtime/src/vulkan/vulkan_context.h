@@ -105,7 +105,9 @@ class Context {
   // Hands `write` a host-visible staging mapping to fill with the `ranges`' bytes, packed in order,
   // then copies them to those ranges of `dst` and waits: for uploads made on the way, without a host
   // copy in between (`write` is not called when the ranges hold no bytes).
-  void write_ranges(const Buffer& dst, const std::vector<ByteRange>& ranges, const std::function<void(char*)>& write);
+  // `staging`: as read_back_ranges's.
+  void write_ranges(const Buffer& dst, const std::vector<ByteRange>& ranges, const std::function<void(char*)>& write,
+                    const Buffer* staging = nullptr);
   // Several write_ranges to different buffers, staged together and copied in one submission waited
   // for once: an edit's few small uploads cost one round trip instead of one each.
   struct RangeWrite {
@@ -117,7 +119,7 @@ class Context {
     // The `ranges` of `dst` from the same ranges of `mirror`, a host copy of it (which must outlive the write).
     static RangeWrite mirrored(const Buffer& dst, const void* mirror, std::vector<ByteRange> ranges);
   };
-  void write_ranges(const std::vector<RangeWrite>& writes);
+  void write_ranges(const std::vector<RangeWrite>& writes, const Buffer* staging = nullptr);
   void download(const Buffer& src, void* data, VkDeviceSize size, VkDeviceSize offset = 0);
   // Copies the `ranges` of `src`, packed in order, into a host-visible staging buffer, waits, and
   // hands `read` its mapping: for read-backs converted on the way, without a host copy in between

@@ -40,6 +40,12 @@ struct BounceGatherStatistics {
   double noise_rms = 0;            // the total's noise at the stop, relative RMS
   bool tail_below_noise = false;   // false: stopped by --bounces, the time budget or the layer cap
   bool tail_completed = false;     // the geometric tail B_k r / (1 - r) was added to the last layer
+  // Wall-clock seconds of the host loop's parts (core/per_bounce_bake.cpp): the estimator's layer
+  // passes (on the GPU: the device's batches and the sums' read-back), the caches' builds, the tail
+  // estimates and the stop tests, and the assembly of the result after the loop.
+  struct Seconds {
+    double passes = 0, caches = 0, tail = 0, assembly = 0;
+  } seconds;
 };
 
 // Sums over `samples` samples (at least 2) whose mean is `mean` and whose variance of the mean is

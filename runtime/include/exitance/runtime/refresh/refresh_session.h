@@ -179,15 +179,16 @@ class RefreshSession {
   // estimate no L1) or without a bound.
   // `caches_on_host`: the layer caches built on the host and uploaded (the path before the device
   // built them; the same results bit for bit), for A/B timing.
-  LightmapEstimate bake_per_bounce(uint32_t spp, double time_budget_seconds, bool caches_on_host = false);
+  // Returns the result lightmap() returns, by reference, as bake_path.
+  const LightmapEstimate& bake_per_bounce(uint32_t spp, double time_budget_seconds, bool caches_on_host = false);
   // Whether lightmap() holds a bake_per_bounce() result.
   bool per_bounce() const;
   // The whole lightmap by grid-guided path tracing (--guiding grid, issue 11) on the session's
   // device: one bake, whose learned table swaps between its passes, so not progressive; otherwise
   // as bake_per_bounce (it replaces what lightmap() returns until the next restart, edit or refresh).
   // `mode`: Grid or Svo (the bundle's svo.bin is the octree; its exitance seeds the first fields).
-  LightmapEstimate bake_guided(uint32_t spp, double time_budget_seconds, float guiding_mix = 0.5f,
-                               GuidingMode mode = GuidingMode::Grid);
+  const LightmapEstimate& bake_guided(uint32_t spp, double time_budget_seconds, float guiding_mix = 0.5f,
+                                      GuidingMode mode = GuidingMode::Grid);
   // Whether lightmap() holds a bake_guided() result.
   bool guided() const;
   // The whole lightmap by unguided path tracing in one run, as bake --backend vulkan runs it (ramped
