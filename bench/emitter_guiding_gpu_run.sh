@@ -25,7 +25,7 @@ run() {  # NAME ARGS...
   $R $B -o $W/$name.bake --seed 3 $common "$@" > $W/$name.json
   python3 -c "
 import json; r=json.load(open('$W/$name.json'))
-print('$name', 'lighting_s %.3f'%r['lighting_seconds'], 'spp', r['samples_per_texel'], 'rays %.3g'%r['rays'], 'rays_per_s %.3g'%r['rays_per_second'], 'guide', r.get('emitter_guiding'))" >> $S
+print('$name', 'lighting_s %.3f'%r['lighting_seconds'], 'spp', r['samples_per_texel'], 'rays %.3g'%r['rays'], 'rays_per_s %.3g'%r['rays_per_second'], 'guide', r.get('emitter_guiding'))" >> $S  # its setup_seconds, folds, fold_seconds: the host's part
   list="$list $W/$name.bake"
 }
 for t in ${TIMES:-0.25 1 4}; do

@@ -290,6 +290,10 @@ TEST(Relight, ReproducesAVulkanEmitterGuidedBakeBitForBit) {
   EXPECT_EQ(report["integrator"], "path");
   ASSERT_TRUE(report.contains("emitter_guiding")) << report.dump();
   EXPECT_GT(report["emitter_guiding"]["records_sampling_learned"].get<uint32_t>(), 0u);
+  // The host's share is reported: a fold after each pass while the cache is active (at least the
+  // first pass's), and the setup.
+  EXPECT_GE(report["emitter_guiding"]["folds"].get<uint32_t>(), 1u);
+  EXPECT_GT(report["emitter_guiding"]["setup_seconds"].get<double>(), 0.0);
   EXPECT_GE(expect_same_pages(baked, output, "the emitter-guided bake's"), 1u);
   options.output = (dir / "refused.bake").string();
   options.frames = 2;

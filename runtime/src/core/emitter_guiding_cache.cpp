@@ -119,7 +119,10 @@ EmitterGuidingCache::EmitterGuidingCache(const LightingScene& scene, const Texel
     punctual_back_.reset(new std::atomic<uint64_t>[records * punctual_count_]);
     for (size_t i = 0; i < records * punctual_count_; ++i) punctual_back_[i].store(0, std::memory_order_relaxed);
   }
-  for (uint32_t r = 0; r < records; ++r) rebuild(r);
+  // Each record's tables are its own (as in swap): on all cores.
+  for_each_chunk(records, [&](size_t begin, size_t end) {
+    for (size_t r = begin; r < end; ++r) rebuild(uint32_t(r));
+  }, 16);
 }
 
 std::unique_ptr<EmitterGuidingCache> EmitterGuidingCache::for_bake(const LightingScene& scene,

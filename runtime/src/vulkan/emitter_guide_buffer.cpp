@@ -45,7 +45,7 @@ EmitterGuideBuffer::EmitterGuideBuffer(const EmitterGuidingCache& cache, size_t 
   if (base_ + back_end_ >= (size_t(1) << 32))
     throw std::runtime_error("Vulkan backend: --emitter-guiding on: " + std::to_string(records_) + " records of " +
                              std::to_string(patches_) + " patches do not fit the guide buffer (use fewer --guiding-grid-cells)");
-  words_.assign(back_end_, 0u);
+  words_.assign(back_, 0u);  // the back sums live on the device alone (zeroed there, read back by the folds)
   auto absolute = [&](size_t at) { return uint32_t(base_ + at); };
   words_[kEmitterGuideLocator] = absolute(locator_at);
   words_[kEmitterGuideRecords] = records_;
@@ -90,6 +90,11 @@ void EmitterGuideBuffer::upload(WavefrontBatchRunner& runner) const {
   const Buffer& buffer = runner.buffers().probes.sh_sums;
   if (buffer.size() < end_word() * 4) throw std::logic_error("EmitterGuideBuffer::upload: the guide buffer was not grown");
   context.upload(buffer, words_.data(), words_.size() * 4, base_ * 4);
+  if (back_end_ > back_) {
+    VkCommandBuffer cmd = context.begin();
+    vkCmdFillBuffer(cmd, buffer.handle(), (base_ + back_) * 4, (back_end_ - back_) * 4, 0);
+    context.submit_and_wait(cmd);
+  }
 }
 
 bool EmitterGuideBuffer::fold_learning(WavefrontBatchRunner& runner, EmitterGuidingCache& cache, uint32_t samples) {

@@ -30,7 +30,7 @@ class EmitterGuideBuffer {
   EmitterGuideBuffer(const EmitterGuidingCache& cache, size_t base);
 
   // Guide buffer words needed up to the end of this section.
-  size_t end_word() const { return base_ + words_.size(); }
+  size_t end_word() const { return base_ + back_end_; }
   // GpuParams::emitter_guide while the cache is active: the section's first word.
   uint32_t params_offset() const { return uint32_t(base_); }
 
@@ -45,7 +45,7 @@ class EmitterGuideBuffer {
   // The front tables and CDFs, words [front_, back_) of the section, written from `at_front` on.
   void pack_front(const EmitterGuidingCache& cache, uint32_t* at_front) const;
 
-  std::vector<uint32_t> words_;  // the section, word 0 = guide buffer word base_
+  std::vector<uint32_t> words_;  // the section up to its back sums, word 0 = guide buffer word base_
   size_t base_ = 0;
   size_t front_ = 0, back_ = 0, back_end_ = 0;  // section-relative
   uint32_t records_ = 0, patches_ = 0, punctual_ = 0;

@@ -336,6 +336,8 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   // its fold between passes; its section follows the other guide's words in the guide buffer.
   std::unique_ptr<EmitterGuidingCache> emitter_guide;
   std::optional<EmitterGuideBuffer> emitter_buffer;
+  LightmapEstimate::EmitterGuidingReport emitter_costs;  // its host seconds (setup, folds)
+  const auto emitter_setup_start = Clock::now();
   if (settings.emitter_guiding) {
     if (share) throw std::invalid_argument("Vulkan backend: --emitter-guiding runs in one process only, not under mpirun with several ranks");
     if (svo_guide)
@@ -364,6 +366,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     }
     emitter_buffer->upload(runner_);
     a.params.emitter_guide = emitter_buffer->params_offset();
+    emitter_costs.setup_seconds = std::chrono::duration<double>(Clock::now() - emitter_setup_start).count();
   }
   PassPolicy policy;
   // Untimed: as many samples per batch as fill the work items; a budget or target error: ramped passes.
@@ -410,8 +413,13 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
       if (share) share->work.texel_samples += uint64_t(a.work_list.size()) * pass;
     }
     if (learning) guide_buffer->fold_learning(runner_, *guide);  // this pass's learning is the next pass's table
-    if (emitter_buffer && a.params.emitter_guide != 0u && !emitter_buffer->fold_learning(runner_, *emitter_guide, first + pass))
-      a.params.emitter_guide = 0;  // no record gains: the default sampling from here, as on the CPU
+    if (emitter_buffer && a.params.emitter_guide != 0u) {
+      const auto fold_start = Clock::now();
+      if (!emitter_buffer->fold_learning(runner_, *emitter_guide, first + pass))
+        a.params.emitter_guide = 0;  // no record gains: the default sampling from here, as on the CPU
+      emitter_costs.fold_seconds += std::chrono::duration<double>(Clock::now() - fold_start).count();
+      ++emitter_costs.folds;
+    }
     if (choice && !choice->decided() && first + pass >= choice->pilot()) {  // the pilot is complete on every texel
       import_strategy_sums(guide_buffer->download_auto_sums(runner_), *choice);
       choice->decide();
@@ -455,6 +463,9 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   if (svo_guide && settings.inspect_svo_guiding) settings.inspect_svo_guiding(*svo_guide);
   if (emitter_guide) {
     emitter_guide->report(estimate.emitter_guiding);
+    estimate.emitter_guiding.setup_seconds = emitter_costs.setup_seconds;
+    estimate.emitter_guiding.fold_seconds = emitter_costs.fold_seconds;
+    estimate.emitter_guiding.folds = emitter_costs.folds;
     if (settings.inspect_emitter_guiding) settings.inspect_emitter_guiding(*emitter_guide);
   }
   if (settings.work_share) settings.work_share->work.rays += estimate.rays;

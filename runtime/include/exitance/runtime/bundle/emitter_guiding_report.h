@@ -14,7 +14,10 @@ inline nlohmann::json emitter_guiding_json(const LightmapEstimate::EmitterGuidin
           {"patches", e.patches},
           {"punctual_lights", e.punctual_lights},
           {"memory_bytes", e.memory_bytes},
-          {"dropped_after_learning", e.dropped}};
+          {"dropped_after_learning", e.dropped},
+          {"setup_seconds", e.setup_seconds},
+          {"folds", e.folds},
+          {"fold_seconds", e.fold_seconds}};
 }
 
 }  // namespace exitance

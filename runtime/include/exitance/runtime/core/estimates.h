@@ -82,6 +82,10 @@ struct LightmapEstimate {
     uint32_t punctual_lights = 0;
     uint64_t memory_bytes = 0;
     bool dropped = false;  // no record gained enough after the learning samples: the default from there on
+    // Vulkan backend's path tracing (0 elsewhere): the host's seconds making the cache and putting
+    // it on the device, and folding the device's learning into it between passes (folds of them).
+    double setup_seconds = 0, fold_seconds = 0;
+    uint32_t folds = 0;
   } emitter_guiding;
   bool adaptive = false;         // samples were planned per texel (core/adaptive_sampling_plan.h)
   uint32_t adaptive_pilot = 0;   // samples per texel of the pilot before the plan (0: no plan made)
