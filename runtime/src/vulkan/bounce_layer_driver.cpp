@@ -222,14 +222,15 @@ void BounceLayerDriver::build_cache(size_t layer, const std::vector<Vec3>& means
                                                     uint32_t(5 * 4), spirv_bounce_cache, sizeof(spirv_bounce_cache), 1,
                                                     "bounce_cache.comp");
   }
-  // Means and validity packed straight into the staging mapping, on all cores.
+  // Means and validity packed straight into the kept staging mapping, on all cores.
+  reserve_staging(VkDeviceSize(texels) * 6 * 8);  // the passes' read-backs' size, so it is made once
   context.write_ranges(cache_means_, {{0, VkDeviceSize(texels) * sizeof(Vec4)}}, [&](char* mapped) {
     Vec4* packed = reinterpret_cast<Vec4*>(mapped);
     for_each_chunk(texels, [&](size_t begin, size_t end) {
       for (size_t i = begin; i < end; ++i)
         packed[i] = Vec4(means[i].x, means[i].y, means[i].z, valid.empty() || valid[i] ? 1.0f : 0.0f);
     });
-  });
+  }, &staging_);
   // The cache buffer may have grown since the descriptors were written.
   const std::array<VkDescriptorBufferInfo, 5> infos{{{runner_.buffers().probes.sh_sums.handle(), 0, VK_WHOLE_SIZE},
                                                      {cache_texels_.handle(), 0, VK_WHOLE_SIZE},
@@ -320,8 +321,7 @@ void BounceLayerDriver::estimate(const BounceLayerPass& pass, const std::vector<
   // listed texel's own entries on all cores; the back-face counts in the first bounce slot, read
   // back only where the pass counts them (B_0).
   const VkDeviceSize sum_bytes = VkDeviceSize(texels) * 6 * 8;
-  if (sum_bytes > 0 && read_staging_.size() < sum_bytes)
-    read_staging_ = context.create_buffer(sum_bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+  reserve_staging(sum_bytes);
   context.read_back_ranges(buffers.texels.sums, {{0, sum_bytes}}, [&](const char* mapped) {
     const double* sums = reinterpret_cast<const double*>(mapped);
     for_each_chunk(work_list_.size(), [&](size_t begin, size_t end) {
@@ -334,14 +334,19 @@ void BounceLayerDriver::estimate(const BounceLayerPass& pass, const std::vector<
         if (pass.texel_rays) pass.texel_rays[i] = 0;  // not counted per texel on the device: an even split
       }
     });
-  }, &read_staging_);
+  }, &staging_);
   if (pass.back_faces)
     context.read_back_ranges(buffers.texels.bounce_sums, {{0, VkDeviceSize(texels) * 3 * 8}}, [&](const char* mapped) {
       const double* counts = reinterpret_cast<const double*>(mapped);
       for_each_chunk(work_list_.size(), [&](size_t begin, size_t end) {
         for (size_t w = begin; w < end; ++w) pass.back_faces[work_list_[w]] += uint32_t(counts[size_t(work_list_[w]) * 3]);
       });
-    }, &read_staging_);
+    }, &staging_);
+}
+
+void BounceLayerDriver::reserve_staging(VkDeviceSize bytes) {
+  if (bytes > 0 && staging_.size() < bytes)
+    staging_ = runner_.context().create_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
 }
 
 BounceGatherCounts BounceLayerDriver::counts() const {

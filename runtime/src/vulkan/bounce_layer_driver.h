@@ -61,7 +61,10 @@ class BounceLayerDriver final : public BounceLayerEstimator {
   size_t layer_words_ = 0, first_layer_word_ = 0;
   std::vector<uint64_t> uploaded_versions_;     // per layer, the cache version on the device (0: none)
   std::vector<uint32_t> work_list_;
-  Buffer read_staging_;  // host-visible: each pass's sums come back through it
+  // Host-visible, kept: each pass's sums come back and each cache's means go up through it (a new
+  // pinned buffer per transfer cost its allocation and page faults: 48 MB at 1 M texels).
+  Buffer staging_;
+  void reserve_staging(VkDeviceSize bytes);
   // Device-built caches (bounce_cache.comp): the kernel, per live texel its page texel, position and
   // normal (uploaded once), the means of the layer being built, a fill flag per page texel, the pages.
   // Emitter guiding (emitter_guide_buffer.h) on the direct-light samples (B_0's, and B_1's traced
