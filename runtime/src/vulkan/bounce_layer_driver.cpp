@@ -91,7 +91,9 @@ void BounceLayerDriver::prepare() {
   WavefrontBuffers& buffers = runner_.buffers();
   max_work_ = runner_.work_items_per_batch(kResultBytes);
   std::vector<GpuSurfacePoint> start_points(texels);
-  for (size_t i = 0; i < texels; ++i) start_points[i] = texel_start_point(gbuffer_.texels[i]);
+  for_each_chunk(texels, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) start_points[i] = texel_start_point(gbuffer_.texels[i]);
+  });
   buffers.items.reserve(context, texels);
   buffers.texels.reserve(context, texels, 1);
   buffers.results.reserve(context, max_work_ * kResultBytes);
@@ -200,17 +202,19 @@ void BounceLayerDriver::build_cache(size_t layer, const std::vector<Vec3>& means
     }
     page_texels_ = first.back();
     std::vector<uint32_t> words(std::max<size_t>(texels, 1) * 8, 0xFFFFFFFFu);
-    for (size_t i = 0; i < texels; ++i) {
-      const LiveTexel& t = gbuffer_.texels[i];
-      uint32_t* w = &words[i * 8];
-      const bool on_page = t.page < gbuffer_.pages.size() && t.x < uint32_t(gbuffer_.pages[t.page].width) &&
-                           t.y < uint32_t(gbuffer_.pages[t.page].height);
-      w[0] = on_page ? first[t.page] + t.y * uint32_t(gbuffer_.pages[t.page].width) + t.x : 0xFFFFFFFFu;
-      const float values[6] = {t.position.x, t.position.y, t.position.z, t.geometric_normal.x, t.geometric_normal.y,
-                               t.geometric_normal.z};
-      for (int c = 0; c < 6; ++c) w[1 + c] = guide_float_bits(values[c]);
-      w[7] = 0;
-    }
+    for_each_chunk(texels, [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) {
+        const LiveTexel& t = gbuffer_.texels[i];
+        uint32_t* w = &words[i * 8];
+        const bool on_page = t.page < gbuffer_.pages.size() && t.x < uint32_t(gbuffer_.pages[t.page].width) &&
+                             t.y < uint32_t(gbuffer_.pages[t.page].height);
+        w[0] = on_page ? first[t.page] + t.y * uint32_t(gbuffer_.pages[t.page].width) + t.x : 0xFFFFFFFFu;
+        const float values[6] = {t.position.x, t.position.y, t.position.z, t.geometric_normal.x, t.geometric_normal.y,
+                                 t.geometric_normal.z};
+        for (int c = 0; c < 6; ++c) w[1 + c] = guide_float_bits(values[c]);
+        w[7] = 0;
+      }
+    });
     if (page_words.empty()) page_words.assign(4, 0u);
     cache_texels_ = context.create_storage_buffer(words.size() * 4);
     context.upload(cache_texels_, words.data(), words.size() * 4);
