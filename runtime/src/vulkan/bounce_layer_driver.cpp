@@ -16,6 +16,9 @@ namespace {
 
 // Per work item: result slot 0 (RGB) and the back-face flag (bindings.glsl bounce_back_face_index).
 constexpr size_t kResultBytes = 16;
+// Per texel, a pass's sums as read back (RGB and their squares, doubles): the largest transfer
+// through the kept staging buffer (a cache's means are 16 bytes per texel).
+constexpr VkDeviceSize kSumBytesPerTexel = 6 * 8;
 
 float word_bits(uint32_t u) {
   float f;
@@ -227,7 +230,7 @@ void BounceLayerDriver::build_cache(size_t layer, const std::vector<Vec3>& means
                                                     "bounce_cache.comp");
   }
   // Means and validity packed straight into the kept staging mapping, on all cores.
-  reserve_staging(VkDeviceSize(texels) * 6 * 8);  // the passes' read-backs' size, so it is made once
+  context.keep_staging(staging_, texels * kSumBytesPerTexel);  // the passes' read-backs' size: made once
   context.write_ranges(cache_means_, {{0, VkDeviceSize(texels) * sizeof(Vec4)}}, [&](char* mapped) {
     Vec4* packed = reinterpret_cast<Vec4*>(mapped);
     for_each_chunk(texels, [&](size_t begin, size_t end) {
@@ -324,8 +327,8 @@ void BounceLayerDriver::estimate(const BounceLayerPass& pass, const std::vector<
   // kept for them (a new 48 MB one per pass at 1 M texels cost its allocation and page faults), each
   // listed texel's own entries on all cores; the back-face counts in the first bounce slot, read
   // back only where the pass counts them (B_0).
-  const VkDeviceSize sum_bytes = VkDeviceSize(texels) * 6 * 8;
-  reserve_staging(sum_bytes);
+  const VkDeviceSize sum_bytes = texels * kSumBytesPerTexel;
+  context.keep_staging(staging_, sum_bytes);
   context.read_back_ranges(buffers.texels.sums, {{0, sum_bytes}}, [&](const char* mapped) {
     const double* sums = reinterpret_cast<const double*>(mapped);
     for_each_chunk(work_list_.size(), [&](size_t begin, size_t end) {
@@ -346,11 +349,6 @@ void BounceLayerDriver::estimate(const BounceLayerPass& pass, const std::vector<
         for (size_t w = begin; w < end; ++w) pass.back_faces[work_list_[w]] += uint32_t(counts[size_t(work_list_[w]) * 3]);
       });
     }, &staging_);
-}
-
-void BounceLayerDriver::reserve_staging(VkDeviceSize bytes) {
-  if (bytes > 0 && staging_.size() < bytes)
-    staging_ = runner_.context().create_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
 }
 
 BounceGatherCounts BounceLayerDriver::counts() const {

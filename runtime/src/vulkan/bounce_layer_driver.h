@@ -61,18 +61,18 @@ class BounceLayerDriver final : public BounceLayerEstimator {
   size_t layer_words_ = 0, first_layer_word_ = 0;
   std::vector<uint64_t> uploaded_versions_;     // per layer, the cache version on the device (0: none)
   std::vector<uint32_t> work_list_;
-  // Host-visible, kept: each pass's sums come back and each cache's means go up through it (a new
-  // pinned buffer per transfer cost its allocation and page faults: 48 MB at 1 M texels).
+  // Host-visible, kept (Context::keep_staging): each pass's sums come back and each cache's means go
+  // up through it (a new pinned buffer per transfer cost its allocation and page faults: 48 MB at
+  // 1 M texels).
   Buffer staging_;
-  void reserve_staging(VkDeviceSize bytes);
-  // Device-built caches (bounce_cache.comp): the kernel, per live texel its page texel, position and
-  // normal (uploaded once), the means of the layer being built, a fill flag per page texel, the pages.
   // Emitter guiding (emitter_guide_buffer.h) on the direct-light samples (B_0's, and B_1's traced
   // ones at gather hits), one cache through all layers' passes, folded before each pass as the CPU's
   // estimator does (cpu/cpu_bounce_integrator.cpp).
   std::unique_ptr<EmitterGuidingCache> emitter_guide_;
   std::unique_ptr<EmitterGuideBuffer> emitter_buffer_;
   uint32_t learned_samples_ = 0;
+  // Device-built caches (bounce_cache.comp): the kernel, per live texel its page texel, position and
+  // normal (uploaded once), the means of the layer being built, a fill flag per page texel, the pages.
   std::unique_ptr<ComputeKernel> cache_kernel_;
   Buffer cache_texels_, cache_means_, cache_flags_, cache_pages_;
   size_t page_texels_ = 0;

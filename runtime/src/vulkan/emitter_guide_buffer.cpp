@@ -90,19 +90,20 @@ void EmitterGuideBuffer::upload(WavefrontBatchRunner& runner) const {
   const Buffer& buffer = runner.buffers().probes.sh_sums;
   if (buffer.size() < end_word() * 4) throw std::logic_error("EmitterGuideBuffer::upload: the guide buffer was not grown");
   context.upload(buffer, words_.data(), words_.size() * 4, base_ * 4);
-  if (back_end_ > back_) {
-    VkCommandBuffer cmd = context.begin();
-    vkCmdFillBuffer(cmd, buffer.handle(), (base_ + back_) * 4, (back_end_ - back_) * 4, 0);
-    context.submit_and_wait(cmd);
-  }
+  clear_back(context, buffer);
+}
+
+void EmitterGuideBuffer::clear_back(Context& context, const Buffer& buffer) const {
+  if (back_end_ == back_) return;
+  VkCommandBuffer cmd = context.begin();
+  vkCmdFillBuffer(cmd, buffer.handle(), (base_ + back_) * 4, (back_end_ - back_) * 4, 0);
+  context.submit_and_wait(cmd);
 }
 
 bool EmitterGuideBuffer::fold_learning(WavefrontBatchRunner& runner, EmitterGuidingCache& cache, uint32_t samples) {
   Context& context = runner.context();
   const Buffer& buffer = runner.buffers().probes.sh_sums;
-  const size_t staged_words = std::max(back_end_ - back_, back_ - front_);
-  if (staged_words > 0 && staging_.size() < staged_words * 4)
-    staging_ = context.create_buffer(staged_words * 4, VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+  context.keep_staging(staging_, std::max(back_end_ - back_, back_ - front_) * 4);
   const size_t punctual_back_at = words_[kEmitterGuidePunctualBack] - base_;
   // The back sums imported straight from the read-back's mapping, records on all cores (the cache's
   // back tables add atomically; each record's rows are its own).
@@ -125,12 +126,7 @@ bool EmitterGuideBuffer::fold_learning(WavefrontBatchRunner& runner, EmitterGuid
         16);
   }, &staging_);
   cache.end_pass(samples);
-  // The back tables at 0 on the device too, for the next pass.
-  if (back_end_ > back_) {
-    VkCommandBuffer cmd = context.begin();
-    vkCmdFillBuffer(cmd, buffer.handle(), (base_ + back_) * 4, (back_end_ - back_) * 4, 0);
-    context.submit_and_wait(cmd);
-  }
+  clear_back(context, buffer);  // at 0 on the device too, for the next pass
   if (!cache.active()) return false;
   // Front and CDFs (adjacent sections) with the new tables; words_ keeps them too, for a whole
   // upload after the buffer grows (BounceLayerDriver's host-built caches).

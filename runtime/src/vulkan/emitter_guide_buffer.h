@@ -44,13 +44,15 @@ class EmitterGuideBuffer {
  private:
   // The front tables and CDFs, words [front_, back_) of the section, written from `at_front` on.
   void pack_front(const EmitterGuidingCache& cache, uint32_t* at_front) const;
+  // The back sums at 0 on the device.
+  void clear_back(Context& context, const Buffer& buffer) const;
 
   std::vector<uint32_t> words_;  // the section up to its back sums, word 0 = guide buffer word base_
   size_t base_ = 0;
   size_t front_ = 0, back_ = 0, back_end_ = 0;  // section-relative
   uint32_t records_ = 0, patches_ = 0, punctual_ = 0;
-  // Host-visible, kept for the folds' read-backs and uploads (tens of MB at a million texels: a new
-  // pinned buffer per fold cost its allocation and page faults).
+  // Host-visible, kept (Context::keep_staging) for the folds' read-backs and uploads (tens of MB at
+  // a million texels: a new pinned buffer per fold cost its allocation and page faults).
   Buffer staging_;
 };
 

@@ -383,8 +383,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   // samples learn only where a record samples what it learned, and fold after each pass: a fold
   // reads back and uploads tens of MB, and the budget's 16-sample passes paid one per 16 samples;
   // the budget still cuts the last pass). With grid guiding beside it, grid's ramp applies.
-  if (emitter_guide && !guide) policy.ramp = true, policy.ramp_below = EmitterGuidingCache::kEveryLearningSamples;
-  else if (emitter_guide && !policy.ramp) policy.ramp = true, policy.ramp_below = EmitterGuidingCache::kEveryLearningSamples;
+  if (emitter_guide && (!guide || !policy.ramp)) policy.ramp = true, policy.ramp_below = EmitterGuidingCache::kEveryLearningSamples;
   PassScheduler passes(settings, policy);
   // The estimate is hundreds of MB at millions of texels: a thread allocates it and touches its
   // pages, and makes the read-back's pinned staging buffer, while the host waits on the device's
@@ -462,10 +461,8 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   if (guide && settings.inspect_guiding) settings.inspect_guiding(*guide);
   if (svo_guide && settings.inspect_svo_guiding) settings.inspect_svo_guiding(*svo_guide);
   if (emitter_guide) {
+    estimate.emitter_guiding = emitter_costs;  // the host's seconds; report() fills in the cache's part
     emitter_guide->report(estimate.emitter_guiding);
-    estimate.emitter_guiding.setup_seconds = emitter_costs.setup_seconds;
-    estimate.emitter_guiding.fold_seconds = emitter_costs.fold_seconds;
-    estimate.emitter_guiding.folds = emitter_costs.folds;
     if (settings.inspect_emitter_guiding) settings.inspect_emitter_guiding(*emitter_guide);
   }
   if (settings.work_share) settings.work_share->work.rays += estimate.rays;

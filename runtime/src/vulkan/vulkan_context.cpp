@@ -439,8 +439,9 @@ struct StagingLease {
   }
 };
 
-const Buffer& Context::staging_for(VkDeviceSize size, Buffer& own, bool& leased) {
+const Buffer& Context::staging_for(VkDeviceSize size, Buffer& own, bool& leased, const Buffer* given) {
   leased = false;
+  if (given && given->mapped() && given->size() >= size) return *given;
   if (size <= kReusedStagingLimit && !small_staging_busy_) {
     if (!small_staging_.handle() || small_staging_.size() < size) {
       // Grown to the next power of two: a moved instance's edit writes a few megabytes each time, and
@@ -455,6 +456,11 @@ const Buffer& Context::staging_for(VkDeviceSize size, Buffer& own, bool& leased)
   }
   own = create_buffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
   return own;
+}
+
+void Context::keep_staging(Buffer& kept, VkDeviceSize bytes) {
+  if (bytes > 0 && kept.size() < bytes)
+    kept = create_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
 }
 
 void Context::upload(const Buffer& dst, const void* data, VkDeviceSize size, VkDeviceSize offset) {
@@ -514,8 +520,7 @@ void Context::write_ranges(const std::vector<RangeWrite>& writes, const Buffer* 
   if (total == 0) return;
   Buffer own;
   bool leased = false;
-  const Buffer& staging = given_staging && given_staging->mapped() && given_staging->size() >= total
-                              ? *given_staging : staging_for(total, own, leased);
+  const Buffer& staging = staging_for(total, own, leased, given_staging);
   StagingLease lease{small_staging_busy_, leased};
   VkCommandBuffer cmd = begin();
   for (size_t w = 0; w < writes.size(); ++w) {
@@ -537,8 +542,7 @@ void Context::read_back_ranges(const Buffer& src, const std::vector<ByteRange>& 
   if (packed == 0) return;
   Buffer own;
   bool leased = false;
-  const Buffer& through =
-      staging && staging->mapped() && staging->size() >= packed ? *staging : staging_for(packed, own, leased);
+  const Buffer& through = staging_for(packed, own, leased, staging);
   StagingLease lease{small_staging_busy_, leased};
   VkCommandBuffer cmd = begin();
   vkCmdCopyBuffer(cmd, src.handle(), through.handle(), uint32_t(regions.size()), regions.data());

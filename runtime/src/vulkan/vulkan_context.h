@@ -128,6 +128,9 @@ class Context {
   // allocating pinned memory is part of a read-back's cost), else one is made here.
   void read_back_ranges(const Buffer& src, const std::vector<ByteRange>& ranges, const std::function<void(const char*)>& read,
                         const Buffer* staging = nullptr);
+  // Grows `kept`, a caller's host-visible staging buffer for the `staging` arguments above, to at
+  // least `bytes` (made once for the largest of a run's transfers, then reused).
+  void keep_staging(Buffer& kept, VkDeviceSize bytes);
 
   VkCommandBuffer begin();  // the context's single command buffer, reset
   // Submits the command buffer and waits for its fence (bounded by fence_timeout_seconds); throws
@@ -190,9 +193,10 @@ class Context {
   bool small_staging_busy_ = false;
   static constexpr VkDeviceSize kSmallStagingBytes = 4 * 1024 * 1024;
   static constexpr VkDeviceSize kReusedStagingLimit = 16 * 1024 * 1024;
-  // The reused staging when `size` fits and it is free (marked busy until `own` is released by the
+  // `given` when it is a mapped buffer of at least `size` bytes (a caller's kept staging), else the
+  // reused staging when `size` fits and it is free (marked busy until `own` is released by the
   // caller's scope: see StagingLease in the .cpp), else a new buffer in `own`.
-  const Buffer& staging_for(VkDeviceSize size, Buffer& own, bool& leased);
+  const Buffer& staging_for(VkDeviceSize size, Buffer& own, bool& leased, const Buffer* given = nullptr);
   bool lost_ = false;
   bool hung_ = false;
   Waits waits_;
