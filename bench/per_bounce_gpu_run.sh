@@ -4,6 +4,7 @@
 # and cornell.bake, building.bake, city.bake: manifest, probes.bin, scene.bin, svo.bin of CPU bakes).
 # Per scene: a two-seed 4096-spp path-traced reference, then path at 64/256/1024 spp and the
 # per-bounce mode at 16/64/256 spp, timed, and each one's relMSE against the reference. With
+# Each per-bounce line ends with the host loop's `bounces.seconds` (passes, caches, tail, assembly).
 # CACHES="device host" the per-bounce runs are repeated with their layer caches built on the host
 # (exitance-relight --bounce-caches host, the earlier path; the same results bit for bit): the A/B of
 # building them on the device (docs/lighting-core.md "Per-bounce mode").
@@ -33,7 +34,8 @@ for scene in ${SCENES:-cornell building city}; do
     for spp in 16 64 256; do
       $R $B -o /tmp/w/$scene-bounces$spp-$caches.bake --spp $spp --seed 1 --integrator bounces --bounce-caches $caches \
         --json > /tmp/w/r.json
-      echo "$scene bounces ($caches caches) $spp spp: lighting $(field lighting_seconds /tmp/w/r.json) s, rays $(field rays /tmp/w/r.json)"
+      echo "$scene bounces ($caches caches) $spp spp: lighting $(field lighting_seconds /tmp/w/r.json) s, rays $(field rays /tmp/w/r.json)," \
+        "host loop $(python3 -c "import json; b=json.load(open('/tmp/w/r.json')).get('bounces', {}); s=b.get('seconds', {}); print(' '.join('%s %.3f' % kv for kv in sorted(s.items())), '; layers', len(b.get('samples_per_layer', [])))")"
       tests="$tests /tmp/w/$scene-bounces$spp-$caches.bake"
     done
   done
