@@ -33,10 +33,12 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <memory>
 
 #include "exitance/common/bounce_gather.h"
 #include "exitance/common/gpu_layout.h"
 #include "exitance/runtime/core/bounce_tail.h"
+#include "exitance/runtime/core/huge_pages.h"
 #include "exitance/runtime/core/partial_layer_pass.h"
 #include "exitance/runtime/core/parallel_chunks.h"
 #include "exitance/runtime/core/pass_scheduler.h"
@@ -61,14 +63,23 @@ constexpr double kAfterLoopPerTail = 2.0;
 // multiply the last bounce's noise by 19 or more; the stopping rule alone bounds their truncation.
 constexpr double kMaxCompletedTailRatio = 0.95;
 
+// `count` zeros, first touched on all cores and in huge pages where the kernel allows: a layer's
+// sums are 48 MB at 1 M texels, and what zeroing them costs is the page faults, not the writes.
+std::unique_ptr<double[]> zeros_on_all_cores(size_t count) {
+  std::unique_ptr<double[]> values = std::make_unique_for_overwrite<double[]>(count);
+  advise_huge_pages(values.get(), count * sizeof(double));
+  for_each_chunk(count, [&](size_t begin, size_t end) { std::fill(values.get() + begin, values.get() + end, 0.0); }, 1 << 18);
+  return values;
+}
+
 // Per texel sums of one layer's samples (RGB, doubles: long runs keep precision).
 struct Layer {
-  std::vector<double> sum, sum_squared;
+  std::unique_ptr<double[]> sum, sum_squared;
   std::vector<uint32_t> back_faces;  // B_0 only: samples whose continuation ray met a back face
   uint32_t samples = 0;  // every texel's
   // Empty, or per texel 1 where the partial last pass of a time budget gave it sample `samples` too.
   std::vector<uint8_t> one_more;
-  explicit Layer(size_t texels) : sum(texels * 3, 0.0), sum_squared(texels * 3, 0.0) {}
+  explicit Layer(size_t texels) : sum(zeros_on_all_cores(texels * 3)), sum_squared(zeros_on_all_cores(texels * 3)) {}
   uint32_t samples_at(size_t i) const { return samples + (one_more.empty() ? 0u : uint32_t(one_more[i])); }
   Vec3 mean(size_t i) const {
     const uint32_t count = samples_at(i);
@@ -102,16 +113,13 @@ double area_of(const LiveTexel& t) {
   return s > 0 && std::isfinite(s) ? s * s : 1.0;
 }
 
-BounceTail tail_after(const std::vector<Layer>& layers, const TexelGBuffer& gbuffer) {
+// `in`: the caller's, kept from one tail to the next (every entry is written here; allocating 56 MB
+// per tail at 1 M texels cost more than computing it).
+BounceTail tail_after(const std::vector<Layer>& layers, const TexelGBuffer& gbuffer, BounceTailInputs& in) {
   const size_t n = gbuffer.texels.size(), last = layers.size() - 1;
-  BounceTailInputs in;
-  in.area.resize(n);
-  in.previous_bounce.resize(n);
-  in.last_bounce.resize(n);
-  in.previous_bounce_variance.resize(n);
-  in.last_bounce_variance.resize(n);
-  in.total.resize(n);
-  in.total_variance.resize(n);
+  for (std::vector<double>* v : {&in.area, &in.previous_bounce, &in.last_bounce, &in.previous_bounce_variance,
+                                 &in.last_bounce_variance, &in.total, &in.total_variance})
+    v->resize(n);
   // Variance of the luminance of a layer's mean, its channels taken as fully correlated (they are
   // nearly so: one ray lights all three).
   auto luminance_variance = [&](const Layer& layer, size_t i) {
@@ -152,6 +160,9 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
 
   // The result's arrays are allocated as the layers are (their first touch costs about as much as
   // filling them), so the assembly after the loop only writes: less of it is left past the budget.
+  // The layer rows are reserved for the layer cap at once (address space, half of kLayerMemoryLimit):
+  // growing them a layer at a time re-copied and re-faulted every earlier row (0.4 of the 0.6 s
+  // outside the timed parts of a 2-spp Cornell run on lavapipe, 2 cores).
   LightmapEstimate estimate;
   estimate.texels.resize(n);
   std::vector<Layer> layers;
@@ -167,6 +178,8 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
     cache_seconds.push_back(0.0);
     estimate.bounces.resize(layers.size() * n * 3, 0.0);
   };
+  estimate.bounces.reserve(size_t(layer_cap) * n * 3);
+  advise_huge_pages(estimate.bounces.data(), estimate.bounces.capacity() * sizeof(double));
   add_layer();
   layers[0].back_faces.assign(n, 0);
   // Texels whose B_0 rays mostly meet back faces are inside or under geometry (as the bake's scene
@@ -174,6 +187,7 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
   std::vector<uint8_t> valid(n, 1);
   auto counters = [&] { return estimator.counts(); };
   BounceTail tail;
+  BounceTailInputs tail_inputs;
   bool tail_known = false;
   double tail_seconds = 0;  // the last tail's, over tail_layers layers: sizes the work after the loop
   size_t tail_layers = 0;
@@ -181,9 +195,10 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
     return tail_layers > 0 ? kAfterLoopPerTail * tail_seconds * double(layers.size()) / double(tail_layers) : 0.0;
   };
   BounceGatherStatistics::Seconds host;  // the loop's parts (estimates.h)
+  std::vector<Vec3> means;  // the layer a cache is built from: kept from one build to the next
   auto build_cache = [&](size_t k) {
     const double build_start = passes.elapsed_seconds();
-    std::vector<Vec3> means(n);
+    means.resize(n);
     for_each_chunk(n, [&](size_t begin, size_t end) {
       for (size_t i = begin; i < end; ++i) means[i] = layers[k].mean(i);
     });
@@ -253,7 +268,7 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
       BounceLayerPass pass;
       pass.layer = int(t);
       pass.begin = own_begin, pass.end = own_end;
-      pass.sum = layer.sum.data(), pass.sum_squared = layer.sum_squared.data();
+      pass.sum = layer.sum.get(), pass.sum_squared = layer.sum_squared.get();
       pass.back_faces = t == 0 ? layer.back_faces.data() : nullptr;
       pass.texel_rays = share ? texel_rays.data() : nullptr;
       const double layer_start = passes.elapsed_seconds();
@@ -277,8 +292,8 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
         for (size_t i = 0; i < n; ++i) layer.one_more[i] = chosen.covers(i) ? 1 : 0;
       }
       if (share && runs) {  // `step` is the same on every rank
-        allgather_items(*share, layer.sum.data(), 3, bounds);
-        allgather_items(*share, layer.sum_squared.data(), 3, bounds);
+        allgather_items(*share, layer.sum.get(), 3, bounds);
+        allgather_items(*share, layer.sum_squared.get(), 3, bounds);
         if (t == 0) allgather_items(*share, layer.back_faces.data(), 1, bounds);
         allgather_items(*share, texel_rays.data(), 1, bounds);
         bounds = split_by_cost(n, texel_rays, share->ranks());
@@ -302,7 +317,7 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
             std::all_of(layers.begin(), layers.end(), [](const Layer& l) { return l.samples >= 2; });
         if (k >= 1) {
           const double tail_start = passes.elapsed_seconds();
-          tail = tail_after(layers, gbuffer);
+          tail = tail_after(layers, gbuffer, tail_inputs);
           tail_known = true;
           tail_seconds = passes.elapsed_seconds() - tail_start, tail_layers = layers.size();
           host.tail += tail_seconds;
@@ -345,7 +360,7 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
   // A layer started but never sampled (the budget ended first) is dropped.
   const double assembly_start = passes.elapsed_seconds();
   while (layers.size() > 1 && layers.back().samples == 0) layers.pop_back();
-  if (!tail_known && layers.size() >= 2) tail = tail_after(layers, gbuffer);
+  if (!tail_known && layers.size() >= 2) tail = tail_after(layers, gbuffer, tail_inputs);
 
   // The bounces not run, added as the geometric tail B_k r / (1 - r) of the last one (automatic
   // bounce count only: --bounces N asks for exactly N). Without it the stop leaves a truncation bias
