@@ -4,6 +4,10 @@
 #include <cstdio>
 #include <memory>
 
+#include <sys/stat.h>
+
+#include "exitance/formats/huge_pages.h"
+
 namespace exitance::formats::binary_io {
 namespace {
 
@@ -19,12 +23,25 @@ std::string errno_text() { return std::strerror(errno); }
 std::vector<uint8_t> read_whole_file(const std::string& path) {
   std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
   if (!file) throw FileAccessError(path + ": cannot open: " + errno_text());
+  // One buffer of the file's size in huge pages (huge_pages.h), read into directly: on a 2-core VM
+  // read_scene_file of a 67 MB scene.bin took 0.57 s, 0.35 s so, 0.15 s with the decoded arrays in
+  // huge pages too (the first touch of 4 KiB pages was the cost). A file that changes size while
+  // it is read is read to its end all the same.
   std::vector<uint8_t> bytes;
-  uint8_t chunk[1 << 16];
-  for (;;) {
-    const size_t got = std::fread(chunk, 1, sizeof(chunk), file.get());
-    bytes.insert(bytes.end(), chunk, chunk + got);
-    if (got < sizeof(chunk)) break;
+  size_t expected = 0;  // a regular file's size (a directory opens too, and its read fails below)
+  struct stat status;
+  if (fstat(fileno(file.get()), &status) == 0 && S_ISREG(status.st_mode) && status.st_size > 0)
+    expected = size_t(status.st_size);
+  resize_in_huge_pages(bytes, expected);
+  size_t got = expected > 0 ? std::fread(bytes.data(), 1, expected, file.get()) : 0;
+  bytes.resize(got);
+  if (got == expected) {  // at the expected end: anything after it (or a file fstat gave no size for)
+    uint8_t chunk[1 << 16];
+    for (;;) {
+      const size_t more = std::fread(chunk, 1, sizeof(chunk), file.get());
+      bytes.insert(bytes.end(), chunk, chunk + more);
+      if (more < sizeof(chunk)) break;
+    }
   }
   if (std::ferror(file.get())) throw FileAccessError(path + ": cannot read: " + errno_text());
   return bytes;

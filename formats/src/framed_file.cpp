@@ -6,6 +6,7 @@
 
 #include "binary_io.h"
 #include "exitance/formats/crc32.h"
+#include "exitance/formats/huge_pages.h"
 #include "exitance/formats/format_error.h"
 
 namespace exitance::formats::framing {
@@ -93,6 +94,7 @@ std::vector<uint8_t> build_frame(const FileKind& kind, const std::vector<uint8_t
 std::vector<uint8_t> begin_frame(const FileKind& kind, size_t payload_capacity) {
   std::vector<uint8_t> file;
   file.reserve(kind.header_size + payload_capacity);
+  advise_huge_pages(file.data(), file.capacity());  // tens of MB written once (huge_pages.h)
   file.resize(kind.header_size, 0);
   return file;
 }

@@ -5,6 +5,7 @@
 #include <cstddef>
 
 #include "binary_io.h"
+#include "exitance/formats/huge_pages.h"
 #include "exitance/formats/probes_file.h"
 #include "framed_file.h"
 
@@ -926,27 +927,29 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
   // The payload size now bounds every count, so these allocations are backed by real bytes.
   binary_io::LittleEndianReader p(frame.payload, size_t(frame.payload_size), name);
   SceneTriangles& t = s.triangles;
-  t.positions.resize(size_t(triangle_count) * 3);
-  t.normals.resize(size_t(triangle_count) * 3);
-  t.lightmap_uv.resize(size_t(triangle_count) * 3);
-  t.uv0.resize(size_t(triangle_count) * 3);
-  t.material.resize(triangle_count);
-  t.instance.resize(triangle_count);
+  // The large arrays in huge pages where the kernel allows (huge_pages.h): their first touch was
+  // most of reading a scene.bin.
+  resize_in_huge_pages(t.positions, size_t(triangle_count) * 3);
+  resize_in_huge_pages(t.normals, size_t(triangle_count) * 3);
+  resize_in_huge_pages(t.lightmap_uv, size_t(triangle_count) * 3);
+  resize_in_huge_pages(t.uv0, size_t(triangle_count) * 3);
+  resize_in_huge_pages(t.material, triangle_count);
+  resize_in_huge_pages(t.instance, triangle_count);
   for (Float3& v : t.positions) get(p, v);
   for (Float3& v : t.normals) get(p, v);
   for (Float2& v : t.lightmap_uv) get(p, v);
   for (Float2& v : t.uv0) get(p, v);
   for (uint32_t& v : t.material) v = p.u32();
   for (uint32_t& v : t.instance) v = p.u32();
-  s.texels.triangle_texel_size.resize(triangle_count);
+  resize_in_huge_pages(s.texels.triangle_texel_size, triangle_count);
   for (float& v : s.texels.triangle_texel_size) v = p.f32();
-  s.bvh.nodes.resize(bvh_node_count);
+  resize_in_huge_pages(s.bvh.nodes, bvh_node_count);
   for (BvhNodeRecord& n : s.bvh.nodes) {
     for (float* plane : {n.lo_x, n.hi_x, n.lo_y, n.hi_y, n.lo_z, n.hi_z})
       for (int c = 0; c < 4; ++c) plane[c] = p.f32();
     for (uint32_t& w : n.child) w = p.u32();
   }
-  s.bvh.leaf_triangles.resize(leaf_count);
+  resize_in_huge_pages(s.bvh.leaf_triangles, leaf_count);
   for (uint32_t& v : s.bvh.leaf_triangles) v = p.u32();
   s.texels.pages.resize(page_count);
   for (TexelPageRecord& page : s.texels.pages) {
@@ -955,7 +958,7 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
     page.live_texels = p.u32();
   }
   std::vector<TexelRecord>& texels = s.texels.texels;
-  texels.resize(texel_count);
+  resize_in_huge_pages(texels, texel_count);
   for (TexelRecord& r : texels) r.triangle = p.u32();
   for (TexelRecord& r : texels) {
     const uint32_t xy = p.u32();

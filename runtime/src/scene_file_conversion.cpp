@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "exitance/formats/huge_pages.h"
 #include "exitance/runtime/texel_gbuffer_codec.h"
 
 namespace exitance {
@@ -214,18 +215,19 @@ PersistedScene restore_scene(const formats::SceneFile& file) {
   if (t.normals.size() != corners || t.lightmap_uv.size() != corners || t.uv0.size() != corners ||
       corners != 3 * t.material.size() || t.instance.size() != t.material.size())
     throw FormatError("scene.bin: triangle arrays disagree in length");
-  scene.positions.reserve(corners);
-  scene.normals.reserve(corners);
-  scene.lightmap_uv.reserve(corners);
-  scene.uv0.reserve(corners);
+  // The large arrays in huge pages where the kernel allows: their first touch was most of a restore.
+  formats::reserve_in_huge_pages(scene.positions, corners);
+  formats::reserve_in_huge_pages(scene.normals, corners);
+  formats::reserve_in_huge_pages(scene.lightmap_uv, corners);
+  formats::reserve_in_huge_pages(scene.uv0, corners);
   for (size_t c = 0; c < corners; ++c) {
     scene.positions.push_back(from_record(t.positions[c]));
     scene.normals.push_back(from_record(t.normals[c]));
     scene.lightmap_uv.push_back(from_record(t.lightmap_uv[c]));
     scene.uv0.push_back(from_record(t.uv0[c]));
   }
-  scene.triangle_material = t.material;
-  scene.triangle_instance = t.instance;
+  scene.triangle_material = formats::copy_in_huge_pages(t.material);
+  scene.triangle_instance = formats::copy_in_huge_pages(t.instance);
 
   for (const formats::MaterialRecord& r : file.materials) {
     Material m;
@@ -314,7 +316,12 @@ PersistedScene restore_scene(const formats::SceneFile& file) {
   out.gbuffer.instance_rects = out.atlas.rects;  // as the raster stage's G-buffer has them
   out.probes = file.probes;
   for (formats::ProbeRecord& r : out.probes.probes) r.sh = {};
-  out.bvh = file.bvh;
+  // Field by field, to copy the arrays into huge pages (the assert catches a field added later).
+  static_assert(sizeof(formats::SceneBvh) == 2 * sizeof(std::vector<uint32_t>) + 2 * sizeof(uint32_t));
+  out.bvh.nodes = formats::copy_in_huge_pages(file.bvh.nodes);
+  out.bvh.leaf_triangles = formats::copy_in_huge_pages(file.bvh.leaf_triangles);
+  out.bvh.stack_entries = file.bvh.stack_entries;
+  out.bvh.depth = file.bvh.depth;
   return out;
 }
 

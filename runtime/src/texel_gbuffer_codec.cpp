@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "exitance/formats/huge_pages.h"
 #include "exitance/runtime/core/parallel_chunks.h"
 #include "exitance/runtime/texel_surface.h"
 
@@ -161,13 +162,15 @@ TexelGBuffer decode_texel_gbuffer(const formats::TexelGBufferRecords& records, c
     AtlasPage page;
     page.width = int(p.width);
     page.height = int(p.height);
-    page.coverage.assign(size_t(p.width) * size_t(p.height), 0.0f);
+    formats::resize_in_huge_pages(page.coverage, size_t(p.width) * size_t(p.height));  // zeros
     area += page.coverage.size();
     gbuffer.pages.push_back(std::move(page));
   }
-  gbuffer.texels.resize(records.texels.size());
+  formats::resize_in_huge_pages(gbuffer.texels, records.texels.size());  // its first touch was most of a decode
   if (records.triangle_texel_size.size() != scene.triangle_count())
     throw FormatError("scene.bin: world texel sizes do not match the triangles");
+  // Checked and placed in file order (the moved and partial tables ascend with the texels), then
+  // each texel's surface derived on all cores, then the moved positions put back over it.
   size_t index = 0, moved = 0, partial = 0;
   for (size_t p = 0; p < records.pages.size(); ++p) {
     AtlasPage& page = gbuffer.pages[p];
@@ -176,22 +179,14 @@ TexelGBuffer decode_texel_gbuffer(const formats::TexelGBufferRecords& records, c
       const formats::TexelRecord& r = records.texels[index];
       if (r.triangle >= scene.triangle_count() || r.x >= uint32_t(page.width) || r.y >= uint32_t(page.height))
         throw FormatError("scene.bin: texel " + std::to_string(index) + " does not fit the scene or its page");
-      const TexelSurface surface = texel_surface(scene, r.triangle, r.b1, r.b2);
       LiveTexel& texel = gbuffer.texels[index];
       texel.page = uint32_t(p);
       texel.x = r.x;
       texel.y = r.y;
-      texel.position = surface.position;
-      texel.geometric_normal = surface.geometric_normal;
-      texel.shading_normal = surface.shading_normal;
-      texel.albedo = surface.albedo;
       texel.instance = scene.triangle_instance[r.triangle];
       texel.triangle = r.triangle;
       texel.world_texel_size = records.triangle_texel_size[r.triangle];
-      if (moved < records.moved.size() && records.moved[moved].texel == index) {
-        const formats::Float3& position = records.moved[moved++].position;
-        texel.position = {position[0], position[1], position[2]};
-      }
+      if (moved < records.moved.size() && records.moved[moved].texel == index) ++moved;
       float coverage = 1.0f;
       if (partial < records.partial_coverage.size() && records.partial_coverage[partial].texel == index)
         coverage = records.partial_coverage[partial++].coverage;
@@ -201,6 +196,21 @@ TexelGBuffer decode_texel_gbuffer(const formats::TexelGBufferRecords& records, c
   if (index != records.texels.size() || moved != records.moved.size() || partial != records.partial_coverage.size())
     throw FormatError(
         "scene.bin: live texel counts, the partial coverage or the moved-texel table do not match the texels");
+  for_each_chunk(gbuffer.texels.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const formats::TexelRecord& r = records.texels[i];
+      const TexelSurface surface = texel_surface(scene, r.triangle, r.b1, r.b2);
+      LiveTexel& texel = gbuffer.texels[i];
+      texel.position = surface.position;
+      texel.geometric_normal = surface.geometric_normal;
+      texel.shading_normal = surface.shading_normal;
+      texel.albedo = surface.albedo;
+    }
+  }, 4096);
+  for (const formats::MovedTexelRecord& m : records.moved) {
+    const formats::Float3& position = m.position;
+    gbuffer.texels[m.texel].position = {position[0], position[1], position[2]};
+  }
   gbuffer.skipped_texels = area - records.texels.size();
   return gbuffer;
 }

@@ -37,8 +37,8 @@
 
 #include "exitance/common/bounce_gather.h"
 #include "exitance/common/gpu_layout.h"
+#include "exitance/formats/huge_pages.h"
 #include "exitance/runtime/core/bounce_tail.h"
-#include "exitance/runtime/core/huge_pages.h"
 #include "exitance/runtime/core/partial_layer_pass.h"
 #include "exitance/runtime/core/parallel_chunks.h"
 #include "exitance/runtime/core/pass_scheduler.h"
@@ -67,7 +67,7 @@ constexpr double kMaxCompletedTailRatio = 0.95;
 // sums are 48 MB at 1 M texels, and what zeroing them costs is the page faults, not the writes.
 std::unique_ptr<double[]> zeros_on_all_cores(size_t count) {
   std::unique_ptr<double[]> values = std::make_unique_for_overwrite<double[]>(count);
-  advise_huge_pages(values.get(), count * sizeof(double));
+  formats::advise_huge_pages(values.get(), count * sizeof(double));
   for_each_chunk(count, [&](size_t begin, size_t end) { std::fill(values.get() + begin, values.get() + end, 0.0); }, 1 << 18);
   return values;
 }
@@ -179,7 +179,7 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
     estimate.bounces.resize(layers.size() * n * 3, 0.0);
   };
   estimate.bounces.reserve(size_t(layer_cap) * n * 3);
-  advise_huge_pages(estimate.bounces.data(), estimate.bounces.capacity() * sizeof(double));
+  formats::advise_huge_pages(estimate.bounces.data(), estimate.bounces.capacity() * sizeof(double));
   add_layer();
   layers[0].back_faces.assign(n, 0);
   // Texels whose B_0 rays mostly meet back faces are inside or under geometry (as the bake's scene
