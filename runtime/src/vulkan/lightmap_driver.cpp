@@ -10,6 +10,7 @@
 #include <utility>
 #include <stdexcept>
 
+#include "exitance/formats/huge_pages.h"
 #include "exitance/runtime/core/grid_guiding_cache.h"
 #include "exitance/runtime/core/guiding_choice.h"
 #include "exitance/runtime/core/pass_scheduler.h"
@@ -145,11 +146,12 @@ void LightmapDriver::run_pass(Accumulation& a, uint32_t first, uint32_t pass) {
 LightmapEstimate LightmapDriver::sized_estimate(size_t texels, int recorded, bool directional, int light_layers) {
   LightmapEstimate estimate;
   estimate.recorded_bounces = recorded;
-  estimate.texels.resize(texels);
-  estimate.bounces.assign(size_t(recorded) * texels * 3, 0.0);
+  // Hundreds of MB at millions of texels, first touched in huge pages where the kernel allows.
+  formats::resize_in_huge_pages(estimate.texels, texels);
+  formats::resize_in_huge_pages(estimate.bounces, size_t(recorded) * texels * 3);
   estimate.light_layers = light_layers;
-  estimate.light_sums.assign(size_t(light_layers) * texels * 3, 0.0);
-  if (directional) estimate.sh1.assign(texels * 9, 0.0);
+  formats::resize_in_huge_pages(estimate.light_sums, size_t(light_layers) * texels * 3);
+  if (directional) formats::resize_in_huge_pages(estimate.sh1, texels * 9);
   return estimate;
 }
 
