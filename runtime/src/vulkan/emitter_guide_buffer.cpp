@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "exitance/formats/huge_pages.h"
 #include "exitance/runtime/core/parallel_chunks.h"
 #include "guide_buffer.h"
 
@@ -45,7 +46,9 @@ EmitterGuideBuffer::EmitterGuideBuffer(const EmitterGuidingCache& cache, size_t 
   if (base_ + back_end_ >= (size_t(1) << 32))
     throw std::runtime_error("Vulkan backend: --emitter-guiding on: " + std::to_string(records_) + " records of " +
                              std::to_string(patches_) + " patches do not fit the guide buffer (use fewer --guiding-grid-cells)");
-  words_.assign(back_, 0u);  // the back sums live on the device alone (zeroed there, read back by the folds)
+  // Zeros up to the back sums, which live on the device alone (zeroed there, read back by the
+  // folds): tens of MB, first touched in huge pages where the kernel allows.
+  formats::resize_in_huge_pages(words_, back_);
   auto absolute = [&](size_t at) { return uint32_t(base_ + at); };
   words_[kEmitterGuideLocator] = absolute(locator_at);
   words_[kEmitterGuideRecords] = records_;
