@@ -2,7 +2,9 @@
 // to the program (Linux's "madvise" mode, Debian's and Ubuntu's default). Their first touch is then
 // one fault per 2 MiB instead of one per 4 KiB: on a 2-core VM, zeroing 25 MB took 64 ms in 4 KiB
 // pages and 7 ms in huge pages. Only advice: elsewhere, or when the kernel has no huge page free,
-// nothing changes. Here, the lowest of the libraries, for the readers and the runtime alike.
+// nothing changes. Here, the lowest of the libraries, for the readers and the runtime alike. For
+// arrays made once (loading, a bake's results), not on a frame's path: where the kernel's THP
+// defrag setting compacts memory at such a fault, the first touch can stall for a while.
 #pragma once
 #include <vector>
 #include <cstddef>
