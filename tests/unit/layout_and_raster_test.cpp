@@ -178,6 +178,37 @@ TEST(Dilation, ParallelRowsMatchTheSerialFill) {
   }
 }
 
+// The gutter fill (every cell fillable) on pages whose widths sit on and beside the 64-cell words the
+// ring search works in, with sparse charts (rectangles and lone texels at the page's edges), so rings
+// cross word borders, page borders and meet each other.
+TEST(Dilation, GutterFillMatchesTheSerialFillAcrossWordBorders) {
+  Pcg32 rng = pcg_init(11, 0, 0);
+  for (int width : {1, 63, 64, 65, 127, 130}) {
+    const int height = 37;
+    const size_t n = size_t(width) * size_t(height);
+    std::vector<float> coverage(n, 0.0f), value(n, 0.0f);
+    auto cover = [&](int x, int y) {
+      const size_t i = size_t(y) * size_t(width) + size_t(x);
+      coverage[i] = 0.25f + pcg_uniform(rng);
+      value[i] = pcg_uniform(rng) * 10.0f;
+    };
+    cover(0, 0), cover(width - 1, height - 1), cover(width - 1, 0);
+    for (int r = 0; r < 3; ++r) {
+      const int x0 = int(pcg_uniform(rng) * float(width)), y0 = int(pcg_uniform(rng) * float(height));
+      for (int y = y0; y < std::min(height, y0 + 4); ++y)
+        for (int x = x0; x < std::min(width, x0 + 9); ++x) cover(x, y);
+    }
+    std::vector<uint8_t> filled(n), fillable(n, 1);
+    for (size_t i = 0; i < n; ++i) filled[i] = coverage[i] > 0;
+    for (int passes : {2, 5, -1}) {
+      std::vector<float> serial = value, fast = value;
+      serial_dilate(width, height, filled, fillable, {serial.data()}, passes);
+      dilate_into_gutter(width, height, coverage, {fast.data()}, passes);
+      EXPECT_EQ(std::memcmp(serial.data(), fast.data(), n * sizeof(float)), 0) << width << " " << passes;
+    }
+  }
+}
+
 TEST(Sampling, CosineHemisphereIsNormalisedAndUpward) {
   Pcg32 rng = pcg_init(1, 2, 3);
   double mean_cos = 0;
