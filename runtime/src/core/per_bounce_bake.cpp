@@ -196,6 +196,7 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
   };
   BounceGatherStatistics::Seconds host;  // the loop's parts (estimates.h)
   std::vector<Vec3> means;  // the layer a cache is built from: kept from one build to the next
+  size_t last_built = SIZE_MAX;  // the cache built last: its plan (cells, rings) serves the next while validity stays
   auto build_cache = [&](size_t k) {
     const double build_start = passes.elapsed_seconds();
     means.resize(n);
@@ -205,7 +206,8 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
     if (estimator.builds_caches())
       estimator.build_cache(k, means, valid);
     else
-      caches[k].build(gbuffer, means, valid, kCacheDilation);
+      caches[k].build(gbuffer, means, valid, kCacheDilation, last_built < caches.size() ? &caches[last_built] : nullptr);
+    last_built = k;
     ++cache_versions[k];
     cache_stale[k] = 0;
     cache_seconds[k] = passes.elapsed_seconds() - build_start;
