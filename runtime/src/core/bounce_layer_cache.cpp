@@ -19,10 +19,12 @@ struct BounceCachePlan {
   static constexpr uint32_t kNoSlot = UINT32_MAX;
   static constexpr uint32_t kPending = UINT32_MAX - 1;  // a cell being filled in the current ring
 
+  // A page's slots: its seeds [first_slot, ring_begin), then its rings [ring_begin, ring_end), which
+  // read only the page's own slots.
   struct Page {
     int width = 0, height = 0;
-    size_t first_cell = 0;          // in slot_of_cell
-    uint32_t ring_begin = 0, ring_end = 0;  // its ring slots (they read only this page's slots)
+    size_t first_cell = 0;  // in slot_of_cell
+    uint32_t first_slot = 0, ring_begin = 0, ring_end = 0;
   };
   const TexelGBuffer* gbuffer = nullptr;
   size_t texel_count = 0;
@@ -30,9 +32,8 @@ struct BounceCachePlan {
   std::vector<uint8_t> valid;  // as built from
   std::vector<Page> pages;
   std::vector<uint32_t> slot_of_cell;  // every page's cells, page after page
-  std::vector<uint32_t> seed_texel;    // slot s < seeds: the live texel it holds
-  uint32_t seeds = 0;
-  std::vector<uint32_t> source_start;  // ring slot seeds + r averages source[source_start[r] .. [r + 1])
+  std::vector<uint32_t> seed_texel;    // per seed slot: the live texel it holds
+  std::vector<uint32_t> source_start;  // ring slot s averages source[source_start[s] .. source_start[s + 1])
   std::vector<uint32_t> source;
   std::vector<Vec3> position, normal;  // per slot, dilated as the colour is
 
@@ -42,15 +43,16 @@ struct BounceCachePlan {
   }
   size_t slots() const { return position.size(); }
 
-  // The ring slots' values in slot order, page by page on all cores: per channel the double sum
-  // over the sources in order, divided by their count, as dilate_into does.
-  template <class Value>
-  void fill_rings(std::vector<Value>& values) const {
+  // Seed slots from `seed_value(texel)`, then the ring slots in slot order, page by page on all
+  // cores: per channel the double sum over the sources in order, divided by their count, as
+  // dilate_into does.
+  template <class Value, class SeedValue>
+  void fill(std::vector<Value>& values, const SeedValue& seed_value) const {
     for_each_chunk(pages.size(), [&](size_t begin, size_t end) {
-      for (size_t p = begin; p < end; ++p)
+      for (size_t p = begin; p < end; ++p) {
+        for (uint32_t slot = pages[p].first_slot; slot < pages[p].ring_begin; ++slot) values[slot] = seed_value(seed_texel[slot]);
         for (uint32_t slot = pages[p].ring_begin; slot < pages[p].ring_end; ++slot) {
-          const uint32_t r = slot - seeds;
-          const uint32_t first = source_start[r], count = source_start[r + 1] - first;
+          const uint32_t first = source_start[slot], count = source_start[slot + 1] - first;
           Value v;
           for (int c = 0; c < 3; ++c) {
             double sum = 0.0;
@@ -59,6 +61,7 @@ struct BounceCachePlan {
           }
           values[slot] = v;
         }
+      }
     }, 1);
   }
 
@@ -72,83 +75,122 @@ struct BounceCachePlan {
     size_t cells = 0;
     for (const AtlasPage& source : gbuffer.pages) {
       Page& page = plan->pages.emplace_back();
-      page.width = source.width, page.height = source.height;
+      page.width = std::max(source.width, 0), page.height = std::max(source.height, 0);
       page.first_cell = cells;
-      cells += size_t(std::max(source.width, 0)) * size_t(std::max(source.height, 0));
+      cells += size_t(page.width) * size_t(page.height);
     }
     formats::resize_in_huge_pages(plan->slot_of_cell, cells);
-    std::fill(plan->slot_of_cell.begin(), plan->slot_of_cell.end(), kNoSlot);
-    // Seeds: the valid texels' cells (a cell two texels name holds the later one's, as the pages did).
-    std::vector<std::vector<uint32_t>> newly(plan->pages.size());
-    for (size_t i = 0; i < gbuffer.texels.size(); ++i) {
+    for_each_chunk(cells, [&](size_t begin, size_t end) {
+      std::fill(plan->slot_of_cell.begin() + ptrdiff_t(begin), plan->slot_of_cell.begin() + ptrdiff_t(end), kNoSlot);
+    });
+    // The valid texels of each page, in texel order (a hand-made G-buffer without pages, or a texel
+    // off its page: nothing to look up).
+    const size_t page_count = plan->pages.size();
+    std::vector<uint32_t> page_start(page_count + 1, 0), by_page;
+    auto seeds_a_cell = [&](size_t i) {
       const LiveTexel& t = gbuffer.texels[i];
-      if (t.page >= plan->pages.size()) continue;  // a hand-made G-buffer without pages: nothing to look up
-      if (!valid.empty() && !valid[i]) continue;
-      const Page& page = plan->pages[t.page];
-      if (t.x >= uint32_t(page.width) || t.y >= uint32_t(page.height)) continue;
-      const uint32_t at = t.y * uint32_t(page.width) + t.x;
-      uint32_t& slot = plan->slot_of_cell[page.first_cell + at];
-      if (slot == kNoSlot) {
-        slot = uint32_t(plan->seed_texel.size());
-        plan->seed_texel.push_back(uint32_t(i));
-        newly[t.page].push_back(at);
-      } else {
-        plan->seed_texel[slot] = uint32_t(i);
+      return t.page < page_count && (valid.empty() || valid[i]) && t.x < uint32_t(plan->pages[t.page].width) &&
+             t.y < uint32_t(plan->pages[t.page].height);
+    };
+    for (size_t i = 0; i < gbuffer.texels.size(); ++i)
+      if (seeds_a_cell(i)) ++page_start[gbuffer.texels[i].page + 1];
+    for (size_t p = 0; p < page_count; ++p) page_start[p + 1] += page_start[p];
+    by_page.resize(page_start.back());
+    {
+      std::vector<uint32_t> next(page_start.begin(), page_start.end() - 1);
+      for (size_t i = 0; i < gbuffer.texels.size(); ++i)
+        if (seeds_a_cell(i)) by_page[next[gbuffer.texels[i].page]++] = uint32_t(i);
+    }
+    // Per page on all cores, slots numbered from 0 within the page: its seeds (a cell two texels
+    // name holds the later one's, as the pages did), then its rings. A cell is filled in ring k
+    // exactly when it is unfilled and has a neighbour filled in ring k - 1 (one filled earlier would
+    // have filled it then), so each ring's candidates are the previous ring's unfilled neighbours;
+    // they read only cells filled before the ring.
+    struct Local {
+      std::vector<uint32_t> seed_texel, source_start, source;
+      uint32_t slots = 0;
+    };
+    std::vector<Local> local(page_count);
+    for_each_chunk(page_count, [&](size_t begin, size_t end) {
+      for (size_t p = begin; p < end; ++p) {
+        Local& l = local[p];
+        const int w = plan->pages[p].width, h = plan->pages[p].height;
+        uint32_t* slot_of = plan->slot_of_cell.data() + plan->pages[p].first_cell;
+        std::vector<uint32_t> newly, ring;
+        for (uint32_t e = page_start[p]; e < page_start[p + 1]; ++e) {
+          const LiveTexel& t = gbuffer.texels[by_page[e]];
+          const uint32_t at = t.y * uint32_t(w) + t.x;
+          if (slot_of[at] == kNoSlot) {
+            slot_of[at] = uint32_t(l.seed_texel.size());
+            l.seed_texel.push_back(by_page[e]);
+            newly.push_back(at);
+          } else {
+            l.seed_texel[slot_of[at]] = by_page[e];
+          }
+        }
+        l.slots = uint32_t(l.seed_texel.size());
+        for (int pass = 0; pass < dilation && !newly.empty(); ++pass) {
+          ring.clear();
+          for (uint32_t at : newly) {
+            const int x = int(at % uint32_t(w)), y = int(at / uint32_t(w));
+            for (int dy = -1; dy <= 1; ++dy)
+              for (int dx = -1; dx <= 1; ++dx) {
+                const int nx = x + dx, ny = y + dy;
+                if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+                const uint32_t j = uint32_t(ny) * uint32_t(w) + uint32_t(nx);
+                if (slot_of[j] == kNoSlot) slot_of[j] = kPending, ring.push_back(j);
+              }
+          }
+          std::sort(ring.begin(), ring.end());  // row order, as the pages were scanned
+          for (uint32_t at : ring) {
+            const int x = int(at % uint32_t(w)), y = int(at / uint32_t(w));
+            l.source_start.push_back(uint32_t(l.source.size()));
+            for (int dy = -1; dy <= 1; ++dy)
+              for (int dx = -1; dx <= 1; ++dx) {
+                const int nx = x + dx, ny = y + dy;
+                if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+                const uint32_t s = slot_of[uint32_t(ny) * uint32_t(w) + uint32_t(nx)];
+                if (s < kPending) l.source.push_back(s);
+              }
+          }
+          for (uint32_t at : ring) slot_of[at] = l.slots++;
+          newly.swap(ring);
+        }
       }
-    }
-    plan->seeds = uint32_t(plan->seed_texel.size());
-    plan->position.resize(plan->seeds);
-    plan->normal.resize(plan->seeds);
-    for (uint32_t s = 0; s < plan->seeds; ++s) {
-      const LiveTexel& t = gbuffer.texels[plan->seed_texel[s]];
-      plan->position[s] = t.position;
-      plan->normal[s] = t.geometric_normal;
-    }
-    plan->source_start.push_back(0);
-    // Rings: a cell is filled in ring k exactly when it is unfilled and has a neighbour filled in
-    // ring k - 1 (one filled earlier would have filled it then), so each ring's candidates are the
-    // previous ring's unfilled neighbours; they read only cells filled before the ring.
-    for (size_t p = 0; p < plan->pages.size(); ++p) {
+    }, 1);
+    // The pages' slots one after another: local numbers become global ones.
+    uint32_t slots = 0, sources = 0;
+    std::vector<uint32_t> first_source(page_count);
+    for (size_t p = 0; p < page_count; ++p) {
       Page& page = plan->pages[p];
-      page.ring_begin = uint32_t(plan->slots());
-      uint32_t* slot_of = plan->slot_of_cell.data() + page.first_cell;
-      const int w = page.width, h = page.height;
-      std::vector<uint32_t> ring;
-      for (int pass = 0; pass < dilation && !newly[p].empty(); ++pass) {
-        ring.clear();
-        for (uint32_t at : newly[p]) {
-          const int x = int(at % uint32_t(w)), y = int(at / uint32_t(w));
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx) {
-              const int nx = x + dx, ny = y + dy;
-              if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
-              const uint32_t j = uint32_t(ny) * uint32_t(w) + uint32_t(nx);
-              if (slot_of[j] == kNoSlot) slot_of[j] = kPending, ring.push_back(j);
-            }
-        }
-        std::sort(ring.begin(), ring.end());  // row order, as the pages were scanned
-        const uint32_t first_slot = uint32_t(plan->slots());
-        for (uint32_t at : ring) {
-          const int x = int(at % uint32_t(w)), y = int(at / uint32_t(w));
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx) {
-              const int nx = x + dx, ny = y + dy;
-              if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
-              const uint32_t s = slot_of[uint32_t(ny) * uint32_t(w) + uint32_t(nx)];
-              if (s < kPending) plan->source.push_back(s);
-            }
-          plan->source_start.push_back(uint32_t(plan->source.size()));
-        }
-        for (size_t k = 0; k < ring.size(); ++k) slot_of[ring[k]] = first_slot + uint32_t(k);
-        plan->position.resize(plan->position.size() + ring.size());
-        plan->normal.resize(plan->normal.size() + ring.size());
-        page.ring_end = uint32_t(plan->slots());
-        newly[p].swap(ring);
-      }
-      page.ring_end = uint32_t(plan->slots());
+      page.first_slot = slots;
+      page.ring_begin = slots + uint32_t(local[p].seed_texel.size());
+      page.ring_end = slots + local[p].slots;
+      first_source[p] = sources;
+      slots += local[p].slots;
+      sources += uint32_t(local[p].source.size());
     }
-    plan->fill_rings(plan->position);
-    plan->fill_rings(plan->normal);
+    plan->seed_texel.assign(slots, 0);
+    plan->source_start.assign(size_t(slots) + 1, sources);
+    plan->source.resize(sources);
+    plan->position.resize(slots);
+    plan->normal.resize(slots);
+    for_each_chunk(page_count, [&](size_t begin, size_t end) {
+      for (size_t p = begin; p < end; ++p) {
+        const Page& page = plan->pages[p];
+        const Local& l = local[p];
+        std::copy(l.seed_texel.begin(), l.seed_texel.end(), plan->seed_texel.begin() + page.first_slot);
+        std::fill(plan->source_start.begin() + page.first_slot, plan->source_start.begin() + page.ring_begin, first_source[p]);
+        for (size_t r = 0; r < l.source_start.size(); ++r) plan->source_start[page.ring_begin + r] = first_source[p] + l.source_start[r];
+        for (size_t k = 0; k < l.source.size(); ++k) plan->source[first_source[p] + k] = page.first_slot + l.source[k];
+        uint32_t* slot_of = plan->slot_of_cell.data() + page.first_cell;
+        const size_t page_cells = size_t(page.width) * size_t(page.height);
+        for (size_t c = 0; c < page_cells; ++c)
+          if (slot_of[c] != kNoSlot) slot_of[c] += page.first_slot;
+      }
+    }, 1);
+    plan->fill(plan->position, [&](uint32_t texel) { return gbuffer.texels[texel].position; });
+    plan->fill(plan->normal, [&](uint32_t texel) { return gbuffer.texels[texel].geometric_normal; });
     return plan;
   }
 };
@@ -161,10 +203,7 @@ void BounceLayerCache::build(const TexelGBuffer& gbuffer, const std::vector<Vec3
     plan_ = BounceCachePlan::make(gbuffer, valid, dilation);
   const BounceCachePlan& plan = *plan_;
   colour_.resize(plan.slots());
-  for_each_chunk(plan.seeds, [&](size_t begin, size_t end) {
-    for (size_t s = begin; s < end; ++s) colour_[s] = texel_values[plan.seed_texel[s]];
-  });
-  plan.fill_rings(colour_);
+  plan.fill(colour_, [&](uint32_t texel) { return texel_values[texel]; });
 }
 
 bool BounceLayerCache::lookup(const TexelGBuffer& gbuffer, uint32_t instance, Vec2 uv, Vec3 position, Vec3 normal,
