@@ -54,16 +54,27 @@ WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::jso
   AssemblyOptions assembly;
   assembly.bounce_layers = options.bounce_layers;
   assembly.dilation_texels = std::max(2, options.atlas.padding * 2);
-  std::vector<formats::LightmapImage> pages =
-      assemble_lightmap_pages(results.gbuffer, results.lightmap, assembly,
-                              results.sealed && results.sealed_skipped ? results.sealed->sealed : std::vector<uint8_t>{});
-  // Seams (runtime/include/exitance/runtime/bundle/seam_stage.h): stitched on the assembled pages,
-  // after their gutter dilation (which the stitching repeats); with --seams off only measured.
-  options.announce_stage("seams");
-  const nlohmann::json seams =
-      stitch_bundle_seams(pages, results.scene, results.layout, assembly.dilation_texels, options.stitch_seams);
-  formats::BundleManifest manifest = build_bundle_manifest(
-      results, pages, results.input_sha256, seconds, diagnostics.warnings.size(), options);
+  // Each page is assembled, its seams stitched (runtime/include/exitance/runtime/bundle/seam_stage.h:
+  // after the gutter dilation, which the stitching repeats; with --seams off only measured) and
+  // written before the next, in one image whose arrays each page reuses: holding every page at
+  // once was 4.9 GB of fresh memory on the open city, whose first touch was most of the assembly.
+  // The preview draws its views from all the pages, so with --preview they are all kept.
+  const LightmapPageAssembler assembler(
+      results.gbuffer, results.lightmap, assembly,
+      results.sealed && results.sealed_skipped ? results.sealed->sealed : std::vector<uint8_t>{});
+  BundleSeamStage seams(results.scene, results.layout, assembly.dilation_texels, options.stitch_seams);
+  std::vector<formats::LightmapImage> pages(assembler.page_count());  // the preview's, or each page's size and channels
+  formats::LightmapImage streamed;
+  auto page_image = [&](size_t p) -> formats::LightmapImage& {
+    formats::LightmapImage& image = options.preview ? pages[p] : streamed;
+    assembler.assemble(p, image);
+    seams.page(p, image);
+    if (!options.preview) {
+      pages[p].width = image.width, pages[p].height = image.height;
+      for (const auto& [name, data] : image.channels) pages[p].channels[name];
+    }
+    return image;
+  };
   // Light layers (--light-layers; docs/bundle.md "Light layers"): the bake's layout is the one its
   // scene.bin gets when opened, layer for layer.
   std::vector<formats::LightmapImage> layer_pages;
@@ -71,19 +82,8 @@ WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::jso
     std::vector<uint32_t> same(size_t(results.lightmap.light_layers));
     for (size_t k = 0; k < same.size(); ++k) same[k] = uint32_t(k);
     layer_pages = assemble_light_layer_pages(results.gbuffer, results.lightmap, same);
-    formats::LightLayersInfo& info = manifest.light_layers.emplace();
-    info.count = uint32_t(results.lightmap.light_layers);
-    info.punctual = punctual_light_layer_count(uint32_t(results.scene.lights.size()), kDefaultLightLayerLimit);
-    for (size_t p = 0; p < layer_pages.size(); ++p) info.files.push_back("light-layers-" + std::to_string(p) + ".exr");
   }
-  {
-    nlohmann::json stats = nlohmann::json::parse(manifest.stats_json);
-    stats["seams"] = seams;
-    manifest.stats_json = stats.dump();
-  }
-  const std::string manifest_text = formats::write_bundle_manifest(manifest);
-
-  std::string stats_json = manifest.stats_json;
+  std::string stats_json;
   const fs::path out = bundle_folder(options);
   write_bundle_atomically(out, [&](const fs::path& dir) {
     // The files other than the pages (scene.bin, probes, svo.bin, radiance.vdb: serial encoders and
@@ -105,12 +105,26 @@ WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::jso
       }
     });
     for (size_t p = 0; p < pages.size(); ++p)
-      formats::write_lightmap_exr((dir / ("lightmap-" + std::to_string(p) + ".exr")).string(), pages[p]);
+      formats::write_lightmap_exr((dir / ("lightmap-" + std::to_string(p) + ".exr")).string(), page_image(p));
+    formats::BundleManifest manifest = build_bundle_manifest(
+        results, pages, results.input_sha256, seconds, diagnostics.warnings.size(), options);
+    if (!layer_pages.empty()) {
+      formats::LightLayersInfo& info = manifest.light_layers.emplace();
+      info.count = uint32_t(results.lightmap.light_layers);
+      info.punctual = punctual_light_layer_count(uint32_t(results.scene.lights.size()), kDefaultLightLayerLimit);
+      for (size_t p = 0; p < layer_pages.size(); ++p) info.files.push_back("light-layers-" + std::to_string(p) + ".exr");
+    }
+    {
+      nlohmann::json stats = nlohmann::json::parse(manifest.stats_json);
+      stats["seams"] = seams.report();
+      manifest.stats_json = stats.dump();
+    }
+    stats_json = manifest.stats_json;
     for (size_t p = 0; p < layer_pages.size(); ++p)
       formats::write_lightmap_exr((dir / manifest.light_layers->files[p]).string(), layer_pages[p]);
     others.get();
     std::ofstream file(dir / "manifest.json");
-    file << manifest_text;
+    file << formats::write_bundle_manifest(manifest);
     if (!file) throw std::runtime_error("cannot write " + (dir / "manifest.json").string());
     file.close();
     // The preview's views are drawn from the staged bundle, so it comes last and then the manifest

@@ -160,113 +160,135 @@ formats::LightmapImage read_atlas_page(const std::string& path, const TexelGBuff
   return image;
 }
 
-std::vector<formats::LightmapImage> assemble_lightmap_pages(const TexelGBuffer& gbuffer, const LightmapEstimate& estimate,
-                                                            const AssemblyOptions& options,
-                                                            const std::vector<uint8_t>& untraced) {
-  std::vector<std::string> layers = {"", "direct.", "indirect."};
+LightmapPageAssembler::LightmapPageAssembler(const TexelGBuffer& gbuffer, const LightmapEstimate& estimate,
+                                             const AssemblyOptions& options, const std::vector<uint8_t>& untraced)
+    : gbuffer_(gbuffer), estimate_(estimate), options_(options), untraced_(untraced) {
+  layers_ = {"", "direct.", "indirect."};
   if (options.bounce_layers)
-    for (int k = 0; k < estimate.recorded_bounces; ++k) layers.push_back("bounce" + std::to_string(k) + ".");
+    for (int k = 0; k < estimate.recorded_bounces; ++k) layers_.push_back("bounce" + std::to_string(k) + ".");
   if (estimate.has_sh1())
-    for (const char* axis : {"x", "y", "z"}) layers.push_back(std::string("sh1.") + axis + ".");
-  std::vector<formats::LightmapImage> pages(gbuffer.pages.size());
-  for (size_t p = 0; p < pages.size(); ++p) {
-    const AtlasPage& source = gbuffer.pages[p];
-    pages[p].width = source.width;
-    pages[p].height = source.height;
-    const size_t n = size_t(source.width) * size_t(source.height);
-    // Zeros in huge pages where the kernel allows (huge_pages.h): a channel is 10 MB at a million
-    // texels, and its first touch was most of the assembly.
-    for (const std::string& layer : layers)
-      for (const char* c : {"R", "G", "B"}) formats::resize_in_huge_pages(pages[p].channels[layer + c], n);
-    pages[p].channels["A"] = formats::copy_in_huge_pages(source.coverage);
-    formats::resize_in_huge_pages(pages[p].channels["error.Y"], n);
-    formats::resize_in_huge_pages(pages[p].channels["valid"], n);
-  }
-  const double error_floor = estimate.error_floor();
-  // Per page, the channels' arrays looked up once (not by name per texel).
-  struct PageChannels {
-    int width = 0;
-    float* total[3];
-    float* direct[3];
-    float* indirect[3];
-    float* error = nullptr;
-    float* valid = nullptr;
-    std::vector<std::array<float*, 3>> bounces;
-    std::array<float*, 3> sh1[3] = {};
-  };
-  std::vector<PageChannels> targets(pages.size());
-  const char* names[3] = {"R", "G", "B"};
-  for (size_t p = 0; p < pages.size(); ++p) {
-    PageChannels& t = targets[p];
-    auto& channels = pages[p].channels;
-    t.width = pages[p].width;
-    for (int c = 0; c < 3; ++c) {
-      t.total[c] = channels[names[c]].data();
-      t.direct[c] = channels[std::string("direct.") + names[c]].data();
-      t.indirect[c] = channels[std::string("indirect.") + names[c]].data();
+    for (const char* axis : {"x", "y", "z"}) layers_.push_back(std::string("sh1.") + axis + ".");
+  error_floor_ = estimate.error_floor();
+  // The live texels of each page, in texel order.
+  const size_t pages = gbuffer.pages.size();
+  page_start_.assign(pages + 1, 0);
+  for (const LiveTexel& t : gbuffer.texels)
+    if (t.page < pages) ++page_start_[size_t(t.page) + 1];
+  for (size_t p = 0; p < pages; ++p) page_start_[p + 1] += page_start_[p];
+  by_page_.resize(page_start_.back());
+  std::vector<uint32_t> next(page_start_.begin(), page_start_.end() - 1);
+  for (size_t i = 0; i < gbuffer.texels.size(); ++i)
+    if (gbuffer.texels[i].page < pages) by_page_[next[gbuffer.texels[i].page]++] = uint32_t(i);
+}
+
+void LightmapPageAssembler::assemble(size_t p, formats::LightmapImage& image) const {
+  const AtlasPage& source = gbuffer_.pages.at(p);
+  image.width = source.width;
+  image.height = source.height;
+  const size_t n = size_t(source.width) * size_t(source.height);
+  // Zeros, in arrays reused from the image's last page where they are large enough (a page's first
+  // touch of fresh memory was most of the assembly: 4.9 GB for the open city's 27 pages at once), else
+  // in huge pages where the kernel allows (huge_pages.h).
+  auto zeros = [n](std::vector<float>& values) {
+    if (values.capacity() < n) {
+      values = {};
+      formats::resize_in_huge_pages(values, n);
+    } else {
+      values.resize(n);
+      for_each_chunk(n, [&](size_t begin, size_t end) { std::fill(values.begin() + ptrdiff_t(begin), values.begin() + ptrdiff_t(end), 0.0f); });
     }
-    t.error = channels["error.Y"].data();
-    t.valid = channels["valid"].data();
-    if (options.bounce_layers)
-      for (int k = 0; k < estimate.recorded_bounces; ++k) {
-        std::array<float*, 3>& b = t.bounces.emplace_back();
-        for (int c = 0; c < 3; ++c) b[c] = channels["bounce" + std::to_string(k) + "." + names[c]].data();
-      }
-    if (estimate.has_sh1())
-      for (int axis = 0; axis < 3; ++axis)
-        for (int c = 0; c < 3; ++c) t.sh1[axis][c] = channels[std::string("sh1.") + "xyz"[axis] + "." + names[c]].data();
+  };
+  const char* names[3] = {"R", "G", "B"};
+  for (const std::string& layer : layers_)
+    for (const char* c : names) zeros(image.channels[layer + c]);
+  {
+    std::vector<float>& a = image.channels["A"];
+    if (a.capacity() < n) a = {};
+    formats::reserve_in_huge_pages(a, n);
+    a.assign(source.coverage.begin(), source.coverage.end());
   }
-  // Per page, the texels to fill from traced neighbours before the gutter is dilated.
-  std::vector<std::vector<uint8_t>> skipped(pages.size());
-  if (!untraced.empty())
-    for (size_t i = 0; i < gbuffer.texels.size(); ++i) {
-      if (!untraced[i]) continue;
-      const LiveTexel& texel = gbuffer.texels[i];
-      std::vector<uint8_t>& page_skipped = skipped[texel.page];
-      if (page_skipped.empty()) page_skipped.assign(size_t(pages[texel.page].width) * size_t(pages[texel.page].height), 0);
-      page_skipped[size_t(texel.y) * size_t(pages[texel.page].width) + size_t(texel.x)] = 1;
+  zeros(image.channels["error.Y"]);
+  zeros(image.channels["valid"]);
+  // The channels' arrays looked up once (not by name per texel).
+  auto& channels = image.channels;
+  const int width = image.width;
+  float* total[3];
+  float* direct[3];
+  float* indirect[3];
+  for (int c = 0; c < 3; ++c) {
+    total[c] = channels[names[c]].data();
+    direct[c] = channels[std::string("direct.") + names[c]].data();
+    indirect[c] = channels[std::string("indirect.") + names[c]].data();
+  }
+  float* error = channels["error.Y"].data();
+  float* valid = channels["valid"].data();
+  std::vector<std::array<float*, 3>> bounces;
+  if (options_.bounce_layers)
+    for (int k = 0; k < estimate_.recorded_bounces; ++k) {
+      std::array<float*, 3>& b = bounces.emplace_back();
+      for (int c = 0; c < 3; ++c) b[c] = channels["bounce" + std::to_string(k) + "." + names[c]].data();
+    }
+  std::array<float*, 3> sh1[3] = {};
+  if (estimate_.has_sh1())
+    for (int axis = 0; axis < 3; ++axis)
+      for (int c = 0; c < 3; ++c) sh1[axis][c] = channels[std::string("sh1.") + "xyz"[axis] + "." + names[c]].data();
+  // The texels to fill from traced neighbours before the gutter is dilated.
+  std::vector<uint8_t> skipped;
+  const uint32_t* texels = by_page_.data() + page_start_[p];
+  const size_t texel_count = page_start_[p + 1] - page_start_[p];
+  if (!untraced_.empty())
+    for (size_t k = 0; k < texel_count; ++k) {
+      if (!untraced_[texels[k]]) continue;
+      const LiveTexel& texel = gbuffer_.texels[texels[k]];
+      if (skipped.empty()) skipped.assign(n, 0);
+      skipped[size_t(texel.y) * size_t(width) + size_t(texel.x)] = 1;
     }
   // Every live texel writes its own cell only: the texels run in parallel.
-  for_each_chunk(gbuffer.texels.size(), [&](size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i) {
-      if (!untraced.empty() && untraced[i]) continue;
-      const LiveTexel& texel = gbuffer.texels[i];
-      const PageChannels& t = targets[texel.page];
-      const size_t at = size_t(texel.y) * size_t(t.width) + size_t(texel.x);
-      t.valid[at] = 1.0f;
-      const Vec3 total = estimate.mean_total(i), direct = estimate.mean_direct(i);
-      const Vec3 indirect = total - direct;
+  for_each_chunk(texel_count, [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) {
+      const size_t i = texels[k];
+      if (!untraced_.empty() && untraced_[i]) continue;
+      const LiveTexel& texel = gbuffer_.texels[i];
+      const size_t at = size_t(texel.y) * size_t(width) + size_t(texel.x);
+      valid[at] = 1.0f;
+      const Vec3 t = estimate_.mean_total(i), d = estimate_.mean_direct(i);
+      const Vec3 in = t - d;
       for (int c = 0; c < 3; ++c) {
-        t.total[c][at] = total[c];
-        t.direct[c][at] = direct[c];
-        t.indirect[c][at] = std::max(0.0f, indirect[c]);
+        total[c][at] = t[c];
+        direct[c][at] = d[c];
+        indirect[c][at] = std::max(0.0f, in[c]);
       }
-      t.error[at] = estimate.relative_standard_error(i, error_floor);
-      for (size_t k = 0; k < t.bounces.size(); ++k) {
-        const Vec3 b = estimate.mean_bounce(int(k), i);
-        for (int c = 0; c < 3; ++c) t.bounces[k][c][at] = b[c];
+      error[at] = estimate_.relative_standard_error(i, error_floor_);
+      for (size_t b = 0; b < bounces.size(); ++b) {
+        const Vec3 v = estimate_.mean_bounce(int(b), i);
+        for (int c = 0; c < 3; ++c) bounces[b][c][at] = v[c];
       }
-      if (estimate.has_sh1())
+      if (estimate_.has_sh1())
         for (int axis = 0; axis < 3; ++axis) {
-          const Vec3 l1 = estimate.mean_sh1(axis, i);
-          for (int c = 0; c < 3; ++c) t.sh1[axis][c][at] = l1[c];
+          const Vec3 l1 = estimate_.mean_sh1(axis, i);
+          for (int c = 0; c < 3; ++c) sh1[axis][c][at] = l1[c];
         }
     }
   });
-  for (size_t p = 0; p < pages.size(); ++p) {
-    std::vector<float*> channels;
-    for (auto& [name, data] : pages[p].channels)
-      if (name != "A" && name != "valid") channels.push_back(data.data());
-    if (!skipped[p].empty()) {
-      // Untraced texels from the traced ones only, as deep as the untraced region is, and only
-      // across chart texels (never from another chart through the gutter).
-      const std::vector<float>& valid = pages[p].channels["valid"];
-      std::vector<uint8_t> traced(valid.size());
-      for (size_t i = 0; i < valid.size(); ++i) traced[i] = valid[i] > 0 ? 1 : 0;
-      dilate_into(pages[p].width, pages[p].height, std::move(traced), skipped[p], channels, -1);
-    }
-    dilate_into_gutter(pages[p].width, pages[p].height, gbuffer.pages[p].coverage, channels, options.dilation_texels);
+  std::vector<float*> dilated;
+  for (auto& [name, data] : channels)
+    if (name != "A" && name != "valid") dilated.push_back(data.data());
+  if (!skipped.empty()) {
+    // Untraced texels from the traced ones only, as deep as the untraced region is, and only
+    // across chart texels (never from another chart through the gutter).
+    std::vector<uint8_t> traced(n);
+    for (size_t i = 0; i < n; ++i) traced[i] = valid[i] > 0 ? 1 : 0;
+    dilate_into(width, image.height, std::move(traced), skipped, dilated, -1);
   }
+  dilate_into_gutter(width, image.height, source.coverage, dilated, options_.dilation_texels);
+}
+
+std::vector<formats::LightmapImage> assemble_lightmap_pages(const TexelGBuffer& gbuffer, const LightmapEstimate& estimate,
+                                                            const AssemblyOptions& options,
+                                                            const std::vector<uint8_t>& untraced) {
+  const LightmapPageAssembler assembler(gbuffer, estimate, options, untraced);
+  std::vector<formats::LightmapImage> pages(gbuffer.pages.size());
+  for (size_t p = 0; p < pages.size(); ++p) assembler.assemble(p, pages[p]);
   return pages;
 }
 

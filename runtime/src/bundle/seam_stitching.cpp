@@ -173,41 +173,58 @@ void solve_page(formats::LightmapImage& page, const PageSystem& system, double l
 
 }  // namespace
 
+SeamStitcher::SeamStitcher(const std::vector<SeamEdge>& seams, const SeamStitchSettings& settings, bool stitch)
+    : settings_(settings),
+      stitch_(stitch),
+      edges_(seams.size()),
+      samples_(seam_samples(seams, settings.samples_per_texel)),
+      before_(samples_),
+      after_(samples_) {}
+
+void SeamStitcher::page(size_t p, formats::LightmapImage& image) {
+  before_.page(p, image);
+  if (!stitch_) return;
+  const auto coverage = image.channels.find("A");
+  const bool has_samples = std::any_of(samples_.begin(), samples_.end(), [&](const SeamSample& s) { return s.page == int(p); });
+  if (has_samples && coverage != image.channels.end()) {
+    DilationMap dilation(image.width, image.height, coverage->second, settings_.dilation_passes);
+    const PageSystem system = page_system(image, samples_, int(p), dilation);
+    if (!system.unknown_texel.empty()) {
+      solve_page(image, system, settings_.value_weight);
+      texels_adjusted_ += system.unknown_texel.size();
+      std::vector<float*> colour;
+      for (auto& [name, values] : image.channels)
+        if (is_colour_channel(name)) colour.push_back(values.data());
+      dilate_into_gutter(image.width, image.height, coverage->second, colour, settings_.dilation_passes);
+    }
+  }
+  after_.page(p, image);
+}
+
+SeamStitchReport SeamStitcher::report() const {
+  SeamStitchReport report;
+  report.edges = edges_;
+  report.samples = samples_.size();
+  const SeamDiscontinuity before = before_.result();
+  report.discontinuity_before = before.mean_relative_difference;
+  report.texel_relative_error = before.mean_texel_relative_error;
+  report.discontinuity_after = stitch_ ? after_.result().mean_relative_difference : report.discontinuity_before;
+  report.texels_adjusted = texels_adjusted_;
+  return report;
+}
+
 SeamStitchReport measure_lightmap_seams(const std::vector<formats::LightmapImage>& pages,
                                         const std::vector<SeamEdge>& seams, const SeamStitchSettings& settings) {
-  SeamStitchReport report;
-  report.edges = seams.size();
-  const std::vector<SeamSample> samples = seam_samples(seams, settings.samples_per_texel);
-  report.samples = samples.size();
-  const SeamDiscontinuity measured = measure_seam_discontinuity(pages, samples);
-  report.discontinuity_before = report.discontinuity_after = measured.mean_relative_difference;
-  report.texel_relative_error = measured.mean_texel_relative_error;
-  return report;
+  SeamStitcher stitcher(seams, settings, false);
+  for (size_t p = 0; p < pages.size(); ++p) stitcher.page(p, const_cast<formats::LightmapImage&>(pages[p]));  // measured only
+  return stitcher.report();
 }
 
 SeamStitchReport stitch_lightmap_seams(std::vector<formats::LightmapImage>& pages, const std::vector<SeamEdge>& seams,
                                        const SeamStitchSettings& settings) {
-  SeamStitchReport report = measure_lightmap_seams(pages, seams, settings);
-  const std::vector<SeamSample> samples = seam_samples(seams, settings.samples_per_texel);
-  std::vector<bool> page_has_samples(pages.size(), false);
-  for (const SeamSample& s : samples)
-    if (size_t(s.page) < pages.size()) page_has_samples[size_t(s.page)] = true;
-  for (size_t p = 0; p < pages.size(); ++p) {
-    formats::LightmapImage& page = pages[p];
-    const auto coverage = page.channels.find("A");
-    if (!page_has_samples[p] || coverage == page.channels.end()) continue;
-    DilationMap dilation(page.width, page.height, coverage->second, settings.dilation_passes);
-    const PageSystem system = page_system(page, samples, int(p), dilation);
-    if (system.unknown_texel.empty()) continue;
-    solve_page(page, system, settings.value_weight);
-    report.texels_adjusted += system.unknown_texel.size();
-    std::vector<float*> colour;
-    for (auto& [name, values] : page.channels)
-      if (is_colour_channel(name)) colour.push_back(values.data());
-    dilate_into_gutter(page.width, page.height, coverage->second, colour, settings.dilation_passes);
-  }
-  report.discontinuity_after = measure_seam_discontinuity(pages, samples).mean_relative_difference;
-  return report;
+  SeamStitcher stitcher(seams, settings, true);
+  for (size_t p = 0; p < pages.size(); ++p) stitcher.page(p, pages[p]);
+  return stitcher.report();
 }
 
 }  // namespace exitance

@@ -3,9 +3,11 @@
 // with stitching off only measure them, so a manifest shows what stitching would address.
 #pragma once
 #include <nlohmann/json.hpp>
+#include <memory>
 #include <vector>
 
 #include "exitance/formats/lightmap_exr.h"
+#include "exitance/runtime/bundle/seam_stitching.h"
 #include "exitance/runtime/lightmap_atlas.h"
 #include "exitance/runtime/scene.h"
 
@@ -16,6 +18,21 @@ namespace exitance {
 // samples, texels_adjusted, discontinuity_before/after, texel_relative_error, seconds.
 nlohmann::json stitch_bundle_seams(std::vector<formats::LightmapImage>& pages, const Scene& scene,
                                    const AtlasLayout& atlas, int dilation_passes, bool stitch);
+
+// The same page by page (pages assembled one at a time): page(p, image) for every page in ascending
+// order, then report() is stitch_bundle_seams's record (its seconds: finding the seams and each
+// page's stitching).
+class BundleSeamStage {
+ public:
+  BundleSeamStage(const Scene& scene, const AtlasLayout& atlas, int dilation_passes, bool stitch);
+  void page(size_t p, formats::LightmapImage& image);
+  nlohmann::json report() const;
+
+ private:
+  std::unique_ptr<SeamStitcher> stitcher_;
+  bool stitch_;
+  double seconds_ = 0;
+};
 
 // The mode a bundle was written with: its manifest's stats.seams.mode ("stitch" or "off"); a bundle
 // without the record (written before seams were stitched, or by hand) counts as the default, stitch.

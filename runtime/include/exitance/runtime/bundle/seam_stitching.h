@@ -12,6 +12,7 @@
 #pragma once
 #include <vector>
 
+#include "exitance/runtime/bundle/seam_discontinuity.h"
 #include "exitance/runtime/bundle/seam_samples.h"
 #include "exitance/formats/lightmap_exr.h"
 
@@ -46,5 +47,26 @@ SeamStitchReport stitch_lightmap_seams(std::vector<formats::LightmapImage>& page
 // The same report without changing the pages (--seams off): texels_adjusted 0, after = before.
 SeamStitchReport measure_lightmap_seams(const std::vector<formats::LightmapImage>& pages,
                                         const std::vector<SeamEdge>& seams, const SeamStitchSettings& settings = {});
+
+// Both, page by page, for pages assembled one at a time (a seam's two sides are on one page):
+// page(p, image) for every page in ascending order stitches page p (or, with `stitch` false, only
+// measures it), and report() after the last is what stitch_lightmap_seams / measure_lightmap_seams
+// report for the pages together.
+class SeamStitcher {
+ public:
+  SeamStitcher(const std::vector<SeamEdge>& seams, const SeamStitchSettings& settings, bool stitch);
+  SeamStitcher(const SeamStitcher&) = delete;
+  SeamStitcher& operator=(const SeamStitcher&) = delete;
+  void page(size_t p, formats::LightmapImage& image);
+  SeamStitchReport report() const;
+
+ private:
+  SeamStitchSettings settings_;
+  bool stitch_;
+  size_t edges_;
+  std::vector<SeamSample> samples_;
+  SeamDiscontinuityMeter before_, after_;
+  size_t texels_adjusted_ = 0;
+};
 
 }  // namespace exitance
