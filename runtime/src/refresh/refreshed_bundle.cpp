@@ -83,12 +83,11 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   AssemblyOptions assembly;
   assembly.bounce_layers = manifest.has_bounce_layers();
   assembly.dilation_texels = session.page_dilation_texels();
-  std::vector<formats::LightmapImage> pages = assemble_lightmap_pages(persisted.gbuffer, estimate, assembly);
-  // Seams stitched as `bake` stitched them (seam_stage.h), or only measured where it ran --seams off.
-  stage("seams");
-  const json seams = stitch_bundle_seams(pages, persisted.scene, persisted.atlas, assembly.dilation_texels,
-                                         bundle_stitches_seams(manifest.stats_json));
-  stage("write");
+  // Each page assembled, its seams stitched as `bake` stitched them (seam_stage.h; only measured where
+  // it ran --seams off) and written before the next, in one image whose arrays each page reuses (as
+  // bake's write_bundle_stage; holding every page at once was the most of the assembly's time).
+  const LightmapPageAssembler assembler(persisted.gbuffer, estimate, assembly);
+  BundleSeamStage seams(persisted.scene, persisted.atlas, assembly.dilation_texels, bundle_stitches_seams(manifest.stats_json));
   // Light layers (docs/bundle.md "Light layers"), where what is published keeps a split by light.
   std::vector<formats::LightmapImage> layer_pages;
   manifest.light_layers.reset();
@@ -108,16 +107,10 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
       for (size_t p = 0; p < layer_pages.size(); ++p) info.files.push_back("light-layers-" + std::to_string(p) + ".exr");
     }
   }
-  // The pages as assembled now, under the file names the manifest gave them.
-  if (pages.size() != manifest.pages.size())
+  // The pages as assembled now (below), under the file names the manifest gave them.
+  if (assembler.page_count() != manifest.pages.size())
     throw BundleInputError((bundle / "manifest.json").string() + ": pages: " + std::to_string(manifest.pages.size()) +
-                           " listed, scene.bin's atlas has " + std::to_string(pages.size()));
-  for (size_t p = 0; p < pages.size(); ++p) {
-    manifest.pages[p].width = uint32_t(pages[p].width);
-    manifest.pages[p].height = uint32_t(pages[p].height);
-    manifest.pages[p].channels.clear();
-    for (const auto& [name, data] : pages[p].channels) manifest.pages[p].channels.push_back(name);
-  }
+                           " listed, scene.bin's atlas has " + std::to_string(assembler.page_count()));
 
   VulkanIntegrator& integrator = session.integrator();
   report["tool"] = "exitance-relight";
@@ -150,7 +143,6 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
     report["error"] = {{"floor", estimate.error_floor()}};
   }
   report["nonfinite_samples"] = estimate.nonfinite_samples + probe_estimate.nonfinite_samples;
-  report["seams"] = seams;
   if (denoised)
     report["denoise"] = {{"radius", denoise_radius},
                          {"texels", denoised->texels},
@@ -174,15 +166,24 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   const std::vector<uint8_t> scene_bytes = formats::encode_scene(session.scene_file());
   manifest.scene->bytes = scene_bytes.size();
   manifest.scene->format_version = formats::kSceneFormatVersion;  // a version 1 input is rewritten as the current one
-  manifest.relight_json = report.dump();
-  const std::string manifest_text = formats::write_bundle_manifest(manifest);
   if (check_before_write) check_before_write();
 
   const fs::path out(output);
   try {
     write_bundle_atomically(out, [&](const fs::path& dir) {
-      for (size_t p = 0; p < pages.size(); ++p)
-        formats::write_lightmap_exr((dir / manifest.pages[p].file).string(), pages[p]);
+      formats::LightmapImage page;
+      for (size_t p = 0; p < manifest.pages.size(); ++p) {
+        assembler.assemble(p, page);
+        seams.page(p, page);
+        manifest.pages[p].width = uint32_t(page.width);
+        manifest.pages[p].height = uint32_t(page.height);
+        manifest.pages[p].channels.clear();
+        for (const auto& [name, data] : page.channels) manifest.pages[p].channels.push_back(name);
+        formats::write_lightmap_exr((dir / manifest.pages[p].file).string(), page);
+      }
+      report["seams"] = seams.report();
+      manifest.relight_json = report.dump();
+      const std::string manifest_text = formats::write_bundle_manifest(manifest);
       for (size_t p = 0; p < layer_pages.size(); ++p)
         formats::write_lightmap_exr((dir / manifest.light_layers->files[p]).string(), layer_pages[p]);
       if (has_probes) formats::write_probes_file((dir / manifest.probes->file).string(), persisted.probes);
