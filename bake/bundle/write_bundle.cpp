@@ -104,8 +104,10 @@ WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::jso
         write_radiance_vdb((dir / "radiance.vdb").string(), results.voxels->svo);
       }
     });
-    for (size_t p = 0; p < pages.size(); ++p)
+    for (size_t p = 0; p < pages.size(); ++p) {
       formats::write_lightmap_exr((dir / ("lightmap-" + std::to_string(p) + ".exr")).string(), page_image(p));
+      if (options.progress) options.progress("write", double(p + 1) / double(pages.size() + 1), 0);  // the rest: the last file
+    }
     formats::BundleManifest manifest = build_bundle_manifest(
         results, pages, results.input_sha256, seconds, diagnostics.warnings.size(), options);
     if (!layer_pages.empty()) {
