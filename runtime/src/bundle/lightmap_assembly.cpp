@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "exitance/formats/huge_pages.h"
+#include "exitance/runtime/core/grouped_indices.h"
 #include "exitance/runtime/core/parallel_chunks.h"
 
 namespace exitance {
@@ -170,15 +171,10 @@ LightmapPageAssembler::LightmapPageAssembler(const TexelGBuffer& gbuffer, const 
     for (const char* axis : {"x", "y", "z"}) layers_.push_back(std::string("sh1.") + axis + ".");
   error_floor_ = estimate.error_floor();
   // The live texels of each page, in texel order.
-  const size_t pages = gbuffer.pages.size();
-  page_start_.assign(pages + 1, 0);
-  for (const LiveTexel& t : gbuffer.texels)
-    if (t.page < pages) ++page_start_[size_t(t.page) + 1];
-  for (size_t p = 0; p < pages; ++p) page_start_[p + 1] += page_start_[p];
-  by_page_.resize(page_start_.back());
-  std::vector<uint32_t> next(page_start_.begin(), page_start_.end() - 1);
-  for (size_t i = 0; i < gbuffer.texels.size(); ++i)
-    if (gbuffer.texels[i].page < pages) by_page_[next[gbuffer.texels[i].page]++] = uint32_t(i);
+  GroupedIndices by_page = group_indices(gbuffer.texels.size(), gbuffer.pages.size(),
+                                         [&](size_t i) { return gbuffer.texels[i].page; });
+  page_start_ = std::move(by_page.start);
+  by_page_ = std::move(by_page.items);
 }
 
 void LightmapPageAssembler::assemble(size_t p, formats::LightmapImage& image) const {

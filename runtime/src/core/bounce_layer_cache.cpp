@@ -6,6 +6,7 @@
 #include "exitance/common/bounce_gather.h"
 #include "exitance/common/gpu_layout.h"
 #include "exitance/formats/huge_pages.h"
+#include "exitance/runtime/core/grouped_indices.h"
 #include "exitance/runtime/core/parallel_chunks.h"
 
 namespace exitance {
@@ -86,21 +87,14 @@ struct BounceCachePlan {
     // The valid texels of each page, in texel order (a hand-made G-buffer without pages, or a texel
     // off its page: nothing to look up).
     const size_t page_count = plan->pages.size();
-    std::vector<uint32_t> page_start(page_count + 1, 0), by_page;
-    auto seeds_a_cell = [&](size_t i) {
+    const GroupedIndices seeds_by_page = group_indices(gbuffer.texels.size(), page_count, [&](size_t i) {
       const LiveTexel& t = gbuffer.texels[i];
-      return t.page < page_count && (valid.empty() || valid[i]) && t.x < uint32_t(plan->pages[t.page].width) &&
-             t.y < uint32_t(plan->pages[t.page].height);
-    };
-    for (size_t i = 0; i < gbuffer.texels.size(); ++i)
-      if (seeds_a_cell(i)) ++page_start[gbuffer.texels[i].page + 1];
-    for (size_t p = 0; p < page_count; ++p) page_start[p + 1] += page_start[p];
-    by_page.resize(page_start.back());
-    {
-      std::vector<uint32_t> next(page_start.begin(), page_start.end() - 1);
-      for (size_t i = 0; i < gbuffer.texels.size(); ++i)
-        if (seeds_a_cell(i)) by_page[next[gbuffer.texels[i].page]++] = uint32_t(i);
-    }
+      const bool seeds = t.page < page_count && (valid.empty() || valid[i]) && t.x < uint32_t(plan->pages[t.page].width) &&
+                         t.y < uint32_t(plan->pages[t.page].height);
+      return seeds ? size_t(t.page) : page_count;
+    });
+    const std::vector<uint32_t>& page_start = seeds_by_page.start;
+    const std::vector<uint32_t>& by_page = seeds_by_page.items;
     // Per page on all cores, slots numbered from 0 within the page: its seeds (a cell two texels
     // name holds the later one's, as the pages did), then its rings. A cell is filled in ring k
     // exactly when it is unfilled and has a neighbour filled in ring k - 1 (one filled earlier would

@@ -10,6 +10,7 @@
 #include "edit_targets.h"
 #include "exitance/runtime/core/bvh4_refit.h"
 #include "moved_instances.h"
+#include "exitance/runtime/core/grouped_indices.h"
 #include "exitance/runtime/core/parallel_chunks.h"
 #include "exitance/runtime/world_box.h"
 
@@ -172,14 +173,10 @@ EditedParts edit_parts(Scene& next, const std::vector<SceneEdit>& edits) {
 }  // namespace
 
 InstanceTexels::InstanceTexels(const TexelGBuffer& gbuffer, size_t instance_count) {
-  start.assign(instance_count + 1, 0);
-  for (const LiveTexel& t : gbuffer.texels)
-    if (t.instance < instance_count) ++start[size_t(t.instance) + 1];
-  for (size_t k = 0; k < instance_count; ++k) start[k + 1] += start[k];
-  texels.resize(start.back());
-  std::vector<uint32_t> next(start.begin(), start.end() - 1);
-  for (size_t i = 0; i < gbuffer.texels.size(); ++i)
-    if (gbuffer.texels[i].instance < instance_count) texels[next[gbuffer.texels[i].instance]++] = uint32_t(i);
+  GroupedIndices by_instance = group_indices(gbuffer.texels.size(), instance_count,
+                                             [&](size_t i) { return gbuffer.texels[i].instance; });
+  start = std::move(by_instance.start);
+  texels = std::move(by_instance.items);
 }
 
 InPlaceEdits apply_scene_edits_in_place(PersistedScene& persisted, const std::vector<SceneEdit>& edits,
