@@ -53,20 +53,24 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   }
   by_light.reset();
 
-  PersistedScene persisted = session.persisted();
+  // Read in place; only the probes are rewritten (a copy of the whole scene and G-buffer cost 0.11 s
+  // at 478 k texels on 2 cores).
+  const PersistedScene& persisted = session.persisted();
+  formats::ProbeGrid probes;
   ProbeEstimate probe_estimate;
   const bool has_probes = persisted.has_probe_grid() && manifest.probes.has_value();
   if (has_probes) {
     stage("probes");
     if (session.refreshes_probes()) {
       // What the refreshed probes show, as the pages hold what texels show (docs/runtime.md "Probes").
-      persisted.probes = session.published_probes();
+      probes = session.published_probes();
     } else {
       std::vector<size_t> traced;
-      for (size_t i = 0; i < persisted.probes.probes.size(); ++i)
-        if (formats::probe_is_usable(persisted.probes.probes[i])) traced.push_back(i);
+      probes = persisted.probes;
+      for (size_t i = 0; i < probes.probes.size(); ++i)
+        if (formats::probe_is_usable(probes.probes[i])) traced.push_back(i);
       probe_estimate = session.probe_estimate(baked.probe_spp);
-      store_probe_radiance(persisted.probes, traced, probe_estimate, baked.probe_dering_window);
+      store_probe_radiance(probes, traced, probe_estimate, baked.probe_dering_window);
     }
     seconds["probes"] = clock.lap();
   }
@@ -186,7 +190,7 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
       const std::string manifest_text = formats::write_bundle_manifest(manifest);
       for (size_t p = 0; p < layer_pages.size(); ++p)
         formats::write_lightmap_exr((dir / manifest.light_layers->files[p]).string(), layer_pages[p]);
-      if (has_probes) formats::write_probes_file((dir / manifest.probes->file).string(), persisted.probes);
+      if (has_probes) formats::write_probes_file((dir / manifest.probes->file).string(), probes);
       if (svo) formats::write_svo_file((dir / manifest.svo->file).string(), *svo);
       std::ofstream scene_out(dir / manifest.scene->file, std::ios::binary);
       scene_out.write(reinterpret_cast<const char*>(scene_bytes.data()), std::streamsize(scene_bytes.size()));
