@@ -7,8 +7,6 @@
 // A body that throws: the first exception is rethrown to the caller once every chunk has ended.
 #pragma once
 #include <algorithm>
-#include <atomic>
-#include <chrono>
 #include <condition_variable>
 #include <cstddef>
 #include <deque>
@@ -33,31 +31,25 @@ class ChunkPool {
   static bool on_worker() { return worker_flag(); }
   size_t workers() const { return threads_.size(); }
 
-  // task(k) for every k in [0, count), each k once, on the calling thread and the workers: each
-  // claims the next k until none is left, so a worker slow to wake (tens of microseconds, more than
-  // a small loop's chunk) leaves its chunk to whoever is free, the caller included. Which thread
-  // runs a chunk never changes the chunk's range.
+  // task(k) for every k in [0, count): k = 0 on the calling thread, the others on the workers.
   void run(size_t count, const std::function<void(size_t)>& task) {
     Job job;
     job.task = &task;
-    job.count = count;
-    const size_t helpers = std::min(count - 1, threads_.size());
+    job.remaining = count - 1;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      for (size_t k = 0; k < helpers; ++k) queue_.push_back(&job);
-      queued_.fetch_add(helpers, std::memory_order_relaxed);
+      for (size_t k = 1; k < count; ++k) queue_.push_back({&job, k});
     }
-    if (helpers == threads_.size()) work_.notify_all();
-    else
-      for (size_t k = 0; k < helpers; ++k) work_.notify_one();
-    const size_t ran = claim_and_run(job);
+    if (count > 2) work_.notify_all();
+    else if (count == 2) work_.notify_one();
+    try {
+      task(0);
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!job.error) job.error = std::current_exception();
+    }
     std::unique_lock<std::mutex> lock(mutex_);
-    // Entries no worker took are dropped: every chunk is claimed already.
-    const auto untaken = std::remove(queue_.begin(), queue_.end(), &job);
-    queued_.fetch_sub(size_t(queue_.end() - untaken), std::memory_order_relaxed);
-    queue_.erase(untaken, queue_.end());
-    job.finished += ran;
-    job.done.wait(lock, [&] { return job.finished == job.count && job.holders == 0; });
+    job.finished.wait(lock, [&] { return job.remaining == 0; });
     if (job.error) std::rethrow_exception(job.error);
   }
 
@@ -75,27 +67,14 @@ class ChunkPool {
  private:
   struct Job {
     const std::function<void(size_t)>* task = nullptr;
-    size_t count = 0;
-    std::atomic<size_t> next{0};  // the next chunk to claim
-    size_t finished = 0;          // chunks ended (under the pool's mutex)
-    size_t holders = 0;           // workers that took the job and may still claim (under the mutex)
-    std::exception_ptr error;     // the first thrown (under the mutex)
-    std::condition_variable done;
+    size_t remaining = 0;  // items not yet finished (under the pool's mutex)
+    std::exception_ptr error;
+    std::condition_variable finished;
   };
-
-  // Runs chunks of `job` until none is left to claim; returns how many this thread ran.
-  size_t claim_and_run(Job& job) {
-    size_t ran = 0;
-    for (size_t k; (k = job.next.fetch_add(1, std::memory_order_relaxed)) < job.count; ++ran) {
-      try {
-        (*job.task)(k);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex_);
-        if (!job.error) job.error = std::current_exception();
-      }
-    }
-    return ran;
-  }
+  struct Item {
+    Job* job;
+    size_t index;
+  };
 
   static bool& worker_flag() {
     thread_local bool flag = false;
@@ -111,35 +90,26 @@ class ChunkPool {
     worker_flag() = true;
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
-      if (queue_.empty() && !stopping_) {
-        // A while awake before sleeping: an edit's loops come tens of microseconds apart, and a
-        // sleeping worker takes about 100 microseconds to wake (bench_parallel_chunks).
-        lock.unlock();
-        const auto until = std::chrono::steady_clock::now() + kAwake;
-        while (queued_.load(std::memory_order_relaxed) == 0 && std::chrono::steady_clock::now() < until)
-          std::this_thread::yield();
-        lock.lock();
-      }
       work_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
       if (queue_.empty()) return;  // stopping, nothing left
-      Job* job = queue_.front();
+      const Item item = queue_.front();
       queue_.pop_front();
-      queued_.fetch_sub(1, std::memory_order_relaxed);
-      ++job->holders;
       lock.unlock();
-      const size_t ran = claim_and_run(*job);
+      std::exception_ptr error;
+      try {
+        (*item.job->task)(item.index);
+      } catch (...) {
+        error = std::current_exception();
+      }
       lock.lock();
-      job->finished += ran;
-      --job->holders;
-      if (job->finished == job->count && job->holders == 0) job->done.notify_one();
+      if (error && !item.job->error) item.job->error = error;
+      if (--item.job->remaining == 0) item.job->finished.notify_one();
     }
   }
 
   std::mutex mutex_;
   std::condition_variable work_;
-  std::deque<Job*> queue_;  // one entry per worker asked to help with a job
-  std::atomic<size_t> queued_{0};  // queue_.size(), read without the mutex by workers staying awake
-  static constexpr std::chrono::microseconds kAwake{250};
+  std::deque<Item> queue_;
   std::vector<std::thread> threads_;
   bool stopping_ = false;
 };
