@@ -2,13 +2,16 @@
 // unocclude push a move carried with them are exactly those a fresh unocclude step would place
 // where the carried push put them. The instance is a "T" (a floor crossing under a wall, so the
 // floor texels behind the wall are pushed by its own geometry) above a ground quad; the bake's
-// unocclude stage (Embree) places the texels first, as bake does, then the edits move it.
+// unocclude stage (Embree) places the texels first, as bake does, then the edits move it. Where a
+// texel lies within reach of another instance's box, its triangles decide (a box that spans more
+// than its triangles keeps no texel from being carried).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 #include <unistd.h>
@@ -131,17 +134,22 @@ struct Carried {
 // rotation the step's 8 sideways rays keep their world directions, not the object's, so the fresh
 // push may end elsewhere past the same back face: then the carried texel must be one the step leaves
 // where it is (no back face within reach) and lie within the reach of the fresh position.
-Carried check_carried(const SceneEdit& edit, bool same_rays = true) {
+// With `triangles`, where a texel lies within reach of another instance's box its triangles are
+// tested (texels_carried_rigidly's `edited_lighting`); `ground_box`: the box the ground instance is
+// given instead of its own (a box that spans more than its triangles, as a city's street floor's).
+Carried check_carried(const SceneEdit& edit, bool same_rays = true, bool triangles = true,
+                      std::optional<WorldBox> ground_box = std::nullopt) {
   PersistedScene p = baked_tee();
   std::vector<WorldBox> boxes;
   for (const Instance& instance : p.scene.instances) boxes.push_back(instance_world_box(p.scene, instance));
   const InPlaceEdits edited = apply_scene_edits_in_place(p, {edit}, nullptr);
   for (size_t j = 0; j < edited.effects.moved_instances.size(); ++j) boxes[edited.effects.moved_instances[j]] = edited.moved_boxes_after[j];
+  if (ground_box) boxes[1] = *ground_box;
+  const LightingScene lighting = build_lighting_scene(std::make_shared<const Scene>(p.scene), build_bvh4(p.scene));
   Carried out;
   out.moved = edited.moved_texels;
   out.carried = texels_carried_rigidly(p, edited.moved_texels, edited.effects.moved_instances, edited.moved_deltas,
-                                       edited.moved_boxes_before, boxes, WorldBox{});
-  const LightingScene lighting = build_lighting_scene(std::make_shared<const Scene>(p.scene), build_bvh4(p.scene));
+                                       edited.moved_boxes_before, boxes, WorldBox{}, triangles ? &lighting : nullptr);
   const ClosestHitQuery query = [&](const Vec3& origin, const Vec3& direction, float t_max) {
     const BvhHit hit = closest_hit(lighting, origin, direction, t_max);
     return OccluderHit{hit.found, hit.distance, hit.geometric_normal};
@@ -184,6 +192,22 @@ TEST(TexelsCarriedRigidly, TexelsWithinReachOfOtherGeometryAreNot) {
   const Carried c = check_carried(move_tee({0, 0, 0}));
   EXPECT_GT(c.carried.size(), 0u);
   EXPECT_LT(c.carried.size(), c.moved.size());
+}
+
+TEST(TexelsCarriedRigidly, ABoxWithoutTrianglesWithinReachKeepsNoTexel) {
+  // The ground's box grown to hold the T before (2 m up) and after (3 m up), its quad still at y = 0:
+  // by boxes alone nothing is carried; by the triangles within reach, all of it (each checked
+  // against a fresh unocclude step in check_carried).
+  const WorldBox spanning{{-10, -1, -10}, {10, 10, 10}};
+  const Carried boxes_alone = check_carried(move_tee({2, 3, -1}), true, false, spanning);
+  EXPECT_TRUE(boxes_alone.carried.empty());
+  const Carried by_triangles = check_carried(move_tee({2, 3, -1}), true, true, spanning);
+  EXPECT_GT(by_triangles.moved.size(), 100u);
+  EXPECT_EQ(by_triangles.carried, by_triangles.moved);
+  // Set down on the ground, the texels at its foot stay within reach of the quad's triangles.
+  const Carried on_ground = check_carried(move_tee({0, 0, 0}), true, true, spanning);
+  EXPECT_GT(on_ground.carried.size(), 0u);
+  EXPECT_LT(on_ground.carried.size(), on_ground.moved.size());
 }
 
 TEST(TexelsCarriedRigidly, UniformScaleIsCarriedOtherScalesAreNot) {

@@ -466,7 +466,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
     }
     const std::vector<uint32_t> carried =
         texels_carried_rigidly(s.persisted, in_place.moved_texels, effects.moved_instances, in_place.moved_deltas,
-                               in_place.moved_boxes_before, s.instance_boxes, s.uninstanced_box);
+                               in_place.moved_boxes_before, s.instance_boxes, s.uninstanced_box, &lighting);
     const std::vector<uint32_t> unoccluded = unocclude_near_boxes(s.persisted, boxes, lighting, &s.texel_grid, &carried);
     for (uint32_t i : unoccluded) s.texel_grid.displace(i, s.persisted.gbuffer.texels[i]);
     std::set_union(in_place.moved_texels.begin(), in_place.moved_texels.end(), unoccluded.begin(), unoccluded.end(),

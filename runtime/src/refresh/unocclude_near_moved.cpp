@@ -113,12 +113,54 @@ double similarity_scale(const Matrix4d& m) {
   return std::sqrt(s2);
 }
 
+// Whether a triangle of `lighting` outside the triangle ranges `skip` has bounds within `margin` of
+// `p` (per axis, as WorldBox::contains grows a box). The BVH's leaves box a split triangle's
+// fragments; its whole bounds are tested, so a triangle any part of which lies within reach is found.
+bool triangle_within(const LightingScene& lighting, const Vec3& p, float margin,
+                     const std::vector<std::pair<uint32_t, uint32_t>>& skip, std::vector<uint32_t>& stack) {
+  const Bvh4& bvh = lighting.bvh;
+  if (bvh.nodes.empty()) return false;
+  const Vec3 lo = p - Vec3{margin, margin, margin}, hi = p + Vec3{margin, margin, margin};
+  auto skipped = [&](uint32_t t) {
+    return std::any_of(skip.begin(), skip.end(), [&](const std::pair<uint32_t, uint32_t>& r) { return t >= r.first && t < r.second; });
+  };
+  stack.assign(1, 0);
+  while (!stack.empty()) {
+    const Bvh4Node& node = bvh.nodes[stack.back()];
+    stack.pop_back();
+    for (int c = 0; c < 4; ++c) {
+      const uint32_t child = node.child[c];
+      if (child == kBvhEmptyChild) continue;
+      if (node.lo_x[c] > hi.x || node.hi_x[c] < lo.x || node.lo_y[c] > hi.y || node.hi_y[c] < lo.y || node.lo_z[c] > hi.z ||
+          node.hi_z[c] < lo.z)
+        continue;
+      if (!(child & kBvhLeafBit)) {
+        stack.push_back(child);
+        continue;
+      }
+      const uint32_t first = (child & ~kBvhLeafBit) >> 2, count = (child & 3u) + 1;
+      for (uint32_t slot = first; slot < first + count; ++slot) {
+        const uint32_t t = bvh.leaf_triangles[slot];
+        if (t >= lighting.triangles.size() || skipped(t)) continue;
+        const GpuTriangle& g = lighting.triangles[t];
+        WorldBox box;
+        box.grow(Vec3{g.p0_material.x, g.p0_material.y, g.p0_material.z});
+        box.grow(Vec3{g.p1_area_pdf.x, g.p1_area_pdf.y, g.p1_area_pdf.z});
+        box.grow(Vec3{g.p2_instance.x, g.p2_instance.y, g.p2_instance.z});
+        if (box.contains(p, margin)) return true;
+      }
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 std::vector<uint32_t> texels_carried_rigidly(const PersistedScene& edited, const std::vector<uint32_t>& moved_texels,
                                              const std::vector<uint32_t>& moved_instances, const std::vector<Matrix4d>& deltas,
                                              const std::vector<WorldBox>& moved_boxes_before,
-                                             const std::vector<WorldBox>& instance_boxes, const WorldBox& uninstanced) {
+                                             const std::vector<WorldBox>& instance_boxes, const WorldBox& uninstanced,
+                                             const LightingScene* edited_lighting) {
   std::vector<uint32_t> carried;
   if (moved_instances.size() != deltas.size() || moved_instances.size() != moved_boxes_before.size()) return carried;
   // Per moved instance: its move's inverse, its scale, and the other geometry's boxes near it.
@@ -126,6 +168,8 @@ std::vector<uint32_t> texels_carried_rigidly(const PersistedScene& edited, const
     Matrix4d inverse;
     double scale = 0;
     std::vector<WorldBox> others;
+    std::vector<WorldBox> others_moved_before;  // the other moved instances' bounds before (not in the BVH)
+    std::vector<std::pair<uint32_t, uint32_t>> own, all_moved;  // triangle ranges the finer test skips
   };
   std::vector<Move> moves(moved_instances.size());
   std::vector<uint32_t> move_of(instance_boxes.size(), UINT32_MAX);
@@ -150,7 +194,18 @@ std::vector<uint32_t> texels_carried_rigidly(const PersistedScene& edited, const
     for (size_t o = 0; o < instance_boxes.size(); ++o)
       if (o != k && near_region(instance_boxes[o])) moves[j].others.push_back(instance_boxes[o]);
     for (size_t o = 0; o < moved_instances.size(); ++o)
-      if (o != j && near_region(moved_boxes_before[o])) moves[j].others.push_back(moved_boxes_before[o]);
+      if (o != j && near_region(moved_boxes_before[o])) {
+        moves[j].others.push_back(moved_boxes_before[o]);
+        moves[j].others_moved_before.push_back(moved_boxes_before[o]);
+      }
+    if (edited_lighting) {
+      auto range_of = [&](uint32_t instance) {
+        const Instance& i = edited.scene.instances[instance];
+        return std::pair<uint32_t, uint32_t>{i.first_triangle, i.first_triangle + i.triangle_count};
+      };
+      moves[j].own.push_back(range_of(k));
+      for (uint32_t m : moved_instances) moves[j].all_moved.push_back(range_of(m));
+    }
     if (near_region(uninstanced)) moves[j].others.push_back(uninstanced);
   }
   std::vector<uint8_t> keep(moved_texels.size(), 0);
@@ -163,9 +218,19 @@ std::vector<uint32_t> texels_carried_rigidly(const PersistedScene& edited, const
       // Where it is and where it was, each within twice the reach it had there (as unocclude_near_boxes tests).
       const float reach_now = unocclude_reach(texel), reach_before = reach_now / float(move.scale);
       const Vec3 before = transform_point(move.inverse, texel.position);
-      const bool near_other = std::any_of(move.others.begin(), move.others.end(), [&](const WorldBox& b) {
+      bool near_other = std::any_of(move.others.begin(), move.others.end(), [&](const WorldBox& b) {
         return b.contains(texel.position, 2 * reach_now) || b.contains(before, 2 * reach_before);
       });
+      if (near_other && edited_lighting) {
+        // A box near is not yet geometry near (a street's box spans the city): the triangles
+        // themselves, now (every instance's but its own, where they are now) and before (those
+        // that did not move; the other moved instances' by their boxes before).
+        thread_local std::vector<uint32_t> stack;
+        near_other = std::any_of(move.others_moved_before.begin(), move.others_moved_before.end(),
+                                 [&](const WorldBox& b) { return b.contains(before, 2 * reach_before); }) ||
+                     triangle_within(*edited_lighting, texel.position, 2 * reach_now, move.own, stack) ||
+                     triangle_within(*edited_lighting, before, 2 * reach_before, move.all_moved, stack);
+      }
       keep[t] = !near_other;
     }
   }, 1024);
