@@ -21,13 +21,13 @@ relight() {  # $1 binary, $2 label, $3 rep
   python3 - "$W/$2_$3.json" "$2" "$3" "$start" "$end" >> $S <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1])); s = r['seconds']; wall = float(sys.argv[5]) - float(sys.argv[4])
-order = ['load', 'edits', 'lighting', 'probes', 'exitance', 'write']
+order = ['load', 'edits', 'lighting', 'read_back', 'probes', 'exitance', 'write']
 cells = ' | '.join('%.3f' % s[k] if k in s else '' for k in order)
 print('| %s %s | %s | %.3f | %.2f | %d |' % (sys.argv[2], sys.argv[3], cells, wall, wall / s['lighting'], r['live_texels']))
 PY
 }
-echo "| run | load | edits | lighting | probes | exitance | write | whole call s | whole / lighting | live texels |" >> $S
-echo "|---|---|---|---|---|---|---|---|---|---|" >> $S
+echo "| run | load | edits | lighting | read back | probes | exitance | write | whole call s | whole / lighting | live texels |" >> $S
+echo "|---|---|---|---|---|---|---|---|---|---|---|" >> $S
 for rep in $(seq 1 ${REPS:-3}); do
   relight $W/runtime/bin/exitance-relight after $rep
   if [ -x $W/before/exitance-relight ]; then relight $W/before/exitance-relight before $rep; fi
