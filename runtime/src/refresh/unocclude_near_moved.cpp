@@ -119,7 +119,8 @@ double similarity_scale(const Matrix4d& m) {
 bool triangle_within(const LightingScene& lighting, const Vec3& p, float margin,
                      const std::vector<std::pair<uint32_t, uint32_t>>& skip, std::vector<uint32_t>& stack) {
   const Bvh4& bvh = lighting.bvh;
-  if (bvh.nodes.empty()) return false;
+  if (bvh.nodes.empty() || !lighting.source) return false;
+  const Scene& scene = *lighting.source;  // the records' positions (refresh_moved_triangles_from_source)
   const Vec3 lo = p - Vec3{margin, margin, margin}, hi = p + Vec3{margin, margin, margin};
   auto skipped = [&](uint32_t t) {
     return std::any_of(skip.begin(), skip.end(), [&](const std::pair<uint32_t, uint32_t>& r) { return t >= r.first && t < r.second; });
@@ -141,13 +142,8 @@ bool triangle_within(const LightingScene& lighting, const Vec3& p, float margin,
       const uint32_t first = (child & ~kBvhLeafBit) >> 2, count = (child & 3u) + 1;
       for (uint32_t slot = first; slot < first + count; ++slot) {
         const uint32_t t = bvh.leaf_triangles[slot];
-        if (t >= lighting.triangles.size() || skipped(t)) continue;
-        const GpuTriangle& g = lighting.triangles[t];
-        WorldBox box;
-        box.grow(Vec3{g.p0_material.x, g.p0_material.y, g.p0_material.z});
-        box.grow(Vec3{g.p1_area_pdf.x, g.p1_area_pdf.y, g.p1_area_pdf.z});
-        box.grow(Vec3{g.p2_instance.x, g.p2_instance.y, g.p2_instance.z});
-        if (box.contains(p, margin)) return true;
+        if (t >= scene.triangle_count() || skipped(t)) continue;
+        if (triangles_world_box(scene, t, 1).contains(p, margin)) return true;
       }
     }
   }
@@ -169,8 +165,17 @@ std::vector<uint32_t> texels_carried_rigidly(const PersistedScene& edited, const
     double scale = 0;
     std::vector<WorldBox> others;
     std::vector<WorldBox> others_moved_before;  // the other moved instances' bounds before (not in the BVH)
-    std::vector<std::pair<uint32_t, uint32_t>> own, all_moved;  // triangle ranges the finer test skips
+    std::vector<std::pair<uint32_t, uint32_t>> own;  // its triangle range, which the finer test skips now
   };
+  // The finer test's triangle ranges: an instance's, and every moved one's (skipped before the move).
+  auto range_of = [&](uint32_t instance) {
+    const Instance& i = edited.scene.instances[instance];
+    return std::pair<uint32_t, uint32_t>{i.first_triangle, i.first_triangle + i.triangle_count};
+  };
+  std::vector<std::pair<uint32_t, uint32_t>> all_moved;
+  if (edited_lighting)
+    for (uint32_t m : moved_instances)
+      if (m < edited.scene.instances.size()) all_moved.push_back(range_of(m));
   std::vector<Move> moves(moved_instances.size());
   std::vector<uint32_t> move_of(instance_boxes.size(), UINT32_MAX);
   float largest_reach = 0;
@@ -198,14 +203,7 @@ std::vector<uint32_t> texels_carried_rigidly(const PersistedScene& edited, const
         moves[j].others.push_back(moved_boxes_before[o]);
         moves[j].others_moved_before.push_back(moved_boxes_before[o]);
       }
-    if (edited_lighting) {
-      auto range_of = [&](uint32_t instance) {
-        const Instance& i = edited.scene.instances[instance];
-        return std::pair<uint32_t, uint32_t>{i.first_triangle, i.first_triangle + i.triangle_count};
-      };
-      moves[j].own.push_back(range_of(k));
-      for (uint32_t m : moved_instances) moves[j].all_moved.push_back(range_of(m));
-    }
+    if (edited_lighting && k < edited.scene.instances.size()) moves[j].own.push_back(range_of(k));
     if (near_region(uninstanced)) moves[j].others.push_back(uninstanced);
   }
   std::vector<uint8_t> keep(moved_texels.size(), 0);
@@ -229,7 +227,7 @@ std::vector<uint32_t> texels_carried_rigidly(const PersistedScene& edited, const
         near_other = std::any_of(move.others_moved_before.begin(), move.others_moved_before.end(),
                                  [&](const WorldBox& b) { return b.contains(before, 2 * reach_before); }) ||
                      triangle_within(*edited_lighting, texel.position, 2 * reach_now, move.own, stack) ||
-                     triangle_within(*edited_lighting, before, 2 * reach_before, move.all_moved, stack);
+                     triangle_within(*edited_lighting, before, 2 * reach_before, all_moved, stack);
       }
       keep[t] = !near_other;
     }
