@@ -445,9 +445,9 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   }
   timings.scene += since(lap);
   // A geometry edit's upload (the refit nodes, the moved triangles' records, the emitters) runs on
-  // its own thread while this one moves texels and finds those near the change: the two read the
-  // lighting scene and write disjoint state, and nothing else here records device work until it is
-  // joined (the texels' upload below). Its errors are the device's, rethrown at the join.
+  // its own thread while this one moves texels and starts the search for those near the change:
+  // they read the lighting scene and write disjoint state, and nothing else here records device
+  // work until it is joined (the texels' upload below). Its errors are the device's, rethrown there.
   std::future<void> geometry_upload;
   if (effects.geometry_changed())
     geometry_upload = std::async(std::launch::async, [&] {
@@ -475,10 +475,14 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   timings.texels = since(lap);
   was.moved_boxes_before = in_place.moved_boxes_before;
   was.moved_boxes_after = in_place.moved_boxes_after;
-  std::vector<uint32_t> near = texels_near_change(s.persisted, was, lighting, effects, &s.texel_grid, &s.near_marks);
-  // Set-aside texels are visited by every query: past an eighth of them, the grid is built again.
-  if (s.texel_grid.displaced_count() > s.persisted.gbuffer.texels.size() / 8) s.texel_grid = TexelGrid(s.persisted.gbuffer);
-  timings.near_texels = since(lap);
+  // The texels near the change are found on their own thread while this one records and waits for
+  // the device work below (the moved geometry's and texels' uploads, the publish), which neither
+  // reads nor writes what the search reads (the edited scene, the lighting scene, the texel grid,
+  // the marks' scratch): host search and device waits overlap (a light edit's 0.7 ms search and
+  // 0.5 ms publish were back to back). Joined before the grid is rebuilt or the list is used.
+  std::future<std::vector<uint32_t>> near_search = std::async(std::launch::async, [&] {
+    return texels_near_change(s.persisted, was, lighting, effects, &s.texel_grid, &s.near_marks);
+  });
   if (geometry_upload.valid()) {
     geometry_upload.get();
     s.integrator->update_texels(s.persisted.gbuffer, changed_texels);
@@ -505,6 +509,10 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   const bool split = published_split_by_light();
   const PublishedLightmap published = publish_on_device(clears, split);
   timings.publish = since(lap);
+  std::vector<uint32_t> near = near_search.get();
+  // Set-aside texels are visited by every query: past an eighth of them, the grid is built again.
+  if (s.texel_grid.displaced_count() > s.persisted.gbuffer.texels.size() / 8) s.texel_grid = TexelGrid(s.persisted.gbuffer);
+  timings.near_texels = since(lap);
   // A base needs variances: after opening without the baked lightmap and before any refresh, restart.
   const bool as_change = lights_only && !pairs.empty() && pairs.size() / 2 <= kMaxChangedLights &&
                          (s.base || (published.single_sample_texels == 0 && published.sampled_texels > 0));

@@ -113,8 +113,8 @@ struct RefreshReport {
 struct EditTimings {
   double scene = 0;        // validating and applying the edits: host scene, lighting scene (light and material uploads), probes restarted
   double texels = 0;       // a moved instance's texels: out of their grid cells, the unocclude step near its bounds
-  double near_texels = 0;  // finding the texels near the change (texels_near_change.h)
-  double uploads = 0;      // a moved instance's uploads (run beside `texels` and `near_texels`): what was left to wait for, and the texels'
+  double near_texels = 0;  // finding the texels near the change (texels_near_change.h): what was left after the uploads and the publish, which it runs beside
+  double uploads = 0;      // a moved instance's uploads (run beside `texels`): what was left to wait for, and the texels'
   double publish = 0;      // keeping what texels showed, on the device (publish.comp)
   double restart = 0;      // starting the accumulation again (a restart or a change estimate), or scaling light layers
   bool scaled_light_layers = false;  // the edit only scaled lights: their layers were scaled, no sample was dropped
