@@ -298,20 +298,22 @@ void GpuScene::set_changed_light_pairs(const LightingScene& edited, const std::v
   check_supported_by_vulkan(edited);
   std::vector<GpuPunctualLight> records = edited.punctual_lights;
   records.insert(records.end(), pairs.begin(), pairs.end());
-  using Write = Context::RangeWrite;
-  std::vector<Write> writes;
   if (!records.empty()) {
     grow(punctual_lights_, records.size() * sizeof(GpuPunctualLight));  // room for kMaxChangedLightPairs from the start
-    writes.push_back(Write::whole(punctual_lights_, records.data(), records.size() * sizeof(GpuPunctualLight)));
+    context_.upload_at_next_submission(punctual_lights_, records.data(), records.size() * sizeof(GpuPunctualLight));
   }
-  writes.push_back(Write::whole(punctual_cdf_, edited.punctual_cdf.data(), edited.punctual_cdf.size() * sizeof(double)));
-  context_.write_ranges(writes);
+  // Both copied at the start of the next submission (the first samples of the change estimate):
+  // a light edit waits for no upload of its own.
+  context_.upload_at_next_submission(punctual_cdf_, edited.punctual_cdf.data(), edited.punctual_cdf.size() * sizeof(double));
 }
 
 void GpuScene::update_punctual_lights(const LightingScene& edited) {
   check_same_shape(edited);
   check_supported_by_vulkan(edited);
-  upload_punctual(edited);
+  // At the start of the next submission, as set_changed_light_pairs.
+  if (punctual_count_ > 0)
+    context_.upload_at_next_submission(punctual_lights_, edited.punctual_lights.data(), edited.punctual_lights.size() * sizeof(GpuPunctualLight));
+  context_.upload_at_next_submission(punctual_cdf_, edited.punctual_cdf.data(), edited.punctual_cdf.size() * sizeof(double));
 }
 
 void GpuScene::update_environment(const LightingScene& edited) {

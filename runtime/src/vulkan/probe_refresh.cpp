@@ -134,11 +134,12 @@ void ProbeRefresh::clear(const std::vector<uint32_t>& order, size_t priority) {
       for (size_t i = 0; i < order_.size(); ++i) order_[i] = uint32_t(i);
     }
     identity_order_ = order.empty();
-    context.upload(runner_.buffers().refresh_probe_items.batch_items, order_.data(), order_.size() * 4);
+    context.upload_at_next_submission(runner_.buffers().refresh_probe_items.batch_items, order_.data(), order_.size() * 4);
   }
-  VkCommandBuffer cmd = context.begin();
-  runner_.buffers().refresh_probe_sums.clear(cmd);
-  context.submit_and_wait(cmd);
+  // The order's upload and the sums' clear run at the start of the next submission (an edit's
+  // publish, or the next probe set): no round trip of their own inside an edit.
+  const ProbeAccumulators& sums = runner_.buffers().refresh_probe_sums;
+  context.record_at_next_submission([&sums](VkCommandBuffer cmd) { sums.clear(cmd); });
 }
 
 uint64_t ProbeRefresh::add_set(const IntegratorSettings& settings, uint32_t target_samples, size_t max_probes,

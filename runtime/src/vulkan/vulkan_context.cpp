@@ -274,6 +274,8 @@ void Context::cleanup() {
   if (device_) {
     if (owns_device_ && !lost_) vkDeviceWaitIdle(device_);
     small_staging_ = Buffer{};
+    deferred_staging_ = Buffer{};
+    pending_.clear();
     if (fence_) vkDestroyFence(device_, fence_, nullptr);
     if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
     fence_ = VK_NULL_HANDLE, pool_ = VK_NULL_HANDLE;
@@ -370,7 +372,44 @@ VkCommandBuffer Context::begin() {
   VkCommandBufferBeginInfo info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   check(vkBeginCommandBuffer(cmd_, &info), "vkBeginCommandBuffer");
+  pending_recorded_ = 0;
+  if (!pending_.empty()) {
+    for (const auto& record : pending_) record(cmd_);
+    pending_recorded_ = pending_.size();
+    VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    barrier.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+    vkCmdPipelineBarrier(cmd_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &barrier, 0, nullptr, 0,
+                         nullptr);
+  }
   return cmd_;
+}
+
+void Context::record_at_next_submission(std::function<void(VkCommandBuffer)> record) {
+  if (lost_) throw VulkanDeviceFailure("Vulkan device failed earlier; create a new integrator");
+  pending_.push_back(std::move(record));
+}
+
+void Context::upload_at_next_submission(const Buffer& dst, const void* data, VkDeviceSize size, VkDeviceSize offset) {
+  if (size == 0) return;
+  if (offset + size > dst.size()) throw std::logic_error("Context::upload_at_next_submission: past the end of the buffer");
+  const VkDeviceSize at = (deferred_bytes_ + 15) & ~VkDeviceSize(15);
+  if (!deferred_staging_.handle() || deferred_staging_.size() < at + size) {
+    // Grown by doubling; the bytes already staged move along (nothing on the device reads them
+    // yet: they are copied only at the next submission, and every submission is waited for).
+    VkDeviceSize bytes = std::max<VkDeviceSize>(64 * 1024, deferred_staging_.size());
+    while (bytes < at + size) bytes *= 2;
+    Buffer larger = create_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+    if (deferred_bytes_ > 0) std::memcpy(larger.mapped(), deferred_staging_.mapped(), deferred_bytes_);
+    deferred_staging_ = std::move(larger);
+  }
+  std::memcpy(static_cast<char*>(deferred_staging_.mapped()) + at, data, size);
+  deferred_bytes_ = at + size;
+  const Buffer* target = &dst;
+  record_at_next_submission([this, target, at, size, offset](VkCommandBuffer cmd) {
+    const VkBufferCopy region{at, offset, size};
+    vkCmdCopyBuffer(cmd, deferred_staging_.handle(), target->handle(), 1, &region);
+  });
 }
 
 void Context::submit_and_wait(VkCommandBuffer cmd, double timeout_seconds) {
@@ -423,6 +462,10 @@ void Context::submit_and_wait(VkCommandBuffer cmd, double timeout_seconds, VkSem
   }
   if (r == VK_ERROR_DEVICE_LOST) fail("Vulkan device lost (vkWaitForFences)");
   check(r, "vkWaitForFences");
+  // What was recorded at the start of this submission has run.
+  pending_.erase(pending_.begin(), pending_.begin() + std::ptrdiff_t(pending_recorded_));
+  pending_recorded_ = 0;
+  if (pending_.empty()) deferred_bytes_ = 0;
 }
 
 void Context::fail(const std::string& message) {

@@ -132,7 +132,17 @@ class Context {
   // least `bytes` (made once for the largest of a run's transfers, then reused).
   void keep_staging(Buffer& kept, VkDeviceSize bytes);
 
-  VkCommandBuffer begin();  // the context's single command buffer, reset
+  // Work recorded at the start of the next submission (in begin(), before the caller's commands,
+  // then a barrier that makes its writes visible to all that follows): an edit's small clears and
+  // uploads then cost no submission and no wait of their own. A recorder reads its buffers'
+  // handles when it runs, so it must outlive nothing it names. Kept until a submission that
+  // recorded it has been waited for (a command buffer begun and never submitted leaves it pending).
+  void record_at_next_submission(std::function<void(VkCommandBuffer)> record);
+  // `size` bytes of `data` copied now into staging the context keeps, and from there to `dst` at
+  // `offset` at the start of the next submission (record_at_next_submission).
+  void upload_at_next_submission(const Buffer& dst, const void* data, VkDeviceSize size, VkDeviceSize offset = 0);
+
+  VkCommandBuffer begin();  // the context's single command buffer, reset; records what is pending (above)
   // Submits the command buffer and waits for its fence (bounded by fence_timeout_seconds); throws
   // VulkanDeviceFailure on timeout or device loss.
   // `timeout_seconds` > 0 replaces the fence timeout for this submission (kernel compilation).
@@ -200,6 +210,12 @@ class Context {
   bool lost_ = false;
   bool hung_ = false;
   Waits waits_;
+  // record_at_next_submission's recorders; the first `pending_recorded_` are in the command buffer
+  // begun last. upload_at_next_submission's bytes, packed in `deferred_staging_` up to `deferred_bytes_`.
+  std::vector<std::function<void(VkCommandBuffer)>> pending_;
+  size_t pending_recorded_ = 0;
+  Buffer deferred_staging_;
+  VkDeviceSize deferred_bytes_ = 0;
 };
 
 }  // namespace exitance::vulkan
