@@ -531,8 +531,10 @@ void LightmapDriver::update_texels(const TexelGBuffer& gbuffer, const std::vecto
   std::vector<uint32_t> sorted = texels;
   std::sort(sorted.begin(), sorted.end());
   sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
-  // The host's start points fill the gaps between joined runs.
-  runner_.context().upload_ranges(buffers.items.start_points, a.start_points.data(), byte_ranges(record_runs(sorted, kPoint), kPoint));
+  // The host's start points fill the gaps between joined runs; staged now, copied at the start of
+  // the next submission (an edit's publish).
+  runner_.context().write_ranges_at_next_submission(
+      {Context::RangeWrite::mirrored(buffers.items.start_points, a.start_points.data(), byte_ranges(record_runs(sorted, kPoint), kPoint))});
 }
 
 uint64_t LightmapDriver::add_samples(uint32_t samples) {

@@ -391,25 +391,40 @@ void Context::record_at_next_submission(std::function<void(VkCommandBuffer)> rec
 }
 
 void Context::upload_at_next_submission(const Buffer& dst, const void* data, VkDeviceSize size, VkDeviceSize offset) {
-  if (size == 0) return;
   if (offset + size > dst.size()) throw std::logic_error("Context::upload_at_next_submission: past the end of the buffer");
-  const VkDeviceSize at = (deferred_bytes_ + 15) & ~VkDeviceSize(15);
-  if (!deferred_staging_.handle() || deferred_staging_.size() < at + size) {
+  write_ranges_at_next_submission({RangeWrite{&dst, {{offset, size}}, [data, size](char* staging) { std::memcpy(staging, data, size_t(size)); }}});
+}
+
+void Context::write_ranges_at_next_submission(const std::vector<RangeWrite>& writes) {
+  std::vector<std::vector<VkBufferCopy>> regions(writes.size());
+  std::vector<VkDeviceSize> start(writes.size(), 0);
+  const VkDeviceSize first = (deferred_bytes_ + 15) & ~VkDeviceSize(15);
+  VkDeviceSize end = first;
+  for (size_t w = 0; w < writes.size(); ++w) {
+    VkDeviceSize packed = 0;
+    regions[w] = staging_regions(writes[w].ranges, /*from_staging=*/true, packed);
+    for (VkBufferCopy& r : regions[w]) r.srcOffset += end;
+    start[w] = end;
+    end += packed;
+  }
+  if (end == first) return;
+  if (!deferred_staging_.handle() || deferred_staging_.size() < end) {
     // Grown by doubling; the bytes already staged move along (nothing on the device reads them
     // yet: they are copied only at the next submission, and every submission is waited for).
     VkDeviceSize bytes = std::max<VkDeviceSize>(64 * 1024, deferred_staging_.size());
-    while (bytes < at + size) bytes *= 2;
+    while (bytes < end) bytes *= 2;
     Buffer larger = create_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
-    if (deferred_bytes_ > 0) std::memcpy(larger.mapped(), deferred_staging_.mapped(), deferred_bytes_);
+    if (deferred_bytes_ > 0) std::memcpy(larger.mapped(), deferred_staging_.mapped(), size_t(deferred_bytes_));
     deferred_staging_ = std::move(larger);
   }
-  std::memcpy(static_cast<char*>(deferred_staging_.mapped()) + at, data, size);
-  deferred_bytes_ = at + size;
-  const Buffer* target = &dst;
-  record_at_next_submission([this, target, at, size, offset](VkCommandBuffer cmd) {
-    const VkBufferCopy region{at, offset, size};
-    vkCmdCopyBuffer(cmd, deferred_staging_.handle(), target->handle(), 1, &region);
-  });
+  deferred_bytes_ = end;  // before the fills: a write that throws leaves the earlier ones' bytes in place
+  for (size_t w = 0; w < writes.size(); ++w) {
+    if (regions[w].empty()) continue;
+    writes[w].write(static_cast<char*>(deferred_staging_.mapped()) + start[w]);
+    record_at_next_submission([this, dst = writes[w].dst, copies = std::move(regions[w])](VkCommandBuffer cmd) {
+      vkCmdCopyBuffer(cmd, deferred_staging_.handle(), dst->handle(), uint32_t(copies.size()), copies.data());
+    });
+  }
 }
 
 void Context::submit_and_wait(VkCommandBuffer cmd, double timeout_seconds) {

@@ -141,6 +141,9 @@ class Context {
   // `size` bytes of `data` copied now into staging the context keeps, and from there to `dst` at
   // `offset` at the start of the next submission (record_at_next_submission).
   void upload_at_next_submission(const Buffer& dst, const void* data, VkDeviceSize size, VkDeviceSize offset = 0);
+  // write_ranges(writes) the same way: each write fills its bytes in the kept staging now, and the
+  // copies are recorded at the start of the next submission.
+  void write_ranges_at_next_submission(const std::vector<RangeWrite>& writes);
 
   VkCommandBuffer begin();  // the context's single command buffer, reset; records what is pending (above)
   // Submits the command buffer and waits for its fence (bounded by fence_timeout_seconds); throws
