@@ -59,6 +59,13 @@ void add_stat64(uint slot, uint value) {
   if (old + value < old) atomicAdd(counters[slot + 1u], 1u);
 }
 
+// Adds 1 to counters[slot] for each invocation that calls it, with one atomicAdd per subgroup (an
+// atomic per invocation on one address serializes: per-bounce passes count every gather).
+void count_in_subgroup(uint slot) {
+  uvec4 ballot = subgroupBallot(true);
+  if (subgroupElect()) atomicAdd(counters[slot], subgroupBallotBitCount(ballot));
+}
+
 // Appends to a queue with one atomicAdd per subgroup: ballot, count, elect, broadcast.
 uint queue_append(uint counter_slot) {
   uvec4 ballot = subgroupBallot(true);

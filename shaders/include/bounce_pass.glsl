@@ -121,11 +121,11 @@ BounceHit shade_bounce_hit(uint p, uint work, uint state, vec4 hit, vec3 wi, vec
     return r;
   }
   if (tri == kInvalid) return r;  // a miss adds 0: the sky is direct light, in B_0
-  atomicAdd(counters[kCounterBounceGathers], 1u);
+  count_in_subgroup(kCounterBounceGathers);
   vec3 ng = triangle_geometric_normal(tri);
   bool front = dot(wi, ng) < 0.0;
   if (!front && !material_double_sided(scene_material(scene_triangle_material(tri)))) {
-    atomicAdd(counters[kCounterBounceBackFaces], 1u);  // absorbs, as in path mode
+    count_in_subgroup(kCounterBounceBackFaces);  // absorbs, as in path mode
     return r;
   }
   vec3 albedo = scene_albedo(tri, hit.z, hit.w);
@@ -139,7 +139,7 @@ BounceHit shade_bounce_hit(uint p, uint work, uint state, vec4 hit, vec3 wi, vec
       add_result(work, 0u, throughput * albedo * b);
       return r;
     }
-    atomicAdd(counters[kCounterBounceTexelless], 1u);
+    count_in_subgroup(kCounterBounceTexelless);
   }
   if (layer == 0u) {
     r.direct_sample = true;

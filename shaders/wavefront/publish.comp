@@ -111,9 +111,8 @@ uint write_base_plus_change(uint t) {
   return uint(m);
 }
 
-void main() {
-  uint t = gl_GlobalInvocationID.x;
-  if (t >= push.texel_count) return;
+// What texel t publishes, written to the out estimate; returns its sample count.
+uint publish_texel(uint t) {
   uint published_samples;
   if (push.mode == kModeRestart) {
     vec3 k = mean_total(kFromPrevious, t), f = mean_total(kFromAccumulation, t);
@@ -140,6 +139,27 @@ void main() {
     copy_texel(kFromAccumulation, t);
     published_samples = acc_samples[t];
   }
-  if (published_samples == 1u) atomicAdd(counts[0], 1u);
-  if (published_samples >= 2u) atomicAdd(counts[1], 1u);
+  return published_samples;
+}
+
+// The counts added per workgroup first: a million atomics on one address each (one per texel)
+// serialize in the device's cache; one per workgroup and counter do not.
+shared uint group_counts[2];
+
+void main() {
+  uint t = gl_GlobalInvocationID.x;
+  if (gl_LocalInvocationIndex == 0u) group_counts[0] = 0u, group_counts[1] = 0u;
+  memoryBarrierShared();
+  barrier();
+  if (t < push.texel_count) {
+    uint published_samples = publish_texel(t);
+    if (published_samples == 1u) atomicAdd(group_counts[0], 1u);
+    if (published_samples >= 2u) atomicAdd(group_counts[1], 1u);
+  }
+  memoryBarrierShared();
+  barrier();
+  if (gl_LocalInvocationIndex == 0u) {
+    if (group_counts[0] > 0u) atomicAdd(counts[0], group_counts[0]);
+    if (group_counts[1] > 0u) atomicAdd(counts[1], group_counts[1]);
+  }
 }
