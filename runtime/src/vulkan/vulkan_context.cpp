@@ -120,6 +120,23 @@ std::vector<VkBufferCopy> staging_regions(const std::vector<ByteRange>& ranges, 
   return regions;
 }
 
+// Each write's copy regions from a staging buffer holding the writes' bytes packed in order from
+// `first`; `start[w]`: where write w's bytes begin. Returns where the packed bytes end.
+VkDeviceSize packed_write_regions(const std::vector<Context::RangeWrite>& writes, VkDeviceSize first,
+                                  std::vector<std::vector<VkBufferCopy>>& regions, std::vector<VkDeviceSize>& start) {
+  regions.assign(writes.size(), {});
+  start.assign(writes.size(), 0);
+  VkDeviceSize end = first;
+  for (size_t w = 0; w < writes.size(); ++w) {
+    VkDeviceSize packed = 0;
+    regions[w] = staging_regions(writes[w].ranges, /*from_staging=*/true, packed);
+    for (VkBufferCopy& r : regions[w]) r.srcOffset += end;
+    start[w] = end;
+    end += packed;
+  }
+  return end;
+}
+
 }  // namespace
 
 // EXITANCE_VULKAN_FENCE_TIMEOUT=SECONDS replaces VulkanDeviceOptions::fence_timeout_seconds (a very
@@ -396,17 +413,10 @@ void Context::upload_at_next_submission(const Buffer& dst, const void* data, VkD
 }
 
 void Context::write_ranges_at_next_submission(const std::vector<RangeWrite>& writes) {
-  std::vector<std::vector<VkBufferCopy>> regions(writes.size());
-  std::vector<VkDeviceSize> start(writes.size(), 0);
+  std::vector<std::vector<VkBufferCopy>> regions;
+  std::vector<VkDeviceSize> start;
   const VkDeviceSize first = (deferred_bytes_ + 15) & ~VkDeviceSize(15);
-  VkDeviceSize end = first;
-  for (size_t w = 0; w < writes.size(); ++w) {
-    VkDeviceSize packed = 0;
-    regions[w] = staging_regions(writes[w].ranges, /*from_staging=*/true, packed);
-    for (VkBufferCopy& r : regions[w]) r.srcOffset += end;
-    start[w] = end;
-    end += packed;
-  }
+  const VkDeviceSize end = packed_write_regions(writes, first, regions, start);
   if (end == first) return;
   if (!deferred_staging_.handle() || deferred_staging_.size() < end) {
     // Grown by doubling; the bytes already staged move along (nothing on the device reads them
@@ -565,16 +575,9 @@ void Context::write_ranges(const Buffer& dst, const std::vector<ByteRange>& rang
 }
 
 void Context::write_ranges(const std::vector<RangeWrite>& writes, const Buffer* given_staging) {
-  std::vector<std::vector<VkBufferCopy>> regions(writes.size());
-  std::vector<VkDeviceSize> start(writes.size(), 0);
-  VkDeviceSize total = 0;
-  for (size_t w = 0; w < writes.size(); ++w) {
-    VkDeviceSize packed = 0;
-    regions[w] = staging_regions(writes[w].ranges, /*from_staging=*/true, packed);
-    for (VkBufferCopy& r : regions[w]) r.srcOffset += total;
-    start[w] = total;
-    total += packed;
-  }
+  std::vector<std::vector<VkBufferCopy>> regions;
+  std::vector<VkDeviceSize> start;
+  const VkDeviceSize total = packed_write_regions(writes, 0, regions, start);
   if (total == 0) return;
   Buffer own;
   bool leased = false;
