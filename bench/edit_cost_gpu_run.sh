@@ -7,7 +7,7 @@
 # and `edits.milliseconds` as an engine's call sees them.
 # With a packed building, bench_edit_cost also moves its point light and back, and doubles its
 # intensity and back (before and after in turn when packed).
-# Env: REPS (9), SAMPLES_BEFORE (16), WARM (16), RELIGHTS (5). Writes $OUT/summary.txt.
+# Env: REPS (9), ROUNDS (2: before and after in turn, this many times), SAMPLES_BEFORE (16), WARM (16), RELIGHTS (5). Writes $OUT/summary.txt.
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
 export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
@@ -17,13 +17,13 @@ S=$OUT/summary.txt
 { nproc; lscpu | grep -i "model name"; } > $S
 cost() { echo "== $1 ${2:-city} ${3:-block}" >> $S; $W/$1 $W/${2:-city}.bake --edits $W/${3:-block}.json --edits-back $W/${3:-block}_back.json \
   --repeat ${REPS:-9} --samples 1 --samples-before ${SAMPLES_BEFORE:-16} >> $S 2>&1; }
-for round in 1 2; do
+for round in $(seq ${ROUNDS:-2}); do
   [ -x $W/bench_edit_cost_before ] && cost bench_edit_cost_before
   cost bench_edit_cost
 done
 # With a packed building (BUILDING= at packing): its point light moved and its intensity doubled.
 if [ -d $W/building.bake ]; then
-  for round in 1 2; do
+  for round in $(seq ${ROUNDS:-2}); do
     for edit in move_light double_light; do
       [ -x $W/bench_edit_cost_before ] && cost bench_edit_cost_before building $edit
       cost bench_edit_cost building $edit
