@@ -120,9 +120,10 @@ struct TailState {
   bool areas_known = false;  // inputs.area: the G-buffer's, the same for every tail of a bake
   // Per texel, the sum over layers [0, prefix_samples.size()) of their means and of their means'
   // variances, added in layer order in float as total_of / total_variance_of add them (so a total
-  // from the prefix is the same bits), while those layers' sample counts are prefix_samples. A tail
-  // then reads the prefix and the top two layers, not every layer (at 1 M texels and seven layers
-  // the tails read ~2 GB: 0.16-0.19 s of a 1.7 s per-bounce run on the H200's host).
+  // from the prefix is the same bits), while those layers' sample counts are prefix_samples (a layer
+  // with a partial pass's extra samples is never kept). A tail then reads the prefix and the top two
+  // layers, not every layer: the Cornell room's tails 0.256 -> 0.206 s on 2 cores; no measurable
+  // change on a 16-thread GPU host (bench/results/per-bounce-gpu.md).
   std::vector<Vec3> prefix_total, prefix_variance;
   std::vector<uint32_t> prefix_samples;
 };
@@ -150,7 +151,7 @@ BounceTail tail_after(const std::vector<Layer>& layers, const TexelGBuffer& gbuf
     state.prefix_variance.assign(n, Vec3{0, 0, 0});
   }
   state.prefix_samples.resize(kept);
-  for (size_t k = kept; k < last; ++k) state.prefix_samples.push_back(layers[k].one_more.empty() ? layers[k].samples : UINT32_MAX);
+  for (size_t k = kept; k < last; ++k) state.prefix_samples.push_back(layers[k].samples);
   // Variance of the luminance of a layer's mean, its channels taken as fully correlated (they are
   // nearly so: one ray lights all three).
   auto luminance_variance = [&](const Layer& layer, size_t i) {

@@ -234,8 +234,6 @@ void GpuScene::update_lights(const LightingScene& edited) {
   update_environment(edited);
 }
 
-void GpuScene::upload_punctual(const LightingScene& edited) { context_.write_ranges(punctual_writes(edited)); }
-
 std::vector<Context::RangeWrite> GpuScene::punctual_writes(const LightingScene& edited) const {
   using Write = Context::RangeWrite;
   std::vector<Write> writes;
@@ -313,10 +311,7 @@ void GpuScene::set_changed_light_pairs(const LightingScene& edited, const std::v
 void GpuScene::update_punctual_lights(const LightingScene& edited) {
   check_same_shape(edited);
   check_supported_by_vulkan(edited);
-  // At the start of the next submission, as set_changed_light_pairs.
-  if (punctual_count_ > 0)
-    context_.upload_at_next_submission(punctual_lights_, edited.punctual_lights.data(), edited.punctual_lights.size() * sizeof(GpuPunctualLight));
-  context_.upload_at_next_submission(punctual_cdf_, edited.punctual_cdf.data(), edited.punctual_cdf.size() * sizeof(double));
+  context_.write_ranges_at_next_submission(punctual_writes(edited));  // at the start of the next submission, as set_changed_light_pairs
 }
 
 void GpuScene::update_environment(const LightingScene& edited) {

@@ -91,7 +91,6 @@ class GpuScene {
   void add_material_writes(const LightingScene& edited, std::vector<Context::RangeWrite>& writes, std::vector<Vec4>& surfaces,
                            std::vector<uint32_t>& emitters);
   void materials_uploaded(const LightingScene& edited);
-  void upload_punctual(const LightingScene& edited);  // the punctual records and their CDF, one submission
   std::vector<Context::RangeWrite> punctual_writes(const LightingScene& edited) const;
   void update_environment(const LightingScene& edited);
 
