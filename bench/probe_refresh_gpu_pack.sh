@@ -16,6 +16,9 @@ mkdir -p $work/pack/building.bake
 cp $building/{manifest.json,scene.bin,probes.bin} $work/pack/building.bake/
 [ ! -f $building/svo.bin ] || cp $building/svo.bin $work/pack/building.bake/  # bench/handover_gpu_run.sh times the voxel exitance
 cmake --install $build --component runtime --prefix $work/pack/runtime > /dev/null
+# BEFORE_RUNTIME: another installed runtime folder, for bench/probe_error_gpu_run.sh's A/B.
+rm -f .replay/probe_refresh_before.txz
+if [ -n "$BEFORE_RUNTIME" ]; then mkdir -p .replay; tar -C $BEFORE_RUNTIME -cf - . | xz -2 -T2 > .replay/probe_refresh_before.txz; fi
 cp $build/bench/bench_edit_cost $build/bench/bench_probe_rel_mse $work/pack/
 for e in double:refresh_double_light move:refresh_move_light; do
   cp bench/${e#*:}.json $work/pack/${e%%:*}.json

@@ -13,7 +13,8 @@ layout(local_size_x = 64) in;
 
 layout(std430, set = 0, binding = 0) readonly buffer Sums { double sums[]; };    // ProbeAccumulators: totals, squared L0, ...
 layout(std430, set = 0, binding = 1) readonly buffer Counts { uint counts[]; };  // [probe][samples, back faces]
-layout(std430, set = 0, binding = 2) readonly buffer Kept { double kept[]; };    // [probe][27 sh, samples, variance (< 0: unknown)]
+// [probe][27 sh, samples, variance (< 0: unknown); a change estimate's base: 27 sh, samples]
+layout(std430, set = 0, binding = 2) readonly buffer Kept { double kept[]; };
 layout(std430, set = 0, binding = 3) readonly buffer GridIndex { uint grid_index[]; };  // per refreshed probe its slot
 layout(std430, set = 0, binding = 4) writeonly buffer Out { float out_sh[]; };          // [grid probe][27]
 
@@ -21,14 +22,54 @@ layout(push_constant) uniform Push {
   uint probe_count;
   uint switch_samples;
   float band_weight[3];  // the dering window per SH band (1 without dering)
+  uint change;           // 1: the sums estimate a change of the lights from the kept base
 } push;
+
+const uint kKeptWords = 57u;
+const uint kBaseAt = 29u;
+
+// During a change estimate (refresh/published_probes.cpp probe_change_choice): publish_after_change
+// on the change's L0 terms chooses what the probe showed before the last edit, the base, or the base
+// plus the change's mean (times the dering window per band; the base as shown is deringed already).
+void publish_change(uint k, uint n, uint at, uint out_at) {
+  double squared = 0.0lf;
+  double variance = 0.0lf;
+  if (n > 0u) {
+    uint squares_at = push.probe_count * 27u + k * 3u;
+    for (uint c = 0u; c < 3u; ++c) {
+      double d = sums[k * 27u + c] / double(n);
+      squared += d * d;
+      variance += double(variance_of_mean_from_sums(sums[k * 27u + c], sums[squares_at + c], n));
+    }
+  }
+  uint choice = publish_after_change(uint(kept[at + kBaseAt + 27u]), n, squared, variance);
+  for (uint i = 0u; i < 27u; ++i) {
+    precise float value;
+    if (choice == kPublishPrevious) {
+      value = float(kept[at + i]);
+    } else {
+      float base = float(kept[at + kBaseAt + i]);
+      value = base;
+      if (choice == kPublishRefreshed) {
+        precise float change = float(sums[k * 27u + i] / double(n)) * push.band_weight[sh_band(int(i / 3u))];
+        precise float sum = base + change;
+        if (!isnan(sum) && !isinf(sum)) value = sum;
+      }
+    }
+    out_sh[out_at + i] = value;
+  }
+}
 
 
 void main() {
   uint k = gl_GlobalInvocationID.x;
   if (k >= push.probe_count) return;
   uint n = counts[k * 2u];
-  uint at = k * 29u;
+  uint at = k * kKeptWords;
+  if (push.change != 0u) {
+    publish_change(k, n, at, grid_index[k] * 27u);
+    return;
+  }
   double difference_squared = 0.0lf;
   double variance = 0.0lf;
   bool all_zero = true;

@@ -46,12 +46,16 @@ void main() {
   } else if (kProbeMode && depth == 0u) {
     vec3 albedo = vec3(0.0);
     uint met_layer = 0u;  // 1 + the light layer of slot 0's radiance (0: none)
+    // A change estimate (params.changed_light_pairs) adds neither sky nor emission: they did not change.
+    bool change = params.changed_light_pairs != 0u;
     if (tri == kInvalid) {
-      add_result(work, 0u, scene_sky_radiance(wi));
-      met_layer = kSkyLightLayer + 1u;
+      if (!change) {
+        add_result(work, 0u, scene_sky_radiance(wi));
+        met_layer = kSkyLightLayer + 1u;
+      }
     } else {
       ProbeHit h = shade_probe_hit(tri, hit.z, hit.w, wi);
-      if (h.radiance != vec3(0.0)) {
+      if (h.radiance != vec3(0.0) && !change) {
         add_result(work, 0u, h.radiance);
         met_layer = emitter_light_layer(tri) + 1u;
       }

@@ -23,6 +23,37 @@ bool probe_shows_refreshed(const KeptProbe& kept, const ProbeEstimate& refreshed
                                  all_zero);
 }
 
+std::array<float, 3> probe_band_weights(float dering_window) {
+  std::array<float, 3> weight{1.0f, 1.0f, 1.0f};
+  if (dering_window > 0)
+    for (int band = 0; band < 3; ++band) weight[size_t(band)] = sh_hanning_band_weight(band, dering_window);
+  return weight;
+}
+
+uint32_t probe_change_choice(const KeptProbe& base, const ProbeEstimate& change, size_t k) {
+  const uint32_t n = k < change.samples.size() ? change.samples[k] : 0;
+  double squared = 0;
+  if (n > 0)
+    for (size_t c = 0; c < 3; ++c) {
+      const double d = change.sh_sum[k][c] / n;
+      squared += d * d;
+    }
+  return publish_after_change(base.samples, n, squared, n > 0 ? change.l0_variance_of_mean(k) : 0.0);
+}
+
+KeptProbe probe_base_plus_change(const KeptProbe& base, const ProbeEstimate& change, size_t k, const std::array<float, 3>& band_weight) {
+  KeptProbe shown = base;
+  const ShRgb mean = change.mean(k);
+  for (size_t i = 0; i < 9; ++i)
+    for (size_t c = 0; c < 3; ++c) {
+      const float d = mean[i][int(c)] * band_weight[size_t(sh_band(int(i)))];
+      const float sum = base.sh[i * 3 + c] + d;
+      if (std::isfinite(sum)) shown.sh[i * 3 + c] = sum;
+    }
+  shown.variance = base.variance < 0 ? -1.0 : base.variance + change.l0_variance_of_mean(k);
+  return shown;
+}
+
 void scale_kept_probes(std::vector<KeptProbe>& kept, const ProbeEstimate& layer, Vec4 factor, float dering_window) {
   for (size_t k = 0; k < kept.size() && k < layer.samples.size(); ++k) {
     if (layer.samples[k] == 0) continue;

@@ -27,6 +27,21 @@ struct KeptProbe {
 // rather than `kept`.
 bool probe_shows_refreshed(const KeptProbe& kept, const ProbeEstimate& refreshed, size_t k, uint32_t switch_samples);
 
+// The dering window's weight per SH band, as store_probe_radiance applies it (none, 0: 1).
+std::array<float, 3> probe_band_weights(float dering_window);
+
+// During a change estimate of light edits (as the lightmap's, path.h punctual_change_rays; the probes'
+// sums then hold the change from `base`, what they showed at its first edit): probe k's choice by
+// publishing_rule.h's publish_after_change on the L0 terms of its change (read back with squared L0
+// sums): kPublishPrevious, kPublishBase or kPublishRefreshed.
+uint32_t probe_change_choice(const KeptProbe& base, const ProbeEstimate& change, size_t k);
+
+// base + probe k's mean change, each coefficient's change times `band_weight` of its band (the dering
+// window; the base, as shown, is deringed already); a sum that is not finite keeps the base's value.
+// Its samples the base's, its variance the base's plus the change's (unknown stays unknown).
+// publish_probes.comp makes the same float operations.
+KeptProbe probe_base_plus_change(const KeptProbe& base, const ProbeEstimate& change, size_t k, const std::array<float, 3>& band_weight);
+
 // An edit that scaled light layer `factor.w`'s emission by factor.xyz: each kept value plus
 // (factor - 1) times that layer's refreshed mean (`layer`: ProbeRefresh::read_layer, deringed with
 // `dering_window` as the kept values are), its variance in proportion to its L0's squared change.

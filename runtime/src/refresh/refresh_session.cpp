@@ -148,7 +148,11 @@ struct RefreshSession::State {
   // probe_spp as the target; the last full batch and its time, which size a call's batch.
   std::vector<size_t> probe_grid_index;
   std::vector<KeptProbe> previous_probes;
-  bool previous_probes_uploaded = false;  // publish_probe_buffer's copy of them is current
+  // While the lightmap estimates a change of punctual lights (`base`), the probes do too: what they
+  // showed at its first edit, the base their sums' change is added to (published_probes.h); empty
+  // otherwise.
+  std::vector<KeptProbe> probe_base;
+  bool previous_probes_uploaded = false;  // publish_probe_buffer's copies of them (and the base) are current
   bool voxel_deposits_current = false;    // publish_voxel_exitance's deposits are the texels' as they are
   uint32_t probe_switch_samples = 0;
   uint32_t probe_target = 0;
@@ -429,21 +433,6 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
       return effects;
     }
   }
-  {
-    // Probes start again, those nearest a local change first (a light moved, an instance moved);
-    // after a change everywhere (the sun, the sky, a material) in their own order.
-    std::vector<Vec3> points;
-    bool global = effects.sky || !effects.materials.empty();
-    for (uint32_t i : effects.lights) {
-      if (s.persisted.scene.lights[i].type == PunctualLight::Type::Directional) global = true;
-      points.push_back(was.light_positions[i]);
-      points.push_back(s.persisted.scene.lights[i].position);
-    }
-    std::vector<WorldBox> boxes = in_place.moved_boxes_before;
-    boxes.insert(boxes.end(), in_place.moved_boxes_after.begin(), in_place.moved_boxes_after.end());
-    restart_probes(global ? std::vector<Vec3>{} : points, global ? std::vector<WorldBox>{} : boxes);
-  }
-  timings.scene += since(lap);
   // A geometry edit's upload (the refit nodes, the moved triangles' records, the emitters) runs on
   // its own thread while this one moves texels and starts the search for those near the change:
   // they read the lighting scene and write disjoint state, and nothing else here records device
@@ -549,6 +538,21 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
     s.near_texels = std::move(near);  // the far texels are listed when their turn comes (refresh)
     s.last_edit_near = s.near_texels;
   }
+  {
+    // Probes start again, those nearest a local change first (a light moved, an instance moved);
+    // after a change everywhere (the sun, the sky, a material) in their own order. Where the
+    // lightmap estimates the lights' change, the probes estimate it too, from what they showed.
+    std::vector<Vec3> points;
+    bool global = effects.sky || !effects.materials.empty();
+    for (uint32_t i : effects.lights) {
+      if (s.persisted.scene.lights[i].type == PunctualLight::Type::Directional) global = true;
+      points.push_back(was.light_positions[i]);
+      points.push_back(s.persisted.scene.lights[i].position);
+    }
+    std::vector<WorldBox> boxes = in_place.moved_boxes_before;
+    boxes.insert(boxes.end(), in_place.moved_boxes_after.begin(), in_place.moved_boxes_after.end());
+    restart_probes(global ? std::vector<Vec3>{} : points, global ? std::vector<WorldBox>{} : boxes, as_change);
+  }
   timings.restart = since(lap);
   timings.device_submissions = s.integrator->waited_submissions() - submissions_before;
   timings.device_wait = (s.integrator->wait_seconds() - wait_before) * 1e3;
@@ -556,7 +560,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   return effects;
 }
 
-void RefreshSession::restart_probes(const std::vector<Vec3>& near_points, const std::vector<WorldBox>& near_boxes) {
+void RefreshSession::restart_probes(const std::vector<Vec3>& near_points, const std::vector<WorldBox>& near_boxes, bool as_change) {
   State& s = *state_;
   if (s.probe_grid_index.empty()) return;
   // What each probe shows now is what it shows until its refreshed estimate of the edited scene is
@@ -565,12 +569,14 @@ void RefreshSession::restart_probes(const std::vector<Vec3>& near_points, const 
   const uint32_t switch_samples = std::min(s.probe_target, kProbeStratifiedSetSize);
   if (s.integrator->probe_refresh_most_samples() > 0) {  // some probe may show its refreshed estimate
     std::vector<bool> refreshed_shown;
-    const ProbeEstimate refreshed = s.integrator->probe_refresh_estimate();
-    const formats::ProbeGrid shown = published_probes(refreshed, &refreshed_shown);
+    std::vector<KeptProbe> records;
+    published_probes(s.integrator->probe_refresh_estimate(), &refreshed_shown, &records);
     for (size_t k = 0; k < s.probe_grid_index.size(); ++k)
-      if (refreshed_shown[k])
-        s.previous_probes[k] = {shown.probes[s.probe_grid_index[k]].sh, refreshed.samples[k], refreshed.l0_variance_of_mean(k)};
+      if (refreshed_shown[k]) s.previous_probes[k] = records[k];
   }
+  // A change estimate's base is what the probes showed at its first edit; later edits of it keep it.
+  if (!as_change) s.probe_base.clear();
+  else if (s.probe_base.empty()) s.probe_base = s.previous_probes;
   s.probe_switch_samples = switch_samples;
   s.previous_probes_uploaded = false;
   std::vector<Vec3> positions;
@@ -581,7 +587,7 @@ void RefreshSession::restart_probes(const std::vector<Vec3>& near_points, const 
     }
   size_t near = 0;
   const std::vector<uint32_t> order = probes_nearest_first(positions, near_points, near_boxes, 0.1f * s.lighting->extent, &near);
-  s.integrator->clear_probe_refresh(order, near);
+  s.integrator->clear_probe_refresh(order, near, as_change);
 }
 
 void RefreshSession::scale_probes(const std::vector<Vec4>& factors) {
@@ -606,17 +612,19 @@ const DeviceProbeBuffer& RefreshSession::publish_probe_buffer() {
   std::vector<uint32_t> grid_index(s.probe_grid_index.begin(), s.probe_grid_index.end());
   std::vector<double> kept;
   if (!s.previous_probes_uploaded) {
-    kept.reserve(s.previous_probes.size() * 29);
-    for (const KeptProbe& k : s.previous_probes) {
-      for (float v : k.sh) kept.push_back(v);
-      kept.push_back(k.samples);
-      kept.push_back(k.variance);
+    kept.reserve(s.previous_probes.size() * 57);  // ProbePublisher::kKeptWords
+    for (size_t k = 0; k < s.previous_probes.size(); ++k) {
+      const KeptProbe& previous = s.previous_probes[k];
+      for (float v : previous.sh) kept.push_back(v);
+      kept.push_back(previous.samples);
+      kept.push_back(previous.variance);
+      const KeptProbe base = s.probe_base.empty() ? KeptProbe{} : s.probe_base[k];
+      for (float v : base.sh) kept.push_back(v);
+      kept.push_back(base.samples);
     }
   }
   // The dering window per band, as store_probe_radiance applies it (none: 1).
-  std::array<float, 3> band_weight{1.0f, 1.0f, 1.0f};
-  if (s.probe_dering > 0)
-    for (int band = 0; band < 3; ++band) band_weight[size_t(band)] = sh_hanning_band_weight(band, s.probe_dering);
+  const std::array<float, 3> band_weight = probe_band_weights(s.probe_dering);
   const DeviceProbeBuffer& buffer =
       s.integrator->write_probe_buffer(s.persisted.probes.probes.size(), grid_index, s.previous_probes_uploaded ? nullptr : &kept,
                                        std::max(1u, s.probe_switch_samples), band_weight);
@@ -645,24 +653,48 @@ formats::ProbeGrid RefreshSession::published_probes() const {
   return published_probes(s.integrator->probe_refresh_estimate(), nullptr);
 }
 
-formats::ProbeGrid RefreshSession::published_probes(const ProbeEstimate& refreshed, std::vector<bool>* refreshed_shown) const {
+formats::ProbeGrid RefreshSession::published_probes(const ProbeEstimate& refreshed, std::vector<bool>* refreshed_shown,
+                                                    std::vector<KeptProbe>* records) const {
   const State& s = *state_;
   formats::ProbeGrid grid = s.persisted.probes;
-  if (refreshed_shown) refreshed_shown->assign(s.probe_grid_index.size(), false);
-  for (size_t k = 0; k < s.probe_grid_index.size(); ++k) grid.probes[s.probe_grid_index[k]].sh = s.previous_probes[k].sh;
-  if (refreshed.samples.size() != s.probe_grid_index.size()) return grid;  // none refreshed
+  const size_t count = s.probe_grid_index.size();
+  if (refreshed_shown) refreshed_shown->assign(count, false);
+  if (records) *records = s.previous_probes;
+  for (size_t k = 0; k < count; ++k) grid.probes[s.probe_grid_index[k]].sh = s.previous_probes[k].sh;
+  if (refreshed.samples.size() != count) return grid;  // none refreshed
+  if (!s.probe_base.empty()) {
+    // A change estimate: the base, or the base plus the change where it is significant.
+    const std::array<float, 3> band_weight = probe_band_weights(s.probe_dering);
+    for (size_t k = 0; k < count; ++k) {
+      const uint32_t choice = probe_change_choice(s.probe_base[k], refreshed, k);
+      if (choice == kPublishPrevious) continue;
+      const KeptProbe shown =
+          choice == kPublishBase ? s.probe_base[k] : probe_base_plus_change(s.probe_base[k], refreshed, k, band_weight);
+      grid.probes[s.probe_grid_index[k]].sh = shown.sh;
+      if (refreshed_shown) (*refreshed_shown)[k] = true;
+      if (records) (*records)[k] = shown;
+    }
+    return grid;
+  }
   // The probes whose refreshed estimate the publishing rule prefers, as probes.bin stores them.
   std::vector<size_t> shown;
+  std::vector<size_t> shown_k;
   ProbeEstimate subset;
-  for (size_t k = 0; k < s.probe_grid_index.size(); ++k) {
+  for (size_t k = 0; k < count; ++k) {
     if (!probe_shows_refreshed(s.previous_probes[k], refreshed, k, std::max(1u, s.probe_switch_samples))) continue;
     if (refreshed_shown) (*refreshed_shown)[k] = true;
     shown.push_back(s.probe_grid_index[k]);
+    shown_k.push_back(k);
     subset.sh_sum.push_back(refreshed.sh_sum[k]);
     subset.samples.push_back(refreshed.samples[k]);
     subset.backface_hits.push_back(refreshed.backface_hits[k]);
   }
   store_probe_radiance(grid, shown, subset, s.probe_dering);
+  if (records)
+    for (size_t j = 0; j < shown.size(); ++j) {
+      const size_t k = shown_k[j];
+      (*records)[k] = {grid.probes[shown[j]].sh, refreshed.samples[k], refreshed.l0_variance_of_mean(k)};
+    }
   return grid;
 }
 
@@ -708,12 +740,13 @@ RefreshSession::ProbeErrors RefreshSession::probe_errors() const {
   if (s.probe_grid_index.empty()) return errors;
   const ProbeEstimate refreshed = s.integrator->probe_refresh_most_samples() > 0 ? s.integrator->probe_refresh_estimate() : ProbeEstimate{};
   std::vector<bool> refreshed_shown;
-  const formats::ProbeGrid shown = published_probes(refreshed, &refreshed_shown);
+  std::vector<KeptProbe> records;
+  const formats::ProbeGrid shown = published_probes(refreshed, &refreshed_shown, &records);
   double sum = 0;
   for (size_t k = 0; k < s.probe_grid_index.size(); ++k) {
     const bool fresh = refreshed_shown[k];
     errors.showing_refreshed += fresh;
-    const double variance = fresh ? refreshed.l0_variance_of_mean(k) : s.previous_probes[k].variance;
+    const double variance = records[k].variance;
     if (variance < 0 || (fresh && refreshed.samples[k] < 2)) continue;
     double signal = 0;
     const std::array<float, 27>& sh = shown.probes[s.probe_grid_index[k]].sh;
@@ -732,6 +765,8 @@ uint32_t RefreshSession::probe_samples() const {
 void RefreshSession::end_change_estimate() {
   State& s = *state_;
   if (!s.base) return;
+  // The probes' change estimate ends with it: what they show, kept; their sums start again.
+  if (!s.probe_base.empty()) restart_probes();
   // What the change estimate published is what texels show until refreshed again.
   const bool split = published_split_by_light();
   s.previous = publish_on_device(false, split).lightmap;

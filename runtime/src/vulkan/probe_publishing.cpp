@@ -11,6 +11,7 @@ namespace {
 struct PublishProbesPush {
   uint32_t probe_count, switch_samples;
   float band_weight[3];
+  uint32_t change;
 };
 
 }  // namespace
@@ -42,7 +43,7 @@ void ProbePublisher::set_kept(const std::vector<double>& kept) {
 }
 
 const DeviceProbeBuffer& ProbePublisher::write(const ProbeAccumulators& sums, uint32_t switch_samples,
-                                               const std::array<float, 3>& band_weight) {
+                                               const std::array<float, 3>& band_weight, bool change) {
   const std::array<VkDescriptorBufferInfo, 5> infos{{{sums.sh_sums.handle(), 0, VK_WHOLE_SIZE},
                                                      {sums.counts.handle(), 0, VK_WHOLE_SIZE},
                                                      {kept_.handle(), 0, VK_WHOLE_SIZE},
@@ -59,7 +60,8 @@ const DeviceProbeBuffer& ProbePublisher::write(const ProbeAccumulators& sums, ui
                        nullptr);
   if (probes_ > 0) {
     kernel_.bind(cmd, 0);
-    const PublishProbesPush push{uint32_t(probes_), switch_samples, {band_weight[0], band_weight[1], band_weight[2]}};
+    const PublishProbesPush push{uint32_t(probes_), switch_samples, {band_weight[0], band_weight[1], band_weight[2]},
+                                 change ? 1u : 0u};
     kernel_.push(cmd, &push, sizeof(push));
     vkCmdDispatch(cmd, uint32_t((probes_ + 63) / 64), 1, 1);
   }

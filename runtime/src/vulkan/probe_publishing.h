@@ -1,7 +1,8 @@
 // The refreshed probes as they show, written by shaders/wavefront/publish_probes.comp into a device
 // buffer an engine reads (DeviceProbeBuffer): per refreshed probe the publishing rule's choice
 // between its refreshed sums (ProbeAccumulators) and what it showed before the last edit (`kept`,
-// uploaded when it changes), in its slot of the grid. No read-back; the values equal
+// uploaded when it changes), or during a change estimate of light edits between that, the change's
+// base and base + change, in its slot of the grid. No read-back; the values equal
 // RefreshSession::published_probes().
 #pragma once
 #include <array>
@@ -18,7 +19,9 @@ namespace exitance::vulkan {
 
 class ProbePublisher {
  public:
-  static constexpr size_t kKeptWords = 29;  // per probe: 27 SH values, samples, variance (< 0: unknown)
+  // Per probe: what it showed before the last edit (27 SH values, samples, variance; < 0: unknown),
+  // then a change estimate's base (27 SH values, samples; ignored without one).
+  static constexpr size_t kKeptWords = 57;
   // A buffer for `grid_probes` probes; `grid_index`: per refreshed probe its slot in the grid.
   ProbePublisher(Context& context, size_t grid_probes, const std::vector<uint32_t>& grid_index);
   ProbePublisher(const ProbePublisher&) = delete;
@@ -29,7 +32,9 @@ class ProbePublisher {
   void set_kept(const std::vector<double>& kept);
   // Writes the buffer in one submission after everything submitted to the queue before it,
   // signals the semaphore and waits for it (bounded). `band_weight`: the dering window per band.
-  const DeviceProbeBuffer& write(const ProbeAccumulators& sums, uint32_t switch_samples, const std::array<float, 3>& band_weight);
+  // `change`: the sums estimate a change of the lights from the kept base (published_probes.h).
+  const DeviceProbeBuffer& write(const ProbeAccumulators& sums, uint32_t switch_samples, const std::array<float, 3>& band_weight,
+                                 bool change = false);
   std::vector<float> read_back() const { return out_buffer_.read_back(); }  // for tests and tools
 
  private:

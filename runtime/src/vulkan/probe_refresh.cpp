@@ -120,7 +120,12 @@ ProbeEstimate ProbeRefresh::read_layer(int layer) const {
   return estimate;
 }
 
-void ProbeRefresh::clear(const std::vector<uint32_t>& order, size_t priority) {
+void ProbeRefresh::clear(const std::vector<uint32_t>& order, size_t priority, uint32_t change_pairs,
+                         const std::vector<uint32_t>& change_layers) {
+  if (change_pairs > kMaxChangedLightPairs || (change_pairs > 0 && change_layers.size() != change_pairs))
+    throw std::logic_error("ProbeRefresh::clear: a change of at most kMaxChangedLightPairs lights, each with its layer");
+  change_pairs_ = change_pairs;
+  change_layers_ = change_layers;
   std::fill(samples_.begin(), samples_.end(), 0u);
   next_ = 0;
   priority_ = order.empty() ? 0 : std::min(priority, order.size());
@@ -171,6 +176,8 @@ uint64_t ProbeRefresh::add_set(const IntegratorSettings& settings, uint32_t targ
   params.light_layers = uint32_t(light_layers_);
   params.punctual_layers = runner_.scene().punctual_light_layers();
   params.light_result_words = kProbeResultWords;
+  params.changed_light_pairs = change_pairs_;
+  for (size_t k = 0; k < change_layers_.size(); ++k) params.changed_light_layers[k] = change_layers_[k];
   const size_t result_bytes = kProbeResultBytes + 12 * size_t(light_layers_);
   BatchTotals totals;
   {

@@ -42,7 +42,12 @@ class ProbeRefresh {
   // probes (the probes nearest a local edit first); its first `priority` probes get every sample up
   // to the target before the others get any (those near the edit: the publishing rule prefers a
   // refreshed estimate with as many samples as the value it kept).
-  void clear(const std::vector<uint32_t>& order = {}, size_t priority = 0);
+  // `change_pairs` > 0: from now on the probes' samples estimate the change of direct light from
+  // that many edited punctual lights (GpuParams::changed_light_pairs; their records set on the scene
+  // by a change estimate's start), pair k's change in light layer `change_layers[k]`; 0: the light.
+  void clear(const std::vector<uint32_t>& order = {}, size_t priority = 0, uint32_t change_pairs = 0,
+             const std::vector<uint32_t>& change_layers = {});
+  uint32_t change_pairs() const { return change_pairs_; }
   // The next probes' next stratified set, round robin over the probes: as many probes as one batch
   // holds and at most `max_probes` (0: no limit), never past `target_samples` per probe. Returns the
   // rays traced (0 once every probe has its target); `refreshed`: how many probes got their set.
@@ -65,6 +70,8 @@ class ProbeRefresh {
   size_t priority_ = 0;            // order_[0, priority_) first, to the target
   size_t next_ = 0;                // the position in order_ the next set starts at
   int light_layers_ = 0;
+  uint32_t change_pairs_ = 0;
+  std::vector<uint32_t> change_layers_;
   std::unique_ptr<ComputeKernel> scaling_;  // scale_probe_layers.comp, made at a start with layers
   Buffer factors_;
 };

@@ -63,6 +63,10 @@ struct VulkanIntegrator::Impl {
   std::unique_ptr<VoxelExitancePublisher> voxel_publisher;  // made at the first write_voxel_exitance
   std::unique_ptr<IndirectDenoiser> denoiser;        // made at the first denoise_indirect
   bool denoiser_stale = false;                       // a start with other texels since it was made
+  // The accumulation's change estimate (start_progressive_change): its pairs and their layers, which
+  // clear_probe_refresh(..., as_change) gives the probes too; 0 pairs after start_progressive.
+  uint32_t change_pairs = 0;
+  std::vector<uint32_t> change_layers;
   std::shared_ptr<DeviceLightmap> denoised;          // denoise_indirect's output, reused once let go
   // Device estimates publish() wrote, reused once their holders let go of them (an edit replaces
   // the previous estimate: at 1 M texels ~100 MB not allocated again).
@@ -131,9 +135,13 @@ ProbeEstimate VulkanIntegrator::bake_probes(const std::vector<Vec3>& positions, 
 void VulkanIntegrator::start_probe_refresh(const std::vector<Vec3>& positions, int light_layers) {
   impl_->probe_refresh.start(positions, light_layers);
 }
-void VulkanIntegrator::clear_probe_refresh(const std::vector<uint32_t>& order, size_t priority) {
-  impl_->probe_refresh.clear(order, priority);
+void VulkanIntegrator::clear_probe_refresh(const std::vector<uint32_t>& order, size_t priority, bool as_change) {
+  if (as_change && impl_->change_pairs == 0)
+    throw std::logic_error("VulkanIntegrator::clear_probe_refresh: a change estimate of the probes needs one of the lightmap");
+  if (as_change) impl_->probe_refresh.clear(order, priority, impl_->change_pairs, impl_->change_layers);
+  else impl_->probe_refresh.clear(order, priority);
 }
+bool VulkanIntegrator::probe_refresh_as_change() const { return impl_->probe_refresh.change_pairs() > 0; }
 int VulkanIntegrator::probe_refresh_light_layers() const { return impl_->probe_refresh.light_layers(); }
 void VulkanIntegrator::scale_probe_layers(const std::vector<Vec4>& factors) { impl_->probe_refresh.scale_layers(factors); }
 ProbeEstimate VulkanIntegrator::probe_refresh_layer(int layer) const { return impl_->probe_refresh.read_layer(layer); }
@@ -152,6 +160,8 @@ void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const Inte
   if (settings.guiding != GuidingMode::Off || settings.emitter_guiding)
     throw std::runtime_error("Vulkan backend: guiding runs in whole bakes only, not in progressive accumulation (relight)");
   impl_->lightmap.start(gbuffer, settings, 0, texels_as_before, accumulation_cleared);
+  impl_->change_pairs = 0;
+  impl_->change_layers.clear();
   impl_->denoiser_stale |= !texels_as_before;
 }
 void VulkanIntegrator::start_progressive_change(const TexelGBuffer& gbuffer, const IntegratorSettings& settings,
@@ -166,6 +176,9 @@ void VulkanIntegrator::start_progressive_change(const TexelGBuffer& gbuffer, con
   if (pairs.size() / 2 > kMaxChangedLightPairs || (!pair_layers.empty() && pair_layers.size() != pairs.size() / 2))
     throw std::invalid_argument("Vulkan backend: at most kMaxChangedLightPairs pairs, each with its light layer");
   impl_->lightmap.start(gbuffer, settings, uint32_t(pairs.size() / 2), texels_as_before, accumulation_cleared, pair_layers);
+  impl_->change_pairs = uint32_t(pairs.size() / 2);
+  impl_->change_layers = pair_layers;
+  impl_->change_layers.resize(impl_->change_pairs, 0);  // without light layers: all in layer 0, unread
   impl_->denoiser_stale |= !texels_as_before;
 }
 uint64_t VulkanIntegrator::add_samples(uint32_t samples) { return impl_->lightmap.add_samples(samples); }
@@ -251,7 +264,7 @@ const DeviceProbeBuffer& VulkanIntegrator::write_probe_buffer(size_t grid_probes
     impl_->probe_publisher = std::make_unique<ProbePublisher>(impl_->context, grid_probes, grid_index);
   }
   if (kept) impl_->probe_publisher->set_kept(*kept);
-  return impl_->probe_publisher->write(impl_->buffers.refresh_probe_sums, switch_samples, band_weight);
+  return impl_->probe_publisher->write(impl_->buffers.refresh_probe_sums, switch_samples, band_weight, probe_refresh_as_change());
 }
 
 const DeviceVoxelExitance& VulkanIntegrator::write_voxel_exitance(const DeviceLightmap& lightmap, const formats::SparseVoxelOctree& svo,

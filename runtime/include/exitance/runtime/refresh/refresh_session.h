@@ -135,6 +135,8 @@ struct OpenTimings {
   double publish = 0;         // the first publish (pipeline and memory the first edit reuses)
 };
 
+struct KeptProbe;  // refresh/published_probes.h
+
 class RefreshSession {
  public:
   // Reads manifest.json, scene.bin and (when listed) svo.bin from `bundle`, builds the lighting
@@ -322,14 +324,20 @@ class RefreshSession {
   void end_change_estimate();
   // An edit: what probes show is kept as what they showed before, and their refresh starts again,
   // nearest the points and boxes first (none: in the grid's order), those near them to the target first.
-  void restart_probes(const std::vector<Vec3>& near_points = {}, const std::vector<WorldBox>& near_boxes = {});
+  // `as_change`: the accumulation has just started a change estimate of the lights; the probes
+  // estimate the same change from what they showed at its first edit.
+  void restart_probes(const std::vector<Vec3>& near_points = {}, const std::vector<WorldBox>& near_boxes = {},
+                      bool as_change = false);
   // An edit that only scaled lights (factors as scale_light_layers'): the probes' sums scaled per
   // light layer on the device and what they showed before by their split, every sample kept;
   // restart_probes() where the probes keep no light layers.
   void scale_probes(const std::vector<Vec4>& factors);
   // published_probes() from a read-back `refreshed` (empty: none refreshed); `refreshed_shown`, per
-  // refreshed probe, whether it shows its refreshed estimate.
-  formats::ProbeGrid published_probes(const ProbeEstimate& refreshed, std::vector<bool>* refreshed_shown) const;
+  // refreshed probe, whether it shows its refreshed estimate (during a change estimate: the base, or
+  // the base plus the change); `records` (may be null), per refreshed probe, what it shows with the
+  // samples and variance behind it.
+  formats::ProbeGrid published_probes(const ProbeEstimate& refreshed, std::vector<bool>* refreshed_shown,
+                                      std::vector<KeptProbe>* records = nullptr) const;
   // `texels_as_before`: the G-buffer's texels are those of the accumulation's last start (no
   // instance moved): not uploaded again.
   void restart(bool texels_as_before);

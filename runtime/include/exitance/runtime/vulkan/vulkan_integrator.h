@@ -147,7 +147,10 @@ class VulkanIntegrator final : public Integrator {
   // not fit the device: probe_refresh_light_layers says).
   void start_probe_refresh(const std::vector<Vec3>& positions, int light_layers = 0);
   // `order`: the probes nearest a local edit first (ProbeRefresh::clear); empty: their own order.
-  void clear_probe_refresh(const std::vector<uint32_t>& order = {}, size_t priority = 0);
+  // `as_change`: the probes' samples estimate the change that the accumulation's change estimate
+  // (start_progressive_change, called first) estimates for texels, into the same light layers.
+  void clear_probe_refresh(const std::vector<uint32_t>& order = {}, size_t priority = 0, bool as_change = false);
+  bool probe_refresh_as_change() const;  // the probes' sums are a change estimate's
   int probe_refresh_light_layers() const;
   // An edit that only scaled lights (factors as scale_light_layers'): the probes' sums scaled on the
   // device, 0 rays, every sample kept. Needs probe_refresh_light_layers() == factors.size().
@@ -228,7 +231,8 @@ class VulkanIntegrator final : public Integrator {
   std::vector<float> read_page_image(size_t page) const;
   // What the refreshed probes show, written into a device buffer of 27 floats per grid probe
   // (vulkan/probe_publishing.h): `grid_index` per refreshed probe its grid slot; `kept` (when not
-  // null: uploaded first) kKeptWords per probe of what each showed before; the rest as
+  // null: uploaded first) kKeptWords per probe of what each showed before and, while the probes
+  // estimate a change (probe_refresh_as_change), its base; the rest as
   // RefreshSession::published_probes decides. One submission, waited for; no read-back.
   const DeviceProbeBuffer& write_probe_buffer(size_t grid_probes, const std::vector<uint32_t>& grid_index,
                                               const std::vector<double>* kept, uint32_t switch_samples,
