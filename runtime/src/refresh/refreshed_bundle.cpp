@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <optional>
 
 #include "exitance/formats/bundle_manifest.h"
@@ -35,6 +36,17 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   const fs::path bundle(session.bundle());
   formats::BundleManifest manifest = session.manifest();
   const formats::BakeSettings baked = manifest.settings.value_or(formats::BakeSettings{});
+  const PersistedScene& persisted = session.persisted();
+  // What does not depend on the lighting starts at once, each on its own thread beside the read-back,
+  // the probes and the pages (the whole call was these stages one after another): scene.bin's
+  // encoding and the seams' detection read only the scene. Nothing below writes what they read.
+  std::future<std::vector<uint8_t>> scene_encoding =
+      std::async(std::launch::async, [&session] { return formats::encode_scene(session.scene_file()); });
+  const int dilation_texels = session.page_dilation_texels();
+  const bool stitches = bundle_stitches_seams(manifest.stats_json);
+  std::future<std::unique_ptr<BundleSeamStage>> seam_detection = std::async(std::launch::async, [&persisted, dilation_texels, stitches] {
+    return std::make_unique<BundleSeamStage>(persisted.scene, persisted.atlas, dilation_texels, stitches);
+  });
   // With light layers split by light where the session has them (docs/bundle.md "Light layers").
   // Not when the indirect light is filtered: light layers hold no split into direct and indirect.
   const int denoise_radius = session.denoise_radius();
@@ -54,9 +66,21 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   by_light.reset();
   seconds["read_back"] = clock.lap();  // what the session shows, read from the device (not the probes' time)
 
+  // The voxel exitance of what is published, on its own thread beside the probes and the pages.
+  std::optional<formats::SparseVoxelOctree> svo;
+  std::future<double> exitance;
+  if (session.svo()) {
+    stage("exitance");
+    svo = *session.svo();
+    exitance = std::async(std::launch::async, [&] {
+      StageClock own;
+      fill_svo_exitance(*svo, persisted.scene, persisted.gbuffer, estimate);
+      return own.lap();
+    });
+  }
+
   // Read in place; only the probes are rewritten (a copy of the whole scene and G-buffer cost 0.11 s
   // at 478 k texels on 2 cores).
-  const PersistedScene& persisted = session.persisted();
   formats::ProbeGrid probes;
   ProbeEstimate probe_estimate;
   const bool has_probes = persisted.has_probe_grid() && manifest.probes.has_value();
@@ -76,23 +100,14 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
     seconds["probes"] = clock.lap();
   }
 
-  std::optional<formats::SparseVoxelOctree> svo;
-  if (session.svo()) {
-    stage("exitance");
-    svo = *session.svo();
-    fill_svo_exitance(*svo, persisted.scene, persisted.gbuffer, estimate);
-    seconds["exitance"] = clock.lap();
-  }
-
   stage("write");
   AssemblyOptions assembly;
   assembly.bounce_layers = manifest.has_bounce_layers();
-  assembly.dilation_texels = session.page_dilation_texels();
+  assembly.dilation_texels = dilation_texels;
   // Each page assembled, its seams stitched as `bake` stitched them (seam_stage.h; only measured where
   // it ran --seams off) and written before the next, in one image whose arrays each page reuses (as
   // bake's write_bundle_stage; holding every page at once was the most of the assembly's time).
   const LightmapPageAssembler assembler(persisted.gbuffer, estimate, assembly);
-  BundleSeamStage seams(persisted.scene, persisted.atlas, assembly.dilation_texels, bundle_stitches_seams(manifest.stats_json));
   // Light layers (docs/bundle.md "Light layers"), where what is published keeps a split by light.
   std::vector<formats::LightmapImage> layer_pages;
   manifest.light_layers.reset();
@@ -168,7 +183,7 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
     manifest.svo->vdb.clear();
     manifest.svo->vdb_note = "radiance.vdb is an inspection export of bake; exitance-relight does not write it";
   }
-  const std::vector<uint8_t> scene_bytes = formats::encode_scene(session.scene_file());
+  const std::vector<uint8_t> scene_bytes = scene_encoding.get();
   manifest.scene->bytes = scene_bytes.size();
   manifest.scene->format_version = formats::kSceneFormatVersion;  // a version 1 input is rewritten as the current one
   if (check_before_write) check_before_write();
@@ -176,6 +191,14 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   const fs::path out(output);
   try {
     write_bundle_atomically(out, [&](const fs::path& dir) {
+      // scene.bin written on its own thread while the pages are assembled and compressed.
+      std::future<void> scene_written = std::async(std::launch::async, [&] {
+        std::ofstream scene_out(dir / manifest.scene->file, std::ios::binary);
+        scene_out.write(reinterpret_cast<const char*>(scene_bytes.data()), std::streamsize(scene_bytes.size()));
+        if (!scene_out) throw std::runtime_error("cannot write " + (dir / manifest.scene->file).string());
+      });
+      const std::unique_ptr<BundleSeamStage> seam_stage = seam_detection.get();
+      BundleSeamStage& seams = *seam_stage;
       formats::LightmapImage page;
       for (size_t p = 0; p < manifest.pages.size(); ++p) {
         assembler.assemble(p, page);
@@ -192,10 +215,11 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
       for (size_t p = 0; p < layer_pages.size(); ++p)
         formats::write_lightmap_exr((dir / manifest.light_layers->files[p]).string(), layer_pages[p]);
       if (has_probes) formats::write_probes_file((dir / manifest.probes->file).string(), probes);
-      if (svo) formats::write_svo_file((dir / manifest.svo->file).string(), *svo);
-      std::ofstream scene_out(dir / manifest.scene->file, std::ios::binary);
-      scene_out.write(reinterpret_cast<const char*>(scene_bytes.data()), std::streamsize(scene_bytes.size()));
-      if (!scene_out) throw std::runtime_error("cannot write " + (dir / manifest.scene->file).string());
+      if (svo) {
+        seconds["exitance"] = exitance.get();  // its own time, beside the probes and the pages
+        formats::write_svo_file((dir / manifest.svo->file).string(), *svo);
+      }
+      scene_written.get();
       std::ofstream file(dir / "manifest.json");
       file << manifest_text;
       if (!file) throw std::runtime_error("cannot write " + (dir / "manifest.json").string());
