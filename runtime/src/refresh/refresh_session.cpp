@@ -286,15 +286,20 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
     throw BundleInputError((bundle / manifest.scene->file).string() + ": " + e.what());
   }
   timings.lighting_scene = since();
+  // The host's indices for edits are built on their own thread while the device is made: both only
+  // read the scene and the lighting scene, and write disjoint state.
+  std::future<void> indices = std::async(std::launch::async, [&s = *state] {
+    s.texel_grid = TexelGrid(s.persisted.gbuffer);
+    s.near_marks.assign(s.persisted.gbuffer.texels.size(), 0);
+    index_for_edits(s);
+    s.all_texels.resize(s.persisted.gbuffer.texels.size());
+    for (size_t i = 0; i < s.all_texels.size(); ++i) s.all_texels[i] = uint32_t(i);
+  });
   state->integrator = VulkanIntegrator::create(state->lighting, options.device);
   timings.device = since();
   state->priority_samples = options.priority_samples;
   state->proportional_split_samples = options.proportional_split_samples;
-  state->texel_grid = TexelGrid(state->persisted.gbuffer);
-  state->near_marks.assign(state->persisted.gbuffer.texels.size(), 0);
-  index_for_edits(*state);
-  state->all_texels.resize(state->persisted.gbuffer.texels.size());
-  for (size_t i = 0; i < state->all_texels.size(); ++i) state->all_texels[i] = uint32_t(i);
+  indices.get();
   timings.indices = since();
   state->integrator->start_progressive(state->persisted.gbuffer, settings);
   state->denoise_radius = options.denoise_radius;

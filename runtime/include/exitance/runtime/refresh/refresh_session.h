@@ -129,7 +129,8 @@ struct OpenTimings {
   double read = 0;            // manifest, scene.bin (read and restored), svo.bin
   double lighting_scene = 0;  // the lighting scene (records, light CDFs) over scene.bin's BVH
   double device = 0;          // the Vulkan backend: device, kernels compiled (or found in the driver's cache), scene uploaded
-  double indices = 0;         // the texel grid, each instance's texels, the BVH links, the texel list
+  double indices = 0;         // the texel grid, each instance's texels, the BVH links, the texel list: built on a
+                              // thread of their own while the device is made; what was left to wait for
   double texels = 0;          // the texels' start points uploaded, the accumulation cleared
   double baked = 0;           // the baked lightmap read (EXR pages) and uploaded
   double publish = 0;         // the first publish (pipeline and memory the first edit reuses)
