@@ -382,20 +382,25 @@ void expect_buffer_is_published(RefreshSession& session, const char* when) {
   EXPECT_EQ(differing, 0u) << when;
 }
 
+// One refresh call whose budget holds one batch of probes.
+void refresh_one_probe_batch(RefreshSession& session) {
+  RefreshBudget small;
+  small.milliseconds = 1e-3;
+  small.max_samples_per_texel = 1;
+  session.refresh(small);
+}
+
 TEST(ProbeRefresh, TheDeviceBufferHoldsWhatProbesShow) {
   if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
   auto session = open_session(26);
   expect_buffer_is_published(*session, "at open");
-  RefreshBudget small;
-  small.milliseconds = 1e-3;
-  small.max_samples_per_texel = 1;
-  session->refresh(small);
+  refresh_one_probe_batch(*session);
   expect_buffer_is_published(*session, "one batch refreshed");
   refresh_probes(*session);
   expect_buffer_is_published(*session, "refreshed");
   session->apply_edits(parse_scene_edits(kBoxMoved, "box.json"));
   expect_buffer_is_published(*session, "after the box moved");
-  session->refresh(small);
+  refresh_one_probe_batch(*session);
   expect_buffer_is_published(*session, "after the box moved, one batch");
   refresh_probes(*session);
   expect_buffer_is_published(*session, "after the box moved, refreshed");
@@ -557,10 +562,7 @@ TEST(ProbeRefresh, ALightMoveIsEstimatedAsAChangeOfTheProbes) {
   const formats::ProbeGrid at_edit = session->published_probes();
   for (size_t i = 0; i < at_edit.probes.size(); ++i) EXPECT_EQ(at_edit.probes[i].sh, before.probes[i].sh) << "probe " << i;
   expect_buffer_is_published(*session, "at the light move");
-  RefreshBudget small;
-  small.milliseconds = 1e-3;
-  small.max_samples_per_texel = 1;
-  session->refresh(small);
+  refresh_one_probe_batch(*session);
   expect_buffer_is_published(*session, "one batch after the light move");
   refresh_probes_to(*session, target);
   expect_buffer_is_published(*session, "refreshed after the light move");
