@@ -182,8 +182,19 @@ LightmapEstimate LightmapDriver::download(const Accumulation& a, const Runs* onl
                                   ? std::move(space.estimate)
                                   : sized_estimate(host_texels, a.recorded, a.directional, a.light_layers);
   const Buffer* staging = space.staging.handle() ? &space.staging : nullptr;
+  Buffer shared_staging;
   if (texel_count > 0) {
     Context& context = runner_.context();
+    // Without a caller's staging, one buffer for every read below: each host-visible allocation of
+    // tens of MB (a million texels' sums) costs its own pinning and first touch.
+    size_t read_texels = 0;
+    for (const auto& [first, end] : runs) read_texels += end - first;
+    const size_t largest =
+        read_texels * std::max<size_t>({size_t(a.recorded) * 24, size_t(a.light_layers) * 24, 48, a.directional ? 72u : 0u});
+    if (!staging && largest > Context::kReusedStagingLimit) {
+      shared_staging = context.create_buffer(largest, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+      staging = &shared_staging;
+    }
     const TexelAccumulators& sums = from ? *from : runner_.buffers().texels;
     // The runs' bytes of a per-texel array of `texel_bytes` per texel starting at byte `base`.
     auto ranges = [&runs](size_t texel_bytes, size_t base) {

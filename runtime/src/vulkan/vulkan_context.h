@@ -72,6 +72,9 @@ inline std::vector<ByteRange> byte_ranges(const std::vector<std::pair<uint32_t, 
 
 class Context {
  public:
+  // Transfers up to this size go through one staging buffer the context keeps; larger ones allocate
+  // their own (or use a caller's).
+  static constexpr VkDeviceSize kReusedStagingLimit = 16 * 1024 * 1024;
   // Creates an instance and a device, or adopts options.external_device (checked, never destroyed).
   explicit Context(const VulkanDeviceOptions& options);
   ~Context();
@@ -205,7 +208,6 @@ class Context {
   Buffer small_staging_;
   bool small_staging_busy_ = false;
   static constexpr VkDeviceSize kSmallStagingBytes = 4 * 1024 * 1024;
-  static constexpr VkDeviceSize kReusedStagingLimit = 16 * 1024 * 1024;
   // `given` when it is a mapped buffer of at least `size` bytes (a caller's kept staging), else the
   // reused staging when `size` fits and it is free (marked busy until `own` is released by the
   // caller's scope: see StagingLease in the .cpp), else a new buffer in `own`.
