@@ -604,6 +604,12 @@ TEST(ProbeRefresh, ALightMoveIsEstimatedAsAChangeOfTheProbes) {
   EXPECT_LT(std::fabs(shown_minus_fresh), 4.0 * std::sqrt(variance))
       << shown_changed << " probes: base + change minus the whole run " << shown_minus_fresh << ", standard error " << std::sqrt(variance);
   EXPECT_LT(error_after, error_before) << "the refreshed probes are further from the edited scene than before the edit";
+  // A restart ends the change estimate: the probes keep what they show and start again.
+  session->restart();
+  EXPECT_FALSE(session->integrator().probe_refresh_as_change());
+  const formats::ProbeGrid after_restart = session->published_probes();
+  for (size_t i = 0; i < after.probes.size(); ++i) EXPECT_EQ(after_restart.probes[i].sh, after.probes[i].sh) << "probe " << i;
+  expect_buffer_is_published(*session, "after the change estimate ended");
   for (const std::string& m : validation_messages()) ADD_FAILURE() << "validation: " << m;
   validation_messages().clear();
 }
