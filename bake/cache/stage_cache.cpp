@@ -27,10 +27,17 @@ std::string sha256_of_bytes(const std::vector<uint8_t>& bytes) {
   return h.hex();
 }
 
+// The whole file in one read (an istreambuf_iterator copies it a character at a time).
 std::vector<uint8_t> read_bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw std::runtime_error(path.filename().string() + " cannot be read");
-  return std::vector<uint8_t>(std::istreambuf_iterator<char>(in), {});
+  const std::streamoff size = in.tellg();
+  if (size < 0) throw std::runtime_error(path.filename().string() + " cannot be read");
+  std::vector<uint8_t> bytes(static_cast<size_t>(size));
+  in.seekg(0);
+  if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size))
+    throw std::runtime_error(path.filename().string() + " cannot be read whole");
+  return bytes;
 }
 
 // A name an entry may list: plain, not entry.json, not hidden, so a damaged entry.json cannot
