@@ -28,21 +28,26 @@ layout(push_constant) uniform Push {
 const uint kKeptWords = 57u;
 const uint kBaseAt = 29u;
 
+// The variance of probe k's L0 mean, summed over rgb, from its sums over n samples, as
+// ProbeEstimate::l0_variance_of_mean adds it (0 below 2 samples).
+double l0_variance_of_mean(uint k, uint n) {
+  double variance = 0.0lf;
+  uint squares_at = push.probe_count * 27u + k * 3u;
+  for (uint c = 0u; c < 3u; ++c) variance += double(variance_of_mean_from_sums(sums[k * 27u + c], sums[squares_at + c], n));
+  return variance;
+}
+
 // During a change estimate (refresh/published_probes.cpp probe_change_choice): publish_after_change
 // on the change's L0 terms chooses what the probe showed before the last edit, the base, or the base
 // plus the change's mean (times the dering window per band; the base as shown is deringed already).
 void publish_change(uint k, uint n, uint at, uint out_at) {
   double squared = 0.0lf;
-  double variance = 0.0lf;
-  if (n > 0u) {
-    uint squares_at = push.probe_count * 27u + k * 3u;
+  if (n > 0u)
     for (uint c = 0u; c < 3u; ++c) {
       double d = sums[k * 27u + c] / double(n);
       squared += d * d;
-      variance += double(variance_of_mean_from_sums(sums[k * 27u + c], sums[squares_at + c], n));
     }
-  }
-  uint choice = publish_after_change(uint(kept[at + kBaseAt + 27u]), n, squared, variance);
+  uint choice = publish_after_change(uint(kept[at + kBaseAt + 27u]), n, squared, l0_variance_of_mean(k, n));
   for (uint i = 0u; i < 27u; ++i) {
     precise float value;
     if (choice == kPublishPrevious) {
@@ -71,7 +76,6 @@ void main() {
     return;
   }
   double difference_squared = 0.0lf;
-  double variance = 0.0lf;
   bool all_zero = true;
   if (n > 0u) {
     uint squares_at = push.probe_count * 27u + k * 3u;
@@ -79,11 +83,10 @@ void main() {
       double d = sums[k * 27u + c] / double(n) - double(float(kept[at + c]));
       difference_squared += d * d;
       all_zero = all_zero && sums[k * 27u + c] == 0.0lf && sums[squares_at + c] == 0.0lf;
-      variance += double(variance_of_mean_from_sums(sums[k * 27u + c], sums[squares_at + c], n));
     }
   }
-  bool refreshed =
-      publish_probe_refreshed(n, push.switch_samples, uint(kept[at + 27u]), kept[at + 28u], difference_squared, variance, all_zero);
+  bool refreshed = publish_probe_refreshed(n, push.switch_samples, uint(kept[at + 27u]), kept[at + 28u], difference_squared,
+                                           l0_variance_of_mean(k, n), all_zero);
   uint out_at = grid_index[k] * 27u;
   for (uint i = 0u; i < 9u; ++i) {
     vec3 value;

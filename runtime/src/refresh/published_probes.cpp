@@ -38,7 +38,7 @@ uint32_t probe_change_choice(const KeptProbe& base, const ProbeEstimate& change,
       const double d = change.sh_sum[k][c] / n;
       squared += d * d;
     }
-  return publish_after_change(base.samples, n, squared, n > 0 ? change.l0_variance_of_mean(k) : 0.0);
+  return publish_after_change(base.samples, n, squared, change.l0_variance_of_mean(k));
 }
 
 KeptProbe probe_base_plus_change(const KeptProbe& base, const ProbeEstimate& change, size_t k, const std::array<float, 3>& band_weight) {
