@@ -238,7 +238,7 @@ InPlaceEdits apply_scene_edits_in_place(PersistedScene& persisted, const std::ve
       LiveTexel& texel = persisted.gbuffer.texels[texels[k].index];
       texel = refresh::moved_texel(texel, texels[k], planned, scene, persisted.gbuffer, persisted.atlas);
     }
-  }, 1024);
+  }, 256);
   for (const refresh::MovingTexel& t : texels) out.moved_texels.push_back(uint32_t(t.index));
   return out;
 }

@@ -95,7 +95,7 @@ void move_triangles(MovedTriangles& m, const Instance& instance, const Matrix4d&
     }
     const std::lock_guard<std::mutex> lock(boxes);
     m.box_before.grow(before), m.box_after.grow(after);
-  }, 1024);
+  }, 256);  // a block's few thousand triangles over all cores
   if (first_collapsed.load() != UINT32_MAX)
     fail(where, "the transform collapses triangle " + std::to_string(m.first + first_collapsed.load()) + " of instance \"" +
                     instance.name + "\" (zero area or not finite)");
@@ -261,7 +261,7 @@ std::vector<MovingTexel> moving_texels(const PlannedMoves& planned, const Scene&
       const LiveTexel& texel = gbuffer.texels[out[k].index];
       out[k].pushed = pushed_off_surface(texel, before, atlas.rects[texel.instance], gbuffer.pages[texel.page], out[k].b1, out[k].b2);
     }
-  }, 1024);
+  }, 256);  // a block's few thousand texels over all cores (0.4 ms in 5 chunks on a 16-core host)
   return out;
 }
 

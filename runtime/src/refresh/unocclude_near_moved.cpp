@@ -25,9 +25,8 @@ std::vector<uint32_t> unocclude_near_boxes(PersistedScene& edited, const std::ve
     const BvhHit hit = closest_hit(edited_lighting, origin, direction, t_max);
     return OccluderHit{hit.found, hit.distance, hit.geometric_normal};
   };
-  // Whether texel i lies within reach of a box, and then its unocclude step again (each texel reads
-  // only itself and the BVH: chunks of texels run on threads).
-  auto reconsider = [&](uint32_t i) {
+  // Whether texel i lies within reach of a box (cheap tests; then placed on its surface point).
+  auto within_reach = [&](uint32_t i) {
     if (carried && std::binary_search(carried->begin(), carried->end(), i)) return false;
     LiveTexel& texel = edited.gbuffer.texels[i];
     // A pushed texel lies at most its reach from its surface point: test the current position
@@ -41,16 +40,21 @@ std::vector<uint32_t> unocclude_near_boxes(PersistedScene& edited, const std::ve
     const Vec3 surface = texel_surface_position(edited.scene, texel.triangle, b1, b2);
     if (!std::any_of(boxes.begin(), boxes.end(), [&](const WorldBox& b) { return b.contains(surface, reach); })) return false;
     texel.position = surface;
-    unocclude_texel(texel, edited_lighting.extent, query);
     return true;
   };
+  // The tests first over all candidates, then the unocclude step (8 rays each) over those within
+  // reach in small chunks: those cluster in index order (a block's own texels not carried), so
+  // contiguous chunks of all candidates left most of the rays to one or two threads.
   auto reconsider_all = [&](const std::vector<uint32_t>& texels) {
-    std::vector<uint8_t> done(texels.size(), 0);
+    std::vector<uint8_t> within(texels.size(), 0);
     for_each_chunk(texels.size(), [&](size_t begin, size_t end) {
-      for (size_t k = begin; k < end; ++k) done[k] = reconsider(texels[k]) ? 1 : 0;
-    }, 512);
+      for (size_t k = begin; k < end; ++k) within[k] = within_reach(texels[k]) ? 1 : 0;
+    }, 256);
     for (size_t k = 0; k < texels.size(); ++k)
-      if (done[k]) reconsidered.push_back(texels[k]);
+      if (within[k]) reconsidered.push_back(texels[k]);
+    for_each_chunk(reconsidered.size(), [&](size_t begin, size_t end) {
+      for (size_t k = begin; k < end; ++k) unocclude_texel(edited.gbuffer.texels[reconsidered[k]], edited_lighting.extent, query);
+    }, 16);
   };
   if (grid && grid->texel_count() == edited.gbuffer.texels.size()) {
     // Candidates within twice the largest reach of a box, each once, ascending: the cells' texels
@@ -231,7 +235,7 @@ std::vector<uint32_t> texels_carried_rigidly(const PersistedScene& edited, const
       }
       keep[t] = !near_other;
     }
-  }, 1024);
+  }, 128);  // the texels near other geometry (BVH queries) cluster in index order: small chunks
   for (size_t t = 0; t < moved_texels.size(); ++t)
     if (keep[t]) carried.push_back(moved_texels[t]);
   return carried;
