@@ -12,7 +12,7 @@ vec3 scene_triangle_vertex(uint t, uint k) {
 }
 vec3 scene_triangle_normal(uint t, uint k) { return k == 0u ? triangles[t].n0.xyz : (k == 1u ? triangles[t].n1.xyz : triangles[t].n2.xyz); }
 uint scene_triangle_material(uint t) { return floatBitsToUint(triangles[t].p0_material.w); }
-float scene_triangle_area_pdf(uint t) { return triangles[t].p1_area_pdf.w; }
+float scene_triangle_area_pdf(uint t) { return triangles[t].p1_area_pdf.w * params.emitter_inverse_power; }
 GpuMaterial scene_material(uint m) { return materials[m]; }
 GpuPunctualLight scene_punctual_light(uint i) { return punctual[i]; }
 uint scene_emitter_count() { return params.emitter_count; }

@@ -306,10 +306,17 @@ TEST(VulkanRuntimeEdits, MovedGeometryUpdateEqualsAFreshIntegrator) {
     const Bvh4Links links = link_bvh4(lighting->bvh, scene->triangle_count());
     const std::vector<uint32_t> moved = {12, 13};
     const std::vector<Vec3> moved_before(scene->positions.begin() + 12 * 3, scene->positions.begin() + 14 * 3);
-    for (size_t v = 12 * 3; v < 14 * 3; ++v) scene->positions[v] = scene->positions[v] + Vec3{0.1f, -0.4f, 0.05f};
+    // Moved and grown about its centre: its area, hence the emitters' total power, changes (the
+    // kernels' GpuParams::emitter_inverse_power must follow, with the CDF, and no other record).
+    Vec3 centre{0, 0, 0};
+    for (size_t v = 12 * 3; v < 14 * 3; ++v) centre = centre + scene->positions[v] / 6.0f;
+    for (size_t v = 12 * 3; v < 14 * 3; ++v)
+      scene->positions[v] = centre + (scene->positions[v] - centre) * 1.2f + Vec3{0.1f, -0.4f, 0.05f};
+    const float inverse_power_before = lighting->emitter_inverse_power;
     const MovedTrianglesRefresh refreshed =
         refresh_moved_triangles_from_source(*lighting, links, moved, moved_before, scene_world_box(*scene));
     EXPECT_TRUE(refreshed.emitters_changed);
+    EXPECT_LT(lighting->emitter_inverse_power, inverse_power_before / 1.3f) << "a larger emitter, more power";
     EXPECT_FALSE(refreshed.bvh_nodes.empty());
     vk->update_moved_geometry(*lighting, links, moved, refreshed.bvh_nodes, refreshed.emitters_changed);
     const LightmapEstimate updated = vk->bake(g, settings);
@@ -317,7 +324,7 @@ TEST(VulkanRuntimeEdits, MovedGeometryUpdateEqualsAFreshIntegrator) {
     expect_identical(updated, fresh->bake(g, settings), "updated vs fresh");
     double rise = 0;
     for (size_t i = 0; i < g.texels.size(); ++i) rise += updated.mean_total(i).y - before.mean_total(i).y;
-    EXPECT_GT(rise, 0.0) << "the emitter came closer to the floor";
+    EXPECT_GT(rise, 0.0) << "the emitter came closer to the floor, and grew";
     EXPECT_THROW(vk->update_moved_geometry(*lighting, links, {13, 12}, refreshed.bvh_nodes, false), std::invalid_argument);
   }
 }

@@ -674,6 +674,7 @@ TEST(LightingSceneGeometry, SetGeometryEqualsABuildOfTheEditedScene) {
   EXPECT_EQ(std::memcmp(lighting.triangles.data(), fresh.triangles.data(), fresh.triangles.size() * sizeof(GpuTriangle)), 0);
   EXPECT_EQ(std::memcmp(lighting.bvh.nodes.data(), fresh.bvh.nodes.data(), fresh.bvh.nodes.size() * sizeof(Bvh4Node)), 0);
   EXPECT_EQ(lighting.emitter_cdf, fresh.emitter_cdf);
+  EXPECT_EQ(lighting.emitter_inverse_power, fresh.emitter_inverse_power);
   EXPECT_EQ(lighting.punctual_cdf, fresh.punctual_cdf);
   EXPECT_EQ(std::memcmp(lighting.punctual_lights.data(), fresh.punctual_lights.data(),
                         fresh.punctual_lights.size() * sizeof(GpuPunctualLight)), 0);
@@ -718,6 +719,7 @@ TEST(SceneEditsLighting, UpdateEqualsABuildOfTheEditedScene) {
     EXPECT_TRUE(same_bytes(lighting.bvh.nodes, fresh.bvh.nodes)) << "case " << c;
     EXPECT_EQ(lighting.emitter_triangles, fresh.emitter_triangles) << "case " << c;
     EXPECT_EQ(lighting.emitter_cdf, fresh.emitter_cdf) << "case " << c;
+    EXPECT_EQ(lighting.emitter_inverse_power, fresh.emitter_inverse_power) << "case " << c;
     EXPECT_EQ(lighting.punctual_cdf, fresh.punctual_cdf) << "case " << c;
     EXPECT_EQ(lighting.sky.z, fresh.sky.z) << "case " << c;
     EXPECT_EQ(lighting.extent, fresh.extent) << "case " << c;

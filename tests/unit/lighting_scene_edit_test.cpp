@@ -28,6 +28,7 @@ void expect_same(const LightingScene& edited, LightingScene rebuilt) {
   EXPECT_TRUE(same_bytes(edited.punctual_lights, rebuilt.punctual_lights));
   EXPECT_EQ(edited.emitter_triangles, rebuilt.emitter_triangles);
   EXPECT_EQ(edited.emitter_cdf, rebuilt.emitter_cdf);
+  EXPECT_EQ(edited.emitter_inverse_power, rebuilt.emitter_inverse_power);
   EXPECT_EQ(edited.punctual_cdf, rebuilt.punctual_cdf);
   EXPECT_EQ(edited.textured, rebuilt.textured);
 }

@@ -2,8 +2,10 @@
 
 #include "exitance/common/light_layers.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -91,8 +93,9 @@ std::vector<double> emission_power_per_area(const Scene& scene) {
   return out;
 }
 
-// Emitters by power (area x luminance of the mean emission, x2 when double sided), and every
-// triangle's area density under that choice, which NEE's MIS needs at any hit on it.
+// Emitters by power (area x luminance of the mean emission, x2 when double sided), and on every
+// emitter's record its material's power per area: with the total's inverse, the area density under
+// that choice, which NEE's MIS needs at any hit on it (scene_access.h scene_triangle_area_pdf).
 void build_emitter_distribution(LightingScene& lighting) {
   const Scene& scene = *lighting.source;
   const std::vector<double> per_area = emission_power_per_area(scene);
@@ -106,6 +109,7 @@ void build_emitter_distribution(LightingScene& lighting) {
     const double power = double(area) * per_area[scene.triangle_material[t]];
     if (!(power > 0) || !(area > 0)) continue;  // zero-area or black emitters can never be hit usefully
     lighting.emitter_triangles.push_back(t);
+    lighting.triangles[t].p1_area_pdf.w = float(per_area[scene.triangle_material[t]]);
     powers.push_back(power);
     areas.push_back(area);
   }
@@ -145,13 +149,15 @@ bool refresh_emitter_powers(LightingScene& lighting, const std::vector<uint32_t>
   return true;
 }
 
-// The emitter CDF over `powers` (per lighting.emitter_triangles) and the emitters' area pdfs.
+// The emitter CDF over `powers` (per lighting.emitter_triangles) and the total's inverse. An
+// emitter's pick probability over its area is its material's power per area over the total: a move
+// (areas, hence the total, change) leaves every emitter's record as it is.
 void set_emitter_distribution(LightingScene& lighting, const std::vector<double>& powers, std::vector<float> areas) {
   const Distribution1D emitters(powers);
   lighting.emitter_cdf = padded_cdf(emitters);
-  for_each_chunk(lighting.emitter_triangles.size(), [&](size_t first, size_t last) {
-    for (size_t i = first; i < last; ++i) lighting.triangles[lighting.emitter_triangles[i]].p1_area_pdf.w = emitters.pmf(i) / areas[i];
-  }, 4096);
+  // Finite even for a total below the smallest float's inverse (0 x it stays 0 on a non-emitter).
+  lighting.emitter_inverse_power =
+      emitters.total() > 0 ? float(std::min(1.0 / emitters.total(), double(std::numeric_limits<float>::max()))) : 0.0f;
   lighting.emitter_areas = std::move(areas);
 }
 

@@ -412,7 +412,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
     if (!effects.materials.empty()) refresh_materials_from_source(lighting, effects.materials);
     if (effects.sky) refresh_lights_from_source(lighting, {}, true);
     moved_bvh_nodes = moved.bvh_nodes;
-    moved_emitters = moved.emitters_changed || !effects.materials.empty();
+    moved_emitters = moved.emitters_changed;
   } else {
     if (!effects.materials.empty()) {
       refresh_materials_from_source(lighting, effects.materials);
@@ -445,7 +445,8 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   std::future<void> geometry_upload;
   if (effects.geometry_changed())
     geometry_upload = std::async(std::launch::async, [&] {
-      s.integrator->update_moved_geometry(lighting, s.bvh_links, in_place.moved_triangles, moved_bvh_nodes, moved_emitters);
+      s.integrator->update_moved_geometry(lighting, s.bvh_links, in_place.moved_triangles, moved_bvh_nodes, moved_emitters,
+                                          !effects.materials.empty());
       if (effects.sky) s.integrator->update_lights(lighting);
     });
   std::vector<uint32_t> changed_texels;

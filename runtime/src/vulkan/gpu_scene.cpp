@@ -113,6 +113,7 @@ GpuScene::GpuScene(Context& context, const LightingScene& scene, bool quantized_
       bounds_lo_(scene.bounds_lo),
       bounds_hi_(scene.bounds_hi),
       extent_(scene.extent),
+      emitter_inverse_power_(scene.emitter_inverse_power),
       environment_width_(scene.environment.enabled() ? scene.environment.width() : 0),
       environment_height_(scene.environment.enabled() ? scene.environment.height() : 0),
       stack_bound_(std::max<uint32_t>(scene.bvh.stack_entries + 1, 8)),
@@ -206,6 +207,7 @@ void GpuScene::add_material_writes(const LightingScene& edited, std::vector<Cont
 
 void GpuScene::materials_uploaded(const LightingScene& edited) {
   emitters_ = edited.emitter_triangles;
+  emitter_inverse_power_ = edited.emitter_inverse_power;
   surface_flags_ = vulkan::surface_flags(edited);
   surfaces_textured_ = surfaces_textured_ || edited.textured;
 }
@@ -245,7 +247,7 @@ std::vector<Context::RangeWrite> GpuScene::punctual_writes(const LightingScene& 
 
 void GpuScene::update_moved_geometry(const LightingScene& edited, const Bvh4Links& links,
                                      const std::vector<uint32_t>& moved_triangles, const std::vector<uint32_t>& changed_nodes,
-                                     bool emitters_changed) {
+                                     bool emitters_changed, bool materials_changed) {
   check_same_shape(edited);
   check_supported_by_vulkan(edited);
   if (links.triangle_slot_start.size() != edited.triangles.size() + 1 || links.slot_leaf.size() != leaf_slots_)
@@ -283,12 +285,20 @@ void GpuScene::update_moved_geometry(const LightingScene& edited, const Bvh4Link
   for (Context::RangeWrite& w : punctual_writes(edited)) writes.push_back(std::move(w));
   std::vector<Vec4> surfaces;
   std::vector<uint32_t> emitters;
-  if (emitters_changed) add_material_writes(edited, writes, surfaces, emitters);  // areas and the emitter CDF follow the moved emitters
+  // Moved emitters keep their list and their records' power per area (their records are among the
+  // moved ones above): their areas change the CDF and the total alone. A changed list (an emitter
+  // whose area fell to 0, or back) or edited materials: every emitter record and material.
+  const bool whole_materials = materials_changed || (emitters_changed && edited.emitter_triangles != emitters_);
+  if (whole_materials)
+    add_material_writes(edited, writes, surfaces, emitters);
+  else if (emitters_changed)
+    writes.push_back(Context::RangeWrite::whole(emitter_cdf_, edited.emitter_cdf.data(), edited.emitter_cdf.size() * sizeof(double)));
   // Waited for here, on the edit's upload thread, while the caller's thread works on the texels
   // (recorded at the start of the publish instead, the copies lengthened the publish's wait by
   // 0.5-0.8 ms on an H100 host: bench/results/refresh-gpu.md).
   context_.write_ranges(writes);
-  if (emitters_changed) materials_uploaded(edited);
+  if (whole_materials) materials_uploaded(edited);
+  else if (emitters_changed) emitter_inverse_power_ = edited.emitter_inverse_power;
   bounds_lo_ = edited.bounds_lo;
   bounds_hi_ = edited.bounds_hi;
   extent_ = edited.extent;

@@ -48,12 +48,13 @@ class GpuScene {
   // BVH nodes and leaf slots, traversal stack bound) differs.
   void update_geometry(const LightingScene& edited);
   // After refresh_moved_triangles_from_source (lighting_scene.h): only the moved triangles' records
-  // and leaf-slot vertex copies, the changed BVH nodes, the punctual lights and CDF, and (when an
-  // emitter moved) what update_materials uploads; takes the bounds and extent. The device scene
-  // then equals update_geometry's. Throws std::invalid_argument for a shape, link or index that is
-  // not this scene's.
+  // and leaf-slot vertex copies, the changed BVH nodes, the punctual lights and CDF, and when an
+  // emitter moved (`emitters_changed`) the emitter CDF and total power, or, when the emitter list
+  // changed or `materials_changed` (material edits in the same call), what update_materials
+  // uploads; takes the bounds and extent. The device scene then equals update_geometry's. Throws
+  // std::invalid_argument for a shape, link or index that is not this scene's.
   void update_moved_geometry(const LightingScene& edited, const Bvh4Links& links, const std::vector<uint32_t>& moved_triangles,
-                             const std::vector<uint32_t>& changed_nodes, bool emitters_changed);
+                             const std::vector<uint32_t>& changed_nodes, bool emitters_changed, bool materials_changed = false);
 
   void bind(DescriptorWrites& writes) const;  // kBindingBvhNodes .. kBindingPunctualCdf, kBindingSurfaces, kBindingEnvironment
 
@@ -63,6 +64,7 @@ class GpuScene {
   Vec3 bounds_lo() const { return bounds_lo_; }
   Vec3 bounds_hi() const { return bounds_hi_; }
   uint32_t emitter_count() const { return uint32_t(emitters_.size()); }
+  float emitter_inverse_power() const { return emitter_inverse_power_; }
   const std::vector<uint32_t>& emitter_triangles() const { return emitters_; }  // the emitter list, in CDF order
   uint32_t punctual_count() const { return punctual_count_; }
   // The scene's light layers as laid out when it was built (LightingScene; fixed through edits).
@@ -107,6 +109,7 @@ class GpuScene {
   uint32_t light_layer_count_ = 1, punctual_light_layers_ = 0;
   Vec3 sky_{0, 0, 0}, bounds_lo_{0, 0, 0}, bounds_hi_{0, 0, 0};
   float extent_ = 1.0f;
+  float emitter_inverse_power_ = 0.0f;  // as uploaded with the emitter CDF
   uint32_t environment_width_ = 0, environment_height_ = 0;  // 0: constant sky
   uint32_t stack_bound_ = 8, node_count_ = 0, leaf_slots_ = 0;
   bool quantized_ = false;

@@ -521,6 +521,7 @@ void LightmapDriver::scene_changed() {
   p.sky = scene.sky;
   p.scene_extent = scene.scene_extent;
   p.emitter_count = scene.emitter_count;
+  p.emitter_inverse_power = scene.emitter_inverse_power;
   p.punctual_count = scene.punctual_count;
   p.surface_flags = scene.surface_flags;
   p.environment_width = scene.environment_width;

@@ -354,8 +354,9 @@ void VulkanIntegrator::update_punctual_lights(const LightingScene& edited) {
 }
 void VulkanIntegrator::update_moved_geometry(const LightingScene& edited, const Bvh4Links& links,
                                              const std::vector<uint32_t>& moved_triangles,
-                                             const std::vector<uint32_t>& changed_nodes, bool emitters_changed) {
-  impl_->scene.update_moved_geometry(edited, links, moved_triangles, changed_nodes, emitters_changed);
+                                             const std::vector<uint32_t>& changed_nodes, bool emitters_changed,
+                                             bool materials_changed) {
+  impl_->scene.update_moved_geometry(edited, links, moved_triangles, changed_nodes, emitters_changed, materials_changed);
   impl_->lightmap.set_guiding_scene(guiding_scene(edited, impl_->created_on));
   impl_->source = edited.source;
 }

@@ -6,7 +6,7 @@
 namespace exitance::vulkan {
 namespace {
 
-static_assert(sizeof(GpuParams) == 224);  // 224 bytes of fields (a multiple of Vec4 alignment)
+static_assert(sizeof(GpuParams) == 240);  // a multiple of 16 bytes (std430 rounds a struct with vec4s so)
 static_assert(sizeof(GpuParams::changed_light_layers) / sizeof(uint32_t) == kMaxChangedLightPairs);
 static_assert(sizeof(GpuSurfacePoint) == 48 && sizeof(ShadowRay) == 32);
 
@@ -71,6 +71,7 @@ GpuParams WavefrontBatchRunner::bake_params(const IntegratorSettings& settings, 
   params.sky = Vec4(scene_.sky(), 0.0f);
   params.scene_extent = scene_.extent();
   params.emitter_count = scene_.emitter_count();
+  params.emitter_inverse_power = scene_.emitter_inverse_power();
   params.punctual_count = scene_.punctual_count();
   params.surface_flags = scene_.surface_flags();
   params.environment_width = scene_.environment_width();

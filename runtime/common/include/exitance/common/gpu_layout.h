@@ -9,7 +9,8 @@ EXITANCE_NAMESPACE_BEGIN
 // One scene triangle for shading: vertices, shading normals, and what light sampling needs.
 struct GpuTriangle {
   vec4 p0_material;  // xyz vertex 0; w material index (uint bits)
-  vec4 p1_area_pdf;  // xyz vertex 1; w area density with which NEE picks a point on it (0: not an emitter)
+  vec4 p1_area_pdf;  // xyz vertex 1; w its material's emitted power per area (0: not an emitter), which
+                     // x GpuParams::emitter_inverse_power is the area density NEE picks a point on it with
   vec4 p2_instance;  // xyz vertex 2; w instance index (uint bits)
   vec4 n0;           // xyz shading normal at vertex 0
   vec4 n1;
@@ -91,6 +92,7 @@ struct GpuParams {
   vec4 bench_hi;
   float scene_extent;   // largest side of the scene bounds (ray offset floor)
   uint emitter_count;
+  float emitter_inverse_power;  // 1 / the emitters' total power (GpuTriangle::p1_area_pdf); 0: none
   uint punctual_count;
   uint recorded;        // K: recorded bounce layers; result slot K gathers the deeper ones
   int max_bounces;
@@ -130,6 +132,7 @@ struct GpuParams {
                              // (kEmitterGuide* below); 0 = the default next-event sampling
   // A change estimate with light layers: pair k's change goes to layer changed_light_layers[k].
   uint changed_light_layers[8];  // kMaxChangedLightPairs
+  uint padding[3];               // to a multiple of 16 bytes, as std430 rounds a struct with vec4s
 };
 
 // The most edited punctual lights a change estimate carries (GpuParams::changed_light_pairs; the

@@ -20,7 +20,9 @@ inline vec3 scene_triangle_normal(const LightingScene& scene, uint t, uint k) {
   return {n.x, n.y, n.z};
 }
 inline uint scene_triangle_material(const LightingScene& scene, uint t) { return floatBitsToUint(scene.triangles[t].p0_material.w); }
-inline float scene_triangle_area_pdf(const LightingScene& scene, uint t) { return scene.triangles[t].p1_area_pdf.w; }
+inline float scene_triangle_area_pdf(const LightingScene& scene, uint t) {
+  return scene.triangles[t].p1_area_pdf.w * scene.emitter_inverse_power;
+}
 inline GpuMaterial scene_material(const LightingScene& scene, uint m) { return scene.materials[m]; }
 inline GpuPunctualLight scene_punctual_light(const LightingScene& scene, uint i) { return scene.punctual_lights[i]; }
 inline uint scene_emitter_count(const LightingScene& scene) { return scene.emitter_count(); }

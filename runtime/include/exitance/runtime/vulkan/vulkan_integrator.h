@@ -277,10 +277,11 @@ class VulkanIntegrator final : public Integrator {
   void update_geometry(const LightingScene& edited);
   // update_geometry for an edit made in place (RefreshSession): after
   // refresh_moved_triangles_from_source, which returned `changed_nodes` for `moved_triangles`;
-  // `emitters_changed` when an emitter was among them. Uploads only what those change; the device
+  // `emitters_changed` when an emitter was among them, `materials_changed` when the same call also
+  // edited materials (refresh_materials_from_source). Uploads only what those change; the device
   // scene then equals update_geometry's.
   void update_moved_geometry(const LightingScene& edited, const Bvh4Links& links, const std::vector<uint32_t>& moved_triangles,
-                             const std::vector<uint32_t>& changed_nodes, bool emitters_changed);
+                             const std::vector<uint32_t>& changed_nodes, bool emitters_changed, bool materials_changed = false);
   // The running accumulation's start points of `texels` (G-buffer indices) taken from `gbuffer`
   // again (texels an edit moved), so a later start_progressive(..., texels_as_before = true) traces
   // from where they are now. Nothing before a start. std::out_of_range for an index beyond it.
