@@ -18,7 +18,9 @@ BvhHit closest_hit(const LightingScene& scene, const Vec3& origin, const Vec3& d
     p1 = xyz(tri.p1_area_pdf);
     p2 = xyz(tri.p2_instance);
   };
-  std::vector<uint32_t> stack;
+  // Per thread, kept between rays, not allocated per ray: the unocclude step after an edit traces
+  // thousands of short rays per moved instance, on all cores.
+  thread_local std::vector<uint32_t> stack;
   const Bvh4WalkHit walk = bvh4_closest_hit(scene.bvh.nodes.data(), scene.bvh.nodes.size(),
                                             scene.bvh.leaf_triangles.data(), corners, origin, direction, t_max, stack);
   BvhHit best;
