@@ -180,7 +180,7 @@ InstanceTexels::InstanceTexels(const TexelGBuffer& gbuffer, size_t instance_coun
 }
 
 InPlaceEdits apply_scene_edits_in_place(PersistedScene& persisted, const std::vector<SceneEdit>& edits,
-                                        const InstanceTexels* by_instance) {
+                                        const InstanceTexels* by_instance, bool defer_texels) {
   Scene& scene = persisted.scene;
   // The parts edits change or read (names, the node tree, instances' world matrices, lights,
   // materials, the sky's colour), copied; the geometry, textures and an environment image are not.
@@ -233,13 +233,22 @@ InPlaceEdits apply_scene_edits_in_place(PersistedScene& persisted, const std::ve
     scene.sky.environment = Texture{};
   }
   for (const refresh::MovedTriangles& m : planned.triangles) m.write_into(scene);
-  for_each_chunk(texels.size(), [&](size_t begin, size_t end) {  // each texel reads the scene and writes itself
-    for (size_t k = begin; k < end; ++k) {
-      LiveTexel& texel = persisted.gbuffer.texels[texels[k].index];
-      texel = refresh::moved_texel(texel, texels[k], planned, scene, persisted.gbuffer, persisted.atlas);
-    }
-  }, 256);
   for (const refresh::MovingTexel& t : texels) out.moved_texels.push_back(uint32_t(t.index));
+  if (texels.empty()) return out;
+  refresh::PlannedMoves moves;  // what moved_texel reads of the plan: the moves' transforms
+  moves.delta = std::move(planned.delta);
+  out.move_texels = [&persisted, moves = std::move(moves), texels = std::move(texels)] {
+    for_each_chunk(texels.size(), [&](size_t begin, size_t end) {  // each texel reads the scene and writes itself
+      for (size_t k = begin; k < end; ++k) {
+        LiveTexel& texel = persisted.gbuffer.texels[texels[k].index];
+        texel = refresh::moved_texel(texel, texels[k], moves, persisted.scene, persisted.gbuffer, persisted.atlas);
+      }
+    }, 256);
+  };
+  if (!defer_texels) {
+    out.move_texels();
+    out.move_texels = nullptr;
+  }
   return out;
 }
 

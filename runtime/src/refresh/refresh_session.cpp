@@ -390,7 +390,11 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
   for (const PunctualLight& light : s.persisted.scene.lights) was.light_positions.push_back(light.position);
   // Validated and computed on copies of the small parts, then committed in place (the session's
   // lighting scene reads persisted.scene itself); nothing below throws for bad input.
-  InPlaceEdits in_place = apply_scene_edits_in_place(s.persisted, edits, &s.instance_texels);
+  InPlaceEdits in_place = apply_scene_edits_in_place(s.persisted, edits, &s.instance_texels, true);
+  // The moved texels are rewritten on their own thread beside the lighting scene's refit below
+  // (each reads the committed scene; they write the G-buffer's moved texels and the lighting scene).
+  std::future<void> texels_moved;
+  if (in_place.move_texels) texels_moved = std::async(std::launch::async, in_place.move_texels);
   const EditEffects& effects = in_place.effects;
   if (effects.geometry_changed() || !effects.materials.empty()) s.voxel_deposits_current = false;  // texels moved, or their albedo or emission
   // Edits of punctual lights alone upload the lights after the publish below, in the submission
@@ -423,6 +427,7 @@ EditEffects RefreshSession::apply_edits(const std::vector<SceneEdit>& edits) {
       if (!punctual_only) s.integrator->update_lights(lighting);
     }
   }
+  if (texels_moved.valid()) texels_moved.get();
   timings.scene = since(lap);
   // Edits that only scaled lights' emission: their layers scaled where the estimates are, 0 rays,
   // every sample kept (light_layer_edits.h).

@@ -21,6 +21,7 @@
 //   material: strength = max(1, the product's largest component), factor = product / strength
 //             (so a product within [0, 1] is the factor itself, glTF's default strength being 1).
 #pragma once
+#include <functional>
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -133,6 +134,10 @@ struct InPlaceEdits {
   std::vector<WorldBox> moved_boxes_before, moved_boxes_after;  // per effects.moved_instances
   std::vector<Matrix4d> moved_deltas;               // per effects.moved_instances: world after * world before^-1
   std::vector<uint32_t> moved_texels;               // ascending: the G-buffer texels rewritten
+  // With `defer_texels`: rewrites moved_texels in the committed scene's G-buffer (reads the scene,
+  // the atlas and those texels, writes those texels only; cannot throw), for the caller to run
+  // beside its other work (the BVH refit); empty when nothing is left to do.
+  std::function<void()> move_texels;
 };
 
 // apply_scene_edits without copying the scene (the runtime's edit path): every edit is validated and
@@ -142,9 +147,10 @@ struct InPlaceEdits {
 // `persisted.bvh` is left as it was: the caller refits it over `moved_triangles` (refit_bvh4_moved;
 // RefreshSession does, on its lighting scene's BVH, and copies the changed nodes back).
 // `by_instance` (may be null: a pass over the texels) must be built on this G-buffer. Throws
-// SceneEditError as apply_scene_edits does, `persisted` untouched.
+// SceneEditError as apply_scene_edits does, `persisted` untouched. `defer_texels`: the moved
+// texels are rewritten by the caller, through the result's move_texels, before it reads them.
 InPlaceEdits apply_scene_edits_in_place(PersistedScene& persisted, const std::vector<SceneEdit>& edits,
-                                        const InstanceTexels* by_instance);
+                                        const InstanceTexels* by_instance, bool defer_texels = false);
 
 // Brings `lighting`, built on the scene before apply_scene_edits, to `edited` (the scene after):
 // set_geometry (lighting_scene.h: everything re-derived, BVH refit) when geometry moved, else
