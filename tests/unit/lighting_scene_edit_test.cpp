@@ -8,6 +8,8 @@
 #include <memory>
 #include <stdexcept>
 
+#include "exitance/common/vector_functions.h"
+#include "exitance/runtime/core/scene_access.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "support/analytic_scenes.h"
 
@@ -72,6 +74,28 @@ TEST(LightingSceneEdit, SetMaterialMatchesARebuild) {
   for (size_t i = 0; i < 3; ++i) EXPECT_EQ(edited.materials[i].emission.w, float(edited.material_light_layers[i]));
   EXPECT_EQ(original_source->materials[1].emission.x, 2.0f) << "the shared source Scene must not change";
   EXPECT_THROW(set_material(edited, 3, Material{}), std::out_of_range);
+}
+
+// The area density NEE and the MIS weight at a hit read (a record's power per area x the total's
+// inverse) is the density NEE samples with: the emitter's CDF cell over its area. Closed form on
+// three_quads: an emissive quad of area 1 (luminance L1, one side) and one of area 4 (luminance 1,
+// both sides: x2); the receiver's triangles 0.
+TEST(LightingSceneEdit, TheEmittersAreaPdfIsTheirPowerPerAreaOverTheTotal) {
+  const LightingScene lighting = *make_lighting_scene(three_quads());
+  ASSERT_EQ(lighting.emitter_count(), 4u);
+  const double l1 = luminance(Vec3{2, 1, 0.5f}), total = l1 * 1 + 2.0 * 4;
+  EXPECT_NEAR(lighting.emitter_inverse_power, 1 / total, 1e-6 / total);
+  for (uint32_t i = 0; i < lighting.emitter_count(); ++i) {
+    const uint32_t t = lighting.emitter_triangles[i];
+    const vec3 p0 = scene_triangle_vertex(lighting, t, 0), p1 = scene_triangle_vertex(lighting, t, 1), p2 = scene_triangle_vertex(lighting, t, 2);
+    const double area = 0.5 * double(length(cross(p1 - p0, p2 - p0)));
+    const double sampled = (lighting.emitter_cdf[i + 1] - lighting.emitter_cdf[i]) / area;  // what NEE picks a point with
+    const double closed_form = (t < 4 ? l1 : 2.0) / total;
+    EXPECT_NEAR(scene_triangle_area_pdf(lighting, t), sampled, 1e-6 * sampled) << "emitter " << i;
+    EXPECT_NEAR(scene_triangle_area_pdf(lighting, t), closed_form, 1e-6 * closed_form) << "emitter " << i;
+  }
+  EXPECT_EQ(scene_triangle_area_pdf(lighting, 0), 0.0f) << "the receiver";
+  EXPECT_EQ(scene_triangle_area_pdf(lighting, 1), 0.0f) << "the receiver";
 }
 
 TEST(LightingSceneEdit, SetPunctualLightMatchesARebuild) {
