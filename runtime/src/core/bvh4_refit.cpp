@@ -192,7 +192,7 @@ std::vector<uint32_t> refit_bvh4_moved(Bvh4& bvh, const Bvh4Links& links, const 
         leaf_box[k].grow(carried_part_box(before_of(t), &positions[size_t(t) * 3], fitted));
       }
     }
-  }, 256);
+  }, 64);  // a moved block's leaves over all cores (clipped fragments make some leaves costlier)
   std::vector<uint32_t> dirty;
   for (size_t k = 0; k < leaves.size(); ++k) {
     set_child_box(bvh.nodes[leaves[k] / 4], int(leaves[k] % 4), leaf_box[k]);
