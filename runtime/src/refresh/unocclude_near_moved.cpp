@@ -44,7 +44,7 @@ std::vector<uint32_t> unocclude_near_boxes(PersistedScene& edited, const std::ve
   };
   // The tests first over all candidates, then the unocclude step (8 rays each) over those within
   // reach in small chunks: those cluster in index order (a block's own texels not carried), so
-  // contiguous chunks of all candidates left most of the rays to one or two threads.
+  // contiguous chunks of all candidates could leave most of the rays to a few threads.
   auto reconsider_all = [&](const std::vector<uint32_t>& texels) {
     std::vector<uint8_t> within(texels.size(), 0);
     for_each_chunk(texels.size(), [&](size_t begin, size_t end) {

@@ -172,12 +172,14 @@ void GpuScene::update_materials(const LightingScene& edited) {
 
 void GpuScene::add_material_writes(const LightingScene& edited, std::vector<Context::RangeWrite>& writes, std::vector<Vec4>& surfaces,
                                    std::vector<uint32_t>& emitters) {
-  // The material records, the triangle records of old and new emitters (their area pdfs), the
+  // The material records, the triangle records of old and new emitters (their power per area), the
   // emitter CDF and list (their buffers grown first when larger) and the surface records, in one
   // submission. A material edit cannot change textures or corners, so the surfaces are the header
   // and material records alone, unless the edit makes an untextured scene textured (everything).
   // Old and new emitters: the same list after a move (areas change, not which triangles emit),
-  // else their union (both ascend as the lighting scene lists them; sorted here when not).
+  // else their union (both ascend as the lighting scene lists them; sorted here when not). Only
+  // the edited materials' emitters and those joining or leaving the list hold new bytes; which
+  // materials changed is not known here, so every emitter's record is written.
   std::vector<uint32_t> changed;
   const std::vector<uint32_t>& now = edited.emitter_triangles;
   if (now == emitters_) {
