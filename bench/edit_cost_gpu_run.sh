@@ -6,7 +6,7 @@
 # with the block edit after WARM samples per texel in 16 ms frames, RELIGHTS times: `seconds.edits`
 # and `edits.milliseconds` as an engine's call sees them.
 # With a packed building, bench_edit_cost also moves its point light and back, and doubles its
-# intensity and back (before and after in turn when packed).
+# intensity and back, and doubles its warm panels' emissiveStrength and back (before and after in turn when packed).
 # Env: REPS (9), ROUNDS (2: before and after in turn, this many times), SAMPLES_BEFORE (16), WARM (16), RELIGHTS (5). Writes $OUT/summary.txt.
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
@@ -18,13 +18,15 @@ S=$OUT/summary.txt
 cost() { echo "== $1 ${2:-city} ${3:-block}" >> $S; $W/$1 $W/${2:-city}.bake --edits $W/${3:-block}.json --edits-back $W/${3:-block}_back.json \
   --repeat ${REPS:-9} --samples 1 --samples-before ${SAMPLES_BEFORE:-16} >> $S 2>&1; }
 for round in $(seq ${ROUNDS:-2}); do
-  [ -x $W/bench_edit_cost_before ] && cost bench_edit_cost_before
-  cost bench_edit_cost
+  for edit in block sky double_windows; do
+    [ -x $W/bench_edit_cost_before ] && cost bench_edit_cost_before city $edit
+    cost bench_edit_cost city $edit
+  done
 done
 # With a packed building (BUILDING= at packing): its point light moved and its intensity doubled.
 if [ -d $W/building.bake ]; then
   for round in $(seq ${ROUNDS:-2}); do
-    for edit in move_light double_light; do
+    for edit in move_light double_light double_panel; do
       [ -x $W/bench_edit_cost_before ] && cost bench_edit_cost_before building $edit
       cost bench_edit_cost building $edit
     done

@@ -8,11 +8,14 @@
 #include "exitance/common/texture_sampling.h"
 
 vec3 scene_triangle_vertex(uint t, uint k) {
-  return k == 0u ? triangles[t].p0_material.xyz : (k == 1u ? triangles[t].p1_area_pdf.xyz : triangles[t].p2_instance.xyz);
+  return k == 0u ? triangles[t].p0_material.xyz : (k == 1u ? triangles[t].p1_emitter.xyz : triangles[t].p2_instance.xyz);
 }
 vec3 scene_triangle_normal(uint t, uint k) { return k == 0u ? triangles[t].n0.xyz : (k == 1u ? triangles[t].n1.xyz : triangles[t].n2.xyz); }
 uint scene_triangle_material(uint t) { return floatBitsToUint(triangles[t].p0_material.w); }
-float scene_triangle_area_pdf(uint t) { return triangles[t].p1_area_pdf.w * params.emitter_inverse_power; }
+// The emitter flag times its material's power per area first (exact), then the total's inverse.
+float scene_triangle_area_pdf(uint t) {
+  return triangles[t].p1_emitter.w * materials[scene_triangle_material(t)].emitter_power.x * params.emitter_inverse_power;
+}
 GpuMaterial scene_material(uint m) { return materials[m]; }
 GpuPunctualLight scene_punctual_light(uint i) { return punctual[i]; }
 uint scene_emitter_count() { return params.emitter_count; }

@@ -1,6 +1,6 @@
 // Runtime edits of a LightingScene (set_material, set_punctual_light) must leave it exactly as
-// build_lighting_scene would build it from the edited Scene: records, CDFs, per-triangle area pdfs;
-// except the light layers, which stay as laid out when the scene was built (a layer's sums are its
+// build_lighting_scene would build it from the edited Scene: records (the materials' power per
+// area, the triangles' emitter flags), CDFs; except the light layers, which stay as laid out when the scene was built (a layer's sums are its
 // light's), where a rebuild lays them out for the edited emitters.
 #include <gtest/gtest.h>
 
@@ -30,6 +30,7 @@ void expect_same(const LightingScene& edited, LightingScene rebuilt) {
   EXPECT_TRUE(same_bytes(edited.punctual_lights, rebuilt.punctual_lights));
   EXPECT_EQ(edited.emitter_triangles, rebuilt.emitter_triangles);
   EXPECT_EQ(edited.emitter_cdf, rebuilt.emitter_cdf);
+  EXPECT_EQ(edited.emitter_areas, rebuilt.emitter_areas);
   EXPECT_EQ(edited.emitter_inverse_power, rebuilt.emitter_inverse_power);
   EXPECT_EQ(edited.punctual_cdf, rebuilt.punctual_cdf);
   EXPECT_EQ(edited.textured, rebuilt.textured);
@@ -74,6 +75,23 @@ TEST(LightingSceneEdit, SetMaterialMatchesARebuild) {
   for (size_t i = 0; i < 3; ++i) EXPECT_EQ(edited.materials[i].emission.w, float(edited.material_light_layers[i]));
   EXPECT_EQ(original_source->materials[1].emission.x, 2.0f) << "the shared source Scene must not change";
   EXPECT_THROW(set_material(edited, 3, Material{}), std::out_of_range);
+}
+
+// Emission edits that keep every emitter emitting (brighter, dimmer, another colour) keep the list:
+// the distribution is derived from the emitters alone (their kept areas), still equal to a rebuild.
+TEST(LightingSceneEdit, EmissionEditsKeepingTheEmittersMatchARebuild) {
+  const Scene scene = three_quads();
+  LightingScene edited = *make_lighting_scene(scene);
+  const std::vector<uint32_t> emitters = edited.emitter_triangles;
+  Scene expected = scene;
+  for (auto [index, emission] : {std::pair{1u, Vec3{6, 3, 1.5f}}, std::pair{2u, Vec3{0.1f, 0.2f, 0.05f}}, std::pair{1u, Vec3{0, 0, 1e-3f}}}) {
+    Material m = expected.materials[index];
+    m.emission = emission;
+    set_material(edited, index, m);
+    expected.materials[index] = m;
+    expect_same(edited, build_lighting_scene(std::make_shared<const Scene>(expected), edited.bvh));
+    EXPECT_EQ(edited.emitter_triangles, emitters);
+  }
 }
 
 // The area density NEE and the MIS weight at a hit read (a record's power per area x the total's

@@ -15,7 +15,7 @@ BvhHit closest_hit(const LightingScene& scene, const Vec3& origin, const Vec3& d
   const auto corners = [&](uint32_t t, Vec3& p0, Vec3& p1, Vec3& p2) {
     const GpuTriangle& tri = scene.triangles[t];
     p0 = xyz(tri.p0_material);
-    p1 = xyz(tri.p1_area_pdf);
+    p1 = xyz(tri.p1_emitter);
     p2 = xyz(tri.p2_instance);
   };
   // Per thread, kept between rays, not allocated per ray: the unocclude step after an edit traces

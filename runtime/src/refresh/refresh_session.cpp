@@ -363,6 +363,8 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   // allocated here, not in the first edit (which reuses it).
   state->integrator->publish(PublishMode::Accumulation, nullptr, nullptr);
   if (settings.light_layers) state->integrator->prepare_light_layer_scaling();  // not inside the first edit
+  // A city block's move stages ~3.6 MB of geometry and its texels' start points: room for both.
+  state->integrator->reserve_edit_staging(size_t(4) << 20);
   timings.publish = since();
   return std::unique_ptr<RefreshSession>(new RefreshSession(std::move(state)));
 }

@@ -1,9 +1,8 @@
 #include "gpu_scene.h"
 
 #include <algorithm>
-#include <iterator>
-#include <bit>
 #include <cstring>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 
@@ -15,7 +14,7 @@
 namespace exitance::vulkan {
 namespace {
 
-static_assert(sizeof(GpuTriangle) == 96 && sizeof(GpuMaterial) == 32 && sizeof(GpuPunctualLight) == 48);
+static_assert(sizeof(GpuTriangle) == 96 && sizeof(GpuMaterial) == 48 && sizeof(GpuPunctualLight) == 48);
 
 // Vulkan buffers cannot be empty.
 template <typename T>
@@ -166,7 +165,9 @@ void GpuScene::update_materials(const LightingScene& edited) {
   std::vector<Vec4> surfaces;
   std::vector<uint32_t> emitters;
   add_material_writes(edited, writes, surfaces, emitters);
-  context_.write_ranges(writes);
+  // Copied at the start of the next submission (before any kernel reads them): a material edit
+  // waits for no upload of its own.
+  context_.write_ranges_at_next_submission(writes);
   materials_uploaded(edited);
 }
 
@@ -176,21 +177,15 @@ void GpuScene::add_material_writes(const LightingScene& edited, std::vector<Cont
   // emitter CDF and list (their buffers grown first when larger) and the surface records, in one
   // submission. A material edit cannot change textures or corners, so the surfaces are the header
   // and material records alone, unless the edit makes an untextured scene textured (everything).
-  // Old and new emitters: the same list after a move (areas change, not which triangles emit),
-  // else their union (both ascend as the lighting scene lists them; sorted here when not). Only
-  // the edited materials' emitters and those joining or leaving the list hold new bytes; which
-  // materials changed is not known here, so every emitter's record is written.
+  // A triangle's record only flags it as an emitter (its power per area is its material's): with
+  // the same list, none changes; else those joining or leaving it (the symmetric difference of old
+  // and new, both ascending as the lighting scene lists them; sorted here when not).
   std::vector<uint32_t> changed;
-  const std::vector<uint32_t>& now = edited.emitter_triangles;
-  if (now == emitters_) {
-    changed = emitters_;
-  } else if (std::is_sorted(now.begin(), now.end()) && std::is_sorted(emitters_.begin(), emitters_.end())) {
-    std::set_union(emitters_.begin(), emitters_.end(), now.begin(), now.end(), std::back_inserter(changed));
-    changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
-  } else {
-    changed = emitters_;
-    changed.insert(changed.end(), now.begin(), now.end());
-    std::sort(changed.begin(), changed.end());
+  if (edited.emitter_triangles != emitters_) {
+    std::vector<uint32_t> before = emitters_, now = edited.emitter_triangles;
+    std::sort(before.begin(), before.end());
+    std::sort(now.begin(), now.end());
+    std::set_symmetric_difference(before.begin(), before.end(), now.begin(), now.end(), std::back_inserter(changed));
     changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
   }
   emitters = at_least_one(edited.emitter_triangles);
@@ -287,9 +282,9 @@ void GpuScene::update_moved_geometry(const LightingScene& edited, const Bvh4Link
   for (Context::RangeWrite& w : punctual_writes(edited)) writes.push_back(std::move(w));
   std::vector<Vec4> surfaces;
   std::vector<uint32_t> emitters;
-  // Moved emitters keep their list and their records' power per area (their records are among the
-  // moved ones above): their areas change the CDF and the total alone. A changed list (an emitter
-  // whose area fell to 0, or back) or edited materials: every emitter record and material.
+  // Moved emitters keep their list (their records are among the moved ones above): their areas
+  // change the CDF and the total alone. A changed list (an emitter whose area fell to 0, or back)
+  // or edited materials: what update_materials writes.
   const bool whole_materials = materials_changed || (emitters_changed && edited.emitter_triangles != emitters_);
   if (whole_materials)
     add_material_writes(edited, writes, surfaces, emitters);

@@ -25,10 +25,11 @@ class GpuScene {
   GpuScene(Context& context, const LightingScene& scene, bool quantized_nodes);
 
   // `edited`: the scene this one was uploaded from, after set_material (lighting_scene.h): uploads
-  // the materials, the emitter list and CDF, and the triangle records of old and new emitters
-  // (their area pdfs), and the per-material surface records (textures, alphaMode); when the edit
-  // makes the scene textured, its textures and corners too. Throws std::invalid_argument when the
-  // scene's shape differs.
+  // the materials (their power per area), the emitter list and CDF, the triangle records of
+  // emitters joining or leaving the list (their flag), and the per-material surface records
+  // (textures, alphaMode); when the edit makes the scene textured, its textures and corners too. At
+  // the start of the next submission (Context::write_ranges_at_next_submission). Throws
+  // std::invalid_argument when the scene's shape differs.
   void update_materials(const LightingScene& edited);
   // After set_punctual_light or a sky edit: uploads the punctual lights and their CDF, takes the
   // constant sky, and uploads the image sky (texels and CDFs, growing their buffers when the new

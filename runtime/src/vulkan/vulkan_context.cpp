@@ -437,6 +437,22 @@ void Context::write_ranges_at_next_submission(const std::vector<RangeWrite>& wri
   }
 }
 
+void Context::reserve_staging(VkDeviceSize bytes) {
+  bytes = std::min(bytes, kReusedStagingLimit);
+  if (!small_staging_busy_ && small_staging_.size() < bytes) {
+    small_staging_ = Buffer{};
+    small_staging_ = create_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+  }
+  if (!small_staging_busy_ && small_staging_.mapped()) std::memset(small_staging_.mapped(), 0, size_t(small_staging_.size()));
+  if (deferred_staging_.size() < bytes) {
+    Buffer larger = create_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+    if (deferred_bytes_ > 0) std::memcpy(larger.mapped(), deferred_staging_.mapped(), size_t(deferred_bytes_));
+    deferred_staging_ = std::move(larger);
+  }
+  // Past the bytes already staged for the next submission.
+  std::memset(static_cast<char*>(deferred_staging_.mapped()) + deferred_bytes_, 0, size_t(deferred_staging_.size() - deferred_bytes_));
+}
+
 void Context::submit_and_wait(VkCommandBuffer cmd, double timeout_seconds) {
   submit_and_wait(cmd, timeout_seconds, VK_NULL_HANDLE, 0);
 }

@@ -147,6 +147,10 @@ class Context {
   // write_ranges(writes) the same way: each write fills its bytes in the kept staging now, and the
   // copies are recorded at the start of the next submission.
   void write_ranges_at_next_submission(const std::vector<RangeWrite>& writes);
+  // Both kept staging buffers (the reused one and the next submission's) at least `bytes`, and
+  // their pages written once: a runtime session's first edit then neither allocates host-visible
+  // memory nor faults its pages in (the first edit's uploads were 0.6-0.8 ms slower than later ones).
+  void reserve_staging(VkDeviceSize bytes);
 
   VkCommandBuffer begin();  // the context's single command buffer, reset; records what is pending (above)
   // Submits the command buffer and waits for its fence (bounded by fence_timeout_seconds); throws

@@ -237,6 +237,8 @@ void VulkanIntegrator::prepare_light_layer_scaling() {
   if (!impl_->scaler) impl_->scaler.emplace(impl_->context);
 }
 
+void VulkanIntegrator::reserve_edit_staging(size_t bytes) { impl_->context.reserve_staging(bytes); }
+
 void VulkanIntegrator::scale_light_layers(const std::vector<Vec4>& factors, const DeviceLightmap* previous, bool previous_split) {
   const LightmapDriver::Shape shape = impl_->lightmap.shape();
   const ScaledEstimate accumulation{&impl_->buffers.texels, shape.texels, shape.layers, shape.light_layers, shape.directional};

@@ -9,8 +9,7 @@ EXITANCE_NAMESPACE_BEGIN
 // One scene triangle for shading: vertices, shading normals, and what light sampling needs.
 struct GpuTriangle {
   vec4 p0_material;  // xyz vertex 0; w material index (uint bits)
-  vec4 p1_area_pdf;  // xyz vertex 1; w its material's emitted power per area (0: not an emitter), which
-                     // x GpuParams::emitter_inverse_power is the area density NEE picks a point on it with
+  vec4 p1_emitter;   // xyz vertex 1; w 1 when NEE picks points on it (in the emitter list), else 0
   vec4 p2_instance;  // xyz vertex 2; w instance index (uint bits)
   vec4 n0;           // xyz shading normal at vertex 0
   vec4 n1;
@@ -21,6 +20,10 @@ struct GpuTriangle {
 struct GpuMaterial {
   vec4 albedo_double_sided;  // xyz diffuse albedo (material.h); w 1 when double sided
   vec4 emission;             // xyz emitted radiance; w its light layer (light_layers.h), a whole number
+  // x its emitted power per area (luminance of the mean emission, x2 when double sided), which x
+  // GpuParams::emitter_inverse_power is the area density NEE picks a point on its emitters with
+  // (so an emission edit rewrites this record and the CDF, not its emitters' triangles); yzw 0.
+  vec4 emitter_power;
 };
 
 // What a material needs where it varies per point (scenes with GpuParams::surface_flags &
@@ -92,7 +95,7 @@ struct GpuParams {
   vec4 bench_hi;
   float scene_extent;   // largest side of the scene bounds (ray offset floor)
   uint emitter_count;
-  float emitter_inverse_power;  // 1 / the emitters' total power (GpuTriangle::p1_area_pdf); 0: none
+  float emitter_inverse_power;  // 1 / the emitters' total power (GpuMaterial::emitter_power); 0: none
   uint punctual_count;
   uint recorded;        // K: recorded bounce layers; result slot K gathers the deeper ones
   int max_bounces;

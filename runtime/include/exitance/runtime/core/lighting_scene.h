@@ -23,9 +23,10 @@ struct LightingScene {
   std::vector<uint32_t> emitter_triangles;   // emissive triangles NEE picks from, by power
   std::vector<double> emitter_cdf;           // emitter_triangles.size() + 1 entries (at least 2)
   std::vector<float> emitter_areas;          // per emitter_triangles: an edit recomputes the moved ones only
-  // 1 / the emitters' total power (0: no emitter). An emitter's record holds its material's power
-  // per area (p1_area_pdf.w): their product is the area density with which NEE picks a point on it,
-  // so a move that changes the total rewrites this value and the CDF, no triangle record.
+  // 1 / the emitters' total power (0: no emitter). An emitter's material record holds its power per
+  // area (GpuMaterial::emitter_power.x; the triangle's record flags it, p1_emitter.w): their product
+  // is the area density with which NEE picks a point on it, so a move that changes the total, or an
+  // emission edit, rewrites this value, the CDF (and the edited material records), no triangle record.
   float emitter_inverse_power = 0.0f;
   std::vector<double> punctual_cdf;          // punctual_lights.size() + 1 entries (at least 2), by power
   Vec3 sky{0, 0, 0};                         // constant sky radiance (when there is no environment map)

@@ -11,7 +11,7 @@ namespace exitance {
 
 inline vec3 scene_triangle_vertex(const LightingScene& scene, uint t, uint k) {
   const GpuTriangle& g = scene.triangles[t];
-  const Vec4& v = k == 0 ? g.p0_material : (k == 1 ? g.p1_area_pdf : g.p2_instance);
+  const Vec4& v = k == 0 ? g.p0_material : (k == 1 ? g.p1_emitter : g.p2_instance);
   return {v.x, v.y, v.z};
 }
 inline vec3 scene_triangle_normal(const LightingScene& scene, uint t, uint k) {
@@ -21,7 +21,8 @@ inline vec3 scene_triangle_normal(const LightingScene& scene, uint t, uint k) {
 }
 inline uint scene_triangle_material(const LightingScene& scene, uint t) { return floatBitsToUint(scene.triangles[t].p0_material.w); }
 inline float scene_triangle_area_pdf(const LightingScene& scene, uint t) {
-  return scene.triangles[t].p1_area_pdf.w * scene.emitter_inverse_power;
+  // The emitter flag times its material's power per area first (exact), then the total's inverse.
+  return scene.triangles[t].p1_emitter.w * scene.materials[scene_triangle_material(scene, t)].emitter_power.x * scene.emitter_inverse_power;
 }
 inline GpuMaterial scene_material(const LightingScene& scene, uint m) { return scene.materials[m]; }
 inline GpuPunctualLight scene_punctual_light(const LightingScene& scene, uint i) { return scene.punctual_lights[i]; }

@@ -210,6 +210,9 @@ class VulkanIntegrator final : public Integrator {
   int light_layers() const;
   // The scaling kernel made (on lavapipe compiled) now rather than inside the first scaling edit.
   void prepare_light_layer_scaling();
+  // Host-visible staging for edits' uploads (`bytes` each for the reused and the next submission's
+  // staging, up to 16 MiB) allocated and its pages touched now rather than inside the first edit.
+  void reserve_edit_staging(size_t bytes);
   void scale_light_layers(const std::vector<Vec4>& factors, const DeviceLightmap* previous, bool previous_split);
   // `published` (an estimate of `gbuffer`'s texels) with its indirect light filtered in texture space
   // on the device (bundle/indirect_denoise.h's filter: the same weights and arithmetic, equal up to
@@ -259,7 +262,7 @@ class VulkanIntegrator final : public Integrator {
 
   // Runtime edits without a rebuild. `edited` is the scene this integrator was created on (or a
   // copy) after set_material / set_punctual_light (lighting_scene.h): update_materials uploads the
-  // materials, the emitter distribution and the area pdfs again; update_lights the punctual lights,
+  // materials (their power per area), the emitter distribution and flags again; update_lights the punctual lights,
   // their CDF and the constant sky. Geometry and BVH stay (update_geometry moves them). Throws
   // std::invalid_argument when the counts of triangles, materials or lights differ,
   // std::runtime_error as create() for what the backend does not support.
