@@ -7,7 +7,6 @@
 #include <utility>
 #include <vector>
 
-#include "exitance/common/ray_offset.h"
 #include "exitance/runtime/core/bvh4_closest_hit.h"
 #include "exitance/runtime/core/parallel_chunks.h"
 #include "exitance/runtime/node_transform.h"
@@ -16,60 +15,6 @@
 #include "exitance/runtime/world_box.h"
 
 namespace exitance {
-namespace {
-
-// Whether unocclude_texel's rays can meet no triangle of `lighting`, so that it would leave the
-// texel where it is: the bake's test (bake/raster/unocclude.cpp, there by Embree's point query) on
-// the lighting scene's BVH4. The rays start at the texel's offset origin and climb away from the
-// plane through it, within unocclude_reach; a triangle none of whose corners comes up to that
-// plane, or whose bounds lie beyond that reach, cannot be met. The same margins as the bake's
-// (radius grown by twice the origin's offset; "below" half that offset under the plane, heights in
-// double), and bounds instead of the triangle's closest point: only ever more triangles count.
-bool sideways_rays_meet_nothing(const LightingScene& lighting, const LiveTexel& texel, std::vector<uint32_t>& stack) {
-  const Bvh4& bvh = lighting.bvh;
-  if (bvh.nodes.empty() || !lighting.source) return false;
-  const Scene& scene = *lighting.source;  // the records' positions (refresh_moved_triangles_from_source)
-  const Vec3 n = texel.geometric_normal;
-  const Vec3 origin = offset_ray_origin(texel.position, n, lighting.extent);
-  const float offset = length(origin - texel.position);
-  const float radius = unocclude_reach(texel) * 1.001f + 2.0f * offset;
-  const double below = -0.5 * double(offset);
-  const Vec3 lo = origin - Vec3{radius, radius, radius}, hi = origin + Vec3{radius, radius, radius};
-  auto reaches_up = [&](uint32_t t) {
-    const Vec3* corners = &scene.positions[size_t(t) * 3];
-    for (int c = 0; c < 3; ++c) {
-      const double height = (double(corners[c].x) - origin.x) * n.x + (double(corners[c].y) - origin.y) * n.y +
-                            (double(corners[c].z) - origin.z) * n.z;
-      if (!(height < below)) return true;
-    }
-    return false;
-  };
-  stack.assign(1, 0);
-  while (!stack.empty()) {
-    const Bvh4Node& node = bvh.nodes[stack.back()];
-    stack.pop_back();
-    for (int c = 0; c < 4; ++c) {
-      const uint32_t child = node.child[c];
-      if (child == kBvhEmptyChild) continue;
-      if (node.lo_x[c] > hi.x || node.hi_x[c] < lo.x || node.lo_y[c] > hi.y || node.hi_y[c] < lo.y || node.lo_z[c] > hi.z ||
-          node.hi_z[c] < lo.z)
-        continue;
-      if (!(child & kBvhLeafBit)) {
-        stack.push_back(child);
-        continue;
-      }
-      const uint32_t first = (child & ~kBvhLeafBit) >> 2, count = (child & 3u) + 1;
-      for (uint32_t slot = first; slot < first + count; ++slot) {
-        const uint32_t t = bvh.leaf_triangles[slot];
-        if (t >= scene.triangle_count()) return false;  // not the scene it should be: let the rays decide
-        if (triangles_world_box(scene, t, 1).contains(origin, radius) && reaches_up(t)) return false;
-      }
-    }
-  }
-  return true;
-}
-
-}  // namespace
 
 std::vector<uint32_t> unocclude_near_boxes(PersistedScene& edited, const std::vector<WorldBox>& boxes,
                                            const LightingScene& edited_lighting, const TexelGrid* grid,
@@ -108,12 +53,7 @@ std::vector<uint32_t> unocclude_near_boxes(PersistedScene& edited, const std::ve
     for (size_t k = 0; k < texels.size(); ++k)
       if (within[k]) reconsidered.push_back(texels[k]);
     for_each_chunk(reconsidered.size(), [&](size_t begin, size_t end) {
-      thread_local std::vector<uint32_t> stack;
-      for (size_t k = begin; k < end; ++k) {
-        LiveTexel& texel = edited.gbuffer.texels[reconsidered[k]];
-        if (unocclude_reach(texel) > 0 && sideways_rays_meet_nothing(edited_lighting, texel, stack)) continue;
-        unocclude_texel(texel, edited_lighting.extent, query);
-      }
+      for (size_t k = begin; k < end; ++k) unocclude_texel(edited.gbuffer.texels[reconsidered[k]], edited_lighting.extent, query);
     }, 16);
   };
   if (grid && grid->texel_count() == edited.gbuffer.texels.size()) {
