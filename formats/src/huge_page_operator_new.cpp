@@ -12,7 +12,16 @@
 
 #include "exitance/formats/huge_pages.h"
 
-#if !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+// GCC says it by __SANITIZE_ADDRESS__, clang (14) only by __has_feature.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define EXITANCE_SANITIZER_ALLOCATOR 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
+#define EXITANCE_SANITIZER_ALLOCATOR 1
+#endif
+#endif
+
+#if !defined(EXITANCE_SANITIZER_ALLOCATOR)
 
 namespace {
 
