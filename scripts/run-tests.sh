@@ -44,7 +44,7 @@ cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEXITANCE_S
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="$sanitize_flags" -DCMAKE_C_FLAGS_RELWITHDEBINFO="$sanitize_flags"
 # Only what the sanitizer run executes: the bake command and the unit/stress test programs.
 cmake --build build-asan -j"$jobs" --target bake stress_tests geometry_warning_tests layout_tests gltf_import_tests \
-  pipeline_tests formats_tests exitance_loader_sample make_loader_test_bundle spherical_harmonics_tests \
+  pipeline_tests formats_tests huge_page_operator_new_tests exitance_loader_sample make_loader_test_bundle spherical_harmonics_tests \
   svo_exitance_tests svo_build_tests probe_placement_tests bundle_end_to_end_tests common_math_tests path_sampler_tests environment_map_tests \
   lighting_scene_edit_tests scene_edits_tests radiance_vdb_tests scene_file_tests exitance-relight \
   exitance_runtime exitance_loader bundle_cache_tests lightmap_uv_generation_tests adaptive_sampling_plan_tests guiding_auto_strategy_tests \

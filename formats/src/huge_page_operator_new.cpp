@@ -1,6 +1,6 @@
 // The global operator new of the programs that link this object (the `bake` and
 // `exitance-relight` tools; never the libraries an engine links): every allocation of at least
-// kAdvisedFrom bytes is advised into transparent huge pages before its first touch (huge_pages.h:
+// kHugePageAdvisedFrom bytes is advised into transparent huge pages before its first touch (huge_pages.h:
 // only the whole 2 MiB pages inside the block; no rounding, so no memory is added). The tools'
 // stages allocate gigabytes of fresh per-texel arrays whose first touch was one kernel fault per
 // 4 KiB page: on the open city's CPU bake (9.6 M texels) 1.3 M faults, 15 % of its CPU time in the
@@ -10,26 +10,16 @@
 #include <cstdlib>
 #include <new>
 
+#include "exitance/formats/huge_page_operator_new.h"
 #include "exitance/formats/huge_pages.h"
-
-// GCC says it by __SANITIZE_ADDRESS__, clang (14) only by __has_feature.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define EXITANCE_SANITIZER_ALLOCATOR 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
-#define EXITANCE_SANITIZER_ALLOCATOR 1
-#endif
-#endif
 
 #if !defined(EXITANCE_SANITIZER_ALLOCATOR)
 
 namespace {
 
-constexpr std::size_t kAdvisedFrom = std::size_t(4) << 20;
-
 void* allocate(std::size_t bytes) noexcept {
   void* block = std::malloc(bytes ? bytes : 1);
-  if (block && bytes >= kAdvisedFrom) exitance::formats::advise_huge_pages(block, bytes);
+  if (block && bytes >= exitance::formats::kHugePageAdvisedFrom) exitance::formats::advise_huge_pages(block, bytes);
   return block;
 }
 
