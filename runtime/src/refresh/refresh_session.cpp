@@ -248,6 +248,11 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
     return seconds;
   };
   OpenTimings& timings = state->open_timings;
+  // The Vulkan device (instance, device chosen and made) on a thread of its own while the bundle is
+  // read: it needs nothing of the scene. A bad bundle still fails as such (the device's own failure,
+  // if any, is only seen when it is taken below); the future's destructor waits for it.
+  std::future<std::shared_ptr<PreparedVulkanDevice>> device =
+      std::async(std::launch::async, [&device_options = options.device] { return VulkanIntegrator::prepare_device(device_options); });
   const fs::path bundle(bundle_folder);
   state->bundle = bundle_folder;
   state->manifest = read_manifest(bundle);
@@ -278,7 +283,7 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   settings.light_layers = options.light_layers;
   // A bundle baked with directional layers is refreshed with them (the same estimator, path.h).
   if (baked.directional == "sh1") settings.directional = DirectionalMode::Sh1;
-  check_denoise_radius(options.denoise_radius, settings, "RefreshSessionOptions::denoise_radius");  // before the device is made
+  check_denoise_radius(options.denoise_radius, settings, "RefreshSessionOptions::denoise_radius");  // before the integrator is made
 
   try {
     state->lighting = std::make_shared<LightingScene>(build_lighting_scene(scene_of(*state), to_bvh4(state->persisted.bvh)));
@@ -295,7 +300,7 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
     s.all_texels.resize(s.persisted.gbuffer.texels.size());
     for (size_t i = 0; i < s.all_texels.size(); ++i) s.all_texels[i] = uint32_t(i);
   });
-  state->integrator = VulkanIntegrator::create(state->lighting, options.device);
+  state->integrator = VulkanIntegrator::create(state->lighting, options.device, device.get());
   timings.device = since();
   state->priority_samples = options.priority_samples;
   state->proportional_split_samples = options.proportional_split_samples;

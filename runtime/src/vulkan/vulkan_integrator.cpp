@@ -44,9 +44,14 @@ vulkan::GuidingScene guiding_scene(const LightingScene& scene, std::shared_ptr<c
 
 }  // namespace
 
+struct PreparedVulkanDevice {
+  std::unique_ptr<Context> context;
+};
+
 // Members in construction order: each uses those above it, and goes before them.
 struct VulkanIntegrator::Impl {
-  Context context;
+  std::unique_ptr<Context> owned_context;  // made here, or by prepare_device
+  Context& context;
   WavefrontSizes sizes;
   GpuScene scene;
   WavefrontKernels kernels;
@@ -77,10 +82,12 @@ struct VulkanIntegrator::Impl {
   std::shared_ptr<const Scene> source;
   std::shared_ptr<const LightingScene> created_on;  // SVO guiding's capture rays
 
-  Impl(std::shared_ptr<const LightingScene> lighting_ptr, const VulkanDeviceOptions& options)
-      : Impl(*lighting_ptr, options, lighting_ptr) {}
-  Impl(const LightingScene& lighting, const VulkanDeviceOptions& options, std::shared_ptr<const LightingScene> lighting_ptr)
-      : context(options),
+  Impl(std::shared_ptr<const LightingScene> lighting_ptr, const VulkanDeviceOptions& options, std::unique_ptr<Context> made)
+      : Impl(*lighting_ptr, options, lighting_ptr, std::move(made)) {}
+  Impl(const LightingScene& lighting, const VulkanDeviceOptions& options, std::shared_ptr<const LightingScene> lighting_ptr,
+       std::unique_ptr<Context> made)
+      : owned_context(made ? std::move(made) : std::make_unique<Context>(options)),
+        context(*owned_context),
         sizes(choose_wavefront_sizes(context, options)),
         scene(context, lighting, sizes.quantized_nodes),
         kernels(context, kernel_stack_bound(sizes, scene.traversal_stack_bound()), sizes.quantized_nodes),
@@ -99,9 +106,26 @@ struct VulkanIntegrator::Impl {
 
 std::unique_ptr<VulkanIntegrator> VulkanIntegrator::create(std::shared_ptr<const LightingScene> scene,
                                                            const VulkanDeviceOptions& options) {
+  return create(std::move(scene), options, nullptr);
+}
+
+std::unique_ptr<VulkanIntegrator> VulkanIntegrator::create(std::shared_ptr<const LightingScene> scene,
+                                                           const VulkanDeviceOptions& options,
+                                                           std::shared_ptr<PreparedVulkanDevice> device) {
   if (!scene) throw std::invalid_argument("Vulkan backend: no scene");
   check_supported_by_vulkan(*scene);
-  return std::unique_ptr<VulkanIntegrator>(new VulkanIntegrator(std::make_unique<Impl>(scene, options)));
+  std::unique_ptr<Context> made;
+  if (device) {
+    if (!device->context) throw std::invalid_argument("Vulkan backend: a prepared device can make one integrator");
+    made = std::move(device->context);
+  }
+  return std::unique_ptr<VulkanIntegrator>(new VulkanIntegrator(std::make_unique<Impl>(scene, options, std::move(made))));
+}
+
+std::shared_ptr<PreparedVulkanDevice> VulkanIntegrator::prepare_device(const VulkanDeviceOptions& options) {
+  auto prepared = std::make_shared<PreparedVulkanDevice>();
+  prepared->context = std::make_unique<Context>(options);
+  return prepared;
 }
 
 VulkanIntegrator::VulkanIntegrator(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}

@@ -128,7 +128,8 @@ struct EditTimings {
 struct OpenTimings {
   double read = 0;            // manifest, scene.bin (read and restored), svo.bin
   double lighting_scene = 0;  // the lighting scene (records, light CDFs) over scene.bin's BVH
-  double device = 0;          // the Vulkan backend: device, kernels compiled (or found in the driver's cache), scene uploaded
+  double device = 0;          // the Vulkan backend: what was left to wait for of the device (made beside `read`), kernels
+                              // compiled (or found in the driver's cache), scene uploaded
   double indices = 0;         // the texel grid, each instance's texels, the BVH links, the texel list: built on a
                               // thread of their own while the device is made; what was left to wait for
   double texels = 0;          // the texels' start points uploaded, the accumulation cleared

@@ -111,6 +111,11 @@ struct DeviceDenoiseCounts {
   uint64_t neighbours = 0;
 };
 
+// A Vulkan device made before its scene is known (instance, physical device chosen, logical device,
+// or an adopted one wrapped): VulkanIntegrator::prepare_device makes it, so that a caller can make it
+// on a thread of its own while it reads the scene (RefreshSession::open), and create() takes it.
+struct PreparedVulkanDevice;
+
 class VulkanIntegrator final : public Integrator {
  public:
   // Uploads the scene (its BVH4 as built by the offline stage or read from scene.bin). Throws
@@ -119,6 +124,11 @@ class VulkanIntegrator final : public Integrator {
   // a silently wrong result. The integrator keeps no reference to `scene`.
   static std::unique_ptr<VulkanIntegrator> create(std::shared_ptr<const LightingScene> scene,
                                                   const VulkanDeviceOptions& options = {});
+  // The same on a device prepare_device made with the same options (none: made here).
+  static std::unique_ptr<VulkanIntegrator> create(std::shared_ptr<const LightingScene> scene, const VulkanDeviceOptions& options,
+                                                  std::shared_ptr<PreparedVulkanDevice> device);
+  // Throws std::runtime_error when no usable Vulkan device exists (as create()). Any thread.
+  static std::shared_ptr<PreparedVulkanDevice> prepare_device(const VulkanDeviceOptions& options = {});
   ~VulkanIntegrator() override;
   VulkanIntegrator(const VulkanIntegrator&) = delete;
   VulkanIntegrator& operator=(const VulkanIntegrator&) = delete;
