@@ -98,7 +98,7 @@ int main(int argc, char** argv) {
     const Seconds sealed_seconds = median_seconds(repeat, [&] { sealed = sealed_texels_stage(scene, gbuffer, checks, options); });
     PersistedSceneFile file;
     const Seconds scene_file =
-        median_seconds(repeat, [&] { file = scene_file_stage(scene, gbuffer, layout, nullptr, options, diagnostics); });
+        median_seconds(repeat, [&] { file = scene_file_stage(scene, gbuffer, layout, nullptr); });
     Digest bytes;
     bytes.add(file.bytes.data(), file.bytes.size());
 

@@ -315,12 +315,13 @@ formats::BundleManifest build_bundle_manifest(const BakeResults& results,
   if (results.probes) manifest.probes = probes_of(*results.probes);
   if (results.voxels) manifest.svo = svo_of(results.voxels->svo);
   formats::SceneFileInfo scene;
-  if (!results.scene_file.bytes.empty()) {
+  const PersistedSceneFile& scene_file = results.scene_file.get();
+  if (!scene_file.bytes.empty()) {
     scene.file = "scene.bin";
     scene.format_version = formats::kSceneFormatVersion;
-    scene.bytes = results.scene_file.bytes.size();
+    scene.bytes = scene_file.bytes.size();
   } else {
-    scene.skipped = results.scene_file.skipped;
+    scene.skipped = scene_file.skipped;
   }
   manifest.scene = scene;
   manifest.stats_json = stats_json(results, seconds, warnings, options).dump();

@@ -36,7 +36,7 @@ std::string write_preview_into_manifest(const fs::path& dir, const std::vector<f
                                         const BakeOptions& options) {
   options.announce_stage("preview");
   const auto start = std::chrono::steady_clock::now();
-  manifest.preview = write_bundle_preview(dir, pages, options.preview_size, results.scene_file.skipped);
+  manifest.preview = write_bundle_preview(dir, pages, options.preview_size, results.scene_file.get().skipped);
   nlohmann::json stats = nlohmann::json::parse(manifest.stats_json);
   stats["seconds"]["preview"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   manifest.stats_json = stats.dump();
@@ -48,8 +48,8 @@ std::string write_preview_into_manifest(const fs::path& dir, const std::vector<f
 
 }  // namespace
 
-WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::json& seconds,
-                                 const Diagnostics& diagnostics, const BakeOptions& options) {
+WrittenBundle write_bundle_stage(const BakeResults& results, const std::function<nlohmann::json()>& seconds,
+                                 Diagnostics& diagnostics, const BakeOptions& options) {
   options.announce_stage("write");
   AssemblyOptions assembly;
   assembly.bounce_layers = options.bounce_layers;
@@ -89,17 +89,20 @@ WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::jso
     // The files other than the pages (scene.bin, probes, svo.bin, radiance.vdb: serial encoders and
     // plain writes, 1-4 s at 10 M texels) on a thread of their own while the pages are compressed:
     // a page's compression has OpenEXR's workers but its line copies and file writes do not.
+    // scene.bin's bytes and the octree's exitance may still be in the making (BakeResults says why).
     // Each file has one writer; if the pages throw, the future's destructor waits for the others
     // before the staging folder is removed.
     std::future<void> others = std::async(std::launch::async, [&] {
       if (results.probes) formats::write_probes_file((dir / "probes.bin").string(), results.probes->grid);
-      if (!results.scene_file.bytes.empty()) {
+      const PersistedSceneFile& scene_file = results.scene_file.get();
+      if (!scene_file.bytes.empty()) {
         std::ofstream scene_out(dir / "scene.bin", std::ios::binary);
-        scene_out.write(reinterpret_cast<const char*>(results.scene_file.bytes.data()),
-                        std::streamsize(results.scene_file.bytes.size()));
+        scene_out.write(reinterpret_cast<const char*>(scene_file.bytes.data()),
+                        std::streamsize(scene_file.bytes.size()));
         if (!scene_out) throw std::runtime_error("cannot write " + (dir / "scene.bin").string());
       }
       if (results.voxels) {
+        if (results.exitance.valid()) results.exitance.get();
         formats::write_svo_file((dir / "svo.bin").string(), results.voxels->svo);
         write_radiance_vdb((dir / "radiance.vdb").string(), results.voxels->svo);
       }
@@ -108,8 +111,17 @@ WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::jso
       formats::write_lightmap_exr((dir / ("lightmap-" + std::to_string(p) + ".exr")).string(), page_image(p));
       if (options.progress) options.progress("write", double(p + 1) / double(pages.size() + 1), 0);  // the rest: the last file
     }
+    // What ran beside the pages is done (or has thrown) before the manifest records it.
+    const PersistedSceneFile& scene_file = results.scene_file.get();
+    if (results.exitance.valid()) results.exitance.get();
+    if (!scene_file.skipped.empty())
+      diagnostics.warn(options.input + ": scene.bin not written (exitance-relight cannot re-light this bundle): " +
+                       scene_file.skipped);
+    if (options.preview && scene_file.bytes.empty())
+      diagnostics.warn("--preview: no views, only the lightmap pages: the bundle has no scene.bin (" +
+                       scene_file.skipped + ")");
     formats::BundleManifest manifest = build_bundle_manifest(
-        results, pages, results.input_sha256, seconds, diagnostics.warnings.size(), options);
+        results, pages, results.input_sha256, seconds(), diagnostics.warnings.size(), options);
     if (!layer_pages.empty()) {
       formats::LightLayersInfo& info = manifest.light_layers.emplace();
       info.count = uint32_t(results.lightmap.light_layers);

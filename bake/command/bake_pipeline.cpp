@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <future>
 #include <iterator>
 #include <filesystem>
 #include <optional>
@@ -192,10 +193,6 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
     probes = clock.time("probe_placement",
                         [&] { return stages.place_probes(scene, voxels ? &*voxels : nullptr, diagnostics); });
 
-  const PersistedSceneFile scene_file = clock.time("scene_file", [&] {
-    return scene_file_stage(scene, gbuffer, layout, probes ? &*probes : nullptr, options, diagnostics);
-  });
-
   // Lighting stage (runtime/): probes, texels, their exitance into the octree. A --time budget covers
   // probes and texels: the probes go first with at most kProbeShareOfTimeBudget of it (and at most
   // --probe-spp), the texels get what the probes left.
@@ -228,7 +225,42 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   std::optional<json> distribution;
   if (options.lighting.work_share) distribution = distribution_json(gather_rank_work(*options.lighting.work_share));
   if (!writer) return json{{"rank", share->rank()}};
-  if (voxels) clock.time("exitance", [&] { exitance_stage(*voxels, scene, gbuffer, lightmap, options); });
+  // scene.bin's bytes and the octree's exitance read only finished products and are serial work
+  // (1.0-1.2 cores busy), as the pages' compression leaves a core part idle (1.6 of 2): each runs on a
+  // thread of its own from here, beside the other and the write, which waits for them where it needs
+  // them. Their seconds are their threads' own and overlap the `write` lap (docs/bundle.md). Neither
+  // reports progress (the write does).
+  BakeOptions quiet = options;
+  quiet.progress = nullptr;
+  double scene_file_seconds = 0, exitance_seconds = 0;
+  auto timed = [](double& seconds, auto&& work) {
+    const auto start = std::chrono::steady_clock::now();
+    auto done = [&] { seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+    if constexpr (std::is_void_v<decltype(work())>) {
+      work();
+      done();
+    } else {
+      auto result = work();
+      done();
+      return result;
+    }
+  };
+  std::shared_future<PersistedSceneFile> scene_file =
+      std::async(std::launch::async, [&] {
+        return timed(scene_file_seconds, [&] { return scene_file_stage(scene, gbuffer, layout, probes ? &*probes : nullptr); });
+      }).share();
+  std::shared_future<void> exitance;
+  if (voxels)
+    exitance = std::async(std::launch::async, [&] {
+                 timed(exitance_seconds, [&] { exitance_stage(*voxels, scene, gbuffer, lightmap, quiet); });
+               }).share();
+  // stats.seconds with the two threads' times, once they are done.
+  auto seconds_with_beside = [&] {
+    json seconds = clock.seconds();
+    seconds["scene_file"] = scene_file_seconds;
+    if (voxels) seconds["exitance"] = exitance_seconds;
+    return seconds;
+  };
 
   // Bundle: everything the stages produced, written at once.
   const BakeResults results{.scene = *scene.scene,
@@ -242,6 +274,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                             .lightmap = lightmap,
                             .probe_lighting = probe_lighting ? &*probe_lighting : nullptr,
                             .scene_file = scene_file,
+                            .exitance = exitance,
                             .input_sha256 = input_sha256,
                             .generated_uvs = &generated_uvs,
                             .sealed = &sealed,
@@ -249,11 +282,8 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
                             .stage_cache = cache ? &stages.outcomes() : nullptr,
                             .distribution = distribution ? &*distribution : nullptr,
                             .denoise = denoised ? &*denoised : nullptr};
-  if (options.preview && scene_file.bytes.empty())
-    diagnostics.warn("--preview: no views, only the lightmap pages: the bundle has no scene.bin (" +
-                     scene_file.skipped + ")");
   WrittenBundle bundle =
-      clock.time("write", [&] { return write_bundle_stage(results, clock.seconds(), diagnostics, decided); });
+      clock.time("write", [&] { return write_bundle_stage(results, seconds_with_beside, diagnostics, decided); });
   if (cache) {
     clock.time("cache_store", [&] { cache->store(cache_key, bundle.folder, diagnostics.warnings, diagnostics); });
     bundle.stats["cache"]["reused"] = false;  // its "stages" are in the manifest already
@@ -261,7 +291,7 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   }
   // After the bundle, so a failed bake writes neither.
   if (!options.write_gltf.empty()) write_gltf_stage(generated_uvs, options, diagnostics);
-  json seconds = clock.seconds();
+  json seconds = seconds_with_beside();
   // --preview runs inside the write stage; the report shows its own time too, from the manifest.
   if (options.preview) seconds["preview"] = bundle.stats["seconds"]["preview"];
   return run_report(bundle, seconds);

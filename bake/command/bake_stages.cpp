@@ -255,21 +255,16 @@ ProbeEstimate probe_lighting_stage(const Integrator& backend, ProbePlacement& pr
 }
 
 PersistedSceneFile scene_file_stage(const SceneForLighting& scene, const TexelGBuffer& gbuffer, const AtlasLayout& layout,
-                                    const ProbePlacement* probes, const BakeOptions& options, Diagnostics& diagnostics) {
-  if (options.progress) options.progress("scene.bin", 0, 0);
+                                    const ProbePlacement* probes) {
   PersistedSceneFile file;
   try {
     // Two steps of about equal time at 10 M texels (bench_offline_stages): gather the records
     // (the texels' surfaces re-derived), then lay out the bytes and their checksum.
     const formats::SceneFile records = make_scene_file(*scene.scene, gbuffer, layout, probes ? &probes->grid : nullptr,
                                                        to_scene_bvh(scene.lighting->bvh));
-    if (options.progress) options.progress("scene.bin", 0.5, 0);
     file.bytes = formats::encode_scene(records);
-    if (options.progress) options.progress("scene.bin", 1, 0);
   } catch (const formats::FormatError& e) {
     file.skipped = e.what();
-    diagnostics.warn(options.input + ": scene.bin not written (exitance-relight cannot re-light this bundle): " +
-                     file.skipped);
   }
   return file;
 }

@@ -3,6 +3,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <future>
 #include <string>
 #include <vector>
 
@@ -45,7 +46,11 @@ struct BakeResults {
   const ProbePlacement* probes;         // probe placement; coefficients filled by probe lighting
   const LightmapEstimate& lightmap;     // lighting
   const ProbeEstimate* probe_lighting;  // probe lighting (set exactly when `probes` is)
-  const PersistedSceneFile& scene_file;  // scene file
+  // scene file, and the octree's exitance (valid when `voxels` is set): both read only finished
+  // products, so bake_pipeline.cpp runs them on threads of their own beside the write; the write
+  // waits for each where it needs it (scene.bin, svo.bin and radiance.vdb, the manifest).
+  std::shared_future<PersistedSceneFile> scene_file;
+  std::shared_future<void> exitance;
   const std::string& input_sha256;       // the input file's SHA-256, hashed once per run (manifest, cache key)
   const std::vector<MeshUvReport>* generated_uvs = nullptr;  // uv generation: the meshes whose UVs it made
   const SealedTexels* sealed = nullptr;  // sealed texels (found before lighting); null: not looked for

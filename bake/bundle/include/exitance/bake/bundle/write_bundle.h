@@ -4,6 +4,7 @@
 #pragma once
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 
 #include <nlohmann/json.hpp>
 
@@ -23,9 +24,11 @@ struct WrittenBundle {
 std::filesystem::path bundle_folder(const BakeOptions& options);
 
 // Writes manifest.json, lightmap-<page>.exr, and with their stages probes.bin, svo.bin and
-// radiance.vdb. `seconds` (stats.seconds so far) and the warning count go into the manifest.
-// Throws std::runtime_error (nothing written) when a file cannot be written.
-WrittenBundle write_bundle_stage(const BakeResults& results, const nlohmann::json& seconds,
-                                 const Diagnostics& diagnostics, const BakeOptions& options);
+// radiance.vdb. `seconds` (stats.seconds so far, asked once the work beside the write is done) and
+// the warning count go into the manifest; a scene.bin the scene cannot have is warned of here.
+// Throws std::runtime_error (nothing written) when a file cannot be written, and rethrows what the
+// results' pending work (BakeResults::scene_file, exitance) threw.
+WrittenBundle write_bundle_stage(const BakeResults& results, const std::function<nlohmann::json()>& seconds,
+                                 Diagnostics& diagnostics, const BakeOptions& options);
 
 }  // namespace exitance

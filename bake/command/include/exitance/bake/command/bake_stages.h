@@ -91,9 +91,10 @@ ProbePlacement place_probes_stage(const SceneForLighting& scene, const Voxelized
 
 // scene file: scene.bin's bytes (the scene, the texel G-buffer the lighting stage will light, the
 // atlas, the probe layout, the BVH4, textures, vertex colours and the sky), so exitance-relight
-// reproduces this bake; a scene scene.bin cannot hold gets none, with a warning saying why.
+// reproduces this bake; a scene scene.bin cannot hold gets none and the encoder's reason (the write
+// warns of it). Reports no progress: the bake runs it on a thread beside other stages.
 PersistedSceneFile scene_file_stage(const SceneForLighting& scene, const TexelGBuffer& gbuffer, const AtlasLayout& layout,
-                                    const ProbePlacement* probes, const BakeOptions& options, Diagnostics& diagnostics);
+                                    const ProbePlacement* probes);
 
 // Whether the lighting stage samples adaptively on `backend_name` (BakeOptions::adaptive_request).
 bool adaptive_sampling_applies(const BakeOptions& options, const std::string& backend_name);
