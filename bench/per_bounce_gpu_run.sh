@@ -10,7 +10,9 @@
 # building them on the device (docs/lighting-core.md "Per-bounce mode").
 # STAGES=1 adds one 64-spp per-bounce run with --stage-statistics per scene: each wavefront stage's
 # GPU seconds beside the run's lighting seconds (the rest is host work and idle device).
-#   bash .replay/per_bounce_gpu_run.sh        (env SCENES, CACHES, STAGES)
+# DENOISE=1 adds the per-bounce mode at 16/64/256 spp and path tracing at 64/256 spp with --denoise
+# (the device's texture-space filter; its `relight.denoise.seconds` printed beside the lighting).
+#   bash .replay/per_bounce_gpu_run.sh        (env SCENES, CACHES, STAGES, DENOISE)
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
 export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
@@ -39,6 +41,19 @@ for scene in ${SCENES:-cornell building city}; do
       tests="$tests /tmp/w/$scene-bounces$spp-$caches.bake"
     done
   done
+  if [ -n "${DENOISE:-}" ]; then
+    denoised() { python3 -c "import json; r=json.load(open('/tmp/w/r.json')); d=r.get('denoise') or r.get('relight', {}).get('denoise') or r.get('stats', {}).get('relight', {}).get('denoise', {}); print('%.3f' % d.get('seconds', -1))"; }
+    for spp in 64 256; do
+      $R $B -o /tmp/w/$scene-path$spp-denoise.bake --spp $spp --seed 1 --denoise --json > /tmp/w/r.json
+      echo "$scene path --denoise $spp spp: lighting $(field lighting_seconds /tmp/w/r.json) s, filter $(denoised) s"
+      tests="$tests /tmp/w/$scene-path$spp-denoise.bake"
+    done
+    for spp in 16 64 256; do
+      $R $B -o /tmp/w/$scene-bounces$spp-denoise.bake --spp $spp --seed 1 --integrator bounces --denoise --json > /tmp/w/r.json
+      echo "$scene bounces --denoise $spp spp: lighting $(field lighting_seconds /tmp/w/r.json) s, filter $(denoised) s"
+      tests="$tests /tmp/w/$scene-bounces$spp-denoise.bake"
+    done
+  fi
   if [ -n "${STAGES:-}" ]; then
     $R $B -o /tmp/w/stages.bake --spp 64 --seed 1 --integrator bounces --stage-statistics --json > /tmp/w/r.json
     python3 -c "
