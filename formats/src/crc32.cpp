@@ -1,6 +1,9 @@
 #include "exitance/formats/crc32.h"
 
+#include <algorithm>
 #include <array>
+#include <thread>
+#include <vector>
 
 namespace exitance::formats {
 namespace {
@@ -29,9 +32,7 @@ uint32_t load_le32(const uint8_t* p) {
   return uint32_t(p[0]) | (uint32_t(p[1]) << 8) | (uint32_t(p[2]) << 16) | (uint32_t(p[3]) << 24);
 }
 
-}  // namespace
-
-uint32_t crc32(const uint8_t* data, size_t size, uint32_t previous_crc) {
+uint32_t crc32_serial(const uint8_t* data, size_t size, uint32_t previous_crc) {
   const auto& t = kCrc32Tables;
   uint32_t c = previous_crc ^ 0xFFFFFFFFu;
   for (; size >= 8; data += 8, size -= 8) {
@@ -41,6 +42,66 @@ uint32_t crc32(const uint8_t* data, size_t size, uint32_t previous_crc) {
   }
   for (; size > 0; ++data, --size) c = t[0][(c ^ *data) & 0xFFu] ^ (c >> 8);
   return c ^ 0xFFFFFFFFu;
+}
+
+// GF(2) 32×32 matrices as 32 columns: the product with a vector, and a matrix's square.
+uint32_t gf2_times(const uint32_t* matrix, uint32_t vector) {
+  uint32_t sum = 0;
+  for (; vector != 0; vector >>= 1, ++matrix)
+    if (vector & 1u) sum ^= *matrix;
+  return sum;
+}
+
+void gf2_square(uint32_t* square, const uint32_t* matrix) {
+  for (int n = 0; n < 32; ++n) square[n] = gf2_times(matrix, matrix[n]);
+}
+
+}  // namespace
+
+uint32_t crc32_combine(uint32_t crc_a, uint32_t crc_b, uint64_t size_b) {
+  if (size_b == 0) return crc_a;
+  uint32_t even[32], odd[32];  // the operator of 2^k zero bits, alternating between the two
+  odd[0] = 0xEDB88320u;        // one zero bit
+  for (int n = 1; n < 32; ++n) odd[n] = 1u << (n - 1);
+  gf2_square(even, odd);  // two zero bits
+  gf2_square(odd, even);  // four
+  // Each pass squares to one zero byte, two, four, ... and applies the powers size_b has.
+  for (;;) {
+    gf2_square(even, odd);
+    if (size_b & 1u) crc_a = gf2_times(even, crc_a);
+    size_b >>= 1;
+    if (size_b == 0) break;
+    gf2_square(odd, even);
+    if (size_b & 1u) crc_a = gf2_times(odd, crc_a);
+    size_b >>= 1;
+    if (size_b == 0) break;
+  }
+  return crc_a ^ crc_b;
+}
+
+uint32_t crc32(const uint8_t* data, size_t size, uint32_t previous_crc) {
+  // scene.bin is tens to hundreds of MB, read and written whole: at ~1.5 GB/s a byte stream's CRC
+  // was a serial 45 ms of a relight's load at 1 M texels (and 180 ms of the open city's encoding).
+  const size_t threads = std::min<size_t>(std::max(1u, std::thread::hardware_concurrency()), size / (kCrc32ParallelFrom / 4));
+  if (size < kCrc32ParallelFrom || threads < 2) return crc32_serial(data, size, previous_crc);
+  const size_t piece = (size + threads - 1) / threads;
+  std::vector<uint32_t> crcs(threads, 0);
+  {
+    std::vector<std::jthread> workers;
+    workers.reserve(threads - 1);
+    for (size_t k = 1; k < threads; ++k)
+      workers.emplace_back([&, k] {
+        const size_t begin = k * piece;
+        crcs[k] = crc32_serial(data + begin, std::min(size, begin + piece) - begin, 0);
+      });
+    crcs[0] = crc32_serial(data, piece, previous_crc);
+  }
+  uint32_t crc = crcs[0];
+  for (size_t k = 1; k < threads; ++k) {
+    const size_t begin = k * piece;
+    crc = crc32_combine(crc, crcs[k], std::min(size, begin + piece) - begin);
+  }
+  return crc;
 }
 
 }  // namespace exitance::formats

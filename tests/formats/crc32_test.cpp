@@ -1,6 +1,7 @@
 // CRC-32 against the IEEE check value and its incremental form.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -45,6 +46,35 @@ TEST(Crc32, EqualsTheBitwiseDefinitionAtEveryLengthAndAlignment) {
       ASSERT_EQ(crc32(bytes.data() + start + split, size - split, crc32(bytes.data() + start, split)),
                 bitwise_crc32(bytes.data() + start, size));
     }
+}
+
+TEST(Crc32, CombinesTwoPiecesIntoTheWholesCrc) {
+  std::vector<uint8_t> bytes(1000);
+  uint32_t state = 777;
+  for (uint8_t& b : bytes) b = uint8_t((state = state * 1664525u + 1013904223u) >> 24);
+  for (size_t split : {size_t(0), size_t(1), size_t(7), size_t(8), size_t(333), size_t(999), size_t(1000)})
+    ASSERT_EQ(crc32_combine(crc32(bytes.data(), split), crc32(bytes.data() + split, bytes.size() - split),
+                            bytes.size() - split),
+              bitwise_crc32(bytes.data(), bytes.size()))
+        << "split " << split;
+}
+
+// Past kCrc32ParallelFrom the pieces are taken on threads and combined: the same value as the
+// serial definition continued over pieces below the threshold, also from a running value.
+TEST(Crc32, ALargeBufferInPiecesOnThreadsGivesTheSerialValue) {
+  const size_t size = kCrc32ParallelFrom * 2 + 12345;  // pieces of unequal length, a tail mid-word
+  std::vector<uint8_t> bytes(size);
+  uint32_t state = 99;
+  for (uint8_t& b : bytes) b = uint8_t((state = state * 1664525u + 1013904223u) >> 24);
+  const size_t step = kCrc32ParallelFrom / 2 - 3;  // serial calls, continued
+  auto serial = [&](size_t begin, uint32_t running) {
+    for (size_t at = begin; at < size; at += step) running = crc32(bytes.data() + at, std::min(step, size - at), running);
+    return running;
+  };
+  EXPECT_EQ(crc32(bytes.data(), size), serial(0, 0));
+  const uint32_t head = crc32(bytes.data(), 5);
+  EXPECT_EQ(crc32(bytes.data() + 5, size - 5, head), serial(5, head));
+  EXPECT_EQ(crc32(bytes.data(), size), crc32_combine(crc32(bytes.data(), 5), crc32(bytes.data() + 5, size - 5), size - 5));
 }
 
 }  // namespace
