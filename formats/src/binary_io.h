@@ -76,6 +76,22 @@ class LittleEndianReader {
     const uint8_t* p = take(n);
     return std::string(reinterpret_cast<const char*>(p), n);
   }
+  // `count` values made of 4-byte fields, as the writer's words() wrote them: one bounds check and
+  // one copy on a little-endian host (scene.bin's arrays are tens of MB), else field by field.
+  template <class T>
+  void words(T* values, size_t count) {
+    static_assert(std::is_trivially_copyable_v<T> && sizeof(T) % 4 == 0, "whole 4-byte fields only");
+    if (count > remaining() / sizeof(T)) throw FormatError(name_ + ": unexpected end of data at byte " + std::to_string(position_));
+    if constexpr (std::endian::native == std::endian::little) {
+      if (count > 0) std::memcpy(static_cast<void*>(values), take(count * sizeof(T)), count * sizeof(T));
+    } else {
+      auto* raw = reinterpret_cast<uint8_t*>(values);
+      for (size_t k = 0; k < count * sizeof(T) / 4; ++k) {
+        const uint32_t field = u32();
+        std::memcpy(raw + 4 * k, &field, 4);
+      }
+    }
+  }
   size_t remaining() const { return size_ - position_; }
   void skip(size_t n) { take(n); }
   size_t position() const { return position_; }

@@ -935,22 +935,18 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
   resize_in_huge_pages(t.uv0, size_t(triangle_count) * 3);
   resize_in_huge_pages(t.material, triangle_count);
   resize_in_huge_pages(t.instance, triangle_count);
-  for (Float3& v : t.positions) get(p, v);
-  for (Float3& v : t.normals) get(p, v);
-  for (Float2& v : t.lightmap_uv) get(p, v);
-  for (Float2& v : t.uv0) get(p, v);
-  for (uint32_t& v : t.material) v = p.u32();
-  for (uint32_t& v : t.instance) v = p.u32();
+  p.words(t.positions.data(), t.positions.size());
+  p.words(t.normals.data(), t.normals.size());
+  p.words(t.lightmap_uv.data(), t.lightmap_uv.size());
+  p.words(t.uv0.data(), t.uv0.size());
+  p.words(t.material.data(), t.material.size());
+  p.words(t.instance.data(), t.instance.size());
   resize_in_huge_pages(s.texels.triangle_texel_size, triangle_count);
-  for (float& v : s.texels.triangle_texel_size) v = p.f32();
+  p.words(s.texels.triangle_texel_size.data(), s.texels.triangle_texel_size.size());
   resize_in_huge_pages(s.bvh.nodes, bvh_node_count);
-  for (BvhNodeRecord& n : s.bvh.nodes) {
-    for (float* plane : {n.lo_x, n.hi_x, n.lo_y, n.hi_y, n.lo_z, n.hi_z})
-      for (int c = 0; c < 4; ++c) plane[c] = p.f32();
-    for (uint32_t& w : n.child) w = p.u32();
-  }
+  p.words(s.bvh.nodes.data(), s.bvh.nodes.size());  // members in the file's order (lo_x .. hi_z, child)
   resize_in_huge_pages(s.bvh.leaf_triangles, leaf_count);
-  for (uint32_t& v : s.bvh.leaf_triangles) v = p.u32();
+  p.words(s.bvh.leaf_triangles.data(), s.bvh.leaf_triangles.size());
   s.texels.pages.resize(page_count);
   for (TexelPageRecord& page : s.texels.pages) {
     page.width = p.u32();
@@ -1067,8 +1063,8 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
   if (vertex_colors) {
     s.vertex_color.resize(size_t(triangle_count) * 3);
     s.vertex_alpha.resize(size_t(triangle_count) * 3);
-    for (Float3& c : s.vertex_color) get(p, c);
-    for (float& a : s.vertex_alpha) a = p.f32();
+    p.words(s.vertex_color.data(), s.vertex_color.size());
+    p.words(s.vertex_alpha.data(), s.vertex_alpha.size());
   }
   // Each texture's pixels are checked against the bytes left before they are allocated.
   s.textures.reserve(texture_count);  // bounded by the payload size check above
@@ -1077,8 +1073,8 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
   if (tangents) {  // bounded by the payload size check above
     s.tangents.resize(size_t(triangle_count) * 3);
     s.tangent_signs.resize(size_t(triangle_count) * 3);
-    for (Float3& v : s.tangents) get(p, v);
-    for (float& w : s.tangent_signs) w = p.f32();
+    p.words(s.tangents.data(), s.tangents.size());
+    p.words(s.tangent_signs.data(), s.tangent_signs.size());
   }
   if (p.remaining() != 0)
     throw FormatError(name + ": payload: " + std::to_string(p.remaining()) + " bytes after the last " +
