@@ -627,6 +627,17 @@ std::string get_name(binary_io::LittleEndianReader& r, const std::string& where)
   if (length > r.remaining()) throw FormatError(where + "name runs past the end of the payload");
   return r.text(length);
 }
+// The triangle table's arrays in the file's order, for the writer and the reader alike (each moves
+// an array with its words()). Each array holds 3 entries per triangle, or 1 (material, instance).
+template <class Triangles, class Words>
+void for_each_triangle_array(Triangles& t, Words&& words) {
+  words(t.positions, 3);
+  words(t.normals, 3);
+  words(t.lightmap_uv, 3);
+  words(t.uv0, 3);
+  words(t.material, 1);
+  words(t.instance, 1);
+}
 template <size_t N>
 void get(binary_io::LittleEndianReader& r, std::array<float, N>& v) {
   for (float& x : v) x = r.f32();
@@ -739,12 +750,7 @@ std::vector<uint8_t> encode_scene(const SceneFile& s, uint32_t version) {
   std::vector<uint8_t> file = framing::begin_frame(
       kind, size_t(fixed) + s.nodes.size() * kMinNodeBytes + s.instances.size() * kMinInstanceBytes);
   binary_io::LittleEndianWriter p(file);
-  p.words(t.positions.data(), t.positions.size());
-  p.words(t.normals.data(), t.normals.size());
-  p.words(t.lightmap_uv.data(), t.lightmap_uv.size());
-  p.words(t.uv0.data(), t.uv0.size());
-  p.words(t.material.data(), t.material.size());
-  p.words(t.instance.data(), t.instance.size());
+  for_each_triangle_array(t, [&](const auto& values, size_t) { p.words(values.data(), values.size()); });
   p.words(s.texels.triangle_texel_size.data(), s.texels.triangle_texel_size.size());
   // A node's fields in the file's order are its members' order (lo_x .. hi_z, then child).
   p.words(s.bvh.nodes.data(), s.bvh.nodes.size());
@@ -929,18 +935,10 @@ SceneFile read_scene(const uint8_t* data, size_t size, const std::string& name) 
   SceneTriangles& t = s.triangles;
   // The large arrays in huge pages where the kernel allows (huge_pages.h): their first touch was
   // most of reading a scene.bin.
-  resize_in_huge_pages(t.positions, size_t(triangle_count) * 3);
-  resize_in_huge_pages(t.normals, size_t(triangle_count) * 3);
-  resize_in_huge_pages(t.lightmap_uv, size_t(triangle_count) * 3);
-  resize_in_huge_pages(t.uv0, size_t(triangle_count) * 3);
-  resize_in_huge_pages(t.material, triangle_count);
-  resize_in_huge_pages(t.instance, triangle_count);
-  p.words(t.positions.data(), t.positions.size());
-  p.words(t.normals.data(), t.normals.size());
-  p.words(t.lightmap_uv.data(), t.lightmap_uv.size());
-  p.words(t.uv0.data(), t.uv0.size());
-  p.words(t.material.data(), t.material.size());
-  p.words(t.instance.data(), t.instance.size());
+  for_each_triangle_array(t, [&](auto& values, size_t per_triangle) {
+    resize_in_huge_pages(values, size_t(triangle_count) * per_triangle);
+    p.words(values.data(), values.size());
+  });
   resize_in_huge_pages(s.texels.triangle_texel_size, triangle_count);
   p.words(s.texels.triangle_texel_size.data(), s.texels.triangle_texel_size.size());
   resize_in_huge_pages(s.bvh.nodes, bvh_node_count);
