@@ -233,26 +233,19 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   BakeOptions quiet = options;
   quiet.progress = nullptr;
   double scene_file_seconds = 0, exitance_seconds = 0;
-  auto timed = [](double& seconds, auto&& work) {
-    const auto start = std::chrono::steady_clock::now();
-    auto done = [&] { seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-    if constexpr (std::is_void_v<decltype(work())>) {
-      work();
-      done();
-    } else {
-      auto result = work();
-      done();
-      return result;
-    }
-  };
   std::shared_future<PersistedSceneFile> scene_file =
       std::async(std::launch::async, [&] {
-        return timed(scene_file_seconds, [&] { return scene_file_stage(scene, gbuffer, layout, probes ? &*probes : nullptr); });
+        StageClock own;
+        PersistedSceneFile file = scene_file_stage(scene, gbuffer, layout, probes ? &*probes : nullptr);
+        scene_file_seconds = own.lap();
+        return file;
       }).share();
   std::shared_future<void> exitance;
   if (voxels)
     exitance = std::async(std::launch::async, [&] {
-                 timed(exitance_seconds, [&] { exitance_stage(*voxels, scene, gbuffer, lightmap, quiet); });
+                 StageClock own;
+                 exitance_stage(*voxels, scene, gbuffer, lightmap, quiet);
+                 exitance_seconds = own.lap();
                }).share();
   // stats.seconds with the two threads' times, once they are done.
   auto seconds_with_beside = [&] {

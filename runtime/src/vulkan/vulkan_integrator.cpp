@@ -50,7 +50,7 @@ struct PreparedVulkanDevice {
 
 // Members in construction order: each uses those above it, and goes before them.
 struct VulkanIntegrator::Impl {
-  std::unique_ptr<Context> owned_context;  // made here, or by prepare_device
+  std::unique_ptr<Context> owned_context;  // made by prepare_device
   Context& context;
   WavefrontSizes sizes;
   GpuScene scene;
@@ -86,7 +86,7 @@ struct VulkanIntegrator::Impl {
       : Impl(*lighting_ptr, options, lighting_ptr, std::move(made)) {}
   Impl(const LightingScene& lighting, const VulkanDeviceOptions& options, std::shared_ptr<const LightingScene> lighting_ptr,
        std::unique_ptr<Context> made)
-      : owned_context(made ? std::move(made) : std::make_unique<Context>(options)),
+      : owned_context(std::move(made)),
         context(*owned_context),
         sizes(choose_wavefront_sizes(context, options)),
         scene(context, lighting, sizes.quantized_nodes),
@@ -114,12 +114,9 @@ std::unique_ptr<VulkanIntegrator> VulkanIntegrator::create(std::shared_ptr<const
                                                            std::shared_ptr<PreparedVulkanDevice> device) {
   if (!scene) throw std::invalid_argument("Vulkan backend: no scene");
   check_supported_by_vulkan(*scene);
-  std::unique_ptr<Context> made;
-  if (device) {
-    if (!device->context) throw std::invalid_argument("Vulkan backend: a prepared device can make one integrator");
-    made = std::move(device->context);
-  }
-  return std::unique_ptr<VulkanIntegrator>(new VulkanIntegrator(std::make_unique<Impl>(scene, options, std::move(made))));
+  if (!device) device = prepare_device(options);
+  if (!device->context) throw std::invalid_argument("Vulkan backend: a prepared device can make one integrator");
+  return std::unique_ptr<VulkanIntegrator>(new VulkanIntegrator(std::make_unique<Impl>(scene, options, std::move(device->context))));
 }
 
 std::shared_ptr<PreparedVulkanDevice> VulkanIntegrator::prepare_device(const VulkanDeviceOptions& options) {

@@ -9,8 +9,9 @@
 namespace exitance::formats {
 
 // Continues a running CRC: crc32(b, nb, crc32(a, na)) == crc32(a ++ b). Start with 0.
-// From kCrc32ParallelFrom bytes on, the data is cut into one piece per hardware thread, each
-// piece's CRC taken on a thread of its own and the pieces combined (the same value).
+// From kCrc32ParallelFrom bytes on, the data is cut into one piece per hardware thread (each at
+// least a quarter of that), each piece's CRC taken on a thread of its own and the pieces combined
+// (the same value).
 uint32_t crc32(const uint8_t* data, size_t size, uint32_t previous_crc = 0);
 inline constexpr size_t kCrc32ParallelFrom = size_t(16) << 20;
 
