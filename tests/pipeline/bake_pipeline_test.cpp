@@ -174,7 +174,9 @@ TEST(BakePipeline, SameSeedSameResult) {
 // A --time budget shorter than the lighting's first pass (one sample of every texel, and of every
 // bounce layer in the per-bounce mode): the bake keeps that pass, writes the bundle, and warns with
 // the time it took against the budget. The budget here (1 ms, the least the lighting gets) is far
-// below what one pass over 16 k texels takes on any machine (tens of milliseconds).
+// below what one pass over 16 k texels takes on any machine (tens of milliseconds). The CPU's
+// default per-bounce mode still gives the first bounce its sample: a lightmap of direct light alone
+// would be black wherever light arrives by a bounce (it was, until B_1 ran past the budget).
 TEST(BakePipeline, ABudgetBelowOnePassWarnsAndStillWrites) {
   const fs::path dir = testing::fresh_temp_dir("budget");
   BakeOptions options;
@@ -184,6 +186,7 @@ TEST(BakePipeline, ABudgetBelowOnePassWarnsAndStillWrites) {
   options.atlas.texel_density = 32;
   options.lighting.spp = 0;
   options.lighting.time_budget_seconds = 1e-3;
+  options.lighting.integrator = IntegratorMode::Bounces;  // the CPU's default (bake's --integrator auto)
   options.probes_enabled = false;
   options.backend.name = "cpu";
   Diagnostics diagnostics;
@@ -193,6 +196,11 @@ TEST(BakePipeline, ABudgetBelowOnePassWarnsAndStillWrites) {
   for (const std::string& w : diagnostics.warnings) warned = warned || w.rfind("--time: the lighting took", 0) == 0;
   EXPECT_TRUE(warned);
   EXPECT_TRUE(fs::exists(dir / "out.bake" / "lightmap-0.exr"));
+  std::ifstream manifest_file(dir / "out.bake" / "manifest.json");
+  const nlohmann::json stats = nlohmann::json::parse(manifest_file)["stats"];
+  ASSERT_EQ(stats["lighting"]["integrator"], "bounces");
+  ASSERT_GE(stats["bounces"]["bounces"].get<int>(), 1);
+  EXPECT_GE(stats["bounces"]["samples_per_layer"][1].get<int>(), 1);
   fs::remove_all(dir);
 }
 
