@@ -69,25 +69,6 @@ void copy_texel(uint t) {
 // weights computed again, the same), so a thread keeps a few sums whatever the recorded layers.
 const uint kLayersPerWindow = 3u;
 
-// The weight of texel j at atlas offset (dx, dy) in texel t's window (0: not in the fit), and its
-// offset in t's plane: indirect_denoise.cpp's, in its order.
-double neighbour_weight(vec3 position, vec3 normal, float texel_size, vec3 own, vec3 own_variance, uint j, int dx,
-                        int dy, int r, out vec2 offset) {
-  offset = vec2(0.0);
-  vec4 ja = texel_records[j * 2u], jb = texel_records[j * 2u + 1u];
-  double w = double(texture_space_filter_weight(position, normal, texel_size, ja.xyz, jb.xyz, dx, dy, r));
-  if (w <= 0.0lf) return 0.0lf;
-  vec3 other = indirect[j * 2u].xyz, other_variance = indirect[j * 2u + 1u].xyz;
-  float difference = 0.0f, variances = 0.0f;
-  for (uint c = 0u; c < 3u; ++c) {
-    difference += (other[c] - own[c]) * (other[c] - own[c]);
-    variances += texture_space_filter_range_variance(own_variance[c], other_variance[c]);
-  }
-  w *= double(texture_space_filter_range_weight(difference, variances));
-  offset = texture_space_filter_plane_offset(normal, ja.xyz - position, texel_size);
-  return w;
-}
-
 // Returns the neighbours with a weight > 0 (the texel itself included); 0 for a texel not filtered.
 uint filter_texel(uint t) {
   uint N = push.texel_count;
@@ -107,44 +88,6 @@ uint filter_texel(uint t) {
   int r = push.radius;
   uint neighbours = 0u;
 
-  // The linear fit's first row (texture_space_filter.h), from one pass over the window.
-  double m00 = 0.0lf, m01 = 0.0lf, m02 = 0.0lf, m11 = 0.0lf, m12 = 0.0lf, m22 = 0.0lf;
-  dvec3 fit_sum = dvec3(0.0lf), fit_u = dvec3(0.0lf), fit_v = dvec3(0.0lf);
-  double q00 = 0.0lf, q01 = 0.0lf, q02 = 0.0lf, q11 = 0.0lf, q12 = 0.0lf, q22 = 0.0lf;
-  for (int dy = -r; dy <= r; ++dy)
-    for (int dx = -r; dx <= r; ++dx) {
-      int px = x + dx, py = y + dy;
-      if (px < 0 || py < 0 || px >= int(info.y) || py >= int(info.z)) continue;
-      uint j = texel_at[info.x + uint(py) * info.y + uint(px)];
-      if (j == kNone || in_samples[j] == 0u) continue;
-      vec2 offset;
-      double w = neighbour_weight(position, normal, texel_size, own, own_variance, j, dx, dy, r, offset);
-      if (w <= 0.0lf) continue;
-      double u = double(offset.x), v = double(offset.y);
-      m00 += w, m01 += w * u, m02 += w * v;
-      m11 += w * u * u, m12 += w * u * v, m22 += w * v * v;
-      vec3 other = indirect[j * 2u].xyz, other_variance = indirect[j * 2u + 1u].xyz;
-      double wv = w * w * (double(other_variance[0]) + double(other_variance[1]) + double(other_variance[2]));
-      q00 += wv, q01 += wv * u, q02 += wv * v;
-      q11 += wv * u * u, q12 += wv * u * v, q22 += wv * v * v;
-      for (uint c = 0u; c < 3u; ++c) {
-        fit_sum[c] += w * double(other[c]);
-        fit_u[c] += w * u * double(other[c]);
-        fit_v[c] += w * v * double(other[c]);
-      }
-    }
-  double c0, c1, c2;
-  bool linear = texture_space_filter_linear_row(m00, m01, m02, m11, m12, m22, c0, c1, c2);
-  // Indirect light is never negative: where the fit would be (extrapolated at a chart's corner
-  // beside a steep change), the weighted mean, which cannot be, is used.
-  double difference_squared = 0.0lf;
-  for (uint c = 0u; c < 3u; ++c) {
-    double fit = c0 * fit_sum[c] + c1 * fit_u[c] + c2 * fit_v[c];
-    linear = linear && fit >= 0.0lf;
-    difference_squared += (fit_sum[c] / m00 - fit) * (fit_sum[c] / m00 - fit);
-  }
-  linear = linear && texture_space_filter_prefers_fit(difference_squared, m00, q00, q01, q02, q11, q12, q22, c0, c1, c2);
-
   uint layers = push.totals_only != 0u ? 1u : push.layers;
   for (uint first = 1u; first == 1u || first < layers; first += kLayersPerWindow) {
     bool totals = first == 1u;
@@ -158,14 +101,20 @@ uint filter_texel(uint t) {
         if (px < 0 || py < 0 || px >= int(info.y) || py >= int(info.z)) continue;
         uint j = texel_at[info.x + uint(py) * info.y + uint(px)];
         if (j == kNone || in_samples[j] == 0u) continue;
-        vec2 offset;
-        double w = neighbour_weight(position, normal, texel_size, own, own_variance, j, dx, dy, r, offset);
+        vec4 ja = texel_records[j * 2u], jb = texel_records[j * 2u + 1u];
+        double w = double(texture_space_filter_weight(position, normal, texel_size, ja.xyz, jb.xyz, dx, dy, r));
         if (w <= 0.0lf) continue;
-        if (totals) ++neighbours;
-        if (linear) w *= c0 + c1 * double(offset.x) + c2 * double(offset.y);
+        vec3 other = indirect[j * 2u].xyz, other_variance = indirect[j * 2u + 1u].xyz;
+        float difference = 0.0f, variances = 0.0f;
+        for (uint c = 0u; c < 3u; ++c) {
+          difference += (other[c] - own[c]) * (other[c] - own[c]);
+          variances += own_variance[c] + other_variance[c];
+        }
+        w *= double(texture_space_filter_range_weight(difference, variances));
+        if (w <= 0.0lf) continue;
         weight_sum += w;
         if (totals) {
-          vec3 other = indirect[j * 2u].xyz, other_variance = indirect[j * 2u + 1u].xyz;
+          ++neighbours;
           for (uint c = 0u; c < 3u; ++c) {
             sum[c] += w * double(other[c]);
             variance_sum[c] += w * w * double(other_variance[c]);
@@ -181,8 +130,7 @@ uint filter_texel(uint t) {
           for (uint c = 0u; c < 3u; ++c) layer_sum[q][c] += per_sample * in_layers[(k * N + j) * 3u + c];
         }
       }
-    // The texel itself always has weight 1 (same surface, offset 0), so the mean's weight_sum >= 1;
-    // the fit's weights sum to 1 (to rounding).
+    // The texel itself always has weight 1 (same surface, offset 0), so weight_sum >= 1.
     if (totals)
       for (uint c = 0u; c < 3u; ++c) {
         double mean = in_layers[t * 3u + c] / d + sum[c] / weight_sum;
