@@ -6,13 +6,16 @@
 # SPPS samples per texel, each output's relMSE against two 4096-spp relights (seeds 101, 202):
 # the filter's error and bias on the GPU's own estimates at 1 M texels, and its host time there.
 #   here: SCENES="building courtyard" bash bench/refresh_change_gpu_pack.sh build
-#   there: bash .replay/denoise_gpu_run.sh        (env BUNDLES, SPPS; writes $OUT/summary.txt)
+#   there: bash .replay/denoise_gpu_run.sh        (env BUNDLES, SPPS, RUNTIME; writes $OUT/summary.txt)
+# An A/B of two runtimes: BEFORE_RUNTIME=<cmake --install of the other commit> for the pack, there
+#   bash .replay/denoise_gpu_run.sh; cp $OUT/summary.txt $OUT/new.txt; RUNTIME=runtime_before bash .replay/denoise_gpu_run.sh
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
 export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
 W=/tmp/w; mkdir -p $W && tar -C $W -xJf .replay/refresh_change.txz
-R=$W/runtime/bin/exitance-relight
-export LD_LIBRARY_PATH=$W/runtime/lib
+# RUNTIME=runtime_before: the pack's second runtime folder (BEFORE_RUNTIME when packing), for an A/B.
+R=$W/${RUNTIME:-runtime}/bin/exitance-relight
+export LD_LIBRARY_PATH=$W/${RUNTIME:-runtime}/lib
 S=$OUT/summary.txt
 $R --list-devices > $S
 for b in ${BUNDLES:-building courtyard}; do
