@@ -1,7 +1,6 @@
 #include "exitance/bake/command/bake_pipeline.h"
 
 #include <algorithm>
-#include <chrono>
 #include <fstream>
 #include <future>
 #include <iterator>
