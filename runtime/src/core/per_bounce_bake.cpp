@@ -382,7 +382,7 @@ LightmapEstimate bake_per_bounce(const TexelGBuffer& gbuffer, const IntegratorSe
       // B_1 gets its first sample even past the budget: without it the lightmap would hold direct
       // light only, no estimate of E at all wherever light arrives by a bounce (the open city at 2
       // texels/m under --time 2 on 2 cores: B_0's first pass alone took the budget). The bake warns
-      // of the overrun (bake_pipeline.cpp).
+      // of the overrun (lighting_stage, bake/command/bake_stages.cpp).
       const bool first_bounce_unsampled = k == 0 && layers.size() > 1 && layers[1].samples == 0;
       if (out_of_time && !first_bounce_unsampled) break;
     }
