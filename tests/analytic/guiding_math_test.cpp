@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "exitance/runtime/core/scene_access.h"
+#include "exitance/common/guide_fold.h"  // after scene_access.h, as the cache includes it
+#include "exitance/runtime/core/grid_guiding_cache.h"
 
 namespace exitance {
 namespace {
@@ -275,6 +277,45 @@ TEST(GuidedDirection, DegenerateInputsGiveNoNaN) {
   EXPECT_EQ(da.pdf, db.pdf);
   EXPECT_EQ(da.direction.x, db.direction.x);
   EXPECT_EQ(continuation_weight(guide_vertex_cosine(), x, da), 1.0f);
+}
+
+// common/guide_fold.h, the fold both backends run (GridGuidingCache::swap, fold_guide.comp), on
+// closed forms: a bin's cumulative mean, and a record's CDF from bins shrunk toward their mean.
+TEST(GuideFold, ABinKeepsTheCumulativeMeanOfItsTargets) {
+  EXPECT_EQ(GridGuidingCache::kUniformFloor, kGuideUniformFloor);
+  const double units = 16777216.0;
+  float radiance = 0, weight = 0;
+  EXPECT_FALSE(guide_fold_bin(radiance, weight, 0, 0, units));
+  EXPECT_EQ(radiance, 0.0f);
+  EXPECT_TRUE(guide_fold_bin(radiance, weight, uint64_t(3.0 * units * 4), 4, units));  // four targets of 3
+  EXPECT_FLOAT_EQ(radiance, 3.0f);
+  EXPECT_EQ(weight, 4.0f);
+  EXPECT_TRUE(guide_fold_bin(radiance, weight, uint64_t(9.0 * units * 12), 12, units));  // twelve of 9
+  EXPECT_FLOAT_EQ(radiance, (4 * 3.0f + 12 * 9.0f) / 16);
+  EXPECT_EQ(weight, 16.0f);
+}
+
+TEST(GuideFold, TheCdfFollowsTheShrunkBinsWithAUniformFloor) {
+  std::vector<float> radiance(kGuideBins, 0.0f), weight(kGuideBins, 8.0f), cdf(kGuideBins + 1, -1.0f);
+  radiance[7] = 1.0f;  // one lit bin among dark ones
+  const GuideFoldFront front = guide_fold_rebuild(GuideFoldRecord{radiance.data(), weight.data(), cdf.data()}, 0.5f);
+  // Every bin has weight 8 = kGuidePriorSamples: shrunk to (L_b + prior) / 2, prior = 1 / 256.
+  const double prior = 1.0 / kGuideBins, lit = (1.0 + prior) / 2, dark = prior / 2, total = lit + (kGuideBins - 1) * dark;
+  EXPECT_FLOAT_EQ(front.expected_cosine, float(total / kGuideBins));
+  EXPECT_EQ(front.guided_probability, 0.5f);
+  EXPECT_EQ(cdf[0], 0.0f);
+  EXPECT_EQ(cdf[kGuideBins], 1.0f);
+  const double floor = kGuideUniformFloor / kGuideBins, share = 1.0 - kGuideUniformFloor;
+  for (uint32_t b = 0; b < kGuideBins; ++b)
+    EXPECT_NEAR(cdf[b + 1] - cdf[b], share * (b == 7 ? lit : dark) / total + floor, 1e-6) << "bin " << b;
+  // Nothing learned: no guided share (the vertex samples cosine only; its CDF, the floor's steps
+  // closed by a last step to 1, is never read).
+  std::fill(radiance.begin(), radiance.end(), 0.0f);
+  const GuideFoldFront none = guide_fold_rebuild(GuideFoldRecord{radiance.data(), weight.data(), cdf.data()}, 0.5f);
+  EXPECT_EQ(none.guided_probability, 0.0f);
+  EXPECT_EQ(none.expected_cosine, 0.0f);
+  for (uint32_t b = 0; b < kGuideBins; ++b) EXPECT_NEAR(cdf[b], b * floor, 1e-7);
+  EXPECT_EQ(cdf[kGuideBins], 1.0f);
 }
 
 }  // namespace

@@ -7,19 +7,9 @@
 #include "exitance/runtime/core/parallel_chunks.h"
 #include "exitance/runtime/core/scene_access.h"
 #include "exitance/common/guide_learning.h"  // after scene_access.h: path.h reads its accessors
+#include "exitance/common/guide_fold.h"
 
 namespace exitance {
-namespace {
-
-// Old sample counts are kept at every swap (a cumulative mean, as the thesis accumulates): passes
-// are small (a few spp), and halving per swap left ~4 samples behind a bin (plots in
-// bench/results/guiding.md), whose noise the sampler then followed.
-constexpr float kCountDecay = 1.0f;
-// Each bin's value is shrunk toward its record's mean by this many pseudo-samples, so a bin seen a
-// few times (one lucky emitter hit) does not draw the sampler.
-constexpr double kPriorSamples = 8;
-
-}  // namespace
 
 GuideFixedPoint guide_fixed_point_for(float reference) {
   // Fixed-point sums: 2^24 units per reference radiance, values capped at 2^16 references, so one
@@ -102,16 +92,10 @@ void GridGuidingCache::swap() {
             const size_t i = r * kGuideBins + b;
             BinAccumulator& a = back_[i];
             const uint32_t count = a.count.load(std::memory_order_relaxed);
-            weight_[i] *= kCountDecay;
-            if (count == 0) continue;
             const uint64_t sum = a.sum.load(std::memory_order_relaxed);
             a.count.store(0, std::memory_order_relaxed);
             a.sum.store(0, std::memory_order_relaxed);
-            const float mean = float(double(sum) / fixed_scale_ / double(count));
-            const float w = weight_[i] + float(count);
-            radiance_[i] += (mean - radiance_[i]) * (float(count) / w);
-            weight_[i] = w;
-            changed = true;
+            changed |= guide_fold_bin(radiance_[i], weight_[i], sum, count, fixed_scale_);
           }
           if (changed) rebuild(uint32_t(r));
         }
@@ -120,33 +104,22 @@ void GridGuidingCache::swap() {
 }
 
 void GridGuidingCache::rebuild(uint32_t record) {
-  const float* learned_radiance = &radiance_[size_t(record) * kGuideBins];
-  const float* weight = &weight_[size_t(record) * kGuideBins];
-  float* cdf = &cdf_[size_t(record) * (kGuideBins + 1)];
-  double weighted = 0, weights = 0;
-  for (uint b = 0; b < kGuideBins; ++b) {
-    weighted += double(weight[b]) * learned_radiance[b];
-    weights += weight[b];
+  const size_t at = size_t(record) * kGuideBins;
+  const GuideFoldFront front =
+      guide_fold_rebuild(GuideFoldRecord{&radiance_[at], &weight_[at], &cdf_[size_t(record) * (kGuideBins + 1)]}, config_.mix);
+  front_[record].expected_cosine = front.expected_cosine;
+  front_[record].guided_probability = front.guided_probability;
+}
+
+void GridGuidingCache::import_tables(const float* radiance, const float* weight, const float* cdf, const float* expected_cosine,
+                                     const float* guided_probability) {
+  std::copy(radiance, radiance + radiance_.size(), radiance_.begin());
+  std::copy(weight, weight + weight_.size(), weight_.begin());
+  std::copy(cdf, cdf + cdf_.size(), cdf_.begin());
+  for (size_t r = 0; r < front_.size(); ++r) {
+    front_[r].expected_cosine = expected_cosine[r];
+    front_[r].guided_probability = guided_probability[r];
   }
-  const double prior = weights > 0 ? weighted / weights : 0.0;
-  double radiance[kGuideBins];
-  double total = 0;
-  for (uint b = 0; b < kGuideBins; ++b) {
-    radiance[b] = (double(weight[b]) * learned_radiance[b] + kPriorSamples * prior) / (double(weight[b]) + kPriorSamples);
-    total += radiance[b];
-  }
-  const bool learned = total > 0 && std::isfinite(total);
-  // (1/pi) * integral of L cos = (1/pi) * sum of L_b * (pi / bins): every bin has cosine mass pi / bins.
-  front_[record].expected_cosine = learned ? float(total / kGuideBins) : 0.0f;
-  front_[record].guided_probability = learned ? config_.mix : 0.0f;
-  double run = 0;
-  cdf[0] = 0;
-  for (uint b = 0; b < kGuideBins; ++b) {
-    const double share = learned ? radiance[b] / total : 0.0;
-    run += (1.0 - kUniformFloor) * share + kUniformFloor / kGuideBins;
-    cdf[b + 1] = float(std::min(run, 1.0));
-  }
-  cdf[kGuideBins] = 1.0f;
 }
 
 size_t GridGuidingCache::bytes_per_record() {

@@ -58,22 +58,30 @@ GuideBuffer::GuideBuffer(const GridGuidingCache& cache) : records_(cache.record_
   front_ = locator + kGuideGridWords + index.size();
   cdf_ = front_ + size_t(records_) * kGuideFrontWords;
   back_ = cdf_ + size_t(records_) * (kGuideBins + 1);
-  const size_t words = back_ + size_t(records_) * kGuideBins * kGuideBackWords;
+  learned_ = back_ + size_t(records_) * kGuideBins * kGuideBackWords;
+  const size_t words = learned_ + size_t(records_) * kGuideBins * kGuideLearnedWords;
   // Learning keys are record * kGuideBins + bin in a uint, and every offset a uint word index.
   if (words >= (size_t(1) << 32) || uint64_t(records_) * kGuideBins >= 0xFFFFFFFFull)
     throw std::runtime_error("Vulkan backend: --guiding grid: " + std::to_string(records_) +
                              " guiding records do not fit the guide buffer (use fewer --guiding-grid-cells)");
   words_.assign(words, 0u);
-  back_end_ = words;
+  mix_ = cache.mix();
   words_[kGuideLocatorKind] = kGuideLocatorGrid;
   words_[kGuideRecordCount] = records_;
   words_[kGuideLocatorOffset] = uint32_t(locator);
   words_[kGuideFrontOffset] = uint32_t(front_);
   words_[kGuideCdfOffset] = uint32_t(cdf_);
   words_[kGuideBackOffset] = uint32_t(back_);
+  words_[kGuideLearnedOffset] = uint32_t(learned_);
   pack_fixed_point(cache.fixed_units(), cache.fixed_cap(), &words_[kGuideFixedUnits]);
   pack_grid_locator(cache.locator(), &words_[locator]);
   pack_front(cache);
+  for (uint32_t r = 0; r < records_; ++r)
+    for (uint32_t b = 0; b < kGuideBins; ++b) {
+      uint32_t* l = &words_[learned_ + (size_t(r) * kGuideBins + b) * kGuideLearnedWords];
+      l[0] = guide_float_bits(cache.radiance(r)[b]);
+      l[1] = guide_float_bits(cache.weight(r)[b]);
+    }
 }
 
 void GuideBuffer::pack_front(const GridGuidingCache& cache) {
@@ -92,10 +100,14 @@ void GuideBuffer::upload(WavefrontBatchRunner& runner) const {
   upload_guide_words(runner, words_, "grid", "use fewer --guiding-grid-cells");
 }
 
-void GuideBuffer::fold_learning(WavefrontBatchRunner& runner, GridGuidingCache& cache) {
+void GuideBuffer::fold_learning(WavefrontBatchRunner& runner, GuideFoldKernel& kernel) {
+  kernel.fold(runner.buffers().probes.sh_sums, records_, mix_);
+}
+
+void GuideBuffer::fold_learning_on_host(WavefrontBatchRunner& runner, GridGuidingCache& cache) {
   Context& context = runner.context();
   const Buffer& buffer = runner.buffers().probes.sh_sums;
-  const size_t back_words = back_end_ - back_;
+  const size_t back_words = learned_ - back_;
   if (back_words == 0) return;
   context.download(buffer, &words_[back_], back_words * 4, back_ * 4);
   // Records on all cores (the cache's back table adds atomically; each record's bins are its own).
@@ -109,14 +121,37 @@ void GuideBuffer::fold_learning(WavefrontBatchRunner& runner, GridGuidingCache& 
           }
       },
       64);
-  std::fill(words_.begin() + std::ptrdiff_t(back_), words_.begin() + std::ptrdiff_t(back_end_), 0u);
+  std::fill(words_.begin() + std::ptrdiff_t(back_), words_.begin() + std::ptrdiff_t(learned_), 0u);
   cache.swap();
   pack_front(cache);
-  // The back sums at 0 on the device for the next pass; front and CDFs (adjacent) with the new table.
+  // The back sums at 0 on the device for the next pass; front and CDFs (adjacent) with the new
+  // table. The learned section is not read on this path (the cache holds it).
   VkCommandBuffer cmd = context.begin();
   vkCmdFillBuffer(cmd, buffer.handle(), back_ * 4, back_words * 4, 0);
   context.submit_and_wait(cmd);
   context.upload(buffer, &words_[front_], (back_ - front_) * 4, front_ * 4);
+}
+
+void GuideBuffer::download_tables(WavefrontBatchRunner& runner, GridGuidingCache& cache) const {
+  if (records_ == 0) return;
+  Context& context = runner.context();
+  const Buffer& buffer = runner.buffers().probes.sh_sums;
+  // Front and CDFs are adjacent; the learned section follows the back sums.
+  std::vector<uint32_t> front_and_cdf(back_ - front_), learned(size_t(records_) * kGuideBins * kGuideLearnedWords);
+  context.download(buffer, front_and_cdf.data(), front_and_cdf.size() * 4, front_ * 4);
+  context.download(buffer, learned.data(), learned.size() * 4, learned_ * 4);
+  std::vector<float> radiance(size_t(records_) * kGuideBins), weight(radiance.size()), expected(records_), probability(records_);
+  for (size_t i = 0; i < radiance.size(); ++i) {
+    std::memcpy(&radiance[i], &learned[i * kGuideLearnedWords], 4);
+    std::memcpy(&weight[i], &learned[i * kGuideLearnedWords + 1], 4);
+  }
+  for (uint32_t r = 0; r < records_; ++r) {
+    std::memcpy(&probability[r], &front_and_cdf[size_t(r) * kGuideFrontWords], 4);
+    std::memcpy(&expected[r], &front_and_cdf[size_t(r) * kGuideFrontWords + 1], 4);
+  }
+  static_assert(sizeof(float) == 4);
+  const float* cdf = reinterpret_cast<const float*>(&front_and_cdf[cdf_ - front_]);
+  cache.import_tables(radiance.data(), weight.data(), cdf, expected.data(), probability.data());
 }
 
 void GuideBuffer::add_auto_sections(const std::vector<uint32_t>& texel_words, uint32_t pilot, uint32_t statistics_from) {

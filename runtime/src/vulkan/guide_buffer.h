@@ -1,14 +1,16 @@
 // Grid guiding's data on the device (gpu_layout.h kBindingGuide, in the probe SH sums' binding):
-// the GridGuidingCache's locator and front table packed as the guide buffer's sections, and its
-// back table's integer sums, learned by the kernels (shaders/include/guide.glsl), read back and
-// imported into the cache between learning passes. The fold and the CDFs are the cache's own
-// (GridGuidingCache::import_learned, swap), so both backends build the same tables from the same sums.
+// the GridGuidingCache's locator, front table and learned radiance packed as the guide buffer's
+// sections, and its back table's integer sums, learned by the kernels (shaders/include/guide.glsl)
+// and folded on the device between learning passes (fold_guide.comp: GridGuidingCache::swap's code,
+// common/guide_fold.h), so both backends build the same tables from the same sums and the device's
+// bake makes no host round trip while it learns. The table comes back to the cache once, at the end.
 #pragma once
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
 #include "exitance/runtime/core/grid_guiding_cache.h"
+#include "guide_fold_kernel.h"
 #include "wavefront_batch.h"
 
 namespace exitance::vulkan {
@@ -35,9 +37,16 @@ class GuideBuffer {
 
   // The whole buffer onto the device (growing and rebinding the binding), back sums at 0.
   void upload(WavefrontBatchRunner& runner) const;
-  // After a learning pass: the device's back sums into `cache` (import_learned), the cache's swap,
-  // the back sums cleared on the device and the new front table uploaded.
-  void fold_learning(WavefrontBatchRunner& runner, GridGuidingCache& cache);
+  // After a learning pass, on the device: the back sums folded into the learned section and
+  // cleared, the front table and CDFs rebuilt (one waited dispatch, nothing read back).
+  void fold_learning(WavefrontBatchRunner& runner, GuideFoldKernel& kernel);
+  // The same on the host (IntegratorSettings::guide_fold_on_host: the equivalence test, benches):
+  // the back sums read back into `cache` (import_learned), its swap, the back sums cleared on the
+  // device and the new front table uploaded. `cache` then holds the table.
+  void fold_learning_on_host(WavefrontBatchRunner& runner, GridGuidingCache& cache);
+  // The device's learned table into `cache` (GridGuidingCache::import_tables): for what reads the
+  // cache after a bake (IntegratorSettings::inspect_guiding).
+  void download_tables(WavefrontBatchRunner& runner, GridGuidingCache& cache) const;
 
   size_t bytes() const { return words_.size() * 4; }
 
@@ -53,10 +62,10 @@ class GuideBuffer {
   void pack_front(const GridGuidingCache& cache);
 
   std::vector<uint32_t> words_;
-  size_t front_ = 0, cdf_ = 0, back_ = 0;  // first words of the sections
-  size_t back_end_ = 0;                    // the grid's last section ends here; auto's follow
+  size_t front_ = 0, cdf_ = 0, back_ = 0, learned_ = 0;  // first words of the sections
   size_t auto_texels_ = 0, auto_sums_ = 0, auto_texel_count_ = 0;
   uint32_t records_ = 0;
+  float mix_ = 0;  // the cache's guided share of a learned record
 };
 
 }  // namespace exitance::vulkan

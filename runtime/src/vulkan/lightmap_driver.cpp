@@ -424,7 +424,12 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
       run_pass(a, first, pass);
       if (share) share->work.texel_samples += uint64_t(a.work_list.size()) * pass;
     }
-    if (learning) guide_buffer->fold_learning(runner_, *guide);  // this pass's learning is the next pass's table
+    if (learning && settings.guide_fold_on_host) {
+      guide_buffer->fold_learning_on_host(runner_, *guide);
+    } else if (learning) {  // this pass's learning is the next pass's table, folded on the device
+      if (!guide_fold_) guide_fold_ = std::make_unique<GuideFoldKernel>(runner_.context());
+      guide_buffer->fold_learning(runner_, *guide_fold_);
+    }
     if (emitter_buffer && a.params.emitter_guide != 0u) {
       const auto fold_start = Clock::now();
       if (!emitter_buffer->fold_learning(runner_, *emitter_guide, first + pass))
@@ -471,7 +476,10 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     estimate.guiding_auto_pilot = choice->pilot();
     if (choice->decided()) estimate.guiding_regions = choice->regions(), estimate.guiding_scene = choice->scene();
   }
-  if (guide && settings.inspect_guiding) settings.inspect_guiding(*guide);
+  if (guide && settings.inspect_guiding) {
+    if (!settings.guide_fold_on_host) guide_buffer->download_tables(runner_, *guide);
+    settings.inspect_guiding(*guide);
+  }
   if (svo_guide && settings.inspect_svo_guiding) settings.inspect_svo_guiding(*svo_guide);
   if (emitter_guide) {
     estimate.emitter_guiding = emitter_costs;  // the host's seconds; report() fills in the cache's part

@@ -15,6 +15,7 @@
 #include "exitance/runtime/core/lighting_scene.h"
 #include "exitance/runtime/texel_gbuffer.h"
 #include "device_lightmaps.h"
+#include "guide_fold_kernel.h"
 #include "wavefront_batch.h"
 
 namespace exitance::vulkan {
@@ -117,6 +118,7 @@ class LightmapDriver {
   WavefrontBatchRunner& runner_;
   GuidingScene guiding_scene_;
   std::optional<Accumulation> progressive_;
+  std::unique_ptr<GuideFoldKernel> guide_fold_;  // made by the first grid-guided bake
 };
 
 }  // namespace exitance::vulkan

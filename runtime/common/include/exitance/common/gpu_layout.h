@@ -224,8 +224,11 @@ const uint kBounceTraceFirst = 2u;          // at layer 0 a gather hit takes a d
 //   cdf      per record kGuideBins + 1 floats (guided_direction.h's CDF; a GuideVertex's cdf handle
 //            is the word offset of its record's CDF)
 //   back     per record and bin kGuideBackWords: fixed-point sum (lo, hi words) and count, added to
-//            with integer atomics during learning passes; the host reads, folds (GridGuidingCache
-//            import_learned + swap) and clears them between passes, then rewrites front and cdf.
+//            with integer atomics during learning passes; between passes fold_guide.comp folds and
+//            clears them (common/guide_fold.h, GridGuidingCache::swap's code) and rewrites front and
+//            cdf, with no host round trip.
+//   learned  per record and bin kGuideLearnedWords: the fold's learned radiance and weight (floats),
+//            GridGuidingCache's radiance and weight tables; read back once, at the end of a bake.
 // The header also holds the fixed-point scale (a double as lo, hi words) and the target cap (float)
 // of common/guide_learning.h guide_fixed_point.
 const uint kBindingGuide = kBindingProbeShSums;
@@ -241,6 +244,7 @@ const uint kGuideAutoTexels = 9u;      // --guiding auto: first word of the per-
 const uint kGuideAutoSums = 10u;       // first word (even) of the per-texel strategy sums (doubles)
 const uint kGuideAutoPilot = 11u;      // pilot samples per texel (GuidingChoice::pilot)
 const uint kGuideAutoStatisticsFrom = 12u;  // first pilot sample whose values are summed
+const uint kGuideLearnedOffset = 13u;  // first word of the learned section (grid guiding)
 const uint kGuideHeaderWords = 16u;
 const uint kGuideLocatorNone = 0u;      // every vertex samples cosine
 const uint kGuideLocatorGrid = 1u;
@@ -255,6 +259,7 @@ const uint kGuideLocatorSvo = 2u;
 const uint kGuideSvoWords = 8u;
 const uint kGuideFrontWords = 4u;
 const uint kGuideBackWords = 3u;
+const uint kGuideLearnedWords = 2u;
 const uint kGuideNoRecord = 0xFFFFFFFFu;
 // Emitter guiding (--emitter-guiding on; core/emitter_guiding_cache.h, common/guided_emitters.h;
 // docs/lighting-core.md "Emitter guiding on the Vulkan backend"): one more section of the guide

@@ -31,6 +31,7 @@
 #include <memory>
 #include <vector>
 
+#include "exitance/common/guide_fold.h"
 #include "exitance/common/guided_direction.h"
 #include "exitance/runtime/core/guide_grid_locator.h"
 #include "exitance/runtime/core/lighting_scene.h"
@@ -56,7 +57,7 @@ struct GridGuidingConfig {
 class GridGuidingCache {
  public:
   static constexpr uint32_t kNoRecord = GuideGridLocator::kNoRecord;
-  static constexpr float kUniformFloor = 0.02f;
+  static constexpr float kUniformFloor = 0.02f;  // common/guide_fold.h kGuideUniformFloor (guide_fold_test checks they agree)
   static constexpr double kMinTexelsPerRecord = 16;
   // Backends learn during the passes of the first samples per texel, then sample the frozen table:
   // on small scenes learning (a target per ray, atomic adds) costs as much as the ray itself, and by
@@ -86,8 +87,17 @@ class GridGuidingCache {
   // common/guide_learning.h guide_fixed_point with fixed_cap() and fixed_units()) to the back table
   // of `bin` of `record`, so swap() folds them exactly as it folds learn()'s.
   void import_learned(uint32_t record, uint32_t bin, uint64_t fixed_sum, uint32_t count);
-  // Between passes: folds the back table into the front one, rebuilds the CDFs, clears the back.
+  // Between passes: folds the back table into the front one, rebuilds the CDFs, clears the back
+  // (common/guide_fold.h, the fold the Vulkan backend runs on the device).
   void swap();
+  // A table folded elsewhere (the Vulkan backend's device fold, read back at the end of a bake):
+  // per record and bin its learned radiance and weight, per record its CDF (kGuideBins + 1) and
+  // front values, in record order; the back table is left as it is.
+  void import_tables(const float* radiance, const float* weight, const float* cdf, const float* expected_cosine,
+                     const float* guided_probability);
+  // The cache's learned weights (kGuideBins per record) and the mix a learned record samples with.
+  const float* weight(uint32_t record) const { return &weight_[size_t(record) * kGuideBins]; }
+  float mix() const { return config_.mix; }
 
   uint32_t record_count() const { return uint32_t(front_.size()); }
   int cells(int axis) const { return locator_.cells(axis); }
