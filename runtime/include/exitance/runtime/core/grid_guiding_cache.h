@@ -57,7 +57,7 @@ struct GridGuidingConfig {
 class GridGuidingCache {
  public:
   static constexpr uint32_t kNoRecord = GuideGridLocator::kNoRecord;
-  static constexpr float kUniformFloor = 0.02f;  // common/guide_fold.h kGuideUniformFloor (guide_fold_test checks they agree)
+  static constexpr float kUniformFloor = 0.02f;  // common/guide_fold.h kGuideUniformFloor (GuideFold.* in guiding_math_test.cpp checks they agree)
   static constexpr double kMinTexelsPerRecord = 16;
   // Backends learn during the passes of the first samples per texel, then sample the frozen table:
   // on small scenes learning (a target per ray, atomic adds) costs as much as the ray itself, and by
