@@ -2,7 +2,8 @@
 // "SVO guiding"): the record of a vertex (grid cell or octree bin), its GuideVertex from the front table, and the learning of its
 // continuation ray into the back table, over the guide buffer's sections (gpu_layout.h
 // kBindingGuide). The estimator and the learning target are the CPU reference's (path.h,
-// common/guide_learning.h); GridGuidingCache on the host folds the back sums between passes.
+// common/guide_learning.h); fold_guide.comp folds the back sums between passes with the CPU cache's
+// fold (common/guide_fold.h).
 #include "exitance/common/guide_learning.h"
 #include "exitance/common/guiding_auto_strategy.h"
 
