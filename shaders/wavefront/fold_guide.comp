@@ -12,8 +12,8 @@ layout(std430, set = 0, binding = 0) buffer Guide { uint guide_words[]; };
 float guide_cdf_at(uint cdf, uint i) { return uintBitsToFloat(guide_words[cdf + i]); }  // guided_direction.h's reader
 #include "exitance/common/guided_direction.h"
 layout(push_constant) uniform Push {
-  float mix;    // the guided share of a learned record (GridGuidingConfig::mix)
   uint first;   // this dispatch's first record
+  float mix;    // the guided share of a learned record (GridGuidingConfig::mix)
 } push;
 
 uint learned_word(uint record, uint bin) { return guide_words[kGuideLearnedOffset] + (record * kGuideBins + bin) * kGuideLearnedWords; }

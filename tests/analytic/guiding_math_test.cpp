@@ -12,7 +12,9 @@
 #include <vector>
 
 #include "exitance/runtime/core/scene_access.h"
+#include "exitance/common/emitter_guide_fold.h"
 #include "exitance/common/guide_fold.h"  // after scene_access.h, as the cache includes it
+#include "exitance/runtime/core/emitter_guiding_cache.h"
 #include "exitance/runtime/core/grid_guiding_cache.h"
 
 namespace exitance {
@@ -316,6 +318,71 @@ TEST(GuideFold, TheCdfFollowsTheShrunkBinsWithAUniformFloor) {
   EXPECT_EQ(none.expected_cosine, 0.0f);
   for (uint32_t b = 0; b < kGuideBins; ++b) EXPECT_NEAR(cdf[b], b * floor, 1e-7);
   EXPECT_EQ(cdf[kGuideBins], 1.0f);
+}
+
+
+// common/emitter_guide_fold.h, emitter guiding's fold on both backends (EmitterGuidingCache::swap,
+// fold_emitter_guide.comp), on closed forms. Punctual lights, four of equal power, all learned light
+// on the first: its CDF step is 0.9 + 0.1 / 4, the others' 0.1 / 4; the second moment under the
+// default is sum q^2 / p0 = 3.43, under the 0.5 mixture sum q^2 / (q / 2 + 1 / 8) = 1.47002, a gain of
+// 2.333 >= kEmitterFoldMinSecondMomentGain: guided. Two lights learned 3 : 1: gain 1.14, not guided.
+TEST(EmitterGuideFold, PunctualSharesAndTheGainRule) {
+  EXPECT_EQ(EmitterGuidingCache::kFloor, kEmitterFoldFloor);
+  EXPECT_EQ(EmitterGuidingCache::kPseudoSamplesPerPatch, kEmitterFoldPseudoSamplesPerPatch);
+  EXPECT_EQ(EmitterGuidingCache::kMinSecondMomentGain, kEmitterFoldMinSecondMomentGain);
+  std::vector<double> learned = {2.0, 0.0, 0.0, 0.0};
+  const std::vector<float> defaults(4, 0.25f);
+  std::vector<float> cdf(5, -1.0f);
+  EmitterFoldRecord r{};
+  r.punctual_learned = learned.data();
+  r.punctual_default = defaults.data();
+  r.punctual_cdf = cdf.data();
+  EXPECT_EQ(emitter_fold_rebuild_punctual(r, 4, 0.5f), 0.5f);
+  EXPECT_EQ(cdf[0], 0.0f);
+  EXPECT_FLOAT_EQ(cdf[1], 0.925f);
+  EXPECT_NEAR(cdf[2] - cdf[1], 0.025f, 1e-7);  // a difference of floats near 0.95
+  EXPECT_EQ(cdf[4], 1.0f);
+  EXPECT_NEAR(emitter_fold_second_moment_gain(r, kEmitterFoldPunctual, 4, 0.5f), 3.43 / 1.4700193, 1e-5);
+  learned = {3.0, 1.0};
+  const std::vector<float> halves(2, 0.5f);
+  r.punctual_default = halves.data();
+  EXPECT_EQ(emitter_fold_rebuild_punctual(r, 2, 0.5f), 0.0f);
+  EXPECT_FLOAT_EQ(cdf[1], 0.9f * 0.75f + 0.05f);
+  EXPECT_NEAR(emitter_fold_second_moment_gain(r, kEmitterFoldPunctual, 2, 0.5f), 1.2025 / 1.0533243, 1e-5);
+  // Nothing learned: the default's CDF, not guided.
+  learned = {0.0, 0.0};
+  EXPECT_EQ(emitter_fold_rebuild_punctual(r, 2, 0.5f), 0.0f);
+  EXPECT_FLOAT_EQ(cdf[1], 0.5f);
+}
+
+// Patches pooled per cluster: cluster 0 = patches {0, 1} learned 1 : 0 from n = 8 samples (trust
+// 8 / (8 + 4 x 2) = 1/2: the shares 1/2 x learned + 1/2 x the cluster's sum spread by default power),
+// cluster 1 = patch {2} never reached (share 0). The fold adds fixed-point sums and counts.
+TEST(EmitterGuideFold, PatchSharesArePooledPerClusterByTrust) {
+  std::vector<double> learned(3, 0.0);
+  std::vector<uint32_t> samples(3, 0);
+  const double units = 1024.0;
+  emitter_fold_add(learned[0], uint64_t(2.0 * units), units);
+  samples[0] += 8;
+  EXPECT_EQ(learned[0], 2.0);
+  const std::vector<float> defaults = {0.25f, 0.25f, 0.5f};
+  const std::vector<uint32_t> clusters = {0, 2, 3};
+  std::vector<float> cdf(4, -1.0f);
+  EmitterFoldRecord r{};
+  r.learned = learned.data();
+  r.samples = samples.data();
+  r.default_probability = defaults.data();
+  r.cluster_first = clusters.data();
+  r.cdf = cdf.data();
+  const float guided = emitter_fold_rebuild_patches(r, 3, 2, 0.5f);
+  const double share0 = 0.5 * 1.0 + 0.5 * 0.5, share1 = 0.5 * 0.5;  // of the total 2
+  EXPECT_FLOAT_EQ(cdf[1], float(0.9 * share0 + 0.1 * 0.25));
+  EXPECT_FLOAT_EQ(cdf[2] - cdf[1], float(0.9 * share1 + 0.1 * 0.25));
+  EXPECT_FLOAT_EQ(cdf[3] - cdf[2], float(0.1 * 0.5));
+  EXPECT_EQ(cdf[3], 1.0f);
+  // q = (0.7, 0.25, 0.05) against p0 = (0.25, 0.25, 0.5): gain 2.215 / 1.29067 = 1.716 < 2.
+  EXPECT_NEAR(emitter_fold_second_moment_gain(r, kEmitterFoldPatches, 3, 0.5f), 2.215 / 1.2906699, 1e-5);
+  EXPECT_EQ(guided, 0.0f);
 }
 
 }  // namespace

@@ -97,6 +97,48 @@ void expect_device_learns_the_cpu_tables(const std::string& label, IntegratorSet
 
 TEST(VulkanEmitterGuiding, DeviceLearnsTheCpuTables) { expect_device_learns_the_cpu_tables("path", settings(64, 5, true)); }
 
+// The fold between passes runs on the device (fold_emitter_guide.comp) with the host's fold code
+// (common/emitter_guide_fold.h): the same run folded on the host (guide_fold_on_host) learns the same
+// tables up to float contraction, far inside the tables' own noise (two seeds), and the same records
+// end up sampling what they learned. On the box (two punctual lights and the lamp's patches) and on
+// the building (its 48 rooms' lamps and point and spot lights).
+void expect_device_fold_equals_host_fold(const std::string& label, const Scene& scene, const TexelGBuffer& gbuffer,
+                                         IntegratorSettings s) {
+  CREATE_VULKAN_OR_SKIP(vk, scene);
+  std::vector<std::vector<float>> device, host, other_seed;
+  s.inspect_emitter_guiding = [&](const EmitterGuidingCache& c) { device = learned_tables(c); };
+  const LightmapEstimate d = vk->bake(gbuffer, s);
+  s.guide_fold_on_host = true;
+  s.inspect_emitter_guiding = [&](const EmitterGuidingCache& c) { host = learned_tables(c); };
+  const LightmapEstimate h = vk->bake(gbuffer, s);
+  s.seed += 1;
+  s.inspect_emitter_guiding = [&](const EmitterGuidingCache& c) { other_seed = learned_tables(c); };
+  vk->bake(gbuffer, s);
+  ASSERT_EQ(device.size(), host.size());
+  ASSERT_GT(device.size(), 0u);
+  const double same = table_distance(device, host), noise = table_distance(host, other_seed);
+  std::printf("[vulkan emitter guided] %s: device fold vs host fold, one seed: tables %.3g apart (two seeds: %.3g); "
+              "records sampling learned: device %u, host %u of %u\n",
+              label.c_str(), same, noise, d.emitter_guiding.records_sampling_learned,
+              h.emitter_guiding.records_sampling_learned, d.emitter_guiding.records);
+  EXPECT_GT(noise, 0.0);
+  EXPECT_LE(same, 0.01 * noise);
+  EXPECT_GT(d.emitter_guiding.records_sampling_learned, 0u) << "guiding must engage";
+  EXPECT_EQ(d.emitter_guiding.records_sampling_learned, h.emitter_guiding.records_sampling_learned);
+  EXPECT_EQ(d.emitter_guiding.dropped, h.emitter_guiding.dropped);
+  EXPECT_EQ(d.nonfinite_samples, 0u);
+}
+
+TEST(VulkanEmitterGuiding, DeviceFoldEqualsTheHostFoldOnTheBox) {
+  const testing::AtlasScene box = testing::box_with_lights_outside();
+  expect_device_fold_equals_host_fold("box", box.scene, box.gbuffer, settings(64, 5, true));
+}
+
+TEST(VulkanEmitterGuiding, DeviceFoldEqualsTheHostFoldOnTheBuilding) {
+  const PreparedScene p = testing::prepared_sample("building", 0.5f);
+  expect_device_fold_equals_host_fold("building", p.scene, p.gbuffer, settings(32, 5, true));
+}
+
 // The texels' luminance variance across runs, summed, over their squared means, summed: texels in
 // the dark (mostly 0, once in a while a little light) weigh by their light, not by 1/mean^2.
 double relative_variance(const std::vector<std::vector<double>>& runs) {

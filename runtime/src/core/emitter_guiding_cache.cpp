@@ -16,19 +16,6 @@ namespace {
 // Back sum and count (one 16-byte accumulator), cumulative samples, cumulative sum, CDF entry.
 constexpr size_t kBytesPerRecordPatch = 16 + sizeof(uint32_t) + sizeof(double) + sizeof(float);
 
-// The direct light's second moment under the default over that under the mixture, if the learned
-// distribution (cdf) is the light's: how much the mixture can lower next-event variance.
-double second_moment_gain(const float* cdf, const float* default_probability, size_t cells, float mix) {
-  double under_default = 0, under_mixture = 0;
-  for (size_t k = 0; k < cells; ++k) {
-    const double q = double(cdf[k + 1]) - double(cdf[k]), p0 = default_probability[k];
-    const double mixture = mix * q + (1 - mix) * p0;
-    if (p0 > 0) under_default += q * q / p0;
-    if (mixture > 0) under_mixture += q * q / mixture;
-  }
-  return under_mixture > 0 ? under_default / under_mixture : 1.0;
-}
-
 }  // namespace
 
 EmitterPatches build_emitter_patches(const std::vector<double>& cdf, uint32_t target, uint32_t cluster_target) {
@@ -220,7 +207,7 @@ void EmitterGuidingCache::swap() {
             const uint64_t units = a.sum.load(std::memory_order_relaxed);
             a.sum.store(0, std::memory_order_relaxed);
             a.count.store(0, std::memory_order_relaxed);
-            learned_[r * patches + k] += double(units) / fixed_scale_;
+            emitter_fold_add(learned_[r * patches + k], units, fixed_scale_);
             samples_[r * patches + k] += count;
             changed = true;
           }
@@ -229,13 +216,31 @@ void EmitterGuidingCache::swap() {
             const uint64_t units = sum.load(std::memory_order_relaxed);
             if (units == 0) continue;
             sum.store(0, std::memory_order_relaxed);
-            punctual_learned_[r * punctual_count_ + i] += double(units) / fixed_scale_;
+            emitter_fold_add(punctual_learned_[r * punctual_count_ + i], units, fixed_scale_);
             changed = true;
           }
           if (changed) rebuild(uint32_t(r));
         }
       },
       16);
+}
+
+void EmitterGuidingCache::import_folded(uint32_t record, const double* learned, const uint32_t* samples, const float* cdf,
+                                        float guided_probability, const double* punctual_learned,
+                                        const float* punctual_cdf, float punctual_guided_probability) {
+  if (record >= record_count()) return;
+  const size_t patches = patch_count();
+  if (patches > 0) {
+    std::copy(learned, learned + patches, &learned_[size_t(record) * patches]);
+    std::copy(samples, samples + patches, &samples_[size_t(record) * patches]);
+    std::copy(cdf, cdf + patches + 1, &cdf_[size_t(record) * (patches + 1)]);
+    guided_probability_[record] = guided_probability;
+  }
+  if (punctual_count_ > 0) {
+    std::copy(punctual_learned, punctual_learned + punctual_count_, &punctual_learned_[size_t(record) * punctual_count_]);
+    std::copy(punctual_cdf, punctual_cdf + punctual_count_ + 1, &punctual_cdf_[size_t(record) * (punctual_count_ + 1)]);
+    punctual_guided_probability_[record] = punctual_guided_probability;
+  }
 }
 
 void EmitterGuidingCache::end_pass(uint32_t samples) {
@@ -253,55 +258,30 @@ void EmitterGuidingCache::report(LightmapEstimate::EmitterGuidingReport& out) co
   out.dropped = !active_;
 }
 
-void EmitterGuidingCache::rebuild(uint32_t record) {
-  std::vector<double> shares;  // learned shares of the cells; empty while nothing is learned
-  if (punctual_count_ > 0) {
-    const double* learned = &punctual_learned_[size_t(record) * punctual_count_];
-    double total = 0;
-    for (size_t i = 0; i < punctual_count_; ++i) total += learned[i];
-    shares.clear();
-    if (total > 0 && std::isfinite(total))
-      for (size_t i = 0; i < punctual_count_; ++i) shares.push_back(learned[i] / total);
-    punctual_guided_probability_[record] = fill_cdf(shares, punctual_default_.data(), punctual_count_,
-                                                    &punctual_cdf_[size_t(record) * (punctual_count_ + 1)]);
-  }
+EmitterFoldRecord EmitterGuidingCache::fold_record(uint32_t record) {
+  EmitterFoldRecord r{};
   const size_t patches = patch_count();
-  if (patches == 0) return;
-  const double* learned = &learned_[size_t(record) * patches];
-  const uint32_t* samples = &samples_[size_t(record) * patches];
-  double total = 0;
-  for (size_t k = 0; k < patches; ++k) total += learned[k];
-  shares.clear();
-  if (total > 0 && std::isfinite(total)) {
-    shares.resize(patches, 0.0);
-    for (uint32_t c = 0; c < patches_.cluster_count(); ++c) {
-      const uint32_t first = patches_.cluster_first[c], end = patches_.cluster_first[c + 1];
-      double cluster_sum = 0, cluster_default = 0, cluster_samples = 0;
-      for (uint32_t k = first; k < end; ++k)
-        cluster_sum += learned[k], cluster_default += patches_.default_probability[k], cluster_samples += samples[k];
-      if (!(cluster_sum > 0)) continue;
-      const double trust = cluster_samples / (cluster_samples + kPseudoSamplesPerPatch * double(end - first));
-      for (uint32_t k = first; k < end; ++k) {
-        const double spread = cluster_default > 0 ? patches_.default_probability[k] / cluster_default : 0.0;
-        shares[k] = (trust * learned[k] + (1 - trust) * cluster_sum * spread) / total;
-      }
-    }
+  if (patches > 0) {
+    r.learned = &learned_[size_t(record) * patches];
+    r.samples = &samples_[size_t(record) * patches];
+    r.default_probability = patches_.default_probability.data();
+    r.cluster_first = patches_.cluster_first.data();
+    r.cdf = &cdf_[size_t(record) * (patches + 1)];
   }
-  guided_probability_[record] =
-      fill_cdf(shares, patches_.default_probability.data(), patches, &cdf_[size_t(record) * (patches + 1)]);
+  if (punctual_count_ > 0) {
+    r.punctual_learned = &punctual_learned_[size_t(record) * punctual_count_];
+    r.punctual_default = punctual_default_.data();
+    r.punctual_cdf = &punctual_cdf_[size_t(record) * (punctual_count_ + 1)];
+  }
+  return r;
 }
 
-float EmitterGuidingCache::fill_cdf(const std::vector<double>& shares, const float* default_probability, size_t cells,
-                                    float* cdf) const {
-  double run = 0;
-  cdf[0] = 0;
-  for (size_t k = 0; k < cells; ++k) {
-    run += shares.empty() ? default_probability[k] : (1.0 - kFloor) * shares[k] + kFloor * default_probability[k];
-    cdf[k + 1] = float(std::min(run, 1.0));
-  }
-  cdf[cells] = 1.0f;
-  if (shares.empty() || second_moment_gain(cdf, default_probability, cells, config_.mix) < kMinSecondMomentGain) return 0.0f;
-  return config_.mix;
+void EmitterGuidingCache::rebuild(uint32_t record) {
+  // common/emitter_guide_fold.h: the device's fold (fold_emitter_guide.comp) runs the same code.
+  const EmitterFoldRecord r = fold_record(record);
+  if (punctual_count_ > 0) punctual_guided_probability_[record] = emitter_fold_rebuild_punctual(r, punctual_count_, config_.mix);
+  if (patch_count() > 0)
+    guided_probability_[record] = emitter_fold_rebuild_patches(r, patch_count(), patches_.cluster_count(), config_.mix);
 }
 
 uint32_t EmitterGuidingCache::records_sampling_learned() const {

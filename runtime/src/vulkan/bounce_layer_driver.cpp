@@ -32,7 +32,11 @@ BounceLayerDriver::~BounceLayerDriver() = default;
 
 void BounceLayerDriver::report(LightmapEstimate::EmitterGuidingReport& out) const {
   if (!emitter_guide_) return;
+  // Tables folded on the device reach the cache only for an inspector (LightmapDriver's rule).
+  if (settings_.inspect_emitter_guiding) emitter_buffer_->download_tables(runner_, *emitter_guide_);
   emitter_guide_->report(out);
+  if (emitter_buffer_->folded_on_device() && emitter_guide_->active())
+    out.records_sampling_learned = emitter_buffer_->records_sampling_learned();
   if (settings_.inspect_emitter_guiding) settings_.inspect_emitter_guiding(*emitter_guide_);
 }
 
@@ -281,8 +285,16 @@ void BounceLayerDriver::estimate(const BounceLayerPass& pass, const std::vector<
   WavefrontBuffers& buffers = runner_.buffers();
   // Emitter guiding: the previous passes' learning becomes this pass's front table (as the CPU's
   // estimator), before any whole upload of the cache buffer could clear its back tables.
-  if (emitter_guide_ && learned_samples_ > 0 && emitter_guide_->active())
-    emitter_buffer_->fold_learning(runner_, *emitter_guide_, learned_samples_);
+  // On the device unless asked otherwise or while the host builds the layer caches (a whole upload
+  // of the cache buffer then rewrites the section from the cache).
+  if (emitter_guide_ && learned_samples_ > 0 && emitter_guide_->active()) {
+    if (settings_.guide_fold_on_host || settings_.bounce_caches_on_host) {
+      emitter_buffer_->fold_learning_on_host(runner_, *emitter_guide_, learned_samples_);
+    } else {
+      if (!emitter_fold_) emitter_fold_ = std::make_unique<GuideFoldKernel>(runner_.context(), GuideFold::Emitter);
+      emitter_buffer_->fold_learning(runner_, *emitter_fold_, *emitter_guide_, learned_samples_);
+    }
+  }
   if (builds_caches())
     reserve_device_layers(size_t(pass.layer));  // the layers below pass.layer were built there
   else

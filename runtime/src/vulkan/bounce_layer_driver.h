@@ -70,6 +70,7 @@ class BounceLayerDriver final : public BounceLayerEstimator {
   // estimator does (cpu/cpu_bounce_integrator.cpp).
   std::unique_ptr<EmitterGuidingCache> emitter_guide_;
   std::unique_ptr<EmitterGuideBuffer> emitter_buffer_;
+  std::unique_ptr<GuideFoldKernel> emitter_fold_;  // made by the first device fold
   uint32_t learned_samples_ = 0;
   // Device-built caches (bounce_cache.comp): the kernel, per live texel its page texel, position and
   // normal (uploaded once), the means of the layer being built, a fill flag per page texel, the pages.

@@ -101,7 +101,7 @@ void GuideBuffer::upload(WavefrontBatchRunner& runner) const {
 }
 
 void GuideBuffer::fold_learning(WavefrontBatchRunner& runner, GuideFoldKernel& kernel) {
-  kernel.fold(runner.buffers().probes.sh_sums, records_, mix_);
+  kernel.fold_grid(runner.buffers().probes.sh_sums, records_, mix_);
 }
 
 void GuideBuffer::fold_learning_on_host(WavefrontBatchRunner& runner, GridGuidingCache& cache) {

@@ -427,13 +427,19 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     if (learning && settings.guide_fold_on_host) {
       guide_buffer->fold_learning_on_host(runner_, *guide);
     } else if (learning) {  // this pass's learning is the next pass's table, folded on the device
-      if (!guide_fold_) guide_fold_ = std::make_unique<GuideFoldKernel>(runner_.context());
+      if (!guide_fold_) guide_fold_ = std::make_unique<GuideFoldKernel>(runner_.context(), GuideFold::Grid);
       guide_buffer->fold_learning(runner_, *guide_fold_);
     }
     if (emitter_buffer && a.params.emitter_guide != 0u) {
       const auto fold_start = Clock::now();
-      if (!emitter_buffer->fold_learning(runner_, *emitter_guide, first + pass))
-        a.params.emitter_guide = 0;  // no record gains: the default sampling from here, as on the CPU
+      bool active = false;
+      if (settings.guide_fold_on_host) {
+        active = emitter_buffer->fold_learning_on_host(runner_, *emitter_guide, first + pass);
+      } else {  // folded on the device: the next pass reads the new tables
+        if (!emitter_fold_) emitter_fold_ = std::make_unique<GuideFoldKernel>(runner_.context(), GuideFold::Emitter);
+        active = emitter_buffer->fold_learning(runner_, *emitter_fold_, *emitter_guide, first + pass);
+      }
+      if (!active) a.params.emitter_guide = 0;  // no record gains: the default sampling from here, as on the CPU
       emitter_costs.fold_seconds += std::chrono::duration<double>(Clock::now() - fold_start).count();
       ++emitter_costs.folds;
     }
@@ -483,7 +489,12 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   if (svo_guide && settings.inspect_svo_guiding) settings.inspect_svo_guiding(*svo_guide);
   if (emitter_guide) {
     estimate.emitter_guiding = emitter_costs;  // the host's seconds; report() fills in the cache's part
+    // Tables folded on the device reach the cache only for an inspector; the report counts the
+    // records sampling what they learned from the last fold.
+    if (settings.inspect_emitter_guiding) emitter_buffer->download_tables(runner_, *emitter_guide);
     emitter_guide->report(estimate.emitter_guiding);
+    if (emitter_buffer->folded_on_device() && emitter_guide->active())
+      estimate.emitter_guiding.records_sampling_learned = emitter_buffer->records_sampling_learned();
     if (settings.inspect_emitter_guiding) settings.inspect_emitter_guiding(*emitter_guide);
   }
   if (settings.work_share) settings.work_share->work.rays += estimate.rays;

@@ -118,7 +118,8 @@ class LightmapDriver {
   WavefrontBatchRunner& runner_;
   GuidingScene guiding_scene_;
   std::optional<Accumulation> progressive_;
-  std::unique_ptr<GuideFoldKernel> guide_fold_;  // made by the first grid-guided bake
+  std::unique_ptr<GuideFoldKernel> guide_fold_;    // made by the first grid-guided bake
+  std::unique_ptr<GuideFoldKernel> emitter_fold_;  // made by the first emitter-guided bake
 };
 
 }  // namespace exitance::vulkan

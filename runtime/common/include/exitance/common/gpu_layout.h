@@ -270,10 +270,18 @@ const uint kGuideNoRecord = 0xFFFFFFFFu;
 //             triangle its emitter (guided_emitters.h EmitterGuide's tables)
 //   front     per record 2 floats: the area lights' and the punctual lights' guided probability
 //   cdf       per record patch_count + 1 floats; punctual cdf: per record punctual_count + 1 floats
+//   fold      what the fold reads besides the learned sums: per patch its default probability
+//             (float), per punctual light its default probability, per cluster its first patch then
+//             the patch count (EmitterPatches::cluster_first)
 //   back      per record and patch kGuideBackWords (fixed-point sum lo, hi; count); punctual back: per
 //             record and light 2 words (sum lo, hi). Added to by integer atomics when a vertex that
-//             learns (EmitterGuidingCache::learning of its sample) sees its shadow ray arrive; read,
-//             folded (EmitterGuidingCache::import_learned + end_pass) and cleared between passes.
+//             learns (EmitterGuidingCache::learning of its sample) sees its shadow ray arrive; between
+//             passes fold_emitter_guide.comp folds and clears them (common/emitter_guide_fold.h,
+//             EmitterGuidingCache::swap's code) and rewrites front and cdf, counting the records that
+//             sample what they learned in header word kEmitterGuideSampling
+//   learned   per record and patch kEmitterGuideLearnedWords: cumulative learned sum (a double as
+//             lo, hi words) and unoccluded samples; punctual learned: per record and light the sum
+//             (a double). The fold's state, on the device alone; read back once, at the end of a bake.
 // Per path, the vertex's emitter record and what its shadow rays learn wait in path_throughput
 // [2P + 2p] and [2P + 2p + 1] (record, patch, value, punctual light; punctual value, learns) from
 // next-event estimation to the connect stage, and the record until the continuation's hit is shaded
@@ -292,9 +300,19 @@ const uint kEmitterGuideBack = 10u;
 const uint kEmitterGuidePunctualBack = 11u;
 const uint kEmitterGuideFixedUnits = 12u;  // + 13: the double's lo, hi words
 const uint kEmitterGuideFixedCap = 14u;
-const uint kEmitterGuideHeaderWords = 16u;
+const uint kEmitterGuideDefault = 15u;          // per patch its default probability
+const uint kEmitterGuidePunctualDefault = 16u;  // per punctual light its default probability
+const uint kEmitterGuideClusterFirst = 17u;     // cluster count + 1 words
+const uint kEmitterGuideClusters = 18u;
+const uint kEmitterGuideMix = 19u;              // float: the learned share where a record gains
+const uint kEmitterGuideLearned = 20u;
+const uint kEmitterGuidePunctualLearned = 21u;
+const uint kEmitterGuideSampling = 22u;         // the fold's count of records sampling what they learned
+const uint kEmitterGuideHeaderWords = 24u;
 const uint kEmitterGuideFrontWords = 2u;
 const uint kEmitterGuidePunctualBackWords = 2u;
+const uint kEmitterGuideLearnedWords = 3u;
+const uint kEmitterGuidePunctualLearnedWords = 2u;
 const uint kGuidingSample = 1u;         // GpuParams::guiding: vertices sample the front table's mixture
 const uint kGuidingLearn = 2u;          // and their continuation rays add to the back table
 const uint kGuidingCount = 4u;          // SVO locator: vertices count themselves per (node, class)

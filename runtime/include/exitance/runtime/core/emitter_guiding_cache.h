@@ -24,6 +24,7 @@
 #include <memory>
 #include <vector>
 
+#include "exitance/common/emitter_guide_fold.h"
 #include "exitance/common/guided_emitters.h"
 #include "exitance/runtime/core/estimates.h"
 #include "exitance/runtime/core/guide_grid_locator.h"
@@ -57,6 +58,8 @@ EmitterPatches build_emitter_patches(const std::vector<double>& emitter_cdf, uin
 class EmitterGuidingCache {
  public:
   static constexpr uint32_t kNoRecord = GuideGridLocator::kNoRecord;
+  // The fold (common/emitter_guide_fold.h, shared with the device) reads its own copies of these
+  // three (a const float there is not a constant expression here): EmitterGuideFold.* checks they agree.
   static constexpr float kFloor = 0.1f;  // of each record's distribution, spread as the default sampling
   static constexpr double kPseudoSamplesPerPatch = 4;
   // A record samples its learned distribution only where that can lower next-event variance enough
@@ -119,6 +122,18 @@ class EmitterGuidingCache {
   const std::vector<uint32_t>& triangle_emitter() const { return triangle_emitter_; }
   // Between passes: folds the sums learned since the last swap into the front tables.
   void swap();
+  // Overwrites `record`'s tables with those a fold elsewhere built (the Vulkan backend's
+  // fold_emitter_guide.comp: the same fold, common/emitter_guide_fold.h), so report(), probability()
+  // and the inspectors read what that backend sampled: per patch the cumulative learned sums and
+  // samples and the CDF (patch_count + 1), per punctual light the learned sums and the CDF
+  // (punctual_count + 1), and the two guided probabilities. Null arrays where the count is 0.
+  void import_folded(uint32_t record, const double* learned, const uint32_t* samples, const float* cdf,
+                     float guided_probability, const double* punctual_learned, const float* punctual_cdf,
+                     float punctual_guided_probability);
+  // The cache stopped where its tables are folded elsewhere (as end_pass stops it here).
+  void deactivate() { active_ = false; }
+  float mix() const { return config_.mix; }
+  const std::vector<float>& punctual_default() const { return punctual_default_; }
   // After a pass that brought texels to `samples` samples each: swap(), and past
   // kEveryLearningSamples, where no record samples a learned distribution (every light seen whole,
   // as in the Cornell room), the cache stops: inactive, its vertices take the default's code path
@@ -142,11 +157,9 @@ class EmitterGuidingCache {
   size_t memory_bytes() const;
 
  private:
+  // The record's CDFs and guided probabilities from its learned sums (common/emitter_guide_fold.h).
   void rebuild(uint32_t record);
-  // Fills cdf (cells + 1 values) with (1 - kFloor) x shares + kFloor x the default (the default alone
-  // while `shares` is empty); returns the guided probability: config mix where that gains
-  // kMinSecondMomentGain, else 0.
-  float fill_cdf(const std::vector<double>& shares, const float* default_probability, size_t cells, float* cdf) const;
+  EmitterFoldRecord fold_record(uint32_t record);
 
   EmitterGuidingConfig config_;
   bool active_ = true;

@@ -55,9 +55,9 @@ struct IntegratorSettings {
   // Bounces mode on the Vulkan backend: build the layer caches on the host and upload them (the path
   // before the device built them; the same pages bit for bit), for the equivalence test and benches.
   bool bounce_caches_on_host = false;
-  // Grid guiding on the Vulkan backend: fold the learned sums on the host between learning passes
-  // (read back, GridGuidingCache::swap, upload: the path before fold_guide.comp), for the
-  // equivalence test and benches.
+  // Grid and emitter guiding on the Vulkan backend: fold the learned sums on the host between
+  // learning passes (read back, GridGuidingCache::swap or EmitterGuidingCache::end_pass, upload: the
+  // path before fold_guide.comp and fold_emitter_guide.comp), for the equivalence tests and benches.
   bool guide_fold_on_host = false;
   int max_bounces = -1;            // diffuse bounces after the first hit; -1 = until Russian roulette
   uint64_t seed = 0;
