@@ -8,7 +8,8 @@
 # with the cache's build, learning and folds) and compared with the reference (bench_bundle_rel_mse:
 # relMSE, the reference's noise subtracted). With a second runtime packed (rt_before: an A/B of a
 # change), every guided run is repeated with it, alternated.
-#   bash .replay/emitter_guiding_gpu_run.sh       (env BUNDLES, TIMES, SPPS; writes $OUT/summary.txt)
+#   bash .replay/emitter_guiding_gpu_run.sh       (env BUNDLES, TIMES, SPPS, STAGES=0 for no per-stage
+#                                                  runs; writes $OUT/summary.txt as it goes)
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
 export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
@@ -44,7 +45,7 @@ print('$name', 'lighting_s %.3f'%r['lighting_seconds'], 'spp', r['samples_per_te
   done
   # Per wavefront stage at 256 spp, unguided and guided (GPU seconds beside the lighting seconds: the
   # rest is the folds' host work and idle device).
-  for mode in off on; do
+  for mode in $([ "${STAGES:-1}" = 1 ] && echo off on); do
     $R $B -o $W/stages.bake --seed 3 --spp 256 --emitter-guiding $mode --stage-statistics $common > $W/stages.json
     python3 -c "
 import json; r=json.load(open('$W/stages.json')); g=sum(s['gpu_seconds'] for s in r['stages'])

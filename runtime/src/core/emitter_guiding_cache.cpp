@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "exitance/formats/huge_pages.h"
 #include "exitance/runtime/core/grid_guiding_cache.h"
@@ -95,30 +96,55 @@ EmitterGuidingCache::EmitterGuidingCache(const LightingScene& scene, const Texel
   guided_probability_.assign(records, 0.0f);
   // Tens of MB at a million texels: zeros first touched in huge pages where the kernel allows.
   formats::resize_in_huge_pages(cdf_, records * (patches + 1));
-  formats::resize_in_huge_pages(learned_, records * patches);
-  formats::resize_in_huge_pages(samples_, records * patches);
-  back_.reset(new Accumulator[records * patches]);
   if (scene.punctual_count() >= 2 && scene.punctual_count() <= kMostGuidedPunctualLights) {
     punctual_count_ = scene.punctual_count();
     for (uint32_t i = 0; i < punctual_count_; ++i)
       punctual_default_.push_back(float(scene.punctual_cdf[i + 1] - scene.punctual_cdf[i]));
     punctual_guided_probability_.assign(records, 0.0f);
     punctual_cdf_.assign(records * (punctual_count_ + 1), 0.0f);
-    punctual_learned_.assign(records * punctual_count_, 0.0);
-    punctual_back_.reset(new std::atomic<uint64_t>[records * punctual_count_]);
-    for (size_t i = 0; i < records * punctual_count_; ++i) punctual_back_[i].store(0, std::memory_order_relaxed);
   }
-  // Each record's tables are its own (as in swap): on all cores.
+  if (config_.learns_on_host) {  // the learned sums and the back tables (a device fold keeps its own)
+    allocate_learned();
+    back_.reset(new Accumulator[records * patches]);
+    if (punctual_count_ > 0) {
+      punctual_back_.reset(new std::atomic<uint64_t>[records * punctual_count_]);
+      for (size_t i = 0; i < records * punctual_count_; ++i) punctual_back_[i].store(0, std::memory_order_relaxed);
+    }
+  }
+  if (records == 0) return;
+  // Nothing learned yet: every record's tables are the same default ones, built once for record 0
+  // from zero sums and copied to the others on all cores.
+  const std::vector<double> zeros(std::max<size_t>(std::max<size_t>(patches, punctual_count_), 1), 0.0);
+  const std::vector<uint32_t> zero_samples(std::max<size_t>(patches, 1), 0u);
+  EmitterFoldRecord first = fold_record(0);
+  first.learned = zeros.data(), first.samples = zero_samples.data(), first.punctual_learned = zeros.data();
+  rebuild(0, first);
   for_each_chunk(records, [&](size_t begin, size_t end) {
-    for (size_t r = begin; r < end; ++r) rebuild(uint32_t(r));
-  }, 16);
+    for (size_t r = std::max<size_t>(begin, 1); r < end; ++r) {
+      std::copy(cdf_.begin(), cdf_.begin() + std::ptrdiff_t(patches + 1), cdf_.begin() + std::ptrdiff_t(r * (patches + 1)));
+      guided_probability_[r] = guided_probability_[0];
+      if (punctual_count_ == 0) continue;
+      std::copy(punctual_cdf_.begin(), punctual_cdf_.begin() + std::ptrdiff_t(punctual_count_ + 1),
+                punctual_cdf_.begin() + std::ptrdiff_t(r * (punctual_count_ + 1)));
+      punctual_guided_probability_[r] = punctual_guided_probability_[0];
+    }
+  }, 64);
+}
+
+void EmitterGuidingCache::allocate_learned() {
+  const size_t records = record_count();
+  formats::resize_in_huge_pages(learned_, records * patch_count());
+  formats::resize_in_huge_pages(samples_, records * patch_count());
+  punctual_learned_.assign(records * punctual_count_, 0.0);
 }
 
 std::unique_ptr<EmitterGuidingCache> EmitterGuidingCache::for_bake(const LightingScene& scene,
                                                                   const TexelGBuffer& gbuffer,
-                                                                  const IntegratorSettings& settings) {
+                                                                  const IntegratorSettings& settings,
+                                                                  bool learns_on_host) {
   if (!settings.emitter_guiding || (scene.emitter_count() == 0 && scene.punctual_count() < 2)) return nullptr;
   EmitterGuidingConfig config;
+  config.learns_on_host = learns_on_host;
   config.mix = settings.emitter_guiding_mix;
   config.cells_on_longest_axis = settings.guiding_grid_cells;
   config.patch_target = settings.emitter_guiding_patches;
@@ -181,6 +207,7 @@ void EmitterGuidingCache::learn_punctual(uint32_t record, uint32_t light, float 
 }
 
 void EmitterGuidingCache::import_learned(uint32_t record, uint32_t patch, uint64_t fixed_sum, uint32_t count) {
+  if (!config_.learns_on_host) throw std::logic_error("EmitterGuidingCache::import_learned: a cache made for a device fold");
   if (record >= record_count() || patch >= patch_count() || count == 0) return;
   Accumulator& a = back_[size_t(record) * patch_count() + patch];
   a.sum.fetch_add(fixed_sum, std::memory_order_relaxed);
@@ -188,11 +215,13 @@ void EmitterGuidingCache::import_learned(uint32_t record, uint32_t patch, uint64
 }
 
 void EmitterGuidingCache::import_learned_punctual(uint32_t record, uint32_t light, uint64_t fixed_sum) {
+  if (!config_.learns_on_host) throw std::logic_error("EmitterGuidingCache::import_learned_punctual: a cache made for a device fold");
   if (record >= record_count() || light >= punctual_count_ || fixed_sum == 0) return;
   punctual_back_[size_t(record) * punctual_count_ + light].fetch_add(fixed_sum, std::memory_order_relaxed);
 }
 
 void EmitterGuidingCache::swap() {
+  if (!config_.learns_on_host) throw std::logic_error("EmitterGuidingCache::swap: a cache made for a device fold");
   // Records are independent (each folds and rebuilds only its own rows): on all cores.
   const size_t patches = patch_count();
   for_each_chunk(
@@ -219,7 +248,7 @@ void EmitterGuidingCache::swap() {
             emitter_fold_add(punctual_learned_[r * punctual_count_ + i], units, fixed_scale_);
             changed = true;
           }
-          if (changed) rebuild(uint32_t(r));
+          if (changed) rebuild(uint32_t(r), fold_record(uint32_t(r)));
         }
       },
       16);
@@ -229,6 +258,7 @@ void EmitterGuidingCache::import_folded(uint32_t record, const double* learned, 
                                         float guided_probability, const double* punctual_learned,
                                         const float* punctual_cdf, float punctual_guided_probability) {
   if (record >= record_count()) return;
+  if (!config_.learns_on_host && learned_.size() + punctual_learned_.size() == 0) allocate_learned();
   const size_t patches = patch_count();
   if (patches > 0) {
     std::copy(learned, learned + patches, &learned_[size_t(record) * patches]);
@@ -276,9 +306,8 @@ EmitterFoldRecord EmitterGuidingCache::fold_record(uint32_t record) {
   return r;
 }
 
-void EmitterGuidingCache::rebuild(uint32_t record) {
+void EmitterGuidingCache::rebuild(uint32_t record, const EmitterFoldRecord& r) {
   // common/emitter_guide_fold.h: the device's fold (fold_emitter_guide.comp) runs the same code.
-  const EmitterFoldRecord r = fold_record(record);
   if (punctual_count_ > 0) punctual_guided_probability_[record] = emitter_fold_rebuild_punctual(r, punctual_count_, config_.mix);
   if (patch_count() > 0)
     guided_probability_[record] = emitter_fold_rebuild_patches(r, patch_count(), patches_.cluster_count(), config_.mix);

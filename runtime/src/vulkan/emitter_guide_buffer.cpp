@@ -22,7 +22,11 @@ std::unique_ptr<EmitterGuidingCache> emitter_guide_for_device(const std::shared_
   if (lighting->emitter_triangles != device_scene.emitter_triangles() || lighting->punctual_count() != device_scene.punctual_count())
     throw std::invalid_argument("Vulkan backend: --emitter-guiding on: the device's scene was edited since the integrator was made; "
                                 "emitter guiding bakes the scene it was made on");
-  return EmitterGuidingCache::for_bake(*lighting, gbuffer, settings);
+  // Folded on the device unless asked otherwise (LightmapDriver, BounceLayerDriver): then the
+  // host's cache keeps no back tables or learned sums (~100 MB at a million texels, first touched
+  // in its setup).
+  return EmitterGuidingCache::for_bake(*lighting, gbuffer, settings,
+                                       settings.guide_fold_on_host || settings.bounce_caches_on_host);
 }
 
 EmitterGuideBuffer::EmitterGuideBuffer(const EmitterGuidingCache& cache, size_t base)
@@ -147,30 +151,26 @@ void EmitterGuideBuffer::download_tables(WavefrontBatchRunner& runner, EmitterGu
   const size_t cdf_at = words_[kEmitterGuideCdf] - base_ - front_;
   const size_t punctual_cdf_at = words_[kEmitterGuidePunctualCdf] - base_ - front_;
   const size_t punctual_learned_at = words_[kEmitterGuidePunctualLearned] - base_ - back_end_;
-  for_each_chunk(
-      records_,
-      [&](size_t first, size_t end) {
-        std::vector<double> sums(patches_), punctual_sums(punctual_);
-        std::vector<uint32_t> samples(patches_);
-        std::vector<float> cdf(patches_ + 1), punctual_cdf(punctual_ + 1);
-        for (size_t r = first; r < end; ++r) {
-          for (uint32_t k = 0; k < patches_; ++k) {
-            const uint32_t* w = &learned[(r * patches_ + k) * kEmitterGuideLearnedWords];
-            sums[k] = std::bit_cast<double>(uint64_t(w[0]) | (uint64_t(w[1]) << 32));
-            samples[k] = w[2];
-          }
-          for (uint32_t i = 0; i < punctual_; ++i) {
-            const uint32_t* w = &learned[punctual_learned_at + (r * punctual_ + i) * kEmitterGuidePunctualLearnedWords];
-            punctual_sums[i] = std::bit_cast<double>(uint64_t(w[0]) | (uint64_t(w[1]) << 32));
-          }
-          std::memcpy(cdf.data(), &tables[cdf_at + r * (patches_ + 1)], patches_ > 0 ? cdf.size() * 4 : 0);
-          std::memcpy(punctual_cdf.data(), &tables[punctual_cdf_at + r * (punctual_ + 1)], punctual_ > 0 ? punctual_cdf.size() * 4 : 0);
-          const uint32_t* f = &tables[r * kEmitterGuideFrontWords];
-          cache.import_folded(uint32_t(r), sums.data(), samples.data(), cdf.data(), std::bit_cast<float>(f[0]),
-                              punctual_sums.data(), punctual_cdf.data(), std::bit_cast<float>(f[1]));
-        }
-      },
-      16);
+  // One thread: the cache allocates its learned tables on the first import (an inspector's path).
+  std::vector<double> sums(patches_), punctual_sums(punctual_);
+  std::vector<uint32_t> samples(patches_);
+  std::vector<float> cdf(patches_ + 1), punctual_cdf(punctual_ + 1);
+  for (size_t r = 0; r < records_; ++r) {
+    for (uint32_t k = 0; k < patches_; ++k) {
+      const uint32_t* w = &learned[(r * patches_ + k) * kEmitterGuideLearnedWords];
+      sums[k] = std::bit_cast<double>(uint64_t(w[0]) | (uint64_t(w[1]) << 32));
+      samples[k] = w[2];
+    }
+    for (uint32_t i = 0; i < punctual_; ++i) {
+      const uint32_t* w = &learned[punctual_learned_at + (r * punctual_ + i) * kEmitterGuidePunctualLearnedWords];
+      punctual_sums[i] = std::bit_cast<double>(uint64_t(w[0]) | (uint64_t(w[1]) << 32));
+    }
+    std::memcpy(cdf.data(), &tables[cdf_at + r * (patches_ + 1)], patches_ > 0 ? cdf.size() * 4 : 0);
+    std::memcpy(punctual_cdf.data(), &tables[punctual_cdf_at + r * (punctual_ + 1)], punctual_ > 0 ? punctual_cdf.size() * 4 : 0);
+    const uint32_t* f = &tables[r * kEmitterGuideFrontWords];
+    cache.import_folded(uint32_t(r), sums.data(), samples.data(), cdf.data(), std::bit_cast<float>(f[0]),
+                        punctual_sums.data(), punctual_cdf.data(), std::bit_cast<float>(f[1]));
+  }
 }
 
 bool EmitterGuideBuffer::fold_learning_on_host(WavefrontBatchRunner& runner, EmitterGuidingCache& cache, uint32_t samples) {

@@ -39,6 +39,10 @@ struct EmitterGuidingConfig {
   int cells_on_longest_axis = 16;   // the guiding grid (GuideGridLocator)
   uint32_t patch_target = 512;      // about this many patches (fewer when the tables would pass kMemoryBudget)
   uint32_t cluster_target = 64;     // about this many clusters (EmitterPatches::cluster_first)
+  // false: the tables are learned and folded elsewhere (the Vulkan backend's device fold): the cache
+  // holds no back tables and no learned sums until import_folded brings them (learn, import_learned
+  // and swap are then refused).
+  bool learns_on_host = true;
 };
 
 // The patch tables of an emitter list (guided_emitters.h): built from its power CDF alone.
@@ -75,7 +79,7 @@ class EmitterGuidingCache {
   // The cache a bake's settings ask for (both CPU estimators): null when settings.emitter_guiding is
   // off or the scene has nothing to guide (no emitter triangle and fewer than two punctual lights).
   static std::unique_ptr<EmitterGuidingCache> for_bake(const LightingScene& scene, const TexelGBuffer& gbuffer,
-                                                       const IntegratorSettings& settings);
+                                                       const IntegratorSettings& settings, bool learns_on_host = true);
 
   // Which vertices of a texel's sample `sample` teach the tables: every vertex in its first
   // kEveryLearningSamples; after them, one sample in kLaterLearningStride, at vertices whose record
@@ -126,7 +130,9 @@ class EmitterGuidingCache {
   // fold_emitter_guide.comp: the same fold, common/emitter_guide_fold.h), so report(), probability()
   // and the inspectors read what that backend sampled: per patch the cumulative learned sums and
   // samples and the CDF (patch_count + 1), per punctual light the learned sums and the CDF
-  // (punctual_count + 1), and the two guided probabilities. Null arrays where the count is 0.
+  // (punctual_count + 1), and the two guided probabilities. Null arrays where the count is 0. On a
+  // cache made with learns_on_host false its first call allocates the learned tables: call it from
+  // one thread.
   void import_folded(uint32_t record, const double* learned, const uint32_t* samples, const float* cdf,
                      float guided_probability, const double* punctual_learned, const float* punctual_cdf,
                      float punctual_guided_probability);
@@ -158,8 +164,9 @@ class EmitterGuidingCache {
 
  private:
   // The record's CDFs and guided probabilities from its learned sums (common/emitter_guide_fold.h).
-  void rebuild(uint32_t record);
+  void rebuild(uint32_t record, const EmitterFoldRecord& rows);
   EmitterFoldRecord fold_record(uint32_t record);
+  void allocate_learned();  // learned_, samples_, punctual_learned_ at 0
 
   EmitterGuidingConfig config_;
   bool active_ = true;
