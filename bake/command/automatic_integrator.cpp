@@ -16,8 +16,8 @@ IntegratorMode automatic_integrator(const BakeOptions& options, const Integrator
 
 GuidingMode automatic_guiding(const BakeOptions& options, const Integrator& backend) {
   if (options.lighting.guiding != GuidingMode::Auto) return options.lighting.guiding;
-  // Vulkan: only when asked for, since its pilot costs (the guide's learning passes are host round
-  // trips: a guided GPU bake costs 22-38x the time per spp, bench/results/guiding-gpu.md).
+  // Vulkan: only when asked for, since its pilot costs and a guided GPU bake still loses at equal
+  // time on the sample scenes (its learning passes, bench/results/guiding-gpu.md).
   const bool backend_measures = backend.backend_name() == "cpu" || (backend.backend_name() == "vulkan" && options.guiding_auto_given);
   const bool measured_choice = backend_measures && options.lighting.integrator == IntegratorMode::Path &&
                                !distributed(options.lighting.work_share);
