@@ -165,8 +165,9 @@ void EmitterGuideBuffer::download_tables(WavefrontBatchRunner& runner, EmitterGu
       const uint32_t* w = &learned[punctual_learned_at + (r * punctual_ + i) * kEmitterGuidePunctualLearnedWords];
       punctual_sums[i] = std::bit_cast<double>(uint64_t(w[0]) | (uint64_t(w[1]) << 32));
     }
-    std::memcpy(cdf.data(), &tables[cdf_at + r * (patches_ + 1)], patches_ > 0 ? cdf.size() * 4 : 0);
-    std::memcpy(punctual_cdf.data(), &tables[punctual_cdf_at + r * (punctual_ + 1)], punctual_ > 0 ? punctual_cdf.size() * 4 : 0);
+    if (patches_ > 0) std::memcpy(cdf.data(), tables.data() + cdf_at + r * (patches_ + 1), cdf.size() * 4);
+    if (punctual_ > 0)
+      std::memcpy(punctual_cdf.data(), tables.data() + punctual_cdf_at + r * (punctual_ + 1), punctual_cdf.size() * 4);
     const uint32_t* f = &tables[r * kEmitterGuideFrontWords];
     cache.import_folded(uint32_t(r), sums.data(), samples.data(), cdf.data(), std::bit_cast<float>(f[0]),
                         punctual_sums.data(), punctual_cdf.data(), std::bit_cast<float>(f[1]));
