@@ -292,14 +292,15 @@ EmitterFoldRecord EmitterGuidingCache::fold_record(uint32_t record) {
   EmitterFoldRecord r{};
   const size_t patches = patch_count();
   if (patches > 0) {
-    r.learned = &learned_[size_t(record) * patches];
-    r.samples = &samples_[size_t(record) * patches];
+    // data() + offset: on a cache made for a device fold these are empty until an import.
+    r.learned = learned_.data() + size_t(record) * patches;
+    r.samples = samples_.data() + size_t(record) * patches;
     r.default_probability = patches_.default_probability.data();
     r.cluster_first = patches_.cluster_first.data();
     r.cdf = &cdf_[size_t(record) * (patches + 1)];
   }
   if (punctual_count_ > 0) {
-    r.punctual_learned = &punctual_learned_[size_t(record) * punctual_count_];
+    r.punctual_learned = punctual_learned_.data() + size_t(record) * punctual_count_;
     r.punctual_default = punctual_default_.data();
     r.punctual_cdf = &punctual_cdf_[size_t(record) * (punctual_count_ + 1)];
   }
