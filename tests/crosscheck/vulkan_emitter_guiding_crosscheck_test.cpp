@@ -63,6 +63,38 @@ double table_distance(const std::vector<std::vector<float>>& a, const std::vecto
   return a.empty() ? 0.0 : sum / double(a.size());
 }
 
+// One bake's learned tables (learned_tables) and estimate.
+struct LearnedRun {
+  std::vector<std::vector<float>> tables;
+  LightmapEstimate estimate;
+};
+template <class Backend>
+LearnedRun learned_run(Backend& backend, const TexelGBuffer& gbuffer, IntegratorSettings s) {
+  LearnedRun run;
+  s.inspect_emitter_guiding = [&](const EmitterGuidingCache& c) { run.tables = learned_tables(c); };
+  run.estimate = backend.bake(gbuffer, s);
+  return run;
+}
+
+// Run `a` learned run `b`'s tables with one seed: their distance at most `share` of the distance
+// between `b`'s tables and `other_seed`'s (the same as `b` with another seed: the tables' own
+// noise), and the same records sampling what they learned.
+void expect_same_tables(const std::string& what, const LearnedRun& a, const LearnedRun& b, const LearnedRun& other_seed,
+                        double share) {
+  ASSERT_EQ(a.tables.size(), b.tables.size());
+  ASSERT_GT(a.tables.size(), 0u);
+  const double same = table_distance(a.tables, b.tables), noise = table_distance(b.tables, other_seed.tables);
+  std::printf("[vulkan emitter guided] %s: one seed, tables %.3g apart (two seeds: %.3g); records sampling learned: "
+              "%u and %u of %u\n",
+              what.c_str(), same, noise, a.estimate.emitter_guiding.records_sampling_learned,
+              b.estimate.emitter_guiding.records_sampling_learned, a.estimate.emitter_guiding.records);
+  EXPECT_GT(noise, 0.0);
+  EXPECT_LE(same, share * noise) << what;
+  EXPECT_EQ(a.estimate.emitter_guiding.records_sampling_learned, b.estimate.emitter_guiding.records_sampling_learned) << what;
+  EXPECT_EQ(a.estimate.emitter_guiding.dropped, b.estimate.emitter_guiding.dropped) << what;
+  EXPECT_EQ(a.estimate.nonfinite_samples, 0u);
+}
+
 // The device learns the CPU's tables: with one seed both backends draw the same random numbers,
 // learn the same values in the same fixed-point units at the same vertices (the shared schedule)
 // and fold them with the same code after the same passes, so the tables differ only where float
@@ -74,25 +106,12 @@ void expect_device_learns_the_cpu_tables(const std::string& label, IntegratorSet
   const testing::AtlasScene box = testing::box_with_lights_outside();
   CREATE_VULKAN_OR_SKIP(vk, box.scene);
   const CpuReferenceIntegrator cpu(box.scene);
-  std::vector<std::vector<float>> device, host, other_seed;
-  s.inspect_emitter_guiding = [&](const EmitterGuidingCache& c) { device = learned_tables(c); };
-  const LightmapEstimate d = vk->bake(box.gbuffer, s);
-  s.inspect_emitter_guiding = [&](const EmitterGuidingCache& c) { host = learned_tables(c); };
-  const LightmapEstimate h = cpu.bake(box.gbuffer, s);
+  const LearnedRun device = learned_run(*vk.operator->(), box.gbuffer, s);
+  const LearnedRun host = learned_run(cpu, box.gbuffer, s);
   s.seed += 1;
-  s.inspect_emitter_guiding = [&](const EmitterGuidingCache& c) { other_seed = learned_tables(c); };
-  cpu.bake(box.gbuffer, s);
-  ASSERT_EQ(device.size(), host.size());
-  ASSERT_GT(device.size(), 0u);
-  const double same = table_distance(device, host), noise = table_distance(host, other_seed);
-  std::printf("[vulkan emitter guided] %s tables: device vs CPU, one seed %.3g; CPU vs CPU, two seeds %.3g; records "
-              "sampling learned: device %u, CPU %u of %u\n",
-              label.c_str(), same, noise, d.emitter_guiding.records_sampling_learned,
-              h.emitter_guiding.records_sampling_learned, d.emitter_guiding.records);
-  EXPECT_GT(noise, 0.0);
-  EXPECT_LE(same, 0.05 * noise);
-  EXPECT_GT(d.emitter_guiding.records_sampling_learned, d.emitter_guiding.records / 2) << "guiding must engage";
-  EXPECT_EQ(d.emitter_guiding.records_sampling_learned, h.emitter_guiding.records_sampling_learned);
+  expect_same_tables(label + " tables, device vs CPU", device, host, learned_run(cpu, box.gbuffer, s), 0.05);
+  EXPECT_GT(device.estimate.emitter_guiding.records_sampling_learned, device.estimate.emitter_guiding.records / 2)
+      << "guiding must engage";
 }
 
 TEST(VulkanEmitterGuiding, DeviceLearnsTheCpuTables) { expect_device_learns_the_cpu_tables("path", settings(64, 5, true)); }
@@ -105,28 +124,12 @@ TEST(VulkanEmitterGuiding, DeviceLearnsTheCpuTables) { expect_device_learns_the_
 void expect_device_fold_equals_host_fold(const std::string& label, const Scene& scene, const TexelGBuffer& gbuffer,
                                          IntegratorSettings s) {
   CREATE_VULKAN_OR_SKIP(vk, scene);
-  std::vector<std::vector<float>> device, host, other_seed;
-  s.inspect_emitter_guiding = [&](const EmitterGuidingCache& c) { device = learned_tables(c); };
-  const LightmapEstimate d = vk->bake(gbuffer, s);
+  const LearnedRun device = learned_run(*vk.operator->(), gbuffer, s);
   s.guide_fold_on_host = true;
-  s.inspect_emitter_guiding = [&](const EmitterGuidingCache& c) { host = learned_tables(c); };
-  const LightmapEstimate h = vk->bake(gbuffer, s);
+  const LearnedRun host = learned_run(*vk.operator->(), gbuffer, s);
   s.seed += 1;
-  s.inspect_emitter_guiding = [&](const EmitterGuidingCache& c) { other_seed = learned_tables(c); };
-  vk->bake(gbuffer, s);
-  ASSERT_EQ(device.size(), host.size());
-  ASSERT_GT(device.size(), 0u);
-  const double same = table_distance(device, host), noise = table_distance(host, other_seed);
-  std::printf("[vulkan emitter guided] %s: device fold vs host fold, one seed: tables %.3g apart (two seeds: %.3g); "
-              "records sampling learned: device %u, host %u of %u\n",
-              label.c_str(), same, noise, d.emitter_guiding.records_sampling_learned,
-              h.emitter_guiding.records_sampling_learned, d.emitter_guiding.records);
-  EXPECT_GT(noise, 0.0);
-  EXPECT_LE(same, 0.01 * noise);
-  EXPECT_GT(d.emitter_guiding.records_sampling_learned, 0u) << "guiding must engage";
-  EXPECT_EQ(d.emitter_guiding.records_sampling_learned, h.emitter_guiding.records_sampling_learned);
-  EXPECT_EQ(d.emitter_guiding.dropped, h.emitter_guiding.dropped);
-  EXPECT_EQ(d.nonfinite_samples, 0u);
+  expect_same_tables(label + ", device fold vs host fold", device, host, learned_run(*vk.operator->(), gbuffer, s), 0.01);
+  EXPECT_GT(device.estimate.emitter_guiding.records_sampling_learned, 0u) << "guiding must engage";
 }
 
 TEST(VulkanEmitterGuiding, DeviceFoldEqualsTheHostFoldOnTheBox) {
