@@ -31,13 +31,7 @@ float word_bits(uint32_t u) {
 BounceLayerDriver::~BounceLayerDriver() = default;
 
 void BounceLayerDriver::report(LightmapEstimate::EmitterGuidingReport& out) const {
-  if (!emitter_guide_) return;
-  // Tables folded on the device reach the cache only for an inspector (LightmapDriver's rule).
-  if (settings_.inspect_emitter_guiding) emitter_buffer_->download_tables(runner_, *emitter_guide_);
-  emitter_guide_->report(out);
-  if (emitter_buffer_->folded_on_device() && emitter_guide_->active())
-    out.records_sampling_learned = emitter_buffer_->records_sampling_learned();
-  if (settings_.inspect_emitter_guiding) settings_.inspect_emitter_guiding(*emitter_guide_);
+  if (emitter_guide_) emitter_buffer_->report(runner_, *emitter_guide_, settings_, out);
 }
 
 BounceLayerDriver::BounceLayerDriver(WavefrontBatchRunner& runner, std::shared_ptr<const Scene> source,

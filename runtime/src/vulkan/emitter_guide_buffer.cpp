@@ -174,6 +174,14 @@ void EmitterGuideBuffer::download_tables(WavefrontBatchRunner& runner, EmitterGu
   }
 }
 
+void EmitterGuideBuffer::report(WavefrontBatchRunner& runner, EmitterGuidingCache& cache, const IntegratorSettings& settings,
+                                LightmapEstimate::EmitterGuidingReport& out) const {
+  if (settings.inspect_emitter_guiding) download_tables(runner, cache);
+  cache.report(out);
+  if (folded_on_device_ && cache.active()) out.records_sampling_learned = sampling_records_;
+  if (settings.inspect_emitter_guiding) settings.inspect_emitter_guiding(cache);
+}
+
 bool EmitterGuideBuffer::fold_learning_on_host(WavefrontBatchRunner& runner, EmitterGuidingCache& cache, uint32_t samples) {
   Context& context = runner.context();
   const Buffer& buffer = runner.buffers().probes.sh_sums;

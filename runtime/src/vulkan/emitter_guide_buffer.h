@@ -49,14 +49,16 @@ class EmitterGuideBuffer {
   // The same on the host: the back sums read back into `cache` (import_learned), its end_pass, the
   // back sums cleared on the device and the new front tables uploaded.
   bool fold_learning_on_host(WavefrontBatchRunner& runner, EmitterGuidingCache& cache, uint32_t samples);
+  // `cache`'s report (EmitterGuidingCache::report) as the device folded it, for both drivers: with
+  // an inspector (settings.inspect_emitter_guiding) the device's tables imported first and the
+  // inspector called; without, the records sampling what they learned from the last device fold.
+  void report(WavefrontBatchRunner& runner, EmitterGuidingCache& cache, const IntegratorSettings& settings,
+              LightmapEstimate::EmitterGuidingReport& out) const;
+
+ private:
   // After device folds: their tables into `cache` (import_folded), for the inspectors (tens of MB:
   // only when a test asks).
   void download_tables(WavefrontBatchRunner& runner, EmitterGuidingCache& cache) const;
-  // The records sampling what they learned after the last fold (the report's records_sampling_learned).
-  uint32_t records_sampling_learned() const { return sampling_records_; }
-  bool folded_on_device() const { return folded_on_device_; }
-
- private:
   // The front tables and CDFs, words [front_, back_) of the section, written from `at_front` on.
   void pack_front(const EmitterGuidingCache& cache, uint32_t* at_front) const;
   // Section words [from, end) at 0 on the device.

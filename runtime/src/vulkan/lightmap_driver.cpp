@@ -489,13 +489,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   if (svo_guide && settings.inspect_svo_guiding) settings.inspect_svo_guiding(*svo_guide);
   if (emitter_guide) {
     estimate.emitter_guiding = emitter_costs;  // the host's seconds; report() fills in the cache's part
-    // Tables folded on the device reach the cache only for an inspector; the report counts the
-    // records sampling what they learned from the last fold.
-    if (settings.inspect_emitter_guiding) emitter_buffer->download_tables(runner_, *emitter_guide);
-    emitter_guide->report(estimate.emitter_guiding);
-    if (emitter_buffer->folded_on_device() && emitter_guide->active())
-      estimate.emitter_guiding.records_sampling_learned = emitter_buffer->records_sampling_learned();
-    if (settings.inspect_emitter_guiding) settings.inspect_emitter_guiding(*emitter_guide);
+    emitter_buffer->report(runner_, *emitter_guide, settings, estimate.emitter_guiding);
   }
   if (settings.work_share) settings.work_share->work.rays += estimate.rays;
   if (share) {
