@@ -41,7 +41,9 @@ bool PassScheduler::next_pass_here(uint32_t& begin, uint32_t& count, double* fra
   if (stopped_ || done_ >= limit_) return false;
   uint32_t pass = std::min(limit_ - done_, policy_.largest_pass);
   if (policy_.ramp && done_ < policy_.ramp_below) {
-    pass = std::min(pass, done_ < 4 ? 1u : (done_ < 64 ? 4u : 16u));
+    const uint32_t ramp_step = done_ < 4 ? 1u : (done_ < policy_.doubling_below ? done_ : (done_ < 64 ? 4u : 16u));
+    pass = std::min(pass, ramp_step);
+    if (done_ < policy_.doubling_below) pass = std::min(pass, policy_.doubling_below - done_);
     pass = std::min(pass, policy_.ramp_below - done_);  // the ramp's last pass ends where it stops
   }
   if (policy_.stratified_set > 0 && timed())

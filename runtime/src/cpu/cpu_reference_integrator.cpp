@@ -286,6 +286,9 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   // Started first, so the time budget covers the allocations below too.
   PassPolicy policy;
   policy.ramp = true;  // small passes early so progress and the time budget are honoured; larger later
+  // Emitter guiding folds after every pass: while every vertex learns, passes that double (the
+  // Vulkan backend's schedule too, so both fold after the same samples).
+  if (settings.emitter_guiding) policy.doubling_below = EmitterGuidingCache::kEveryLearningSamples;
   PassScheduler passes(settings, policy);
   const size_t texel_count = gbuffer.texels.size();
   LightmapEstimate estimate;
@@ -330,7 +333,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
                                                    });
     if (svo_guide->seeded()) svo_guide->rebuild(nullptr, 0, settings.seed);
   }
-  // Emitter guiding: learned from every pass's next-event samples, folded after each pass.
+  // Emitter guiding: learned from every pass's next-event samples, folded where folds_after says.
   const std::unique_ptr<EmitterGuidingCache> emitter_guide = EmitterGuidingCache::for_bake(*impl_->lighting, gbuffer, settings);
   if (emitter_guide && share)
     throw std::invalid_argument("CPU backend: --emitter-guiding runs in one process only, not under mpirun with several ranks");
@@ -481,7 +484,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       }
     }
     if (learning) guide->swap();  // this pass's learning becomes the next pass's frozen table
-    if (emitter_guide) emitter_guide->end_pass(first + count);
+    if (emitter_guide && EmitterGuidingCache::folds_after(first + count)) emitter_guide->end_pass(first + count);
     if (svo_guide && svo_counting) {  // this pass reached the next rebuild and counted its vertices
       svo_guide->rebuild(&estimate, double(count) * fraction, settings.seed);
       svo_next_rebuild = 2 * (first + count);

@@ -391,12 +391,14 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   if (guide && !policy.ramp) policy.ramp = true, policy.ramp_below = choice ? choice->pilot() : GridGuidingCache::kLearningSamples;
   // SVO: ramped throughout, as on the CPU, so its rebuilds (1, 2, 4, ... spp) end passes of the same sizes.
   if (svo_guide) policy.ramp = true, policy.ramp_below = PassPolicy{}.ramp_below;
-  // Emitter guiding: ramped while every vertex learns, so its tables fold after the same samples as
-  // the CPU's; after that passes as large as fill the work items, under a time budget too (later
-  // samples learn only where a record samples what it learned, and fold after each pass: a fold
-  // reads back and uploads tens of MB, and the budget's 16-sample passes paid one per 16 samples;
-  // the budget still cuts the last pass). With grid guiding beside it, grid's ramp applies.
+  // Emitter guiding: ramped while every vertex learns, in passes that double as the CPU's do, and
+  // folded where EmitterGuidingCache::folds_after says (1, 2, 3, 4, 8, 16, 32, 64 samples: the
+  // CPU's points, whatever the work items cut a pass to); after that passes as large as fill the
+  // work items, under a time budget too (later samples learn only where a record samples what it
+  // learned, and fold after each pass; the budget still cuts the last pass). With grid guiding
+  // beside it, grid's ramp applies.
   if (emitter_guide && (!guide || !policy.ramp)) policy.ramp = true, policy.ramp_below = EmitterGuidingCache::kEveryLearningSamples;
+  if (settings.emitter_guiding) policy.doubling_below = EmitterGuidingCache::kEveryLearningSamples;
   PassScheduler passes(settings, policy);
   // The estimate is hundreds of MB at millions of texels: a thread allocates it and touches its
   // pages, and makes the read-back's pinned staging buffer, while the host waits on the device's
@@ -430,7 +432,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
       if (!guide_fold_) guide_fold_ = std::make_unique<GuideFoldKernel>(runner_.context(), GuideFold::Grid);
       guide_buffer->fold_learning(runner_, *guide_fold_);
     }
-    if (emitter_buffer && a.params.emitter_guide != 0u) {
+    if (emitter_buffer && a.params.emitter_guide != 0u && EmitterGuidingCache::folds_after(first + pass)) {
       const auto fold_start = Clock::now();
       bool active = false;
       if (settings.guide_fold_on_host) {

@@ -91,6 +91,14 @@ class EmitterGuidingCache {
   static constexpr uint32_t kEveryLearningSamples = kEmitterEveryLearningSamples;
   static constexpr uint32_t kLaterLearningStride = kEmitterLaterLearningStride;
   static Learning learning(uint32_t sample) { return Learning(emitter_learning_of_sample(sample)); }
+  // Whether path tracing folds the tables (end_pass) once texels hold `samples` samples: at 1, 2, 3,
+  // 4, 8, 16, 32 and 64 while every vertex learns, then after every pass. Both backends fold there
+  // whatever their pass sizes (a Vulkan pass is bounded by its work items, a CPU pass by the time
+  // budget), so the same seed learns the same tables; each fold on the device is a dispatch and a
+  // wait (bench/results/emitter-guiding.md: 19 folds to 64 samples became 8).
+  static bool folds_after(uint32_t samples) {
+    return samples >= kEveryLearningSamples || samples <= 4 || (samples & (samples - 1)) == 0;
+  }
 
 
   uint32_t record_of(Vec3 position, Vec3 shading_normal) const;

@@ -17,6 +17,11 @@ struct PassPolicy {
   // The ramp applies while fewer samples than this are done (a backend that needs the small passes
   // only early, e.g. Vulkan grid guiding's learning passes, then runs its largest).
   uint32_t ramp_below = 0xFFFFFFFFu;
+  // > 0: within the ramp, from 4 samples until this many, each pass doubles the samples done (4, 8,
+  // 16, 32, ...) instead of adding 4: a learner that folds its tables after every pass (emitter
+  // guiding) then folds at 1, 2, 3, 4, 8, 16, 32, 64 samples, 8 passes where the ramp took 19 (each
+  // pass a wait on the device and a fold: bench/results/emitter-guiding.md).
+  uint32_t doubling_below = 0;
   // > 0: when a budget may stop the run, passes end on multiples of this and the budget is checked
   // only there (probes: a stopped run never leaves a stratified set's strata out).
   uint32_t stratified_set = 0;
