@@ -351,11 +351,28 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   std::optional<EmitterGuideBuffer> emitter_buffer;
   LightmapEstimate::EmitterGuidingReport emitter_costs;  // its host seconds (setup, folds)
   const auto emitter_setup_start = Clock::now();
+  bool learning_grown = false;  // the path state grown for the learning (the descriptors must follow)
   if (settings.emitter_guiding) {
     if (share) throw std::invalid_argument("Vulkan backend: --emitter-guiding runs in one process only, not under mpirun with several ranks");
     if (svo_guide)
       throw std::invalid_argument("Vulkan backend: --emitter-guiding on with --guiding svo is implemented on the CPU backend only");
-    emitter_guide = emitter_guide_for_device(guiding_scene_.lighting, runner_.scene(), gbuffer, settings);
+    // The host's cache (19-21 ms at a million texels on an H100's host) is made on a thread while the
+    // device allocates the learning's path state (64 B per path slot; with the guide buffer's growth
+    // 30-37 ms: bench/results/emitter-guiding.md), which does not depend on it.
+    std::future<std::unique_ptr<EmitterGuidingCache>> made = std::async(std::launch::async, [&] {
+      return emitter_guide_for_device(guiding_scene_.lighting, runner_.scene(), gbuffer, settings);
+    });
+    const LightingScene* lighting = guiding_scene_.lighting.get();
+    if (lighting && (lighting->emitter_count() > 0 || lighting->punctual_count() >= 2))  // for_bake's test: a cache will exist
+      learning_grown = runner_.buffers().paths.reserve_emitter_learning(runner_.context());
+    // A grown buffer replaced the one the descriptors name: bound again whatever happens next.
+    try {
+      emitter_guide = made.get();
+    } catch (...) {
+      if (learning_grown) runner_.bind_buffers();
+      throw;
+    }
+    if (!emitter_guide && learning_grown) runner_.bind_buffers();
   }
   if (emitter_guide) {
     Context& context = runner_.context();
@@ -366,7 +383,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
       throw std::runtime_error("Vulkan backend: --emitter-guiding on: the guide buffer (" + std::to_string(bytes) +
                                " bytes) passes the device's largest storage buffer (use fewer --guiding-grid-cells or "
                                "--emitter-guiding-patches)");
-    bool rebind = buffers.paths.reserve_emitter_learning(context);
+    bool rebind = buffers.paths.reserve_emitter_learning(context) || learning_grown;
     if (buffers.probes.sh_sums.size() < bytes) {
       buffers.probes.reserve_bytes(context, bytes);  // a new buffer: the other guide's words again
       rebind = true;
