@@ -6,7 +6,8 @@
 # one packed): a two-seed 4096-spp unguided reference (seeds 101, 202), then both modes at equal
 # lighting time (TIMES seconds, --time) and at equal samples (SPPS), each timed (lighting seconds,
 # with the cache's build, learning and folds) and compared with the reference (bench_bundle_rel_mse:
-# relMSE, the reference's noise subtracted). With a second runtime packed (rt_before: an A/B of a
+# relMSE, the reference's noise subtracted; read_back_s: the progressive relight's download of the
+# estimate, which the one-run guided mode counts in its lighting seconds). With a second runtime packed (rt_before: an A/B of a
 # change), every guided run is repeated with it, alternated.
 #   bash .replay/emitter_guiding_gpu_run.sh       (env BUNDLES, TIMES, SPPS, STAGES=0 for no per-stage
 #                                                  runs; writes $OUT/summary.txt as it goes)
@@ -32,7 +33,7 @@ for b in ${BUNDLES:-$(cd $W && ls -d *.bake | sed 's/\.bake$//')}; do
     $W/$rt/bin/exitance-relight $B -o $W/$name.bake --seed 3 $common "$@" > $W/$name.json
     python3 -c "
 import json; r=json.load(open('$W/$name.json'))
-print('$name', 'lighting_s %.3f'%r['lighting_seconds'], 'spp', r['samples_per_texel'], 'rays %.3g'%r['rays'], 'rays_per_s %.3g'%r['rays_per_second'], 'guide', r.get('emitter_guiding'))" >> $S  # its setup_seconds, folds, fold_seconds: the host's part
+print('$name', 'lighting_s %.3f'%r['lighting_seconds'], 'read_back_s %.3f'%r['seconds'].get('read_back', 0), 'spp', r['samples_per_texel'], 'rays %.3g'%r['rays'], 'rays_per_s %.3g'%r['rays_per_second'], 'guide', r.get('emitter_guiding'))" >> $S  # its setup_seconds, folds, fold_seconds: the host's part
     list="$list $W/$name.bake"
   }
   for t in ${TIMES:-0.25 1 4}; do
