@@ -7,7 +7,7 @@
 # lighting time (TIMES seconds, --time) and at equal samples (SPPS), each timed (lighting seconds,
 # with the cache's build, learning and folds) and compared with the reference (bench_bundle_rel_mse:
 # relMSE, the reference's noise subtracted; read_back_s: the progressive relight's download of the
-# estimate, which the one-run guided mode counts in its lighting seconds). With a second runtime packed (rt_before: an A/B of a
+# estimate, which the one-run guided mode counts in its lighting seconds, after its budget's passes). With a second runtime packed (rt_before: an A/B of a
 # change), every guided run is repeated with it, alternated.
 #   bash .replay/emitter_guiding_gpu_run.sh       (env BUNDLES, TIMES, SPPS, STAGES=0 for no per-stage
 #                                                  runs; writes $OUT/summary.txt as it goes)
