@@ -142,7 +142,7 @@ std::unique_ptr<EmitterGuidingCache> EmitterGuidingCache::for_bake(const Lightin
                                                                   const TexelGBuffer& gbuffer,
                                                                   const IntegratorSettings& settings,
                                                                   bool learns_on_host) {
-  if (!settings.emitter_guiding || (scene.emitter_count() == 0 && scene.punctual_count() < 2)) return nullptr;
+  if (!settings.emitter_guiding || !guides(scene)) return nullptr;
   EmitterGuidingConfig config;
   config.learns_on_host = learns_on_host;
   config.mix = settings.emitter_guiding_mix;
@@ -150,6 +150,8 @@ std::unique_ptr<EmitterGuidingCache> EmitterGuidingCache::for_bake(const Lightin
   config.patch_target = settings.emitter_guiding_patches;
   return std::make_unique<EmitterGuidingCache>(scene, gbuffer, config);
 }
+
+bool EmitterGuidingCache::guides(const LightingScene& scene) { return scene.emitter_count() > 0 || scene.punctual_count() >= 2; }
 
 uint32_t EmitterGuidingCache::record_of(Vec3 position, Vec3 shading_normal) const {
   return patch_count() > 0 || punctual_count_ > 0 ? locator_.record_of(position, shading_normal) : kNoRecord;

@@ -286,8 +286,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   // Started first, so the time budget covers the allocations below too.
   PassPolicy policy;
   policy.ramp = true;  // small passes early so progress and the time budget are honoured; larger later
-  // Emitter guiding folds after every pass: while every vertex learns, passes that double (the
-  // Vulkan backend's schedule too, so both fold after the same samples).
+  // Emitter guiding folds at EmitterGuidingCache::folds_after's points: while every vertex learns,
+  // passes that double to reach them (the Vulkan backend's schedule too).
   if (settings.emitter_guiding) policy.doubling_below = EmitterGuidingCache::kEveryLearningSamples;
   PassScheduler passes(settings, policy);
   const size_t texel_count = gbuffer.texels.size();

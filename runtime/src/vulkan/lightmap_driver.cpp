@@ -351,7 +351,6 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   std::optional<EmitterGuideBuffer> emitter_buffer;
   LightmapEstimate::EmitterGuidingReport emitter_costs;  // its host seconds (setup, folds)
   const auto emitter_setup_start = Clock::now();
-  bool learning_grown = false;  // the path state grown for the learning (the descriptors must follow)
   if (settings.emitter_guiding) {
     if (share) throw std::invalid_argument("Vulkan backend: --emitter-guiding runs in one process only, not under mpirun with several ranks");
     if (svo_guide)
@@ -362,17 +361,11 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     std::future<std::unique_ptr<EmitterGuidingCache>> made = std::async(std::launch::async, [&] {
       return emitter_guide_for_device(guiding_scene_.lighting, runner_.scene(), gbuffer, settings);
     });
+    // A grown buffer replaces the one the descriptors name: they follow it at once.
     const LightingScene* lighting = guiding_scene_.lighting.get();
-    if (lighting && (lighting->emitter_count() > 0 || lighting->punctual_count() >= 2))  // for_bake's test: a cache will exist
-      learning_grown = runner_.buffers().paths.reserve_emitter_learning(runner_.context());
-    // A grown buffer replaced the one the descriptors name: bound again whatever happens next.
-    try {
-      emitter_guide = made.get();
-    } catch (...) {
-      if (learning_grown) runner_.bind_buffers();
-      throw;
-    }
-    if (!emitter_guide && learning_grown) runner_.bind_buffers();
+    if (lighting && EmitterGuidingCache::guides(*lighting) && runner_.buffers().paths.reserve_emitter_learning(runner_.context()))
+      runner_.bind_buffers();
+    emitter_guide = made.get();
   }
   if (emitter_guide) {
     Context& context = runner_.context();
@@ -383,13 +376,11 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
       throw std::runtime_error("Vulkan backend: --emitter-guiding on: the guide buffer (" + std::to_string(bytes) +
                                " bytes) passes the device's largest storage buffer (use fewer --guiding-grid-cells or "
                                "--emitter-guiding-patches)");
-    bool rebind = buffers.paths.reserve_emitter_learning(context) || learning_grown;
     if (buffers.probes.sh_sums.size() < bytes) {
       buffers.probes.reserve_bytes(context, bytes);  // a new buffer: the other guide's words again
-      rebind = true;
       if (guide_buffer) guide_buffer->upload(runner_);
+      runner_.bind_buffers();
     }
-    if (rebind) runner_.bind_buffers();
     if (!guide_buffer) {  // no other guide: a header of zeros (no locator, no auto sections)
       const std::vector<uint32_t> header(kGuideHeaderWords, 0u);
       context.upload(buffers.probes.sh_sums, header.data(), header.size() * 4);

@@ -80,6 +80,9 @@ class EmitterGuidingCache {
   // off or the scene has nothing to guide (no emitter triangle and fewer than two punctual lights).
   static std::unique_ptr<EmitterGuidingCache> for_bake(const LightingScene& scene, const TexelGBuffer& gbuffer,
                                                        const IntegratorSettings& settings, bool learns_on_host = true);
+  // Whether `scene` has anything to guide (an emitter triangle or two punctual lights): for_bake
+  // makes a cache exactly then, when emitter guiding is on.
+  static bool guides(const LightingScene& scene);
 
   // Which vertices of a texel's sample `sample` teach the tables: every vertex in its first
   // kEveryLearningSamples; after them, one sample in kLaterLearningStride, at vertices whose record
