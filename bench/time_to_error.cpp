@@ -2,7 +2,7 @@
 // content hash outside the repository) is the reference; runs at doubling spp record seconds,
 // relMSE, MAE, worst-texel error and rays/s as CSV, and the time to reach a target relMSE.
 //
-//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,adaptive,bounces,guided,svo,guided_auto,nee,guided_nee,svo_nee,bounces_nee] [--guiding-mix M] [--name NAME]
+//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,adaptive,bounces,guided,svo,guided_auto,nee,guided_nee,svo_nee,bounces_nee,light] [--guiding-mix M] [--name NAME]
 //                       [--sky R,G,B] [--texel-density T] [--reference-spp N] [--max-spp N]
 //                       [--max-seconds S] [--target 0.01] [--bounces N] [--min-spp N] [--cache DIR] [--csv FILE]
 //                       [--texel-csv FILE] [--guiding-fields FILE] [--samplers sobol,independent]
@@ -93,13 +93,15 @@ int main(int argc, char** argv) {
                  "comma-separated: path, adaptive (path with adaptive sampling; spp = mean), bounces, bounces_cached "
                  "(bounces with --first-bounce cached), guided (path with --guiding grid), svo (path with --guiding svo), "
                  "guided_auto (path with --guiding auto), nee / guided_nee / svo_nee / bounces_nee (path, guided, "
-                 "svo and bounces with --emitter-guiding on)");
+                 "svo and bounces with --emitter-guiding on), light / light_nee (path with --light-paths on, without and with --emitter-guiding on)");
   float guiding_mix = 0.5f;
   app.add_option("--guiding-mix", guiding_mix, "guided component's probability (guided runs)");
   float emitter_guiding_mix = 0.5f;
   uint32_t emitter_guiding_patches = 512;
   app.add_option("--emitter-guiding-mix", emitter_guiding_mix, "learned next-event component's probability (*nee runs)");
   app.add_option("--emitter-guiding-patches", emitter_guiding_patches, "about this many emitter patches (*nee runs)");
+  double light_subpaths_per_sample = 0.25;
+  app.add_option("--light-subpaths-per-sample", light_subpaths_per_sample, "light subpaths per texel sample (light runs)");
   std::string guiding_fields;
   app.add_option("--guiding-fields", guiding_fields,
                  "CSV of the learned grid guiding tables of the last guided run (record, cell, class, bins); svo "
@@ -205,6 +207,7 @@ int main(int argc, char** argv) {
     uint32_t sampler = kSamplerSobol;
     bool trace_first_bounce = true;  // bounces: B_1 traced (true) or read from the B_0 lightmap
     bool emitter_guiding = false;
+    bool light_subpaths = false;
   };
   std::vector<Mode> modes;
   auto listed = [&](const std::string& name) {
@@ -230,6 +233,10 @@ int main(int argc, char** argv) {
     octree = build_sparse_voxel_octree(scene, build);
     std::cerr << "svo guiding octree: depth " << build.depth << ", " << octree.nodes.size() << " nodes\n";
   }
+  // Light subpaths connected to every path vertex (--light-paths on).
+  if (listed("light")) modes.push_back({IntegratorMode::Path, GuidingMode::Off, "path_light_subpaths", false, kSamplerSobol, true, false, true});
+  if (listed("light_nee"))
+    modes.push_back({IntegratorMode::Path, GuidingMode::Off, "path_light_subpaths_nee", false, kSamplerSobol, true, true, true});
   if (listed("bounces")) modes.push_back({IntegratorMode::Bounces, GuidingMode::Off, "per_bounce"});
   if (listed("bounces_nee"))
     modes.push_back({IntegratorMode::Bounces, GuidingMode::Off, "per_bounce_nee", false, kSamplerSobol, true, true});
@@ -273,6 +280,8 @@ int main(int argc, char** argv) {
         settings.guiding = m.guiding;
         settings.guiding_mix = guiding_mix;
         settings.emitter_guiding = m.emitter_guiding;
+        settings.light_subpaths = m.light_subpaths;
+        settings.light_subpaths_per_sample = light_subpaths_per_sample;
         settings.emitter_guiding_mix = emitter_guiding_mix;
         settings.emitter_guiding_patches = emitter_guiding_patches;
         settings.guiding_octree = &octree;

@@ -211,7 +211,12 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
   const char* guiding_names[] = {"off", "grid", "svo", "auto"};
   stats["lighting"] = {{"integrator", options.lighting.integrator == IntegratorMode::Bounces ? "bounces" : "path"},
                        {"guiding", guiding_names[int(options.lighting.guiding)]},
-                       {"emitter_guiding", options.lighting.emitter_guiding}};
+                       {"emitter_guiding", options.lighting.emitter_guiding},
+                       {"light_paths", options.lighting.light_subpaths}};
+  if (options.lighting.light_subpaths)
+    stats["light_paths"] = {{"subpaths", estimate.light_subpaths},
+                            {"vertices", estimate.light_subpath_vertices},
+                            {"per_sample", options.lighting.light_subpaths_per_sample}};
   if (results.denoise)
     stats["denoise"] = {{"radius", options.denoise_radius},
                         {"texels", results.denoise->texels},

@@ -13,11 +13,11 @@ namespace {
 // guiding_octree (the bake's own octree, from the hashed voxel options), the inspect callbacks,
 // budget_clock (the time budget's clock; the budget itself is hashed) and bounce_caches_on_host
 // (where the per-bounce caches are built: the same pages bit for bit).
-static_assert(sizeof(IntegratorSettings) == 320, "IntegratorSettings changed: hash the new field in bake_cache_key");
+static_assert(sizeof(IntegratorSettings) == 336, "IntegratorSettings changed: hash the new field in bake_cache_key");
 static_assert(sizeof(AtlasSettings) == 24, "AtlasSettings changed: hash the new field in bake_cache_key");
 // Not hashed: input and output paths (the input's name and bytes are), cache_directory and
 // write_gltf (where results go does not change them), progress.
-static_assert(sizeof(BakeOptions) == 624, "BakeOptions changed: hash the new field in bake_cache_key (or say why not)");
+static_assert(sizeof(BakeOptions) == 640, "BakeOptions changed: hash the new field in bake_cache_key (or say why not)");
 static_assert(sizeof(ImportOptions) == 8, "ImportOptions changed: hash the new field in bake_cache_key");
 static_assert(sizeof(Material) == 168, "Material changed: hash the new field in bake_cache_key");
 static_assert(sizeof(PunctualLight) == 88, "PunctualLight changed: hash the new field in bake_cache_key");
@@ -80,6 +80,7 @@ void hash_options(Sha256Stream& h, const BakeOptions& o) {
   h.value(l.guiding_svo_c_ray), h.value(l.guiding_svo_rays_per_bin), h.value(l.guiding_svo_emitted);
   h.value(l.guiding_svo_texels);
   h.value(l.emitter_guiding), h.value(l.emitter_guiding_mix), h.value(l.emitter_guiding_patches);
+  h.value(l.light_subpaths), h.value(l.light_subpaths_per_sample);
   h.value(o.bounce_layers), h.value(o.probes_enabled), h.value(o.probe_spacing), h.value(o.probe_spp);
   h.value(o.probe_sh_window), h.value(o.svo_enabled), h.value(o.voxel_resolution);
   h.value(o.skip_sealed_texels), h.value(o.stitch_seams), h.value(o.denoise), h.value(o.denoise_radius);

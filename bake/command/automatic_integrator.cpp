@@ -11,11 +11,13 @@ IntegratorMode automatic_integrator(const BakeOptions& options, const Integrator
   // A guide the user names guides path tracing, so auto picks it (auto guiding does not ask for it).
   if (options.lighting.guiding == GuidingMode::Grid || options.lighting.guiding == GuidingMode::Svo) return IntegratorMode::Path;
   if (options.adaptive_request == AdaptiveRequest::On) return IntegratorMode::Path;
+  if (options.lighting.light_subpaths) return IntegratorMode::Path;  // connections are path-tracing strategies
   return IntegratorMode::Bounces;
 }
 
 GuidingMode automatic_guiding(const BakeOptions& options, const Integrator& backend) {
   if (options.lighting.guiding != GuidingMode::Auto) return options.lighting.guiding;
+  if (options.lighting.light_subpaths) return GuidingMode::Off;  // not combined with guided vertices yet
   // Vulkan: only when asked for, since its pilot costs and a guided GPU bake still loses at equal
   // time on the sample scenes (its learning passes, bench/results/guiding-gpu.md).
   const bool backend_measures = backend.backend_name() == "cpu" || (backend.backend_name() == "vulkan" && options.guiding_auto_given);

@@ -123,6 +123,10 @@ std::shared_ptr<const Integrator> backend_stage(const SceneForLighting& scene, c
     request.name = "cpu";
     diagnostics.warn("--adaptive on: using the CPU reference (Embree), the only backend with adaptive sampling yet");
   }
+  if (options.lighting.light_subpaths && request.name == "auto") {
+    request.name = "cpu";
+    diagnostics.warn("--light-paths on: using the CPU reference (Embree), the only backend with light subpaths yet");
+  }
   return choose_lighting_backend(scene.lighting, scene.embree, request, diagnostics);
 }
 

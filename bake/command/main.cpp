@@ -159,6 +159,13 @@ int main(int argc, char** argv) {
   app.add_option("--emitter-guiding-mix", options.lighting.emitter_guiding_mix,
                  "probability of the learned emitter distribution in the mixture with the default (default 0.5)")
       ->check(CLI::Range(0.0f, 1.0f));
+  std::string light_paths = "off";
+  app.add_option("--light-paths", light_paths,
+                 "on | off (default): also trace light subpaths from emitters and point and spot lights into a pool "
+                 "that every path vertex connects to, weighted with the path tracer's strategies by MIS (light "
+                 "entering through narrow openings: docs/lighting-core.md \"Light subpaths\"); CPU backend, path "
+                 "tracing, without --guiding grid/svo")
+      ->check(CLI::IsMember({"on", "off"}));
   std::string sampler = "sobol";
   app.add_option("--sampler", sampler,
                  "sobol (Owen-scrambled Sobol points per texel, the default) | independent (independent random "
@@ -320,6 +327,17 @@ int main(int argc, char** argv) {
     options.lighting.emitter_guiding = true;
   }
   options.emitter_guiding_auto = emitter_guiding == "auto";
+  if (light_paths == "on") {
+    const char* conflict = integrator == "bounces"                 ? "--integrator bounces (light subpaths are path-tracing strategies)"
+                           : guiding == "grid" || guiding == "svo" ? "--guiding grid/svo (not combined yet)"
+                           : options.backend.name == "vulkan"      ? "--backend vulkan (CPU backend only so far)"
+                                                                   : nullptr;
+    if (conflict) {
+      std::cerr << "bake: error: --light-paths on contradicts " << conflict << "\n";
+      return 2;
+    }
+    options.lighting.light_subpaths = true;
+  }
   options.guiding_auto_given = guiding == "auto" && app.get_option("--guiding")->count() > 0;
 
   if (no_cache && !cache_directory.empty()) {

@@ -45,6 +45,10 @@ TEST(BakeGuidingOptions, ContradictionsAreOneLineAndExit2) {
       {"--denoise --light-layers", "--denoise filters the indirect light, which --light-layers do not keep apart"},
       {"--denoise --directional sh1", "--denoise filters the indirect light, which --directional sh1 does not keep apart"},
       {"--denoise --denoise-radius 0", "--denoise-radius"},
+      // Light subpaths: path-tracing strategies of the CPU backend, not combined with guiding yet.
+      {"--light-paths on --integrator bounces", "--light-paths on contradicts --integrator bounces"},
+      {"--light-paths on --guiding grid", "--light-paths on contradicts --guiding grid/svo"},
+      {"--light-paths on --backend vulkan", "--light-paths on contradicts --backend vulkan"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.options);
@@ -62,7 +66,9 @@ TEST(BakeGuidingOptions, ContradictionsAreOneLineAndExit2) {
 }
 
 // A guide the user names guides path tracing, so --integrator auto (the CPU's default would be the
-// per-bounce mode) picks path tracing for it, and the report says what was chosen.
+// per-bounce mode) picks path tracing for it, and the report says what was chosen; so does
+// --light-paths on, which also turns automatic path guiding off (not combined yet) and keeps
+// emitter guiding.
 TEST(BakeGuidingOptions, ANamedGuideMakesAutoChoosePathTracing) {
   const fs::path dir = testing::fresh_temp_dir("guiding-choice");
   const struct {
@@ -73,6 +79,7 @@ TEST(BakeGuidingOptions, ANamedGuideMakesAutoChoosePathTracing) {
       {"--guiding svo", "path", "svo"},
       {"--guiding grid", "path", "grid"},
       {"--guiding off", "bounces", "off"},
+      {"--light-paths on", "path", "off"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.options);
@@ -84,6 +91,13 @@ TEST(BakeGuidingOptions, ANamedGuideMakesAutoChoosePathTracing) {
     const nlohmann::json stats = nlohmann::json::parse(read_text(report));
     EXPECT_EQ(stats.at("lighting").at("integrator"), c.integrator);
     EXPECT_EQ(stats.at("lighting").at("guiding"), c.guiding);
+    const bool light_paths = std::string(c.options) == "--light-paths on";
+    EXPECT_EQ(stats.at("lighting").at("light_paths"), light_paths);
+    if (light_paths) {
+      EXPECT_EQ(stats.at("lighting").at("emitter_guiding"), true);
+      EXPECT_GT(stats.at("light_paths").at("subpaths").get<uint64_t>(), 0u);
+      EXPECT_GT(stats.at("light_paths").at("vertices").get<uint64_t>(), 0u);
+    }
     fs::remove_all(out);
   }
   fs::remove_all(dir);

@@ -24,6 +24,7 @@
 #include "exitance/common/light_layers.h"
 #include "exitance/runtime/core/work_share.h"
 #include "exitance/runtime/embree_scene.h"
+#include "light_vertex_pool.h"
 
 namespace exitance {
 namespace {
@@ -33,6 +34,9 @@ constexpr int kMaxRecordedBounces = 16;
 // small scenes the learning (a target per ray, atomic adds) costs as much as the ray itself, and by
 // then the table has stopped improving (bench/results/guiding.md). Shared with the Vulkan backend.
 constexpr uint32_t kGuidingLearningSamples = GridGuidingCache::kLearningSamples;
+// Light subpaths traced into one pool at most (~4 vertices and 320 bytes each on indoor scenes):
+// larger passes trace a pool per chunk of their samples.
+constexpr uint64_t kMostLightSubpathsPerPool = uint64_t(1) << 17;
 // A target error plans at most this many samples for a texel without --spp (documented).
 constexpr uint32_t kMostSamplesForTarget = 1u << 17;
 
@@ -172,13 +176,62 @@ struct CpuReferenceIntegrator::Impl {
   };
 
   // One path sample of E/pi at x; `first_bounce` is the bounce x stands for (0 at a texel).
+  // Light subpaths (light_subpaths.h): eye vertex x (bounce `bounce`, its light-subpath state `eye`)
+  // connects to one pool vertex picked uniformly; the connection's E/pi goes to bounce + the
+  // vertex's depth, and to its light's layer.
+  void connect_to_pool(const LightVertexPool& pool, const SurfacePoint& x, Vec3 origin, Vec3 throughput,
+                       const GuideVertex& g, int bounce, const EyeSubpathVertex& eye, bool directional_texel,
+                       PathSampler& rng, PathContributions& out, uint64_t& rays) const {
+    const float u = sample_1d(rng);
+    const size_t count = pool.vertices.size();
+    const LightVertex& y = pool.vertices[std::min(size_t(double(u) * double(count)), count - 1)];
+    const uint32_t depth = floatBitsToUint(y.position_depth.w);
+    if (bounce + int(depth) > pool.max_depth) return;
+    const Vec3 position{y.position_depth.x, y.position_depth.y, y.position_depth.z};
+    const Vec3 to_light = position - x.position;
+    const float distance2 = dot(to_light, to_light);
+    if (!(distance2 > 0)) return;
+    const Vec3 wi = to_light / std::sqrt(distance2);
+    const float cos_x = dot(x.shading_normal, wi);
+    const float cos_x_geometric = dot(x.geometric_normal, wi);
+    const Vec3 y_normal{y.geometric_normal_layer.x, y.geometric_normal_layer.y, y.geometric_normal_layer.z};
+    const float cos_y = -dot(y_normal, wi);
+    if (!(cos_x > 0) || !(cos_x_geometric > 0) || !(cos_y > 0)) return;
+    const Vec3 y_shading{y.shading_normal_ratio.x, y.shading_normal_ratio.y, y.shading_normal_ratio.z};
+    const float eye_density = continuation_pdf(g, x, wi) * cos_y / distance2;
+    const float light_density = std::max(-dot(y_shading, wi), 0.0f) * kInvPi * cos_x_geometric / distance2;
+    const float eye_ratio = bounce > 0 && eye.pdf_forward > 0 ? light_density / eye.pdf_forward : 0.0f;
+    const float weight = connection_weight(pool.sampling, y, eye_density, eye_ratio, eye.eye_sum);
+    const Vec3 c = throughput * Vec3{y.weight_a.x, y.weight_a.y, y.weight_a.z} *
+                   (cos_x * kInvPi * cos_y / distance2 * pool.sampling.scale * weight);
+    if (!(max_component(c) > 0)) return;
+    const Vec3 target = offset_ray_origin(position, y_normal, scene().extent);
+    const Vec3 span = target - origin;
+    const float span_length = length(span);
+    if (!(span_length > 0)) return;
+    ++rays;
+    if (embree->occluded(origin, span / span_length, span_length)) return;
+    out.add(bounce + int(depth), c);
+    out.add_light(floatBitsToUint(y.geometric_normal_layer.w), c);
+    if (directional_texel) {
+      const Vec3 f = sh1_direction_factor(x, wi);
+      for (int axis = 0; axis < 3; ++axis) out.texel_nee_sh1[axis] += c * f[axis];
+      out.texel_nee += c;
+    }
+  }
+
+  // One path sample of E/pi at x; `first_bounce` is the bounce x stands for (0 at a texel).
+  // `pool`: light subpaths to connect to (null or empty: the path tracer alone).
   template <class Guide>
   void trace(SurfacePoint x, const IntegratorSettings& settings, PathSampler& rng, PathContributions& out,
              uint64_t& rays, const Guide& guide, uint64_t* guided_vertices = nullptr,
-             EmitterGuiding emitter_guiding = {}) const {
+             EmitterGuiding emitter_guiding = {}, const LightVertexPool* pool = nullptr) const {
     const LightingScene& s = scene();
     const PathLimits limits{settings.max_bounces, settings.russian_roulette_start, settings.safety_bounce_cap};
     Vec3 throughput{1, 1, 1};
+    const bool subpaths = pool && pool->sampling.count > 0;
+    EyeSubpathVertex eye = eye_subpath_vertex_none();
+    if (subpaths) eye.sampling = pool->sampling;
     for (int bounce = 0;; ++bounce) {
       const Vec3 origin = offset_ray_origin(x.position, x.geometric_normal, s.extent);
       const uint32_t record = guide.site(x, bounce);
@@ -191,7 +244,7 @@ struct CpuReferenceIntegrator::Impl {
           EmitterGuidingCache::vertex_site(emitter_guiding.cache, x.position, x.shading_normal, emitter_guiding.learning);
       const EmitterGuide& eg = site.guide;
       EmitterLearning learning;
-      next_event_estimation(s, x, origin, throughput, g, eg, rng, shadow[0], shadow[1], shadow[2], learning);
+      next_event_estimation(s, x, origin, throughput, g, eg, eye, rng, shadow[0], shadow[1], shadow[2], learning);
       bool arrived[3];
       Vec3 each[3];
       const Vec3 direct = connect(shadow, origin, rays, x, directional_texel ? out.texel_nee_sh1 : nullptr, &arrived,
@@ -209,6 +262,7 @@ struct CpuReferenceIntegrator::Impl {
       out.add(bounce, direct);
       if (directional_texel) out.texel_nee = direct;
       const DirectionSample d = sample_continuation(g, x, rng);
+      if (subpaths) connect_to_pool(*pool, x, origin, throughput, g, bounce, eye, directional_texel, rng, out, rays);
       if (!(d.pdf > 0)) return;
       if (directional_texel) out.first_factor = sh1_direction_factor(x, d.direction);
       const Vec3 ray_throughput = throughput * continuation_weight(g, x, d);
@@ -221,12 +275,31 @@ struct CpuReferenceIntegrator::Impl {
         out.add_light(kSkyLightLayer, sky);
         return;
       }
+      const float distance2 = hit.distance * hit.distance;
+      const float cos_hit = std::fabs(dot(hit.geometric_normal, d.direction));
+      float emission_extra = 0;
+      if (subpaths && bounce > 0 && s.triangles[hit.triangle].p1_emitter.w > 0) {
+        const bool double_sided = material_double_sided(s.materials[scene_triangle_material(s, hit.triangle)]);
+        // The subpath's start density over NEE's (emitter guiding at x scales NEE's).
+        const float start_over_nee =
+            eye.sampling.area_probability / emitter_guide_ratio_at_triangle(scene_emitter_cdf(s), eg, hit.triangle, hit.b1, hit.b2);
+        const float start = light_start_ratio(eye.sampling, start_over_nee, emitter_direction_pdf(cos_hit, double_sided),
+                                              dot(x.geometric_normal, d.direction), distance2, eye.pdf_forward);
+        emission_extra = light_subpath_emission_extra(start, eye.eye_sum);
+      }
       const HitResult h = shade_continuation_hit(s, hit.triangle, hit.distance, hit.b1, hit.b2, d.direction, d.pdf,
-                                                 ray_throughput, bounce, limits, eg, rng);
+                                                 ray_throughput, bounce, limits, eg, emission_extra, rng);
       out.add(bounce, h.radiance);
       if (out.by_light && (h.radiance.x != 0 || h.radiance.y != 0 || h.radiance.z != 0))
         out.add_light(emitter_light_layer(hit.triangle), h.radiance);
       if (!h.continues) return;
+      if (subpaths) {  // x_{j+1}'s state: the eye's area density, and C_{j+1} (light_subpaths.h)
+        const float reverse = std::max(-dot(h.next.shading_normal, d.direction), 0.0f) * kInvPi *
+                              dot(x.geometric_normal, d.direction) / distance2;
+        const float ratio = bounce > 0 && eye.pdf_forward > 0 ? reverse / eye.pdf_forward : 0.0f;
+        eye.eye_sum = next_eye_sum(bounce == 0, eye.eye_sum, ratio);
+        eye.pdf_forward = d.pdf * cos_hit / distance2;
+      }
       throughput = h.throughput;
       x = h.next;
     }
@@ -275,8 +348,14 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       throw std::invalid_argument("CPU backend: --emitter-guiding runs in one process only, not under mpirun with several ranks");
     if (settings.adaptive)
       throw std::invalid_argument("CPU backend: adaptive sampling applies to path tracing, not to --integrator bounces");
+    if (settings.light_subpaths)
+      throw std::invalid_argument("CPU backend: --light-paths applies to path tracing, not to --integrator bounces");
     return bake_per_bounce(*impl_->lighting, *impl_->embree, gbuffer, settings);
   }
+  if (settings.light_subpaths && settings.guiding != GuidingMode::Off)
+    throw std::invalid_argument("CPU backend: --light-paths does not combine with --guiding grid, svo or auto yet (use --guiding off)");
+  if (settings.light_subpaths && !(settings.light_subpaths_per_sample > 0 && settings.light_subpaths_per_sample <= 64))
+    throw std::invalid_argument("CPU backend: light subpaths per sample must be in (0, 64]");
   const auto start = std::chrono::steady_clock::now();
   // Split over processes (work_share.h): this rank estimates the texels [bounds[rank], bounds[rank + 1]).
   WorkShare* share = distributed(settings.work_share);
@@ -365,6 +444,23 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   bool planning = false;          // past the pilot
   double progress_after_pilot = 0, planned_progress = 0;
 
+  // Light subpaths (light_subpaths.h): a pool per pass, or per chunk of a large pass's samples, of
+  // light_subpaths_per_sample subpaths per texel sample it serves.
+  const LightSubpathSampling subpath_start = settings.light_subpaths ? light_subpath_start(*impl_->lighting) : light_subpaths_none();
+  const bool light_subpaths = subpath_start.area_probability > 0 || subpath_start.punctual_scale > 0;
+  const int subpath_depth = std::min(settings.max_bounces >= 0 ? settings.max_bounces : INT32_MAX, settings.safety_bounce_cap - 1);
+  LightVertexPool light_pool;
+  auto trace_light_pool = [&](double texel_samples, uint32_t key) {
+    const double wanted = std::ceil(texel_samples * settings.light_subpaths_per_sample);
+    const uint64_t paths = uint64_t(std::clamp(wanted, 1.0, double(kMostLightSubpathsPerPool)));
+    EmitterGuidingCache* emitter_cache = emitter_guide && emitter_guide->active() ? emitter_guide.get() : nullptr;
+    light_pool = trace_light_vertex_pool(*impl_->lighting, *impl_->embree, subpath_start, paths, settings.seed, key,
+                                         settings.sampler, subpath_depth, settings.russian_roulette_start, emitter_cache);
+    rays_per_thread.local() += light_pool.rays;
+    estimate.light_subpaths += light_pool.paths;
+    estimate.light_subpath_vertices += light_pool.vertices.size();
+  };
+
   // One sample `s` of texel `i`.
   auto take_sample = [&](size_t i, uint32_t s, bool learning, PathContributions& contributions) {
     uint64_t& rays = rays_per_thread.local();
@@ -402,7 +498,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       impl_->trace(point, settings, rng, contributions, rays, Impl::GridGuide{*impl_, *sample_guide, learning},
                    &guided_vertices, emitter_guiding);
     else
-      impl_->trace(point, settings, rng, contributions, rays, Impl::NoGuide{}, &guided_vertices, emitter_guiding);
+      impl_->trace(point, settings, rng, contributions, rays, Impl::NoGuide{}, &guided_vertices, emitter_guiding,
+                   light_subpaths ? &light_pool : nullptr);
     const Vec3 total = contributions.total();
     Vec3 l1[3];
     bool l1_finite = true;
@@ -455,6 +552,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     svo_counting = svo_guide && first + count >= svo_next_rebuild;
     if (planning) {
       const double progress = double(first) - progress_after_pilot + double(count) * fraction;
+      if (light_subpaths) trace_light_pool(double(texel_count) * double(count) * fraction, first);
       tbb::parallel_for(tbb::blocked_range<size_t>(0, texel_count, 16), [&](const tbb::blocked_range<size_t>& range) {
         PathContributions contributions;
         for (size_t i = range.begin(); i != range.end(); ++i)
@@ -469,13 +567,28 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       const size_t own_begin = share ? bounds[size_t(share->rank())] : 0;
       const size_t own_end = share ? bounds[size_t(share->rank()) + 1] : texel_count;
       const auto pass_start = std::chrono::steady_clock::now();
-      tbb::parallel_for(tbb::blocked_range<size_t>(own_begin, own_end, 64), [&](const tbb::blocked_range<size_t>& range) {
-        PathContributions contributions;
-        for (size_t i = range.begin(); i != range.end(); ++i) {
-          if (covered_below != UINT64_MAX && (splitmix64(salt + i) >> 11) >= covered_below) continue;
-          for (uint32_t s = first; s < first + count; ++s) take_sample(i, s, learning, contributions);
+      auto take_samples = [&](uint32_t sample_begin, uint32_t sample_end) {
+        tbb::parallel_for(tbb::blocked_range<size_t>(own_begin, own_end, 64), [&](const tbb::blocked_range<size_t>& range) {
+          PathContributions contributions;
+          for (size_t i = range.begin(); i != range.end(); ++i) {
+            if (covered_below != UINT64_MAX && (splitmix64(salt + i) >> 11) >= covered_below) continue;
+            for (uint32_t s = sample_begin; s < sample_end; ++s) take_sample(i, s, learning, contributions);
+          }
+        });
+      };
+      if (light_subpaths) {
+        // The same pools on every rank: sized by the whole atlas's covered texels.
+        const double covered = double(texel_count) * std::min(fraction, 1.0);
+        const double per_sample = std::max(1.0, covered * settings.light_subpaths_per_sample);
+        const uint32_t chunk = uint32_t(std::max(1.0, std::floor(double(kMostLightSubpathsPerPool) / per_sample)));
+        for (uint32_t sample_begin = first; sample_begin < first + count; sample_begin += std::min(chunk, first + count - sample_begin)) {
+          const uint32_t sample_end = sample_begin + std::min(chunk, first + count - sample_begin);
+          trace_light_pool(covered * double(sample_end - sample_begin), sample_begin);
+          take_samples(sample_begin, sample_end);
         }
-      });
+      } else {
+        take_samples(first, first + count);
+      }
       if (share) {
         share->work.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - pass_start).count();
         gather_texel_sums(*share, estimate, bounds, texel_rays);

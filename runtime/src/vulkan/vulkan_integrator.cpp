@@ -130,6 +130,8 @@ VulkanIntegrator::~VulkanIntegrator() = default;
 
 LightmapEstimate VulkanIntegrator::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const {
   if (settings.adaptive) throw std::runtime_error("Vulkan backend: --adaptive on is implemented on the CPU backend only (use --backend cpu)");
+  if (settings.light_subpaths)
+    throw std::runtime_error("Vulkan backend: --light-paths is implemented on the CPU backend only (use --backend cpu)");
   if (settings.spp == 0 && !(settings.time_budget_seconds > 0) && !(settings.target_relative_error > 0))
     throw std::invalid_argument("Vulkan backend: spp 0 needs a time budget or a target error");
   if (settings.integrator == IntegratorMode::Bounces) {

@@ -242,6 +242,14 @@ EXITANCE_FN EmitterPoint emitter_mixture_sample(CDF_REF, uint emitter_count, Emi
   return p;
 }
 
+// The mixture's probability of punctual light `light`, whichever component would choose it.
+EXITANCE_FN float punctual_mixture_probability(CDF_REF, EmitterGuide g, uint light) {
+  float guided = g.punctual_count > 0u ? g.punctual_guided_probability : 0.0f;
+  float probability = cdf_pmf(cdf, light);
+  if (guided > 0.0f) probability = (1.0f - guided) * probability + guided * guide_bin_probability(g.punctual_cdf, light);
+  return probability;
+}
+
 // The punctual light of next-event estimation: u_choose below the guided probability picks from
 // the learned distribution, else by power (u_choose rescaled; as is without tables). `probability`
 // is the mixture's probability of the light, whichever component chose it (a discrete choice).
@@ -255,8 +263,7 @@ EXITANCE_FN uint punctual_mixture_sample(CDF_REF, uint punctual_count, EmitterGu
     float pmf;
     light = sample_cdf(cdf, punctual_count, guided > 0.0f ? rescaled_unit(u_choose, guided, 1.0f - guided) : u_choose, pmf);
   }
-  probability = cdf_pmf(cdf, light);
-  if (guided > 0.0f) probability = (1.0f - guided) * probability + guided * guide_bin_probability(g.punctual_cdf, light);
+  probability = punctual_mixture_probability(cdf, g, light);
   return light;
 }
 

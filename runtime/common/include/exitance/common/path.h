@@ -28,6 +28,7 @@
 #include "exitance/common/gpu_layout.h"
 #include "exitance/common/guided_direction.h"
 #include "exitance/common/guided_emitters.h"
+#include "exitance/common/light_subpaths.h"
 #include "exitance/common/punctual_light.h"
 #include "exitance/common/ray_offset.h"
 #include "exitance/common/path_sampler.h"
@@ -223,10 +224,26 @@ struct EmitterLearning {
   uint punctual_index;
 };
 
+// An eye vertex's light-subpath state (light_subpaths.h), which its next-event and emitter-hit weights
+// need: sampling.count 0 (no pool) gives the path tracer's weights.
+struct EyeSubpathVertex {
+  LightSubpathSampling sampling;
+  float pdf_forward;  // the eye's area density of this vertex; 0 at the texel (never moved)
+  float eye_sum;      // C_j
+};
+
+EXITANCE_FN EyeSubpathVertex eye_subpath_vertex_none() {
+  EyeSubpathVertex e;
+  e.sampling = light_subpaths_none();
+  e.pdf_forward = 0.0f;
+  e.eye_sum = 1.0f;
+  return e;
+}
+
 EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, vec3 throughput, GuideVertex guide,
-                                       EmitterGuide emitter_guide, INOUT(PathSampler) rng, OUT(ShadowRay) area_ray,
-                                       OUT(ShadowRay) punctual_ray, OUT(ShadowRay) environment_ray,
-                                       OUT(EmitterLearning) learning) {
+                                       EmitterGuide emitter_guide, EyeSubpathVertex eye, INOUT(PathSampler) rng,
+                                       OUT(ShadowRay) area_ray, OUT(ShadowRay) punctual_ray,
+                                       OUT(ShadowRay) environment_ray, OUT(EmitterLearning) learning) {
   area_ray = no_shadow_ray();
   punctual_ray = no_shadow_ray();
   environment_ray = no_shadow_ray();
@@ -268,7 +285,16 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
         float span_length = length(span);
         if (span_length > 0.0f) {
           float pdf_light = pdf_area * distance2 / cos_l;
-          float weight = power_heuristic(pdf_light, continuation_pdf(guide, x, wi));
+          float weight;
+          if (eye.sampling.count > 0.0f) {
+            bool double_sided = material_double_sided(scene_material(SCENE_ARG scene_triangle_material(SCENE_ARG tri)));
+            float start = light_start_ratio(eye.sampling, eye.sampling.area_probability * scene_triangle_area_pdf(SCENE_ARG tri) / pdf_area,
+                                            emitter_direction_pdf(cos_l, double_sided), dot(x.geometric_normal, wi),
+                                            distance2, eye.pdf_forward);
+            weight = light_subpath_nee_weight(continuation_pdf(guide, x, wi) / pdf_light, start, eye.eye_sum);
+          } else {
+            weight = power_heuristic(pdf_light, continuation_pdf(guide, x, wi));
+          }
           vec3 le = scene_emission(SCENE_ARG tri, bary.x, bary.y);
           area_ray.direction_length = vec4(span / span_length, span_length);
           area_ray.contribution_state = vec4(throughput * (le * (cos_x * kInvPi * weight / pdf_light)), kShadowTrace);
@@ -286,7 +312,18 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
     float probability;
     uint light_index = punctual_mixture_sample(scene_punctual_cdf(SCENE_ALONE_ARG), punctual, emitter_guide, u_choose, probability);
     learning.punctual_index = light_index;
-    float value = punctual_light_ray(scene_punctual_light(SCENE_ARG light_index), x, throughput, probability, punctual_ray);
+    GpuPunctualLight light = scene_punctual_light(SCENE_ARG light_index);
+    float value = punctual_light_ray(light, x, throughput, probability, punctual_ray);
+    if (eye.sampling.count > 0.0f && punctual_ray.contribution_state.w == kShadowTrace) {
+      vec3 wi = vec3(punctual_ray.direction_length.x, punctual_ray.direction_length.y, punctual_ray.direction_length.z);
+      float distance = punctual_ray.direction_length.w;
+      float start_over_nee = eye.sampling.punctual_scale * cdf_pmf(scene_punctual_cdf(SCENE_ALONE_ARG), light_index) / probability;
+      float start = light_start_ratio(eye.sampling, start_over_nee, punctual_direction_pdf(light, -wi),
+                                      dot(x.geometric_normal, wi), distance * distance, eye.pdf_forward);
+      float weight = light_subpath_nee_weight(0.0f, start, eye.eye_sum);
+      punctual_ray.contribution_state = vec4(vec3(punctual_ray.contribution_state.x, punctual_ray.contribution_state.y,
+                                                  punctual_ray.contribution_state.z) * weight, kShadowTrace);
+    }
     if (punctual_ray.contribution_state.w != kShadowNone && emitter_guide.punctual_count > 0u) {
       learning.punctual_light = light_index;
       learning.punctual_value = value;
@@ -304,6 +341,14 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
           vec4(throughput * (scene_sky_radiance(SCENE_ARG wi) * (cos_x * kInvPi * weight / pdf_env)), kShadowTrace);
     }
   }
+}
+
+EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, vec3 throughput, GuideVertex guide,
+                                       EmitterGuide emitter_guide, INOUT(PathSampler) rng, OUT(ShadowRay) area_ray,
+                                       OUT(ShadowRay) punctual_ray, OUT(ShadowRay) environment_ray,
+                                       OUT(EmitterLearning) learning) {
+  next_event_estimation(SCENE_ARG x, origin, throughput, guide, emitter_guide, eye_subpath_vertex_none(), rng, area_ray,
+                        punctual_ray, environment_ray, learning);
 }
 
 EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, vec3 throughput, GuideVertex guide,
@@ -387,9 +432,10 @@ struct HitResult {
 // `bounce`: the bounce of the vertex the ray left (0 = the texel). Draws one random number when
 // Russian roulette is played. `emitter_guide`: the area-light strategy of the vertex the ray left,
 // whose density weighs an emitter hit.
+// `emission_extra`: light_subpath_emission_extra of the vertex the ray left (0: no light subpaths).
 EXITANCE_FN HitResult shade_continuation_hit(SCENE_PARAM uint tri, float t_hit, float b1, float b2, vec3 wi,
                                              float pdf_continuation, vec3 throughput, int bounce, PathLimits limits,
-                                             EmitterGuide emitter_guide, INOUT(PathSampler) rng) {
+                                             EmitterGuide emitter_guide, float emission_extra, INOUT(PathSampler) rng) {
   HitResult h;
   h.radiance = vec3(0.0f);
   h.continues = false;
@@ -404,7 +450,7 @@ EXITANCE_FN HitResult shade_continuation_hit(SCENE_PARAM uint tri, float t_hit, 
       float cos_l = abs(dot(wi, ng));
       float pdf_light = scene_triangle_area_pdf(SCENE_ARG tri) * t_hit * t_hit / cos_l;
       pdf_light *= emitter_guide_ratio_at_triangle(scene_emitter_cdf(SCENE_ALONE_ARG), emitter_guide, tri, b1, b2);
-      h.radiance = throughput * le * power_heuristic(pdf_continuation, pdf_light);
+      h.radiance = throughput * le * power_heuristic_with_extra(pdf_continuation, pdf_light, emission_extra);
     }
   }
   // Back faces of single-sided surfaces absorb (glTF culls them; light cannot leave through them).
@@ -424,6 +470,13 @@ EXITANCE_FN HitResult shade_continuation_hit(SCENE_PARAM uint tri, float t_hit, 
   h.continues = true;
   h.next = surface_point_on_triangle(SCENE_ARG tri, ng, b1, b2, front);
   return h;
+}
+
+EXITANCE_FN HitResult shade_continuation_hit(SCENE_PARAM uint tri, float t_hit, float b1, float b2, vec3 wi,
+                                             float pdf_continuation, vec3 throughput, int bounce, PathLimits limits,
+                                             EmitterGuide emitter_guide, INOUT(PathSampler) rng) {
+  return shade_continuation_hit(SCENE_ARG tri, t_hit, b1, b2, wi, pdf_continuation, throughput, bounce, limits,
+                                emitter_guide, 0.0f, rng);
 }
 
 EXITANCE_FN HitResult shade_continuation_hit(SCENE_PARAM uint tri, float t_hit, float b1, float b2, vec3 wi,

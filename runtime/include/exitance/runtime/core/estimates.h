@@ -67,6 +67,9 @@ struct LightmapEstimate {
   uint64_t nonfinite_samples = 0;  // samples discarded because they were NaN/Inf (should stay 0)
   BounceGatherStatistics bounce_statistics;
   uint64_t guided_vertices = 0;  // path vertices that sampled a guided mixture (--guiding); 0 unguided
+  // Light subpaths (IntegratorSettings::light_subpaths): traced, and their vertices kept in pools.
+  uint64_t light_subpaths = 0;
+  uint64_t light_subpath_vertices = 0;
   // GuidingMode::Auto: what the choice measured and kept per region (core/guiding_choice.h); empty
   // otherwise or when the bake ended before the pilot did (then every sample tossed its coin).
   bool guiding_auto = false;

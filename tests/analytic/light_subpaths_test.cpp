@@ -1,0 +1,197 @@
+// Light subpaths (bake --light-paths, common/light_subpaths.h, issue 35 item 3) on the CPU backend.
+//  - Unbiased: with subpaths the estimate converges to the path tracer's per region (instance) and
+//    per bounce layer (each path length is its own integral, so a wrong MIS weight for one strategy
+//    shows in its layer), on a box lit by an emitter and a point light (with brighter lights outside
+//    that reach nothing), the Cornell room, ajar_room and the building (point, spot and area lights,
+//    a sky); also with a bounce limit, and with emitter guiding (next-event estimation's learned
+//    density then weighs the subpaths) against the unguided path tracer.
+//  - Deterministic: bit-identical per seed and thread count.
+//  - It pays where the path tracer is weak: ajar_room's variance at equal samples.
+// Statistics as emitter_guided_path_test.cpp: kSeeds independent seeds, kZLimit = 5 standard errors,
+// and each comparison checks its power (a 10 % bias in the median region must exceed kZLimit SE).
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "exitance/bake/command/prepared_scene.h"
+#include "exitance/runtime/cpu_reference_integrator.h"
+#include "support/atlas_box.h"
+#include "support/box_with_lights_outside.h"
+#include "support/identical_estimates.h"
+#include "support/independent_estimates.h"
+#include "support/region_and_furnace_checks.h"
+#include "support/region_runs.h"
+
+namespace exitance {
+namespace {
+
+constexpr double kZLimit = 5.0;
+constexpr int kSeeds = 16;
+constexpr double kDetectableBias = 0.10;
+constexpr int kLayers = 4;  // bounce0 .. bounce2 and the rest (IntegratorSettings::recorded_bounces)
+
+// `per_sample`: light subpaths per texel sample; the agreement tests trace 1 (4x the default) so
+// that the strategies with light vertices carry more of each estimate: the test's power is theirs.
+IntegratorSettings settings(uint32_t spp, uint64_t seed, bool subpaths, double per_sample = 1.0, bool emitter_guiding = false) {
+  IntegratorSettings s;
+  s.emitter_guiding = emitter_guiding;
+  s.spp = spp;
+  s.seed = seed;
+  s.light_subpaths = subpaths;
+  s.light_subpaths_per_sample = per_sample;
+  s.recorded_bounces = kLayers;
+  return s;
+}
+
+// The box with a spot light inside too, tilted, its cone partly on the walls.
+testing::AtlasScene box_with_spot() {
+  testing::AtlasScene box = testing::box_with_lights_outside();
+  PunctualLight spot;
+  spot.type = PunctualLight::Type::Spot;
+  spot.name = "spot";
+  spot.position = {0.7f, 0.8f, 0.3f};
+  spot.direction = normalize(Vec3{-0.5f, -1.0f, 0.4f});
+  spot.intensity = {1.0f, 0.8f, 0.6f};
+  spot.cos_inner = std::cos(0.3f);
+  spot.cos_outer = std::cos(0.6f);
+  box.scene.lights.push_back(spot);
+  return box;
+}
+
+// With subpaths against without, per region and bounce layer, over kSeeds seeds each; returns the
+// median over regions of the relative standard error of the totals' difference.
+double expect_regions_agree(const std::string& label, const Scene& scene, const TexelGBuffer& gbuffer, uint32_t spp,
+                            int max_bounces = -1, bool emitter_guiding = false) {
+  const CpuReferenceIntegrator integrator(scene);
+  testing::RegionRuns with, without, layers_with[kLayers], layers_without[kLayers];
+  uint64_t subpaths = 0;
+  for (int seed = 0; seed < kSeeds; ++seed) {
+    IntegratorSettings a = settings(spp, uint64_t(seed), true, 1.0, emitter_guiding), b = settings(spp, uint64_t(seed) + 1000, false);
+    a.max_bounces = b.max_bounces = max_bounces;
+    const LightmapEstimate w = integrator.bake(gbuffer, a);
+    const LightmapEstimate u = integrator.bake(gbuffer, b);
+    EXPECT_EQ(w.nonfinite_samples, 0u);
+    EXPECT_EQ(u.nonfinite_samples, 0u);
+    subpaths += w.light_subpaths;
+    testing::add_regions(gbuffer, w, with);
+    testing::add_regions(gbuffer, u, without);
+    for (int k = 0; k < kLayers; ++k) {
+      testing::add_layer_regions(gbuffer, w, k, layers_with[k]);
+      testing::add_layer_regions(gbuffer, u, k, layers_without[k]);
+    }
+  }
+  EXPECT_GT(subpaths, 0u) << "no light subpath was traced";
+  for (int k = 0; k < kLayers; ++k) {
+    // Layers without light (direct light where none reaches) have nothing to compare.
+    testing::RegionRuns lit_with, lit_without;
+    for (const auto& [region, runs] : layers_without[k])
+      if (testing::mean_and_standard_error(runs).mean > 0 || testing::mean_and_standard_error(layers_with[k].at(region)).mean > 0)
+        lit_with[region] = layers_with[k].at(region), lit_without[region] = runs;
+    if (!lit_without.empty())
+      testing::expect_regions_agree("light subpaths", label + " bounce" + std::to_string(k), lit_without, lit_with, kZLimit);
+  }
+  return testing::expect_regions_agree("light subpaths", label, without, with, kZLimit);
+}
+
+PreparedScene sample_scene(const char* name, float density) {
+  AtlasSettings atlas;
+  atlas.texel_density = density;
+  Diagnostics diagnostics;
+  return prepare_scene_for_lighting(std::string(EXITANCE_SAMPLE_DIR "/") + name + ".gltf", "", atlas, diagnostics);
+}
+
+TEST(LightSubpaths, BoxWithLightsOutsideAgreesWithPathTracing) {
+  const testing::AtlasScene box = box_with_spot();
+  EXPECT_LT(kZLimit * expect_regions_agree("box", box.scene, box.gbuffer, 64), kDetectableBias)
+      << "the test could not see a 10 % bias";
+}
+
+TEST(LightSubpaths, BoxAgreesUnderABounceLimit) {
+  const testing::AtlasScene box = box_with_spot();
+  EXPECT_LT(kZLimit * expect_regions_agree("box, 2 bounces", box.scene, box.gbuffer, 64, 2), kDetectableBias)
+      << "the test could not see a 10 % bias";
+}
+
+// Emitter guiding learns that the lights outside never arrive: next-event estimation's density
+// then differs from the subpaths' start density by up to 100x, which the weights must follow.
+TEST(LightSubpaths, BoxWithEmitterGuidingAgreesWithPathTracing) {
+  const testing::AtlasScene box = box_with_spot();
+  EXPECT_LT(kZLimit * expect_regions_agree("box, emitter guided", box.scene, box.gbuffer, 64, -1, true), kDetectableBias)
+      << "the test could not see a 10 % bias";
+}
+
+TEST(LightSubpaths, AjarRoomWithEmitterGuidingAgreesWithPathTracing) {
+  const PreparedScene p = sample_scene("ajar_room", 4);
+  EXPECT_LT(kZLimit * expect_regions_agree("ajar_room, emitter guided", p.scene, p.gbuffer, 64, -1, true), kDetectableBias)
+      << "the test could not see a 10 % bias";
+}
+
+TEST(LightSubpaths, CornellRoomAgreesWithPathTracing) {
+  const PreparedScene p = sample_scene("cornell_room", 2);
+  EXPECT_LT(kZLimit * expect_regions_agree("cornell_room", p.scene, p.gbuffer, 32), kDetectableBias)
+      << "the test could not see a 10 % bias";
+}
+
+TEST(LightSubpaths, AjarRoomAgreesWithPathTracing) {
+  const PreparedScene p = sample_scene("ajar_room", 4);
+  EXPECT_LT(kZLimit * expect_regions_agree("ajar_room", p.scene, p.gbuffer, 64), kDetectableBias)
+      << "the test could not see a 10 % bias";
+}
+
+TEST(LightSubpaths, BuildingAgreesWithPathTracing) {
+  const PreparedScene p = sample_scene("building", 0.5f);
+  EXPECT_LT(kZLimit * expect_regions_agree("building", p.scene, p.gbuffer, 64), kDetectableBias)
+      << "the test could not see a 10 % bias";
+}
+
+TEST(LightSubpaths, BitIdenticalPerSeedAndThreadCount) {
+  const testing::AtlasScene box = testing::box_with_lights_outside();
+  const CpuReferenceIntegrator integrator(box.scene);
+  const LightmapEstimate a = integrator.bake(box.gbuffer, settings(24, 7, true, 0.25));
+  const LightmapEstimate b = integrator.bake(box.gbuffer, settings(24, 7, true, 0.25));
+  EXPECT_TRUE(testing::identical_texel_sums(a, b)) << "two runs with one seed differ";
+  {
+    tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+    const LightmapEstimate c = integrator.bake(box.gbuffer, settings(24, 7, true, 0.25));
+    EXPECT_TRUE(testing::identical_texel_sums(a, c)) << "one thread and all threads differ";
+  }
+  const LightmapEstimate without = integrator.bake(box.gbuffer, settings(24, 7, false));
+  EXPECT_FALSE(testing::identical_texel_sums(a, without)) << "light subpaths must change the samples";
+}
+
+// The mean over texels of each texel's variance across seeds, relative to its squared mean.
+double mean_relative_variance(const std::vector<std::vector<double>>& runs) {
+  const size_t texels = runs.front().size();
+  double sum = 0;
+  size_t counted = 0;
+  for (size_t i = 0; i < texels; ++i) {
+    std::vector<double> values;
+    for (const auto& run : runs) values.push_back(run[i]);
+    const testing::MeanAndError m = testing::mean_and_standard_error(values);
+    if (!(m.mean > 0)) continue;
+    sum += m.standard_error * m.standard_error * double(values.size()) / (m.mean * m.mean);
+    ++counted;
+  }
+  return sum / double(counted);
+}
+
+TEST(LightSubpaths, LowerAjarRoomsVarianceAtEqualSamples) {
+  const PreparedScene p = sample_scene("ajar_room", 4);
+  const CpuReferenceIntegrator integrator(p.scene);
+  std::vector<std::vector<double>> with, without;
+  for (int seed = 0; seed < 8; ++seed) {
+    with.push_back(testing::luminance_means(integrator.bake(p.gbuffer, settings(16, uint64_t(seed), true, 0.25))));
+    without.push_back(testing::luminance_means(integrator.bake(p.gbuffer, settings(16, uint64_t(seed) + 1000, false))));
+  }
+  const double ratio = mean_relative_variance(with) / mean_relative_variance(without);
+  std::printf("[light subpaths] ajar_room relative variance per texel at 16 spp: with / without = %.3f\n", ratio);
+  EXPECT_LT(ratio, 0.5);
+}
+
+}  // namespace
+}  // namespace exitance
