@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
   uint32_t emitter_guiding_patches = 512;
   app.add_option("--emitter-guiding-mix", emitter_guiding_mix, "learned next-event component's probability (*nee runs)");
   app.add_option("--emitter-guiding-patches", emitter_guiding_patches, "about this many emitter patches (*nee runs)");
-  double light_subpaths_per_sample = 0.25;
+  double light_subpaths_per_sample = 0.0625;
   app.add_option("--light-subpaths-per-sample", light_subpaths_per_sample, "light subpaths per texel sample (light runs)");
   std::string guiding_fields;
   app.add_option("--guiding-fields", guiding_fields,

@@ -37,6 +37,8 @@ constexpr uint32_t kGuidingLearningSamples = GridGuidingCache::kLearningSamples;
 // Light subpaths traced into one pool at most (~4 vertices and 320 bytes each on indoor scenes):
 // larger passes trace a pool per chunk of their samples.
 constexpr uint64_t kMostLightSubpathsPerPool = uint64_t(1) << 17;
+// ... and at least this many, so small passes of small atlases do not share a handful of vertices.
+constexpr uint64_t kFewestLightSubpathsPerPool = 256;
 // A target error plans at most this many samples for a texel without --spp (documented).
 constexpr uint32_t kMostSamplesForTarget = 1u << 17;
 
@@ -452,7 +454,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   LightVertexPool light_pool;
   auto trace_light_pool = [&](double texel_samples, uint32_t key) {
     const double wanted = std::ceil(texel_samples * settings.light_subpaths_per_sample);
-    const uint64_t paths = uint64_t(std::clamp(wanted, 1.0, double(kMostLightSubpathsPerPool)));
+    const uint64_t paths = uint64_t(std::clamp(wanted, double(kFewestLightSubpathsPerPool), double(kMostLightSubpathsPerPool)));
     EmitterGuidingCache* emitter_cache = emitter_guide && emitter_guide->active() ? emitter_guide.get() : nullptr;
     light_pool = trace_light_vertex_pool(*impl_->lighting, *impl_->embree, subpath_start, paths, settings.seed, key,
                                          settings.sampler, subpath_depth, settings.russian_roulette_start, emitter_cache);

@@ -93,9 +93,9 @@ struct IntegratorSettings {
   // traces light_subpaths_per_sample subpaths per texel sample from the emitters and point and spot
   // lights into a shared pool, and every eye vertex connects to one pool vertex, all strategies
   // combined by the power heuristic. Path mode, CPU backend; not with path guiding (emitter
-  // guiding combines). 0.25 subpaths per sample: bench/results/light-subpaths.md.
+  // guiding combines). 1/16 subpath per sample: bench/results/light-subpaths.md.
   bool light_subpaths = false;
-  double light_subpaths_per_sample = 0.25;
+  double light_subpaths_per_sample = 0.0625;
   std::function<void(double fraction_done, uint64_t rays)> progress;  // called between passes
   // The seconds the time budget has run (PassScheduler::elapsed_seconds); null: since the
   // integrator's scheduler started. bake starts it with the lighting stage, so the stage's setup
