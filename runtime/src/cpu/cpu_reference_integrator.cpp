@@ -177,7 +177,6 @@ struct CpuReferenceIntegrator::Impl {
     void observe(uint32_t, const GuideVertex&, Vec3, const Hit&) const {}
   };
 
-  // One path sample of E/pi at x; `first_bounce` is the bounce x stands for (0 at a texel).
   // Light subpaths (light_subpaths.h): eye vertex x (bounce `bounce`, its light-subpath state `eye`)
   // connects to one pool vertex picked uniformly; the connection's E/pi goes to bounce + the
   // vertex's depth, and to its light's layer.
@@ -277,31 +276,16 @@ struct CpuReferenceIntegrator::Impl {
         out.add_light(kSkyLightLayer, sky);
         return;
       }
-      const float distance2 = hit.distance * hit.distance;
-      const float cos_hit = std::fabs(dot(hit.geometric_normal, d.direction));
-      float emission_extra = 0;
-      if (subpaths && bounce > 0 && s.triangles[hit.triangle].p1_emitter.w > 0) {
-        const bool double_sided = material_double_sided(s.materials[scene_triangle_material(s, hit.triangle)]);
-        // The subpath's start density over NEE's (emitter guiding at x scales NEE's).
-        const float start_over_nee =
-            eye.sampling.area_probability / emitter_guide_ratio_at_triangle(scene_emitter_cdf(s), eg, hit.triangle, hit.b1, hit.b2);
-        const float start = light_start_ratio(eye.sampling, start_over_nee, emitter_direction_pdf(cos_hit, double_sided),
-                                              dot(x.geometric_normal, d.direction), distance2, eye.pdf_forward);
-        emission_extra = light_subpath_emission_extra(start, eye.eye_sum);
-      }
+      const float emission_extra =
+          subpaths ? light_subpath_emitter_hit_extra(s, x, eye, eg, hit.triangle, hit.geometric_normal, hit.distance, hit.b1, hit.b2,
+                                                     d.direction) : 0.0f;
       const HitResult h = shade_continuation_hit(s, hit.triangle, hit.distance, hit.b1, hit.b2, d.direction, d.pdf,
                                                  ray_throughput, bounce, limits, eg, emission_extra, rng);
       out.add(bounce, h.radiance);
       if (out.by_light && (h.radiance.x != 0 || h.radiance.y != 0 || h.radiance.z != 0))
         out.add_light(emitter_light_layer(hit.triangle), h.radiance);
       if (!h.continues) return;
-      if (subpaths) {  // x_{j+1}'s state: the eye's area density, and C_{j+1} (light_subpaths.h)
-        const float reverse = std::max(-dot(h.next.shading_normal, d.direction), 0.0f) * kInvPi *
-                              dot(x.geometric_normal, d.direction) / distance2;
-        const float ratio = bounce > 0 && eye.pdf_forward > 0 ? reverse / eye.pdf_forward : 0.0f;
-        eye.eye_sum = next_eye_sum(bounce == 0, eye.eye_sum, ratio);
-        eye.pdf_forward = d.pdf * cos_hit / distance2;
-      }
+      if (subpaths) eye = next_eye_subpath_vertex(eye, x, h.next, hit.geometric_normal, hit.distance, d.direction, d.pdf, bounce == 0);
       throughput = h.throughput;
       x = h.next;
     }
@@ -583,8 +567,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
         const double covered = double(texel_count) * std::min(fraction, 1.0);
         const double per_sample = std::max(1.0, covered * settings.light_subpaths_per_sample);
         const uint32_t chunk = uint32_t(std::max(1.0, std::floor(double(kMostLightSubpathsPerPool) / per_sample)));
-        for (uint32_t sample_begin = first; sample_begin < first + count; sample_begin += std::min(chunk, first + count - sample_begin)) {
-          const uint32_t sample_end = sample_begin + std::min(chunk, first + count - sample_begin);
+        for (uint32_t sample_begin = first, sample_end; sample_begin < first + count; sample_begin = sample_end) {
+          sample_end = sample_begin + std::min(chunk, first + count - sample_begin);
           trace_light_pool(covered * double(sample_end - sample_begin), sample_begin);
           take_samples(sample_begin, sample_end);
         }

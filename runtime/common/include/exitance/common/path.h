@@ -359,6 +359,37 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
                         environment_ray, learning);
 }
 
+// ---- Light subpaths at the eye's continuation hits (light_subpaths.h) ----
+// light_subpath_emission_extra of a continuation ray from x (state `eye`, emitter strategy
+// `emitter_guide`) that hit triangle `tri` (unit geometric normal `ng`, either side) at distance
+// t_hit: 0 unless NEE samples it and x is not the texel (the texel never moves to the light side).
+EXITANCE_FN float light_subpath_emitter_hit_extra(SCENE_PARAM SurfacePoint x, EyeSubpathVertex eye, EmitterGuide emitter_guide,
+                                                  uint tri, vec3 ng, float t_hit, float b1, float b2, vec3 wi) {
+  if (!(eye.pdf_forward > 0.0f) || !(scene_triangle_area_pdf(SCENE_ARG tri) > 0.0f)) return 0.0f;
+  bool double_sided = material_double_sided(scene_material(SCENE_ARG scene_triangle_material(SCENE_ARG tri)));
+  float cos_hit = abs(dot(ng, wi));
+  // The subpath's start density over NEE's (emitter guiding at x scales NEE's).
+  float start_over_nee =
+      eye.sampling.area_probability / emitter_guide_ratio_at_triangle(scene_emitter_cdf(SCENE_ALONE_ARG), emitter_guide, tri, b1, b2);
+  float start = light_start_ratio(eye.sampling, start_over_nee, emitter_direction_pdf(cos_hit, double_sided),
+                                  dot(x.geometric_normal, wi), t_hit * t_hit, eye.pdf_forward);
+  return light_subpath_emission_extra(start, eye.eye_sum);
+}
+
+// The state of the continuation's hit `next` (unit geometric normal `ng`, either side, at distance
+// t_hit along wi, sampled from x with solid-angle density pdf_continuation): the eye's area density
+// of it, and C_{j+1} from Q_j, the light side's density of x scattered at `next` over the eye's.
+EXITANCE_FN EyeSubpathVertex next_eye_subpath_vertex(EyeSubpathVertex eye, SurfacePoint x, SurfacePoint next, vec3 ng,
+                                                     float t_hit, vec3 wi, float pdf_continuation, bool from_texel) {
+  float distance2 = t_hit * t_hit;
+  float reverse = max(-dot(next.shading_normal, wi), 0.0f) * kInvPi * dot(x.geometric_normal, wi) / distance2;
+  float ratio = !from_texel && eye.pdf_forward > 0.0f ? reverse / eye.pdf_forward : 0.0f;
+  EyeSubpathVertex e = eye;
+  e.eye_sum = next_eye_sum(from_texel, eye.eye_sum, ratio);
+  e.pdf_forward = pdf_continuation * abs(dot(ng, wi)) / distance2;
+  return e;
+}
+
 // ---- The change of direct light from edited punctual lights (the runtime's refresh) ----
 // After an edit that only changed punctual lights, the runtime estimates the change of E/pi from a
 // base estimate (RefreshSession, docs/runtime.md): paths are sampled as usual, but each vertex adds
