@@ -2,7 +2,7 @@
 // content hash outside the repository) is the reference; runs at doubling spp record seconds,
 // relMSE, MAE, worst-texel error and rays/s as CSV, and the time to reach a target relMSE.
 //
-//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,adaptive,bounces,guided,svo,guided_auto,nee,guided_nee,svo_nee,bounces_nee,light] [--guiding-mix M] [--name NAME]
+//   bench_time_to_error SCENE.gltf [--backends cpu,vulkan] [--integrators path,adaptive,bounces,guided,svo,guided_auto,auto_light,auto_nee,guided_auto_nee,nee,guided_nee,svo_nee,bounces_nee,light] [--guiding-mix M] [--name NAME]
 //                       [--sky R,G,B] [--texel-density T] [--reference-spp N] [--max-spp N]
 //                       [--max-seconds S] [--target 0.01] [--bounces N] [--min-spp N] [--cache DIR] [--csv FILE]
 //                       [--texel-csv FILE] [--guiding-fields FILE] [--samplers sobol,independent]
@@ -92,7 +92,9 @@ int main(int argc, char** argv) {
   app.add_option("--integrators", integrators,
                  "comma-separated: path, adaptive (path with adaptive sampling; spp = mean), bounces, bounces_cached "
                  "(bounces with --first-bounce cached), guided (path with --guiding grid), svo (path with --guiding svo), "
-                 "guided_auto (path with --guiding auto), nee / guided_nee / svo_nee / bounces_nee (path, guided, "
+                 "guided_auto (path with --guiding auto measuring grid guiding), auto_light (--guiding auto measuring light "
+                 "subpaths), auto_nee (bake --integrator path's CPU default: --guiding auto, its candidate from the scene, "
+                 "--emitter-guiding on), guided_auto_nee (the same measuring grid guiding), nee / guided_nee / svo_nee / bounces_nee (path, guided, "
                  "svo and bounces with --emitter-guiding on), light / light_nee (path with --light-paths on, without and with --emitter-guiding on)");
   float guiding_mix = 0.5f;
   app.add_option("--guiding-mix", guiding_mix, "guided component's probability (guided runs)");
@@ -208,6 +210,7 @@ int main(int argc, char** argv) {
     bool trace_first_bounce = true;  // bounces: B_1 traced (true) or read from the B_0 lightmap
     bool emitter_guiding = false;
     bool light_subpaths = false;
+    AutoGuidingCandidate candidate = AutoGuidingCandidate::Grid;  // GuidingMode::Auto's
   };
   std::vector<Mode> modes;
   auto listed = [&](const std::string& name) {
@@ -237,6 +240,17 @@ int main(int argc, char** argv) {
   if (listed("light")) modes.push_back({IntegratorMode::Path, GuidingMode::Off, "path_light_subpaths", false, kSamplerSobol, true, false, true});
   if (listed("light_nee"))
     modes.push_back({IntegratorMode::Path, GuidingMode::Off, "path_light_subpaths_nee", false, kSamplerSobol, true, true, true});
+  // --guiding auto measuring light subpaths (auto_light), and `bake --integrator path`'s default on the
+  // CPU (auto_nee: auto's candidate from the scene, emitter guiding on) beside the default before it
+  // (guided_auto_nee: auto measuring grid guiding).
+  if (listed("auto_light"))
+    modes.push_back({IntegratorMode::Path, GuidingMode::Auto, "path_auto_light_subpaths", false, kSamplerSobol, true, false, false,
+                     AutoGuidingCandidate::LightSubpaths});
+  if (listed("auto_nee"))
+    modes.push_back({IntegratorMode::Path, GuidingMode::Auto, "path_auto_nee", false, kSamplerSobol, true, true, false,
+                     AutoGuidingCandidate::Scene});
+  if (listed("guided_auto_nee"))
+    modes.push_back({IntegratorMode::Path, GuidingMode::Auto, "path_guided_auto_nee", false, kSamplerSobol, true, true});
   if (listed("bounces")) modes.push_back({IntegratorMode::Bounces, GuidingMode::Off, "per_bounce"});
   if (listed("bounces_nee"))
     modes.push_back({IntegratorMode::Bounces, GuidingMode::Off, "per_bounce_nee", false, kSamplerSobol, true, true});
@@ -281,6 +295,7 @@ int main(int argc, char** argv) {
         settings.guiding_mix = guiding_mix;
         settings.emitter_guiding = m.emitter_guiding;
         settings.light_subpaths = m.light_subpaths;
+        settings.guiding_auto_candidate = m.candidate;
         settings.light_subpaths_per_sample = light_subpaths_per_sample;
         settings.emitter_guiding_mix = emitter_guiding_mix;
         settings.emitter_guiding_patches = emitter_guiding_patches;

@@ -125,7 +125,11 @@ json error_distribution_json(const LightmapEstimate& estimate) {
 
 // stats.guiding (--guiding auto): what the measured choice kept, and why (core/guiding_choice.h).
 json guiding_auto_json(const LightmapEstimate& estimate, const std::string& backend) {
-  json out = {{"mode", "auto"}, {"candidate", "grid"}, {"pilot_samples_per_texel", estimate.guiding_auto_pilot},
+  json out = {{"mode", "auto"},
+              {"candidate", estimate.guiding_auto_light_subpaths ? "light-paths" : "grid"},
+              {"pilot_samples_per_texel", estimate.guiding_auto_pilot},
+              // Light subpaths: the pilot's samples of texels that then connected, dropped (cpu_reference_integrator.cpp).
+              {"pilot_samples_dropped", estimate.pilot_samples_dropped},
               {"guided_vertices", estimate.guided_vertices}};
   const std::vector<RegionChoice>& regions = estimate.guiding_regions;
   if (regions.empty()) {
@@ -213,7 +217,7 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
                        {"guiding", guiding_names[int(options.lighting.guiding)]},
                        {"emitter_guiding", options.lighting.emitter_guiding},
                        {"light_paths", options.lighting.light_subpaths}};
-  if (options.lighting.light_subpaths)
+  if (options.lighting.light_subpaths || estimate.light_subpaths > 0)
     stats["light_paths"] = {{"subpaths", estimate.light_subpaths},
                             {"vertices", estimate.light_subpath_vertices},
                             {"per_sample", options.lighting.light_subpaths_per_sample}};

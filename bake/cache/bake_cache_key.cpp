@@ -80,7 +80,7 @@ void hash_options(Sha256Stream& h, const BakeOptions& o) {
   h.value(l.guiding_svo_c_ray), h.value(l.guiding_svo_rays_per_bin), h.value(l.guiding_svo_emitted);
   h.value(l.guiding_svo_texels);
   h.value(l.emitter_guiding), h.value(l.emitter_guiding_mix), h.value(l.emitter_guiding_patches);
-  h.value(l.light_subpaths), h.value(l.light_subpaths_per_sample);
+  h.value(l.light_subpaths), h.value(l.light_subpaths_per_sample), h.value(l.guiding_auto_candidate);
   h.value(o.bounce_layers), h.value(o.probes_enabled), h.value(o.probe_spacing), h.value(o.probe_spp);
   h.value(o.probe_sh_window), h.value(o.svo_enabled), h.value(o.voxel_resolution);
   h.value(o.skip_sealed_texels), h.value(o.stitch_seams), h.value(o.denoise), h.value(o.denoise_radius);

@@ -141,9 +141,10 @@ int main(int argc, char** argv) {
   app.add_option("--denoise-radius", options.denoise_radius, "--denoise window radius in texels (default 3)")
       ->check(CLI::Range(1, exitance::kFilterMaxRadius));
   app.add_option("--guiding", guiding,
-                 "auto (default: path tracing on the CPU backend measures guided (grid) against unguided samples "
-                 "during a pilot and keeps guiding per region where it pays; on Vulkan only when given (its pilot "
-                 "costs); off per-bounce and under mpirun) "
+                 "auto (default: path tracing on the CPU backend measures a candidate against unguided samples "
+                 "during a pilot and keeps it per region where it pays: light subpaths where the scene has emitters "
+                 "or point or spot lights (unless --light-paths off), else grid guiding; on Vulkan grid guiding, only "
+                 "when given (its pilot costs); off per-bounce and under mpirun) "
                  "| off | svo (fields from exitance in the bake's voxel octree, seed 000) | grid (regular-grid SARSA "
                  "cache, seed 002)")
       ->check(CLI::IsMember({"auto", "off", "svo", "grid"}));
@@ -159,13 +160,14 @@ int main(int argc, char** argv) {
   app.add_option("--emitter-guiding-mix", options.lighting.emitter_guiding_mix,
                  "probability of the learned emitter distribution in the mixture with the default (default 0.5)")
       ->check(CLI::Range(0.0f, 1.0f));
-  std::string light_paths = "off";
+  std::string light_paths = "auto";
   app.add_option("--light-paths", light_paths,
-                 "on | off (default): also trace light subpaths from emitters and point and spot lights into a pool "
-                 "that every path vertex connects to, weighted with the path tracer's strategies by MIS (light "
-                 "entering through narrow openings: docs/lighting-core.md \"Light subpaths\"); CPU backend, path "
-                 "tracing, without --guiding grid/svo")
-      ->check(CLI::IsMember({"on", "off"}));
+                 "auto (default: --guiding auto measures them against unguided samples where the scene has emitters or "
+                 "point or spot lights, and keeps them per region where they pay) | on | off: light subpaths from "
+                 "emitters and point and spot lights into a pool that path vertices connect to, weighted with the "
+                 "path tracer's strategies by MIS (light entering through narrow openings: docs/lighting-core.md "
+                 "\"Light subpaths\"); CPU backend, path tracing; on: every sample, without --guiding grid/svo")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   std::string sampler = "sobol";
   app.add_option("--sampler", sampler,
                  "sobol (Owen-scrambled Sobol points per texel, the default) | independent (independent random "
@@ -338,6 +340,8 @@ int main(int argc, char** argv) {
     }
     options.lighting.light_subpaths = true;
   }
+  // Off: --guiding auto measures grid guiding (its candidate before light subpaths) wherever it runs.
+  if (light_paths == "off") options.lighting.guiding_auto_candidate = exitance::AutoGuidingCandidate::Grid;
   options.guiding_auto_given = guiding == "auto" && app.get_option("--guiding")->count() > 0;
 
   if (no_cache && !cache_directory.empty()) {

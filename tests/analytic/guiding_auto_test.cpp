@@ -1,5 +1,7 @@
 // --guiding auto (issue 11) on the CPU backend: a pilot of guided and unguided samples on every texel,
 // then each region keeps the strategy with the lower variance x counted cost (core/guiding_choice.h).
+// Its candidate is grid guiding (AutoGuidingCandidate::Grid) or light subpaths (issue 35 item 4: the
+// candidate of scenes with emitters or point or spot lights); both are checked the same way.
 // Mixing the two unbiased strategies in one texel's mean, with the choice made from earlier samples,
 // is unbiased: auto converges to the unguided path tracer per region (Cornell room, ajar_room). The
 // choice and the image are bit-identical per seed and thread count. In a white furnace cosine
@@ -33,26 +35,43 @@ constexpr double kZLimit = 5.0;
 constexpr int kSeeds = 16;
 constexpr double kDetectableBias = 0.10;
 
-IntegratorSettings settings(uint32_t spp, uint64_t seed, GuidingMode guiding) {
+IntegratorSettings settings(uint32_t spp, uint64_t seed, GuidingMode guiding,
+                            AutoGuidingCandidate candidate = AutoGuidingCandidate::Grid) {
   IntegratorSettings s;
   s.spp = spp;
   s.seed = seed;
   s.guiding = guiding;
+  s.guiding_auto_candidate = candidate;
   return s;
 }
 
 // Auto against unguided, per region (instance), over kSeeds seeds each. Returns the median over
 // regions of the relative standard error of the difference.
-double expect_auto_agrees(const std::string& label, const PreparedScene& p, uint32_t spp) {
+// `seeds_kept`: how many seeds kept the candidate in at least one region.
+// `adaptive`: auto's samples planned per texel too (bake's default with --time), spp their mean.
+double expect_auto_agrees(const std::string& label, const PreparedScene& p, uint32_t spp,
+                          AutoGuidingCandidate candidate = AutoGuidingCandidate::Grid, int* seeds_kept = nullptr,
+                          bool adaptive = false) {
   const CpuReferenceIntegrator integrator(p.scene);
   std::map<uint32_t, std::vector<double>> automatic, unguided;
   size_t decided = 0, regions_guided = 0, regions = 0;
+  const bool light_subpaths = candidate == AutoGuidingCandidate::LightSubpaths;
   for (int seed = 0; seed < kSeeds; ++seed) {
-    const LightmapEstimate a = integrator.bake(p.gbuffer, settings(spp, uint64_t(seed), GuidingMode::Auto));
+    IntegratorSettings automatic_settings = settings(spp, uint64_t(seed), GuidingMode::Auto, candidate);
+    automatic_settings.adaptive = adaptive;
+    const LightmapEstimate a = integrator.bake(p.gbuffer, automatic_settings);
+    EXPECT_EQ(a.adaptive, adaptive);
+    if (adaptive && light_subpaths) EXPECT_EQ(a.adaptive_pilot, 2 * a.guiding_auto_pilot) << "the plan's pilot follows the choice's";
     const LightmapEstimate u = integrator.bake(p.gbuffer, settings(spp, uint64_t(seed) + 1000, GuidingMode::Off));
     EXPECT_EQ(a.nonfinite_samples, 0u);
     EXPECT_TRUE(a.guiding_auto);
-    EXPECT_GT(a.guided_vertices, 0u);  // the pilot's guided samples at least
+    EXPECT_EQ(a.guiding_auto_light_subpaths, light_subpaths);
+    if (light_subpaths)
+      EXPECT_GT(a.light_subpaths, 0u);  // the pilot's connected samples' pools at least
+    else
+      EXPECT_GT(a.guided_vertices, 0u);  // the pilot's guided samples at least
+    if (seeds_kept) *seeds_kept += a.guiding_regions.end() != std::find_if(a.guiding_regions.begin(), a.guiding_regions.end(),
+                                                                            [](const RegionChoice& r) { return r.guided; });
     decided += !a.guiding_regions.empty();
     for (const RegionChoice& r : a.guiding_regions) regions_guided += r.guided, ++regions;
     for (auto& [region, m] : testing::region_means(p.gbuffer, testing::luminance_means(a))) automatic[region].push_back(m);
@@ -88,6 +107,63 @@ TEST(GuidingAuto, AjarRoomAgreesWithUnguided) {
   EXPECT_LT(kZLimit * se, kDetectableBias) << "the test could not see a 10 % bias";
 }
 
+// Light subpaths as the candidate: the pilot's connected halves, then connections kept per region,
+// the pilot's samples dropped where a texel connects, then adaptive sampling's pilot and plan (as
+// bake --time runs it: its pilot follows the choice's, from samples 256 to 512). At
+// 1024 spp the pilot is its full 256 samples; at 2 texels/m ajar_room's few regions keep connections
+// on some seeds only (7 of 16 when written), so both branches are checked against unguided.
+TEST(GuidingAuto, LightPathCandidateOnAjarRoomAgreesWithUnguided) {
+  const PreparedScene p = testing::prepared_sample("ajar_room", 2);
+  int kept = 0;
+  const double se = expect_auto_agrees("ajar_room light paths", p, 1024, AutoGuidingCandidate::LightSubpaths, &kept, true);
+  EXPECT_LT(kZLimit * se, kDetectableBias) << "the test could not see a 10 % bias";
+  std::printf("[auto] ajar_room light paths: %d of %d seeds kept connections somewhere\n", kept, kSeeds);
+  EXPECT_GE(kept, 1) << "no seed kept connections: the branch after the choice went unchecked";
+}
+
+// The choice itself: at 4 texels/m ajar_room's evidence is clear (light through a door gap, where
+// connections pay ~6x at equal time: bench/results/guiding-auto-light-paths.md; the scene's z read 6
+// against the choice's threshold of 3), and the regions keep connections on the scene's evidence.
+TEST(GuidingAuto, LightPathCandidateIsKeptOnAjarRoom) {
+  const PreparedScene p = testing::prepared_sample("ajar_room", 4);
+  const CpuReferenceIntegrator integrator(p.scene);
+  for (uint64_t seed : {1, 2}) {
+    const LightmapEstimate a = integrator.bake(p.gbuffer, settings(1024, seed, GuidingMode::Auto, AutoGuidingCandidate::LightSubpaths));
+    ASSERT_FALSE(a.guiding_regions.empty());
+    size_t kept = 0;
+    for (const RegionChoice& r : a.guiding_regions) kept += r.guided;
+    std::printf("[auto] ajar_room 4 texels/m seed %d: scene ratio %.2f z %.1f, %zu of %zu regions connect\n", int(seed),
+                a.guiding_scene.efficiency_ratio(), a.guiding_scene.z(), kept, a.guiding_regions.size());
+    EXPECT_GT(a.guiding_scene.z(), kChoiceZ) << "seed " << seed;
+    EXPECT_GE(2 * kept, a.guiding_regions.size()) << "seed " << seed;
+    EXPECT_GT(a.pilot_samples_dropped, 0u);
+  }
+}
+
+// The Cornell room's ceiling light is seen by every surface: connections do not pay (the choice
+// keeps them nowhere on significant evidence), and the pilot's connected samples stay unbiased.
+TEST(GuidingAuto, LightPathCandidateOnCornellRoomAgreesWithUnguided) {
+  const PreparedScene p = testing::prepared_sample("cornell_room", 2);
+  const double se = expect_auto_agrees("cornell_room light paths", p, 64, AutoGuidingCandidate::LightSubpaths);
+  EXPECT_LT(kZLimit * se, kDetectableBias) << "the test could not see a 10 % bias";
+}
+
+// The scene's candidate: light subpaths with an emissive triangle (the Cornell room's ceiling light),
+// grid guiding under a sun and a sky only (the courtyard: no light a subpath starts from).
+TEST(GuidingAuto, SceneCandidateFollowsTheLights) {
+  const PreparedScene cornell = testing::prepared_sample("cornell_room", 1);
+  const LightmapEstimate c =
+      CpuReferenceIntegrator(cornell.scene).bake(cornell.gbuffer, settings(8, 1, GuidingMode::Auto, AutoGuidingCandidate::Scene));
+  EXPECT_TRUE(c.guiding_auto_light_subpaths);
+  EXPECT_GT(c.light_subpaths, 0u);
+  const PreparedScene courtyard = testing::prepared_sample("courtyard", 0.5);
+  const LightmapEstimate y = CpuReferenceIntegrator(courtyard.scene)
+                                 .bake(courtyard.gbuffer, settings(8, 1, GuidingMode::Auto, AutoGuidingCandidate::Scene));
+  EXPECT_TRUE(y.guiding_auto);
+  EXPECT_FALSE(y.guiding_auto_light_subpaths);
+  EXPECT_EQ(y.light_subpaths, 0u);
+}
+
 bool identical(const LightmapEstimate& a, const LightmapEstimate& b) {
   if (!testing::identical_texel_sums(a, b)) return false;
   if (a.guiding_regions.size() != b.guiding_regions.size()) return false;
@@ -113,6 +189,25 @@ TEST(GuidingAuto, ChoiceAndResultBitIdenticalPerSeedAndThreadCount) {
   }
   const LightmapEstimate other = integrator.bake(p.gbuffer, settings(96, 8, GuidingMode::Auto));
   EXPECT_FALSE(identical(a, other)) << "the seed must matter";
+}
+
+// The same with light subpaths as the candidate: pools sized by the connected share of each pass.
+TEST(GuidingAuto, LightPathChoiceAndResultBitIdenticalPerSeedAndThreadCount) {
+  const PreparedScene p = testing::prepared_sample("ajar_room", 2);
+  const CpuReferenceIntegrator integrator(p.scene);
+  const IntegratorSettings s = settings(96, 7, GuidingMode::Auto, AutoGuidingCandidate::LightSubpaths);
+  const LightmapEstimate a = integrator.bake(p.gbuffer, s);
+  ASSERT_FALSE(a.guiding_regions.empty()) << "96 spp: the pilot (16) ends within the bake";
+  EXPECT_EQ(a.guiding_auto_pilot, 16u);
+  EXPECT_GT(a.light_subpaths, 0u);
+  EXPECT_TRUE(identical(a, integrator.bake(p.gbuffer, s))) << "two runs with one seed differ";
+  {
+    tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+    EXPECT_TRUE(identical(a, integrator.bake(p.gbuffer, s))) << "one thread and all threads differ";
+  }
+  IntegratorSettings other = s;
+  other.seed = 8;
+  EXPECT_FALSE(identical(a, integrator.bake(p.gbuffer, other))) << "the seed must matter";
 }
 
 // A white furnace (every face emits Le, albedo rho): cosine sampling makes every bounce's

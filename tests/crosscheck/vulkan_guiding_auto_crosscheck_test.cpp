@@ -45,6 +45,8 @@ IntegratorSettings settings(uint32_t spp, uint64_t seed, GuidingMode guiding) {
   s.spp = spp;
   s.seed = seed;
   s.guiding = guiding;
+  // What the Vulkan backend measures; the CPU's own candidate for these scenes would be light subpaths.
+  s.guiding_auto_candidate = AutoGuidingCandidate::Grid;
   return s;
 }
 

@@ -150,7 +150,8 @@ void GuidingChoice::decide(double floor) {
     const StrategySums* s = &sums_[i * 2];
     for (int k = 0; k < 2; ++k) {
       t.samples[k] = s[k].samples;
-      t.cost[k] = double(s[k].rays) + guided_vertex_cost_ * double(s[k].guided_vertices);
+      t.cost[k] = double(s[k].rays) + guided_vertex_cost_ * double(s[k].guided_vertices) +
+                  (k == 1 ? guided_sample_cost_ * double(s[k].samples) : 0.0);
     }
     // Both strategies' variances are weighted by the same (pooled mean + floor)^2, so the comparison
     // is the one relMSE makes, and bright texels do not outvote dim ones.

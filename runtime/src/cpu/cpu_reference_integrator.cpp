@@ -16,6 +16,7 @@
 #include "exitance/runtime/core/adaptive_sampling_plan.h"
 #include "exitance/runtime/core/emitter_guiding_cache.h"
 #include "exitance/runtime/core/grid_guiding_cache.h"
+#include "exitance/runtime/core/guide_grid_locator.h"
 #include "exitance/runtime/core/guiding_choice.h"
 #include "exitance/runtime/core/pass_scheduler.h"
 #include "exitance/runtime/core/svo_guiding_fields.h"
@@ -39,6 +40,12 @@ constexpr uint32_t kGuidingLearningSamples = GridGuidingCache::kLearningSamples;
 constexpr uint64_t kMostLightSubpathsPerPool = uint64_t(1) << 17;
 // ... and at least this many, so small passes of small atlases do not share a handful of vertices.
 constexpr uint64_t kFewestLightSubpathsPerPool = 256;
+// --guiding auto's pilot with the light-subpath candidate, before GuidingChoice::pilot_for shortens it
+// for small --spp. Longer than grid guiding's (64, its learning): what connections fix is a heavy
+// tail (rare paths through a gap), which a short pilot's sample variance misses. Measured on
+// ajar_room, where connections pay ~6x at equal time: the scene's efficiency ratio read 0.82 after
+// 32 samples (so auto dropped them), 1.6 after 128, 2.4 after 256 (bench/results/guiding-auto-light-paths.md).
+constexpr uint32_t kLightSubpathPilotSamples = 256;
 // A target error plans at most this many samples for a texel without --spp (documented).
 constexpr uint32_t kMostSamplesForTarget = 1u << 17;
 
@@ -372,10 +379,21 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   std::vector<uint64_t> texel_rays(share ? texel_count : 0);  // this pass's, per texel: the next split's cost
   tbb::combinable<uint64_t> shared_samples_per_thread([] { return uint64_t(0); });  // this rank's (stats.rank_work)
 
+  // Light subpaths (light_subpaths.h): with --light-paths on for every sample; with --guiding auto as
+  // its candidate (AutoGuidingCandidate) where the scene has a light they start from, for the samples
+  // the choice gives them.
+  const bool auto_guiding = settings.guiding == GuidingMode::Auto;
+  const LightSubpathSampling subpath_start =
+      settings.light_subpaths || auto_guiding ? light_subpath_start(*impl_->lighting) : light_subpaths_none();
+  const bool scene_starts_subpaths = subpath_start.area_probability > 0 || subpath_start.punctual_scale > 0;
+  const bool auto_light_subpaths =
+      auto_guiding && (settings.guiding_auto_candidate == AutoGuidingCandidate::LightSubpaths ||
+                       (settings.guiding_auto_candidate == AutoGuidingCandidate::Scene && scene_starts_subpaths));
+  const bool light_subpaths = scene_starts_subpaths && (settings.light_subpaths || auto_light_subpaths);
+
   // Built inside the timed bake: guided results are measured with the cost of their guiding data.
   std::unique_ptr<GridGuidingCache> guide;
-  const GuidingMode guided_kind = settings.guiding == GuidingMode::Auto ? settings.guiding_auto_candidate : settings.guiding;
-  if (guided_kind == GuidingMode::Grid) {
+  if (settings.guiding == GuidingMode::Grid || (auto_guiding && !auto_light_subpaths)) {
     GridGuidingConfig config;
     config.mix = settings.guiding_mix;
     config.cells_on_longest_axis = settings.guiding_grid_cells;
@@ -406,16 +424,21 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   // the texel), the unit whose learned table decides how well its texels' first vertices are guided,
   // with at least 16 texels each, so a region's variance sums are not one texel's noise. Texels
   // without a record share one more region.
+  // The light-subpath candidate has the same regions (the grid's records, no tables), a shorter
+  // pilot (nothing learns) and statistics from its first sample.
   std::unique_ptr<GuidingChoice> choice;
-  if (settings.guiding == GuidingMode::Auto) {
-    if (!guide) throw std::invalid_argument("CPU backend: --guiding auto has no guided kind to measure (candidate not built)");
-    const uint32_t pilot = GuidingChoice::pilot_for(settings.spp, kGuidingLearningSamples);
+  if (auto_guiding) {
+    const GuideGridLocator locator = guide ? guide->locator()
+                                           : GuideGridLocator(impl_->lighting->bounds_lo, impl_->lighting->bounds_hi, gbuffer,
+                                                              settings.guiding_grid_cells, GridGuidingCache::kMinTexelsPerRecord);
+    const uint32_t pilot = GuidingChoice::pilot_for(settings.spp, guide ? kGuidingLearningSamples : kLightSubpathPilotSamples);
     std::vector<uint32_t> region(texel_count);
     for (size_t i = 0; i < texel_count; ++i) {
-      const uint32_t r = guide->record_of(gbuffer.texels[i].position, gbuffer.texels[i].shading_normal);
-      region[i] = r == GridGuidingCache::kNoRecord ? guide->record_count() : r;
+      const uint32_t r = locator.record_of(gbuffer.texels[i].position, gbuffer.texels[i].shading_normal);
+      region[i] = r == GuideGridLocator::kNoRecord ? locator.record_count() : r;
     }
-    choice = std::make_unique<GuidingChoice>(std::move(region), guide->record_count() + 1, pilot, pilot / 4, settings.seed);
+    choice = std::make_unique<GuidingChoice>(std::move(region), locator.record_count() + 1, pilot, guide ? pilot / 4 : 0,
+                                             settings.seed);
   }
 
   // Adaptive sampling (adaptive_sampling_plan.h): a uniform pilot, then per-texel rates from the
@@ -423,19 +446,28 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   // running error would be biased.
   const bool adaptive = settings.adaptive || settings.target_relative_error > 0;
   std::vector<TexelSampleSums> pilot_sums(adaptive ? texel_count : 0);
-  // Pilot samples per texel (a ramp boundary, so no pass crosses it).
-  const uint32_t pilot = settings.spp != 0 && settings.spp < 64 ? 4 : 16;
+  // Pilot samples per texel (a ramp boundary, so no pass crosses it). With --guiding auto measuring
+  // light subpaths, the plan's pilot follows the choice's (as many samples again), so the rates come
+  // from the strategy each texel keeps: planned from the choice's pilot, mostly unconnected samples,
+  // they cost ajar_room 1.5x the relMSE at 20 s (bench/results/guiding-auto-light-paths.md).
+  const uint32_t plan_from = choice && auto_light_subpaths ? choice->pilot() : 0;
+  const uint32_t pilot = plan_from > 0 ? 2 * plan_from : settings.spp != 0 && settings.spp < 64 ? 4 : 16;
   AdaptivePlan plan;
   std::vector<uint32_t> planned;  // target-error mode: each texel's samples
   bool planning = false;          // past the pilot
   double progress_after_pilot = 0, planned_progress = 0;
 
-  // Light subpaths (light_subpaths.h): a pool per pass, or per chunk of a large pass's samples, of
+  // Light subpaths: a pool per pass, or per chunk of a large pass's samples, of
   // light_subpaths_per_sample subpaths per texel sample it serves.
-  const LightSubpathSampling subpath_start = settings.light_subpaths ? light_subpath_start(*impl_->lighting) : light_subpaths_none();
-  const bool light_subpaths = subpath_start.area_probability > 0 || subpath_start.punctual_scale > 0;
   const int subpath_depth = std::min(settings.max_bounces >= 0 ? settings.max_bounces : INT32_MAX, settings.safety_bounce_cap - 1);
   LightVertexPool light_pool;
+  uint64_t pool_rays = 0;  // all pools': with the subpaths traced, the price of a connected sample's share
+  // The share of texel samples that connect: every one with --light-paths on; with auto, the pilot's
+  // expected share (a quarter of the texels measure, half their samples connected), then the texels
+  // whose regions kept connections.
+  double connected_share = light_subpaths ? (auto_light_subpaths ? kPilotMeasuringShare * 0.5 : 1.0) : 0.0;
+  // Per texel, pilot samples dropped when it began to connect (their sample indices stay used).
+  std::vector<uint32_t> dropped;
   auto trace_light_pool = [&](double texel_samples, uint32_t key) {
     const double wanted = std::ceil(texel_samples * settings.light_subpaths_per_sample);
     const uint64_t paths = uint64_t(std::clamp(wanted, double(kFewestLightSubpathsPerPool), double(kMostLightSubpathsPerPool)));
@@ -443,8 +475,36 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     light_pool = trace_light_vertex_pool(*impl_->lighting, *impl_->embree, subpath_start, paths, settings.seed, key,
                                          settings.sampler, subpath_depth, settings.russian_roulette_start, emitter_cache);
     rays_per_thread.local() += light_pool.rays;
+    pool_rays += light_pool.rays;
     estimate.light_subpaths += light_pool.paths;
     estimate.light_subpath_vertices += light_pool.vertices.size();
+  };
+
+  // Auto with light subpaths: a texel whose verdict is to connect drops its pilot's samples, mostly
+  // unconnected ones. Where connections pay, those carry the heavy tail that connections remove (rare
+  // paths through a gap): kept, 256 of them raised ajar_room's relMSE 2x after 9 000 connected samples
+  // (bench/results/guiding-auto-light-paths.md). Unbiased as the choice is: whether a texel drops is
+  // its region's verdict from other texels' samples, not its own values, and its estimate is then the
+  // mean of a number of later samples fixed without them.
+  auto drop_pilot_of_connecting_texels = [&]() {
+    dropped.assign(texel_count, 0);
+    const int layers = estimate.recorded_bounces;
+    for (size_t i = 0; i < texel_count; ++i) {
+      if (!choice->sample_guided(i, choice->pilot())) continue;
+      dropped[i] = estimate.texels[i].samples;
+      estimate.pilot_samples_dropped += dropped[i];
+      estimate.texels[i] = TexelAccumulator{};
+      for (int k = 0; k < layers; ++k) std::fill_n(&estimate.bounces[(size_t(k) * texel_count + i) * 3], 3, 0.0);
+      if (directional) std::fill_n(&estimate.sh1[i * 9], 9, 0.0);
+      for (int k = 0; k < estimate.light_layers; ++k) std::fill_n(&estimate.light_sums[(size_t(k) * texel_count + i) * 3], 3, 0.0);
+    }
+  };
+  // Whether the bake goes on long enough after the pilot for dropping it to pay: at least as many
+  // samples again (--spp), or a third of the time budget spent at most.
+  auto room_after_pilot = [&](const PassScheduler& p, uint32_t pilot) {
+    if (settings.spp != 0) return settings.spp >= 2 * pilot;
+    if (settings.time_budget_seconds > 0) return p.elapsed_seconds() < settings.time_budget_seconds / 3;
+    return true;
   };
 
   // One sample `s` of texel `i`.
@@ -456,6 +516,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     // trace without the guide, so regions that chose cosine pay nothing for it.
     const bool guided_sample = !choice || choice->sample_guided(i, s);
     GridGuidingCache* sample_guide = guided_sample ? guide.get() : nullptr;
+    const bool connects = light_subpaths && (!auto_light_subpaths || guided_sample);
     const LiveTexel& texel = gbuffer.texels[i];
     const SurfacePoint point{texel.position, texel.geometric_normal, texel.shading_normal};
     TexelAccumulator& acc = estimate.texels[i];
@@ -485,7 +546,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
                    &guided_vertices, emitter_guiding);
     else
       impl_->trace(point, settings, rng, contributions, rays, Impl::NoGuide{}, &guided_vertices, emitter_guiding,
-                   light_subpaths ? &light_pool : nullptr);
+                   connects ? &light_pool : nullptr);
     const Vec3 total = contributions.total();
     Vec3 l1[3];
     bool l1_finite = true;
@@ -512,7 +573,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     if (choice && !choice->decided())
       choice->record(i, s, guided_sample, luminance(total), rays - rays_before, guided_vertices - guided_before);
     if (share) texel_rays[i] += rays - rays_before, ++shared_samples_per_thread.local();
-    if (adaptive && !planning) {
+    if (adaptive && !planning && s >= plan_from) {
       TexelSampleSums& p = pilot_sums[i];
       const double y = luminance(total);
       ++p.samples, p.rays += rays - rays_before, p.sum += y, p.sum_squared += y * y;
@@ -538,11 +599,12 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     svo_counting = svo_guide && first + count >= svo_next_rebuild;
     if (planning) {
       const double progress = double(first) - progress_after_pilot + double(count) * fraction;
-      if (light_subpaths) trace_light_pool(double(texel_count) * double(count) * fraction, first);
+      if (connected_share > 0) trace_light_pool(double(texel_count) * double(count) * fraction * connected_share, first);
       tbb::parallel_for(tbb::blocked_range<size_t>(0, texel_count, 16), [&](const tbb::blocked_range<size_t>& range) {
         PathContributions contributions;
         for (size_t i = range.begin(); i != range.end(); ++i)
-          for (uint32_t s = estimate.texels[i].samples, target = planned_count(i, progress); s < target; ++s)
+          for (uint32_t s = estimate.texels[i].samples + (dropped.empty() ? 0 : dropped[i]), target = planned_count(i, progress);
+               s < target; ++s)
             take_sample(i, s, learning, contributions);
       });
     } else {
@@ -562,9 +624,9 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
           }
         });
       };
-      if (light_subpaths) {
+      if (connected_share > 0) {
         // The same pools on every rank: sized by the whole atlas's covered texels.
-        const double covered = double(texel_count) * std::min(fraction, 1.0);
+        const double covered = double(texel_count) * std::min(fraction, 1.0) * connected_share;
         const double per_sample = std::max(1.0, covered * settings.light_subpaths_per_sample);
         const uint32_t chunk = uint32_t(std::max(1.0, std::floor(double(kMostLightSubpathsPerPool) / per_sample)));
         for (uint32_t sample_begin = first, sample_end; sample_begin < first + count; sample_begin = sample_end) {
@@ -589,8 +651,17 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       svo_next_rebuild = 2 * (first + count);
     }
     passes.finish_pass(rays_per_thread.combine(std::plus<uint64_t>()));
-    // Auto: the pilot is complete on every texel; each texel takes its region's cheaper strategy from here.
-    if (choice && !choice->decided() && passes.samples_done() >= choice->pilot() && fraction == 1) choice->decide();
+    // Auto: the pilot is complete on every texel; each texel takes its region's cheaper strategy from
+    // here. A connected sample's share of the pools: their rays per subpath x subpaths per sample.
+    if (choice && !choice->decided() && passes.samples_done() >= choice->pilot() && fraction == 1) {
+      if (auto_light_subpaths && estimate.light_subpaths > 0)
+        choice->set_guided_sample_cost(double(pool_rays) / double(estimate.light_subpaths) * settings.light_subpaths_per_sample);
+      choice->decide();
+      if (auto_light_subpaths && light_subpaths) {
+        connected_share = double(choice->texels_guided()) / double(std::max<size_t>(texel_count, 1));
+        if (room_after_pilot(passes, choice->pilot())) drop_pilot_of_connecting_texels();
+      }
+    }
     if (adaptive && !planning && passes.samples_done() == pilot && fraction == 1) {
       // The pilot is complete: every texel's rate from its neighbours' pilot samples.
       plan = plan_adaptive_rates(gbuffer, pilot_sums);
@@ -604,6 +675,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
         double extra = 0;
         for (size_t i = 0; i < texel_count; ++i) {
           planned[i] = samples_for_target(plan.relative_deviation[i], settings.target_relative_error, pilot, most);
+          // A texel that dropped its choice pilot's samples takes as many more (its indices run on).
+          if (!dropped.empty()) planned[i] = uint32_t(std::min<uint64_t>(uint64_t(planned[i]) + dropped[i], 0xFFFFFFF0u));
           extra += planned[i] - pilot;
         }
         // Every texel reaches its count when the progress reaches the mean extra samples per texel.
@@ -630,6 +703,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   estimate.guided_vertices = guided_per_thread.combine(std::plus<uint64_t>());
   if (choice) {
     estimate.guiding_auto = true;
+    estimate.guiding_auto_light_subpaths = auto_light_subpaths;
     estimate.guiding_auto_pilot = choice->pilot();
     if (choice->decided()) estimate.guiding_regions = choice->regions(), estimate.guiding_scene = choice->scene();
   }

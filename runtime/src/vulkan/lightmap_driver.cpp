@@ -300,8 +300,9 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   // strategy's samples per texel (gpu_layout.h kGuidingAuto), read back once when the pilot is
   // complete; GuidingChoice decides per region, and the texels' verdicts go back as strategy words.
   const bool auto_guiding = settings.guiding == GuidingMode::Auto;
-  if (auto_guiding && settings.guiding_auto_candidate != GuidingMode::Grid)
-    throw std::invalid_argument("Vulkan backend: --guiding auto measures grid guiding against unguided only");
+  // The scene's candidate is grid guiding here: light subpaths are traced by the CPU backend only.
+  if (auto_guiding && settings.guiding_auto_candidate == AutoGuidingCandidate::LightSubpaths)
+    throw std::invalid_argument("Vulkan backend: --guiding auto measures grid guiding against unguided only, not light subpaths");
   std::unique_ptr<GuidingChoice> choice;
   std::vector<uint32_t> auto_words;
   if (settings.guiding == GuidingMode::Grid || auto_guiding) {

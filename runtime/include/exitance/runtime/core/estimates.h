@@ -70,9 +70,11 @@ struct LightmapEstimate {
   // Light subpaths (IntegratorSettings::light_subpaths): traced, and their vertices kept in pools.
   uint64_t light_subpaths = 0;
   uint64_t light_subpath_vertices = 0;
+  uint64_t pilot_samples_dropped = 0;  // --guiding auto: by texels that began to connect after its pilot
   // GuidingMode::Auto: what the choice measured and kept per region (core/guiding_choice.h); empty
   // otherwise or when the bake ended before the pilot did (then every sample tossed its coin).
   bool guiding_auto = false;
+  bool guiding_auto_light_subpaths = false;  // what it measured against unguided: light subpaths (else grid guiding)
   uint32_t guiding_auto_pilot = 0;  // samples per texel before the choice
   std::vector<RegionChoice> guiding_regions;
   EfficiencyEvidence guiding_scene;  // the whole scene's evidence, which regions without their own follow

@@ -52,8 +52,11 @@
 // mixture's pdf in next-event estimation's MIS weight), calibrated once on the CPU backend
 // (kGuidedVertexCostInRays, bench/results/guiding-auto.md).
 //
-// Another guided kind (an SVO guide, say) plugs in as the candidate unchanged: the integrator only
-// needs to say, per sample, which strategy ran and what it cost.
+// Another guided kind plugs in as the candidate unchanged: the integrator only needs to say, per
+// sample, which strategy ran and what it cost. Light subpaths do (IntegratorSettings's
+// AutoGuidingCandidate): a "guided" sample is then one whose eye vertices connect to the pass's
+// light-subpath pool, its rays count the connections' shadow rays, and each such sample also pays
+// its share of the pool's rays (set_guided_sample_cost).
 #pragma once
 #include <cstdint>
 #include <string>
@@ -136,6 +139,9 @@ class GuidingChoice {
   // CPU's); a backend whose guided vertices cost otherwise sets its own before decide().
   void set_guided_vertex_cost(double rays) { guided_vertex_cost_ = rays; }
   double guided_vertex_cost() const { return guided_vertex_cost_; }
+  // A fixed price per guided sample in rays, besides its own rays and vertices (default 0): the
+  // light-subpath candidate's share of the pool it connects to (traced once for many samples).
+  void set_guided_sample_cost(double rays) { guided_sample_cost_ = rays; }
 
   uint32_t pilot() const { return pilot_; }
   bool decided() const { return decided_; }
@@ -185,6 +191,7 @@ class GuidingChoice {
   uint64_t seed_;
   uint64_t measuring_below_;  // hash threshold: measuring_share x 2^64
   double guided_vertex_cost_ = kGuidedVertexCostInRays;
+  double guided_sample_cost_ = 0;
   bool decided_ = false;
 };
 

@@ -28,6 +28,13 @@ enum class IntegratorMode { Path, Bounces };
 // it pays (core/guiding_choice.h); CPU backend, which alone has it so far (bake hands Off to the others).
 enum class GuidingMode { Off, Grid, Svo, Auto };
 
+// What GuidingMode::Auto measures against unguided samples (issue 35, item 4). Scene: light subpaths
+// where the scene has emissive triangles or point or spot lights and the backend traces them (the CPU;
+// bench/results/guiding-auto-light-paths.md), grid guiding otherwise. Grid: grid guiding always.
+// LightSubpaths: light subpaths always (CPU backend; a scene with no light they start from measures
+// nothing and stays unguided).
+enum class AutoGuidingCandidate { Scene, Grid, LightSubpaths };
+
 // Directional lightmaps (bake --directional, issue 14). Sh1: per texel also the world-space L1 SH
 // coefficients of cosine-convolved irradiance in units of E/pi (LightmapEstimate::sh1,
 // docs/bundle.md "Directional layers"); the texel's first continuation then samples a defensive
@@ -71,7 +78,7 @@ struct IntegratorSettings {
   uint32_t sampler = 0;            // random numbers: kSamplerSobol (0) or kSamplerIndependent (path_sampler.h)
   GuidingMode guiding = GuidingMode::Off;  // Path mode only; backends refuse modes they lack
   DirectionalMode directional = DirectionalMode::Off;  // Path mode only
-  GuidingMode guiding_auto_candidate = GuidingMode::Grid;  // the guided kind Auto measures against unguided
+  AutoGuidingCandidate guiding_auto_candidate = AutoGuidingCandidate::Scene;  // what Auto measures against unguided
   float guiding_mix = 0.5f;         // probability of the guided component at a guided vertex (0..1)
   int guiding_grid_cells = 16;      // grid cells along the scene's longest axis (cubic cells)
   // GuidingMode::Svo: the bake's octree (its structure; exitance it holds seeds the guide), and
