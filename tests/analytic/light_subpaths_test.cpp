@@ -141,6 +141,37 @@ TEST(LightSubpaths, AjarRoomAgreesWithPathTracing) { expect_sample_scene_agrees(
 
 TEST(LightSubpaths, BuildingAgreesWithPathTracing) { expect_sample_scene_agrees("building", 0.5f, 64); }
 
+// Probes (bake --light-paths on connects their paths too, from each probe ray's first hit): the
+// SH's constant term per probe and channel against the path tracer's, over kSeeds seeds, in the box
+// with a spot light and far brighter lights outside; bit-identical per seed and thread count.
+TEST(LightSubpaths, ProbesAgreeWithPathTracing) {
+  const testing::AtlasScene box = box_with_spot();
+  const CpuReferenceIntegrator integrator(box.scene);
+  const std::vector<Vec3> probes = {{0.5f, 0.5f, 0.5f}, {0.25f, 0.2f, 0.25f}, {0.75f, 0.3f, 0.6f}, {0.3f, 0.75f, 0.7f}};
+  testing::RegionRuns with, without;
+  uint64_t subpaths = 0;
+  auto add = [&](const ProbeEstimate& e, testing::RegionRuns& runs) {
+    EXPECT_EQ(e.nonfinite_samples, 0u);
+    for (size_t i = 0; i < probes.size(); ++i)
+      for (int c = 0; c < 3; ++c) runs[uint32_t(i * 3 + size_t(c))].push_back(e.sh_sum[i][size_t(c)] / double(e.samples[i]));
+  };
+  for (int seed = 0; seed < kSeeds; ++seed) {
+    const ProbeEstimate w = integrator.bake_probes(probes, settings(4096, uint64_t(seed), true));
+    subpaths += w.light_subpaths;
+    add(w, with);
+    add(integrator.bake_probes(probes, settings(4096, uint64_t(seed) + 1000, false)), without);
+  }
+  EXPECT_GT(subpaths, 0u) << "no light subpath was traced for the probes";
+  EXPECT_LT(kZLimit * testing::expect_regions_agree("light subpaths", "box probes", without, with, kZLimit), kDetectableBias)
+      << "the test could not see a 10 % bias";
+  const ProbeEstimate a = integrator.bake_probes(probes, settings(256, 7, true, 0.25));
+  const ProbeEstimate b = integrator.bake_probes(probes, settings(256, 7, true, 0.25));
+  tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+  const ProbeEstimate c = integrator.bake_probes(probes, settings(256, 7, true, 0.25));
+  EXPECT_TRUE(a.sh_sum == b.sh_sum && a.sh_sum == c.sh_sum) << "runs with one seed differ";
+  EXPECT_FALSE(a.sh_sum == integrator.bake_probes(probes, settings(256, 7, false)).sh_sum) << "subpaths must change the samples";
+}
+
 TEST(LightSubpaths, BitIdenticalPerSeedAndThreadCount) {
   const testing::AtlasScene box = testing::box_with_lights_outside();
   const CpuReferenceIntegrator integrator(box.scene);

@@ -298,9 +298,10 @@ struct CpuReferenceIntegrator::Impl {
     }
   }
 
-  // Incident radiance at `origin` from direction -`direction` (see ProbeEstimate).
+  // Incident radiance at `origin` from direction -`direction` (see ProbeEstimate). `pool`: light
+  // subpaths the path from the ray's first hit connects to (that hit is its fixed x_0, as a texel is).
   Vec3 radiance_along_ray(Vec3 origin, Vec3 direction, const IntegratorSettings& settings, PathSampler& rng,
-                          uint64_t& rays, bool& backface) const {
+                          uint64_t& rays, bool& backface, const LightVertexPool* pool = nullptr) const {
     backface = false;
     ++rays;
     const Hit hit = embree->intersect(origin, direction, INFINITY);
@@ -310,7 +311,7 @@ struct CpuReferenceIntegrator::Impl {
     if (!h.continues) return h.radiance;
     PathContributions contributions;
     contributions.recorded = 0;
-    trace(h.next, settings, rng, contributions, rays, NoGuide{});
+    trace(h.next, settings, rng, contributions, rays, NoGuide{}, nullptr, {}, pool);
     return h.radiance + h.albedo * contributions.total();
   }
 };
@@ -740,21 +741,43 @@ ProbeEstimate CpuReferenceIntegrator::bake_probes(const std::vector<Vec3>& posit
   std::vector<size_t> bounds = share ? split_by_cost(probe_count, {}, share->ranks()) : std::vector<size_t>{};
   std::vector<uint64_t> probe_rays(share ? probe_count : 0);  // this pass's: the next split's cost
   uint64_t own_samples = 0;
+  // Light subpaths (--light-paths on): every probe sample's path connects to a pool traced for its
+  // chunk of samples, as texels' do (light_subpaths_per_sample subpaths per probe sample; the keys'
+  // top bit keeps the probes' pools apart from the texels'). Without emitter guiding, as probes' NEE.
+  const LightSubpathSampling subpath_start = settings.light_subpaths ? light_subpath_start(*impl_->lighting) : light_subpaths_none();
+  const bool light_subpaths = subpath_start.area_probability > 0 || subpath_start.punctual_scale > 0;
+  const int subpath_depth = std::min(settings.max_bounces >= 0 ? settings.max_bounces : INT32_MAX, settings.safety_bounce_cap - 1);
+  LightVertexPool light_pool;
   uint32_t first = 0, count = 0;
   while (passes.next_pass(first, count)) {
     const size_t own_begin = share ? bounds[size_t(share->rank())] : 0;
     const size_t own_end = share ? bounds[size_t(share->rank()) + 1] : probe_count;
     const auto pass_start = std::chrono::steady_clock::now();
+    // The same pools on every rank: sized by all probes.
+    const double per_sample = std::max(1.0, double(probe_count) * settings.light_subpaths_per_sample);
+    const uint32_t chunk = light_subpaths ? uint32_t(std::max(1.0, std::floor(double(kMostLightSubpathsPerPool) / per_sample))) : count;
+    for (uint32_t sample_begin = first, sample_end; sample_begin < first + count; sample_begin = sample_end) {
+    sample_end = sample_begin + std::min(chunk, first + count - sample_begin);
+    if (light_subpaths) {
+      const double wanted = std::ceil(per_sample * double(sample_end - sample_begin));
+      const uint64_t paths = uint64_t(std::clamp(wanted, double(kFewestLightSubpathsPerPool), double(kMostLightSubpathsPerPool)));
+      light_pool = trace_light_vertex_pool(*impl_->lighting, *impl_->embree, subpath_start, paths, settings.seed,
+                                           sample_begin | 0x80000000u, settings.sampler, subpath_depth,
+                                           settings.russian_roulette_start, nullptr);
+      rays_per_thread.local() += light_pool.rays;
+      estimate.light_subpaths += light_pool.paths;
+    }
     tbb::parallel_for(tbb::blocked_range<size_t>(own_begin, own_end, 1), [&](const tbb::blocked_range<size_t>& range) {
       uint64_t& rays = rays_per_thread.local();
       uint64_t& nonfinite = nonfinite_per_thread.local();
       for (size_t i = range.begin(); i != range.end(); ++i) {
         const uint64_t rays_before = rays;
-        for (uint32_t s = first; s < first + count; ++s) {
+        for (uint32_t s = sample_begin; s < sample_end; ++s) {
           PathSampler rng = path_sampler(settings.seed, kProbeRngStreamBase + i, s, settings.sampler);
           const Vec3 direction = probe_ray_direction(s, spp, rng);
           bool backface = false;
-          const Vec3 radiance = impl_->radiance_along_ray(positions[i], direction, settings, rng, rays, backface);
+          const Vec3 radiance = impl_->radiance_along_ray(positions[i], direction, settings, rng, rays, backface,
+                                                          light_subpaths ? &light_pool : nullptr);
           if (backface) ++estimate.backface_hits[i];
           if (!is_finite(radiance)) {
             ++nonfinite;
@@ -772,9 +795,10 @@ ProbeEstimate CpuReferenceIntegrator::bake_probes(const std::vector<Vec3>& posit
           }
           ++estimate.samples[i];
         }
-        if (share) probe_rays[i] = rays - rays_before;
+        if (share) probe_rays[i] += rays - rays_before;
       }
     });
+    }
     if (share) {
       share->work.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - pass_start).count();
       own_samples += uint64_t(own_end - own_begin) * count;
@@ -784,6 +808,7 @@ ProbeEstimate CpuReferenceIntegrator::bake_probes(const std::vector<Vec3>& posit
       allgather_items(*share, estimate.backface_hits.data(), 1, bounds);
       allgather_items(*share, probe_rays.data(), 1, bounds);
       bounds = split_by_cost(probe_count, probe_rays, share->ranks());
+      std::fill(probe_rays.begin(), probe_rays.end(), 0);
     }
     passes.finish_pass(rays_per_thread.combine(std::plus<uint64_t>()));
   }

@@ -147,6 +147,7 @@ struct ProbeEstimate {
   // layers sum to sh_sum. Empty when light_layers is 0.
   int light_layers = 0;
   std::vector<std::array<double, 27>> light_sh_sum;
+  uint64_t light_subpaths = 0;  // traced for the probes' connections (IntegratorSettings::light_subpaths)
   uint64_t rays = 0;
   double seconds = 0;
   uint64_t nonfinite_samples = 0;
