@@ -115,7 +115,7 @@ TEST(GuidingAuto, AjarRoomAgreesWithUnguided) {
 TEST(GuidingAuto, LightPathCandidateOnAjarRoomAgreesWithUnguided) {
   const PreparedScene p = testing::prepared_sample("ajar_room", 2);
   int kept = 0;
-  const double se = expect_auto_agrees("ajar_room light paths", p, 512, AutoGuidingCandidate::LightSubpaths, &kept, true);
+  const double se = expect_auto_agrees("ajar_room light paths", p, 1024, AutoGuidingCandidate::LightSubpaths, &kept, true);
   EXPECT_LT(kZLimit * se, kDetectableBias) << "the test could not see a 10 % bias";
   std::printf("[auto] ajar_room light paths: %d of %d seeds kept connections somewhere\n", kept, kSeeds);
   EXPECT_GE(kept, 1) << "no seed kept connections: the branch after the choice went unchecked";
