@@ -134,6 +134,8 @@ json guiding_auto_json(const LightmapEstimate& estimate, const std::string& back
   const std::vector<RegionChoice>& regions = estimate.guiding_regions;
   if (regions.empty()) {
     out["decided"] = false;  // the bake ended within the pilot: every sample tossed the pilot's coin
+    // ... or, light subpaths under --time, gave it up unmeasured in its first half (all unguided from there).
+    if (estimate.guiding_auto_abandoned_at > 0) out["abandoned_at_samples_per_texel"] = estimate.guiding_auto_abandoned_at;
     return out;
   }
   size_t texels = 0, texels_guided = 0, regions_guided = 0, measured = 0, by_basis[3] = {0, 0, 0};

@@ -104,30 +104,31 @@ TEST(BakeGuidingOptions, ANamedGuideMakesAutoChoosePathTracing) {
 }
 
 // --guiding auto's candidate (issue 35 item 4): light subpaths where the scene has an emitter or a
-// point or spot light (the Cornell room's ceiling light), unless --light-paths off names grid guiding;
-// the report names it.
+// point or spot light (the Cornell room's ceiling light) and the bake is long enough for their pilot
+// (--spp 1024: four pilots of 256), unless --light-paths off names grid guiding; the report names it.
 TEST(BakeGuidingOptions, AutoMeasuresLightPathsUnlessTheyAreOff) {
   const fs::path dir = testing::fresh_temp_dir("guiding-candidate");
   const struct {
     const char* options;
     const char* candidate;
   } cases[] = {
-      {"", "light-paths"},
-      {"--light-paths auto --guiding auto", "light-paths"},
-      {"--light-paths off", "grid"},
+      {"--spp 1024", "light-paths"},
+      {"--spp 1024 --light-paths auto --guiding auto", "light-paths"},
+      {"--spp 1024 --light-paths off", "grid"},
+      {"--spp 512", "grid"},  // too short for the light subpaths' pilot
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.options);
     const fs::path out = dir / "out.bake", report = dir / "report.json";
     ASSERT_EQ(run(std::string(EXITANCE_BAKE) + " " + EXITANCE_SAMPLE_DIR +
-                  "/cornell_room.gltf --no-cache --backend cpu --integrator path --spp 16 --texel-density 2 --probes none " +
+                  "/cornell_room.gltf --no-cache --backend cpu --integrator path --texel-density 0.5 --probes none " +
                   c.options + " -o " + out.string() + " --json >" + report.string() + " 2>/dev/null"),
               0);
     const nlohmann::json stats = nlohmann::json::parse(read_text(report));
     EXPECT_EQ(stats.at("lighting").at("guiding"), "auto");
     EXPECT_EQ(stats.at("lighting").at("light_paths"), false);  // not on every sample
     EXPECT_EQ(stats.at("guiding").at("candidate"), c.candidate);
-    EXPECT_EQ(stats.at("guiding").at("decided"), true);  // 16 spp: a pilot of 4
+    EXPECT_EQ(stats.at("guiding").at("decided"), true);  // a pilot of 256 (64 for grid guiding)
     EXPECT_EQ(stats.contains("light_paths"), std::string(c.candidate) == "light-paths");  // the pilot's pools
     fs::remove_all(out);
   }

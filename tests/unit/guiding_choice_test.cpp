@@ -91,6 +91,29 @@ TEST(GuidingChoice, DeterministicGivenTheSums) {
 
 // Every texel's pilot: one aligned half guided, the other not (stratified Sobol blocks); the guided
 // half first for about half the texels (binomial, 5 standard deviations), depending on the seed.
+// Light subpaths' pilot (set_candidate_half_second): every measuring texel's candidate half comes
+// second, so abandoning in the first half leaves an unguided bake whose samples keep their indices.
+TEST(GuidingChoice, CandidateHalfSecondAndAbandoned) {
+  const uint32_t pilot = 16;
+  std::vector<uint32_t> region(64, 0);
+  GuidingChoice choice(region, 1, pilot, 0, 3, 1.0);  // every texel measures
+  choice.set_candidate_half_second();
+  for (size_t i = 0; i < region.size(); ++i)
+    for (uint32_t s = 0; s < pilot; ++s) EXPECT_EQ(choice.sample_guided(i, s), s >= pilot / 2) << i << " " << s;
+  choice.abandon();
+  EXPECT_TRUE(choice.decided());
+  EXPECT_TRUE(choice.abandoned());
+  EXPECT_EQ(choice.texels_guided(), 0u);
+  for (size_t i = 0; i < region.size(); ++i)
+    for (uint32_t s = 0; s < 4 * pilot; ++s) {
+      EXPECT_FALSE(choice.sample_guided(i, s));
+      EXPECT_EQ(choice.strategy_sample_index(i, s, false), s) << "the unguided sequence, unbroken";
+    }
+  // Without the candidate half second, a candidate sample may already be in: not abandoned.
+  GuidingChoice coin(region, 1, pilot, 0, 3, 1.0);
+  EXPECT_THROW(coin.abandon(), std::logic_error);
+}
+
 TEST(GuidingChoice, PilotHalvesPerTexel) {
   constexpr size_t kMany = 1000;
   GuidingChoice c(std::vector<uint32_t>(kMany, 0), 1, kPilot, kFrom, 5, 1.0);

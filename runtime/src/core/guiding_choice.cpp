@@ -31,6 +31,7 @@ bool GuidingChoice::measuring(size_t texel) const {
 }
 
 uint32_t GuidingChoice::strategy_sample_index(size_t texel, uint32_t sample, bool guided) const {
+  if (abandoned_) return sample;  // no candidate sample was taken: the unguided sequence, unbroken
   return auto_strategy_sample_index(measuring(texel) ? kAutoMeasuring : 0u, sample, pilot_, guided);
 }
 
@@ -39,12 +40,19 @@ bool GuidingChoice::sample_guided(size_t texel, uint32_t sample) const {
 }
 
 uint32_t GuidingChoice::strategy_word(size_t texel) const {
+  if (abandoned_) return kAutoDecided;  // unguided, at its own index (strategy_sample_index)
   // The measuring bit stays after the choice: the texel's sample indices depend on its pilot.
   const uint32_t word = measuring(texel) ? kAutoMeasuring : 0u;
   if (decided_) return word | kAutoDecided | (texel_guided_[texel] != 0 ? kAutoGuided : 0u);
   // Which half of the pilot is guided: a hash of (seed, texel) with its own salt (see the header).
-  const bool guided_first = (splitmix64(seed_ ^ 0x6A1D1C401CE5A17Bull ^ uint64_t(texel)) >> 63) != 0;
+  const bool guided_first = !candidate_half_second_ && (splitmix64(seed_ ^ 0x6A1D1C401CE5A17Bull ^ uint64_t(texel)) >> 63) != 0;
   return word != 0 && guided_first ? word | kAutoGuidedFirst : word;
+}
+
+void GuidingChoice::abandon() {
+  if (!candidate_half_second_) throw std::logic_error("GuidingChoice::abandon: candidate samples may have been taken");
+  abandoned_ = decided_ = true;
+  texel_guided_.assign(texel_region_.size(), 0);
 }
 
 void GuidingChoice::record(size_t texel, uint32_t sample, bool guided, double luminance, uint64_t rays,

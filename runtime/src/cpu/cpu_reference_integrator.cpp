@@ -46,6 +46,12 @@ constexpr uint64_t kFewestLightSubpathsPerPool = 256;
 // ajar_room, where connections pay ~6x at equal time: the scene's efficiency ratio read 0.82 after
 // 32 samples (so auto dropped them), 1.6 after 128, 2.4 after 256 (bench/results/guiding-auto-light-paths.md).
 constexpr uint32_t kLightSubpathPilotSamples = 256;
+// ... and only in bakes of this many pilots at least: --spp, or what a time budget's pass rate
+// promises (else the candidate is abandoned in the pilot's first half). Connections can cost far
+// more variance than they save (the open city's lit windows), and a pilot's connected samples stay
+// in the means of texels that do not connect: at 0.25 texels/m and 20 s (~140 spp, inside the pilot)
+// the city read 1.4x the unguided relMSE (bench/results/guiding-auto-light-paths.md).
+constexpr uint32_t kLightSubpathPilots = 4;
 // A target error plans at most this many samples for a texel without --spp (documented).
 constexpr uint32_t kMostSamplesForTarget = 1u << 17;
 
@@ -387,9 +393,10 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   const LightSubpathSampling subpath_start =
       settings.light_subpaths || auto_guiding ? light_subpath_start(*impl_->lighting) : light_subpaths_none();
   const bool scene_starts_subpaths = subpath_start.area_probability > 0 || subpath_start.punctual_scale > 0;
+  const bool long_enough = settings.spp == 0 || settings.spp >= kLightSubpathPilots * kLightSubpathPilotSamples;
   const bool auto_light_subpaths =
       auto_guiding && (settings.guiding_auto_candidate == AutoGuidingCandidate::LightSubpaths ||
-                       (settings.guiding_auto_candidate == AutoGuidingCandidate::Scene && scene_starts_subpaths));
+                       (settings.guiding_auto_candidate == AutoGuidingCandidate::Scene && scene_starts_subpaths && long_enough));
   const bool light_subpaths = scene_starts_subpaths && (settings.light_subpaths || auto_light_subpaths);
 
   // Built inside the timed bake: guided results are measured with the cost of their guiding data.
@@ -440,6 +447,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     }
     choice = std::make_unique<GuidingChoice>(std::move(region), locator.record_count() + 1, pilot, guide ? pilot / 4 : 0,
                                              settings.seed);
+    if (!guide) choice->set_candidate_half_second();  // so that a short bake can abandon it unmeasured
   }
 
   // Adaptive sampling (adaptive_sampling_plan.h): a uniform pilot, then per-texel rates from the
@@ -448,11 +456,14 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   const bool adaptive = settings.adaptive || settings.target_relative_error > 0;
   std::vector<TexelSampleSums> pilot_sums(adaptive ? texel_count : 0);
   // Pilot samples per texel (a ramp boundary, so no pass crosses it). With --guiding auto measuring
-  // light subpaths, the plan's pilot follows the choice's (as many samples again), so the rates come
-  // from the strategy each texel keeps: planned from the choice's pilot, mostly unconnected samples,
-  // they cost ajar_room 1.5x the relMSE at 20 s (bench/results/guiding-auto-light-paths.md).
+  // light subpaths, the plan waits for the choice: where texels connect, its pilot is the samples
+  // after the choice's (as many again), so the rates come from the strategy each texel keeps
+  // (planned from the choice's pilot, mostly unconnected samples, they cost ajar_room 1.5x the
+  // relMSE at 20 s: bench/results/guiding-auto-light-paths.md); where none connects, the plan is
+  // made at the choice from its pilot's samples.
   const uint32_t plan_from = choice && auto_light_subpaths ? choice->pilot() : 0;
-  const uint32_t pilot = plan_from > 0 ? 2 * plan_from : settings.spp != 0 && settings.spp < 64 ? 4 : 16;
+  const uint32_t usual_pilot = settings.spp != 0 && settings.spp < 64 ? 4 : 16;
+  uint32_t pilot = plan_from > 0 ? 2 * plan_from : usual_pilot;
   AdaptivePlan plan;
   std::vector<uint32_t> planned;  // target-error mode: each texel's samples
   bool planning = false;          // past the pilot
@@ -463,10 +474,16 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   const int subpath_depth = std::min(settings.max_bounces >= 0 ? settings.max_bounces : INT32_MAX, settings.safety_bounce_cap - 1);
   LightVertexPool light_pool;
   uint64_t pool_rays = 0;  // all pools': with the subpaths traced, the price of a connected sample's share
-  // The share of texel samples that connect: every one with --light-paths on; with auto, the pilot's
-  // expected share (a quarter of the texels measure, half their samples connected), then the texels
-  // whose regions kept connections.
-  double connected_share = light_subpaths ? (auto_light_subpaths ? kPilotMeasuringShare * 0.5 : 1.0) : 0.0;
+  // The share of texel samples that connect: every one with --light-paths on; with auto, in the
+  // pilot's second half the measuring texels' (a quarter of them), then the texels whose regions
+  // kept connections (connected_share).
+  double connected_share = light_subpaths && !auto_light_subpaths ? 1.0 : 0.0;
+  auto pass_connected_share = [&](uint32_t begin, uint32_t samples) -> double {
+    if (!light_subpaths || !auto_light_subpaths || choice->decided()) return connected_share;
+    const uint32_t half = choice->pilot() / 2;
+    const uint32_t in_second_half = std::min(begin + samples, choice->pilot()) - std::min(std::max(begin, half), begin + samples);
+    return samples > 0 ? kPilotMeasuringShare * double(in_second_half) / double(samples) : 0.0;
+  };
   // Per texel, pilot samples dropped when it began to connect (their sample indices stay used).
   std::vector<uint32_t> dropped;
   auto trace_light_pool = [&](double texel_samples, uint32_t key) {
@@ -574,7 +591,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     if (choice && !choice->decided())
       choice->record(i, s, guided_sample, luminance(total), rays - rays_before, guided_vertices - guided_before);
     if (share) texel_rays[i] += rays - rays_before, ++shared_samples_per_thread.local();
-    if (adaptive && !planning && s >= plan_from) {
+    if (adaptive && !planning) {
       TexelSampleSums& p = pilot_sums[i];
       const double y = luminance(total);
       ++p.samples, p.rays += rays - rays_before, p.sum += y, p.sum_squared += y * y;
@@ -592,7 +609,9 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
 
   uint32_t first = 0, count = 0;
   double fraction = 1;
+  const double loop_start = passes.elapsed_seconds();
   while (passes.next_pass(first, count, &fraction)) {
+    const double connecting = pass_connected_share(first, count);
     const bool learning = guide && first < (choice ? choice->pilot() : kGuidingLearningSamples) &&
                           (!choice || !choice->decided());
     // SVO bins come from the vertices of the pass that reaches the next rebuild (the thesis's
@@ -600,7 +619,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     svo_counting = svo_guide && first + count >= svo_next_rebuild;
     if (planning) {
       const double progress = double(first) - progress_after_pilot + double(count) * fraction;
-      if (connected_share > 0) trace_light_pool(double(texel_count) * double(count) * fraction * connected_share, first);
+      if (connecting > 0) trace_light_pool(double(texel_count) * double(count) * fraction * connecting, first);
       tbb::parallel_for(tbb::blocked_range<size_t>(0, texel_count, 16), [&](const tbb::blocked_range<size_t>& range) {
         PathContributions contributions;
         for (size_t i = range.begin(); i != range.end(); ++i)
@@ -625,9 +644,9 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
           }
         });
       };
-      if (connected_share > 0) {
+      if (connecting > 0) {
         // The same pools on every rank: sized by the whole atlas's covered texels.
-        const double covered = double(texel_count) * std::min(fraction, 1.0) * connected_share;
+        const double covered = double(texel_count) * std::min(fraction, 1.0) * connecting;
         const double per_sample = std::max(1.0, covered * settings.light_subpaths_per_sample);
         const uint32_t chunk = uint32_t(std::max(1.0, std::floor(double(kMostLightSubpathsPerPool) / per_sample)));
         for (uint32_t sample_begin = first, sample_end; sample_begin < first + count; sample_begin = sample_end) {
@@ -652,6 +671,20 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       svo_next_rebuild = 2 * (first + count);
     }
     passes.finish_pass(rays_per_thread.combine(std::plus<uint64_t>()));
+    // Auto with light subpaths under a time budget: while no candidate sample has been taken (the
+    // pilot's first half), a bake whose pass rate promises fewer than kLightSubpathPilots pilots
+    // abandons the candidate and runs on as the unguided bake (kLightSubpathPilots says why).
+    if (choice && auto_light_subpaths && !choice->decided() && settings.time_budget_seconds > 0 && fraction == 1 &&
+        passes.samples_done() >= 4 && passes.samples_done() <= choice->pilot() / 2) {
+      const double elapsed = passes.elapsed_seconds();
+      const double per_sample = (elapsed - loop_start) / double(passes.samples_done());
+      const double expected = double(passes.samples_done()) + (settings.time_budget_seconds - elapsed) / per_sample;
+      if (!(expected >= double(kLightSubpathPilots) * double(choice->pilot()))) {
+        choice->abandon();
+        estimate.guiding_auto_abandoned_at = passes.samples_done();
+        if (adaptive && !planning) pilot = std::max(passes.samples_done(), usual_pilot);
+      }
+    }
     // Auto: the pilot is complete on every texel; each texel takes its region's cheaper strategy from
     // here. A connected sample's share of the pools: their rays per subpath x subpaths per sample.
     if (choice && !choice->decided() && passes.samples_done() >= choice->pilot() && fraction == 1) {
@@ -661,6 +694,12 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       if (auto_light_subpaths && light_subpaths) {
         connected_share = double(choice->texels_guided()) / double(std::max<size_t>(texel_count, 1));
         if (room_after_pilot(passes, choice->pilot())) drop_pilot_of_connecting_texels();
+      }
+      if (adaptive && !planning && plan_from > 0) {
+        if (connected_share > 0)
+          std::fill(pilot_sums.begin(), pilot_sums.end(), TexelSampleSums{});  // the plan's pilot: [plan_from, 2 plan_from)
+        else
+          pilot = passes.samples_done();  // nothing connects: plan now, from the choice's pilot
       }
     }
     if (adaptive && !planning && passes.samples_done() == pilot && fraction == 1) {
@@ -706,7 +745,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
     estimate.guiding_auto = true;
     estimate.guiding_auto_light_subpaths = auto_light_subpaths;
     estimate.guiding_auto_pilot = choice->pilot();
-    if (choice->decided()) estimate.guiding_regions = choice->regions(), estimate.guiding_scene = choice->scene();
+    if (choice->decided() && !choice->abandoned()) estimate.guiding_regions = choice->regions(), estimate.guiding_scene = choice->scene();
   }
   if (guide && settings.inspect_guiding) settings.inspect_guiding(*guide);
   if (svo_guide && settings.inspect_svo_guiding) settings.inspect_svo_guiding(*svo_guide);

@@ -76,6 +76,9 @@ struct LightmapEstimate {
   bool guiding_auto = false;
   bool guiding_auto_light_subpaths = false;  // what it measured against unguided: light subpaths (else grid guiding)
   uint32_t guiding_auto_pilot = 0;  // samples per texel before the choice
+  // Light subpaths under a time budget: the samples per texel at which the pilot was abandoned
+  // unmeasured (the pass rate promised too few samples for it to pay); 0: it was not.
+  uint32_t guiding_auto_abandoned_at = 0;
   std::vector<RegionChoice> guiding_regions;
   EfficiencyEvidence guiding_scene;  // the whole scene's evidence, which regions without their own follow
   // Emitter guiding (core/emitter_guiding_cache.h): what the cache held at the end of the bake;

@@ -142,6 +142,14 @@ class GuidingChoice {
   // A fixed price per guided sample in rays, besides its own rays and vertices (default 0): the
   // light-subpath candidate's share of the pool it connects to (traced once for many samples).
   void set_guided_sample_cost(double rays) { guided_sample_cost_ = rays; }
+  // Every measuring texel takes its candidate half of the pilot second (not by the hashed coin):
+  // until half the pilot the bake is then an unguided one, which abandon() can keep. Before any sample.
+  void set_candidate_half_second() { candidate_half_second_ = true; }
+  // Ends the pilot in its first half (with set_candidate_half_second, so no candidate sample was
+  // taken): every texel unguided from here, each sample at its own index, as if nothing had been
+  // measured (the bake is then the unguided one). regions() stay unmeasured.
+  void abandon();
+  bool abandoned() const { return abandoned_; }
 
   uint32_t pilot() const { return pilot_; }
   bool decided() const { return decided_; }
@@ -192,6 +200,8 @@ class GuidingChoice {
   uint64_t measuring_below_;  // hash threshold: measuring_share x 2^64
   double guided_vertex_cost_ = kGuidedVertexCostInRays;
   double guided_sample_cost_ = 0;
+  bool candidate_half_second_ = false;
+  bool abandoned_ = false;
   bool decided_ = false;
 };
 
