@@ -52,6 +52,18 @@ constexpr uint32_t kLightSubpathPilotSamples = 256;
 // in the means of texels that do not connect: at 0.25 texels/m and 20 s (~140 spp, inside the pilot)
 // the city read 1.4x the unguided relMSE (bench/results/guiding-auto-light-paths.md).
 constexpr uint32_t kLightSubpathPilots = 4;
+// The deepest light-subpath vertex: the eye paths' bounce limit (or the safety cap).
+int light_subpath_depth(const IntegratorSettings& s) {
+  return std::min(s.max_bounces >= 0 ? s.max_bounces : INT32_MAX, s.safety_bounce_cap - 1);
+}
+// Subpaths in a pool that serves `samples` texel or probe samples, `per_sample` each, within the bounds.
+uint64_t light_subpaths_for(double samples, double per_sample) {
+  return uint64_t(std::clamp(std::ceil(samples * per_sample), double(kFewestLightSubpathsPerPool), double(kMostLightSubpathsPerPool)));
+}
+// Samples per pool in passes over `items` texels or probes: the most that keep a pool within its bound.
+uint32_t samples_per_pool(double items, double per_sample) {
+  return uint32_t(std::max(1.0, std::floor(double(kMostLightSubpathsPerPool) / std::max(1.0, items * per_sample))));
+}
 // A target error plans at most this many samples for a texel without --spp (documented).
 constexpr uint32_t kMostSamplesForTarget = 1u << 17;
 
@@ -471,7 +483,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
 
   // Light subpaths: a pool per pass, or per chunk of a large pass's samples, of
   // light_subpaths_per_sample subpaths per texel sample it serves.
-  const int subpath_depth = std::min(settings.max_bounces >= 0 ? settings.max_bounces : INT32_MAX, settings.safety_bounce_cap - 1);
+  const int subpath_depth = light_subpath_depth(settings);
   LightVertexPool light_pool;
   uint64_t pool_rays = 0;  // all pools': with the subpaths traced, the price of a connected sample's share
   // The share of texel samples that connect: every one with --light-paths on; with auto, in the
@@ -480,15 +492,13 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   double connected_share = light_subpaths && !auto_light_subpaths ? 1.0 : 0.0;
   auto pass_connected_share = [&](uint32_t begin, uint32_t samples) -> double {
     if (!light_subpaths || !auto_light_subpaths || choice->decided()) return connected_share;
-    const uint32_t half = choice->pilot() / 2;
-    const uint32_t in_second_half = std::min(begin + samples, choice->pilot()) - std::min(std::max(begin, half), begin + samples);
-    return samples > 0 ? kPilotMeasuringShare * double(in_second_half) / double(samples) : 0.0;
+    const uint32_t from = std::max(begin, choice->pilot() / 2), to = std::min(begin + samples, choice->pilot());
+    return to > from ? kPilotMeasuringShare * double(to - from) / double(samples) : 0.0;
   };
   // Per texel, pilot samples dropped when it began to connect (their sample indices stay used).
   std::vector<uint32_t> dropped;
   auto trace_light_pool = [&](double texel_samples, uint32_t key) {
-    const double wanted = std::ceil(texel_samples * settings.light_subpaths_per_sample);
-    const uint64_t paths = uint64_t(std::clamp(wanted, double(kFewestLightSubpathsPerPool), double(kMostLightSubpathsPerPool)));
+    const uint64_t paths = light_subpaths_for(texel_samples, settings.light_subpaths_per_sample);
     EmitterGuidingCache* emitter_cache = emitter_guide && emitter_guide->active() ? emitter_guide.get() : nullptr;
     light_pool = trace_light_vertex_pool(*impl_->lighting, *impl_->embree, subpath_start, paths, settings.seed, key,
                                          settings.sampler, subpath_depth, settings.russian_roulette_start, emitter_cache);
@@ -647,8 +657,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
       if (connecting > 0) {
         // The same pools on every rank: sized by the whole atlas's covered texels.
         const double covered = double(texel_count) * std::min(fraction, 1.0) * connecting;
-        const double per_sample = std::max(1.0, covered * settings.light_subpaths_per_sample);
-        const uint32_t chunk = uint32_t(std::max(1.0, std::floor(double(kMostLightSubpathsPerPool) / per_sample)));
+        const uint32_t chunk = samples_per_pool(covered, settings.light_subpaths_per_sample);
         for (uint32_t sample_begin = first, sample_end; sample_begin < first + count; sample_begin = sample_end) {
           sample_end = sample_begin + std::min(chunk, first + count - sample_begin);
           trace_light_pool(covered * double(sample_end - sample_begin), sample_begin);
@@ -785,7 +794,7 @@ ProbeEstimate CpuReferenceIntegrator::bake_probes(const std::vector<Vec3>& posit
   // top bit keeps the probes' pools apart from the texels'). Without emitter guiding, as probes' NEE.
   const LightSubpathSampling subpath_start = settings.light_subpaths ? light_subpath_start(*impl_->lighting) : light_subpaths_none();
   const bool light_subpaths = subpath_start.area_probability > 0 || subpath_start.punctual_scale > 0;
-  const int subpath_depth = std::min(settings.max_bounces >= 0 ? settings.max_bounces : INT32_MAX, settings.safety_bounce_cap - 1);
+  const int subpath_depth = light_subpath_depth(settings);
   LightVertexPool light_pool;
   uint32_t first = 0, count = 0;
   while (passes.next_pass(first, count)) {
@@ -793,50 +802,49 @@ ProbeEstimate CpuReferenceIntegrator::bake_probes(const std::vector<Vec3>& posit
     const size_t own_end = share ? bounds[size_t(share->rank()) + 1] : probe_count;
     const auto pass_start = std::chrono::steady_clock::now();
     // The same pools on every rank: sized by all probes.
-    const double per_sample = std::max(1.0, double(probe_count) * settings.light_subpaths_per_sample);
-    const uint32_t chunk = light_subpaths ? uint32_t(std::max(1.0, std::floor(double(kMostLightSubpathsPerPool) / per_sample))) : count;
+    const uint32_t chunk = light_subpaths ? samples_per_pool(double(probe_count), settings.light_subpaths_per_sample) : count;
     for (uint32_t sample_begin = first, sample_end; sample_begin < first + count; sample_begin = sample_end) {
-    sample_end = sample_begin + std::min(chunk, first + count - sample_begin);
-    if (light_subpaths) {
-      const double wanted = std::ceil(per_sample * double(sample_end - sample_begin));
-      const uint64_t paths = uint64_t(std::clamp(wanted, double(kFewestLightSubpathsPerPool), double(kMostLightSubpathsPerPool)));
-      light_pool = trace_light_vertex_pool(*impl_->lighting, *impl_->embree, subpath_start, paths, settings.seed,
-                                           sample_begin | 0x80000000u, settings.sampler, subpath_depth,
-                                           settings.russian_roulette_start, nullptr);
-      rays_per_thread.local() += light_pool.rays;
-      estimate.light_subpaths += light_pool.paths;
-    }
-    tbb::parallel_for(tbb::blocked_range<size_t>(own_begin, own_end, 1), [&](const tbb::blocked_range<size_t>& range) {
-      uint64_t& rays = rays_per_thread.local();
-      uint64_t& nonfinite = nonfinite_per_thread.local();
-      for (size_t i = range.begin(); i != range.end(); ++i) {
-        const uint64_t rays_before = rays;
-        for (uint32_t s = sample_begin; s < sample_end; ++s) {
-          PathSampler rng = path_sampler(settings.seed, kProbeRngStreamBase + i, s, settings.sampler);
-          const Vec3 direction = probe_ray_direction(s, spp, rng);
-          bool backface = false;
-          const Vec3 radiance = impl_->radiance_along_ray(positions[i], direction, settings, rng, rays, backface,
-                                                          light_subpaths ? &light_pool : nullptr);
-          if (backface) ++estimate.backface_hits[i];
-          if (!is_finite(radiance)) {
-            ++nonfinite;
-            continue;
-          }
-          const ShBasis y = sh_basis(direction);
-          for (int k = 0; k < kShCoefficients; ++k)
-            for (int c = 0; c < 3; ++c)
-              estimate.sh_sum[i][size_t(k) * 3 + size_t(c)] += double(radiance[c]) * double(y[k]) * double(kShSphereMeasure);
-          for (int axis = 0; axis < 6; ++axis) {
-            const float cosine = (axis % 2 ? -1.0f : 1.0f) * direction[axis / 2];
-            if (cosine <= 0) continue;
-            for (int c = 0; c < 3; ++c)
-              estimate.axis_irradiance_sum[i][size_t(axis) * 3 + size_t(c)] += double(radiance[c]) * cosine * 4.0;
-          }
-          ++estimate.samples[i];
-        }
-        if (share) probe_rays[i] += rays - rays_before;
+      sample_end = sample_begin + std::min(chunk, first + count - sample_begin);
+      if (light_subpaths) {
+        const uint64_t paths =
+            light_subpaths_for(double(probe_count) * double(sample_end - sample_begin), settings.light_subpaths_per_sample);
+        light_pool = trace_light_vertex_pool(*impl_->lighting, *impl_->embree, subpath_start, paths, settings.seed,
+                                             sample_begin | 0x80000000u, settings.sampler, subpath_depth,
+                                             settings.russian_roulette_start, nullptr);
+        rays_per_thread.local() += light_pool.rays;
+        estimate.light_subpaths += light_pool.paths;
       }
-    });
+      tbb::parallel_for(tbb::blocked_range<size_t>(own_begin, own_end, 1), [&](const tbb::blocked_range<size_t>& range) {
+        uint64_t& rays = rays_per_thread.local();
+        uint64_t& nonfinite = nonfinite_per_thread.local();
+        for (size_t i = range.begin(); i != range.end(); ++i) {
+          const uint64_t rays_before = rays;
+          for (uint32_t s = sample_begin; s < sample_end; ++s) {
+            PathSampler rng = path_sampler(settings.seed, kProbeRngStreamBase + i, s, settings.sampler);
+            const Vec3 direction = probe_ray_direction(s, spp, rng);
+            bool backface = false;
+            const Vec3 radiance = impl_->radiance_along_ray(positions[i], direction, settings, rng, rays, backface,
+                                                            light_subpaths ? &light_pool : nullptr);
+            if (backface) ++estimate.backface_hits[i];
+            if (!is_finite(radiance)) {
+              ++nonfinite;
+              continue;
+            }
+            const ShBasis y = sh_basis(direction);
+            for (int k = 0; k < kShCoefficients; ++k)
+              for (int c = 0; c < 3; ++c)
+                estimate.sh_sum[i][size_t(k) * 3 + size_t(c)] += double(radiance[c]) * double(y[k]) * double(kShSphereMeasure);
+            for (int axis = 0; axis < 6; ++axis) {
+              const float cosine = (axis % 2 ? -1.0f : 1.0f) * direction[axis / 2];
+              if (cosine <= 0) continue;
+              for (int c = 0; c < 3; ++c)
+                estimate.axis_irradiance_sum[i][size_t(axis) * 3 + size_t(c)] += double(radiance[c]) * cosine * 4.0;
+            }
+            ++estimate.samples[i];
+          }
+          if (share) probe_rays[i] += rays - rays_before;
+        }
+      });
     }
     if (share) {
       share->work.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - pass_start).count();
