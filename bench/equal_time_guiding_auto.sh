@@ -1,17 +1,18 @@
 #!/bin/bash
 # `bake --integrator path --spp 0 --time T` on the CPU three ways, two seeds each, against two converged
 # bakes (light subpaths on every sample, seeds 101 and 202), relMSE per texel by bench_bundle_rel_mse:
-#   default: --guiding auto with its candidate from the scene (light subpaths where it has emitters or
-#            point or spot lights), --light-paths auto;
+#   default: --guiding auto with its candidate from the scene (light subpaths where any light starts
+#            them: emitters, punctual lights, the sky), --light-paths auto;
 #   lpoff:   --light-paths off (--guiding auto measures grid guiding: the default before issue 35 item 4);
 #   off:     --light-paths off --guiding off (unguided; emitter guiding and adaptive sampling as default).
 # Usage: bash bench/equal_time_guiding_auto.sh BUILD_DIR SCENE DENSITY REFERENCE_SPP SECONDS [WORK_DIR]
 # (bench/results/guiding-auto-light-paths.md). References are kept in WORK_DIR and reused.
+# BAKE_EXTRA: options for every bake (e.g. BAKE_EXTRA="--sky 0.8,0.85,1.0" for the outdoor samples).
 set -e
 build=$1; scene=$2; density=$3; reference_spp=$4; seconds=$5
 work=${6:-/tmp/equal_time_guiding_auto}/$(basename $scene .gltf)
 mkdir -p $work
-common="--texel-density $density --probes none --voxel-resolution none --no-cache --seams off"
+common="--texel-density $density --probes none --voxel-resolution none --no-cache --seams off $BAKE_EXTRA"
 for seed in 101 202; do
   [ -f $work/ref$seed.bake/manifest.json ] ||
     $build/bake/bake $scene -o $work/ref$seed.bake $common --integrator path --light-paths on --guiding off \

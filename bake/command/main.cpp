@@ -142,8 +142,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, exitance::kFilterMaxRadius));
   app.add_option("--guiding", guiding,
                  "auto (default: path tracing on the CPU backend measures a candidate against unguided samples "
-                 "during a pilot and keeps it per region where it pays: light subpaths where the scene has emitters "
-                 "or point or spot lights (unless --light-paths off), else grid guiding; on Vulkan grid guiding, only "
+                 "during a pilot and keeps it per region where it pays: light subpaths where a light starts them (emitters, "
+                 "punctual lights, the sky; unless --light-paths off), else grid guiding; on Vulkan grid guiding, only "
                  "when given (its pilot costs); off per-bounce and under mpirun) "
                  "| off | svo (fields from exitance in the bake's voxel octree, seed 000) | grid (regular-grid SARSA "
                  "cache, seed 002)")
@@ -162,9 +162,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0f, 1.0f));
   std::string light_paths = "auto";
   app.add_option("--light-paths", light_paths,
-                 "auto (default: --guiding auto measures them against unguided samples where the scene has emitters or "
-                 "point or spot lights, and keeps them per region where they pay) | on | off: light subpaths from "
-                 "emitters and point and spot lights into a pool that path vertices connect to, weighted with the "
+                 "auto (default: --guiding auto measures them against unguided samples where a light starts them, "
+                 "and keeps them per region where they pay) | on | off: light subpaths from "
+                 "emitters, punctual lights and the sky into a pool that path vertices connect to, weighted with the "
                  "path tracer's strategies by MIS (light entering through narrow openings: docs/lighting-core.md "
                  "\"Light subpaths\"); CPU backend, path tracing; on: every sample, without --guiding grid/svo")
       ->check(CLI::IsMember({"auto", "on", "off"}));

@@ -24,6 +24,8 @@ EnvironmentSampler::EnvironmentSampler(const Texture& environment) : texture_(&e
   const Distribution1D marginal(row_weights);
   marginal_cdf_ = marginal.cdf();
   enabled_ = !marginal.empty();
+  // Each texel spans (2 pi / w) x (pi / h) in (phi, theta), sin(theta) already in the weights.
+  luminance_integral_ = marginal.total() * 2.0 * kPi * kPi / (double(w) * double(h));
 }
 
 Vec3 EnvironmentSampler::radiance(Vec3 direction) const {

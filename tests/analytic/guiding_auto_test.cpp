@@ -1,7 +1,7 @@
 // --guiding auto (issue 11) on the CPU backend: a pilot of guided and unguided samples on every texel,
 // then each region keeps the strategy with the lower variance x counted cost (core/guiding_choice.h).
 // Its candidate is grid guiding (AutoGuidingCandidate::Grid) or light subpaths (issue 35 item 4: the
-// candidate of scenes with emitters or point or spot lights); both are checked the same way.
+// candidate wherever a light starts them); both are checked the same way.
 // Mixing the two unbiased strategies in one texel's mean, with the choice made from earlier samples,
 // is unbiased: auto converges to the unguided path tracer per region (Cornell room, ajar_room). The
 // choice and the image are bit-identical per seed and thread count. In a white furnace cosine
@@ -166,12 +166,18 @@ TEST(GuidingAuto, SceneCandidateFollowsTheLights) {
       cornell_integrator.bake(cornell.gbuffer, settings(512, 1, GuidingMode::Auto, AutoGuidingCandidate::Scene));
   EXPECT_FALSE(short_bake.guiding_auto_light_subpaths);
   EXPECT_EQ(short_bake.light_subpaths, 0u);
-  const PreparedScene courtyard = testing::prepared_sample("courtyard", 0.5);
-  const LightmapEstimate y = CpuReferenceIntegrator(courtyard.scene)
-                                 .bake(courtyard.gbuffer, settings(8, 1, GuidingMode::Auto, AutoGuidingCandidate::Scene));
-  EXPECT_TRUE(y.guiding_auto);
-  EXPECT_FALSE(y.guiding_auto_light_subpaths);
-  EXPECT_EQ(y.light_subpaths, 0u);
+  // The courtyard's only light is its sun: subpaths start there too (through the bounding sphere's disc).
+  const PreparedScene courtyard = testing::prepared_sample("courtyard", 0.25);
+  const CpuReferenceIntegrator courtyard_integrator(courtyard.scene);
+  const LightmapEstimate y = courtyard_integrator.bake(courtyard.gbuffer, settings(1024, 1, GuidingMode::Auto, AutoGuidingCandidate::Scene));
+  EXPECT_TRUE(y.guiding_auto_light_subpaths);
+  EXPECT_GT(y.light_subpaths, 0u);
+  EXPECT_GT(y.light_subpath_vertices, 0u);
+  const LightmapEstimate grid =
+      courtyard_integrator.bake(courtyard.gbuffer, settings(8, 1, GuidingMode::Auto, AutoGuidingCandidate::Scene));
+  EXPECT_TRUE(grid.guiding_auto);
+  EXPECT_FALSE(grid.guiding_auto_light_subpaths);
+  EXPECT_EQ(grid.light_subpaths, 0u);
 }
 
 bool identical(const LightmapEstimate& a, const LightmapEstimate& b) {

@@ -2,8 +2,9 @@
 //  - Unbiased: with subpaths the estimate converges to the path tracer's per region (instance) and
 //    per bounce layer (each path length is its own integral, so a wrong MIS weight for one strategy
 //    shows in its layer), on a box lit by an emitter and a point light (with brighter lights outside
-//    that reach nothing), the Cornell room, ajar_room and the building (point, spot and area lights,
-//    a sky); also with a bounce limit, and with emitter guiding (next-event estimation's learned
+//    that reach nothing), the Cornell room, ajar_room and the building (point, spot and area lights),
+//    a room lit through a door gap by a sun and a constant sky or an environment map (subpaths that
+//    start at infinity); also with a bounce limit, and with emitter guiding (next-event estimation's learned
 //    density then weighs the subpaths) against the unguided path tracer.
 //  - Deterministic: bit-identical per seed and thread count.
 //  - It pays where the path tracer is weak: ajar_room's variance at equal samples.
@@ -26,6 +27,7 @@
 #include "support/independent_estimates.h"
 #include "support/region_and_furnace_checks.h"
 #include "support/region_runs.h"
+#include "support/sky_lit_room.h"
 
 namespace exitance {
 namespace {
@@ -133,6 +135,21 @@ TEST(LightSubpaths, BoxWithEmitterGuidingAgreesWithPathTracing) {
       << "the test could not see a 10 % bias";
 }
 
+// Subpaths from the sky and a sun (starts at infinity, through the bounding sphere's disc) into a
+// room they light only through a door gap: a constant sky (no next-event strategy: the eye's escape
+// stands in for it) and an environment map (importance sampled by NEE and the subpaths alike).
+TEST(LightSubpaths, SkyLitRoomAgreesWithPathTracing) {
+  const testing::AtlasScene room = testing::sky_lit_room(false, 6);
+  EXPECT_LT(kZLimit * expect_regions_agree("sky-lit room", room.scene, room.gbuffer, 512), kDetectableBias)
+      << "the test could not see a 10 % bias";
+}
+
+TEST(LightSubpaths, EnvironmentLitRoomAgreesWithPathTracing) {
+  const testing::AtlasScene room = testing::sky_lit_room(true, 6);
+  EXPECT_LT(kZLimit * expect_regions_agree("environment-lit room", room.scene, room.gbuffer, 512), kDetectableBias)
+      << "the test could not see a 10 % bias";
+}
+
 TEST(LightSubpaths, AjarRoomWithEmitterGuidingAgreesWithPathTracing) { expect_sample_scene_agrees("ajar_room", 4, 64, true); }
 
 TEST(LightSubpaths, CornellRoomAgreesWithPathTracing) { expect_sample_scene_agrees("cornell_room", 2, 32); }
@@ -214,6 +231,28 @@ TEST(LightSubpaths, LowerAjarRoomsVarianceAtEqualSamples) {
   const double ratio = mean_relative_variance(with) / mean_relative_variance(without);
   std::printf("[light subpaths] ajar_room relative variance per texel at 16 spp: with / without = %.3f\n", ratio);
   EXPECT_LT(ratio, 0.5);
+}
+
+// The sky's and the sun's subpaths pay less than a lamp's beside the gap (their disc is the whole
+// scene's, so few pass the gap), but at equal samples they still lower the door-gap room's variance.
+TEST(LightSubpaths, LowerSkyLitRoomsVarianceAtEqualSamples) {
+  for (const bool environment : {false, true}) {
+    const testing::AtlasScene room = testing::sky_lit_room(environment, 16);
+    const CpuReferenceIntegrator integrator(room.scene);
+    std::vector<std::vector<double>> with, without;
+    uint64_t rays_with = 0, rays_without = 0;
+    for (int seed = 0; seed < 8; ++seed) {
+      const LightmapEstimate a = integrator.bake(room.gbuffer, settings(16, uint64_t(seed), true, 0.25));
+      const LightmapEstimate b = integrator.bake(room.gbuffer, settings(16, uint64_t(seed) + 1000, false));
+      rays_with += a.rays, rays_without += b.rays;
+      with.push_back(testing::luminance_means(a));
+      without.push_back(testing::luminance_means(b));
+    }
+    const double ratio = mean_relative_variance(with) / mean_relative_variance(without);
+    std::printf("[light subpaths] %s room relative variance per texel at 16 spp: with / without = %.3f for %.2fx the rays\n",
+                environment ? "environment-lit" : "sky-lit", ratio, double(rays_with) / double(rays_without));
+    EXPECT_LT(ratio, 0.85);
+  }
 }
 
 }  // namespace

@@ -62,12 +62,6 @@ GpuPunctualLight punctual_record(const PunctualLight& light) {
   return g;
 }
 
-// The bounding sphere's radius: the disc a directional light's power crosses.
-float scene_radius(const LightingScene& lighting) {
-  if (lighting.triangles.empty()) return 1.0f;
-  return std::max(0.5f * length(lighting.bounds_hi - lighting.bounds_lo), 1e-6f);
-}
-
 // Point 4 pi I, spot 2 pi (1 - cos_outer) I, directional pi r^2 E.
 double punctual_power(const PunctualLight& light, float radius) {
   const double intensity = luminance(light.intensity);
@@ -226,6 +220,11 @@ Scene& writable_source(LightingScene& lighting) {
 }
 
 }  // namespace
+
+float scene_radius(const LightingScene& lighting) {
+  if (lighting.triangles.empty()) return 1.0f;
+  return std::max(0.5f * length(lighting.bounds_hi - lighting.bounds_lo), 1e-6f);
+}
 
 LightingScene build_lighting_scene(std::shared_ptr<const Scene> source, Bvh4 bvh) {
   const Scene& scene = *source;

@@ -296,7 +296,8 @@ struct CpuReferenceIntegrator::Impl {
       const Hit hit = embree->intersect(origin, d.direction, INFINITY);
       guide.observe(record, g, d.direction, hit);
       if (!hit.found) {
-        const Vec3 sky = ray_throughput * escaped_radiance(s, d.direction, d.pdf);
+        const Vec3 sky = ray_throughput * (subpaths ? escaped_radiance_with_subpaths(s, x, eye, d.direction, d.pdf)
+                                                    : escaped_radiance(s, d.direction, d.pdf));
         out.add(bounce, sky);
         out.add_light(kSkyLightLayer, sky);
         return;
@@ -404,7 +405,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   const bool auto_guiding = settings.guiding == GuidingMode::Auto;
   const LightSubpathSampling subpath_start =
       settings.light_subpaths || auto_guiding ? light_subpath_start(*impl_->lighting) : light_subpaths_none();
-  const bool scene_starts_subpaths = subpath_start.area_probability > 0 || subpath_start.punctual_scale > 0;
+  const bool scene_starts_subpaths = light_subpaths_start_anywhere(subpath_start);
   const bool long_enough = settings.spp == 0 || settings.spp >= kLightSubpathPilots * kLightSubpathPilotSamples;
   const bool auto_light_subpaths =
       auto_guiding && (settings.guiding_auto_candidate == AutoGuidingCandidate::LightSubpaths ||
@@ -793,7 +794,7 @@ ProbeEstimate CpuReferenceIntegrator::bake_probes(const std::vector<Vec3>& posit
   // chunk of samples, as texels' do (light_subpaths_per_sample subpaths per probe sample; the keys'
   // top bit keeps the probes' pools apart from the texels'). Without emitter guiding, as probes' NEE.
   const LightSubpathSampling subpath_start = settings.light_subpaths ? light_subpath_start(*impl_->lighting) : light_subpaths_none();
-  const bool light_subpaths = subpath_start.area_probability > 0 || subpath_start.punctual_scale > 0;
+  const bool light_subpaths = light_subpaths_start_anywhere(subpath_start);
   const int subpath_depth = light_subpath_depth(settings);
   LightVertexPool light_pool;
   uint32_t first = 0, count = 0;

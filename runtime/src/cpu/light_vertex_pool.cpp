@@ -15,22 +15,33 @@
 namespace exitance {
 namespace {
 
-// Luminance power of a point or spot light (0: directional, which starts no subpath).
-double punctual_subpath_power(const GpuPunctualLight& light) {
+// Luminance power of a punctual light: point 4 pi I, spot 2 pi (1 - cos_outer) I, directional
+// pi r^2 E across the bounding sphere's disc (as the punctual CDF weighs them).
+double punctual_subpath_power(const GpuPunctualLight& light, float radius) {
   const uint32_t type = floatBitsToUint(light.position_type.w);
   const double intensity = luminance(vec3(light.intensity_cos_outer.x, light.intensity_cos_outer.y, light.intensity_cos_outer.z));
   if (type == kPunctualPoint) return 4.0 * M_PI * intensity;
   if (type == kPunctualSpot) return 2.0 * M_PI * (1.0 - double(light.intensity_cos_outer.w)) * intensity;
+  if (type == kPunctualDirectional) return M_PI * double(radius) * double(radius) * intensity;
   return 0.0;
+}
+
+// The sky's luminance power across the bounding sphere's disc: pi r^2 x its integral over directions.
+double sky_subpath_power(const LightingScene& scene, float radius) {
+  const double across = M_PI * double(radius) * double(radius);
+  if (scene.environment.enabled()) return across * scene.environment.luminance_integral();
+  return across * 4.0 * M_PI * double(luminance(scene.sky));
 }
 
 struct PathStart {
   bool valid = false;
   bool area = false;
+  bool sky = false;
+  bool infinite = false;  // the sky or a directional light: y_0 at infinity, y_1 by disk_density
   Vec3 beta{0, 0, 0};  // L_e cos / p_start (emitter) or I attenuation / p_start (punctual)
   Vec3 origin{0, 0, 0};
   Vec3 direction{0, 0, 0};
-  float pdf_direction = 0;
+  float pdf_direction = 0;  // solid angle; disk_density for a start at infinity
   float cos_light = 0;  // at an emitter point, toward the direction (for y_1's eye density of y_0)
   float nee_area_pdf = 0;  // NEE's by power (unguided)
   float start_probability = 0;  // the subpath's density of its start (area density, or the light's probability)
@@ -44,13 +55,21 @@ struct PoolTracer {
   const EmbreeScene& embree;
   LightSubpathSampling start;
   std::vector<double> punctual_cdf;     // over subpath_lights, by NEE's pmf
-  std::vector<uint32_t> subpath_lights;  // the point and spot lights
+  std::vector<uint32_t> subpath_lights;  // the punctual lights
+  Vec3 centre;                           // of the bounding sphere, radius `radius`
+  float radius;
   int max_depth;
   int rr_start;
   EmitterGuidingCache* emitter_guide;
 
-  // NEE's density of the subpath's start from y (its learned sampling there, if any).
+  // NEE's density of the subpath's start from y (its learned sampling there, if any); for a constant
+  // sky, which NEE does not sample, the eye's escape density toward it (light_subpaths.h).
   float nee_density(const PathStart& s, const SurfacePoint& y) const {
+    if (s.sky) {
+      const Vec3 toward_sky = -s.direction;
+      if (scene.environment.enabled()) return scene.environment.pdf(toward_sky);
+      return std::max(dot(y.shading_normal, toward_sky), 0.0f) * kInvPi;
+    }
     const EmitterGuide g =
         EmitterGuidingCache::vertex_site(emitter_guide, y.position, y.shading_normal, EmitterGuidingCache::Learning::None).guide;
     if (s.area) return s.nee_area_pdf * emitter_guide_ratio_at_triangle(scene_emitter_cdf(scene), g, s.triangle, s.barycentrics.x, s.barycentrics.y);
@@ -90,6 +109,34 @@ struct PoolTracer {
     return p;
   }
 
+  // A start at infinity travelling along `direction`: a point uniform on the bounding sphere's disc
+  // across it, outside the sphere.
+  void enter_from_infinity(PathStart& p, Vec3 direction, PathSampler& rng) const {
+    const vec2 u = sample_2d(rng);
+    const float r = radius * std::sqrt(u.x), phi = 2.0f * kPi * u.y;
+    p.origin = centre - direction * radius + to_world(vec3(r * std::cos(phi), r * std::sin(phi), 0.0f), direction);
+    p.direction = direction;
+    p.pdf_direction = start.disk_density;
+    p.infinite = true;
+  }
+
+  PathStart start_in_sky(PathSampler& rng) const {
+    PathStart p;
+    const vec2 u = sample_2d(rng);
+    float pdf = constant_sky_direction_pdf();
+    const Vec3 toward_sky = scene.environment.enabled() ? scene.environment.sample(u.x, u.y, pdf) : uniform_sphere(u.x, u.y);
+    const float p_start = start.sky_probability * pdf;
+    const Vec3 radiance = scene_sky_radiance(scene, toward_sky);
+    if (!(p_start > 0) || !(max_component(radiance) > 0)) return p;
+    enter_from_infinity(p, -toward_sky, rng);
+    p.valid = true;
+    p.sky = true;
+    p.beta = radiance / p_start;
+    p.start_probability = p_start;
+    p.layer = kSkyLightLayer;
+    return p;
+  }
+
   PathStart start_at_punctual(float u_choose, PathSampler& rng) const {
     PathStart p;
     float pmf = 0;
@@ -97,8 +144,18 @@ struct PoolTracer {
     const uint32_t index = subpath_lights[k];
     const GpuPunctualLight light = scene_punctual_light(scene, index);
     const float p_start = start.punctual_scale * cdf_pmf(scene_punctual_cdf(scene), index);
-    const vec2 u = sample_2d(rng);
     const vec3 axis = vec3(light.direction_cos_inner.x, light.direction_cos_inner.y, light.direction_cos_inner.z);
+    if (floatBitsToUint(light.position_type.w) == kPunctualDirectional) {
+      if (!(p_start > 0)) return p;
+      enter_from_infinity(p, axis, rng);
+      p.valid = true;
+      p.beta = vec3(light.intensity_cos_outer.x, light.intensity_cos_outer.y, light.intensity_cos_outer.z) / p_start;
+      p.start_probability = p_start;
+      p.light = index;
+      p.layer = punctual_light_layer(index, scene.punctual_light_layers);
+      return p;
+    }
+    const vec2 u = sample_2d(rng);
     const bool spot = floatBitsToUint(light.position_type.w) == kPunctualSpot;
     const vec3 direction = spot ? sample_spot_cone(axis, light.intensity_cos_outer.w, u.x, u.y) : uniform_sphere(u.x, u.y);
     p.pdf_direction = punctual_direction_pdf(light, direction);
@@ -120,9 +177,11 @@ struct PoolTracer {
   void trace(uint64_t path, uint64_t seed, uint32_t key, uint32_t sampler, std::vector<LightVertex>& out, uint64_t& rays) const {
     PathSampler rng = path_sampler(seed, kLightSubpathStreamBase + path, key, sampler);
     const float u = sample_1d(rng);
-    PathStart s = u < start.area_probability
-                      ? start_on_emitter(rescaled_unit(u, 0.0f, start.area_probability), rng)
-                      : start_at_punctual(rescaled_unit(u, start.area_probability, 1.0f - start.area_probability), rng);
+    const float sky_end = start.area_probability + start.sky_probability;
+    const bool sky = start.sky_probability > 0 && u >= start.area_probability && (u < sky_end || subpath_lights.empty());
+    PathStart s = u < start.area_probability ? start_on_emitter(rescaled_unit(u, 0.0f, start.area_probability), rng)
+                  : sky                      ? start_in_sky(rng)
+                                             : start_at_punctual(rescaled_unit(u, sky_end, 1.0f - sky_end), rng);
     if (!s.valid) return;
     Vec3 beta = s.beta, origin = s.origin, direction = s.direction;
     float pdf_direction = s.pdf_direction;
@@ -141,18 +200,21 @@ struct PoolTracer {
       const SurfacePoint y = surface_point_on_triangle(scene, tri, ng, hit.b1, hit.b2, front);
       const float cos_geometric = std::fabs(dot(ng, direction));
       const float cos_shading = -dot(y.shading_normal, direction);
-      const float distance2 = hit.distance * hit.distance;
+      // From infinity the first hit's density is disk_density x cos (no 1 / d^2).
+      const float distance2 = depth == 1 && s.infinite ? 1.0f : hit.distance * hit.distance;
       if (!(cos_shading > 0) || !(cos_geometric > 0) || !(distance2 > 0)) return;
       const float reverse_density = pdf_direction * cos_geometric / distance2;
       const Vec3 alpha = beta * (cos_shading * kInvPi / (pdf_direction * cos_geometric));
       // The eye's area density of the previous vertex, sampled (cosine) here.
-      const float eye_density = cos_shading * kInvPi * cos_previous / distance2;
+      // (a solid-angle density toward a start at infinity).
+      const float eye_density = cos_shading * kInvPi * (depth == 1 && s.infinite ? 1.0f : cos_previous / distance2);
       vec2 next_sums;
       float next_ratio;
       if (depth == 1) {
         const float nee = nee_density(s, y);
         if (!(nee > 0)) return;  // NEE samples every light it can start from
-        const float r0 = s.area ? eye_density / nee : 0.0f;  // y_0 hit by the eye against NEE
+        // y_0 hit by the eye against NEE (an emitter, an environment map; a constant sky's NEE is that hit).
+        const float r0 = s.area || (s.sky && scene.environment.enabled()) ? eye_density / nee : 0.0f;
         next_sums = vec2(1.0f + r0 * r0, 0.0f);
         next_ratio = nee / s.start_probability / reverse_density;  // e_1 / p_1
       } else {
@@ -194,17 +256,22 @@ struct PoolTracer {
 
 LightSubpathSampling light_subpath_start(const LightingScene& scene) {
   LightSubpathSampling s = light_subpaths_none();
+  const float radius = scene_radius(scene);
   const double area_power = scene.emitter_count() > 0 && scene.emitter_inverse_power > 0 ? M_PI / scene.emitter_inverse_power : 0.0;
   double punctual_power = 0, punctual_mass = 0;
   for (uint32_t i = 0; i < scene.punctual_count(); ++i) {
-    const double power = punctual_subpath_power(scene.punctual_lights[i]);
+    const double power = punctual_subpath_power(scene.punctual_lights[i], radius);
     if (power > 0) punctual_power += power, punctual_mass += cdf_pmf(scene.punctual_cdf.data(), i);
   }
   if (!(punctual_mass > 0)) punctual_power = 0;
-  const double total = area_power + punctual_power;
+  double sky_power = scene.triangles.empty() ? 0.0 : sky_subpath_power(scene, radius);
+  if (!(sky_power > 0) || !std::isfinite(sky_power)) sky_power = 0;
+  const double total = area_power + punctual_power + sky_power;
   if (!(total > 0)) return s;
   s.area_probability = float(area_power / total);
-  s.punctual_scale = punctual_power > 0 ? float((1.0 - double(s.area_probability)) / punctual_mass) : 0.0f;
+  s.sky_probability = float(sky_power / total);
+  s.punctual_scale = punctual_power > 0 ? float(punctual_power / total / punctual_mass) : 0.0f;
+  s.disk_density = float(1.0 / (M_PI * double(radius) * double(radius)));
   return s;
 }
 
@@ -213,10 +280,11 @@ LightVertexPool trace_light_vertex_pool(const LightingScene& scene, const Embree
                                         int rr_start, EmitterGuidingCache* emitter_guide) {
   LightVertexPool pool;
   pool.max_depth = max_depth;
-  if (paths == 0 || max_depth < 1 || !(start.area_probability > 0 || start.punctual_scale > 0)) return pool;
-  PoolTracer tracer{scene, embree, start, {0.0}, {}, max_depth, rr_start, emitter_guide};
+  if (paths == 0 || max_depth < 1 || !light_subpaths_start_anywhere(start)) return pool;
+  const float radius = scene_radius(scene);
+  PoolTracer tracer{scene, embree, start, {0.0}, {}, (scene.bounds_lo + scene.bounds_hi) * 0.5f, radius, max_depth, rr_start, emitter_guide};
   for (uint32_t i = 0; i < scene.punctual_count(); ++i)
-    if (punctual_subpath_power(scene.punctual_lights[i]) > 0) {
+    if (punctual_subpath_power(scene.punctual_lights[i], radius) > 0) {
       tracer.subpath_lights.push_back(i);
       tracer.punctual_cdf.push_back(tracer.punctual_cdf.back() + cdf_pmf(scene.punctual_cdf.data(), i));
     }

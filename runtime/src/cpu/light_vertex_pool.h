@@ -1,5 +1,5 @@
 // The CPU backend's pool of light-subpath vertices (common/light_subpaths.h): subpaths traced from the
-// scene's emitters and point and spot lights by Embree, their vertices kept in path order so a pool
+// scene's emitters, punctual lights and sky by Embree, their vertices kept in path order so a pool
 // is the same for a seed whatever the thread count.
 #pragma once
 #include <cstdint>
@@ -25,8 +25,9 @@ struct LightVertexPool {
   int max_depth = 0;
 };
 
-// How subpaths start in `scene`: emitters against point and spot lights by power (emitters pi x
-// their NEE power; point 4 pi I, spot 2 pi (1 - cos_outer) I, luminance). count and scale are 0.
+// How subpaths start in `scene`: emitters, punctual lights and the sky by power (emitters pi x their
+// NEE power; point 4 pi I, spot 2 pi (1 - cos_outer) I, directional pi r^2 E, the sky pi r^2 x its
+// luminance's integral over directions; r = scene_radius). count and scale are 0.
 LightSubpathSampling light_subpath_start(const LightingScene& scene);
 
 // `paths` light subpaths of sample `key` (each a stream of its own), vertices up to `max_depth`

@@ -21,6 +21,9 @@ class EnvironmentSampler {
   // Samples a direction; returns its solid-angle pdf (0 if the sample is unusable).
   Vec3 sample(float u1, float u2, float& pdf) const;
   float pdf(Vec3 direction) const;
+  // The integral of the map's luminance over the sphere (texels by their solid angle): the sky's
+  // power per unit of area across its directions, which starting light subpaths there weighs by.
+  double luminance_integral() const { return luminance_integral_; }
 
   // What the GPU reads (enabled only): the image, width * height * 3 floats (row 0 = +Y), the
   // marginal CDF over rows (height + 1) and the rows' conditional CDFs (height * (width + 1)).
@@ -33,6 +36,7 @@ class EnvironmentSampler {
  private:
   const Texture* texture_ = nullptr;
   bool enabled_ = false;
+  double luminance_integral_ = 0;
   std::vector<double> marginal_cdf_;
   std::vector<double> row_cdfs_;
 };

@@ -18,8 +18,14 @@
 // vertex (the cache's sample count); a connection's contribution is multiplied by 1 / n_c.
 // Densities omit Russian roulette on both sides (the same function for every strategy, so the
 // weights still sum to 1). Light subpaths start on emissive triangles (by NEE's power CDF, cosine
-// directions) and on point and spot lights (uniform in their sphere or cone); the sky and
-// directional lights start none, so the paths they light keep the path tracer's weights.
+// directions), on point and spot lights (uniform in their sphere or cone), and from the sky and
+// directional lights: a direction (the environment map's importance sampling, uniform for a
+// constant sky, the light's own for a directional one), then a point uniform on the disc of the
+// scene's bounding sphere across it (area density disk_density), traced into the scene. Such a
+// start y_0 lies at infinity: densities toward it are solid-angle ones and y_1's area density is
+// disk_density x |cos| (no 1 / d^2). A constant sky has no next-event strategy: there the eye's
+// escape (s = 0) takes NEE's place in the sums (y_1 stores the eye's escape density over its own,
+// with no further term), and an escape's weight is 1 / (1 + (p_2 / p_0)^2 C_j).
 // Eye vertices here sample cosine directions (the texel: its strategy, with the defensive uniform
 // component of directional texels): path-guided vertices are not combined yet. Next-event
 // estimation may be emitter-guided: its density at the first hit of a subpath is the one the eye
@@ -43,7 +49,9 @@ struct LightVertex {
 // How subpaths start, and the pool's counts, as the strategies' densities need them.
 struct LightSubpathSampling {
   float area_probability;  // a subpath starts on an emissive triangle (then as NEE picks them)
-  float punctual_scale;    // ... at point or spot light L with probability punctual_scale x NEE's pmf(L)
+  float punctual_scale;    // ... at point, spot or directional light L with probability punctual_scale x NEE's pmf(L)
+  float sky_probability;   // ... in the sky
+  float disk_density;      // 1 / (pi r^2): where the sky's and directional lights' subpaths enter the bounding sphere
   float count;             // n_c, connection strategies' sample count; 0: no pool (no such strategies)
   float scale;             // 1 / n_c: a connection's contribution factor
 };
@@ -52,9 +60,16 @@ EXITANCE_FN LightSubpathSampling light_subpaths_none() {
   LightSubpathSampling s;
   s.area_probability = 0.0f;
   s.punctual_scale = 0.0f;
+  s.sky_probability = 0.0f;
+  s.disk_density = 0.0f;
   s.count = 0.0f;
   s.scale = 0.0f;
   return s;
+}
+
+// Whether any light starts subpaths.
+EXITANCE_FN bool light_subpaths_start_anywhere(LightSubpathSampling s) {
+  return s.area_probability > 0.0f || s.punctual_scale > 0.0f || s.sky_probability > 0.0f;
 }
 
 // The solid-angle density of an emitter's cosine-distributed direction (double-sided emitters pick
@@ -63,8 +78,12 @@ EXITANCE_FN float emitter_direction_pdf(float cos_light, bool double_sided) {
   return abs(cos_light) * kInvPi * (double_sided ? 0.5f : 1.0f);
 }
 
+// The solid-angle density of a constant sky's subpath directions (uniform over the sphere).
+EXITANCE_FN float constant_sky_direction_pdf() { return 0.25f * kInvPi; }
+
 // The solid-angle density of a punctual light's direction toward `light_to_point` (unit): uniform
-// over the sphere (point) or the outer cone (spot); 0 for directional lights (they start no subpath).
+// over the sphere (point) or the outer cone (spot); 0 for directional lights (a delta: see
+// punctual_start_area_factor).
 EXITANCE_FN float punctual_direction_pdf(GpuPunctualLight light, vec3 light_to_point) {
   uint type = floatBitsToUint(light.position_type.w);
   if (type == kPunctualPoint) return 0.25f * kInvPi;
@@ -83,9 +102,18 @@ EXITANCE_FN vec3 sample_spot_cone(vec3 axis, float cos_outer, float u1, float u2
   return to_world(vec3(r * cos(phi), r * sin(phi), z), axis);
 }
 
+// The density with which a subpath from punctual light `light` arrives at a point at squared distance
+// `distance2` (over |cos| there): its direction density / d^2, or disk_density for a directional light.
+EXITANCE_FN float punctual_start_area_factor(LightSubpathSampling s, GpuPunctualLight light, vec3 light_to_point, float distance2) {
+  if (floatBitsToUint(light.position_type.w) == kPunctualDirectional) return s.disk_density;
+  if (!(distance2 > 0.0f)) return 0.0f;
+  return punctual_direction_pdf(light, light_to_point) / distance2;
+}
+
 // p_{s+1} / p_s when eye vertex x_j (j >= 1) moves to the light side after next-event estimation
 // or an emitter hit: n_c x (the subpath's start density / NEE's) x (the light's direction density
-// toward x_j, as an area density at x_j) / the eye's area density of x_j.
+// toward x_j, as an area density at x_j) / the eye's area density of x_j. For a start at infinity
+// (the sky, a directional light) pass disk_density as the direction density and distance2 = 1.
 EXITANCE_FN float light_start_ratio(LightSubpathSampling s, float start_over_nee, float light_direction_pdf,
                                     float cos_at_vertex, float distance2, float pdf_forward) {
   if (!(pdf_forward > 0.0f) || !(distance2 > 0.0f)) return 0.0f;

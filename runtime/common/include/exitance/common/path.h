@@ -318,8 +318,8 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
       vec3 wi = vec3(punctual_ray.direction_length.x, punctual_ray.direction_length.y, punctual_ray.direction_length.z);
       float distance = punctual_ray.direction_length.w;
       float start_over_nee = eye.sampling.punctual_scale * cdf_pmf(scene_punctual_cdf(SCENE_ALONE_ARG), light_index) / probability;
-      float start = light_start_ratio(eye.sampling, start_over_nee, punctual_direction_pdf(light, -wi),
-                                      dot(x.geometric_normal, wi), distance * distance, eye.pdf_forward);
+      float start_area = punctual_start_area_factor(eye.sampling, light, -wi, distance * distance);
+      float start = light_start_ratio(eye.sampling, start_over_nee, start_area, dot(x.geometric_normal, wi), 1.0f, eye.pdf_forward);
       float weight = light_subpath_nee_weight(0.0f, start, eye.eye_sum);
       punctual_ray.contribution_state = vec4(vec3(punctual_ray.contribution_state.x, punctual_ray.contribution_state.y,
                                                   punctual_ray.contribution_state.z) * weight, kShadowTrace);
@@ -336,6 +336,12 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
     float cos_x = dot(x.shading_normal, wi);
     if (pdf_env > 0.0f && cos_x > 0.0f && dot(x.geometric_normal, wi) > 0.0f) {
       float weight = power_heuristic(pdf_env, continuation_pdf(guide, x, wi));
+      if (eye.sampling.count > 0.0f && eye.sampling.sky_probability > 0.0f) {
+        // The sky's subpaths sample directions as this does: start over NEE = the sky's probability.
+        float start = light_start_ratio(eye.sampling, eye.sampling.sky_probability, eye.sampling.disk_density,
+                                        dot(x.geometric_normal, wi), 1.0f, eye.pdf_forward);
+        weight = light_subpath_nee_weight(continuation_pdf(guide, x, wi) / pdf_env, start, eye.eye_sum);
+      }
       environment_ray.direction_length = vec4(wi, uintBitsToFloat(0x7F800000u));
       environment_ray.contribution_state =
           vec4(throughput * (scene_sky_radiance(SCENE_ARG wi) * (cos_x * kInvPi * weight / pdf_env)), kShadowTrace);
@@ -431,6 +437,28 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
 EXITANCE_FN vec3 escaped_radiance(SCENE_PARAM vec3 wi, float pdf_continuation) {
   float weight = 1.0f;
   if (scene_has_environment(SCENE_ALONE_ARG)) weight = power_heuristic(pdf_continuation, scene_environment_pdf(SCENE_ARG wi));
+  return scene_sky_radiance(SCENE_ARG wi) * weight;
+}
+
+// escaped_radiance for a continuation ray from x (light-subpath state `eye`, the ray's density
+// pdf_continuation) when the sky also starts light subpaths (light_subpaths.h): weighed against
+// environment sampling and against x's connection to their first hits.
+EXITANCE_FN vec3 escaped_radiance_with_subpaths(SCENE_PARAM SurfacePoint x, EyeSubpathVertex eye, vec3 wi, float pdf_continuation) {
+  if (!(eye.sampling.count > 0.0f) || !(eye.sampling.sky_probability > 0.0f) || !(eye.pdf_forward > 0.0f))
+    return escaped_radiance(SCENE_ARG wi, pdf_continuation);
+  float weight;
+  if (scene_has_environment(SCENE_ALONE_ARG)) {
+    float start = light_start_ratio(eye.sampling, eye.sampling.sky_probability, eye.sampling.disk_density,
+                                    dot(x.geometric_normal, wi), 1.0f, eye.pdf_forward);
+    weight = power_heuristic_with_extra(pdf_continuation, scene_environment_pdf(SCENE_ARG wi),
+                                        light_subpath_emission_extra(start, eye.eye_sum));
+  } else {
+    // No next-event strategy: p_2 / p_0 directly.
+    float start = pdf_continuation > 0.0f ? light_start_ratio(eye.sampling, eye.sampling.sky_probability * constant_sky_direction_pdf() / pdf_continuation,
+                                                              eye.sampling.disk_density, dot(x.geometric_normal, wi), 1.0f, eye.pdf_forward)
+                                          : 0.0f;
+    weight = light_subpath_nee_weight(0.0f, start, eye.eye_sum);
+  }
   return scene_sky_radiance(SCENE_ARG wi) * weight;
 }
 

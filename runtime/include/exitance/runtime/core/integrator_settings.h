@@ -29,7 +29,7 @@ enum class IntegratorMode { Path, Bounces };
 enum class GuidingMode { Off, Grid, Svo, Auto };
 
 // What GuidingMode::Auto measures against unguided samples (issue 35, item 4). Scene: light subpaths
-// where the scene has emissive triangles or point or spot lights and the backend traces them (the CPU;
+// where any light starts them (emissive triangles, punctual lights, the sky) and the backend traces them (the CPU;
 // bench/results/guiding-auto-light-paths.md), grid guiding otherwise. Grid: grid guiding always.
 // LightSubpaths: light subpaths always (CPU backend; a scene with no light they start from measures
 // nothing and stays unguided).

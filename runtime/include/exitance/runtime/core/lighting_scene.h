@@ -60,6 +60,10 @@ LightingScene build_lighting_scene(std::shared_ptr<const Scene> scene, Bvh4 bvh)
 // default limit (kDefaultLightLayerLimit).
 void lay_out_light_layers(LightingScene& scene, uint32_t limit);
 
+// The radius of the bounds' sphere (centred on the bounds' centre; 1 without triangles): the disc a
+// directional light's power crosses, and where the sky's and the sun's light subpaths start.
+float scene_radius(const LightingScene& scene);
+
 // After geometry moved (an instance transform edit, refresh/scene_edits.h): `edited` is the source
 // scene with the same triangles (count, order, materials, instances) at new positions, and
 // possibly other edits. Everything is derived again as build_lighting_scene does (triangle
