@@ -268,7 +268,9 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
                        {"rays", probe_estimate.rays},
                        {"rays_per_second",
                         probe_estimate.seconds > 0 ? double(probe_estimate.rays) / probe_estimate.seconds : 0.0},
-                       {"nonfinite_samples", probe_estimate.nonfinite_samples}};
+                       {"nonfinite_samples", probe_estimate.nonfinite_samples},
+                       // Light subpaths traced for the probes' connections (0: none connected).
+                       {"light_subpaths", probe_estimate.light_subpaths}};
   } else {
     skipped["probes"] = "--probes none";
   }

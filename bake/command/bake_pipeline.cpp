@@ -200,19 +200,32 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   // SVO guiding builds its fields over the octree voxelized above (main refuses it without one).
   if (voxels) lighting_options.lighting.guiding_octree = &voxels->svo;
   const double budget = options.lighting.time_budget_seconds;
-  if (probes) {
+  // Where --guiding auto may measure light subpaths (the CPU backend), the probes follow the texels'
+  // verdict (probes_follow_texels): they are lit after the texels, with what a budget leaves.
+  const bool probes_after_texels = probes && !share && backend->backend_name() == "cpu" &&
+                                   decided.lighting.guiding == GuidingMode::Auto &&
+                                   decided.lighting.guiding_auto_candidate != AutoGuidingCandidate::Grid;
+  if (probes && !probes_after_texels) {
     const double probe_budget = budget > 0 ? kProbeShareOfTimeBudget * budget : 0.0;
     probe_lighting = clock.time(
         "probes", [&] { return probe_lighting_stage(*backend, *probes, decided, diagnostics, probe_budget); });
     // Never 0 (= no budget): a budget the probes used up leaves the texels one pass.
     if (budget > 0) lighting_options.lighting.time_budget_seconds = std::max(1e-3, budget - probe_lighting->seconds);
   }
+  if (probes_after_texels && budget > 0) lighting_options.lighting.time_budget_seconds = (1.0 - kProbeShareOfTimeBudget) * budget;
   if (share) fail_here_if_asked(*share);
   LightmapEstimate lightmap =
       clock.time("lighting", [&] {
         return lighting_stage(*backend, gbuffer, options.skip_sealed_texels ? &sealed : nullptr, lighting_options,
                               diagnostics);
       });
+  if (probes_after_texels) {
+    const BakeOptions probe_options = probes_follow_texels(decided, lightmap);
+    // Never 0 (= no budget): texels that used it up leave the probes one pass.
+    const double probe_budget = budget > 0 ? std::max(1e-3, budget - lightmap.seconds) : 0.0;
+    probe_lighting = clock.time(
+        "probes", [&] { return probe_lighting_stage(*backend, *probes, probe_options, diagnostics, probe_budget); });
+  }
   std::optional<IndirectDenoiseReport> denoised;
   if (options.denoise && writer) {
     options.announce_stage("denoise");

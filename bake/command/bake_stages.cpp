@@ -21,6 +21,7 @@
 #include "exitance/runtime/scene_file_conversion.h"
 #include "exitance/runtime/bundle/probe_results.h"
 #include "exitance/runtime/bundle/texel_exitance.h"
+#include "exitance/runtime/core/guiding_choice.h"
 #include "exitance/runtime/core/work_share.h"
 #include "exitance/runtime/cpu/bvh4_builder.h"
 
@@ -232,6 +233,15 @@ void exitance_stage(VoxelizedScene& voxels, const SceneForLighting& scene, const
                     const LightmapEstimate& lightmap, const BakeOptions& options) {
   options.announce_stage("exitance");
   fill_svo_exitance(voxels.svo, *scene.scene, gbuffer, lightmap);
+}
+
+BakeOptions probes_follow_texels(const BakeOptions& options, const LightmapEstimate& lightmap) {
+  BakeOptions out = options;
+  if (lightmap.guiding_auto_light_subpaths && lightmap.guiding_scene.z() > kChoiceZ) {
+    out.lighting.light_subpaths = true;
+    out.lighting.guiding = GuidingMode::Off;
+  }
+  return out;
 }
 
 ProbeEstimate probe_lighting_stage(const Integrator& backend, ProbePlacement& probes, const BakeOptions& options,

@@ -20,6 +20,7 @@
 #include <map>
 #include <string>
 
+#include "exitance/bake/command/bake_stages.h"
 #include "exitance/bake/command/prepared_scene.h"
 #include "exitance/runtime/cpu_reference_integrator.h"
 #include "support/atlas_box.h"
@@ -142,6 +143,15 @@ TEST(GuidingAuto, LightPathCandidateIsKeptOnAjarRoom) {
     EXPECT_GT(a.guiding_scene.z(), kChoiceZ) << "seed " << seed;
     EXPECT_GE(2 * kept, a.guiding_regions.size()) << "seed " << seed;
     EXPECT_GT(a.pilot_samples_dropped, 0u);
+    // The probes follow the scene's verdict (bake_stages.h): every probe sample connects.
+    BakeOptions options;
+    options.lighting = settings(1024, seed, GuidingMode::Auto, AutoGuidingCandidate::LightSubpaths);
+    const BakeOptions probes = probes_follow_texels(options, a);
+    EXPECT_TRUE(probes.lighting.light_subpaths);
+    EXPECT_EQ(probes.lighting.guiding, GuidingMode::Off);
+    IntegratorSettings probe_settings = probes.lighting;
+    probe_settings.spp = 256;
+    EXPECT_GT(integrator.bake_probes({{0.0f, 1.5f, 0.0f}}, probe_settings).light_subpaths, 0u);
   }
 }
 
@@ -154,14 +164,18 @@ TEST(GuidingAuto, LightPathCandidateOnCornellRoomAgreesWithUnguided) {
 }
 
 // The scene's candidate: light subpaths with an emissive triangle (the Cornell room's ceiling light)
-// in a bake of four of their pilots (--spp 1024), grid guiding in a shorter one and under a sun and a
-// sky only (the courtyard: no light a subpath starts from).
+// in a bake of four of their pilots (--spp 1024), grid guiding in a shorter one; and light subpaths
+// under a sun alone (the courtyard: its subpaths start at infinity). Where connections do not pay
+// (the Cornell room) the probes do not connect either.
 TEST(GuidingAuto, SceneCandidateFollowsTheLights) {
   const PreparedScene cornell = testing::prepared_sample("cornell_room", 0.5);
   const CpuReferenceIntegrator cornell_integrator(cornell.scene);
   const LightmapEstimate c = cornell_integrator.bake(cornell.gbuffer, settings(1024, 1, GuidingMode::Auto, AutoGuidingCandidate::Scene));
   EXPECT_TRUE(c.guiding_auto_light_subpaths);
   EXPECT_GT(c.light_subpaths, 0u);
+  BakeOptions options;
+  options.lighting = settings(1024, 1, GuidingMode::Auto, AutoGuidingCandidate::Scene);
+  EXPECT_FALSE(probes_follow_texels(options, c).lighting.light_subpaths) << "scene z " << c.guiding_scene.z();
   const LightmapEstimate short_bake =
       cornell_integrator.bake(cornell.gbuffer, settings(512, 1, GuidingMode::Auto, AutoGuidingCandidate::Scene));
   EXPECT_FALSE(short_bake.guiding_auto_light_subpaths);

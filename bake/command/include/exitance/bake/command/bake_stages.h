@@ -108,8 +108,15 @@ LightmapEstimate lighting_stage(const Integrator& backend, const TexelGBuffer& g
 void exitance_stage(VoxelizedScene& voxels, const SceneForLighting& scene, const TexelGBuffer& gbuffer,
                     const LightmapEstimate& lightmap, const BakeOptions& options);
 
-// The part of a --time budget the probes may use (they run first; the texels get the rest).
+// The part of a --time budget the probes may use (they run first and the texels get the rest; or,
+// where they follow the texels' verdict, second with what the texels' share leaves).
 constexpr double kProbeShareOfTimeBudget = 0.1;
+
+// The probes' settings after the texels' --guiding auto measured light subpaths: every probe sample
+// connects (IntegratorSettings::light_subpaths, unguided) where the scene's evidence says connections
+// pay (efficiency ratio above 1 beyond kChoiceZ standard errors), else `options` as they are. The
+// probes have no regions of their own to measure, so the scene's verdict is theirs.
+BakeOptions probes_follow_texels(const BakeOptions& options, const LightmapEstimate& lightmap);
 
 // probes: L2 SH of incident radiance at every usable probe on the backend (--probe-spp rays each, or
 // fewer, in whole stratified sets, when `time_budget_seconds` > 0 ends them first), stored into
