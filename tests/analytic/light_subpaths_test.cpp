@@ -140,13 +140,13 @@ TEST(LightSubpaths, BoxWithEmitterGuidingAgreesWithPathTracing) {
 // stands in for it) and an environment map (importance sampled by NEE and the subpaths alike).
 TEST(LightSubpaths, SkyLitRoomAgreesWithPathTracing) {
   const testing::AtlasScene room = testing::sky_lit_room(false, 6);
-  EXPECT_LT(kZLimit * expect_regions_agree("sky-lit room", room.scene, room.gbuffer, 512), kDetectableBias)
+  EXPECT_LT(kZLimit * expect_regions_agree("sky-lit room", room.scene, room.gbuffer, 256), kDetectableBias)
       << "the test could not see a 10 % bias";
 }
 
 TEST(LightSubpaths, EnvironmentLitRoomAgreesWithPathTracing) {
   const testing::AtlasScene room = testing::sky_lit_room(true, 6);
-  EXPECT_LT(kZLimit * expect_regions_agree("environment-lit room", room.scene, room.gbuffer, 512), kDetectableBias)
+  EXPECT_LT(kZLimit * expect_regions_agree("environment-lit room", room.scene, room.gbuffer, 256), kDetectableBias)
       << "the test could not see a 10 % bias";
 }
 
