@@ -166,7 +166,8 @@ int main(int argc, char** argv) {
                  "and keeps them per region where they pay) | on | off: light subpaths from "
                  "emitters, punctual lights and the sky into a pool that path vertices connect to, weighted with the "
                  "path tracer's strategies by MIS (light entering through narrow openings: docs/lighting-core.md "
-                 "\"Light subpaths\"); CPU backend, path tracing; on: every sample, without --guiding grid/svo")
+                 "\"Light subpaths\"); path tracing; on: every sample, without --guiding grid/svo (on the Vulkan backend: "
+                 "texels, without --emitter-guiding; auto measures grid guiding there)")
       ->check(CLI::IsMember({"auto", "on", "off"}));
   std::string sampler = "sobol";
   app.add_option("--sampler", sampler,
@@ -332,7 +333,8 @@ int main(int argc, char** argv) {
   if (light_paths == "on") {
     const char* conflict = integrator == "bounces"                 ? "--integrator bounces (light subpaths are path-tracing strategies)"
                            : guiding == "grid" || guiding == "svo" ? "--guiding grid/svo (not combined yet)"
-                           : options.backend.name == "vulkan"      ? "--backend vulkan (CPU backend only so far)"
+                           : options.backend.name == "vulkan" && options.lighting.emitter_guiding
+                               ? "--emitter-guiding on with --backend vulkan (combined on the CPU backend only)"
                                                                    : nullptr;
     if (conflict) {
       std::cerr << "bake: error: --light-paths on contradicts " << conflict << "\n";

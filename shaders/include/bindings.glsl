@@ -48,6 +48,8 @@ layout(std430, set = 0, binding = kBindingBounceCache) readonly buffer BounceCac
 // kBindingGuide); shaders/include/guide.glsl reads and learns into them.
 layout(std430, set = 0, binding = kBindingGuide) buffer GuideBuffer { uint guide_words[]; };
 layout(std430, set = 0, binding = kBindingProbeCounts) buffer ProbeCountBuffer { uint acc_probe_counts[]; };  // [probe][samples, back faces]
+// Light subpaths: the batch's pool (gpu_layout.h kLightPool*; light_subpaths.comp writes it).
+layout(std430, set = 0, binding = kBindingLightSubpaths) buffer LightPoolBuffer { uint light_pool[]; };
 
 layout(push_constant) uniform Push {
   uint cur;    // which ray queue is read this iteration (0/1)

@@ -3,6 +3,7 @@
 // they ask for queued to the connect and extend stages instead of traced at once.
 #include "exitance/common/path.h"
 #include "exitance/common/light_layers.h"
+#include "exitance/common/light_subpath_walk.h"
 #include "guide.glsl"
 #include "emitter_guide.glsl"
 
@@ -12,6 +13,65 @@ PathLimits path_limits() {
   limits.rr_start = params.rr_start;
   limits.safety_cap = params.safety_cap;
   return limits;
+}
+
+// ---- Light subpaths (GpuParams::light_subpaths; light_subpaths.comp traces the batch's pool) ----
+// Texel path batches only: never probes, per-bounce passes or the runtime's change estimate.
+bool light_subpaths_on() {
+  return !kProbeMode && params.light_subpaths != 0u && params.bounce_flags == 0u && params.changed_light_pairs == 0u;
+}
+
+LightSubpathSampling light_subpath_start_of_params() {
+  LightSubpathSampling s = light_subpaths_none();
+  s.area_probability = params.light_subpath_start.x;
+  s.punctual_scale = params.light_subpath_start.y;
+  s.sky_probability = params.light_subpath_start.z;
+  s.disk_density = params.light_subpath_start.w;
+  return s;
+}
+
+// The pool's sampling as the eye's strategies weigh it: n_c = subpaths / vertices (0: an empty pool,
+// the path tracer's weights).
+LightSubpathSampling light_pool_sampling() {
+  LightSubpathSampling s = light_subpath_start_of_params();
+  uint vertices = light_pool[kLightPoolVertices], paths = light_pool[kLightPoolPaths];
+  if (vertices > 0u && paths > 0u) {
+    s.count = float(double(paths) / double(vertices));
+    s.scale = float(double(vertices) / double(paths));
+  }
+  return s;
+}
+
+LightVertex light_pool_vertex(uint k) {
+  uint w = kLightPoolVertexWord + k * kLightVertexWords;
+  LightVertex v;
+  v.position_depth = uintBitsToFloat(uvec4(light_pool[w], light_pool[w + 1u], light_pool[w + 2u], light_pool[w + 3u]));
+  v.geometric_normal_layer = uintBitsToFloat(uvec4(light_pool[w + 4u], light_pool[w + 5u], light_pool[w + 6u], light_pool[w + 7u]));
+  v.shading_normal_ratio = uintBitsToFloat(uvec4(light_pool[w + 8u], light_pool[w + 9u], light_pool[w + 10u], light_pool[w + 11u]));
+  v.weight_a = uintBitsToFloat(uvec4(light_pool[w + 12u], light_pool[w + 13u], light_pool[w + 14u], light_pool[w + 15u]));
+  v.b = uintBitsToFloat(uvec4(light_pool[w + 16u], light_pool[w + 17u], light_pool[w + 18u], light_pool[w + 19u]));
+  return v;
+}
+
+// Path p's eye-vertex state (gpu_layout.h: path_throughput [4P + 2p], [4P + 2p + 1]).
+uint eye_subpath_index(uint p) { return 4u * params.path_capacity + 2u * p; }
+
+EyeSubpathVertex stored_eye_subpath_vertex(uint p) {
+  EyeSubpathVertex e = eye_subpath_vertex_none();
+  e.sampling = light_pool_sampling();
+  vec4 s = path_throughput[eye_subpath_index(p)];
+  e.pdf_forward = s.x;
+  e.eye_sum = s.y;
+  return e;
+}
+
+// The vertex path p's continuation ray left, as the hit's MIS ratios read it (its geometric normal).
+SurfacePoint stored_eye_vertex(uint p) {
+  SurfacePoint x;
+  x.position = vec3(0.0);
+  x.geometric_normal = path_throughput[eye_subpath_index(p) + 1u].xyz;
+  x.shading_normal = x.geometric_normal;
+  return x;
 }
 
 // Traces path p's pending shadow rays and adds what they carry to its work item (connect stage,
@@ -29,12 +89,18 @@ uint connect_shadow_rays(uint p, inout uint steps) {
     if (contribution.w != kShadowTrace) continue;
     vec4 ray = shadow_rays[slot].direction_length;
     if (trace_any(origin, ray.xyz, ray.w, steps)) continue;
-    if (params.emitter_guide != 0u) emitter_guide_learn_arrived(p, k);
-    add_result(work, depth, contribution.xyz);
-    if (params.light_layers != 0u) {
-      // Slot 0: the area sample (layer in the low half of path_ray_o.w), 1: the punctual light (high half), 2: the sky.
-      uint layers = floatBitsToUint(path_ray_o[p].w);
-      add_light_result(work, k == 0u ? (layers & 0xFFFFu) : k == 1u ? (layers >> 16u) : kSkyLightLayer, contribution.xyz);
+    if (k == kShadowSlotConnection) {  // a light subpath's: its vertex's depth and light layer
+      vec4 eye = path_throughput[eye_subpath_index(p)];
+      add_result(work, depth + floatBitsToUint(eye.z), contribution.xyz);
+      add_light_result(work, floatBitsToUint(eye.w), contribution.xyz);
+    } else {
+      if (params.emitter_guide != 0u) emitter_guide_learn_arrived(p, k);
+      add_result(work, depth, contribution.xyz);
+      if (params.light_layers != 0u) {
+        // Slot 0: the area sample (layer in the low half of path_ray_o.w), 1: the punctual light (high half), 2: the sky.
+        uint layers = floatBitsToUint(path_ray_o[p].w);
+        add_light_result(work, k == 0u ? (layers & 0xFFFFu) : k == 1u ? (layers >> 16u) : kSkyLightLayer, contribution.xyz);
+      }
     }
     if (params.directional != 0u) {
       // The texel's own next-event samples carry their shadow ray's direction; deeper ones the first continuation's.
@@ -74,6 +140,16 @@ uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rn
     if (guide.guided_probability > 0.0) add_auto_cost(path_work[p], 1u, 1u);
   }
   if (directional_texel) guide = with_uniform_component(guide, kDirectionalUniformProbability);
+  // Light subpaths: the texel starts a fresh state; deeper vertices read the one their hit stored (shade.comp).
+  bool subpaths = light_subpaths_on();
+  EyeSubpathVertex eye = eye_subpath_vertex_none();
+  if (subpaths) {
+    if (path_depth[p] == 0u) {
+      eye.sampling = light_pool_sampling();
+    } else {
+      eye = stored_eye_subpath_vertex(p);
+    }
+  }
   if (params.changed_light_pairs > 0u) {  // the runtime's change estimate: the edited lights alone
     environment = no_shadow_ray();
     uint pair;
@@ -87,7 +163,7 @@ uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rn
     uint emitter_record = kGuideNoRecord;
     bool emitter_learns = false;
     EmitterGuide emitter = kProbeMode ? emitter_guide_none() : emitter_guide_site(p, x, emitter_record, emitter_learns);
-    next_event_estimation(x, origin, throughput, guide, emitter, rng, area, punctual_light, environment, sources);
+    next_event_estimation(x, origin, throughput, guide, emitter, eye, rng, area, punctual_light, environment, sources);
     if (!kProbeMode && params.emitter_guide != 0u) emitter_guide_keep(p, emitter_record, emitter_learns, sources);
     if (params.light_layers != 0u) {
       // Which layers the shadow rays' light goes to, read back by connect_shadow_rays.
@@ -105,6 +181,25 @@ uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rn
     shadows = shadows || environment.contribution_state.w != kShadowNone;
   }
   DirectionSample d = sample_continuation(guide, x, rng);
+  if (subpaths) {
+    // One connection to a pool vertex picked uniformly (light_subpath_walk.h), in its own shadow slot.
+    ShadowRay connection = no_shadow_ray();
+    uint vertex_depth = 0u, vertex_layer = 0u;
+    if (eye.sampling.count > 0.0) {
+      float u = sample_1d(rng);
+      uint count = light_pool[kLightPoolVertices];
+      LightVertex y = light_pool_vertex(min(uint(double(u) * double(count)), count - 1u));
+      connection = light_subpath_connection(eye.sampling, y, x, origin, throughput, guide, int(path_depth[p]), eye,
+                                            params.light_subpath_depth);
+      vertex_depth = floatBitsToUint(y.position_depth.w);
+      vertex_layer = floatBitsToUint(y.geometric_normal_layer.w);
+    }
+    shadow_rays[first + kShadowSlotConnection] = connection;
+    shadows = shadows || connection.contribution_state.w != kShadowNone;
+    uint e = eye_subpath_index(p);
+    path_throughput[e] = vec4(eye.pdf_forward, eye.eye_sum, uintBitsToFloat(vertex_depth), uintBitsToFloat(vertex_layer));
+    path_throughput[e + 1u] = vec4(x.geometric_normal, 0.0);
+  }
   uint pending = shadows ? 2u : 0u;
   if (directional_texel) path_throughput[sh1_factor_index(p)] = vec4(d.pdf > 0.0 ? sh1_direction_factor(x, d.direction) : vec3(0.0), 0.0);
   if (!(d.pdf > 0.0)) return pending;

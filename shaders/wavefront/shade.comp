@@ -71,7 +71,9 @@ void main() {
   } else if (tri == kInvalid) {
     // The change estimate (params.changed_light_pairs, path.h) adds no sky: it did not change.
     if (params.changed_light_pairs == 0u) {
-      vec3 sky = throughput * escaped_radiance(wi, tp.w);
+      // With light subpaths from the sky, weighed against the left vertex's connections to them too.
+      vec3 sky = throughput * (light_subpaths_on() ? escaped_radiance_with_subpaths(stored_eye_vertex(p), stored_eye_subpath_vertex(p), wi, tp.w)
+                                                   : escaped_radiance(wi, tp.w));
       add_path_result(p, work, depth, sky);
       add_light_result(work, kSkyLightLayer, sky);
     }
@@ -79,7 +81,25 @@ void main() {
     int bounce = kProbeMode ? int(depth) - 1 : int(depth);  // the vertex's bounce as the texel estimator counts it
     // Emitter guiding: the hit's MIS weight reads the density of the mixture its vertex sampled.
     EmitterGuide emitter = kProbeMode ? emitter_guide_none() : emitter_guide_of_path(p);
-    HitResult h = shade_continuation_hit(tri, hit.x, hit.z, hit.w, wi, tp.w, throughput, bounce, path_limits(), emitter, rng);
+    // Light subpaths: the emitter hit's weight counts the strategies with more light vertices, and
+    // the new vertex's state follows from the left one's (path.h).
+    bool subpaths = light_subpaths_on();
+    EyeSubpathVertex eye = eye_subpath_vertex_none();
+    SurfacePoint left;
+    vec3 ng = vec3(0.0);
+    float emission_extra = 0.0;
+    if (subpaths) {
+      eye = stored_eye_subpath_vertex(p);
+      left = stored_eye_vertex(p);
+      ng = triangle_geometric_normal(tri);
+      emission_extra = light_subpath_emitter_hit_extra(left, eye, emitter, tri, ng, hit.x, hit.z, hit.w, wi);
+    }
+    HitResult h = shade_continuation_hit(tri, hit.x, hit.z, hit.w, wi, tp.w, throughput, bounce, path_limits(), emitter,
+                                         emission_extra, rng);
+    if (subpaths && h.continues) {
+      eye = next_eye_subpath_vertex(eye, left, h.next, ng, hit.x, wi, tp.w, depth == 0u);
+      path_throughput[eye_subpath_index(p)].xy = vec2(eye.pdf_forward, eye.eye_sum);
+    }
     // Only emitters add: a read-modify-write of the result slot per hit cost the H200 14 % of this stage.
     if (h.radiance != vec3(0.0) && params.changed_light_pairs == 0u) {
       add_path_result(p, work, depth, h.radiance);

@@ -194,7 +194,11 @@ void set_emitter_distribution(LightingScene& lighting, const std::vector<double>
 void build_punctual_distribution(LightingScene& lighting) {
   std::vector<double> powers;
   const float radius = scene_radius(lighting);
-  for (const PunctualLight& light : lighting.source->lights) powers.push_back(punctual_power(light, radius));
+  lighting.punctual_power = 0.0;
+  for (const PunctualLight& light : lighting.source->lights) {
+    powers.push_back(punctual_power(light, radius));
+    if (powers.back() > 0) lighting.punctual_power += powers.back();
+  }
   lighting.punctual_cdf = padded_cdf(Distribution1D(powers));
 }
 

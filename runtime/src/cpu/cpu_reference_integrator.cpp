@@ -25,6 +25,7 @@
 #include "exitance/common/light_layers.h"
 #include "exitance/runtime/core/work_share.h"
 #include "exitance/runtime/embree_scene.h"
+#include "exitance/common/light_subpath_walk.h"
 #include "light_vertex_pool.h"
 
 namespace exitance {
@@ -203,44 +204,25 @@ struct CpuReferenceIntegrator::Impl {
   };
 
   // Light subpaths (light_subpaths.h): eye vertex x (bounce `bounce`, its light-subpath state `eye`)
-  // connects to one pool vertex picked uniformly; the connection's E/pi goes to bounce + the
-  // vertex's depth, and to its light's layer.
+  // connects to one pool vertex picked uniformly (light_subpath_walk.h light_subpath_connection); the
+  // connection's E/pi goes to bounce + the vertex's depth, and to its light's layer.
   void connect_to_pool(const LightVertexPool& pool, const SurfacePoint& x, Vec3 origin, Vec3 throughput,
                        const GuideVertex& g, int bounce, const EyeSubpathVertex& eye, bool directional_texel,
                        PathSampler& rng, PathContributions& out, uint64_t& rays) const {
     const float u = sample_1d(rng);
     const size_t count = pool.vertices.size();
     const LightVertex& y = pool.vertices[std::min(size_t(double(u) * double(count)), count - 1)];
-    const uint32_t depth = floatBitsToUint(y.position_depth.w);
-    if (bounce + int(depth) > pool.max_depth) return;
-    const Vec3 position{y.position_depth.x, y.position_depth.y, y.position_depth.z};
-    const Vec3 to_light = position - x.position;
-    const float distance2 = dot(to_light, to_light);
-    if (!(distance2 > 0)) return;
-    const Vec3 wi = to_light / std::sqrt(distance2);
-    const float cos_x = dot(x.shading_normal, wi);
-    const float cos_x_geometric = dot(x.geometric_normal, wi);
-    const Vec3 y_normal{y.geometric_normal_layer.x, y.geometric_normal_layer.y, y.geometric_normal_layer.z};
-    const float cos_y = -dot(y_normal, wi);
-    if (!(cos_x > 0) || !(cos_x_geometric > 0) || !(cos_y > 0)) return;
-    const Vec3 y_shading{y.shading_normal_ratio.x, y.shading_normal_ratio.y, y.shading_normal_ratio.z};
-    const float eye_density = continuation_pdf(g, x, wi) * cos_y / distance2;
-    const float light_density = std::max(-dot(y_shading, wi), 0.0f) * kInvPi * cos_x_geometric / distance2;
-    const float eye_ratio = bounce > 0 && eye.pdf_forward > 0 ? light_density / eye.pdf_forward : 0.0f;
-    const float weight = connection_weight(pool.sampling, y, eye_density, eye_ratio, eye.eye_sum);
-    const Vec3 c = throughput * Vec3{y.weight_a.x, y.weight_a.y, y.weight_a.z} *
-                   (cos_x * kInvPi * cos_y / distance2 * pool.sampling.scale * weight);
-    if (!(max_component(c) > 0)) return;
-    const Vec3 target = offset_ray_origin(position, y_normal, scene().extent);
-    const Vec3 span = target - origin;
-    const float span_length = length(span);
-    if (!(span_length > 0)) return;
+    const ShadowRay ray = light_subpath_connection(scene(), pool.sampling, y, x, origin, throughput, g, bounce, eye, pool.max_depth);
+    if (ray.contribution_state.w != kShadowTrace) return;
     ++rays;
-    if (embree->occluded(origin, span / span_length, span_length)) return;
-    out.add(bounce + int(depth), c);
+    const Vec3 direction{ray.direction_length.x, ray.direction_length.y, ray.direction_length.z};
+    if (embree->occluded(origin, direction, ray.direction_length.w)) return;
+    const Vec3 c{ray.contribution_state.x, ray.contribution_state.y, ray.contribution_state.z};
+    out.add(bounce + int(floatBitsToUint(y.position_depth.w)), c);
     out.add_light(floatBitsToUint(y.geometric_normal_layer.w), c);
     if (directional_texel) {
-      const Vec3 f = sh1_direction_factor(x, wi);
+      const Vec3 to_light = Vec3{y.position_depth.x, y.position_depth.y, y.position_depth.z} - x.position;
+      const Vec3 f = sh1_direction_factor(x, to_light / std::sqrt(dot(to_light, to_light)));
       for (int axis = 0; axis < 3; ++axis) out.texel_nee_sh1[axis] += c * f[axis];
       out.texel_nee += c;
     }

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "exitance/runtime/core/light_subpath_start.h"
 #include "exitance/runtime/core/lighting_scene.h"
 #include "exitance/runtime/core/scene_access.h"
 
@@ -12,9 +13,6 @@ namespace exitance {
 
 class EmbreeScene;
 class EmitterGuidingCache;
-
-// Random streams of light subpaths: path_sampler(seed, kLightSubpathStreamBase + path, key).
-constexpr uint64_t kLightSubpathStreamBase = uint64_t(1) << 41;
 
 struct LightVertexPool {
   std::vector<LightVertex> vertices;
@@ -24,11 +22,6 @@ struct LightVertexPool {
   // The deepest vertex kept (connections need depth + eye bounce <= this).
   int max_depth = 0;
 };
-
-// How subpaths start in `scene`: emitters, punctual lights and the sky by power (emitters pi x their
-// NEE power; point 4 pi I, spot 2 pi (1 - cos_outer) I, directional pi r^2 E, the sky pi r^2 x its
-// luminance's integral over directions; r = scene_radius). count and scale are 0.
-LightSubpathSampling light_subpath_start(const LightingScene& scene);
 
 // `paths` light subpaths of sample `key` (each a stream of its own), vertices up to `max_depth`
 // edges from the light (the eye's bounce limits), Russian roulette from depth rr_start.

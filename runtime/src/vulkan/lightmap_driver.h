@@ -86,6 +86,9 @@ class LightmapDriver {
     size_t max_work = 0;
     GpuParams params{};
     BatchTotals totals;
+    // Light subpaths (IntegratorSettings::light_subpaths): per texel sample of a batch (0: none);
+    // each batch traces its own pool (gpu_layout.h kBindingLightSubpaths).
+    double light_subpaths_per_sample = 0;
     uint32_t next_sample = 0;
     double seconds = 0;
   };
@@ -96,6 +99,9 @@ class LightmapDriver {
                Accumulation* reuse = nullptr, bool accumulation_cleared = false);
   void upload_items(const Accumulation& a);
   void run_pass(Accumulation& a, uint32_t first, uint32_t pass);
+  // Light subpaths: the pool's parameters, its binding and the path state's room for them.
+  void prepare_light_subpaths(const IntegratorSettings& settings, Accumulation& a);
+  uint64_t light_pool_most_vertices() const;  // within the device's largest storage buffer
   // What a read-back fills, made ahead of time (bake(): on a thread while the passes run): the
   // estimate's per-texel arrays for `host_texels`, zero (their memory touched), and a pinned
   // staging buffer for the largest array of `read_texels` texels (allocating it is part of a

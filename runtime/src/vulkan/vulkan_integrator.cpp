@@ -12,6 +12,7 @@
 #include "light_layer_scaling.h"
 #include "exitance/runtime/core/grid_guiding_cache.h"
 #include "exitance/runtime/core/per_bounce_bake.h"
+#include "exitance/runtime/core/work_share.h"
 #include "gpu_scene.h"
 #include "kernel_launches.h"
 #include "exitance/common/texture_space_filter.h"
@@ -130,8 +131,18 @@ VulkanIntegrator::~VulkanIntegrator() = default;
 
 LightmapEstimate VulkanIntegrator::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const {
   if (settings.adaptive) throw std::runtime_error("Vulkan backend: --adaptive on is implemented on the CPU backend only (use --backend cpu)");
-  if (settings.light_subpaths)
-    throw std::runtime_error("Vulkan backend: --light-paths is implemented on the CPU backend only (use --backend cpu)");
+  if (settings.light_subpaths) {  // texels' path tracing alone, as on the CPU (whose probes and emitter guiding also combine)
+    if (settings.integrator == IntegratorMode::Bounces)
+      throw std::invalid_argument("Vulkan backend: --light-paths applies to path tracing, not to --integrator bounces");
+    if (settings.guiding != GuidingMode::Off)
+      throw std::invalid_argument("Vulkan backend: --light-paths is not combined with --guiding (use --guiding off)");
+    if (settings.emitter_guiding)
+      throw std::invalid_argument("Vulkan backend: --light-paths with --emitter-guiding on is implemented on the CPU backend only");
+    if (distributed(settings.work_share))
+      throw std::invalid_argument("Vulkan backend: --light-paths runs in one process only, not under mpirun with several ranks");
+    if (!(settings.light_subpaths_per_sample > 0 && settings.light_subpaths_per_sample <= 64))
+      throw std::invalid_argument("Vulkan backend: light subpaths per sample must be in (0, 64]");
+  }
   if (settings.spp == 0 && !(settings.time_budget_seconds > 0) && !(settings.target_relative_error > 0))
     throw std::invalid_argument("Vulkan backend: spp 0 needs a time budget or a target error");
   if (settings.integrator == IntegratorMode::Bounces) {

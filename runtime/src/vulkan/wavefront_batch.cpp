@@ -1,12 +1,14 @@
 #include "wavefront_batch.h"
 
 #include <algorithm>
+#include <cstddef>
 #include <string>
 
 namespace exitance::vulkan {
 namespace {
 
-static_assert(sizeof(GpuParams) == 240);  // a multiple of 16 bytes (std430 rounds a struct with vec4s so)
+static_assert(sizeof(GpuParams) == 272);  // a multiple of 16 bytes (std430 rounds a struct with vec4s so)
+static_assert(offsetof(GpuParams, light_subpath_start) == 240);  // std430: a vec4 at a multiple of 16
 static_assert(sizeof(GpuParams::changed_light_layers) / sizeof(uint32_t) == kMaxChangedLightPairs);
 static_assert(sizeof(GpuSurfacePoint) == 48 && sizeof(ShadowRay) == 32);
 
@@ -22,6 +24,9 @@ void BatchTotals::add(const uint32_t* c) {
   bounce_gathers += c[kCounterBounceGathers], bounce_texelless += c[kCounterBounceTexelless];
   bounce_back_faces += c[kCounterBounceBackFaces];
   guided_vertices += stat64(c, kCounterGuidedVertices);
+  light_subpaths += c[kCounterLightSubpaths], light_subpath_rays += c[kCounterRaysLightSubpaths];
+  if (c[kCounterLightSubpaths] > 0) light_subpath_vertices += c[kCounterLightSubpathVertices];
+  pool_vertices_needed = std::max(pool_vertices_needed, c[kCounterLightSubpathVertices]);
   extend_busy += stat64(c, kCounterStatExtendActive), extend_launched += stat64(c, kCounterStatExtendLaunched);
   connect_busy += stat64(c, kCounterStatConnectActive), connect_launched += stat64(c, kCounterStatConnectLaunched);
   shade_items += stat64(c, kCounterStatShadeItems), shade_lanes += stat64(c, kCounterStatShadeLanes);
@@ -31,6 +36,8 @@ void BatchTotals::add(const BatchTotals& o) {
   rays_primary += o.rays_primary, rays_bounce += o.rays_bounce, rays_shadow += o.rays_shadow, nonfinite += o.nonfinite;
   bounce_gathers += o.bounce_gathers, bounce_texelless += o.bounce_texelless, bounce_back_faces += o.bounce_back_faces;
   guided_vertices += o.guided_vertices;
+  light_subpaths += o.light_subpaths, light_subpath_vertices += o.light_subpath_vertices, light_subpath_rays += o.light_subpath_rays;
+  pool_vertices_needed = std::max(pool_vertices_needed, o.pool_vertices_needed);
   extend_busy += o.extend_busy, extend_launched += o.extend_launched, connect_busy += o.connect_busy;
   connect_launched += o.connect_launched, shade_items += o.shade_items, shade_lanes += o.shade_lanes;
 }
@@ -136,6 +143,12 @@ void WavefrontBatchRunner::run(GpuParams& params, BatchRange range, size_t resul
     vkCmdFillBuffer(first.commands(), buffers_.results.slots.handle(), 0,
                     VkDeviceSize(params.batch_work_total) * result_bytes_per_item, 0);
     first.barrier();
+    // Light subpaths: the batch's pool before its paths (light_subpaths.comp): counts, their offsets, vertices.
+    if (params.light_subpaths > 0) {
+      first.launch(stage::kLightSubpathsCount, Kernel::LightSubpaths, groups_for(params.light_subpaths), {0, kLightSubpathsCount});
+      first.launch(stage::kLightSubpathsOffsets, Kernel::LightSubpaths, 1, {0, kLightSubpathsOffsets});
+      first.launch(stage::kLightSubpathsWrite, Kernel::LightSubpaths, groups_for(params.light_subpaths), {0, kLightSubpathsWrite});
+    }
     // Generate appends to ray queue 0, the queue the shade after it reads (push constant 1: "1 ^ 1").
     first.launch(kernels.generate_name, kernels.generate, groups_for(sizes_.paths), {1, 0});
     trace_queued_rays(first, 1);

@@ -31,6 +31,9 @@ inline constexpr char kExtend[] = "extend: continuation rays (closest hit)";
 inline constexpr char kReduceTexels[] = "reduce: samples into texel sums";
 inline constexpr char kReduceProbes[] = "reduce: samples onto probe SH sums";
 inline constexpr char kTraversalOnly[] = "traversal only: incoherent rays (closest hit)";
+inline constexpr char kLightSubpathsCount[] = "light subpaths: traced, their vertices counted";
+inline constexpr char kLightSubpathsOffsets[] = "light subpaths: where each one's vertices start";
+inline constexpr char kLightSubpathsWrite[] = "light subpaths: traced again, their vertices written";
 inline constexpr char kRaysPrimary[] = "rays: primary";
 inline constexpr char kRaysBounce[] = "rays: bounce";
 }  // namespace stage
@@ -59,8 +62,12 @@ struct BatchTotals {
   uint64_t rays_primary = 0, rays_bounce = 0, rays_shadow = 0, nonfinite = 0;
   uint64_t bounce_gathers = 0, bounce_texelless = 0, bounce_back_faces = 0;  // per-bounce layer passes
   uint64_t guided_vertices = 0;  // guided batches: vertices that sampled a learned table
+  // Light subpaths: the pools' subpaths and vertices (a pool left empty counts its subpaths as 0 and
+  // the vertices it needed: pool_vertices_needed), and their rays (both traces).
+  uint64_t light_subpaths = 0, light_subpath_vertices = 0, light_subpath_rays = 0;
+  uint32_t pool_vertices_needed = 0;  // the largest a batch's pool needed
   uint64_t extend_busy = 0, extend_launched = 0, connect_busy = 0, connect_launched = 0, shade_items = 0, shade_lanes = 0;
-  uint64_t rays() const { return rays_primary + rays_bounce + rays_shadow; }
+  uint64_t rays() const { return rays_primary + rays_bounce + rays_shadow + light_subpath_rays; }
   void add(const uint32_t* counters);
   void add(const BatchTotals& other);
 };

@@ -1,5 +1,7 @@
 #include "wavefront_buffers.h"
 
+#include <algorithm>
+
 namespace exitance::vulkan {
 namespace {
 
@@ -38,6 +40,15 @@ bool PathStateBuffers::reserve_emitter_learning(Context& context) {
   if (throughput.size() >= bytes) return false;
   throughput = context.create_storage_buffer(bytes);
   return true;
+}
+
+bool PathStateBuffers::reserve_light_subpaths(Context& context) {
+  bool grew = false;
+  const VkDeviceSize state = VkDeviceSize(paths) * 6 * 16;
+  if (throughput.size() < state) throughput = context.create_storage_buffer(state), grew = true;
+  const VkDeviceSize slots = VkDeviceSize(paths) * kShadowSlotsWithConnection * sizeof(ShadowRay);
+  if (shadow_rays.size() < slots) shadow_rays = context.create_storage_buffer(slots), grew = true;
+  return grew;
 }
 
 void PathStateBuffers::bind(DescriptorWrites& writes) const {
@@ -119,6 +130,23 @@ void ProbeAccumulators::bind(DescriptorWrites& writes) const {
   writes.set(kBindingProbeCounts, counts);
 }
 
+LightPool::LightPool(Context& context) : words(context.create_storage_buffer(kPlaceholder)) {}
+
+bool LightPool::reserve(Context& context, uint64_t vertices) {
+  const VkDeviceSize bytes = (VkDeviceSize(kLightPoolVertexWord) + VkDeviceSize(vertices) * kLightVertexWords) * 4;
+  if (words.size() >= bytes) return false;
+  words = context.create_storage_buffer(bytes);
+  return true;
+}
+
+uint32_t LightPool::capacity() const {
+  const VkDeviceSize word_count = words.size() / 4;
+  if (word_count <= kLightPoolVertexWord) return 0;
+  return uint32_t(std::min<VkDeviceSize>((word_count - kLightPoolVertexWord) / kLightVertexWords, 0xFFFFFFFFu));
+}
+
+void LightPool::bind(DescriptorWrites& writes) const { writes.set(kBindingLightSubpaths, words); }
+
 WavefrontBuffers::WavefrontBuffers(Context& context, uint32_t path_count)
     : control(context),
       paths(context, path_count),
@@ -130,7 +158,8 @@ WavefrontBuffers::WavefrontBuffers(Context& context, uint32_t path_count)
       texels(context),
       probes(context),
       refresh_probe_items(context),
-      refresh_probe_sums(context) {}
+      refresh_probe_sums(context),
+      light_pool(context) {}
 
 void WavefrontBuffers::bind(DescriptorWrites& writes) const {
   control.bind(writes);
@@ -142,6 +171,7 @@ void WavefrontBuffers::bind(DescriptorWrites& writes) const {
   results.bind(writes);
   texels.bind(writes);
   (probe_refresh_bound ? refresh_probe_sums : probes).bind(writes);
+  light_pool.bind(writes);
 }
 
 }  // namespace exitance::vulkan

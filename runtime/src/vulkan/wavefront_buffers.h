@@ -42,6 +42,10 @@ struct PathStateBuffers {
   // The throughput buffer with emitter guiding's 2P entries (a new buffer when it grows: rebind).
   // Returns whether it grew.
   bool reserve_emitter_learning(Context& context);
+  // Light subpaths: the throughput buffer with the eye-vertex state's 2P entries after emitter
+  // guiding's, and a fourth shadow slot per path, for the connection (gpu_layout.h
+  // kShadowSlotConnection). New buffers when they grow (rebind); returns whether one did.
+  bool reserve_light_subpaths(Context& context);
   uint32_t paths = 0;
   static constexpr size_t kBytesPerPath = 4 + 4 + 16 + 16 + 16 + 16 + 16 + kShadowRaysPerVertex * sizeof(ShadowRay);
 };
@@ -142,6 +146,19 @@ struct ProbeAccumulators {
 };
 
 // Everything of the wavefront but the scene.
+// Light subpaths (gpu_layout.h kBindingLightSubpaths): the batch's pool, header, per-subpath offsets
+// and vertices. A placeholder until a bake with light subpaths reserves it.
+struct LightPool {
+  Buffer words;
+
+  explicit LightPool(Context& context);
+  // Room for `vertices` pool vertices (a new buffer when it grows: rebind); returns whether it grew.
+  bool reserve(Context& context, uint64_t vertices);
+  // The most vertices the buffer holds (0: the placeholder).
+  uint32_t capacity() const;
+  void bind(DescriptorWrites& writes) const;
+};
+
 struct WavefrontBuffers {
   WavefrontControl control;
   PathStateBuffers paths;
@@ -158,6 +175,7 @@ struct WavefrontBuffers {
   WorkItems refresh_probe_items;
   ProbeAccumulators refresh_probe_sums;
   bool probe_refresh_bound = false;
+  LightPool light_pool;
 
   WavefrontBuffers(Context& context, uint32_t path_count);
   void bind(DescriptorWrites& writes) const;

@@ -8,6 +8,7 @@
 #include "exitance_spirv/connect.h"
 #include "exitance_spirv/extend.h"
 #include "exitance_spirv/generate.h"
+#include "exitance_spirv/light_subpaths.h"
 #include "exitance_spirv/prepare.h"
 #include "exitance_spirv/reduce.h"
 #include "exitance_spirv/reduce_probes.h"
@@ -35,6 +36,7 @@ KernelSource source_of(Kernel k) {
     case Kernel::ReduceTexels: return {spirv_reduce, sizeof(spirv_reduce), false, "reduce.comp"};
     case Kernel::ReduceProbes: return {spirv_reduce_probes, sizeof(spirv_reduce_probes), false, "reduce_probes.comp"};
     case Kernel::TraversalOnly: return {spirv_bench_rays, sizeof(spirv_bench_rays), false, "bench_rays.comp"};
+    case Kernel::LightSubpaths: return {spirv_light_subpaths, sizeof(spirv_light_subpaths), false, "light_subpaths.comp"};
     default: throw std::logic_error("no such kernel");
   }
 }

@@ -15,7 +15,7 @@ namespace exitance::vulkan {
 // for probe work items (bindings.glsl kProbeMode).
 enum class Kernel {
   Generate, GenerateProbes, Prepare, Shade, ShadeProbes, Connect, Extend, ReduceTexels, ReduceProbes, TraversalOnly,
-  Count
+  LightSubpaths, Count
 };
 
 const char* kernel_file(Kernel kernel);  // "shade.comp (probes)", ...

@@ -135,7 +135,13 @@ struct GpuParams {
                              // (kEmitterGuide* below); 0 = the default next-event sampling
   // A change estimate with light layers: pair k's change goes to layer changed_light_layers[k].
   uint changed_light_layers[8];  // kMaxChangedLightPairs
-  uint padding[3];               // to a multiple of 16 bytes, as std430 rounds a struct with vec4s
+  // Light subpaths (light_subpaths.h; texel path batches, bake --light-paths on): the batch's pool
+  // (kBindingLightSubpaths) is traced from this many subpaths before its paths start; 0 = none.
+  uint light_subpaths;
+  uint light_subpath_capacity;   // pool vertices the binding holds (a pool is cut to the subpaths that fit)
+  int light_subpath_depth;       // the deepest vertex kept: the eye paths' bounce limit (or the safety cap)
+  vec4 light_subpath_start;      // LightSubpathSampling: area_probability, punctual_scale, sky_probability, disk_density
+  vec4 light_subpath_sphere;     // the bounds' sphere where the sky's and directional lights' subpaths enter: centre, radius
 };
 
 // The most edited punctual lights a change estimate carries (GpuParams::changed_light_pairs; the
@@ -329,7 +335,30 @@ const uint kGuidingAuto = 8u;           // each texel sample's strategy from its
 const uint kGuidingAutoRecord = 16u;    // pilot passes: count work items' costs, add the strategy sums
 const uint kAutoSumDoubles = 7u;
 const uint kAutoCostWords = 2u;         // per work item: rays, guided vertices (floats)
-const uint kBindingCount = 31u;
+// Light subpaths on the wavefront (GpuParams::light_subpaths; shaders/wavefront/light_subpaths.comp):
+// the batch's pool, as uints. Header words kLightPool*; from word kLightPoolCounts one word per
+// subpath (its vertex count, then the exclusive prefix sum: where its vertices start); from word
+// kLightPoolVertexWord the vertices, kLightVertexWords each (light_subpaths.h LightVertex), in
+// subpath order, so the pool is the same for a seed whatever the schedule. lavapipe allows 32
+// storage buffers per stage: this is the 32nd binding.
+const uint kBindingLightSubpaths = 31u;
+const uint kLightPoolVertices = 0u;   // header: vertices kept
+const uint kLightPoolPaths = 1u;      // header: subpaths whose vertices all fit (the pool's subpath count)
+const uint kLightPoolCounts = 4u;
+const uint kLightPoolMostPaths = 262144u;  // 2^18 subpaths per pool at most
+const uint kLightPoolVertexWord = kLightPoolCounts + kLightPoolMostPaths;
+const uint kLightVertexWords = 20u;
+const uint kLightSubpathsCount = 0u;    // light_subpaths.comp modes (push constant): count each subpath's vertices,
+const uint kLightSubpathsOffsets = 1u;  // their prefix sums (one workgroup),
+const uint kLightSubpathsWrite = 2u;    // then trace again, writing them
+// Per path, the eye vertex's light-subpath state (path.h EyeSubpathVertex) from next-event
+// estimation to its continuation's hit: path_throughput [4P + 2p]: pdf_forward, eye_sum, and the
+// pending connection's light-vertex depth and light layer (uint bits); [4P + 2p + 1]: the vertex's
+// geometric normal (the hit's MIS ratios need it). The connection's shadow ray is slot
+// kShadowSlotConnection.
+const uint kShadowSlotConnection = 3u;
+const uint kShadowSlotsWithConnection = 4u;
+const uint kBindingCount = 32u;
 
 // Counter slots (uint each; statistics are 64-bit lo/hi pairs).
 const uint kCounterRayQueue0 = 0u;  // ray queue sizes, ping-pong (0 and 1)
@@ -342,6 +371,7 @@ const uint kCounterRaysShadow = 7u;
 const uint kCounterBounceGathers = 8u;     // per-bounce passes: gather rays that hit a surface,
 const uint kCounterBounceTexelless = 9u;   // of those estimated on the fly (no lit texel there),
 const uint kCounterBounceBackFaces = 10u;  // of those single-sided back faces
+const uint kCounterRaysLightSubpaths = 11u;  // light subpaths' rays (both of light_subpaths.comp's traces)
 const uint kCounterGuidedVertices = 12u;   // guided batches: vertices with a learned record (lo, hi)
 const uint kCounterStatExtendActive = 16u;  // lanes active inside traversal loops / lanes launched there
 const uint kCounterStatExtendLaunched = 18u;
@@ -354,11 +384,15 @@ const uint kCounterStatShadeLanes = 26u;
 // work claim that did not advance the work counter (kernel_prelude.glsl regenerate).
 const uint kCounterFaultTraversal = 28u;
 const uint kCounterFaultWorkClaim = 29u;
+const uint kCounterLightSubpaths = 30u;        // light subpaths in the batch's pool (kLightPoolPaths)
+const uint kCounterLightSubpathVertices = 31u;  // and their vertices
 const uint kCounterCount = 32u;
 
 // Light probes: random streams path_sampler(seed, kProbeRngStreamBase + probe, sample), and stratified
 // sets of kProbeStratifiedSetSize consecutive samples (sampling.h probe_direction).
 const uint64_t kProbeRngStreamBase = 1099511627776ul;  // 2^40
+// Light subpaths: path_sampler(seed, kLightSubpathStreamBase + subpath, key) (light_subpaths.h).
+const uint64_t kLightSubpathStreamBase = 2199023255552ul;  // 2^41
 const uint kProbeStratifiedSetSize = 256u;
 
 EXITANCE_NAMESPACE_END

@@ -29,6 +29,7 @@ struct LightingScene {
   // emission edit, rewrites this value, the CDF (and the edited material records), no triangle record.
   float emitter_inverse_power = 0.0f;
   std::vector<double> punctual_cdf;          // punctual_lights.size() + 1 entries (at least 2), by power
+  double punctual_power = 0.0;               // the luminance power that CDF is of, summed over the lights
   Vec3 sky{0, 0, 0};                         // constant sky radiance (when there is no environment map)
   EnvironmentSampler environment;            // enabled when the sky is an image
   Vec3 bounds_lo{0, 0, 0}, bounds_hi{0, 0, 0};
