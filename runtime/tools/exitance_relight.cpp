@@ -77,6 +77,11 @@ int main(int argc, char** argv) {
                  "bake --emitter-guiding on: the whole lightmap in one run; not with --frames, --budget-ms, --guiding or "
                  "--integrator bounces)")
       ->check(CLI::IsMember({"off", "on"}));
+  app.add_option("--light-paths", options.light_paths,
+                 "off (default) | on (light subpaths that the texels' paths connect to, as bake --light-paths on: the "
+                 "whole lightmap in one run; not with --frames, --budget-ms, --guiding, --emitter-guiding on or "
+                 "--integrator bounces)")
+      ->check(CLI::IsMember({"off", "on"}));
   app.add_option("--seed", seed, "random seed (default: the bake's); results are deterministic per seed and device");
   app.add_option("--device", options.device_index, "Vulkan device index (see --list-devices)")->check(CLI::NonNegativeNumber);
   app.add_flag("--list-devices", list_devices, "print the Vulkan devices and exit");

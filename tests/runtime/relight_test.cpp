@@ -320,6 +320,44 @@ TEST(Relight, ReproducesAVulkanEmitterGuidedBakeBitForBit) {
   fs::remove_all(dir);
 }
 
+// exitance-relight --light-paths on is bake --backend vulkan --light-paths on (the same seed, the same
+// pool per batch): the same pages bit for bit; it reports the subpaths, and refuses --frames,
+// --emitter-guiding on beside it and an unknown value, writing nothing.
+TEST(Relight, ReproducesAVulkanLightPathsBakeBitForBit) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const fs::path dir = fs::temp_directory_path() / ("exitance-relight-light-paths-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path baked = dir / "connected.bake", output = dir / "connected-relit.bake";
+  bake_to_relight("ajar_room", baked, 2.0f, 8, [](BakeOptions& b) {
+    b.lighting.integrator = IntegratorMode::Path;
+    b.lighting.guiding = GuidingMode::Off;
+    b.lighting.light_subpaths = true;
+    b.integrator_auto = false;
+  });
+  RelightOptions options;
+  options.bundle = baked.string();
+  options.output = output.string();
+  options.seed = 9;
+  options.spp = 8;
+  options.light_paths = "on";
+  const nlohmann::json report = relight_bundle(options);
+  ASSERT_TRUE(report.contains("light_paths")) << report.dump();
+  EXPECT_GT(report["light_paths"]["vertices"].get<uint64_t>(), 0u);
+  EXPECT_GE(expect_same_pages(baked, output, "the light-path bake's"), 1u);
+  options.output = (dir / "refused.bake").string();
+  options.frames = 2;
+  EXPECT_THROW(relight_bundle(options), RelightInputError);
+  options.frames = 0;
+  options.emitter_guiding = "on";
+  EXPECT_THROW(relight_bundle(options), RelightInputError);
+  options.emitter_guiding = "off";
+  options.light_paths = "sometimes";
+  EXPECT_THROW(relight_bundle(options), RelightInputError);
+  EXPECT_FALSE(fs::exists(dir / "refused.bake"));
+  fs::remove_all(dir);
+}
+
 // A scene with smooth lightmap UV seams (a sphere with generated UVs over a floor): the bake stitches
 // them, and so does the relight, from scene.bin's scene and atlas, bit for bit as the bake did; a bake
 // written with --seams off is relit unstitched (the mode follows the bundle's stats.seams.mode).

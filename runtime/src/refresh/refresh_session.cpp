@@ -1065,7 +1065,7 @@ const LightmapEstimate& RefreshSession::bake_guided(uint32_t spp, double time_bu
 }
 
 const LightmapEstimate& RefreshSession::bake_path(uint32_t spp, double time_budget_seconds, WorkShare* share,
-                                                  bool emitter_guiding) {
+                                                  bool emitter_guiding, bool light_subpaths) {
   State& s = *state_;
   end_change_estimate();
   if (spp == 0 && !(time_budget_seconds > 0)) throw std::invalid_argument("path tracing in one run needs samples per texel or a time budget");
@@ -1076,6 +1076,7 @@ const LightmapEstimate& RefreshSession::bake_path(uint32_t spp, double time_budg
   settings.time_budget_seconds = time_budget_seconds;
   settings.work_share = share;
   settings.emitter_guiding = emitter_guiding;
+  settings.light_subpaths = light_subpaths;
   budget_from_now(settings);
   s.per_bounce = s.integrator->bake(s.persisted.gbuffer, settings);
   s.whole_run_path = true;

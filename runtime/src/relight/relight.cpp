@@ -58,16 +58,22 @@ json relight_bundle(const RelightOptions& options) {
   if (emitter_guided && (per_bounce || guided || options.frames > 0 || options.frame_budget_ms > 0))
     throw RelightInputError("--emitter-guiding on guides path tracing of the whole lightmap in one run: it takes no "
                             "--integrator bounces, --guiding, --frames or --budget-ms");
+  if (options.light_paths != "off" && options.light_paths != "on")
+    throw RelightInputError("--light-paths " + options.light_paths + ": expected off or on");
+  const bool light_paths = options.light_paths == "on";
+  if (light_paths && (per_bounce || guided || emitter_guided || options.frames > 0 || options.frame_budget_ms > 0))
+    throw RelightInputError("--light-paths on adds strategies to path tracing of the whole lightmap in one run: it takes no "
+                            "--integrator bounces, --guiding, --emitter-guiding on, --frames or --budget-ms");
 
   const bool share = options.share_ranks > 0;
   if (share) {
     if (options.share_rank < 0 || options.share_rank >= options.share_ranks)
       throw RelightInputError("--share " + std::to_string(options.share_rank) + "/" + std::to_string(options.share_ranks) +
                               ": expected R/N with 0 <= R < N");
-    if (per_bounce || guided || emitter_guided || options.frames > 0 || options.frame_budget_ms > 0 || options.time_budget_seconds > 0 ||
+    if (per_bounce || guided || emitter_guided || light_paths || options.frames > 0 || options.frame_budget_ms > 0 || options.time_budget_seconds > 0 ||
         !options.edits_file.empty() || !options.output.empty() || !options.spp || *options.spp == 0)
       throw RelightInputError("--share measures one rank's share of path tracing at a fixed --spp: it takes no --integrator bounces, "
-                              "--guiding, --emitter-guiding, --frames, --budget-ms, --time, --edits or -o (it writes nothing)");
+                              "--guiding, --emitter-guiding, --light-paths, --frames, --budget-ms, --time, --edits or -o (it writes nothing)");
   }
   const fs::path bundle(options.bundle);
   const fs::path out = options.output.empty() ? bundle : fs::path(options.output);
@@ -193,6 +199,19 @@ json relight_bundle(const RelightOptions& options) {
     emitter_guiding_report = emitter_guiding_json(run->emitter_guiding);
     report("lighting", 1, rays);
   }
+  json light_paths_report;
+  if (light_paths) {
+    report("lighting", 0, 0);
+    const LightmapEstimate* run = nullptr;
+    try {
+      run = &session->bake_path(spp, options.time_budget_seconds, nullptr, false, true);
+    } catch (const std::invalid_argument& e) {
+      throw RelightInputError(options.bundle + ": " + e.what());
+    }
+    rays = run->rays;
+    light_paths_report = {{"subpaths", run->light_subpaths}, {"vertices", run->light_subpath_vertices}};
+    report("lighting", 1, rays);
+  }
   uint64_t share_texels = 0;
   double share_passes_seconds = 0;
   if (share) {
@@ -205,7 +224,7 @@ json relight_bundle(const RelightOptions& options) {
     share_texels = rank_alone.work.texel_samples / spp;
     report("lighting", 1, rays);
   }
-  for (uint32_t frame = 0; !per_bounce && !guided && !emitter_guided && !share && (options.frames == 0 || frame < options.frames); ++frame) {
+  for (uint32_t frame = 0; !per_bounce && !guided && !emitter_guided && !light_paths && !share && (options.frames == 0 || frame < options.frames); ++frame) {
     RefreshBudget budget;
     budget.max_samples_per_texel = spp;
     budget.milliseconds = options.frame_budget_ms;
@@ -279,6 +298,7 @@ json relight_bundle(const RelightOptions& options) {
   run["integrator"] = per_bounce ? "bounces" : "path";
   if (guided) run["guiding"] = options.guiding;
   if (emitter_guided) run["emitter_guiding"] = emitter_guiding_report;
+  if (light_paths) run["light_paths"] = light_paths_report;
   if (per_bounce) run["bounces"] = bounces_report;
   run["spp"] = session->samples_per_texel();
   // Light layers kept per texel (docs/runtime.md "Light layers"; 0: --no-light-layers or a whole run)

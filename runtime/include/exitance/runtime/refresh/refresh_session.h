@@ -202,9 +202,10 @@ class RefreshSession {
   // Returns the result lightmap() returns, by reference (valid until the next restart, edit or
   // refresh: a million texels' estimate is ~100 MB).
   // `emitter_guiding`: next-event estimation guided by emitter distributions learned during the run
-  // (bake --emitter-guiding on; one process only).
+  // (bake --emitter-guiding on; one process only). `light_subpaths`: the texels' paths also connect
+  // to light subpaths (bake --light-paths on; not with emitter guiding on this backend).
   const LightmapEstimate& bake_path(uint32_t spp, double time_budget_seconds, WorkShare* share = nullptr,
-                                    bool emitter_guiding = false);
+                                    bool emitter_guiding = false, bool light_subpaths = false);
 
   // The lightmap accumulated since the last edit or restart (a read-back: it waits for the device);
   // after a light edit estimated as a change (changed_lights() > 0), that change.

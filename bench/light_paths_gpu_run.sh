@@ -1,0 +1,53 @@
+#!/bin/bash
+# Light subpaths against plain path tracing on the GPU machine (issue 35, item 3), through
+# exitance-relight (--light-paths on: one path-traced bake of the whole lightmap whose texel paths
+# connect to a pool of light subpaths per batch, as bake --backend vulkan --light-paths on; off: the
+# progressive relight). Carry .gl and .replay; .replay/lp.txz comes from bench/light_paths_gpu_pack.sh.
+# Per bundle (BUNDLES, default every one packed): a two-seed 4096-spp reference without subpaths
+# (seeds 101, 202), then both modes at equal lighting time (TIMES seconds, --time) and at equal
+# samples (SPPS), compared with the reference (bench_bundle_rel_mse: relMSE, the reference's noise
+# subtracted); then per wavefront stage at 256 spp, both modes.
+#   bash .replay/light_paths_gpu_run.sh       (env BUNDLES, TIMES, SPPS, STAGES=0 for no per-stage runs;
+#                                              writes $OUT/summary.txt as it goes)
+set -e
+for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
+export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+W=/tmp/w; mkdir -p $W && tar -C $W -xJf .replay/lp.txz
+S=$OUT/summary.txt
+nvidia-smi --query-gpu=name,driver_version --format=csv,noheader > $S
+common="--ignore-baked --no-light-layers --json"
+R=$W/rt/bin/exitance-relight
+for b in ${BUNDLES:-$(cd $W && ls -d *.bake | sed 's/\.bake$//')}; do
+  B=$W/$b.bake
+  $R $B -o $W/warm.bake --spp 4 --seed 1 $common > /dev/null  # shader and driver caches
+  $R $B -o $W/warm.bake --spp 4 --seed 1 --light-paths on $common > /dev/null
+  for s in 101 202; do $R $B -o $W/ref_$s.bake --spp 4096 --seed $s $common > /dev/null; done
+  list=""
+  run() {  # NAME ARGS...
+    local name=$b-$1; shift
+    $R $B -o $W/$name.bake --seed 3 $common "$@" > $W/$name.json
+    python3 -c "
+import json; r=json.load(open('$W/$name.json'))
+print('$name', 'lighting_s %.3f'%r['lighting_seconds'], 'spp', r['samples_per_texel'], 'rays %.3g'%r['rays'], 'rays_per_s %.3g'%r['rays_per_second'], 'light_paths', r.get('light_paths'))" >> $S
+    list="$list $W/$name.bake"
+  }
+  for t in ${TIMES:-0.25 1}; do
+    run off_t$t --time $t
+    run on_t$t --time $t --light-paths on
+  done
+  for n in ${SPPS:-64 256}; do
+    run off_s$n --spp $n
+    run on_s$n --spp $n --light-paths on
+  done
+  for mode in $([ "${STAGES:-1}" = 1 ] && echo off on); do
+    $R $B -o $W/stages.bake --seed 3 --spp 256 --light-paths $mode --stage-statistics $common > $W/stages.json
+    python3 -c "
+import json; r=json.load(open('$W/stages.json')); g=sum(s['gpu_seconds'] for s in r['stages'])
+print('$b stages $mode: lighting %.3f s, GPU stages %.3f s'%(r['lighting_seconds'], g))
+for s in r['stages']: print('  %-55s %.4f s  rays %.3g  lanes %.2f'%(s['stage'], s['gpu_seconds'], s['rays'], s['lane_efficiency']))" >> $S
+  done
+  echo "$b relMSE:" >> $S
+  LD_LIBRARY_PATH=$W/rt/lib $W/rt/bin/bench_bundle_rel_mse $W/ref_101.bake $W/ref_202.bake $list | sed "s#$W/##" >> $S
+  rm -rf $W/$b-*.bake $W/ref_*.bake
+done
+cat $S
