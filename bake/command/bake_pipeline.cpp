@@ -200,11 +200,9 @@ json run_bake(const BakeOptions& options, Diagnostics& diagnostics) {
   // SVO guiding builds its fields over the octree voxelized above (main refuses it without one).
   if (voxels) lighting_options.lighting.guiding_octree = &voxels->svo;
   const double budget = options.lighting.time_budget_seconds;
-  // Where --guiding auto may measure light subpaths (the CPU backend), the probes follow the texels'
-  // verdict (probes_follow_texels): they are lit after the texels, with what a budget leaves.
-  const bool probes_after_texels = probes && !share && backend->backend_name() == "cpu" &&
-                                   decided.lighting.guiding == GuidingMode::Auto &&
-                                   decided.lighting.guiding_auto_candidate != AutoGuidingCandidate::Grid;
+  // Where --guiding auto may measure light subpaths (the backend says where), the probes follow the
+  // texels' verdict (probes_follow_texels): they are lit after the texels, with what a budget leaves.
+  const bool probes_after_texels = probes && !share && backend->auto_guiding_may_measure_light_subpaths(decided.lighting);
   if (probes && !probes_after_texels) {
     const double probe_budget = budget > 0 ? kProbeShareOfTimeBudget * budget : 0.0;
     probe_lighting = clock.time(

@@ -333,6 +333,10 @@ std::string CpuReferenceIntegrator::device_description() const {
   return "Embree 3 CPU reference on " + std::to_string(tbb::info::default_concurrency()) + " threads";
 }
 
+bool CpuReferenceIntegrator::auto_guiding_may_measure_light_subpaths(const IntegratorSettings& settings) const {
+  return settings.guiding == GuidingMode::Auto && settings.guiding_auto_candidate != AutoGuidingCandidate::Grid;
+}
+
 LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const {
   if (settings.integrator == IntegratorMode::Bounces) {
     if (settings.directional != DirectionalMode::Off)
@@ -390,8 +394,8 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   const bool scene_starts_subpaths = light_subpaths_start_anywhere(subpath_start);
   const bool long_enough = settings.spp == 0 || settings.spp >= kLightSubpathPilots * kLightSubpathPilotSamples;
   const bool auto_light_subpaths =
-      auto_guiding && (settings.guiding_auto_candidate == AutoGuidingCandidate::LightSubpaths ||
-                       (settings.guiding_auto_candidate == AutoGuidingCandidate::Scene && scene_starts_subpaths && long_enough));
+      auto_guiding_may_measure_light_subpaths(settings) &&
+      (settings.guiding_auto_candidate == AutoGuidingCandidate::LightSubpaths || (scene_starts_subpaths && long_enough));
   const bool light_subpaths = scene_starts_subpaths && (settings.light_subpaths || auto_light_subpaths);
 
   // Built inside the timed bake: guided results are measured with the cost of their guiding data.

@@ -37,6 +37,7 @@ class CpuReferenceIntegrator final : public Integrator {
   // safety_bounce_cap, progress; probes are independent of the lightmap bake. Also fills the ambient
   // cube (axis_irradiance_sum).
   ProbeEstimate bake_probes(const std::vector<Vec3>& positions, const IntegratorSettings& settings) const override;
+  bool auto_guiding_may_measure_light_subpaths(const IntegratorSettings& settings) const override;
 
  private:
   struct Impl;

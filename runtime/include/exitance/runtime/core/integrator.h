@@ -29,6 +29,11 @@ class Integrator {
   // a time budget), time_budget_seconds (checked at stratified-set boundaries), max_bounces, seed,
   // russian_roulette_start, safety_bounce_cap, progress.
   virtual ProbeEstimate bake_probes(const std::vector<Vec3>& origins, const IntegratorSettings& settings) const = 0;
+
+  // Whether bake(settings)'s --guiding auto may take light subpaths as its candidate (the CPU
+  // backend's rule: docs/lighting-core.md "`--guiding auto`"); bake then lights the probes after the
+  // texels, to follow their verdict (bake_stages.h probes_follow_texels).
+  virtual bool auto_guiding_may_measure_light_subpaths(const IntegratorSettings& settings) const { return false; }
 };
 
 }  // namespace exitance
