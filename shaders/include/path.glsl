@@ -53,8 +53,8 @@ LightVertex light_pool_vertex(uint k) {
   return v;
 }
 
-// Path p's eye-vertex state (gpu_layout.h: path_throughput [4P + 2p], [4P + 2p + 1]).
-uint eye_subpath_index(uint p) { return 4u * params.path_capacity + 2u * p; }
+// Path p's eye-vertex state (gpu_layout.h: path_throughput [2P + p]).
+uint eye_subpath_index(uint p) { return 2u * params.path_capacity + p; }
 
 EyeSubpathVertex stored_eye_subpath_vertex(uint p) {
   EyeSubpathVertex e = eye_subpath_vertex_none();
@@ -65,14 +65,11 @@ EyeSubpathVertex stored_eye_subpath_vertex(uint p) {
   return e;
 }
 
-// The vertex path p's continuation ray left, as the hit's MIS ratios read it (its geometric normal).
-SurfacePoint stored_eye_vertex(uint p) {
-  SurfacePoint x;
-  x.position = vec3(0.0);
-  x.geometric_normal = path_throughput[eye_subpath_index(p) + 1u].xyz;
-  x.shading_normal = x.geometric_normal;
-  return x;
-}
+// The cosine at the vertex path p's continuation ray left, toward the ray (path.h cos_left).
+float stored_cos_left(uint p) { return path_throughput[eye_subpath_index(p)].z; }
+
+// The shadow slot of a vertex's connection: the last (gpu_layout.h kShadowSlotsWith*).
+bool is_connection_slot(uint k) { return light_subpaths_on() && k + 1u == params.shadow_slots; }
 
 // Traces path p's pending shadow rays and adds what they carry to its work item (connect stage,
 // and inline for a path that ends right after next-event estimation). Returns rays traced.
@@ -89,10 +86,10 @@ uint connect_shadow_rays(uint p, inout uint steps) {
     if (contribution.w != kShadowTrace) continue;
     vec4 ray = shadow_rays[slot].direction_length;
     if (trace_any(origin, ray.xyz, ray.w, steps)) continue;
-    if (k == kShadowSlotConnection) {  // a light subpath's: its vertex's depth and light layer
-      vec4 eye = path_throughput[eye_subpath_index(p)];
-      add_result(work, depth + floatBitsToUint(eye.z), contribution.xyz);
-      add_light_result(work, floatBitsToUint(eye.w), contribution.xyz);
+    if (is_connection_slot(k)) {  // a light subpath's: its vertex's depth and light layer
+      uint vertex = floatBitsToUint(path_throughput[eye_subpath_index(p)].w);
+      add_result(work, depth + (vertex & 0xFFFFu), contribution.xyz);
+      add_light_result(work, vertex >> 16u, contribution.xyz);
     } else {
       if (params.emitter_guide != 0u) emitter_guide_learn_arrived(p, k);
       add_result(work, depth, contribution.xyz);
@@ -184,21 +181,19 @@ uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rn
   if (subpaths) {
     // One connection to a pool vertex picked uniformly (light_subpath_walk.h), in its own shadow slot.
     ShadowRay connection = no_shadow_ray();
-    uint vertex_depth = 0u, vertex_layer = 0u;
+    uint vertex = 0u;  // its depth | light layer << 16
     if (eye.sampling.count > 0.0) {
       float u = sample_1d(rng);
       uint count = light_pool[kLightPoolVertices];
       LightVertex y = light_pool_vertex(min(uint(double(u) * double(count)), count - 1u));
       connection = light_subpath_connection(eye.sampling, y, x, origin, throughput, guide, int(path_depth[p]), eye,
                                             params.light_subpath_depth);
-      vertex_depth = floatBitsToUint(y.position_depth.w);
-      vertex_layer = floatBitsToUint(y.geometric_normal_layer.w);
+      vertex = floatBitsToUint(y.position_depth.w) | (floatBitsToUint(y.geometric_normal_layer.w) << 16u);
     }
-    shadow_rays[first + kShadowSlotConnection] = connection;
+    shadow_rays[first + params.shadow_slots - 1u] = connection;
     shadows = shadows || connection.contribution_state.w != kShadowNone;
-    uint e = eye_subpath_index(p);
-    path_throughput[e] = vec4(eye.pdf_forward, eye.eye_sum, uintBitsToFloat(vertex_depth), uintBitsToFloat(vertex_layer));
-    path_throughput[e + 1u] = vec4(x.geometric_normal, 0.0);
+    float cos_left = d.pdf > 0.0 ? dot(x.geometric_normal, d.direction) : 0.0;
+    path_throughput[eye_subpath_index(p)] = vec4(eye.pdf_forward, eye.eye_sum, cos_left, uintBitsToFloat(vertex));
   }
   uint pending = shadows ? 2u : 0u;
   if (directional_texel) path_throughput[sh1_factor_index(p)] = vec4(d.pdf > 0.0 ? sh1_direction_factor(x, d.direction) : vec3(0.0), 0.0);

@@ -72,7 +72,7 @@ void main() {
     // The change estimate (params.changed_light_pairs, path.h) adds no sky: it did not change.
     if (params.changed_light_pairs == 0u) {
       // With light subpaths from the sky, weighed against the left vertex's connections to them too.
-      vec3 sky = throughput * (light_subpaths_on() ? escaped_radiance_with_subpaths(stored_eye_vertex(p), stored_eye_subpath_vertex(p), wi, tp.w)
+      vec3 sky = throughput * (light_subpaths_on() ? escaped_radiance_with_subpaths(stored_cos_left(p), stored_eye_subpath_vertex(p), wi, tp.w)
                                                    : escaped_radiance(wi, tp.w));
       add_path_result(p, work, depth, sky);
       add_light_result(work, kSkyLightLayer, sky);
@@ -85,19 +85,17 @@ void main() {
     // the new vertex's state follows from the left one's (path.h).
     bool subpaths = light_subpaths_on();
     EyeSubpathVertex eye = eye_subpath_vertex_none();
-    SurfacePoint left;
     vec3 ng = vec3(0.0);
     float emission_extra = 0.0;
     if (subpaths) {
       eye = stored_eye_subpath_vertex(p);
-      left = stored_eye_vertex(p);
       ng = triangle_geometric_normal(tri);
-      emission_extra = light_subpath_emitter_hit_extra(left, eye, emitter, tri, ng, hit.x, hit.z, hit.w, wi);
+      emission_extra = light_subpath_emitter_hit_extra(stored_cos_left(p), eye, emitter, tri, ng, hit.x, hit.z, hit.w, wi);
     }
     HitResult h = shade_continuation_hit(tri, hit.x, hit.z, hit.w, wi, tp.w, throughput, bounce, path_limits(), emitter,
                                          emission_extra, rng);
     if (subpaths && h.continues) {
-      eye = next_eye_subpath_vertex(eye, left, h.next, ng, hit.x, wi, tp.w, depth == 0u);
+      eye = next_eye_subpath_vertex(eye, stored_cos_left(p), h.next, ng, hit.x, wi, tp.w, depth == 0u);
       path_throughput[eye_subpath_index(p)].xy = vec2(eye.pdf_forward, eye.eye_sum);
     }
     // Only emitters add: a read-modify-write of the result slot per hit cost the H200 14 % of this stage.

@@ -5,7 +5,8 @@
 // tracer, per region and per bounce layer (each path length is its own integral, so a wrong weight
 // for one strategy shows in its layer), over kSeeds seeds: a box lit by an emitter, a point and a
 // spot light (brighter lights outside reach nothing), and a room lit through a door gap by a sun and
-// a constant sky (subpaths that start at infinity; the eye's escape stands in for NEE). The same
+// a constant sky (subpaths that start at infinity; the eye's escape stands in for NEE) or an
+// environment map. The same
 // seed gives the same bits, and ajar_room's variance falls as on the CPU. Validation layers on;
 // without a Vulkan device, SKIP.
 // Statistics as light_subpaths_test.cpp: kZLimit = 5 standard errors per region, each comparison's
@@ -104,6 +105,13 @@ TEST(VulkanLightSubpaths, BoxAgreesWithCpuPathTracing) {
 TEST(VulkanLightSubpaths, SkyLitRoomAgreesWithCpuPathTracing) {
   const testing::AtlasScene room = testing::sky_lit_room(false, 6);
   expect_device_agrees("sky-lit room", room.scene, room.gbuffer, 256);
+}
+
+// An environment map instead (importance sampled by NEE and the subpaths alike; the connection in a
+// fourth shadow slot beside the environment's).
+TEST(VulkanLightSubpaths, EnvironmentLitRoomAgreesWithCpuPathTracing) {
+  const testing::AtlasScene room = testing::sky_lit_room(true, 6);
+  expect_device_agrees("environment-lit room", room.scene, room.gbuffer, 256);
 }
 
 // The mean over texels of each texel's variance across seeds, relative to its squared mean.

@@ -278,14 +278,14 @@ struct CpuReferenceIntegrator::Impl {
       const Hit hit = embree->intersect(origin, d.direction, INFINITY);
       guide.observe(record, g, d.direction, hit);
       if (!hit.found) {
-        const Vec3 sky = ray_throughput * (subpaths ? escaped_radiance_with_subpaths(s, x, eye, d.direction, d.pdf)
+        const Vec3 sky = ray_throughput * (subpaths ? escaped_radiance_with_subpaths(s, dot(x.geometric_normal, d.direction), eye, d.direction, d.pdf)
                                                     : escaped_radiance(s, d.direction, d.pdf));
         out.add(bounce, sky);
         out.add_light(kSkyLightLayer, sky);
         return;
       }
       const float emission_extra =
-          subpaths ? light_subpath_emitter_hit_extra(s, x, eye, eg, hit.triangle, hit.geometric_normal, hit.distance, hit.b1, hit.b2,
+          subpaths ? light_subpath_emitter_hit_extra(s, dot(x.geometric_normal, d.direction), eye, eg, hit.triangle, hit.geometric_normal, hit.distance, hit.b1, hit.b2,
                                                      d.direction) : 0.0f;
       const HitResult h = shade_continuation_hit(s, hit.triangle, hit.distance, hit.b1, hit.b2, d.direction, d.pdf,
                                                  ray_throughput, bounce, limits, eg, emission_extra, rng);
@@ -293,7 +293,7 @@ struct CpuReferenceIntegrator::Impl {
       if (out.by_light && (h.radiance.x != 0 || h.radiance.y != 0 || h.radiance.z != 0))
         out.add_light(emitter_light_layer(hit.triangle), h.radiance);
       if (!h.continues) return;
-      if (subpaths) eye = next_eye_subpath_vertex(eye, x, h.next, hit.geometric_normal, hit.distance, d.direction, d.pdf, bounce == 0);
+      if (subpaths) eye = next_eye_subpath_vertex(eye, dot(x.geometric_normal, d.direction), h.next, hit.geometric_normal, hit.distance, d.direction, d.pdf, bounce == 0);
       throughput = h.throughput;
       x = h.next;
     }

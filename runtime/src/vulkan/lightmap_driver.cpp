@@ -159,11 +159,12 @@ void LightmapDriver::prepare_light_subpaths(const IntegratorSettings& settings, 
   a.params.light_subpath_start = Vec4(start.area_probability, start.punctual_scale, start.sky_probability, start.disk_density);
   a.params.light_subpath_sphere = Vec4((lighting->bounds_lo + lighting->bounds_hi) * 0.5f, scene_radius(*lighting));
   a.params.light_subpath_depth = std::min(settings.max_bounces >= 0 ? settings.max_bounces : INT32_MAX, settings.safety_bounce_cap - 1);
-  a.params.shadow_slots = kShadowSlotsWithConnection;
+  const bool environment = runner_.scene().environment_width() > 0;
+  a.params.shadow_slots = environment ? kShadowSlotsWithEnvironmentAndConnection : kShadowSlotsWithConnection;
   Context& context = runner_.context();
   WavefrontBuffers& buffers = runner_.buffers();
   const uint64_t vertices = uint64_t(light_pool_paths(double(a.max_work), a.light_subpaths_per_sample)) * kLightPoolVerticesPerPath;
-  const bool grew = buffers.paths.reserve_light_subpaths(context);
+  const bool grew = buffers.paths.reserve_light_subpaths(context, environment);
   if (buffers.light_pool.reserve(context, std::min(vertices, light_pool_most_vertices())) || grew) runner_.bind_buffers();
   a.params.light_subpath_capacity = buffers.light_pool.capacity();
 }

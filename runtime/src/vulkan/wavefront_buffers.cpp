@@ -42,11 +42,12 @@ bool PathStateBuffers::reserve_emitter_learning(Context& context) {
   return true;
 }
 
-bool PathStateBuffers::reserve_light_subpaths(Context& context) {
+bool PathStateBuffers::reserve_light_subpaths(Context& context, bool environment) {
   bool grew = false;
-  const VkDeviceSize state = VkDeviceSize(paths) * 6 * 16;
+  const VkDeviceSize state = VkDeviceSize(paths) * 3 * 16;
   if (throughput.size() < state) throughput = context.create_storage_buffer(state), grew = true;
-  const VkDeviceSize slots = VkDeviceSize(paths) * kShadowSlotsWithConnection * sizeof(ShadowRay);
+  const VkDeviceSize slots =
+      VkDeviceSize(paths) * (environment ? kShadowSlotsWithEnvironmentAndConnection : kShadowSlotsWithConnection) * sizeof(ShadowRay);
   if (shadow_rays.size() < slots) shadow_rays = context.create_storage_buffer(slots), grew = true;
   return grew;
 }

@@ -42,10 +42,10 @@ struct PathStateBuffers {
   // The throughput buffer with emitter guiding's 2P entries (a new buffer when it grows: rebind).
   // Returns whether it grew.
   bool reserve_emitter_learning(Context& context);
-  // Light subpaths: the throughput buffer with the eye-vertex state's 2P entries after emitter
-  // guiding's, and a fourth shadow slot per path, for the connection (gpu_layout.h
-  // kShadowSlotConnection). New buffers when they grow (rebind); returns whether one did.
-  bool reserve_light_subpaths(Context& context);
+  // Light subpaths: the throughput buffer with the eye-vertex state's P entries, and with an
+  // environment map a fourth shadow slot per path (gpu_layout.h kShadowSlotsWith*). New buffers
+  // when they grow (rebind); returns whether one did.
+  bool reserve_light_subpaths(Context& context, bool environment);
   uint32_t paths = 0;
   static constexpr size_t kBytesPerPath = 4 + 4 + 16 + 16 + 16 + 16 + 16 + kShadowRaysPerVertex * sizeof(ShadowRay);
 };

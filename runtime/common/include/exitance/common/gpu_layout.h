@@ -352,12 +352,14 @@ const uint kLightSubpathsCount = 0u;    // light_subpaths.comp modes (push const
 const uint kLightSubpathsOffsets = 1u;  // their prefix sums (one workgroup),
 const uint kLightSubpathsWrite = 2u;    // then trace again, writing them
 // Per path, the eye vertex's light-subpath state (path.h EyeSubpathVertex) from next-event
-// estimation to its continuation's hit: path_throughput [4P + 2p]: pdf_forward, eye_sum, and the
-// pending connection's light-vertex depth and light layer (uint bits); [4P + 2p + 1]: the vertex's
-// geometric normal (the hit's MIS ratios need it). The connection's shadow ray is slot
-// kShadowSlotConnection.
-const uint kShadowSlotConnection = 3u;
-const uint kShadowSlotsWithConnection = 4u;
+// estimation to its continuation's hit, in one vec4 at path_throughput [2P + p] (the section
+// emitter guiding's learning uses, which light subpaths are not combined with on this backend):
+// pdf_forward, eye_sum, cos_left (path.h: the cosine at the vertex toward its continuation), and
+// the pending connection's light-vertex depth | light layer << 16 (uint bits). The connection's
+// shadow ray is the last slot (GpuParams::shadow_slots - 1): the environment's slot when the sky is
+// constant (3 slots: the buffer's size already), a fourth with an environment map.
+const uint kShadowSlotsWithConnection = 3u;
+const uint kShadowSlotsWithEnvironmentAndConnection = 4u;
 const uint kBindingCount = 32u;
 
 // Counter slots (uint each; statistics are 64-bit lo/hi pairs).

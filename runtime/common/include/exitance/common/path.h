@@ -366,10 +366,12 @@ EXITANCE_FN void next_event_estimation(SCENE_PARAM SurfacePoint x, vec3 origin, 
 }
 
 // ---- Light subpaths at the eye's continuation hits (light_subpaths.h) ----
+// These read the vertex x the continuation ray wi left through cos_left = dot(x's geometric
+// normal, wi) alone (the wavefront keeps that one float per path between its stages).
 // light_subpath_emission_extra of a continuation ray from x (state `eye`, emitter strategy
 // `emitter_guide`) that hit triangle `tri` (unit geometric normal `ng`, either side) at distance
 // t_hit: 0 unless NEE samples it and x is not the texel (the texel never moves to the light side).
-EXITANCE_FN float light_subpath_emitter_hit_extra(SCENE_PARAM SurfacePoint x, EyeSubpathVertex eye, EmitterGuide emitter_guide,
+EXITANCE_FN float light_subpath_emitter_hit_extra(SCENE_PARAM float cos_left, EyeSubpathVertex eye, EmitterGuide emitter_guide,
                                                   uint tri, vec3 ng, float t_hit, float b1, float b2, vec3 wi) {
   if (!(eye.pdf_forward > 0.0f) || !(scene_triangle_area_pdf(SCENE_ARG tri) > 0.0f)) return 0.0f;
   bool double_sided = material_double_sided(scene_material(SCENE_ARG scene_triangle_material(SCENE_ARG tri)));
@@ -378,17 +380,17 @@ EXITANCE_FN float light_subpath_emitter_hit_extra(SCENE_PARAM SurfacePoint x, Ey
   float start_over_nee =
       eye.sampling.area_probability / emitter_guide_ratio_at_triangle(scene_emitter_cdf(SCENE_ALONE_ARG), emitter_guide, tri, b1, b2);
   float start = light_start_ratio(eye.sampling, start_over_nee, emitter_direction_pdf(cos_hit, double_sided),
-                                  dot(x.geometric_normal, wi), t_hit * t_hit, eye.pdf_forward);
+                                  cos_left, t_hit * t_hit, eye.pdf_forward);
   return light_subpath_emission_extra(start, eye.eye_sum);
 }
 
 // The state of the continuation's hit `next` (unit geometric normal `ng`, either side, at distance
 // t_hit along wi, sampled from x with solid-angle density pdf_continuation): the eye's area density
 // of it, and C_{j+1} from Q_j, the light side's density of x scattered at `next` over the eye's.
-EXITANCE_FN EyeSubpathVertex next_eye_subpath_vertex(EyeSubpathVertex eye, SurfacePoint x, SurfacePoint next, vec3 ng,
+EXITANCE_FN EyeSubpathVertex next_eye_subpath_vertex(EyeSubpathVertex eye, float cos_left, SurfacePoint next, vec3 ng,
                                                      float t_hit, vec3 wi, float pdf_continuation, bool from_texel) {
   float distance2 = t_hit * t_hit;
-  float reverse = max(-dot(next.shading_normal, wi), 0.0f) * kInvPi * dot(x.geometric_normal, wi) / distance2;
+  float reverse = max(-dot(next.shading_normal, wi), 0.0f) * kInvPi * cos_left / distance2;
   float ratio = !from_texel && eye.pdf_forward > 0.0f ? reverse / eye.pdf_forward : 0.0f;
   EyeSubpathVertex e = eye;
   e.eye_sum = next_eye_sum(from_texel, eye.eye_sum, ratio);
@@ -443,19 +445,19 @@ EXITANCE_FN vec3 escaped_radiance(SCENE_PARAM vec3 wi, float pdf_continuation) {
 // escaped_radiance for a continuation ray from x (light-subpath state `eye`, the ray's density
 // pdf_continuation) when the sky also starts light subpaths (light_subpaths.h): weighed against
 // environment sampling and against x's connection to their first hits.
-EXITANCE_FN vec3 escaped_radiance_with_subpaths(SCENE_PARAM SurfacePoint x, EyeSubpathVertex eye, vec3 wi, float pdf_continuation) {
+EXITANCE_FN vec3 escaped_radiance_with_subpaths(SCENE_PARAM float cos_left, EyeSubpathVertex eye, vec3 wi, float pdf_continuation) {
   if (!(eye.sampling.count > 0.0f) || !(eye.sampling.sky_probability > 0.0f) || !(eye.pdf_forward > 0.0f))
     return escaped_radiance(SCENE_ARG wi, pdf_continuation);
   float weight;
   if (scene_has_environment(SCENE_ALONE_ARG)) {
     float start = light_start_ratio(eye.sampling, eye.sampling.sky_probability, eye.sampling.disk_density,
-                                    dot(x.geometric_normal, wi), 1.0f, eye.pdf_forward);
+                                    cos_left, 1.0f, eye.pdf_forward);
     weight = power_heuristic_with_extra(pdf_continuation, scene_environment_pdf(SCENE_ARG wi),
                                         light_subpath_emission_extra(start, eye.eye_sum));
   } else {
     // No next-event strategy: p_2 / p_0 directly.
     float start = pdf_continuation > 0.0f ? light_start_ratio(eye.sampling, eye.sampling.sky_probability * constant_sky_direction_pdf() / pdf_continuation,
-                                                              eye.sampling.disk_density, dot(x.geometric_normal, wi), 1.0f, eye.pdf_forward)
+                                                              eye.sampling.disk_density, cos_left, 1.0f, eye.pdf_forward)
                                           : 0.0f;
     weight = light_subpath_nee_weight(0.0f, start, eye.eye_sum);
   }
