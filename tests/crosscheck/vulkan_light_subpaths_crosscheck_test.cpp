@@ -1,14 +1,13 @@
 // Light subpaths (bake --light-paths on, issue 35 item 3) on the Vulkan backend: each batch's pool
 // traced on the device (shaders/wavefront/light_subpaths.comp, the CPU pool's walk in
-// common/light_subpath_walk.h) and every eye vertex connected to one pool vertex in the wavefront's
-// fourth shadow slot, weighted by the CPU's MIS (path.h). Checked against the CPU reference's path
-// tracer, per region and per bounce layer (each path length is its own integral, so a wrong weight
-// for one strategy shows in its layer), over kSeeds seeds: a box lit by an emitter, a point and a
-// spot light (brighter lights outside reach nothing), and a room lit through a door gap by a sun and
-// a constant sky (subpaths that start at infinity; the eye's escape stands in for NEE) or an
-// environment map. The same
-// seed gives the same bits, and ajar_room's variance falls as on the CPU. Validation layers on;
-// without a Vulkan device, SKIP.
+// common/light_subpath_walk.h) and every eye vertex connected to one pool vertex through the
+// wavefront's last shadow slot, weighted by the CPU's MIS (path.h). Checked against the CPU
+// reference's path tracer, per region and per bounce layer (each path length is its own integral,
+// so a wrong weight for one strategy shows in its layer), over kSeeds seeds: a box lit by an
+// emitter, a point and a spot light (brighter lights outside reach nothing), and a room lit through
+// a door gap by a sun and a constant sky (subpaths that start at infinity; the eye's escape stands
+// in for NEE) or an environment map. The same seed gives the same bits, and ajar_room's variance
+// falls as on the CPU. Validation layers on; without a Vulkan device, SKIP.
 // Statistics as light_subpaths_test.cpp: kZLimit = 5 standard errors per region, each comparison's
 // power checked (a 10 % bias in the median region must exceed kZLimit SEs).
 #include <gtest/gtest.h>
