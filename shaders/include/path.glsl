@@ -16,10 +16,12 @@ PathLimits path_limits() {
 }
 
 // ---- Light subpaths (GpuParams::light_subpaths; light_subpaths.comp traces the batch's pool) ----
-// Texel path batches only: never probes, per-bounce passes or the runtime's change estimate.
-bool light_subpaths_on() {
-  return !kProbeMode && params.light_subpaths != 0u && params.bounce_flags == 0u && params.changed_light_pairs == 0u;
-}
+// Texel and probe path batches: never per-bounce passes or the runtime's change estimate.
+bool light_subpaths_on() { return params.light_subpaths != 0u && params.bounce_flags == 0u && params.changed_light_pairs == 0u; }
+
+// The depth of a path's fixed eye vertex x_0, never sampled from the light side: the texel, or the
+// first hit of a probe's ray (whose vertices count their bounces from it).
+uint eye_origin_depth() { return kProbeMode ? 1u : 0u; }
 
 LightSubpathSampling light_subpath_start_of_params() {
   LightSubpathSampling s = light_subpaths_none();
@@ -137,11 +139,11 @@ uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rn
     if (guide.guided_probability > 0.0) add_auto_cost(path_work[p], 1u, 1u);
   }
   if (directional_texel) guide = with_uniform_component(guide, kDirectionalUniformProbability);
-  // Light subpaths: the texel starts a fresh state; deeper vertices read the one their hit stored (shade.comp).
+  // Light subpaths: x_0 starts a fresh state; deeper vertices read the one their hit stored (shade.comp).
   bool subpaths = light_subpaths_on();
   EyeSubpathVertex eye = eye_subpath_vertex_none();
   if (subpaths) {
-    if (path_depth[p] == 0u) {
+    if (path_depth[p] == eye_origin_depth()) {
       eye.sampling = light_pool_sampling();
     } else {
       eye = stored_eye_subpath_vertex(p);
@@ -186,8 +188,8 @@ uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rn
       float u = sample_1d(rng);
       uint count = light_pool[kLightPoolVertices];
       LightVertex y = light_pool_vertex(min(uint(double(u) * double(count)), count - 1u));
-      connection = light_subpath_connection(eye.sampling, y, x, origin, throughput, guide, int(path_depth[p]), eye,
-                                            params.light_subpath_depth);
+      connection = light_subpath_connection(eye.sampling, y, x, origin, throughput, guide,
+                                            int(path_depth[p]) - int(eye_origin_depth()), eye, params.light_subpath_depth);
       vertex = floatBitsToUint(y.position_depth.w) | (floatBitsToUint(y.geometric_normal_layer.w) << 16u);
     }
     shadow_rays[first + params.shadow_slots - 1u] = connection;

@@ -95,7 +95,7 @@ void main() {
     HitResult h = shade_continuation_hit(tri, hit.x, hit.z, hit.w, wi, tp.w, throughput, bounce, path_limits(), emitter,
                                          emission_extra, rng);
     if (subpaths && h.continues) {
-      eye = next_eye_subpath_vertex(eye, stored_cos_left(p), h.next, ng, hit.x, wi, tp.w, depth == 0u);
+      eye = next_eye_subpath_vertex(eye, stored_cos_left(p), h.next, ng, hit.x, wi, tp.w, bounce == 0);
       path_throughput[eye_subpath_index(p)].xy = vec2(eye.pdf_forward, eye.eye_sum);
     }
     // Only emitters add: a read-modify-write of the result slot per hit cost the H200 14 % of this stage.

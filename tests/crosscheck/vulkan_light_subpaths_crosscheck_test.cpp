@@ -6,8 +6,8 @@
 // so a wrong weight for one strategy shows in its layer), over kSeeds seeds: a box lit by an
 // emitter, a point and a spot light (brighter lights outside reach nothing), and a room lit through
 // a door gap by a sun and a constant sky (subpaths that start at infinity; the eye's escape stands
-// in for NEE) or an environment map. The same seed gives the same bits, and ajar_room's variance
-// falls as on the CPU. Validation layers on; without a Vulkan device, SKIP.
+// in for NEE) or an environment map; the box's probes too. The same seed gives the same bits, and
+// ajar_room's variance falls as on the CPU. Validation layers on; without a Vulkan device, SKIP.
 // Statistics as light_subpaths_test.cpp: kZLimit = 5 standard errors per region, each comparison's
 // power checked (a 10 % bias in the median region must exceed kZLimit SEs).
 #include <gtest/gtest.h>
@@ -111,6 +111,39 @@ TEST(VulkanLightSubpaths, SkyLitRoomAgreesWithCpuPathTracing) {
 TEST(VulkanLightSubpaths, EnvironmentLitRoomAgreesWithCpuPathTracing) {
   const testing::AtlasScene room = testing::sky_lit_room(true, 6);
   expect_device_agrees("environment-lit room", room.scene, room.gbuffer, 256);
+}
+
+// Probes connect too, from each probe ray's first hit (the path's fixed x_0): the SH's constant term
+// per probe and channel against the CPU path tracer's probes over kSeeds seeds, in the box with a spot
+// light and far brighter lights outside; the same seed gives the same sums.
+TEST(VulkanLightSubpaths, ProbesAgreeWithCpuPathTracing) {
+  const testing::AtlasScene box = box_with_spot();
+  CREATE_VULKAN_OR_SKIP(vk, box.scene);
+  const CpuReferenceIntegrator cpu(box.scene);
+  const std::vector<Vec3> probes = {{0.5f, 0.5f, 0.5f}, {0.25f, 0.2f, 0.25f}, {0.75f, 0.3f, 0.6f}, {0.3f, 0.75f, 0.7f}};
+  testing::RegionRuns with, without;
+  uint64_t subpaths = 0;
+  auto add = [&](const ProbeEstimate& e, testing::RegionRuns& runs) {
+    EXPECT_EQ(e.nonfinite_samples, 0u);
+    for (size_t i = 0; i < probes.size(); ++i)
+      for (int c = 0; c < 3; ++c) runs[uint32_t(i * 3 + size_t(c))].push_back(e.sh_sum[i][size_t(c)] / double(e.samples[i]));
+  };
+  for (int seed = 0; seed < kSeeds; ++seed) {
+    const ProbeEstimate w = vk->bake_probes(probes, settings(4096, uint64_t(seed), true));
+    subpaths += w.light_subpaths;
+    add(w, with);
+    add(cpu.bake_probes(probes, settings(4096, uint64_t(seed) + 1000, false)), without);
+  }
+  EXPECT_GT(subpaths, 0u) << "no light subpath was traced for the probes";
+  EXPECT_LT(kZLimit * testing::expect_regions_agree("vulkan light subpaths", "box probes", without, with, kZLimit), kDetectableBias)
+      << "the test could not see a 10 % bias";
+  // (Most subpaths start at the far brighter lights outside and leave no vertex: a whole subpath per
+  // sample keeps some in a 256-sample pool.)
+  const ProbeEstimate a = vk->bake_probes(probes, settings(256, 7, true));
+  const ProbeEstimate b = vk->bake_probes(probes, settings(256, 7, true));
+  EXPECT_GT(a.light_subpaths, 0u);
+  EXPECT_TRUE(a.sh_sum == b.sh_sum) << "runs with one seed differ";
+  EXPECT_FALSE(a.sh_sum == vk->bake_probes(probes, settings(256, 7, false)).sh_sum) << "subpaths must change the samples";
 }
 
 // The mean over texels of each texel's variance across seeds, relative to its squared mean.

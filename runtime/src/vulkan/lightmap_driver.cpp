@@ -13,7 +13,6 @@
 #include "exitance/formats/huge_pages.h"
 #include "exitance/runtime/core/grid_guiding_cache.h"
 #include "exitance/runtime/core/guiding_choice.h"
-#include "exitance/runtime/core/light_subpath_start.h"
 #include "exitance/runtime/core/pass_scheduler.h"
 #include "exitance/runtime/core/work_share.h"
 #include "exitance/runtime/core/svo_guiding_fields.h"
@@ -136,58 +135,13 @@ void LightmapDriver::upload_items(const Accumulation& a) {
 }
 
 // Samples [first, first + pass) of every texel on the work list, in batches of at most max_work items.
-namespace {
-
-// Subpaths in the pool of a batch of `work` texel samples, `per_sample` each (the CPU's bounds, up to
-// the binding's kLightPoolMostPaths).
-uint32_t light_pool_paths(double work, double per_sample) {
-  return uint32_t(std::clamp(std::ceil(work * per_sample), 256.0, double(kLightPoolMostPaths)));
-}
-
-// Pool vertices reserved per subpath at first: indoor scenes keep 2-5; a pool that needs more grows
-// the binding for the next batch (LightmapDriver::run_pass).
-constexpr uint64_t kLightPoolVerticesPerPath = 16;
-
-}  // namespace
-
-void LightmapDriver::prepare_light_subpaths(const IntegratorSettings& settings, Accumulation& a) {
-  const LightingScene* lighting = guiding_scene_.lighting.get();
-  if (!lighting) throw std::logic_error("Vulkan backend: light subpaths without the integrator's scene");
-  const LightSubpathSampling start = light_subpath_start(*lighting);
-  if (!light_subpaths_start_anywhere(start) || a.texel_count == 0) return;  // no light starts one: path tracing
-  a.light_subpaths_per_sample = settings.light_subpaths_per_sample;
-  a.params.light_subpath_start = Vec4(start.area_probability, start.punctual_scale, start.sky_probability, start.disk_density);
-  a.params.light_subpath_sphere = Vec4((lighting->bounds_lo + lighting->bounds_hi) * 0.5f, scene_radius(*lighting));
-  a.params.light_subpath_depth = std::min(settings.max_bounces >= 0 ? settings.max_bounces : INT32_MAX, settings.safety_bounce_cap - 1);
-  const bool environment = runner_.scene().environment_width() > 0;
-  a.params.shadow_slots = environment ? kShadowSlotsWithEnvironmentAndConnection : kShadowSlotsWithConnection;
-  Context& context = runner_.context();
-  WavefrontBuffers& buffers = runner_.buffers();
-  const uint64_t vertices = uint64_t(light_pool_paths(double(a.max_work), a.light_subpaths_per_sample)) * kLightPoolVerticesPerPath;
-  const bool grew = buffers.paths.reserve_light_subpaths(context, environment);
-  if (buffers.light_pool.reserve(context, std::min(vertices, light_pool_most_vertices())) || grew) runner_.bind_buffers();
-  a.params.light_subpath_capacity = buffers.light_pool.capacity();
-}
-
-uint64_t LightmapDriver::light_pool_most_vertices() const {
-  const uint64_t range = runner_.context().properties().limits.maxStorageBufferRange;
-  return range / 4 > kLightPoolVertexWord ? (range / 4 - kLightPoolVertexWord) / kLightVertexWords : 0;
-}
-
 void LightmapDriver::run_pass(Accumulation& a, uint32_t first, uint32_t pass) {
   const uint32_t chunk = uint32_t(std::min(a.work_list.size(), a.max_work));
   for (size_t offset = 0; offset < a.work_list.size(); offset += chunk) {
     const uint32_t n = uint32_t(std::min<size_t>(chunk, a.work_list.size() - offset));
-    if (a.light_subpaths_per_sample > 0) a.params.light_subpaths = light_pool_paths(double(n) * pass, a.light_subpaths_per_sample);
+    if (a.light_pools) a.light_pools->before_batch(a.params, double(n) * pass);
     runner_.run(a.params, {uint32_t(offset), n, first, pass}, a.result_bytes, kTexelBatch, a.totals);
-    // A pool that did not fit was left empty: the binding grows past it for the next batches
-    // (within the device's largest storage buffer).
-    if (a.light_subpaths_per_sample > 0 && a.totals.pool_vertices_needed > a.params.light_subpath_capacity &&
-        a.params.light_subpath_capacity < light_pool_most_vertices()) {
-      const uint64_t wanted = std::min(uint64_t(a.totals.pool_vertices_needed) * 2, light_pool_most_vertices());
-      if (runner_.buffers().light_pool.reserve(runner_.context(), wanted)) runner_.bind_buffers();
-      a.params.light_subpath_capacity = runner_.buffers().light_pool.capacity();
-    }
+    if (a.light_pools) a.light_pools->after_batch(a.totals, a.params);
   }
 }
 
@@ -353,7 +307,10 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   // The scene's candidate is grid guiding here: --guiding auto does not measure light subpaths on this backend.
   if (auto_guiding && settings.guiding_auto_candidate == AutoGuidingCandidate::LightSubpaths)
     throw std::invalid_argument("Vulkan backend: --guiding auto measures grid guiding against unguided only, not light subpaths");
-  if (settings.light_subpaths) prepare_light_subpaths(settings, a);
+  if (settings.light_subpaths) {
+    if (!guiding_scene_.lighting) throw std::logic_error("Vulkan backend: light subpaths without the integrator's scene");
+    a.light_pools = std::make_shared<LightSubpathPools>(runner_, *guiding_scene_.lighting, settings, a.max_work, a.params);
+  }
   std::unique_ptr<GuidingChoice> choice;
   std::vector<uint32_t> auto_words;
   if (settings.guiding == GuidingMode::Grid || auto_guiding) {

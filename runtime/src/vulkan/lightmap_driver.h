@@ -16,6 +16,7 @@
 #include "exitance/runtime/texel_gbuffer.h"
 #include "device_lightmaps.h"
 #include "guide_fold_kernel.h"
+#include "light_subpath_pools.h"
 #include "wavefront_batch.h"
 
 namespace exitance::vulkan {
@@ -34,6 +35,7 @@ class LightmapDriver {
  public:
   explicit LightmapDriver(WavefrontBatchRunner& runner) : runner_(runner) {}
   void set_guiding_scene(const GuidingScene& scene) { guiding_scene_ = scene; }
+  const GuidingScene& guiding_scene() const { return guiding_scene_; }
   LightmapEstimate bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings);
 
   // `changed_light_pairs` > 0: the accumulation estimates the change of direct light from that many
@@ -86,9 +88,8 @@ class LightmapDriver {
     size_t max_work = 0;
     GpuParams params{};
     BatchTotals totals;
-    // Light subpaths (IntegratorSettings::light_subpaths): per texel sample of a batch (0: none);
-    // each batch traces its own pool (gpu_layout.h kBindingLightSubpaths).
-    double light_subpaths_per_sample = 0;
+    // Light subpaths (IntegratorSettings::light_subpaths): each batch traces its own pool (null: none).
+    std::shared_ptr<LightSubpathPools> light_pools;
     uint32_t next_sample = 0;
     double seconds = 0;
   };
@@ -99,9 +100,6 @@ class LightmapDriver {
                Accumulation* reuse = nullptr, bool accumulation_cleared = false);
   void upload_items(const Accumulation& a);
   void run_pass(Accumulation& a, uint32_t first, uint32_t pass);
-  // Light subpaths: the pool's parameters, its binding and the path state's room for them.
-  void prepare_light_subpaths(const IntegratorSettings& settings, Accumulation& a);
-  uint64_t light_pool_most_vertices() const;  // within the device's largest storage buffer
   // What a read-back fills, made ahead of time (bake(): on a thread while the passes run): the
   // estimate's per-texel arrays for `host_texels`, zero (their memory touched), and a pinned
   // staging buffer for the largest array of `read_texels` texels (allocating it is part of a

@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
 #include "exitance/runtime/core/pass_scheduler.h"
+#include "light_subpath_pools.h"
 #include "exitance/runtime/core/work_share.h"
 
 namespace exitance::vulkan {
@@ -50,7 +52,8 @@ void ProbeDriver::upload_probes(const std::vector<Vec3>& positions, size_t first
   context.submit_and_wait(cmd);
 }
 
-ProbeEstimate ProbeDriver::bake(const std::vector<Vec3>& positions, const IntegratorSettings& settings) {
+ProbeEstimate ProbeDriver::bake(const std::vector<Vec3>& positions, const IntegratorSettings& settings,
+                                const LightingScene* lighting) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   const size_t probe_count = positions.size();
@@ -80,6 +83,13 @@ ProbeEstimate ProbeDriver::bake(const std::vector<Vec3>& positions, const Integr
 
   GpuParams params = runner_.bake_params(settings, 1, uint32_t(probe_count));  // slot 0: what the probe ray meets; 1: E/pi at its hit
   params.probe_spp = settings.spp == 0 ? std::numeric_limits<uint32_t>::max() : settings.spp;
+  // Light subpaths: each batch's probe paths connect from each probe ray's first hit (its fixed x_0,
+  // as a texel is) to a pool of their own.
+  std::optional<LightSubpathPools> light_pools;
+  if (settings.light_subpaths) {
+    if (!lighting) throw std::logic_error("Vulkan backend: light subpaths for probes without the integrator's scene");
+    light_pools.emplace(runner_, *lighting, settings, max_work, params);
+  }
   BatchTotals totals;
   const uint32_t chunk = uint32_t(std::min(probe_count, max_work));
   PassPolicy policy;
@@ -93,7 +103,9 @@ ProbeEstimate ProbeDriver::bake(const std::vector<Vec3>& positions, const Integr
     const auto pass_start = Clock::now();
     for (size_t offset = 0; offset < own_count; offset += chunk) {
       const uint32_t n = uint32_t(std::min<size_t>(chunk, own_count - offset));
+      if (light_pools) light_pools->before_batch(params, double(n) * pass);
       runner_.run(params, {uint32_t(offset), n, first, pass}, kProbeResultBytes, kProbeBatch, totals);
+      if (light_pools) light_pools->after_batch(totals, params);
     }
     if (share) {
       share->work.probe_samples += uint64_t(own_count) * pass;
@@ -105,6 +117,7 @@ ProbeEstimate ProbeDriver::bake(const std::vector<Vec3>& positions, const Integr
   read_probe_sums(context, buffers.probes, estimate);
   estimate.rays = totals.rays();
   estimate.nonfinite_samples = totals.nonfinite;
+  estimate.light_subpaths = totals.light_subpaths;
   estimate.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   runner_.record_statistics(totals, kProbeBatch);
   if (settings.work_share) settings.work_share->work.rays += estimate.rays;

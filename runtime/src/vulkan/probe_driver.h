@@ -7,6 +7,7 @@
 
 #include "exitance/runtime/core/estimates.h"
 #include "exitance/runtime/core/integrator_settings.h"
+#include "exitance/runtime/core/lighting_scene.h"
 #include "wavefront_batch.h"
 
 namespace exitance::vulkan {
@@ -25,7 +26,10 @@ void read_probe_sums(Context& context, const ProbeAccumulators& sums, ProbeEstim
 class ProbeDriver {
  public:
   explicit ProbeDriver(WavefrontBatchRunner& runner) : runner_(runner) {}
-  ProbeEstimate bake(const std::vector<Vec3>& positions, const IntegratorSettings& settings);
+  // `lighting`: the scene the device holds, where light subpaths start (settings.light_subpaths;
+  // may be null otherwise).
+  ProbeEstimate bake(const std::vector<Vec3>& positions, const IntegratorSettings& settings,
+                     const LightingScene* lighting = nullptr);
 
  private:
   void upload_probes(const std::vector<Vec3>& positions, size_t first, size_t end);

@@ -131,7 +131,7 @@ VulkanIntegrator::~VulkanIntegrator() = default;
 
 LightmapEstimate VulkanIntegrator::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const {
   if (settings.adaptive) throw std::runtime_error("Vulkan backend: --adaptive on is implemented on the CPU backend only (use --backend cpu)");
-  if (settings.light_subpaths) {  // texels' path tracing alone, as on the CPU (whose probes and emitter guiding also combine)
+  if (settings.light_subpaths) {  // path tracing alone, as on the CPU (whose emitter guiding also combines)
     if (settings.integrator == IntegratorMode::Bounces)
       throw std::invalid_argument("Vulkan backend: --light-paths applies to path tracing, not to --integrator bounces");
     if (settings.guiding != GuidingMode::Off)
@@ -163,7 +163,9 @@ LightmapEstimate VulkanIntegrator::bake(const TexelGBuffer& gbuffer, const Integ
 ProbeEstimate VulkanIntegrator::bake_probes(const std::vector<Vec3>& positions, const IntegratorSettings& settings) const {
   if (settings.spp == 0 && !(settings.time_budget_seconds > 0))
     throw std::invalid_argument("Vulkan backend: probes with spp 0 need a time budget");
-  return impl_->probes.bake(positions, settings);
+  if (settings.light_subpaths && (settings.emitter_guiding || distributed(settings.work_share)))
+    throw std::invalid_argument("Vulkan backend: probes with light subpaths run in one process, without emitter guiding");
+  return impl_->probes.bake(positions, settings, impl_->lightmap.guiding_scene().lighting.get());
 }
 
 void VulkanIntegrator::start_probe_refresh(const std::vector<Vec3>& positions, int light_layers) {
