@@ -50,21 +50,6 @@ IntegratorSettings settings(uint32_t spp, uint64_t seed, bool subpaths, double p
   return s;
 }
 
-// The box with a spot light inside too, tilted, its cone partly on the walls.
-testing::AtlasScene box_with_spot() {
-  testing::AtlasScene box = testing::box_with_lights_outside();
-  PunctualLight spot;
-  spot.type = PunctualLight::Type::Spot;
-  spot.name = "spot";
-  spot.position = {0.7f, 0.8f, 0.3f};
-  spot.direction = normalize(Vec3{-0.5f, -1.0f, 0.4f});
-  spot.intensity = {1.0f, 0.8f, 0.6f};
-  spot.cos_inner = std::cos(0.3f);
-  spot.cos_outer = std::cos(0.6f);
-  box.scene.lights.push_back(spot);
-  return box;
-}
-
 // With subpaths against without, per region and bounce layer, over kSeeds seeds each; returns the
 // median over regions of the relative standard error of the totals' difference.
 double expect_regions_agree(const std::string& label, const Scene& scene, const TexelGBuffer& gbuffer, uint32_t spp,
@@ -116,13 +101,13 @@ void expect_sample_scene_agrees(const char* name, float density, uint32_t spp, b
 }
 
 TEST(LightSubpaths, BoxWithLightsOutsideAgreesWithPathTracing) {
-  const testing::AtlasScene box = box_with_spot();
+  const testing::AtlasScene box = testing::box_with_lights_outside_and_a_spot();
   EXPECT_LT(kZLimit * expect_regions_agree("box", box.scene, box.gbuffer, 64), kDetectableBias)
       << "the test could not see a 10 % bias";
 }
 
 TEST(LightSubpaths, BoxAgreesUnderABounceLimit) {
-  const testing::AtlasScene box = box_with_spot();
+  const testing::AtlasScene box = testing::box_with_lights_outside_and_a_spot();
   EXPECT_LT(kZLimit * expect_regions_agree("box, 2 bounces", box.scene, box.gbuffer, 64, 2), kDetectableBias)
       << "the test could not see a 10 % bias";
 }
@@ -130,7 +115,7 @@ TEST(LightSubpaths, BoxAgreesUnderABounceLimit) {
 // Emitter guiding learns that the lights outside never arrive: next-event estimation's density
 // then differs from the subpaths' start density by up to 100x, which the weights must follow.
 TEST(LightSubpaths, BoxWithEmitterGuidingAgreesWithPathTracing) {
-  const testing::AtlasScene box = box_with_spot();
+  const testing::AtlasScene box = testing::box_with_lights_outside_and_a_spot();
   EXPECT_LT(kZLimit * expect_regions_agree("box, emitter guided", box.scene, box.gbuffer, 64, -1, true), kDetectableBias)
       << "the test could not see a 10 % bias";
 }
@@ -162,7 +147,7 @@ TEST(LightSubpaths, BuildingAgreesWithPathTracing) { expect_sample_scene_agrees(
 // SH's constant term per probe and channel against the path tracer's, over kSeeds seeds, in the box
 // with a spot light and far brighter lights outside; bit-identical per seed and thread count.
 TEST(LightSubpaths, ProbesAgreeWithPathTracing) {
-  const testing::AtlasScene box = box_with_spot();
+  const testing::AtlasScene box = testing::box_with_lights_outside_and_a_spot();
   const CpuReferenceIntegrator integrator(box.scene);
   const std::vector<Vec3> probes = {{0.5f, 0.5f, 0.5f}, {0.25f, 0.2f, 0.25f}, {0.75f, 0.3f, 0.6f}, {0.3f, 0.75f, 0.7f}};
   testing::RegionRuns with, without;
@@ -204,22 +189,6 @@ TEST(LightSubpaths, BitIdenticalPerSeedAndThreadCount) {
   EXPECT_FALSE(testing::identical_texel_sums(a, without)) << "light subpaths must change the samples";
 }
 
-// The mean over texels of each texel's variance across seeds, relative to its squared mean.
-double mean_relative_variance(const std::vector<std::vector<double>>& runs) {
-  const size_t texels = runs.front().size();
-  double sum = 0;
-  size_t counted = 0;
-  for (size_t i = 0; i < texels; ++i) {
-    std::vector<double> values;
-    for (const auto& run : runs) values.push_back(run[i]);
-    const testing::MeanAndError m = testing::mean_and_standard_error(values);
-    if (!(m.mean > 0)) continue;
-    sum += m.standard_error * m.standard_error * double(values.size()) / (m.mean * m.mean);
-    ++counted;
-  }
-  return sum / double(counted);
-}
-
 TEST(LightSubpaths, LowerAjarRoomsVarianceAtEqualSamples) {
   const PreparedScene p = sample_scene("ajar_room", 4);
   const CpuReferenceIntegrator integrator(p.scene);
@@ -228,7 +197,7 @@ TEST(LightSubpaths, LowerAjarRoomsVarianceAtEqualSamples) {
     with.push_back(testing::luminance_means(integrator.bake(p.gbuffer, settings(16, uint64_t(seed), true, 0.25))));
     without.push_back(testing::luminance_means(integrator.bake(p.gbuffer, settings(16, uint64_t(seed) + 1000, false))));
   }
-  const double ratio = mean_relative_variance(with) / mean_relative_variance(without);
+  const double ratio = testing::mean_relative_variance(with) / testing::mean_relative_variance(without);
   std::printf("[light subpaths] ajar_room relative variance per texel at 16 spp: with / without = %.3f\n", ratio);
   EXPECT_LT(ratio, 0.5);
 }
@@ -248,7 +217,7 @@ TEST(LightSubpaths, LowerSkyLitRoomsVarianceAtEqualSamples) {
       with.push_back(testing::luminance_means(a));
       without.push_back(testing::luminance_means(b));
     }
-    const double ratio = mean_relative_variance(with) / mean_relative_variance(without);
+    const double ratio = testing::mean_relative_variance(with) / testing::mean_relative_variance(without);
     std::printf("[light subpaths] %s room relative variance per texel at 16 spp: with / without = %.3f for %.2fx the rays\n",
                 environment ? "environment-lit" : "sky-lit", ratio, double(rays_with) / double(rays_without));
     EXPECT_LT(ratio, 0.85);

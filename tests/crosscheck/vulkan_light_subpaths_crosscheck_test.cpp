@@ -48,21 +48,6 @@ IntegratorSettings settings(uint32_t spp, uint64_t seed, bool subpaths, double p
   return s;
 }
 
-// The box with a spot light inside too, tilted, its cone partly on the walls (light_subpaths_test.cpp's).
-testing::AtlasScene box_with_spot() {
-  testing::AtlasScene box = testing::box_with_lights_outside();
-  PunctualLight spot;
-  spot.type = PunctualLight::Type::Spot;
-  spot.name = "spot";
-  spot.position = {0.7f, 0.8f, 0.3f};
-  spot.direction = normalize(Vec3{-0.5f, -1.0f, 0.4f});
-  spot.intensity = {1.0f, 0.8f, 0.6f};
-  spot.cos_inner = std::cos(0.3f);
-  spot.cos_outer = std::cos(0.6f);
-  box.scene.lights.push_back(spot);
-  return box;
-}
-
 // The device with subpaths against the CPU's path tracer, per region and bounce layer.
 void expect_device_agrees(const std::string& label, const Scene& scene, const TexelGBuffer& gbuffer, uint32_t spp) {
   CREATE_VULKAN_OR_SKIP(vk, scene);
@@ -97,7 +82,7 @@ void expect_device_agrees(const std::string& label, const Scene& scene, const Te
 }
 
 TEST(VulkanLightSubpaths, BoxAgreesWithCpuPathTracing) {
-  const testing::AtlasScene box = box_with_spot();
+  const testing::AtlasScene box = testing::box_with_lights_outside_and_a_spot();
   expect_device_agrees("box", box.scene, box.gbuffer, 256);
 }
 
@@ -117,7 +102,7 @@ TEST(VulkanLightSubpaths, EnvironmentLitRoomAgreesWithCpuPathTracing) {
 // per probe and channel against the CPU path tracer's probes over kSeeds seeds, in the box with a spot
 // light and far brighter lights outside; the same seed gives the same sums.
 TEST(VulkanLightSubpaths, ProbesAgreeWithCpuPathTracing) {
-  const testing::AtlasScene box = box_with_spot();
+  const testing::AtlasScene box = testing::box_with_lights_outside_and_a_spot();
   CREATE_VULKAN_OR_SKIP(vk, box.scene);
   const CpuReferenceIntegrator cpu(box.scene);
   const std::vector<Vec3> probes = {{0.5f, 0.5f, 0.5f}, {0.25f, 0.2f, 0.25f}, {0.75f, 0.3f, 0.6f}, {0.3f, 0.75f, 0.7f}};
@@ -146,21 +131,6 @@ TEST(VulkanLightSubpaths, ProbesAgreeWithCpuPathTracing) {
   EXPECT_FALSE(a.sh_sum == vk->bake_probes(probes, settings(256, 7, false)).sh_sum) << "subpaths must change the samples";
 }
 
-// The mean over texels of each texel's variance across seeds, relative to its squared mean.
-double mean_relative_variance(const std::vector<std::vector<double>>& runs) {
-  double sum = 0;
-  size_t counted = 0;
-  for (size_t i = 0; i < runs.front().size(); ++i) {
-    std::vector<double> values;
-    for (const auto& run : runs) values.push_back(run[i]);
-    const testing::MeanAndError m = testing::mean_and_standard_error(values);
-    if (!(m.mean > 0)) continue;
-    sum += m.standard_error * m.standard_error * double(values.size()) / (m.mean * m.mean);
-    ++counted;
-  }
-  return sum / double(counted);
-}
-
 // One seed, the same bits (the pool is written in subpath order); subpaths change the samples; and
 // where the path tracer is weak (ajar_room's lamp behind a 5 cm gap) the texels' variance at equal
 // samples falls as on the CPU (light_subpaths_test.cpp: below half).
@@ -177,7 +147,7 @@ TEST(VulkanLightSubpaths, BitIdenticalPerSeedAndLowerAjarRoomsVariance) {
     without.push_back(testing::luminance_means(vk->bake(p.gbuffer, settings(16, uint64_t(seed) + 1000, false))));
   }
   EXPECT_FALSE(with[7] == without[7]);
-  const double ratio = mean_relative_variance(with) / mean_relative_variance(without);
+  const double ratio = testing::mean_relative_variance(with) / testing::mean_relative_variance(without);
   std::printf("[vulkan light subpaths] ajar_room relative variance per texel at 16 spp: with / without = %.3f\n", ratio);
   EXPECT_LT(ratio, 0.5);
 }

@@ -2,6 +2,8 @@
 // default next-event sampling by power sends 99 % of its shadow rays to lights that never arrive, so
 // emitter guiding's learned distributions pay (emitter_guided_path_test.cpp, the Vulkan crosscheck).
 #pragma once
+#include <cmath>
+
 #include "support/atlas_box.h"
 
 namespace exitance::testing {
@@ -26,6 +28,22 @@ inline AtlasScene box_with_lights_outside() {
   outside.position = {0.5f, 2.0f, 0.5f};
   outside.intensity = {50, 50, 50};
   box.scene.lights = {outside, inside};
+  return box;
+}
+
+// The same box with a spot light inside too, tilted, its cone partly on the walls (light subpaths'
+// tests: every kind of start at once).
+inline AtlasScene box_with_lights_outside_and_a_spot() {
+  AtlasScene box = box_with_lights_outside();
+  PunctualLight spot;
+  spot.type = PunctualLight::Type::Spot;
+  spot.name = "spot";
+  spot.position = {0.7f, 0.8f, 0.3f};
+  spot.direction = normalize(Vec3{-0.5f, -1.0f, 0.4f});
+  spot.intensity = {1.0f, 0.8f, 0.6f};
+  spot.cos_inner = std::cos(0.3f);
+  spot.cos_outer = std::cos(0.6f);
+  box.scene.lights.push_back(spot);
   return box;
 }
 

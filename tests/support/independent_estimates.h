@@ -24,4 +24,20 @@ inline MeanAndError mean_and_standard_error(const std::vector<double>& values) {
   return m;
 }
 
+// runs[k][i]: run k's estimate of item i (a texel). The mean over items with a positive mean of
+// each item's variance across runs relative to its squared mean (equal-sample variance ratios).
+inline double mean_relative_variance(const std::vector<std::vector<double>>& runs) {
+  double sum = 0;
+  size_t counted = 0;
+  for (size_t i = 0; i < runs.front().size(); ++i) {
+    std::vector<double> values;
+    for (const auto& run : runs) values.push_back(run[i]);
+    const MeanAndError m = mean_and_standard_error(values);
+    if (!(m.mean > 0)) continue;
+    sum += m.standard_error * m.standard_error * double(values.size()) / (m.mean * m.mean);
+    ++counted;
+  }
+  return sum / double(counted);  // NaN when no item has light: a ratio of it fails every bound
+}
+
 }  // namespace exitance::testing
