@@ -39,8 +39,6 @@ constexpr uint32_t kGuidingLearningSamples = GridGuidingCache::kLearningSamples;
 // Light subpaths traced into one pool at most (~4 vertices and 320 bytes each on indoor scenes):
 // larger passes trace a pool per chunk of their samples.
 constexpr uint64_t kMostLightSubpathsPerPool = uint64_t(1) << 17;
-// ... and at least this many, so small passes of small atlases do not share a handful of vertices.
-constexpr uint64_t kFewestLightSubpathsPerPool = 256;
 // --guiding auto's pilot with the light-subpath candidate, before GuidingChoice::pilot_for shortens it
 // for small --spp. Longer than grid guiding's (64, its learning): what connections fix is a heavy
 // tail (rare paths through a gap), which a short pilot's sample variance misses. Measured on
@@ -53,10 +51,6 @@ constexpr uint32_t kLightSubpathPilotSamples = 256;
 // in the means of texels that do not connect: at 0.25 texels/m and 20 s (~140 spp, inside the pilot)
 // the city read 1.4x the unguided relMSE (bench/results/guiding-auto-light-paths.md).
 constexpr uint32_t kLightSubpathPilots = 4;
-// The deepest light-subpath vertex: the eye paths' bounce limit (or the safety cap).
-int light_subpath_depth(const IntegratorSettings& s) {
-  return std::min(s.max_bounces >= 0 ? s.max_bounces : INT32_MAX, s.safety_bounce_cap - 1);
-}
 // Subpaths in a pool that serves `samples` texel or probe samples, `per_sample` each, within the bounds.
 uint64_t light_subpaths_for(double samples, double per_sample) {
   return uint64_t(std::clamp(std::ceil(samples * per_sample), double(kFewestLightSubpathsPerPool), double(kMostLightSubpathsPerPool)));

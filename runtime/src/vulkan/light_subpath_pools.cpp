@@ -1,7 +1,6 @@
 #include "light_subpath_pools.h"
 
 #include <algorithm>
-#include <climits>
 #include <cmath>
 
 #include "exitance/runtime/core/light_subpath_start.h"
@@ -12,7 +11,7 @@ namespace {
 // Subpaths in the pool of a batch of `work` samples, `per_sample` each (the CPU's bounds, up to the
 // binding's kLightPoolMostPaths).
 uint32_t pool_paths(double work, double per_sample) {
-  return uint32_t(std::clamp(std::ceil(work * per_sample), 256.0, double(kLightPoolMostPaths)));
+  return uint32_t(std::clamp(std::ceil(work * per_sample), double(kFewestLightSubpathsPerPool), double(kLightPoolMostPaths)));
 }
 
 // Pool vertices reserved per subpath at first: indoor scenes keep 2-5 (ajar_room 2.8, the building
@@ -29,7 +28,7 @@ LightSubpathPools::LightSubpathPools(WavefrontBatchRunner& runner, const Lightin
   per_sample_ = settings.light_subpaths_per_sample;
   params.light_subpath_start = Vec4(start.area_probability, start.punctual_scale, start.sky_probability, start.disk_density);
   params.light_subpath_sphere = Vec4((lighting.bounds_lo + lighting.bounds_hi) * 0.5f, scene_radius(lighting));
-  params.light_subpath_depth = std::min(settings.max_bounces >= 0 ? settings.max_bounces : INT_MAX, settings.safety_bounce_cap - 1);
+  params.light_subpath_depth = light_subpath_depth(settings);
   const bool environment = runner_.scene().environment_width() > 0;
   params.shadow_slots = environment ? kShadowSlotsWithEnvironmentAndConnection : kShadowSlotsWithConnection;
   Context& context = runner_.context();
