@@ -1,18 +1,20 @@
 #!/bin/bash
 # Light subpaths against plain path tracing on the GPU machine (issue 35, item 3), through
-# exitance-relight (--light-paths on: one path-traced bake of the whole lightmap whose texel paths
-# connect to a pool of light subpaths per batch, as bake --backend vulkan --light-paths on; off: the
-# progressive relight). Carry .gl and .replay; .replay/lp.txz comes from bench/light_paths_gpu_pack.sh.
+# exitance-relight: with --time or --frames both modes run the progressive refresh (--light-paths on:
+# its passes' texel paths connect to a pool of light subpaths per batch); with --spp alone, on is one
+# path-traced run of the whole lightmap as bake --backend vulkan --light-paths on, off the progressive
+# relight. Carry .gl and .replay; .replay/lp.txz comes from bench/light_paths_gpu_pack.sh.
 # Per bundle (BUNDLES, default every one packed): a two-seed 4096-spp reference without subpaths
 # (seeds 101, 202), then both modes at equal lighting time (TIMES seconds, --time) and at equal
 # samples (SPPS), compared with the reference (bench_bundle_rel_mse: relMSE, the reference's noise
 # subtracted); then per wavefront stage at 256 spp, both modes.
-#   bash .replay/light_paths_gpu_run.sh       (env BUNDLES, TIMES, SPPS, STAGES=0 for no per-stage runs;
-#                                              writes $OUT/summary.txt as it goes)
+# Then FRAMES (default 6) frames of 16 ms each, both modes (the runtime's refresh at a game's budget).
+#   bash .replay/light_paths_gpu_run.sh       (env BUNDLES, TIMES, SPPS, FRAMES, STAGES=0 for no per-stage
+#                                              runs; writes $OUT/summary.txt as it goes)
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
 export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
-W=/tmp/w; mkdir -p $W && tar -C $W -xJf .replay/lp.txz
+W=/tmp/light_paths_gpu_$$; mkdir -p $W  # its own folder: a warm machine keeps other scripts' /tmp && tar -C $W -xJf .replay/lp.txz
 S=$OUT/summary.txt
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader > $S
 common="--ignore-baked --no-light-layers --json"
@@ -35,6 +37,10 @@ print('$name', 'lighting_s %.3f'%r['lighting_seconds'], 'spp', r['samples_per_te
     run off_t$t --time $t
     run on_t$t --time $t --light-paths on
   done
+  for f in ${FRAMES:-6}; do
+    run off_f$f --frames $f --budget-ms 16 --spp 0 --no-frame-errors
+    run on_f$f --frames $f --budget-ms 16 --spp 0 --no-frame-errors --light-paths on
+  done
   for n in ${SPPS:-64 256}; do
     run off_s$n --spp $n
     run on_s$n --spp $n --light-paths on
@@ -50,4 +56,5 @@ for s in r['stages']: print('  %-55s %.4f s  rays %.3g  lanes %.2f'%(s['stage'],
   LD_LIBRARY_PATH=$W/rt/lib $W/rt/bin/bench_bundle_rel_mse $W/ref_101.bake $W/ref_202.bake $list | sed "s#$W/##" >> $S
   rm -rf $W/$b-*.bake $W/ref_*.bake
 done
+rm -rf $W
 cat $S

@@ -78,9 +78,9 @@ int main(int argc, char** argv) {
                  "--integrator bounces)")
       ->check(CLI::IsMember({"off", "on"}));
   app.add_option("--light-paths", options.light_paths,
-                 "off (default) | on (light subpaths that the texels' paths connect to, as bake --light-paths on: the "
-                 "whole lightmap in one run; not with --frames, --budget-ms, --guiding, --emitter-guiding on or "
-                 "--integrator bounces)")
+                 "off (default) | on (light subpaths that the texels' paths connect to, as bake --light-paths on: with "
+                 "--time, --frames or --budget-ms in the progressive refresh's passes, else the whole lightmap in one "
+                 "run; not with --guiding, --emitter-guiding on or --integrator bounces)")
       ->check(CLI::IsMember({"off", "on"}));
   app.add_option("--seed", seed, "random seed (default: the bake's); results are deterministic per seed and device");
   app.add_option("--device", options.device_index, "Vulkan device index (see --list-devices)")->check(CLI::NonNegativeNumber);

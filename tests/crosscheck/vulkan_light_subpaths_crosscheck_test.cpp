@@ -12,7 +12,10 @@
 // power checked (a 10 % bias in the median region must exceed kZLimit SEs).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -48,14 +51,19 @@ IntegratorSettings settings(uint32_t spp, uint64_t seed, bool subpaths, double p
   return s;
 }
 
+// One seed's device estimate with subpaths (default: a bake).
+using DeviceRun = std::function<LightmapEstimate(VulkanIntegrator&, const IntegratorSettings&)>;
+
 // The device with subpaths against the CPU's path tracer, per region and bounce layer.
-void expect_device_agrees(const std::string& label, const Scene& scene, const TexelGBuffer& gbuffer, uint32_t spp) {
+void expect_device_agrees(const std::string& label, const Scene& scene, const TexelGBuffer& gbuffer, uint32_t spp,
+                          const DeviceRun& device = nullptr) {
   CREATE_VULKAN_OR_SKIP(vk, scene);
   const CpuReferenceIntegrator cpu(scene);
   testing::RegionRuns with, without, layers_with[kLayers], layers_without[kLayers];
   uint64_t subpaths = 0, vertices = 0;
   for (int seed = 0; seed < kSeeds; ++seed) {
-    const LightmapEstimate w = vk->bake(gbuffer, settings(spp, uint64_t(seed), true));
+    const IntegratorSettings s = settings(spp, uint64_t(seed), true);
+    const LightmapEstimate w = device ? device(*vk.operator->(), s) : vk->bake(gbuffer, s);
     const LightmapEstimate u = cpu.bake(gbuffer, settings(spp, uint64_t(seed) + 1000, false));
     EXPECT_EQ(w.nonfinite_samples, 0u);
     subpaths += w.light_subpaths, vertices += w.light_subpath_vertices;
@@ -96,6 +104,33 @@ TEST(VulkanLightSubpaths, SkyLitRoomAgreesWithCpuPathTracing) {
 TEST(VulkanLightSubpaths, EnvironmentLitRoomAgreesWithCpuPathTracing) {
   const testing::AtlasScene room = testing::sky_lit_room(true, 6);
   expect_device_agrees("environment-lit room", room.scene, room.gbuffer, 256);
+}
+
+// The progressive accumulation (the runtime's refresh, RefreshSessionOptions::light_subpaths) connects
+// too: 256 samples added in uneven calls (1, 3, 60, 192), each pass's batches with their own pool,
+// agree with the CPU's path tracer per region and bounce layer. With light layers on, each
+// connection lands in the layer of the light its subpath started from, so the layers still add up
+// to each texel's estimate (within float rounding: the device sums in floats).
+TEST(VulkanLightSubpaths, ProgressiveAccumulationAgreesWithCpuPathTracing) {
+  const testing::AtlasScene box = testing::box_with_lights_outside_and_a_spot();
+  expect_device_agrees("box, progressive", box.scene, box.gbuffer, 256, [&](VulkanIntegrator& vk, const IntegratorSettings& s) {
+    IntegratorSettings layered = s;
+    layered.light_layers = true;
+    vk.start_progressive(box.gbuffer, layered);
+    for (const uint32_t samples : {1u, 3u, 60u, 192u}) vk.add_samples(samples);
+    LightmapEstimate e = vk.progressive_estimate();
+    EXPECT_GT(e.light_layers, 1);
+    const size_t n = e.texels.size();
+    double largest_gap = 0;
+    for (size_t i = 0; i < n; ++i)
+      for (int c = 0; c < 3; ++c) {
+        double layers = 0;
+        for (int k = 0; k < e.light_layers; ++k) layers += e.light_sums[(size_t(k) * n + i) * 3 + size_t(c)];
+        largest_gap = std::max(largest_gap, std::abs(layers - e.texels[i].total[c]) / std::max(1e-3, std::abs(e.texels[i].total[c])));
+      }
+    EXPECT_LT(largest_gap, 1e-4) << "the light layers do not add up to the texels' estimates";
+    return e;
+  });
 }
 
 // Probes connect too, from each probe ray's first hit (the path's fixed x_0): the SH's constant term

@@ -320,9 +320,9 @@ TEST(Relight, ReproducesAVulkanEmitterGuidedBakeBitForBit) {
   fs::remove_all(dir);
 }
 
-// exitance-relight --light-paths on is bake --backend vulkan --light-paths on (the same seed, the same
-// pool per batch): the same pages bit for bit; it reports the subpaths, and refuses --frames,
-// --emitter-guiding on beside it and an unknown value, writing nothing.
+// exitance-relight --light-paths on with --spp alone is bake --backend vulkan --light-paths on (the
+// same seed, the same pool per batch): the same pages bit for bit; it reports the subpaths, and
+// refuses --emitter-guiding on beside it and an unknown value, writing nothing.
 TEST(Relight, ReproducesAVulkanLightPathsBakeBitForBit) {
   if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
   const fs::path dir = fs::temp_directory_path() / ("exitance-relight-light-paths-" + std::to_string(::getpid()));
@@ -346,15 +346,52 @@ TEST(Relight, ReproducesAVulkanLightPathsBakeBitForBit) {
   EXPECT_GT(report["light_paths"]["vertices"].get<uint64_t>(), 0u);
   EXPECT_GE(expect_same_pages(baked, output, "the light-path bake's"), 1u);
   options.output = (dir / "refused.bake").string();
-  options.frames = 2;
-  EXPECT_THROW(relight_bundle(options), RelightInputError);
-  options.frames = 0;
   options.emitter_guiding = "on";
   EXPECT_THROW(relight_bundle(options), RelightInputError);
   options.emitter_guiding = "off";
   options.light_paths = "sometimes";
   EXPECT_THROW(relight_bundle(options), RelightInputError);
   EXPECT_FALSE(fs::exists(dir / "refused.bake"));
+  fs::remove_all(dir);
+}
+
+// With --frames (or --time, --budget-ms) --light-paths on refreshes progressively, the session's
+// passes connecting (RefreshSessionOptions::light_subpaths): refreshed before an edit that only scales
+// the lamp panel's emission (its light layer scaled with 0 rays, every sample kept, the subpaths'
+// start made again for the new power), then in frames after it; the totals come from the
+// accumulation, and every sample is finite.
+TEST(Relight, LightPathsRefreshInFramesAcrossAScalingEdit) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const fs::path dir = fs::temp_directory_path() / ("exitance-relight-light-path-frames-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path baked = dir / "ajar.bake";
+  bake_to_relight("ajar_room", baked, 2.0f, 8, [](BakeOptions& b) {
+    b.lighting.integrator = IntegratorMode::Path;
+    b.lighting.guiding = GuidingMode::Off;
+    b.integrator_auto = false;
+  });
+  const fs::path edits = dir / "dimmer.json";
+  std::ofstream(edits) << R"({"edits": [{"material": "Panel", "emissiveFactor": [0.5, 0.4, 0.3]}]})";
+  RelightOptions options;
+  options.bundle = baked.string();
+  options.output = (dir / "relit.bake").string();
+  options.seed = 9;
+  options.spp = 8;
+  options.from_baked = false;  // nothing shown from before: the scaling edit needs no split of a baked lightmap
+  options.light_paths = "on";
+  options.samples_before_edits = 4;
+  options.edits_file = edits.string();
+  options.frames = 3;
+  options.frame_budget_ms = 2000;
+  const nlohmann::json report = relight_bundle(options);
+  ASSERT_TRUE(report.contains("light_paths")) << report.dump();
+  EXPECT_GT(report["light_paths"]["subpaths"].get<uint64_t>(), 0u);
+  EXPECT_GT(report["light_paths"]["vertices"].get<uint64_t>(), 0u);
+  EXPECT_TRUE(report["edits"]["scaled_light_layers"].get<bool>()) << report["edits"].dump();
+  EXPECT_EQ(report["spp"].get<uint32_t>(), 8u);
+  EXPECT_EQ(report["nonfinite_samples"].get<uint64_t>(), 0u);
+  EXPECT_FALSE(report["frames"].empty());
   fs::remove_all(dir);
 }
 

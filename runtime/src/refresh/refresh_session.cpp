@@ -281,6 +281,10 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   settings.safety_bounce_cap = baked.safety_bounce_cap;
   settings.sampler = baked.sampler == "independent" ? kSamplerIndependent : kSamplerSobol;
   settings.light_layers = options.light_layers;
+  settings.light_subpaths = options.light_subpaths;
+  settings.light_subpaths_per_sample = options.light_subpaths_per_sample;
+  if (options.light_subpaths && !(options.light_subpaths_per_sample > 0 && options.light_subpaths_per_sample <= 64))
+    throw std::invalid_argument("RefreshSessionOptions::light_subpaths_per_sample must be in (0, 64]");
   // A bundle baked with directional layers is refreshed with them (the same estimator, path.h).
   if (baked.directional == "sh1") settings.directional = DirectionalMode::Sh1;
   check_denoise_radius(options.denoise_radius, settings, "RefreshSessionOptions::denoise_radius");  // before the integrator is made
@@ -1028,6 +1032,7 @@ const LightmapEstimate& RefreshSession::bake_per_bounce(uint32_t spp, double tim
     throw std::invalid_argument("the per-bounce mode needs samples per texel or a time budget");
   IntegratorSettings settings = s.settings;
   settings.integrator = IntegratorMode::Bounces;
+  settings.light_subpaths = false;  // the per-bounce mode has no light-subpath strategy
   settings.spp = spp;
   settings.time_budget_seconds = time_budget_seconds;
   const formats::BakeSettings baked = s.manifest.settings.value_or(formats::BakeSettings{});
@@ -1050,6 +1055,7 @@ const LightmapEstimate& RefreshSession::bake_guided(uint32_t spp, double time_bu
   IntegratorSettings settings = s.settings;
   settings.integrator = IntegratorMode::Path;
   settings.guiding = mode;
+  settings.light_subpaths = false;  // guiding is not combined with light subpaths
   if (mode == GuidingMode::Svo) {
     // The bundle's octree: its published exitance (the bake's light) seeds the guide's first fields.
     if (!s.svo) throw std::invalid_argument("--guiding svo: the bundle has no svo.bin (baked with --voxel-resolution none)");

@@ -163,6 +163,9 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
     report["error"] = {{"floor", estimate.error_floor()}};
   }
   report["nonfinite_samples"] = estimate.nonfinite_samples + probe_estimate.nonfinite_samples;
+  // A progressive refresh with light subpaths (RefreshSessionOptions::light_subpaths): the pools' totals.
+  if (session.settings().light_subpaths && !report.contains("light_paths"))
+    report["light_paths"] = {{"subpaths", estimate.light_subpaths}, {"vertices", estimate.light_subpath_vertices}};
   if (denoised)
     report["denoise"] = {{"radius", denoise_radius},
                          {"texels", denoised->texels},

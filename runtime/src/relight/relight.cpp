@@ -61,9 +61,14 @@ json relight_bundle(const RelightOptions& options) {
   if (options.light_paths != "off" && options.light_paths != "on")
     throw RelightInputError("--light-paths " + options.light_paths + ": expected off or on");
   const bool light_paths = options.light_paths == "on";
-  if (light_paths && (per_bounce || guided || emitter_guided || options.frames > 0 || options.frame_budget_ms > 0))
-    throw RelightInputError("--light-paths on adds strategies to path tracing of the whole lightmap in one run: it takes no "
-                            "--integrator bounces, --guiding, --emitter-guiding on, --frames or --budget-ms");
+  if (light_paths && (per_bounce || guided || emitter_guided))
+    throw RelightInputError("--light-paths on adds strategies to path tracing: it takes no --integrator bounces, --guiding or "
+                            "--emitter-guiding on");
+  // With --time, --frames or --budget-ms, light paths refresh progressively as path tracing alone
+  // does (RefreshSessionOptions::light_subpaths: the session's passes connect, edits keep their
+  // rules); with --spp alone, one whole run, bake --backend vulkan --light-paths on's bit for bit.
+  const bool whole_run_light_paths =
+      light_paths && options.frames == 0 && options.frame_budget_ms == 0 && options.time_budget_seconds == 0;
 
   const bool share = options.share_ranks > 0;
   if (share) {
@@ -93,6 +98,7 @@ json relight_bundle(const RelightOptions& options) {
                                                           options.frame_budget_ms > 0 || options.samples_before_edits > 0);
   // Probes are refreshed in frames (a whole run bakes them once, for the bundle it writes).
   session_options.refresh_probes = options.frames > 0 || options.frame_budget_ms > 0;
+  session_options.light_subpaths = light_paths;
   session_options.device.device_index = options.device_index;
   session_options.device.validation = options.validation;
   session_options.device.collect_stage_statistics = options.stage_statistics;
@@ -186,30 +192,19 @@ json relight_bundle(const RelightOptions& options) {
                                 options.guiding == "svo" ? GuidingMode::Svo : GuidingMode::Grid).rays;
     report("lighting", 1, rays);
   }
-  json emitter_guiding_report;
-  if (emitter_guided) {
+  // One path-traced run of the whole lightmap: --emitter-guiding on, or --light-paths on with --spp alone.
+  json emitter_guiding_report, light_paths_report;
+  if (emitter_guided || whole_run_light_paths) {
     report("lighting", 0, 0);
     const LightmapEstimate* run = nullptr;
     try {
-      run = &session->bake_path(spp, options.time_budget_seconds, nullptr, true);
+      run = &session->bake_path(spp, options.time_budget_seconds, nullptr, emitter_guided, whole_run_light_paths);
     } catch (const std::invalid_argument& e) {  // e.g. the edits changed the emitters the guide was made for
       throw RelightInputError(options.bundle + ": " + e.what());
     }
     rays = run->rays;
-    emitter_guiding_report = emitter_guiding_json(run->emitter_guiding);
-    report("lighting", 1, rays);
-  }
-  json light_paths_report;
-  if (light_paths) {
-    report("lighting", 0, 0);
-    const LightmapEstimate* run = nullptr;
-    try {
-      run = &session->bake_path(spp, options.time_budget_seconds, nullptr, false, true);
-    } catch (const std::invalid_argument& e) {
-      throw RelightInputError(options.bundle + ": " + e.what());
-    }
-    rays = run->rays;
-    light_paths_report = {{"subpaths", run->light_subpaths}, {"vertices", run->light_subpath_vertices}};
+    if (emitter_guided) emitter_guiding_report = emitter_guiding_json(run->emitter_guiding);
+    if (whole_run_light_paths) light_paths_report = {{"subpaths", run->light_subpaths}, {"vertices", run->light_subpath_vertices}};
     report("lighting", 1, rays);
   }
   uint64_t share_texels = 0;
@@ -224,7 +219,7 @@ json relight_bundle(const RelightOptions& options) {
     share_texels = rank_alone.work.texel_samples / spp;
     report("lighting", 1, rays);
   }
-  for (uint32_t frame = 0; !per_bounce && !guided && !emitter_guided && !light_paths && !share && (options.frames == 0 || frame < options.frames); ++frame) {
+  for (uint32_t frame = 0; !per_bounce && !guided && !emitter_guided && !whole_run_light_paths && !share && (options.frames == 0 || frame < options.frames); ++frame) {
     RefreshBudget budget;
     budget.max_samples_per_texel = spp;
     budget.milliseconds = options.frame_budget_ms;
@@ -298,7 +293,7 @@ json relight_bundle(const RelightOptions& options) {
   run["integrator"] = per_bounce ? "bounces" : "path";
   if (guided) run["guiding"] = options.guiding;
   if (emitter_guided) run["emitter_guiding"] = emitter_guiding_report;
-  if (light_paths) run["light_paths"] = light_paths_report;
+  if (whole_run_light_paths) run["light_paths"] = light_paths_report;  // else write_refreshed_bundle's, from the accumulation
   if (per_bounce) run["bounces"] = bounces_report;
   run["spp"] = session->samples_per_texel();
   // Light layers kept per texel (docs/runtime.md "Light layers"; 0: --no-light-layers or a whole run)

@@ -126,6 +126,12 @@ void LightmapDriver::prepare(const TexelGBuffer& gbuffer, const IntegratorSettin
   context.submit_and_wait(cmd);
 }
 
+void LightmapDriver::make_light_pools(Accumulation& a, const IntegratorSettings& settings) {
+  if (!guiding_scene_.lighting) throw std::logic_error("Vulkan backend: light subpaths without the integrator's scene");
+  a.light_pools = std::make_shared<LightSubpathPools>(runner_, *guiding_scene_.lighting, settings, a.max_work, a.params);
+  a.light_pool_settings = settings;
+}
+
 void LightmapDriver::upload_items(const Accumulation& a) {
   Context& context = runner_.context();
   WavefrontBuffers& buffers = runner_.buffers();
@@ -307,10 +313,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   // The scene's candidate is grid guiding here: --guiding auto does not measure light subpaths on this backend.
   if (auto_guiding && settings.guiding_auto_candidate == AutoGuidingCandidate::LightSubpaths)
     throw std::invalid_argument("Vulkan backend: --guiding auto measures grid guiding against unguided only, not light subpaths");
-  if (settings.light_subpaths) {
-    if (!guiding_scene_.lighting) throw std::logic_error("Vulkan backend: light subpaths without the integrator's scene");
-    a.light_pools = std::make_shared<LightSubpathPools>(runner_, *guiding_scene_.lighting, settings, a.max_work, a.params);
-  }
+  if (settings.light_subpaths) make_light_pools(a, settings);
   std::unique_ptr<GuidingChoice> choice;
   std::vector<uint32_t> auto_words;
   if (settings.guiding == GuidingMode::Grid || auto_guiding) {
@@ -542,6 +545,9 @@ void LightmapDriver::start(const TexelGBuffer& gbuffer, const IntegratorSettings
   // A change estimate's contributions go to the edited lights' layers (GpuParams::changed_light_layers).
   for (size_t k = 0; k < kMaxChangedLightPairs; ++k)
     a.params.changed_light_layers[k] = k < changed_light_layers.size() ? changed_light_layers[k] : 0;
+  // Light subpaths, a pool per batch as in bake(); not for a change estimate, whose paths add only
+  // the edited lights' direct light (path.glsl light_subpaths_on), so a pool would go unread.
+  if (settings.light_subpaths && changed_light_pairs == 0) make_light_pools(a, settings);
   a.seconds = std::chrono::duration<double>(Clock::now() - start_time).count();
   progressive_ = std::move(a);
 }
@@ -560,6 +566,10 @@ void LightmapDriver::scene_changed() {
   p.environment_height = scene.environment_height;
   p.shadow_slots = scene.shadow_slots;
   p.traversal_steps = scene.traversal_steps;
+  // The subpaths' start probabilities follow the lights' power: made again from the edited scene
+  // (they also set the shadow slots the connection takes). Samples before keep their own, each
+  // unbiased for the lights they were traced under.
+  if (progressive_->light_pools) make_light_pools(*progressive_, progressive_->light_pool_settings);
 }
 
 void LightmapDriver::update_texels(const TexelGBuffer& gbuffer, const std::vector<uint32_t>& texels) {

@@ -48,7 +48,8 @@ class LightmapDriver {
   void start(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, uint32_t changed_light_pairs = 0,
              bool texels_as_before = false, bool accumulation_cleared = false, const std::vector<uint32_t>& changed_light_layers = {});
   // The scene's lights changed under a running accumulation (an edit that only scaled them): the
-  // parameters the kernels take from the scene (the constant sky, counts) read again.
+  // parameters the kernels take from the scene (the constant sky, counts) read again, and the light
+  // subpaths' start (its probabilities follow the lights' power) made for the edited scene.
   void scene_changed();
   // `samples` more per texel (sample indices continue where the last call ended); returns the rays traced.
   uint64_t add_samples(uint32_t samples);
@@ -90,6 +91,7 @@ class LightmapDriver {
     BatchTotals totals;
     // Light subpaths (IntegratorSettings::light_subpaths): each batch traces its own pool (null: none).
     std::shared_ptr<LightSubpathPools> light_pools;
+    IntegratorSettings light_pool_settings;  // what made them: a progressive accumulation's pools are made again after a scene change
     uint32_t next_sample = 0;
     double seconds = 0;
   };
@@ -99,6 +101,8 @@ class LightmapDriver {
   void prepare(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, Accumulation& a, const Runs* bake_runs = nullptr,
                Accumulation* reuse = nullptr, bool accumulation_cleared = false);
   void upload_items(const Accumulation& a);
+  // `a`'s batches trace light subpaths (settings.light_subpaths) from the integrator's current scene.
+  void make_light_pools(Accumulation& a, const IntegratorSettings& settings);
   void run_pass(Accumulation& a, uint32_t first, uint32_t pass);
   // What a read-back fills, made ahead of time (bake(): on a thread while the passes run): the
   // estimate's per-texel arrays for `host_texels`, zero (their memory touched), and a pinned

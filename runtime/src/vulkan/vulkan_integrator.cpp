@@ -34,6 +34,22 @@ namespace exitance {
 using namespace exitance::vulkan;
 namespace {
 
+// Light subpaths add their strategies to path tracing alone, as on the CPU (whose emitter guiding
+// also combines): texels, probes and the progressive accumulation refuse the rest alike.
+void check_light_subpaths(const IntegratorSettings& settings) {
+  if (!settings.light_subpaths) return;
+  if (settings.integrator == IntegratorMode::Bounces)
+    throw std::invalid_argument("Vulkan backend: --light-paths applies to path tracing, not to --integrator bounces");
+  if (settings.guiding != GuidingMode::Off)
+    throw std::invalid_argument("Vulkan backend: --light-paths is not combined with --guiding (use --guiding off)");
+  if (settings.emitter_guiding)
+    throw std::invalid_argument("Vulkan backend: --light-paths with --emitter-guiding on is implemented on the CPU backend only");
+  if (distributed(settings.work_share))
+    throw std::invalid_argument("Vulkan backend: --light-paths runs in one process only, not under mpirun with several ranks");
+  if (!(settings.light_subpaths_per_sample > 0 && settings.light_subpaths_per_sample <= 64))
+    throw std::invalid_argument("Vulkan backend: light subpaths per sample must be in (0, 64]");
+}
+
 vulkan::GuidingScene guiding_scene(const LightingScene& scene, std::shared_ptr<const LightingScene> created) {
   vulkan::GuidingScene g;
   g.lighting = std::move(created);
@@ -131,18 +147,7 @@ VulkanIntegrator::~VulkanIntegrator() = default;
 
 LightmapEstimate VulkanIntegrator::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) const {
   if (settings.adaptive) throw std::runtime_error("Vulkan backend: --adaptive on is implemented on the CPU backend only (use --backend cpu)");
-  if (settings.light_subpaths) {  // path tracing alone, as on the CPU (whose emitter guiding also combines)
-    if (settings.integrator == IntegratorMode::Bounces)
-      throw std::invalid_argument("Vulkan backend: --light-paths applies to path tracing, not to --integrator bounces");
-    if (settings.guiding != GuidingMode::Off)
-      throw std::invalid_argument("Vulkan backend: --light-paths is not combined with --guiding (use --guiding off)");
-    if (settings.emitter_guiding)
-      throw std::invalid_argument("Vulkan backend: --light-paths with --emitter-guiding on is implemented on the CPU backend only");
-    if (distributed(settings.work_share))
-      throw std::invalid_argument("Vulkan backend: --light-paths runs in one process only, not under mpirun with several ranks");
-    if (!(settings.light_subpaths_per_sample > 0 && settings.light_subpaths_per_sample <= 64))
-      throw std::invalid_argument("Vulkan backend: light subpaths per sample must be in (0, 64]");
-  }
+  check_light_subpaths(settings);
   if (settings.spp == 0 && !(settings.time_budget_seconds > 0) && !(settings.target_relative_error > 0))
     throw std::invalid_argument("Vulkan backend: spp 0 needs a time budget or a target error");
   if (settings.integrator == IntegratorMode::Bounces) {
@@ -163,8 +168,7 @@ LightmapEstimate VulkanIntegrator::bake(const TexelGBuffer& gbuffer, const Integ
 ProbeEstimate VulkanIntegrator::bake_probes(const std::vector<Vec3>& positions, const IntegratorSettings& settings) const {
   if (settings.spp == 0 && !(settings.time_budget_seconds > 0))
     throw std::invalid_argument("Vulkan backend: probes with spp 0 need a time budget");
-  if (settings.light_subpaths && (settings.emitter_guiding || distributed(settings.work_share)))
-    throw std::invalid_argument("Vulkan backend: probes with light subpaths run in one process, without emitter guiding");
+  check_light_subpaths(settings);
   return impl_->probes.bake(positions, settings, impl_->lightmap.guiding_scene().lighting.get());
 }
 
@@ -195,6 +199,7 @@ void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const Inte
   // pass where a learned table could swap: guiding runs in bake() only.
   if (settings.guiding != GuidingMode::Off || settings.emitter_guiding)
     throw std::runtime_error("Vulkan backend: guiding runs in whole bakes only, not in progressive accumulation (relight)");
+  check_light_subpaths(settings);
   impl_->lightmap.start(gbuffer, settings, 0, texels_as_before, accumulation_cleared);
   impl_->change_pairs = 0;
   impl_->change_layers.clear();

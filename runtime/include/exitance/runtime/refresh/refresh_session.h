@@ -76,6 +76,14 @@ struct RefreshSessionOptions {
   // them again; published_probes() shows them. Off: probes stay as baked.
   bool refresh_probes = true;
   double probe_budget_share = 0.25;
+  // Light subpaths (bake --light-paths on; docs/runtime.md "Light paths"): each pass of the
+  // progressive refresh traces a pool of subpaths from the lights and the sky, and every texel
+  // path's vertex connects to one of them, weighted by MIS: light entering through narrow openings
+  // (a door ajar) converges several times sooner. Each batch traces its own pool (keyed by the
+  // pass's first sample), so the result depends on how calls split the samples, not only on the
+  // seed. Probes are still refreshed by path tracing alone.
+  bool light_subpaths = false;
+  double light_subpaths_per_sample = IntegratorSettings{}.light_subpaths_per_sample;  // (0, 64]
   // Filter the indirect light of what is shown in texture space, with this window radius in texels
   // (1 to 16; 0: off, the default): RefreshSession::set_denoise_radius.
   int denoise_radius = 0;

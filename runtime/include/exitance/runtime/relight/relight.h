@@ -53,8 +53,9 @@ struct RelightOptions {
   // "off" or "on": next-event estimation guided by emitter distributions learned during a whole run
   // (bake --emitter-guiding on; path tracing of the whole lightmap in one run, as --guiding).
   std::string emitter_guiding = "off";
-  // "off" or "on": light subpaths the texels' paths connect to (bake --light-paths on; path tracing of
-  // the whole lightmap in one run, as --emitter-guiding; not with it, nor with --guiding).
+  // "off" or "on": light subpaths the texels' paths connect to (bake --light-paths on; not with
+  // --emitter-guiding on, --guiding or integrator "bounces"). With a time, frame count or frame budget
+  // the progressive refresh's passes connect (RefreshSessionOptions::light_subpaths); else one whole run.
   std::string light_paths = "off";
   // With integrator "bounces": where the layer caches are built, "device" or "host" (the path before
   // the device built them, for A/B timing; the same results bit for bit).
