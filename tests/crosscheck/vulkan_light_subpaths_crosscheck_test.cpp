@@ -135,14 +135,15 @@ TEST(VulkanLightSubpaths, ProgressiveAccumulationAgreesWithCpuPathTracing) {
 
 // Probes connect too, from each probe ray's first hit (the path's fixed x_0): the SH's constant term
 // per probe and channel against the CPU path tracer's probes over kSeeds seeds, in the box with a spot
-// light and far brighter lights outside; the same seed gives the same sums.
+// light and far brighter lights outside, baked and refreshed (the runtime's probe sets, one
+// stratified set per call); the same seed gives the same sums.
 TEST(VulkanLightSubpaths, ProbesAgreeWithCpuPathTracing) {
   const testing::AtlasScene box = testing::box_with_lights_outside_and_a_spot();
   CREATE_VULKAN_OR_SKIP(vk, box.scene);
   const CpuReferenceIntegrator cpu(box.scene);
   const std::vector<Vec3> probes = {{0.5f, 0.5f, 0.5f}, {0.25f, 0.2f, 0.25f}, {0.75f, 0.3f, 0.6f}, {0.3f, 0.75f, 0.7f}};
-  testing::RegionRuns with, without;
-  uint64_t subpaths = 0;
+  testing::RegionRuns with, refreshed, without;
+  uint64_t subpaths = 0, refreshed_subpaths = 0;
   auto add = [&](const ProbeEstimate& e, testing::RegionRuns& runs) {
     EXPECT_EQ(e.nonfinite_samples, 0u);
     for (size_t i = 0; i < probes.size(); ++i)
@@ -153,9 +154,19 @@ TEST(VulkanLightSubpaths, ProbesAgreeWithCpuPathTracing) {
     subpaths += w.light_subpaths;
     add(w, with);
     add(cpu.bake_probes(probes, settings(4096, uint64_t(seed) + 1000, false)), without);
+    vk->start_probe_refresh(probes);
+    while (vk->refresh_probe_set(settings(4096, uint64_t(seed) + 2000, true), 4096) > 0) {
+    }
+    const ProbeEstimate r = vk->probe_refresh_estimate();
+    refreshed_subpaths += r.light_subpaths;
+    add(r, refreshed);
   }
   EXPECT_GT(subpaths, 0u) << "no light subpath was traced for the probes";
+  EXPECT_GT(refreshed_subpaths, 0u) << "no light subpath was traced for the refreshed probes";
   EXPECT_LT(kZLimit * testing::expect_regions_agree("vulkan light subpaths", "box probes", without, with, kZLimit), kDetectableBias)
+      << "the test could not see a 10 % bias";
+  EXPECT_LT(kZLimit * testing::expect_regions_agree("vulkan light subpaths", "box probes refreshed", without, refreshed, kZLimit),
+            kDetectableBias)
       << "the test could not see a 10 % bias";
   // (Most subpaths start at the far brighter lights outside and leave no vertex: a whole subpath per
   // sample keeps some in a 256-sample pool.)

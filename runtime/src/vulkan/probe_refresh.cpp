@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
+#include <optional>
 #include <stdexcept>
 
 #include "exitance_spirv/scale_probe_layers.h"
+#include "light_subpath_pools.h"
 #include "probe_driver.h"
 
 namespace exitance::vulkan {
@@ -45,6 +47,7 @@ void ProbeRefresh::start(const std::vector<Vec3>& positions, int light_layers) {
   WavefrontBuffers& buffers = runner_.buffers();
   samples_.assign(positions.size(), 0);
   next_ = 0;
+  light_subpaths_ = 0;
   // Layers only where their sums fit one storage buffer binding and a batch holds a set's work.
   const VkDeviceSize limit = context.properties().limits.maxStorageBufferRange;
   light_layers_ = std::max(0, light_layers);
@@ -126,6 +129,7 @@ void ProbeRefresh::clear(const std::vector<uint32_t>& order, size_t priority, ui
     throw std::logic_error("ProbeRefresh::clear: a change of at most kMaxChangedLightPairs lights, each with its layer");
   change_pairs_ = change_pairs;
   change_layers_ = change_layers;
+  light_subpaths_ = 0;
   std::fill(samples_.begin(), samples_.end(), 0u);
   next_ = 0;
   priority_ = order.empty() ? 0 : std::min(priority, order.size());
@@ -148,7 +152,7 @@ void ProbeRefresh::clear(const std::vector<uint32_t>& order, size_t priority, ui
 }
 
 uint64_t ProbeRefresh::add_set(const IntegratorSettings& settings, uint32_t target_samples, size_t max_probes,
-                               size_t* refreshed) {
+                               size_t* refreshed, const LightingScene* lighting) {
   if (refreshed) *refreshed = 0;
   const size_t count = samples_.size();
   if (count == 0) return 0;
@@ -179,11 +183,22 @@ uint64_t ProbeRefresh::add_set(const IntegratorSettings& settings, uint32_t targ
   params.changed_light_pairs = change_pairs_;
   for (size_t k = 0; k < change_layers_.size(); ++k) params.changed_light_layers[k] = change_layers_[k];
   const size_t result_bytes = kProbeResultBytes + 12 * size_t(light_layers_);
+  // Light subpaths: the set's probe paths connect from each probe ray's first hit to a pool of their
+  // own, as a probe bake's batches (probe_driver.cpp); not in a change estimate, whose paths add only
+  // the edited lights' direct light.
+  std::optional<LightSubpathPools> light_pools;
+  if (settings.light_subpaths && change_pairs_ == 0) {
+    if (!lighting) throw std::logic_error("Vulkan backend: light subpaths for refreshed probes without the integrator's scene");
+    light_pools.emplace(runner_, *lighting, settings, max_work, params);
+  }
   BatchTotals totals;
   {
     const ProbeRefreshBinding bound(runner_);
+    if (light_pools) light_pools->before_batch(params, double(end - next_) * set);
     runner_.run(params, {uint32_t(next_), uint32_t(end - next_), first_sample, set}, result_bytes, kProbeBatch, totals);
+    if (light_pools) light_pools->after_batch(totals, params);
   }
+  light_subpaths_ += totals.light_subpaths;
   for (size_t i = next_; i < end; ++i) samples_[order_[i]] += set;
   if (refreshed) *refreshed = end - next_;
   next_ = end;
@@ -197,6 +212,7 @@ ProbeEstimate ProbeRefresh::read(bool with_layers) const {
   estimate.samples.assign(count, 0);
   estimate.backface_hits.assign(count, 0);
   read_probe_sums(runner_.context(), runner_.buffers().refresh_probe_sums, estimate, with_layers ? light_layers_ : 0);
+  estimate.light_subpaths = light_subpaths_;
   return estimate;
 }
 

@@ -51,10 +51,12 @@ class ProbeRefresh {
   // The next probes' next stratified set, round robin over the probes: as many probes as one batch
   // holds and at most `max_probes` (0: no limit), never past `target_samples` per probe. Returns the
   // rays traced (0 once every probe has its target); `refreshed`: how many probes got their set.
+  // With settings.light_subpaths the set's probe paths connect to a pool of light subpaths traced
+  // from `lighting` (as a probe bake's; none in a change estimate).
   uint64_t add_set(const IntegratorSettings& settings, uint32_t target_samples, size_t max_probes = 0,
-                   size_t* refreshed = nullptr);
+                   size_t* refreshed = nullptr, const LightingScene* lighting = nullptr);
   // A read-back (waits for the device): totals, squared L0 sums and counts, and with `with_layers`
-  // every light layer's sums (27 doubles per probe and layer).
+  // every light layer's sums (27 doubles per probe and layer); the light subpaths traced for them.
   ProbeEstimate read(bool with_layers = false) const;
   size_t probe_count() const { return samples_.size(); }
   // The fewest samples of a probe (every probe has whole sets).
@@ -72,6 +74,7 @@ class ProbeRefresh {
   int light_layers_ = 0;
   uint32_t change_pairs_ = 0;
   std::vector<uint32_t> change_layers_;
+  uint64_t light_subpaths_ = 0;    // traced for the sets since the last start or clear (read()'s light_subpaths)
   std::unique_ptr<ComputeKernel> scaling_;  // scale_probe_layers.comp, made at a start with layers
   Buffer factors_;
 };

@@ -187,7 +187,8 @@ void VulkanIntegrator::scale_probe_layers(const std::vector<Vec4>& factors) { im
 ProbeEstimate VulkanIntegrator::probe_refresh_layer(int layer) const { return impl_->probe_refresh.read_layer(layer); }
 uint64_t VulkanIntegrator::refresh_probe_set(const IntegratorSettings& settings, uint32_t target_samples, size_t max_probes,
                                              size_t* refreshed) {
-  return impl_->probe_refresh.add_set(settings, target_samples, max_probes, refreshed);
+  check_light_subpaths(settings);
+  return impl_->probe_refresh.add_set(settings, target_samples, max_probes, refreshed, impl_->lightmap.guiding_scene().lighting.get());
 }
 ProbeEstimate VulkanIntegrator::probe_refresh_estimate(bool with_layers) const { return impl_->probe_refresh.read(with_layers); }
 uint32_t VulkanIntegrator::probe_refresh_samples() const { return impl_->probe_refresh.least_samples(); }

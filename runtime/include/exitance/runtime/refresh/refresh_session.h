@@ -81,7 +81,7 @@ struct RefreshSessionOptions {
   // path's vertex connects to one of them, weighted by MIS: light entering through narrow openings
   // (a door ajar) converges several times sooner. Each batch traces its own pool (keyed by the
   // pass's first sample), so the result depends on how calls split the samples, not only on the
-  // seed. Probes are still refreshed by path tracing alone.
+  // seed. The refreshed probes' sets connect too (a pool per set).
   bool light_subpaths = false;
   double light_subpaths_per_sample = IntegratorSettings{}.light_subpaths_per_sample;  // (0, 64]
   // Filter the indirect light of what is shown in texture space, with this window radius in texels
