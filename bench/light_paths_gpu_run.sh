@@ -14,7 +14,8 @@
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
 export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
-W=/tmp/light_paths_gpu_$$; mkdir -p $W  # its own folder: a warm machine keeps other scripts' /tmp && tar -C $W -xJf .replay/lp.txz
+# Its own folder: a warm machine keeps other scripts' /tmp.
+W=/tmp/light_paths_gpu_$$; mkdir -p $W && tar -C $W -xJf .replay/lp.txz
 S=$OUT/summary.txt
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader > $S
 common="--ignore-baked --no-light-layers --json"
