@@ -2,7 +2,7 @@
 // bundle baked here, on lavapipe in CI: samples added over several refresh calls are the bake's
 // samples bit for bit; a restart drops every sample; the estimated relMSE a refresh reports is
 // within 2x of the relMSE measured against a converged lightmap; an engine's adopted device gives
-// the same results; bad budgets are refused.
+// the same results; light subpaths switched between refreshes; bad budgets are refused.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -276,6 +276,42 @@ TEST(RefreshSession, TexelsNearAnEditReachAnErrorInFewerCalls) {
   ASSERT_GT(prioritized.far, 0);
   EXPECT_LT(prioritized.near, prioritized.far);
   EXPECT_LT(prioritized.near, uniform.near);  // the priorities, not the texels' own noise, make the difference
+}
+
+// set_light_subpaths: switched on before the first refresh, the session gives what one opened with
+// RefreshSessionOptions::light_subpaths gives, bit for bit; switched off, its passes trace no subpath
+// (the totals stop growing) and on again, they grow; a per-sample count outside (0, 64] is refused
+// and changes nothing.
+TEST(RefreshSession, LightSubpathsSwitchedBetweenRefreshes) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  RefreshSessionOptions with;
+  with.light_subpaths = true;
+  auto opened_with = RefreshSession::open(baked_bundle().string(), with);
+  opened_with->refresh({0, 2});
+  auto switched = RefreshSession::open(baked_bundle().string());
+  EXPECT_THROW(switched->set_light_subpaths(true, 0), std::invalid_argument);
+  EXPECT_THROW(switched->set_light_subpaths(true, 65), std::invalid_argument);
+  EXPECT_THROW(switched->set_light_subpaths(true, std::numeric_limits<double>::quiet_NaN()), std::invalid_argument);
+  EXPECT_FALSE(switched->settings().light_subpaths);
+  switched->set_light_subpaths(true);
+  EXPECT_TRUE(switched->settings().light_subpaths);
+  switched->refresh({0, 2});
+  const LightmapEstimate two = switched->lightmap();
+  expect_same_sums(two, opened_with->lightmap());
+  ASSERT_GT(two.light_subpaths, 0u);  // the Cornell room's ceiling panel starts them
+  EXPECT_EQ(two.light_subpaths, opened_with->lightmap().light_subpaths);
+
+  switched->set_light_subpaths(false);
+  switched->refresh({0, 4});
+  EXPECT_EQ(switched->lightmap().light_subpaths, two.light_subpaths);
+  switched->set_light_subpaths(true, 0.25);
+  switched->refresh({0, 5});
+  const LightmapEstimate five = switched->lightmap();
+  EXPECT_GT(five.light_subpaths, two.light_subpaths);
+  for (const TexelAccumulator& t : five.texels) {
+    ASSERT_EQ(t.samples, 5u);
+    for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(t.total[c]) && t.total[c] >= 0);
+  }
 }
 
 TEST(RefreshSession, BadBudgetsAreRefused) {

@@ -1,7 +1,7 @@
 // libexitance_runtime's C API (exitance/runtime/exitance_runtime.h), linked as the shared library
 // an engine links: a C99 walkthrough, errors as codes with one-line messages, failed calls that
-// change nothing, and a written bundle the loader opens. The bundle is baked by the `bake` program,
-// so this test links nothing of the offline stage.
+// change nothing, a written bundle the loader opens, and light paths switched between refreshes. The
+// bundle is baked by the `bake` program, so this test links nothing of the offline stage.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -115,6 +115,50 @@ TEST(RuntimeCApi, FailedCallsChangeNothing) {
   }
   EXPECT_GT(lit, rgb.size() / 4);
   exitance_runtime_release(rt);
+}
+
+// exitance_runtime_set_light_paths: on changes what the next refresh adds (the Cornell room's panel
+// starts subpaths), off after on gives plain path tracing's bits again, 0 subpaths per sample is the
+// default 1/16, and bad arguments are one-line errors that change nothing.
+TEST(RuntimeCApi, LightPathsSwitchBetweenRefreshes) {
+  if (!has_device()) GTEST_SKIP() << "no Vulkan device";
+  const auto page_after_two_samples = [](const auto& configure) {
+    ExitanceRuntime* rt = nullptr;
+    EXPECT_EQ(exitance_runtime_open(bundle().c_str(), nullptr, &rt), EXITANCE_RUNTIME_OK);
+    configure(rt);
+    ExitanceRefreshReport report{};
+    EXPECT_EQ(exitance_runtime_refresh(rt, 0, 2, &report), EXITANCE_RUNTIME_OK);
+    EXPECT_EQ(report.samples_per_texel, 2u);
+    ExitanceRuntimePageInfo page{};
+    EXPECT_EQ(exitance_runtime_page_info(rt, 0, &page), EXITANCE_RUNTIME_OK);
+    std::vector<float> rgb(size_t(page.width) * page.height * 3);
+    EXPECT_EQ(exitance_runtime_read_page(rt, 0, rgb.data(), page.width, page.height), EXITANCE_RUNTIME_OK);
+    exitance_runtime_release(rt);
+    return rgb;
+  };
+  const std::vector<float> plain = page_after_two_samples([](ExitanceRuntime*) {});
+  const std::vector<float> connected = page_after_two_samples([](ExitanceRuntime* rt) {
+    EXPECT_EQ(exitance_runtime_set_light_paths(rt, 1, 0), EXITANCE_RUNTIME_OK);
+  });
+  EXPECT_NE(plain, connected);
+  for (float v : connected) ASSERT_TRUE(std::isfinite(v) && v >= 0);
+  EXPECT_EQ(page_after_two_samples([](ExitanceRuntime* rt) {
+              EXPECT_EQ(exitance_runtime_set_light_paths(rt, 1, 0.5), EXITANCE_RUNTIME_OK);
+              EXPECT_EQ(exitance_runtime_set_light_paths(rt, 0, 0), EXITANCE_RUNTIME_OK);
+            }),
+            plain);
+  EXPECT_EQ(page_after_two_samples([](ExitanceRuntime* rt) {
+              EXPECT_EQ(exitance_runtime_set_light_paths(rt, 2, 0), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+              EXPECT_EQ(std::string(exitance_runtime_last_error_message()),
+                        "exitance_runtime_set_light_paths: on must be 0 or 1");
+              EXPECT_EQ(exitance_runtime_set_light_paths(rt, 1, std::numeric_limits<double>::quiet_NaN()),
+                        EXITANCE_RUNTIME_INVALID_ARGUMENT);
+              EXPECT_EQ(exitance_runtime_set_light_paths(rt, 1, 65), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+              EXPECT_EQ(exitance_runtime_set_light_paths(rt, 1, -1), EXITANCE_RUNTIME_INVALID_ARGUMENT);
+              EXPECT_EQ(exitance_runtime_set_light_paths(rt, 1, 1.0 / 16), EXITANCE_RUNTIME_OK);
+            }),
+            connected);
+  EXPECT_EQ(exitance_runtime_set_light_paths(nullptr, 1, 0), EXITANCE_RUNTIME_INVALID_ARGUMENT);
 }
 
 // A bundle baked with --directional sh1: read_page_channel returns the refreshed sh1 layers exactly as

@@ -753,6 +753,17 @@ void RefreshSession::set_probe_budget_share(double share) {
   state_->probe_budget_share = share;
 }
 
+void RefreshSession::set_light_subpaths(bool on, double per_sample) {
+  if (!(per_sample > 0 && per_sample <= 64))
+    throw std::invalid_argument("set_light_subpaths: " + std::to_string(per_sample) + " subpaths per sample is not in (0, 64]");
+  IntegratorSettings settings = state_->settings;
+  settings.light_subpaths = on;
+  settings.light_subpaths_per_sample = per_sample;
+  // The probes' sets read the session's settings as each is traced; the texels' passes take them here.
+  state_->integrator->set_progressive_light_subpaths(settings);
+  state_->settings = settings;
+}
+
 bool RefreshSession::refreshes_probes() const { return !state_->probe_grid_index.empty(); }
 
 RefreshSession::ProbeErrors RefreshSession::probe_errors() const {

@@ -262,6 +262,16 @@ ExitanceRuntimeError exitance_runtime_set_probe_budget_share(ExitanceRuntime* ru
   });
 }
 
+ExitanceRuntimeError exitance_runtime_set_light_paths(ExitanceRuntime* runtime, int32_t on, double subpaths_per_sample) {
+  return guarded("exitance_runtime_set_light_paths", [&] {
+    require(runtime != nullptr, "runtime is NULL");
+    require(on == 0 || on == 1, "on must be 0 or 1");
+    require(subpaths_per_sample >= 0 && subpaths_per_sample <= 64, "subpaths_per_sample is not 0 (the default) or in (0, 64]");
+    runtime->session->set_light_subpaths(on == 1, subpaths_per_sample == 0 ? IntegratorSettings{}.light_subpaths_per_sample
+                                                                            : subpaths_per_sample);
+  });
+}
+
 ExitanceRuntimeError exitance_runtime_voxel_count(const ExitanceRuntime* runtime, uint32_t* out_count) {
   return guarded("exitance_runtime_voxel_count", [&] {
     require(runtime != nullptr && out_count != nullptr, "runtime or out_count is NULL");

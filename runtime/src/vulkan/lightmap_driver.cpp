@@ -572,6 +572,20 @@ void LightmapDriver::scene_changed() {
   if (progressive_->light_pools) make_light_pools(*progressive_, progressive_->light_pool_settings);
 }
 
+void LightmapDriver::set_light_subpaths(const IntegratorSettings& settings) {
+  if (!progressive_) return;
+  Accumulation& a = *progressive_;
+  // A change estimate's paths add only the edited lights' direct light: no pool (as start()).
+  if (settings.light_subpaths && a.params.changed_light_pairs == 0) {
+    make_light_pools(a, settings);
+    return;
+  }
+  if (!a.light_pools) return;
+  a.light_pools.reset();
+  a.params.light_subpaths = 0;  // before_batch set it for the pools' last batch
+  a.params.shadow_slots = runner_.bake_params(IntegratorSettings{}, a.params.recorded, a.params.item_count_total).shadow_slots;
+}
+
 void LightmapDriver::update_texels(const TexelGBuffer& gbuffer, const std::vector<uint32_t>& texels) {
   if (!progressive_ || texels.empty()) return;
   Accumulation& a = *progressive_;

@@ -51,6 +51,9 @@ class LightmapDriver {
   // parameters the kernels take from the scene (the constant sky, counts) read again, and the light
   // subpaths' start (its probabilities follow the lights' power) made for the edited scene.
   void scene_changed();
+  // The running accumulation's light subpaths as `settings` asks from its next pass on
+  // (VulkanIntegrator::set_progressive_light_subpaths); nothing before a start.
+  void set_light_subpaths(const IntegratorSettings& settings);
   // `samples` more per texel (sample indices continue where the last call ended); returns the rays traced.
   uint64_t add_samples(uint32_t samples);
   // The start points of `texels` taken from `gbuffer` again (an edit moved them), on the host and,

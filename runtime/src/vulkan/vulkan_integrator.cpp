@@ -206,6 +206,10 @@ void VulkanIntegrator::start_progressive(const TexelGBuffer& gbuffer, const Inte
   impl_->change_layers.clear();
   impl_->denoiser_stale |= !texels_as_before;
 }
+void VulkanIntegrator::set_progressive_light_subpaths(const IntegratorSettings& settings) {
+  check_light_subpaths(settings);
+  impl_->lightmap.set_light_subpaths(settings);
+}
 void VulkanIntegrator::start_progressive_change(const TexelGBuffer& gbuffer, const IntegratorSettings& settings,
                                                 const LightingScene& edited, const std::vector<GpuPunctualLight>& pairs,
                                                 bool texels_as_before, bool accumulation_cleared, const std::vector<uint32_t>& pair_layers) {

@@ -122,6 +122,16 @@ ExitanceRuntimeError exitance_runtime_read_probes(ExitanceRuntime* runtime, floa
  * EXITANCE_RUNTIME_INVALID_ARGUMENT, nothing changed. */
 ExitanceRuntimeError exitance_runtime_set_probe_budget_share(ExitanceRuntime* runtime, double share);
 
+/* Light subpaths in the refresh (docs/runtime.md "Light paths"): with on = 1, every pass from the
+ * next exitance_runtime_refresh call on connects each texel path's vertices (and each refreshed
+ * probe's) to a pool of subpaths traced from the lights and the sky, weighted by MIS: light that
+ * enters through narrow openings (a door ajar) converges several times sooner, at about 1.6x a
+ * plain sample's cost (bench/results/light-subpaths.md). on = 0 (the default) path traces. Samples
+ * taken before keep theirs. subpaths_per_sample: the pool's size per texel sample, in (0, 64];
+ * 0 takes the default, 1/16. on other than 0 or 1, or subpaths_per_sample negative, NaN or over
+ * 64: EXITANCE_RUNTIME_INVALID_ARGUMENT, nothing changed. */
+ExitanceRuntimeError exitance_runtime_set_light_paths(ExitanceRuntime* runtime, int32_t on, double subpaths_per_sample);
+
 /* The sparse voxel octree's radiant exitance as the runtime shows it now (docs/runtime.md "Voxel
  * exitance"): per node of the bundle's svo.bin, in its order (breadth-first, formats/svo_format.md; the
  * loader (exitance_loader.h) reads the structure), 6 floats: front RGB then back RGB, M = pi L_o in

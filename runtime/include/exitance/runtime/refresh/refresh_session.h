@@ -311,6 +311,14 @@ class RefreshSession {
   // probe_budget_share), in [0, 1]; 0: no probe is refreshed (each keeps showing what it shows).
   // Throws std::invalid_argument outside [0, 1] (nothing changed).
   void set_probe_budget_share(double share);
+  // Light subpaths (RefreshSessionOptions::light_subpaths) from the next pass on: `on` makes every
+  // pass of the progressive refresh (and each refreshed probe set) connect to a pool of subpaths,
+  // `per_sample` of them per texel sample; off makes the passes plain path tracing again. Samples
+  // already taken keep the estimator they were taken with (each is unbiased, so their mean stays
+  // so). A change estimate in progress traces none (its paths add only the edited lights' direct
+  // light); the accumulation after it does. Throws std::invalid_argument (nothing changed) for
+  // `per_sample` outside (0, 64].
+  void set_light_subpaths(bool on, double per_sample = IntegratorSettings{}.light_subpaths_per_sample);
   // The bundle's sparse voxel octree with the radiant exitance of what texels show now
   // (shown_lightmap; fill_svo_exitance, as write_refreshed_bundle writes svo.bin), without
   // writing a bundle; nullopt when the bundle has no svo.bin. A read-back and a host pass over the

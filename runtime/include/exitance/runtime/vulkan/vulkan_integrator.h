@@ -188,6 +188,11 @@ class VulkanIntegrator final : public Integrator {
   // since: no submission to clear them again.
   void start_progressive(const TexelGBuffer& gbuffer, const IntegratorSettings& settings, bool texels_as_before = false,
                          bool accumulation_cleared = false);
+  // The running progressive accumulation's light subpaths as `settings` asks (light_subpaths,
+  // light_subpaths_per_sample) from its next pass on: pools made, or dropped so that its passes path
+  // trace; a change estimate's passes trace none either way. Nothing before a start. Throws as
+  // start_progressive does for settings it refuses.
+  void set_progressive_light_subpaths(const IntegratorSettings& settings);
   // A progressive accumulation of the change of E/pi from edited punctual lights (path.h
   // punctual_change_rays: the same paths, each vertex adding an edited light's direct light as edited
   // minus as it was; no emission, no sky). `edited`: the scene as update_lights last uploaded it;
