@@ -333,8 +333,6 @@ int main(int argc, char** argv) {
   if (light_paths == "on") {
     const char* conflict = integrator == "bounces"                 ? "--integrator bounces (light subpaths are path-tracing strategies)"
                            : guiding == "grid" || guiding == "svo" ? "--guiding grid/svo (not combined yet)"
-                           : options.backend.name == "vulkan" && options.lighting.emitter_guiding
-                               ? "--emitter-guiding on with --backend vulkan (combined on the CPU backend only)"
                                                                    : nullptr;
     if (conflict) {
       std::cerr << "bake: error: --light-paths on contradicts " << conflict << "\n";

@@ -56,7 +56,8 @@ LightVertex light_pool_vertex(uint k) {
 }
 
 // Path p's eye-vertex state (gpu_layout.h: path_throughput [2P + p]).
-uint eye_subpath_index(uint p) { return 2u * params.path_capacity + p; }
+// After emitter guiding's 2P entries where it runs (emitter_learning_index; wavefront_buffers.h).
+uint eye_subpath_index(uint p) { return (params.emitter_guide != 0u ? 4u : 2u) * params.path_capacity + p; }
 
 EyeSubpathVertex stored_eye_subpath_vertex(uint p) {
   EyeSubpathVertex e = eye_subpath_vertex_none();

@@ -45,12 +45,9 @@ TEST(BakeGuidingOptions, ContradictionsAreOneLineAndExit2) {
       {"--denoise --light-layers", "--denoise filters the indirect light, which --light-layers do not keep apart"},
       {"--denoise --directional sh1", "--denoise filters the indirect light, which --directional sh1 does not keep apart"},
       {"--denoise --denoise-radius 0", "--denoise-radius"},
-      // Light subpaths: path-tracing strategies, not combined with path guiding yet (nor, on the
-      // Vulkan backend, with emitter guiding).
+      // Light subpaths: path-tracing strategies, not combined with path guiding yet.
       {"--light-paths on --integrator bounces", "--light-paths on contradicts --integrator bounces"},
       {"--light-paths on --guiding grid", "--light-paths on contradicts --guiding grid/svo"},
-      {"--light-paths on --backend vulkan --emitter-guiding on",
-       "--light-paths on contradicts --emitter-guiding on with --backend vulkan"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.options);

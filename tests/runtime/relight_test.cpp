@@ -321,8 +321,9 @@ TEST(Relight, ReproducesAVulkanEmitterGuidedBakeBitForBit) {
 }
 
 // exitance-relight --light-paths on with --spp alone is bake --backend vulkan --light-paths on (the
-// same seed, the same pool per batch): the same pages bit for bit; it reports the subpaths, and
-// refuses --emitter-guiding on beside it and an unknown value, writing nothing.
+// same seed, the same pool per batch): the same pages bit for bit, and so with --emitter-guiding on
+// beside it (the learned tables folded between passes, the pools' first hits weighed by them); it
+// reports the subpaths, and refuses --guiding grid beside it and an unknown value, writing nothing.
 TEST(Relight, ReproducesAVulkanLightPathsBakeBitForBit) {
   if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
   const fs::path dir = fs::temp_directory_path() / ("exitance-relight-light-paths-" + std::to_string(::getpid()));
@@ -345,10 +346,30 @@ TEST(Relight, ReproducesAVulkanLightPathsBakeBitForBit) {
   ASSERT_TRUE(report.contains("light_paths")) << report.dump();
   EXPECT_GT(report["light_paths"]["vertices"].get<uint64_t>(), 0u);
   EXPECT_GE(expect_same_pages(baked, output, "the light-path bake's"), 1u);
-  options.output = (dir / "refused.bake").string();
+
+  const fs::path guided_bake = dir / "connected-guided.bake", guided_relit = dir / "connected-guided-relit.bake";
+  bake_to_relight("ajar_room", guided_bake, 2.0f, 8, [](BakeOptions& b) {
+    b.lighting.integrator = IntegratorMode::Path;
+    b.lighting.guiding = GuidingMode::Off;
+    b.lighting.light_subpaths = true;
+    b.lighting.emitter_guiding = true;
+    b.integrator_auto = false;
+    b.emitter_guiding_auto = false;
+  });
+  options.bundle = guided_bake.string();
+  options.output = guided_relit.string();
   options.emitter_guiding = "on";
-  EXPECT_THROW(relight_bundle(options), RelightInputError);
+  const nlohmann::json both = relight_bundle(options);
+  ASSERT_TRUE(both.contains("light_paths") && both.contains("emitter_guiding")) << both.dump();
+  EXPECT_GT(both["light_paths"]["vertices"].get<uint64_t>(), 0u);
+  EXPECT_GE(expect_same_pages(guided_bake, guided_relit, "the emitter-guided light-path bake's"), 1u);
+  EXPECT_EQ(both["nonfinite_samples"].get<uint64_t>(), 0u);
+
+  options.output = (dir / "refused.bake").string();
   options.emitter_guiding = "off";
+  options.guiding = "grid";
+  EXPECT_THROW(relight_bundle(options), RelightInputError);
+  options.guiding = "off";
   options.light_paths = "sometimes";
   EXPECT_THROW(relight_bundle(options), RelightInputError);
   EXPECT_FALSE(fs::exists(dir / "refused.bake"));

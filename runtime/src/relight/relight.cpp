@@ -61,14 +61,14 @@ json relight_bundle(const RelightOptions& options) {
   if (options.light_paths != "off" && options.light_paths != "on")
     throw RelightInputError("--light-paths " + options.light_paths + ": expected off or on");
   const bool light_paths = options.light_paths == "on";
-  if (light_paths && (per_bounce || guided || emitter_guided))
-    throw RelightInputError("--light-paths on adds strategies to path tracing: it takes no --integrator bounces, --guiding or "
-                            "--emitter-guiding on");
+  if (light_paths && (per_bounce || guided))
+    throw RelightInputError("--light-paths on adds strategies to path tracing: it takes no --integrator bounces or --guiding");
   // With --time, --frames or --budget-ms, light paths refresh progressively as path tracing alone
   // does (RefreshSessionOptions::light_subpaths: the session's passes connect, edits keep their
-  // rules); with --spp alone, one whole run, bake --backend vulkan --light-paths on's bit for bit.
+  // rules); with --spp alone, or with --emitter-guiding on (a whole run itself), one whole run, bake
+  // --backend vulkan --light-paths on's bit for bit.
   const bool whole_run_light_paths =
-      light_paths && options.frames == 0 && options.frame_budget_ms == 0 && options.time_budget_seconds == 0;
+      light_paths && (emitter_guided || (options.frames == 0 && options.frame_budget_ms == 0 && options.time_budget_seconds == 0));
 
   const bool share = options.share_ranks > 0;
   if (share) {
@@ -192,7 +192,7 @@ json relight_bundle(const RelightOptions& options) {
                                 options.guiding == "svo" ? GuidingMode::Svo : GuidingMode::Grid).rays;
     report("lighting", 1, rays);
   }
-  // One path-traced run of the whole lightmap: --emitter-guiding on, or --light-paths on with --spp alone.
+  // One path-traced run of the whole lightmap: --emitter-guiding on, or --light-paths on with --spp alone (or both).
   json emitter_guiding_report, light_paths_report;
   if (emitter_guided || whole_run_light_paths) {
     report("lighting", 0, 0);

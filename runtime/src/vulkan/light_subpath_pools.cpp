@@ -34,7 +34,7 @@ LightSubpathPools::LightSubpathPools(WavefrontBatchRunner& runner, const Lightin
   Context& context = runner_.context();
   WavefrontBuffers& buffers = runner_.buffers();
   const uint64_t vertices = uint64_t(pool_paths(double(max_work), per_sample_)) * kVerticesPerPath;
-  const bool grew = buffers.paths.reserve_light_subpaths(context, environment);
+  const bool grew = buffers.paths.reserve_light_subpaths(context, environment, settings.emitter_guiding);
   if (buffers.light_pool.reserve(context, std::min(vertices, most_vertices())) || grew) runner_.bind_buffers();
   params.light_subpath_capacity = buffers.light_pool.capacity();
 }

@@ -375,7 +375,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     });
     // A grown buffer replaces the one the descriptors name: they follow it at once.
     const LightingScene* lighting = guiding_scene_.lighting.get();
-    if (lighting && EmitterGuidingCache::guides(*lighting) && runner_.buffers().paths.reserve_emitter_learning(runner_.context()))
+    if (lighting && EmitterGuidingCache::guides(*lighting) && runner_.buffers().paths.reserve_emitter_learning(runner_.context(), settings.light_subpaths))
       runner_.bind_buffers();
     emitter_guide = made.get();
   }

@@ -42,8 +42,6 @@ void check_light_subpaths(const IntegratorSettings& settings) {
     throw std::invalid_argument("Vulkan backend: --light-paths applies to path tracing, not to --integrator bounces");
   if (settings.guiding != GuidingMode::Off)
     throw std::invalid_argument("Vulkan backend: --light-paths is not combined with --guiding (use --guiding off)");
-  if (settings.emitter_guiding)
-    throw std::invalid_argument("Vulkan backend: --light-paths with --emitter-guiding on is implemented on the CPU backend only");
   if (distributed(settings.work_share))
     throw std::invalid_argument("Vulkan backend: --light-paths runs in one process only, not under mpirun with several ranks");
   if (!(settings.light_subpaths_per_sample > 0 && settings.light_subpaths_per_sample <= 64))

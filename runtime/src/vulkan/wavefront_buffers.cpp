@@ -35,16 +35,16 @@ PathStateBuffers::PathStateBuffers(Context& context, uint32_t paths)
       shadow_rays(context.create_storage_buffer(size_t(paths) * kShadowRaysPerVertex * sizeof(ShadowRay))),
       paths(paths) {}
 
-bool PathStateBuffers::reserve_emitter_learning(Context& context) {
-  const VkDeviceSize bytes = VkDeviceSize(paths) * 4 * 16;
+bool PathStateBuffers::reserve_emitter_learning(Context& context, bool light_subpaths) {
+  const VkDeviceSize bytes = VkDeviceSize(paths) * (light_subpaths ? 5 : 4) * 16;
   if (throughput.size() >= bytes) return false;
   throughput = context.create_storage_buffer(bytes);
   return true;
 }
 
-bool PathStateBuffers::reserve_light_subpaths(Context& context, bool environment) {
+bool PathStateBuffers::reserve_light_subpaths(Context& context, bool environment, bool emitter_learning) {
   bool grew = false;
-  const VkDeviceSize state = VkDeviceSize(paths) * 3 * 16;
+  const VkDeviceSize state = VkDeviceSize(paths) * (emitter_learning ? 5 : 3) * 16;
   if (throughput.size() < state) throughput = context.create_storage_buffer(state), grew = true;
   const VkDeviceSize slots =
       VkDeviceSize(paths) * (environment ? kShadowSlotsWithEnvironmentAndConnection : kShadowSlotsWithConnection) * sizeof(ShadowRay);

@@ -39,13 +39,14 @@ struct PathStateBuffers {
 
   PathStateBuffers(Context& context, uint32_t paths);
   void bind(DescriptorWrites& writes) const;
-  // The throughput buffer with emitter guiding's 2P entries (a new buffer when it grows: rebind).
-  // Returns whether it grew.
-  bool reserve_emitter_learning(Context& context);
-  // Light subpaths: the throughput buffer with the eye-vertex state's P entries, and with an
-  // environment map a fourth shadow slot per path (gpu_layout.h kShadowSlotsWith*). New buffers
-  // when they grow (rebind); returns whether one did.
-  bool reserve_light_subpaths(Context& context, bool environment);
+  // The throughput buffer with emitter guiding's 2P entries (a new buffer when it grows: rebind),
+  // and after them the light subpaths' P where both run (path.glsl eye_subpath_index). Returns
+  // whether it grew.
+  bool reserve_emitter_learning(Context& context, bool light_subpaths = false);
+  // Light subpaths: the throughput buffer with the eye-vertex state's P entries (after emitter
+  // guiding's 2P where `emitter_learning`), and with an environment map a fourth shadow slot per
+  // path (gpu_layout.h kShadowSlotsWith*). New buffers when they grow (rebind); returns whether one did.
+  bool reserve_light_subpaths(Context& context, bool environment, bool emitter_learning = false);
   uint32_t paths = 0;
   static constexpr size_t kBytesPerPath = 4 + 4 + 16 + 16 + 16 + 16 + 16 + kShadowRaysPerVertex * sizeof(ShadowRay);
 };
