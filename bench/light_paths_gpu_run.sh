@@ -10,7 +10,8 @@
 # subtracted); then per wavefront stage at 256 spp, both modes.
 # Then FRAMES (default 6) frames of 16 ms each, both modes (the runtime's refresh at a game's budget).
 #   bash .replay/light_paths_gpu_run.sh       (env BUNDLES, TIMES, SPPS, FRAMES, STAGES=0 for no per-stage
-#                                              runs; writes $OUT/summary.txt as it goes)
+#                                              runs, EMITTER=1 for emitter guiding alone and with light
+#                                              paths at each time; writes $OUT/summary.txt as it goes)
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
 export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
@@ -37,6 +38,11 @@ print('$name', 'lighting_s %.3f'%r['lighting_seconds'], 'spp', r['samples_per_te
   for t in ${TIMES:-0.25 1}; do
     run off_t$t --time $t
     run on_t$t --time $t --light-paths on
+    # EMITTER=1: emitter guiding alone and with light subpaths (both whole runs) at the same time.
+    if [ "${EMITTER:-0}" = 1 ]; then
+      run eg_t$t --time $t --emitter-guiding on
+      run egon_t$t --time $t --emitter-guiding on --light-paths on
+    fi
   done
   for f in ${FRAMES:-6}; do
     run off_f$f --frames $f --budget-ms 16 --spp 0 --no-frame-errors

@@ -181,6 +181,11 @@ struct RefreshSession::State {
 
 namespace {
 
+void check_light_subpaths_per_sample(double per_sample, const std::string& what) {
+  if (!(per_sample > 0 && per_sample <= 64))
+    throw std::invalid_argument(what + ": " + std::to_string(per_sample) + " subpaths per texel sample is not in (0, 64]");
+}
+
 void check_denoise_radius(int radius, const IntegratorSettings& settings, const std::string& what) {
   if (radius < 0 || radius > kFilterMaxRadius)
     throw std::invalid_argument(what + ": radius " + std::to_string(radius) + " is not 0 (off) to " + std::to_string(kFilterMaxRadius));
@@ -283,8 +288,7 @@ std::unique_ptr<RefreshSession> RefreshSession::open(const std::string& bundle_f
   settings.light_layers = options.light_layers;
   settings.light_subpaths = options.light_subpaths;
   settings.light_subpaths_per_sample = options.light_subpaths_per_sample;
-  if (options.light_subpaths && !(options.light_subpaths_per_sample > 0 && options.light_subpaths_per_sample <= 64))
-    throw std::invalid_argument("RefreshSessionOptions::light_subpaths_per_sample must be in (0, 64]");
+  if (options.light_subpaths) check_light_subpaths_per_sample(options.light_subpaths_per_sample, "RefreshSessionOptions::light_subpaths_per_sample");
   // A bundle baked with directional layers is refreshed with them (the same estimator, path.h).
   if (baked.directional == "sh1") settings.directional = DirectionalMode::Sh1;
   check_denoise_radius(options.denoise_radius, settings, "RefreshSessionOptions::denoise_radius");  // before the integrator is made
@@ -754,8 +758,7 @@ void RefreshSession::set_probe_budget_share(double share) {
 }
 
 void RefreshSession::set_light_subpaths(bool on, double per_sample) {
-  if (!(per_sample > 0 && per_sample <= 64))
-    throw std::invalid_argument("set_light_subpaths: " + std::to_string(per_sample) + " subpaths per sample is not in (0, 64]");
+  check_light_subpaths_per_sample(per_sample, "set_light_subpaths");
   IntegratorSettings settings = state_->settings;
   settings.light_subpaths = on;
   settings.light_subpaths_per_sample = per_sample;
