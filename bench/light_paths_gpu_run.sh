@@ -25,6 +25,9 @@ for b in ${BUNDLES:-$(cd $W && ls -d *.bake | sed 's/\.bake$//')}; do
   B=$W/$b.bake
   $R $B -o $W/warm.bake --spp 4 --seed 1 $common > /dev/null  # shader and driver caches
   $R $B -o $W/warm.bake --spp 4 --seed 1 --light-paths on $common > /dev/null
+  # The emitter-guided kernels too (their pipelines were built inside the first timed run otherwise:
+  # ajar_room's eg at 0.25 s ran 1 sample in the H100 run of 2026-12-07).
+  [ "${EMITTER:-0}" = 1 ] && $R $B -o $W/warm.bake --spp 4 --seed 1 --emitter-guiding on --light-paths on $common > /dev/null
   for s in 101 202; do $R $B -o $W/ref_$s.bake --spp 4096 --seed $s $common > /dev/null; done
   list=""
   run() {  # NAME ARGS...
