@@ -49,12 +49,21 @@ EmitterGuide emitter_guide_site(uint p, SurfacePoint x, out uint record, out boo
   if (params.emitter_guide == 0u) return emitter_guide_none();
   uint found = emitter_guide_record(x.position, x.shading_normal);
   EmitterGuide g = emitter_guide_of(found);
-  bool sampling_learned = g.guided_probability > 0.0 || g.punctual_guided_probability > 0.0;
+  bool sampling_learned = emitter_guide_samples_learned(g);
   uint sample_index = params.batch_sample_begin + path_work[p] / params.batch_item_count;
   learns = emitter_vertex_learns(emitter_learning_of_sample(sample_index), found != kGuideNoRecord, sampling_learned);
   if (!learns && !sampling_learned) return emitter_guide_none();
   record = found;
   return g;
+}
+
+// The strategy next-event estimation uses at a vertex that does not learn (emitter_guide_site
+// without the learning; EmitterGuidingCache::vertex_site with Learning::None): the record's learned
+// mixture where it samples one, else the default's.
+EmitterGuide emitter_guide_without_learning(vec3 position, vec3 shading_normal) {
+  if (params.emitter_guide == 0u) return emitter_guide_none();
+  EmitterGuide g = emitter_guide_of(emitter_guide_record(position, shading_normal));
+  return emitter_guide_samples_learned(g) ? g : emitter_guide_none();
 }
 
 // Keeps the site's record and what next-event estimation reported for the connect stage and the

@@ -26,15 +26,6 @@ void store_pool_vertex(uint k, LightVertex v) {
   }
 }
 
-// The emitter strategy of an eye vertex at y that does not learn (emitter_guide_site without the
-// learning): the record's learned mixture where it samples one, else the default's.
-EmitterGuide first_hit_emitter_guide(SurfacePoint y) {
-  if (params.emitter_guide == 0u) return emitter_guide_none();
-  EmitterGuide g = emitter_guide_of(emitter_guide_record(y.position, y.shading_normal));
-  bool sampling_learned = g.guided_probability > 0.0 || g.punctual_guided_probability > 0.0;
-  return sampling_learned ? g : emitter_guide_none();
-}
-
 // Subpath i's vertices (written from pool vertex `first` when `write`); returns how many it keeps.
 uint trace_subpath(uint i, bool write, uint first) {
   uint64_t seed = (uint64_t(params.seed_hi) << 32) | uint64_t(params.seed_lo);
@@ -53,7 +44,7 @@ uint trace_subpath(uint i, bool write, uint first) {
     // NEE's density of the start from the first hit, with the strategy an eye vertex there uses
     // (emitter guiding's learned mixture where its record samples it, as the CPU's pool takes
     // EmitterGuidingCache::vertex_site; none on probes' pools, whose NEE is unguided).
-    float nee = w.depth == 1u ? light_subpath_nee_density(w, y, first_hit_emitter_guide(y)) : 0.0;
+    float nee = w.depth == 1u ? light_subpath_nee_density(w, y, emitter_guide_without_learning(y.position, y.shading_normal)) : 0.0;
     LightVertex v;
     vec3 albedo;
     if (!light_subpath_vertex(w, tri, hit.x, hit.z, hit.w, y, nee, v, albedo)) break;

@@ -182,7 +182,7 @@ EmitterGuidingCache::Site EmitterGuidingCache::vertex_site(EmitterGuidingCache* 
   if (!cache) return s;
   s.record = cache->record_of(position, shading_normal);
   const EmitterGuide guide = cache->vertex(s.record);
-  const bool sampling_learned = guide.guided_probability > 0 || guide.punctual_guided_probability > 0;
+  const bool sampling_learned = emitter_guide_samples_learned(guide);
   s.learns = emitter_vertex_learns(uint(learning), s.record != kNoRecord, sampling_learned);
   if (s.learns || sampling_learned) s.guide = guide;
   return s;

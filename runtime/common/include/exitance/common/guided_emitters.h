@@ -76,6 +76,12 @@ EXITANCE_FN EmitterGuide emitter_guide_none() {
   return g;
 }
 
+// Whether a record's strategy samples a learned distribution (area or punctual); where it does not,
+// next-event estimation's density is the default's.
+EXITANCE_FN bool emitter_guide_samples_learned(EmitterGuide g) {
+  return g.guided_probability > 0.0f || g.punctual_guided_probability > 0.0f;
+}
+
 // Which vertices of a texel's sample `sample` teach the tables (both backends): every vertex in the
 // first kEmitterEveryLearningSamples; after them, one sample in kEmitterLaterLearningStride, at
 // vertices whose record samples a learned distribution (they keep improving it). Vertices that
