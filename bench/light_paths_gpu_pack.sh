@@ -28,6 +28,6 @@ cmake --install $build --component runtime --prefix $work/pack/rt > /dev/null
 cp $build/bench/bench_bundle_rel_mse $work/pack/rt/bin/
 mkdir -p .replay
 tar -C $work/pack -cf - . | xz -6 -T2 > .replay/lp.txz
-cp bench/light_paths_gpu_run.sh .replay/
+cp bench/light_paths_gpu_run.sh bench/light_paths_modes.sh .replay/
 rm -rf $work
 ls -la .replay/lp.txz

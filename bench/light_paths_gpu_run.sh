@@ -3,7 +3,8 @@
 # exitance-relight: with --time or --frames both modes run the progressive refresh (--light-paths on:
 # its passes' texel paths connect to a pool of light subpaths per batch); with --spp alone, on is one
 # path-traced run of the whole lightmap as bake --backend vulkan --light-paths on, off the progressive
-# relight. Carry .gl and .replay; .replay/lp.txz comes from bench/light_paths_gpu_pack.sh.
+# relight. Carry .gl and .replay; .replay/lp.txz (and light_paths_modes.sh, the runs it shares with
+# bench/light_paths_lavapipe_run.sh) come from bench/light_paths_gpu_pack.sh.
 # Per bundle (BUNDLES, default every one packed): a two-seed 4096-spp reference without subpaths
 # (seeds 101, 202), then both modes at equal lighting time (TIMES seconds, --time) and at equal
 # samples (SPPS), compared with the reference (bench_bundle_rel_mse: relMSE, the reference's noise
@@ -19,41 +20,17 @@ export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
 W=/tmp/light_paths_gpu_$$; mkdir -p $W && tar -C $W -xJf .replay/lp.txz
 S=$OUT/summary.txt
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader > $S
-common="--ignore-baked --no-light-layers --json"
 R=$W/rt/bin/exitance-relight
+. "$(dirname "$0")/light_paths_modes.sh"  # packed beside this script
 for b in ${BUNDLES:-$(cd $W && ls -d *.bake | sed 's/\.bake$//')}; do
   B=$W/$b.bake
-  $R $B -o $W/warm.bake --spp 4 --seed 1 $common > /dev/null  # shader and driver caches
-  $R $B -o $W/warm.bake --spp 4 --seed 1 --light-paths on $common > /dev/null
-  # The emitter-guided kernels too (their pipelines were built inside the first timed run otherwise:
-  # ajar_room's eg at 0.25 s ran 1 sample in the H100 run of 2026-12-07).
-  [ "${EMITTER:-0}" = 1 ] && $R $B -o $W/warm.bake --spp 4 --seed 1 --emitter-guiding on --light-paths on $common > /dev/null
-  for s in 101 202; do $R $B -o $W/ref_$s.bake --spp 4096 --seed $s $common > /dev/null; done
-  list=""
-  run() {  # NAME ARGS...
-    local name=$b-$1; shift
-    $R $B -o $W/$name.bake --seed 3 $common "$@" > $W/$name.json
-    python3 -c "
-import json; r=json.load(open('$W/$name.json'))
-print('$name', 'lighting_s %.3f'%r['lighting_seconds'], 'spp', r['samples_per_texel'], 'rays %.3g'%r['rays'], 'rays_per_s %.3g'%r['rays_per_second'], 'light_paths', r.get('light_paths'))" >> $S
-    list="$list $W/$name.bake"
-  }
-  for t in ${TIMES:-0.25 1}; do
-    run off_t$t --time $t
-    run on_t$t --time $t --light-paths on
-    # EMITTER=1: emitter guiding alone and with light subpaths (both whole runs) at the same time.
-    if [ "${EMITTER:-0}" = 1 ]; then
-      run eg_t$t --time $t --emitter-guiding on
-      run egon_t$t --time $t --emitter-guiding on --light-paths on
-    fi
-  done
-  for f in ${FRAMES:-6}; do
-    run off_f$f --frames $f --budget-ms 16 --spp 0 --no-frame-errors
-    run on_f$f --frames $f --budget-ms 16 --spp 0 --no-frame-errors --light-paths on
-  done
+  PREFIX=$b-
+  light_paths_warm_and_references
+  light_paths_at_times ${TIMES:-0.25 1} >> $S
+  for f in ${FRAMES:-6}; do light_paths_in_frames $f 16 >> $S; done
   for n in ${SPPS:-64 256}; do
-    run off_s$n --spp $n
-    run on_s$n --spp $n --light-paths on
+    light_paths_run off_s$n --spp $n >> $S
+    light_paths_run on_s$n --spp $n --light-paths on >> $S
   done
   for mode in $([ "${STAGES:-1}" = 1 ] && echo off on); do
     $R $B -o $W/stages.bake --seed 3 --spp 256 --light-paths $mode --stage-statistics $common > $W/stages.json
