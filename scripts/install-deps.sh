@@ -8,7 +8,7 @@ packages=(
   clang libclang-rt-14-dev
   libembree-dev libtbb-dev
   libopenvdb-dev libopenvdb-tools
-  libopenexr-dev libopenimageio-dev openimageio-tools
+  libopenexr-dev libdeflate-dev libopenimageio-dev openimageio-tools
   libtinygltf-dev libstb-dev nlohmann-json3-dev libcli11-dev
   libcgal-dev libeigen3-dev
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools glslang-tools

@@ -4,8 +4,6 @@
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
-#include <ImfOutputFile.h>
-#include <ImfStringAttribute.h>
 #include <ImfThreading.h>
 
 #include <algorithm>
@@ -21,30 +19,6 @@ int lightmap_exr_threads() {
     return hardware;
   }();
   return threads;
-}
-
-void write_lightmap_exr(const std::string& path, const LightmapImage& image, int threads) {
-  try {
-    Imf::Header header(image.width, image.height);
-    header.compression() = Imf::ZIP_COMPRESSION;
-    // zlib level 1: a third less CPU than OpenEXR 3.1's default 4 for 4-11 % larger files, the
-    // same pixels (bench_exr_compression, bench/results/host-stages.md).
-    header.zipCompressionLevel() = 1;
-    header.insert("generator", Imf::StringAttribute("exitance"));
-    Imf::FrameBuffer frame;
-    for (const auto& [name, data] : image.channels) {
-      if (data.size() != size_t(image.width) * size_t(image.height))
-        throw std::runtime_error("channel " + name + " has the wrong size");
-      header.channels().insert(name, Imf::Channel(Imf::FLOAT));
-      frame.insert(name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(data.data())), sizeof(float),
-                                    sizeof(float) * size_t(image.width)));
-    }
-    Imf::OutputFile file(path.c_str(), header, threads < 0 ? lightmap_exr_threads() : threads);
-    file.setFrameBuffer(frame);
-    file.writePixels(image.height);
-  } catch (const std::exception& e) {
-    throw std::runtime_error("cannot write " + path + ": " + e.what());
-  }
 }
 
 LightmapImage read_lightmap_exr(const std::string& path, int threads) {

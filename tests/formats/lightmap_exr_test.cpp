@@ -1,6 +1,8 @@
-// Lightmap EXR pages written and read on OpenEXR's worker threads (formats::write_lightmap_exr,
-// read_lightmap_exr): the file's bytes do not depend on the thread count, and every float reads
-// back bit-identical, including -0, denormals, infinities and NaN payloads.
+// Lightmap EXR pages written on worker threads (formats::write_lightmap_exr: ZIP chunks deflated by
+// libdeflate, formats/src/exr_zip_chunks.h) and read by OpenEXR's own reader on its worker threads
+// (read_lightmap_exr): the file's bytes do not depend on the thread count, and every float reads
+// back bit-identical, including -0, denormals, infinities and NaN payloads, in chunks that deflate
+// and in chunks stored raw because they do not.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,6 +13,7 @@
 #include <iterator>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include <unistd.h>
 
@@ -83,5 +86,57 @@ TEST(LightmapExr, ThreadCountChangesNeitherBytesNorPixels) {
     SCOPED_TRACE(threads);
     expect_bit_identical(page, exitance::formats::read_lightmap_exr((dir / "serial.exr").string(), threads));
   }
+  fs::remove_all(dir);
+}
+
+// Random bit patterns do not deflate: such chunks are stored as they are (OpenEXR's rule, which its
+// reader recognises by the chunk's size). Sizes down to one pixel and one partial chunk.
+TEST(LightmapExr, IncompressibleAndTinyPagesReadBackBitIdentical) {
+  const fs::path dir = fs::temp_directory_path() / ("exitance_lightmap_exr_raw_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  for (const auto& [width, height] : {std::pair{257, 41}, {1, 1}, {3, 17}, {64, 16}}) {
+    SCOPED_TRACE(std::to_string(width) + "x" + std::to_string(height));
+    LightmapImage page = test_page(width, height);
+    uint64_t state = 0x9E3779B97F4A7C15ull;
+    for (auto& [name, data] : page.channels)
+      for (size_t i = name == "R" ? 4 : 0; i < data.size(); ++i) {  // R keeps its special values
+        state ^= state << 13, state ^= state >> 7, state ^= state << 17;
+        const uint32_t bits = uint32_t(state >> 16);
+        std::memcpy(&data[i], &bits, sizeof bits);
+      }
+    const fs::path path = dir / "page.exr";
+    exitance::formats::write_lightmap_exr(path.string(), page, 3);
+    const std::string bytes = file_bytes(path);
+    // Every chunk stored raw: the file holds at least every pixel's bytes.
+    EXPECT_GE(bytes.size(), size_t(width) * size_t(height) * page.channels.size() * sizeof(float));
+    expect_bit_identical(page, exitance::formats::read_lightmap_exr(path.string(), 0));
+    exitance::formats::write_lightmap_exr(path.string(), page, 0);
+    EXPECT_EQ(file_bytes(path), bytes);
+  }
+  fs::remove_all(dir);
+}
+
+// A page that cannot be written throws one message naming the file and leaves no file behind.
+TEST(LightmapExr, AFailedWriteNamesTheFileAndLeavesNothing) {
+  const fs::path dir = fs::temp_directory_path() / ("exitance_lightmap_exr_bad_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path missing = dir / "no_such_folder" / "lightmap-0.exr";
+  try {
+    exitance::formats::write_lightmap_exr(missing.string(), test_page(8, 8));
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(missing.string()), std::string::npos) << e.what();
+  }
+  LightmapImage wrong = test_page(8, 8);
+  wrong.channels["B"].pop_back();
+  const fs::path path = dir / "lightmap-1.exr";
+  try {
+    exitance::formats::write_lightmap_exr(path.string(), wrong);
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("channel B"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(path));
+  EXPECT_FALSE(fs::exists(missing));
   fs::remove_all(dir);
 }

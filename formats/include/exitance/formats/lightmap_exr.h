@@ -1,5 +1,6 @@
-// lightmap-<page>.exr: OpenEXR, float32, scanline, ZIP compressed at zlib level 1 (the
-// compression and level chosen by measurement: bench/results/host-stages.md). Channel layers are named
+// lightmap-<page>.exr: OpenEXR, float32, scanline, ZIP compressed (OpenEXR's ZIP chunks, deflated
+// by libdeflate at level 4: the compression and its encoder chosen by measurement,
+// bench/results/host-stages.md; any OpenEXR reader reads them). Channel layers are named
 // "<layer>.R/G/B" except the main one, which is plain R, G, B plus A (texel coverage) and `valid`
 // (1 = the texel was traced; 0 = gutter, or a sealed texel that no light reaches, skipped by bake and
 // filled by dilation from its traced neighbours: docs/bundle.md), and the single-channel `error.Y`
@@ -18,9 +19,10 @@ struct LightmapImage {
   std::map<std::string, std::vector<float>> channels;
 };
 
-// Throws std::runtime_error on I/O failure. `threads`: OpenEXR worker threads that compress (write)
-// or decompress (read) the file's blocks; -1 = lightmap_exr_threads(), 0 = all on the calling
-// thread. The file's bytes and the pixels read do not depend on it (tests/formats).
+// Throw std::runtime_error naming the file on I/O failure (a page that fails to write is removed).
+// `threads`: worker threads that compress (write: threads of the writer's own) or decompress (read:
+// OpenEXR's pool) the file's blocks; -1 = lightmap_exr_threads(), 0 = all on the calling thread.
+// The file's bytes and the pixels read do not depend on it (tests/formats).
 void write_lightmap_exr(const std::string& path, const LightmapImage& image, int threads = -1);
 LightmapImage read_lightmap_exr(const std::string& path, int threads = -1);
 
