@@ -12,6 +12,7 @@
 #include "exitance/common/sampling.h"
 #include "exitance/runtime/bundle/bounce_statistics_report.h"
 #include "exitance/runtime/bundle/emitter_guiding_report.h"
+#include "exitance/runtime/bundle/light_paths_report.h"
 #include "exitance/runtime/material_eval.h"
 
 namespace exitance {
@@ -219,10 +220,10 @@ json stats_json(const BakeResults& results, const json& seconds, size_t warnings
                        {"guiding", guiding_names[int(options.lighting.guiding)]},
                        {"emitter_guiding", options.lighting.emitter_guiding},
                        {"light_paths", options.lighting.light_subpaths}};
-  if (options.lighting.light_subpaths || estimate.light_subpaths > 0)
-    stats["light_paths"] = {{"subpaths", estimate.light_subpaths},
-                            {"vertices", estimate.light_subpath_vertices},
-                            {"per_sample", options.lighting.light_subpaths_per_sample}};
+  if (options.lighting.light_subpaths || estimate.light_subpaths > 0) {
+    stats["light_paths"] = light_paths_json(estimate);
+    stats["light_paths"]["per_sample"] = options.lighting.light_subpaths_per_sample;
+  }
   if (results.denoise)
     stats["denoise"] = {{"radius", options.denoise_radius},
                         {"texels", results.denoise->texels},

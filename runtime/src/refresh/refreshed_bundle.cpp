@@ -14,6 +14,7 @@
 #include "exitance/formats/svo_file.h"
 #include "exitance/runtime/bundle/bundle_directory.h"
 #include "exitance/runtime/bundle/light_layer_pages.h"
+#include "exitance/runtime/bundle/light_paths_report.h"
 #include "exitance/runtime/bundle/lightmap_assembly.h"
 #include "exitance/runtime/bundle/probe_results.h"
 #include "exitance/runtime/bundle/seam_stage.h"
@@ -165,7 +166,7 @@ json write_refreshed_bundle(RefreshSession& session, const std::string& output, 
   report["nonfinite_samples"] = estimate.nonfinite_samples + probe_estimate.nonfinite_samples;
   // A progressive refresh with light subpaths (RefreshSessionOptions::light_subpaths): the pools' totals.
   if (session.settings().light_subpaths && !report.contains("light_paths"))
-    report["light_paths"] = {{"subpaths", estimate.light_subpaths}, {"vertices", estimate.light_subpath_vertices}};
+    report["light_paths"] = light_paths_json(estimate);
   if (denoised)
     report["denoise"] = {{"radius", denoise_radius},
                          {"texels", denoised->texels},

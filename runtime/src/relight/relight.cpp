@@ -11,6 +11,7 @@
 
 #include "exitance/runtime/bundle/bounce_statistics_report.h"
 #include "exitance/runtime/bundle/emitter_guiding_report.h"
+#include "exitance/runtime/bundle/light_paths_report.h"
 #include "exitance/formats/bundle_manifest.h"
 #include "exitance/runtime/refresh/refreshed_bundle.h"
 #include "exitance/runtime/stage_clock.h"
@@ -204,7 +205,7 @@ json relight_bundle(const RelightOptions& options) {
     }
     rays = run->rays;
     if (emitter_guided) emitter_guiding_report = emitter_guiding_json(run->emitter_guiding);
-    if (whole_run_light_paths) light_paths_report = {{"subpaths", run->light_subpaths}, {"vertices", run->light_subpath_vertices}};
+    if (whole_run_light_paths) light_paths_report = light_paths_json(*run);
     report("lighting", 1, rays);
   }
   uint64_t share_texels = 0;
