@@ -47,6 +47,7 @@ LightmapImage test_page(int width, int height) {
     }
   }
   std::vector<float>& r = image.channels["R"];
+  if (r.size() < 4) return image;  // too small for the special values
   r[0] = -0.0f;
   r[1] = std::numeric_limits<float>::denorm_min();
   r[2] = std::numeric_limits<float>::infinity();
