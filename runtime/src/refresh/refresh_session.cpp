@@ -24,6 +24,7 @@
 #include "exitance/formats/svo_file.h"
 #include "exitance/runtime/refresh/baked_lightmap.h"
 #include "exitance/runtime/refresh/light_layer_edits.h"
+#include "exitance/runtime/refresh/pass_cost.h"
 #include "exitance/runtime/refresh/published_estimate.h"
 #include "exitance/runtime/refresh/texel_grid.h"
 #include "exitance/runtime/refresh/texels_near_change.h"
@@ -47,61 +48,7 @@ struct RefreshSession::State {
   std::shared_ptr<LightingScene> lighting;
   IntegratorSettings settings;
   std::unique_ptr<VulkanIntegrator> integrator;
-  // What a pass over a work list costs, to size passes to a millisecond budget: a fixed part (its
-  // drain and submissions) plus a part per sample, fitted from the last two passes of different
-  // sizes; until then the last pass's cost per sample, fixed part included (conservative). Kept
-  // per list (a small list's passes are not a large one's).
-  struct PassCost {
-    size_t texels = 0;  // the list it was measured on
-    double last_work = 0, last_ms = 0;  // texel-samples and milliseconds of the last pass
-    double fixed_ms = 0, ms_per_work = 0;
-    bool fitted = false, explored = false;
-    // Not measured on this list yet: the cost is the last list's, a prior, whose passes get
-    // kPriorShare of the time left (a list's texels can cost more per sample than the last list's:
-    // the texels near an edit are not a random subset).
-    bool prior = false;
-    static constexpr double kPriorShare = 0.6;
-    // The last list's fitted fixed part (a pass's drain and submissions, whichever its texels):
-    // until this list has two pass sizes, its one measurement gives the part per texel-sample
-    // beyond it (without, that part also carries the fixed cost, and the next pass is sized small).
-    double known_fixed_ms = 0;
-    void add(double work, double ms) {
-      bool refitted = false;
-      if (last_work > 0 && work != last_work) {
-        const double slope = (ms - last_ms) / (work - last_work), intercept = ms - slope * work;
-        if (slope > 0 && intercept >= 0) fixed_ms = intercept, ms_per_work = slope, fitted = refitted = true;
-      }
-      if (fitted && !refitted) {
-        // No new slope (the same size again, or two sizes that give none): the fit is moved through
-        // this pass, so that a fit from two noisy passes (a process's first passes, at low clocks)
-        // does not hold for as long as the sizes repeat (it held the courtyard's frames after a sun
-        // edit at 2 samples where 14 fit).
-        const double intercept = ms - ms_per_work * work;
-        if (intercept >= 0) fixed_ms = intercept;
-        else fixed_ms = 0, ms_per_work = ms / work;
-      }
-      if (!fitted) {
-        fixed_ms = ms > 2 * known_fixed_ms ? known_fixed_ms : 0;
-        ms_per_work = (ms - fixed_ms) / work;
-      }
-      last_work = work, last_ms = ms;
-      prior = false;
-    }
-    // Samples of `texels` that fit in `remaining` ms; 0 when none.
-    double fitting(double remaining, size_t texels) const {
-      const double per_sample = ms_per_work * double(texels);
-      const double usable = prior ? kPriorShare * remaining : remaining;
-      return per_sample > 0 ? std::floor((usable - fixed_ms) / per_sample) : 1.0;
-    }
-    // A model for another list of `list_texels`, starting from this one's cost as its prior.
-    PassCost for_list(size_t list_texels) const {
-      PassCost next{list_texels};
-      if (ms_per_work > 0) next.fixed_ms = fixed_ms, next.ms_per_work = ms_per_work, next.prior = true;
-      if (fitted) next.known_fixed_ms = fixed_ms;
-      else next.known_fixed_ms = known_fixed_ms;
-      return next;
-    }
-  } pass_cost;
+  refresh::PassCost pass_cost;  // sizes passes to a millisecond budget (refresh/pass_cost.h)
   uint32_t priority_samples = 32;
   // The accumulation since the last edit, as lists of texels with their sample counts: after a
   // local edit, the texels near it first (until priority_samples), then the others until they
@@ -995,8 +942,8 @@ RefreshReport RefreshSession::refresh(const RefreshBudget& budget) {
         // the lightmap: lavapipe, or a budget of a millisecond or two on a GPU), at least
         // kLeastPartTexels, and that only as a call's first pass (a call adds at least one).
         if (part == 0) part = list->size();
-        const double usable = (s.pass_cost.prior ? State::PassCost::kPriorShare : 1.0) * remaining - s.pass_cost.fixed_ms;
-        const double fit = std::floor(usable / s.pass_cost.ms_per_work);
+        const double usable = (s.pass_cost.prior ? refresh::PassCost::kPriorShare : 1.0) * remaining - s.pass_cost.fixed_ms;
+        const double fit = std::min(std::floor(usable / s.pass_cost.ms_per_work), std::floor(s.pass_cost.work_cap()));
         const size_t least = std::min(part, kLeastPartTexels);
         if (fit < double(least)) {
           if (report.rays > 0) break;
