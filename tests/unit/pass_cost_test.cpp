@@ -36,6 +36,8 @@ TEST(PassCost, ANoisyFitOfSmallPassesCannotSizeAHugePass) {
   EXPECT_LT(cost.ms_per_work * kTexels, 0.05);
   const double samples = cost.fitting(16.0, kTexels);
   EXPECT_EQ(samples, 16.0) << "at most kMaxGrowth x the largest pass (4 samples)";
+  // A pass over part of a list (one sample of as many texels as fit) has the same cap.
+  EXPECT_EQ(cost.fitting_texels(16.0), 16.0 * kTexels);
   // That pass, measured at its true cost, refits the model: the next one is sized from it.
   cost.add(samples * kTexels, 4.0 + 1.0 * samples);
   EXPECT_NEAR(cost.ms_per_work * kTexels, (20.0 - 5.02) / 12.0, 1e-9);

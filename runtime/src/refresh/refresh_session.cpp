@@ -942,8 +942,7 @@ RefreshReport RefreshSession::refresh(const RefreshBudget& budget) {
         // the lightmap: lavapipe, or a budget of a millisecond or two on a GPU), at least
         // kLeastPartTexels, and that only as a call's first pass (a call adds at least one).
         if (part == 0) part = list->size();
-        const double usable = (s.pass_cost.prior ? refresh::PassCost::kPriorShare : 1.0) * remaining - s.pass_cost.fixed_ms;
-        const double fit = std::min(std::floor(usable / s.pass_cost.ms_per_work), std::floor(s.pass_cost.work_cap()));
+        const double fit = s.pass_cost.fitting_texels(remaining);
         const size_t least = std::min(part, kLeastPartTexels);
         if (fit < double(least)) {
           if (report.rays > 0) break;

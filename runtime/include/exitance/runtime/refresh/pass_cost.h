@@ -57,13 +57,18 @@ struct PassCost {
   // The most texel-samples a pass may have now (kMaxGrowth times the largest measured; unbounded
   // before any).
   double work_cap() const { return max_work > 0 ? kMaxGrowth * max_work : INFINITY; }
+  // The time a pass may take of `remaining` ms: all of it, or kPriorShare of it on a prior.
+  double usable(double remaining) const { return prior ? kPriorShare * remaining : remaining; }
   // Whole samples of `texels` that fit in `remaining` ms, at most work_cap(); 0 when none.
   double fitting(double remaining, size_t texels) const {
     const double per_sample = ms_per_work * double(texels);
-    const double usable = prior ? kPriorShare * remaining : remaining;
     if (!(per_sample > 0)) return 1.0;
-    const double fit = std::floor((usable - fixed_ms) / per_sample);
-    return texels > 0 ? std::min(fit, std::max(1.0, std::floor(work_cap() / double(texels)))) : fit;
+    const double fit = std::floor((usable(remaining) - fixed_ms) / per_sample);
+    return std::min(fit, std::max(1.0, std::floor(work_cap() / double(texels))));
+  }
+  // Texels of one sample that fit in `remaining` ms (a pass over part of a list), at most work_cap().
+  double fitting_texels(double remaining) const {
+    return std::min(std::floor((usable(remaining) - fixed_ms) / ms_per_work), std::floor(work_cap()));
   }
   // A model for another list of `list_texels`, starting from this one's cost as its prior.
   PassCost for_list(size_t list_texels) const {
