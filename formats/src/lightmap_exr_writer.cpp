@@ -34,15 +34,21 @@ void check_core(exr_result_t result, const char* what) {
     throw std::runtime_error(std::string(what) + ": " + (core_error.empty() ? exr_get_default_error_message(result) : core_error));
 }
 
-// A file left unfinished (an error on the way) is closed and removed: no partial page stays.
+// A file left unfinished (an error on the way, or in finish() itself) is closed and removed: no
+// partial page stays.
 struct CoreWriteContext {
   exr_context_t context = nullptr;
   std::string path;
+  bool finished = false;
+  void finish() {
+    check_core(exr_finish(&context), "finish");
+    finished = true;
+  }
   ~CoreWriteContext() {
-    if (!context) return;
-    exr_finish(&context);
+    if (finished) return;
+    if (context) exr_finish(&context);
     std::error_code ignored;
-    std::filesystem::remove(path, ignored);
+    if (!path.empty()) std::filesystem::remove(path, ignored);
   }
 };
 
@@ -167,9 +173,7 @@ void write_lightmap_exr(const std::string& path, const LightmapImage& image, int
       if (writer_error) std::rethrow_exception(writer_error);
       if (worker_error) std::rethrow_exception(worker_error);
     }
-    exr_context_t context = file.context;
-    file.context = nullptr;
-    check_core(exr_finish(&context), "finish");
+    file.finish();
   } catch (const std::exception& e) {
     throw std::runtime_error("cannot write " + path + ": " + e.what());
   }
