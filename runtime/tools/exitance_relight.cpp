@@ -1,4 +1,4 @@
-// exitance-relight BUNDLE [-o OUT] [--edits EDITS.json] [--spp N] [--time S] [--budget-ms N] [--frames N] [--guiding off|grid|svo] [--emitter-guiding off|on] [--seed N] [--device N] [--json] [--share R/N]
+// exitance-relight BUNDLE [-o OUT] [--edits EDITS.json] [--spp N] [--time S] [--budget-ms N] [--frames N] [--guiding off|grid|svo|auto] [--emitter-guiding off|on] [--seed N] [--device N] [--json] [--share R/N]
 // Re-lights a baked bundle from its scene.bin on the GPU (runtime/src/relight). Links the runtime
 // library and nothing of the offline stage; runs where only a Vulkan driver exists.
 #include <CLI/CLI.hpp>
@@ -64,9 +64,10 @@ int main(int argc, char** argv) {
                  "in one run; not with --frames or --budget-ms)")
       ->check(CLI::IsMember({"path", "bounces"}));
   app.add_option("--guiding", options.guiding,
-                 "off (default) | grid | svo (guided path tracing, as bake --guiding grid|svo; svo reads the bundle's "
-                 "svo.bin: the whole lightmap in one run; not with --frames, --budget-ms or --integrator bounces; auto is "
-                 "refused: the measured choice runs in bake only)")
+                 "off (default) | grid | svo | auto (guided path tracing, as bake --backend vulkan --guiding grid|svo|auto; "
+                 "svo reads the bundle's svo.bin; auto keeps grid guiding where its measured pilot says it pays and "
+                 "reports the choice as guiding_auto: the whole lightmap in one run; not with --frames, --budget-ms or "
+                 "--integrator bounces)")
       ->check(CLI::IsMember({"off", "grid", "svo", "auto"}));
   app.add_option("--bounce-caches", options.bounce_caches,
                  "device (default) | host: where --integrator bounces builds its layer caches (host: the earlier path, "

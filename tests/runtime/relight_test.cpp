@@ -263,6 +263,42 @@ TEST(Relight, ReproducesAVulkanGuidedBakeBitForBit) {
   fs::remove_all(dir);
 }
 
+// --guiding auto: a bundle baked with the measured choice on the Vulkan backend (bake --backend vulkan
+// --guiding auto) is relit with it from scene.bin bit for bit (the same pilot, sums, choice and
+// seed), and the report's guiding_auto is the bake manifest's stats.guiding; refused with --frames.
+TEST(Relight, ReproducesAVulkanAutoGuidedBakeBitForBit) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const fs::path dir = fs::temp_directory_path() / ("exitance-relight-auto-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path baked = dir / "auto.bake", output = dir / "auto-relit.bake";
+  bake_to_relight("cornell_room", baked, 4, 16, [](BakeOptions& b) {
+    b.lighting.integrator = IntegratorMode::Path;
+    b.lighting.guiding = GuidingMode::Auto;
+    b.guiding_auto_given = true;
+    b.integrator_auto = false;
+  });
+  const nlohmann::json manifest = nlohmann::json::parse(file_bytes(baked / "manifest.json"));
+  ASSERT_TRUE(manifest["stats"].contains("guiding")) << "the bake ran no measured choice";
+  RelightOptions options;
+  options.bundle = baked.string();
+  options.output = output.string();
+  options.seed = 9;
+  options.spp = 16;
+  options.guiding = "auto";
+  const nlohmann::json report = relight_bundle(options);
+  EXPECT_EQ(report["guiding"], "auto");
+  ASSERT_TRUE(report.contains("guiding_auto"));
+  EXPECT_EQ(report["guiding_auto"]["decided"], true);  // a pilot of 4 samples, complete within 16
+  EXPECT_EQ(report["guiding_auto"], manifest["stats"]["guiding"]);
+  EXPECT_GE(expect_same_pages(baked, output, "the auto-guided bake's"), 1u);
+  options.output = (dir / "refused.bake").string();
+  options.frames = 2;
+  EXPECT_THROW(relight_bundle(options), RelightInputError);
+  EXPECT_FALSE(fs::exists(dir / "refused.bake"));
+  fs::remove_all(dir);
+}
+
 // Emitter guiding (--emitter-guiding on): a bundle baked emitter-guided on the Vulkan backend is
 // relit emitter-guided from scene.bin bit for bit (the same cache, passes, folds and seed); the
 // report says what the cache held; refused with --frames (not progressive), with --guiding and an
@@ -558,9 +594,9 @@ TEST(Relight, BadScenesAreOneLineAndExitTwo) {
   EXPECT_EQ(run_relight((f.dir / "no-such.bake").string(), errors), 2);
   EXPECT_NE(errors.find("manifest.json"), std::string::npos) << errors;
   EXPECT_EQ(run_relight(f.baked.string() + " --spp -3", errors), 2);
-  // --guiding auto: bake's measured choice, refused here in one line.
+  // --guiding auto: a whole run, as bake's measured choice, refused with frames in one line.
   const fs::path guided_out = f.dir / "svo-out.bake";
-  EXPECT_EQ(run_relight(f.baked.string() + " -o " + guided_out.string() + " --guiding auto --spp 1", errors), 2);
+  EXPECT_EQ(run_relight(f.baked.string() + " -o " + guided_out.string() + " --guiding auto --frames 2", errors), 2);
   EXPECT_EQ(std::count(errors.begin(), errors.end(), '\n'), 1) << errors;
   EXPECT_NE(errors.find("--guiding auto"), std::string::npos) << errors;
   EXPECT_FALSE(fs::exists(guided_out)) << "partial output";

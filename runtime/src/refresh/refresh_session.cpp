@@ -1011,10 +1011,13 @@ const LightmapEstimate& RefreshSession::bake_guided(uint32_t spp, double time_bu
   end_change_estimate();
   if (spp == 0 && !(time_budget_seconds > 0))
     throw std::invalid_argument("guided path tracing needs samples per texel or a time budget");
-  if (mode != GuidingMode::Grid && mode != GuidingMode::Svo) throw std::invalid_argument("bake_guided: the mode must be grid or svo");
+  if (mode != GuidingMode::Grid && mode != GuidingMode::Svo && mode != GuidingMode::Auto)
+    throw std::invalid_argument("bake_guided: the mode must be grid, svo or auto");
   IntegratorSettings settings = s.settings;
   settings.integrator = IntegratorMode::Path;
   settings.guiding = mode;
+  // Auto on this backend measures grid guiding against unguided samples (lightmap_driver.cpp), as bake --backend vulkan does.
+  if (mode == GuidingMode::Auto) settings.guiding_auto_candidate = AutoGuidingCandidate::Grid;
   settings.light_subpaths = false;  // guiding is not combined with light subpaths
   if (mode == GuidingMode::Svo) {
     // The bundle's octree: its published exitance (the bake's light) seeds the guide's first fields.

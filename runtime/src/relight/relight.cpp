@@ -11,6 +11,7 @@
 
 #include "exitance/runtime/bundle/bounce_statistics_report.h"
 #include "exitance/runtime/bundle/emitter_guiding_report.h"
+#include "exitance/runtime/bundle/guiding_auto_report.h"
 #include "exitance/runtime/bundle/light_paths_report.h"
 #include "exitance/formats/bundle_manifest.h"
 #include "exitance/runtime/refresh/refreshed_bundle.h"
@@ -41,11 +42,8 @@ json relight_bundle(const RelightOptions& options) {
     throw RelightInputError("--spp-before-edits refreshes before the edits: it needs --edits");
   if (per_bounce && (options.frames > 0 || options.frame_budget_ms > 0))
     throw RelightInputError("--integrator bounces runs the whole lightmap at once: --frames and --budget-ms need --integrator path");
-  if (options.guiding == "auto")
-    throw RelightInputError("--guiding auto: the measured choice runs in bake only (bake --backend vulkan --guiding auto); "
-                            "relight with --guiding off, grid or svo");
-  const bool guided = options.guiding == "grid" || options.guiding == "svo";
-  if (!guided && options.guiding != "off") throw RelightInputError("--guiding " + options.guiding + ": expected off, grid or svo");
+  const bool guided = options.guiding == "grid" || options.guiding == "svo" || options.guiding == "auto";
+  if (!guided && options.guiding != "off") throw RelightInputError("--guiding " + options.guiding + ": expected off, grid, svo or auto");
   if (guided && per_bounce) throw RelightInputError("--guiding " + options.guiding + " guides path tracing: it needs --integrator path");
   if (guided && (options.frames > 0 || options.frame_budget_ms > 0))
     throw RelightInputError("--guiding " + options.guiding + " runs the whole lightmap at once: --frames and --budget-ms need --guiding off");
@@ -187,10 +185,13 @@ json relight_bundle(const RelightOptions& options) {
     }
     report("lighting", 1, rays);
   }
+  json guiding_auto_report;
   if (guided) {
     report("lighting", 0, 0);
-    rays = session->bake_guided(spp, options.time_budget_seconds, 0.5f,
-                                options.guiding == "svo" ? GuidingMode::Svo : GuidingMode::Grid).rays;
+    const GuidingMode mode = options.guiding == "svo" ? GuidingMode::Svo : options.guiding == "auto" ? GuidingMode::Auto : GuidingMode::Grid;
+    const LightmapEstimate& run = session->bake_guided(spp, options.time_budget_seconds, 0.5f, mode);
+    rays = run.rays;
+    if (mode == GuidingMode::Auto) guiding_auto_report = guiding_auto_json(run, "vulkan");
     report("lighting", 1, rays);
   }
   // One path-traced run of the whole lightmap: --emitter-guiding on, or --light-paths on with --spp alone (or both).
@@ -293,6 +294,7 @@ json relight_bundle(const RelightOptions& options) {
   json run;
   run["integrator"] = per_bounce ? "bounces" : "path";
   if (guided) run["guiding"] = options.guiding;
+  if (!guiding_auto_report.is_null()) run["guiding_auto"] = guiding_auto_report;  // bake's stats.guiding
   if (emitter_guided) run["emitter_guiding"] = emitter_guiding_report;
   if (whole_run_light_paths) run["light_paths"] = light_paths_report;  // else write_refreshed_bundle's, from the accumulation
   if (per_bounce) run["bounces"] = bounces_report;

@@ -198,7 +198,9 @@ class RefreshSession {
   // The whole lightmap by grid-guided path tracing (--guiding grid, issue 11) on the session's
   // device: one bake, whose learned table swaps between its passes, so not progressive; otherwise
   // as bake_per_bounce (it replaces what lightmap() returns until the next restart, edit or refresh).
-  // `mode`: Grid or Svo (the bundle's svo.bin is the octree; its exitance seeds the first fields).
+  // `mode`: Grid, Svo (the bundle's svo.bin is the octree; its exitance seeds the first fields) or
+  // Auto (grid guiding where its measured pilot says it pays, core/guiding_choice.h; the estimate's
+  // guiding_* fields say what it chose).
   const LightmapEstimate& bake_guided(uint32_t spp, double time_budget_seconds, float guiding_mix = 0.5f,
                                       GuidingMode mode = GuidingMode::Grid);
   // Whether lightmap() holds a bake_guided() result.
