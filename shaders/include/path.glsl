@@ -19,6 +19,16 @@ PathLimits path_limits() {
 // Texel and probe path batches: never per-bounce passes or the runtime's change estimate.
 bool light_subpaths_on() { return params.light_subpaths != 0u && params.bounce_flags == 0u && params.changed_light_pairs == 0u; }
 
+// Whether path p's vertices connect to the pool: every texel and probe path of a batch with light
+// subpaths, except under --guiding auto with light subpaths as its candidate (kGuidingAutoSubpaths),
+// where only texel samples of the guided strategy connect and the others keep the path tracer's
+// weights (an unbiased estimate either way, as on the CPU).
+bool path_connects(uint p) {
+  if (!light_subpaths_on()) return false;
+  if (kProbeMode || (params.guiding & kGuidingAutoSubpaths) == 0u) return true;
+  return auto_work_guided(path_work[p]);
+}
+
 // The depth of a path's fixed eye vertex x_0, never sampled from the light side: the texel, or the
 // first hit of a probe's ray (whose vertices count their bounces from it).
 uint eye_origin_depth() { return kProbeMode ? 1u : 0u; }
@@ -141,7 +151,7 @@ uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rn
   }
   if (directional_texel) guide = with_uniform_component(guide, kDirectionalUniformProbability);
   // Light subpaths: x_0 starts a fresh state; deeper vertices read the one their hit stored (shade.comp).
-  bool subpaths = light_subpaths_on();
+  bool subpaths = path_connects(p);
   EyeSubpathVertex eye = eye_subpath_vertex_none();
   if (subpaths) {
     if (path_depth[p] == eye_origin_depth()) {
@@ -197,6 +207,8 @@ uint sample_vertex(uint p, SurfacePoint x, vec3 throughput, inout PathSampler rn
     shadows = shadows || connection.contribution_state.w != kShadowNone;
     float cos_left = d.pdf > 0.0 ? dot(x.geometric_normal, d.direction) : 0.0;
     path_throughput[eye_subpath_index(p)] = vec4(eye.pdf_forward, eye.eye_sum, cos_left, uintBitsToFloat(vertex));
+  } else if (light_subpaths_on()) {
+    shadow_rays[first + params.shadow_slots - 1u] = no_shadow_ray();  // the batch's connection slot, unused by this path
   }
   uint pending = shadows ? 2u : 0u;
   if (directional_texel) path_throughput[sh1_factor_index(p)] = vec4(d.pdf > 0.0 ? sh1_direction_factor(x, d.direction) : vec3(0.0), 0.0);

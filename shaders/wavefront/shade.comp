@@ -72,7 +72,7 @@ void main() {
     // The change estimate (params.changed_light_pairs, path.h) adds no sky: it did not change.
     if (params.changed_light_pairs == 0u) {
       // With light subpaths from the sky, weighed against the left vertex's connections to them too.
-      vec3 sky = throughput * (light_subpaths_on() ? escaped_radiance_with_subpaths(stored_cos_left(p), stored_eye_subpath_vertex(p), wi, tp.w)
+      vec3 sky = throughput * (path_connects(p) ? escaped_radiance_with_subpaths(stored_cos_left(p), stored_eye_subpath_vertex(p), wi, tp.w)
                                                    : escaped_radiance(wi, tp.w));
       add_path_result(p, work, depth, sky);
       add_light_result(work, kSkyLightLayer, sky);
@@ -83,7 +83,7 @@ void main() {
     EmitterGuide emitter = kProbeMode ? emitter_guide_none() : emitter_guide_of_path(p);
     // Light subpaths: the emitter hit's weight counts the strategies with more light vertices, and
     // the new vertex's state follows from the left one's (path.h).
-    bool subpaths = light_subpaths_on();
+    bool subpaths = path_connects(p);
     EyeSubpathVertex eye = eye_subpath_vertex_none();
     vec3 ng = vec3(0.0);
     float emission_extra = 0.0;

@@ -39,18 +39,6 @@ constexpr uint32_t kGuidingLearningSamples = GridGuidingCache::kLearningSamples;
 // Light subpaths traced into one pool at most (~4 vertices and 320 bytes each on indoor scenes):
 // larger passes trace a pool per chunk of their samples.
 constexpr uint64_t kMostLightSubpathsPerPool = uint64_t(1) << 17;
-// --guiding auto's pilot with the light-subpath candidate, before GuidingChoice::pilot_for shortens it
-// for small --spp. Longer than grid guiding's (64, its learning): what connections fix is a heavy
-// tail (rare paths through a gap), which a short pilot's sample variance misses. Measured on
-// ajar_room, where connections pay ~6x at equal time: the scene's efficiency ratio read 0.82 after
-// 32 samples (so auto dropped them), 1.6 after 128, 2.4 after 256 (bench/results/guiding-auto-light-paths.md).
-constexpr uint32_t kLightSubpathPilotSamples = 256;
-// ... and only in bakes of this many pilots at least: --spp, or what a time budget's pass rate
-// promises (else the candidate is abandoned in the pilot's first half). Connections can cost far
-// more variance than they save (the open city's lit windows), and a pilot's connected samples stay
-// in the means of texels that do not connect: at 0.25 texels/m and 20 s (~140 spp, inside the pilot)
-// the city read 1.4x the unguided relMSE (bench/results/guiding-auto-light-paths.md).
-constexpr uint32_t kLightSubpathPilots = 4;
 // Subpaths in a pool that serves `samples` texel or probe samples, `per_sample` each, within the bounds.
 uint64_t light_subpaths_for(double samples, double per_sample) {
   return uint64_t(std::clamp(std::ceil(samples * per_sample), double(kFewestLightSubpathsPerPool), double(kMostLightSubpathsPerPool)));

@@ -1016,8 +1016,9 @@ const LightmapEstimate& RefreshSession::bake_guided(uint32_t spp, double time_bu
   IntegratorSettings settings = s.settings;
   settings.integrator = IntegratorMode::Path;
   settings.guiding = mode;
-  // Auto on this backend measures grid guiding against unguided samples (lightmap_driver.cpp), as bake --backend vulkan does.
-  if (mode == GuidingMode::Auto) settings.guiding_auto_candidate = AutoGuidingCandidate::Grid;
+  // Auto: the scene's candidate (light subpaths in bakes long enough for their pilot, else grid
+  // guiding: lightmap_driver.cpp), as bake --backend vulkan --guiding auto measures it.
+  if (mode == GuidingMode::Auto) settings.guiding_auto_candidate = AutoGuidingCandidate::Scene;
   settings.light_subpaths = false;  // guiding is not combined with light subpaths
   if (mode == GuidingMode::Svo) {
     // The bundle's octree: its published exitance (the bake's light) seeds the guide's first fields.

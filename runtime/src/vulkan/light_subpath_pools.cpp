@@ -40,7 +40,8 @@ LightSubpathPools::LightSubpathPools(WavefrontBatchRunner& runner, const Lightin
 }
 
 void LightSubpathPools::before_batch(GpuParams& params, double work) const {
-  params.light_subpaths = active() ? pool_paths(work, per_sample_) : 0u;
+  // A share of 0 still traces the fewest subpaths: the batch's paths keep their connection slot's layout.
+  params.light_subpaths = active() ? pool_paths(work * connected_share_, per_sample_) : 0u;
 }
 
 void LightSubpathPools::after_batch(const BatchTotals& totals, GpuParams& params) {

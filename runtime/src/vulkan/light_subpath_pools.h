@@ -18,8 +18,12 @@ class LightSubpathPools {
   LightSubpathPools(WavefrontBatchRunner& runner, const LightingScene& lighting, const IntegratorSettings& settings,
                     size_t max_work, GpuParams& params);
   bool active() const { return per_sample_ > 0; }
-  // Before a batch of `work` work items: its pool's subpaths (IntegratorSettings::light_subpaths_per_sample each).
+  // Before a batch of `work` work items: its pool's subpaths (IntegratorSettings::light_subpaths_per_sample
+  // for each of the work items that connect: set_connected_share's share of them, at least the fewest).
   void before_batch(GpuParams& params, double work) const;
+  // --guiding auto with light subpaths as its candidate (lightmap_driver.cpp): the share of the work
+  // items whose paths connect (1 by default; 0: the fewest subpaths, which no path reads).
+  void set_connected_share(double share) { connected_share_ = share; }
   // After it: a pool that did not fit was left empty; the binding grows past it for the next batches
   // (within the device's largest storage buffer).
   void after_batch(const BatchTotals& totals, GpuParams& params);
@@ -29,6 +33,7 @@ class LightSubpathPools {
 
   WavefrontBatchRunner& runner_;
   double per_sample_ = 0;
+  double connected_share_ = 1;
 };
 
 }  // namespace exitance::vulkan

@@ -13,6 +13,7 @@
 #include "exitance/formats/huge_pages.h"
 #include "exitance/runtime/core/grid_guiding_cache.h"
 #include "exitance/runtime/core/guiding_choice.h"
+#include "exitance/runtime/core/light_subpath_start.h"
 #include "exitance/runtime/core/pass_scheduler.h"
 #include "exitance/runtime/core/work_share.h"
 #include "exitance/runtime/core/svo_guiding_fields.h"
@@ -310,10 +311,23 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   // strategy's samples per texel (gpu_layout.h kGuidingAuto), read back once when the pilot is
   // complete; GuidingChoice decides per region, and the texels' verdicts go back as strategy words.
   const bool auto_guiding = settings.guiding == GuidingMode::Auto;
-  // The scene's candidate is grid guiding here: --guiding auto does not measure light subpaths on this backend.
-  if (auto_guiding && settings.guiding_auto_candidate == AutoGuidingCandidate::LightSubpaths)
-    throw std::invalid_argument("Vulkan backend: --guiding auto measures grid guiding against unguided only, not light subpaths");
-  if (settings.light_subpaths) make_light_pools(a, settings);
+  // Its candidate (AutoGuidingCandidate), as on the CPU: light subpaths where a light starts them
+  // and the bake is long enough for their pilot (--spp of kLightSubpathPilots pilots, or unlimited:
+  // under --time the pass rate decides below), or where they are named; grid guiding otherwise. A
+  // "guided" sample is then one whose path connects to the batch's pool (gpu_layout.h
+  // kGuidingAutoSubpaths); the grid's records are the regions and its buffer carries the strategy
+  // words and sums, but no vertex samples its table.
+  bool auto_light_subpaths = false;
+  if (auto_guiding && settings.guiding_auto_candidate != AutoGuidingCandidate::Grid && guiding_scene_.lighting) {
+    const bool starts = light_subpaths_start_anywhere(light_subpath_start(*guiding_scene_.lighting));
+    const bool long_enough = settings.spp == 0 || settings.spp >= kLightSubpathPilots * kLightSubpathPilotSamples;
+    auto_light_subpaths = starts && (settings.guiding_auto_candidate == AutoGuidingCandidate::LightSubpaths || long_enough);
+  }
+  if (settings.light_subpaths || auto_light_subpaths) {
+    IntegratorSettings pool_settings = settings;
+    pool_settings.light_subpaths = true;
+    make_light_pools(a, pool_settings);
+  }
   std::unique_ptr<GuidingChoice> choice;
   std::vector<uint32_t> auto_words;
   if (settings.guiding == GuidingMode::Grid || auto_guiding) {
@@ -326,16 +340,21 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     guide_buffer.emplace(*guide);
     if (auto_guiding) {
       // Regions: the guide's records (grid cell x normal class), texels without one in one more (as on the CPU).
-      const uint32_t pilot = GuidingChoice::pilot_for(settings.spp, GridGuidingCache::kLearningSamples);
+      const uint32_t pilot =
+          GuidingChoice::pilot_for(settings.spp, auto_light_subpaths ? kLightSubpathPilotSamples : GridGuidingCache::kLearningSamples);
       std::vector<uint32_t> region(a.texel_count);
       for (size_t i = 0; i < a.texel_count; ++i) {
         const uint32_t r = guide->record_of(gbuffer.texels[i].position, gbuffer.texels[i].shading_normal);
         region[i] = r == GridGuidingCache::kNoRecord ? guide->record_count() : r;
       }
-      choice = std::make_unique<GuidingChoice>(std::move(region), guide->record_count() + 1, pilot, pilot / 4, settings.seed);
+      // Light subpaths: statistics from the first sample (nothing learns), the connected half of the
+      // pilot second, so that a short bake can abandon them unmeasured (as on the CPU).
+      const uint32_t statistics_from = auto_light_subpaths ? 0 : pilot / 4;
+      choice = std::make_unique<GuidingChoice>(std::move(region), guide->record_count() + 1, pilot, statistics_from, settings.seed);
       choice->set_guided_vertex_cost(kGuidedVertexCostInRaysVulkan);
+      if (auto_light_subpaths) choice->set_candidate_half_second();
       auto_words = strategy_words(*choice, a.texel_count);
-      guide_buffer->add_auto_sections(auto_words, pilot, pilot / 4);
+      guide_buffer->add_auto_sections(auto_words, pilot, statistics_from);
     }
     guide_buffer->upload(runner_);
   }
@@ -428,17 +447,29 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   std::future<ReadBackSpace> space = std::async(std::launch::async, &LightmapDriver::read_back_space, this,
                                                 whole_here ? a.texel_count : a.work_list.size(), a.work_list.size(), a.recorded,
                                                 a.directional, a.light_layers);
+  // Light subpaths as auto's candidate: the share of a pass's samples that connect. In the pilot's
+  // second half the measuring texels' (kPilotMeasuringShare of them); after the choice the texels that
+  // kept connections (none once abandoned).
+  auto pass_connected_share = [&](uint32_t begin, uint32_t samples) -> double {
+    if (choice->decided()) return double(choice->texels_guided()) / double(std::max<size_t>(a.texel_count, 1));
+    const uint32_t from = std::max(begin, choice->pilot() / 2), to = std::min(begin + samples, choice->pilot());
+    return to > from ? kPilotMeasuringShare * double(to - from) / double(std::max(samples, 1u)) : 0.0;
+  };
+  const double loop_start = passes.elapsed_seconds();
+  uint32_t abandoned_at = 0;  // samples per texel when the light-subpath candidate was abandoned
   uint32_t first = 0, pass = 0;
   while ((share || !a.work_list.empty()) && passes.next_pass(first, pass)) {
     const auto pass_start = Clock::now();
     // Auto: the guide learns during the pilot only; the pilot's passes record the strategy sums; after
     // the choice only its guided texels' samples look the guide up (none at all: no guide lookup,
     // but the strategy words still index each texel's unguided sequence where its pilot left it).
-    const bool learning = guide && first < (choice ? choice->pilot() : GridGuidingCache::kLearningSamples) &&
+    const bool learning = guide && !auto_light_subpaths && first < (choice ? choice->pilot() : GridGuidingCache::kLearningSamples) &&
                           (!choice || !choice->decided());
-    if (guide) a.params.guiding = kGuidingSample | (learning ? kGuidingLearn : 0u);
+    if (guide) a.params.guiding = auto_light_subpaths ? kGuidingAutoSubpaths : kGuidingSample | (learning ? kGuidingLearn : 0u);
     if (choice) a.params.guiding |= kGuidingAuto | (choice->decided() ? 0u : kGuidingAutoRecord);
     if (choice && choice->decided() && choice->texels_guided() == 0) a.params.guiding = kGuidingAuto;
+    // Light subpaths as the candidate: the pool serves the pass's connecting samples only.
+    if (auto_light_subpaths && a.light_pools) a.light_pools->set_connected_share(pass_connected_share(first, pass));
     if (!a.work_list.empty()) {
       const size_t chunk = std::min(a.work_list.size(), a.max_work);
       pass = std::min<uint32_t>(pass, uint32_t(std::max<size_t>(1, a.max_work / chunk)));
@@ -465,8 +496,28 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
       emitter_costs.fold_seconds += std::chrono::duration<double>(Clock::now() - fold_start).count();
       ++emitter_costs.folds;
     }
+    // Light subpaths as auto's candidate under a time budget: while no candidate sample has been taken
+    // (the pilot's first half), a bake whose pass rate promises fewer than kLightSubpathPilots pilots
+    // abandons the candidate and runs on as the unguided bake (kLightSubpathPilots says why; as on the CPU).
+    const uint32_t done_here = first + pass;
+    if (choice && auto_light_subpaths && !choice->decided() && settings.time_budget_seconds > 0 && done_here >= 4 &&
+        done_here <= choice->pilot() / 2) {
+      const double elapsed = passes.elapsed_seconds();
+      const double per_sample = (elapsed - loop_start) / double(done_here);
+      const double expected = double(done_here) + (settings.time_budget_seconds - elapsed) / per_sample;
+      if (!(expected >= double(kLightSubpathPilots) * double(choice->pilot()))) {
+        choice->abandon();
+        abandoned_at = done_here;
+        auto_words = strategy_words(*choice, a.texel_count);
+        guide_buffer->upload_auto_words(runner_, auto_words);
+      }
+    }
     if (choice && !choice->decided() && first + pass >= choice->pilot()) {  // the pilot is complete on every texel
       import_strategy_sums(guide_buffer->download_auto_sums(runner_), *choice);
+      // A connected sample's share of the pools: their rays per subpath x subpaths per sample.
+      if (auto_light_subpaths && a.totals.light_subpaths > 0)
+        choice->set_guided_sample_cost(double(a.totals.light_subpath_rays) / double(a.totals.light_subpaths) *
+                                       settings.light_subpaths_per_sample);
       choice->decide();
       auto_words = strategy_words(*choice, a.texel_count);
       guide_buffer->upload_auto_words(runner_, auto_words);
@@ -501,10 +552,12 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   LightmapEstimate estimate = download(a, share ? &own_runs : nullptr, space.get(), /*packed=*/!whole_here);
   if (choice) {
     estimate.guiding_auto = true;
+    estimate.guiding_auto_light_subpaths = auto_light_subpaths;
     estimate.guiding_auto_pilot = choice->pilot();
-    if (choice->decided()) estimate.guiding_regions = choice->regions(), estimate.guiding_scene = choice->scene();
+    estimate.guiding_auto_abandoned_at = abandoned_at;
+    if (choice->decided() && !choice->abandoned()) estimate.guiding_regions = choice->regions(), estimate.guiding_scene = choice->scene();
   }
-  if (guide && settings.inspect_guiding) {
+  if (guide && !auto_light_subpaths && settings.inspect_guiding) {
     if (!settings.guide_fold_on_host) guide_buffer->download_tables(runner_, *guide);
     settings.inspect_guiding(*guide);
   }

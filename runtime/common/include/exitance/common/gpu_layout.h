@@ -333,6 +333,10 @@ const uint kGuidingCount = 4u;          // SVO locator: vertices count themselve
 // and guided vertices, as 2 floats after the batch's result slots (bindings.glsl auto_cost_index).
 const uint kGuidingAuto = 8u;           // each texel sample's strategy from its strategy word
 const uint kGuidingAutoRecord = 16u;    // pilot passes: count work items' costs, add the strategy sums
+// With kGuidingAuto: the candidate is light subpaths, not the grid: a texel sample of the guided
+// strategy connects to the batch's pool (path.glsl path_connects), the others are the path tracer's
+// alone (their MIS weights without the connections), and no vertex samples the grid's table.
+const uint kGuidingAutoSubpaths = 32u;
 const uint kAutoSumDoubles = 7u;
 const uint kAutoCostWords = 2u;         // per work item: rays, guided vertices (floats)
 // Light subpaths on the wavefront (GpuParams::light_subpaths; shaders/wavefront/light_subpaths.comp):

@@ -74,6 +74,19 @@ constexpr double kGuidedVertexCostInRays = 0.65;
 constexpr double kGuidedVertexCostInRaysVulkan = 1.0;
 // Standard errors a difference of efficiency must exceed to count (one-sided 1.3e-3 under a normal).
 constexpr double kChoiceZ = 3.0;
+
+// --guiding auto's pilot with the light-subpath candidate, before GuidingChoice::pilot_for shortens it
+// for small --spp. Longer than grid guiding's (64, its learning): what connections fix is a heavy
+// tail (rare paths through a gap), which a short pilot's sample variance misses. Measured on
+// ajar_room, where connections pay ~6x at equal time: the scene's efficiency ratio read 0.82 after
+// 32 samples (so auto dropped them), 1.6 after 128, 2.4 after 256 (bench/results/guiding-auto-light-paths.md). Both backends.
+constexpr uint32_t kLightSubpathPilotSamples = 256;
+// ... and only in bakes of this many pilots at least: --spp, or what a time budget's pass rate
+// promises (else the candidate is abandoned in the pilot's first half). Connections can cost far
+// more variance than they save (the open city's lit windows), and a pilot's connected samples stay
+// in the means of texels that do not connect: at 0.25 texels/m and 20 s (~140 spp, inside the pilot)
+// the city read 1.4x the unguided relMSE (bench/results/guiding-auto-light-paths.md).
+constexpr uint32_t kLightSubpathPilots = 4;
 // The share of texels that measure both strategies in the pilot (the rest take unguided samples):
 // the pilot's cost on QMC-friendly scenes scales with it; a region of 16 texels keeps ~4 measuring
 // ones, so regions mostly follow the scene's evidence.

@@ -25,14 +25,15 @@ enum class IntegratorMode { Path, Bounces };
 // fields built from exitance in the bake's octree (seed 000, core/svo_guiding_fields.h; needs
 // guiding_octree). Auto: the integrator measures, during a pilot, the variance per counted cost of
 // guided (the `guiding_auto_candidate` kind) and unguided samples per region and keeps guiding where
-// it pays (core/guiding_choice.h); CPU backend, which alone has it so far (bake hands Off to the others).
+// it pays (core/guiding_choice.h); both backends (bake runs it on Vulkan only when --guiding auto is given).
 enum class GuidingMode { Off, Grid, Svo, Auto };
 
 // What GuidingMode::Auto measures against unguided samples (issue 35, item 4). Scene: light subpaths
-// where any light starts them (emissive triangles, punctual lights, the sky) and the backend traces them (the CPU;
-// bench/results/guiding-auto-light-paths.md), grid guiding otherwise. Grid: grid guiding always.
-// LightSubpaths: light subpaths always (CPU backend; a scene with no light they start from measures
-// nothing and stays unguided).
+// where any light starts them (emissive triangles, punctual lights, the sky) and the bake is long
+// enough for their pilot (spp of kLightSubpathPilots pilots, or a time budget whose pass rate
+// promises them; bench/results/guiding-auto-light-paths.md), grid guiding otherwise. Grid: grid
+// guiding always. LightSubpaths: light subpaths always (a scene with no light they start from
+// measures grid guiding on the Vulkan backend and nothing on the CPU's). Both backends.
 enum class AutoGuidingCandidate { Scene, Grid, LightSubpaths };
 
 // Directional lightmaps (bake --directional, issue 14). Sh1: per texel also the world-space L1 SH
