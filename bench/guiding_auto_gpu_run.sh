@@ -31,11 +31,11 @@ for scene in ${SCENES:-cornell courtyard city ajar}; do
   $R $B -o /tmp/w/$scene-refA.bake --spp 4096 --seed 101 --json > /dev/null
   $R $B -o /tmp/w/$scene-refB.bake --spp 4096 --seed 202 --json > /dev/null
   tests=""
-  for t in ${TIMES:-0.25 1}; do
+  for t in ${TIMES:-0.25 1 4}; do
     run off-${t}s --spp 0 --time $t
     run auto-${t}s --spp 0 --time $t --guiding auto
   done
-  for spp in ${SPPS:-256}; do
+  for spp in ${SPPS:-256 1024}; do
     run off-${spp}spp --spp $spp
     run auto-${spp}spp --spp $spp --guiding auto
   done
