@@ -288,7 +288,18 @@ TEST(VulkanGuidingAuto, LightSubpathCandidateIsBitIdenticalPerSeedAndAbandonedIn
   EXPECT_LE(t.guiding_auto_abandoned_at, t.guiding_auto_pilot / 2) << "abandoned before any connected sample";
   EXPECT_TRUE(t.guiding_regions.empty()) << "nothing measured";
   EXPECT_EQ(t.nonfinite_samples, 0u);
-  for (const TexelAccumulator& texel : t.texels) EXPECT_GT(texel.samples, 0u);
+  // Abandoned before any connected sample, every sample is the unguided bake's (its stream and index,
+  // no connection, the path tracer's weights): the texels' sums are those of an unguided bake of as
+  // many samples with the seed, bit for bit (both add each texel's samples in sample order).
+  ASSERT_FALSE(t.texels.empty());
+  const uint32_t taken = t.texels[0].samples;
+  ASSERT_GT(taken, 0u);
+  for (const TexelAccumulator& texel : t.texels) ASSERT_EQ(texel.samples, taken) << "whole passes";
+  const LightmapEstimate plain = vk->bake(p.gbuffer, settings(taken, 5, GuidingMode::Off));
+  size_t differ = 0;
+  for (size_t i = 0; i < t.texels.size(); ++i)
+    differ += std::memcmp(t.texels[i].total, plain.texels[i].total, sizeof(t.texels[i].total)) != 0;
+  EXPECT_EQ(differ, 0u) << "of " << t.texels.size() << " texels differ from the unguided bake of " << taken << " samples";
 
   IntegratorSettings short_bake = settings(64, 5, GuidingMode::Auto);
   short_bake.guiding_auto_candidate = AutoGuidingCandidate::Scene;

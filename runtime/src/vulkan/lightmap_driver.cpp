@@ -467,7 +467,8 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
                           (!choice || !choice->decided());
     if (guide) a.params.guiding = auto_light_subpaths ? kGuidingAutoSubpaths : kGuidingSample | (learning ? kGuidingLearn : 0u);
     if (choice) a.params.guiding |= kGuidingAuto | (choice->decided() ? 0u : kGuidingAutoRecord);
-    if (choice && choice->decided() && choice->texels_guided() == 0) a.params.guiding = kGuidingAuto;
+    if (choice && choice->decided() && choice->texels_guided() == 0)
+      a.params.guiding = kGuidingAuto | (auto_light_subpaths ? kGuidingAutoSubpaths : 0u);  // no path connects either
     // Light subpaths as the candidate: the pool serves the pass's connecting samples only.
     if (auto_light_subpaths && a.light_pools) a.light_pools->set_connected_share(pass_connected_share(first, pass));
     if (!a.work_list.empty()) {
