@@ -455,7 +455,16 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     const uint32_t from = std::max(begin, choice->pilot() / 2), to = std::min(begin + samples, choice->pilot());
     return to > from ? kPilotMeasuringShare * double(to - from) / double(std::max(samples, 1u)) : 0.0;
   };
-  const double loop_start = passes.elapsed_seconds();
+  // Once no texel connects (the candidate abandoned, or no region kept connections) the pools go: the
+  // batches then have the unguided bake's layout and cost (before, an abandoned 1 s bake of the Cornell
+  // room at 64 texels/m still traced a pool per batch and took half the unguided samples on an H100).
+  auto drop_unread_pools = [&] {
+    if (!auto_light_subpaths || !a.light_pools || settings.light_subpaths || choice->texels_guided() > 0) return;
+    a.light_pools.reset();
+    a.params.light_subpaths = 0;
+    a.params.shadow_slots = runner_.bake_params(IntegratorSettings{}, a.params.recorded, a.params.item_count_total).shadow_slots;
+  };
+  double elapsed_at_4 = -1;   // the budget's seconds when 4 samples per texel were done
   uint32_t abandoned_at = 0;  // samples per texel when the light-subpath candidate was abandoned
   uint32_t first = 0, pass = 0;
   while ((share || !a.work_list.empty()) && passes.next_pass(first, pass)) {
@@ -499,18 +508,23 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     }
     // Light subpaths as auto's candidate under a time budget: while no candidate sample has been taken
     // (the pilot's first half), a bake whose pass rate promises fewer than kLightSubpathPilots pilots
-    // abandons the candidate and runs on as the unguided bake (kLightSubpathPilots says why; as on the CPU).
+    // abandons the candidate and runs on as the unguided bake (kLightSubpathPilots says why; as on the
+    // CPU). The rate is that of the passes after the first 4 samples, from 16 on: the ramp's first
+    // passes, of one sample each, carry a pass's fixed costs (from them an H100 promised the Cornell
+    // room at 64 texels/m 400 samples in 4 s, where it took 2 900-3 900).
     const uint32_t done_here = first + pass;
-    if (choice && auto_light_subpaths && !choice->decided() && settings.time_budget_seconds > 0 && done_here >= 4 &&
-        done_here <= choice->pilot() / 2) {
+    if (choice && auto_light_subpaths && done_here == 4) elapsed_at_4 = passes.elapsed_seconds();
+    if (choice && auto_light_subpaths && !choice->decided() && settings.time_budget_seconds > 0 && elapsed_at_4 >= 0 &&
+        done_here >= std::min(16u, choice->pilot() / 2) && done_here > 4 && done_here <= choice->pilot() / 2) {
       const double elapsed = passes.elapsed_seconds();
-      const double per_sample = (elapsed - loop_start) / double(done_here);
+      const double per_sample = (elapsed - elapsed_at_4) / double(done_here - 4);
       const double expected = double(done_here) + (settings.time_budget_seconds - elapsed) / per_sample;
       if (!(expected >= double(kLightSubpathPilots) * double(choice->pilot()))) {
         choice->abandon();
         abandoned_at = done_here;
         auto_words = strategy_words(*choice, a.texel_count);
         guide_buffer->upload_auto_words(runner_, auto_words);
+        drop_unread_pools();
       }
     }
     if (choice && !choice->decided() && first + pass >= choice->pilot()) {  // the pilot is complete on every texel
@@ -522,6 +536,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
       choice->decide();
       auto_words = strategy_words(*choice, a.texel_count);
       guide_buffer->upload_auto_words(runner_, auto_words);
+      drop_unread_pools();
     }
     if (svo_guide && (a.params.guiding & kGuidingCount) != 0u) {  // this pass counted: rebuild the fields
       svo_buffer->import_counts(runner_, *svo_guide);
