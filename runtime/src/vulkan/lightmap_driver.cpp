@@ -14,6 +14,7 @@
 #include "exitance/runtime/core/grid_guiding_cache.h"
 #include "exitance/runtime/core/guiding_choice.h"
 #include "exitance/runtime/core/light_subpath_start.h"
+#include "exitance/runtime/core/parallel_chunks.h"
 #include "exitance/runtime/core/pass_scheduler.h"
 #include "exitance/runtime/core/work_share.h"
 #include "exitance/runtime/core/svo_guiding_fields.h"
@@ -30,7 +31,9 @@ using Clock = std::chrono::steady_clock;
 // --guiding auto: every texel's strategy word (common/guiding_auto_strategy.h) from the choice.
 std::vector<uint32_t> strategy_words(const GuidingChoice& choice, size_t texel_count) {
   std::vector<uint32_t> words(texel_count);
-  for (size_t i = 0; i < texel_count; ++i) words[i] = choice.strategy_word(i);
+  for_each_chunk(texel_count, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) words[i] = choice.strategy_word(i);
+  });
   return words;
 }
 
@@ -342,11 +345,14 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
       // Regions: the guide's records (grid cell x normal class), texels without one in one more (as on the CPU).
       const uint32_t pilot =
           GuidingChoice::pilot_for(settings.spp, auto_light_subpaths ? kLightSubpathPilotSamples : GridGuidingCache::kLearningSamples);
+      // On all host cores: the lookups are independent, and at a million texels this is inside the timed bake.
       std::vector<uint32_t> region(a.texel_count);
-      for (size_t i = 0; i < a.texel_count; ++i) {
-        const uint32_t r = guide->record_of(gbuffer.texels[i].position, gbuffer.texels[i].shading_normal);
-        region[i] = r == GridGuidingCache::kNoRecord ? guide->record_count() : r;
-      }
+      for_each_chunk(a.texel_count, [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i) {
+          const uint32_t r = guide->record_of(gbuffer.texels[i].position, gbuffer.texels[i].shading_normal);
+          region[i] = r == GridGuidingCache::kNoRecord ? guide->record_count() : r;
+        }
+      });
       // Light subpaths: statistics from the first sample (nothing learns), the connected half of the
       // pilot second, so that a short bake can abandon them unmeasured (as on the CPU).
       const uint32_t statistics_from = auto_light_subpaths ? 0 : pilot / 4;
