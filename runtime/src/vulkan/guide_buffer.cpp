@@ -37,11 +37,13 @@ void pack_fixed_point(double units, float cap, uint32_t* out) {
   out[2] = guide_float_bits(cap);
 }
 
+// The zeros after `words` cleared on the device (--guiding auto's pilot sums: 112 B per texel, not
+// worth building on the host and copying across at a million texels).
 void upload_guide_words(WavefrontBatchRunner& runner, const std::vector<uint32_t>& words, const char* mode,
-                        const char* remedy) {
+                        const char* remedy, size_t zero_words) {
   Context& context = runner.context();
   WavefrontBuffers& buffers = runner.buffers();
-  const size_t bytes = words.size() * 4;
+  const size_t bytes = (words.size() + zero_words) * 4;
   if (uint64_t(bytes) > context.properties().limits.maxStorageBufferRange)
     throw std::runtime_error(std::string("Vulkan backend: --guiding ") + mode + ": the guide buffer (" +
                              std::to_string(bytes) + " bytes) passes the device's largest storage buffer (" + remedy + ")");
@@ -49,7 +51,11 @@ void upload_guide_words(WavefrontBatchRunner& runner, const std::vector<uint32_t
     buffers.probes.reserve_bytes(context, bytes);
     runner.bind_buffers();
   }
-  context.upload(buffers.probes.sh_sums, words.data(), bytes);
+  context.upload(buffers.probes.sh_sums, words.data(), words.size() * 4);
+  if (zero_words == 0) return;
+  VkCommandBuffer cmd = context.begin();
+  vkCmdFillBuffer(cmd, buffers.probes.sh_sums.handle(), words.size() * 4, zero_words * 4, 0);
+  context.submit_and_wait(cmd);
 }
 
 GuideBuffer::GuideBuffer(const GridGuidingCache& cache) : records_(cache.record_count()) {
@@ -97,7 +103,7 @@ void GuideBuffer::pack_front(const GridGuidingCache& cache) {
 }
 
 void GuideBuffer::upload(WavefrontBatchRunner& runner) const {
-  upload_guide_words(runner, words_, "grid", "use fewer --guiding-grid-cells");
+  upload_guide_words(runner, words_, "grid", "use fewer --guiding-grid-cells", sum_words_);
 }
 
 void GuideBuffer::fold_learning(WavefrontBatchRunner& runner, GuideFoldKernel& kernel) {
@@ -162,7 +168,8 @@ void GuideBuffer::add_auto_sections(const std::vector<uint32_t>& texel_words, ui
   if (words >= (size_t(1) << 32))
     throw std::runtime_error("Vulkan backend: --guiding auto: " + std::to_string(auto_texel_count_) +
                              " texels' strategy sums do not fit the guide buffer (use a lower --texel-density)");
-  words_.resize(words, 0u);
+  words_.resize(auto_sums_, 0u);  // the sums after them are cleared on the device (upload)
+  sum_words_ = words - auto_sums_;
   std::copy(texel_words.begin(), texel_words.end(), words_.begin() + std::ptrdiff_t(auto_texels_));
   words_[kGuideAutoTexels] = uint32_t(auto_texels_);
   words_[kGuideAutoSums] = uint32_t(auto_sums_);

@@ -26,9 +26,9 @@ void pack_grid_locator(const GuideGridLocator& locator, uint32_t* out);
 void pack_fixed_point(double units, float cap, uint32_t* out);
 // Every guide layout's words onto the device, in the guide binding (the probe SH sums' buffer, grown
 // and rebound when too small). `mode` and `remedy` complete the error when the device's largest
-// storage buffer is too small.
+// storage buffer is too small. `zero_words` zeros follow `words`, cleared on the device.
 void upload_guide_words(WavefrontBatchRunner& runner, const std::vector<uint32_t>& words, const char* mode,
-                        const char* remedy);
+                        const char* remedy, size_t zero_words = 0);
 
 class GuideBuffer {
  public:
@@ -48,7 +48,7 @@ class GuideBuffer {
   // cache after a bake (IntegratorSettings::inspect_guiding).
   void download_tables(WavefrontBatchRunner& runner, GridGuidingCache& cache) const;
 
-  size_t bytes() const { return words_.size() * 4; }
+  size_t bytes() const { return (words_.size() + sum_words_) * 4; }
 
   // --guiding auto (gpu_layout.h kGuidingAuto): appends the per-texel strategy words and the zeroed
   // strategy sums (kAutoSumDoubles x 2 per texel) after the grid's sections. Before upload().
@@ -64,6 +64,7 @@ class GuideBuffer {
   std::vector<uint32_t> words_;
   size_t front_ = 0, cdf_ = 0, back_ = 0, learned_ = 0;  // first words of the sections
   size_t auto_texels_ = 0, auto_sums_ = 0, auto_texel_count_ = 0;
+  size_t sum_words_ = 0;  // the pilot sums' words after words_ (zeros, cleared on the device)
   uint32_t records_ = 0;
   float mix_ = 0;  // the cache's guided share of a learned record
 };
