@@ -50,12 +50,16 @@ IntegratorSettings settings(uint32_t spp, uint64_t seed, GuidingMode guiding) {
   return s;
 }
 
-PreparedScene cornell_room() {
+// A sample scene at `density` texels per unit, ready to light.
+PreparedScene sample_scene(const std::string& name, float density) {
   AtlasSettings atlas;
-  atlas.texel_density = 2;
+  atlas.texel_density = density;
   Diagnostics diagnostics;
-  return prepare_scene_for_lighting(EXITANCE_SAMPLE_DIR "/cornell_room.gltf", "", atlas, diagnostics);
+  return prepare_scene_for_lighting(std::string(EXITANCE_SAMPLE_DIR) + "/" + name + ".gltf", "", atlas, diagnostics);
 }
+
+PreparedScene cornell_room() { return sample_scene("cornell_room", 2); }
+PreparedScene ajar_room() { return sample_scene("ajar_room", 4); }
 
 bool identical(const LightmapEstimate& a, const LightmapEstimate& b) {
   if (a.texels.size() != b.texels.size() || a.bounces != b.bounces || a.rays != b.rays) return false;
@@ -106,10 +110,7 @@ TEST(VulkanGuidingAuto, CornellRoomAgreesWithUnguided) {
 }
 
 TEST(VulkanGuidingAuto, AjarRoomAgreesWithUnguided) {
-  AtlasSettings atlas;
-  atlas.texel_density = 4;
-  Diagnostics diagnostics;
-  const PreparedScene p = prepare_scene_for_lighting(EXITANCE_SAMPLE_DIR "/ajar_room.gltf", "", atlas, diagnostics);
+  const PreparedScene p = ajar_room();
   size_t texels_guided = 0;
   expect_auto_agrees("ajar_room", p.scene, p.gbuffer, 64, texels_guided);
   EXPECT_GT(texels_guided, 0u) << "no texel kept guiding: the samples guided after the pilot went untested";
@@ -195,10 +196,7 @@ TEST(VulkanGuidingAuto, BitIdenticalPerSeedAndReported) {
 // bake is bit-identical per seed too: the guided samples after the pilot read a table frozen at the
 // pilot's end, and the sums are added in the same order.
 TEST(VulkanGuidingAuto, GuidedAfterThePilotIsBitIdenticalPerSeed) {
-  AtlasSettings atlas;
-  atlas.texel_density = 4;
-  Diagnostics diagnostics;
-  const PreparedScene p = prepare_scene_for_lighting(EXITANCE_SAMPLE_DIR "/ajar_room.gltf", "", atlas, diagnostics);
+  const PreparedScene p = ajar_room();
   CREATE_VULKAN_OR_SKIP(vk, p.scene);
   for (uint64_t seed = 0; seed < 8; ++seed) {
     const LightmapEstimate a = vk->bake(p.gbuffer, settings(64, seed, GuidingMode::Auto));
@@ -227,12 +225,6 @@ IntegratorSettings light_subpath_settings(uint32_t spp, uint64_t seed) {
   return s;
 }
 
-PreparedScene ajar_room() {
-  AtlasSettings atlas;
-  atlas.texel_density = 4;
-  Diagnostics diagnostics;
-  return prepare_scene_for_lighting(EXITANCE_SAMPLE_DIR "/ajar_room.gltf", "", atlas, diagnostics);
-}
 
 TEST(VulkanGuidingAuto, LightSubpathCandidateAgreesWithUnguided) {
   const PreparedScene p = ajar_room();

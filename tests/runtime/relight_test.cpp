@@ -228,31 +228,34 @@ TEST(Relight, ReproducesAVulkanPerBounceBakeBitForBit) {
   fs::remove_all(dir);
 }
 
-// Grid guiding (--guiding grid): a bundle baked guided on the Vulkan backend is relit guided from
-// scene.bin bit for bit (the same texels, grid, learning passes and seed); the report says so; it
-// is refused with --frames (not progressive) and with --integrator bounces.
-TEST(Relight, ReproducesAVulkanGuidedBakeBitForBit) {
-  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
-  const fs::path dir = fs::temp_directory_path() / ("exitance-relight-guided-" + std::to_string(::getpid()));
+// A bundle baked guided (`mode`: grid or auto) on the Vulkan backend at `spp` is relit with
+// --guiding `mode` from scene.bin bit for bit (the same texels, grid, learning or pilot passes, choice
+// and seed); the report says so; it is refused with --frames (not progressive) and with
+// --integrator bounces. Returns the report and the bake's manifest.
+std::pair<nlohmann::json, nlohmann::json> expect_guided_relight_bit_for_bit(const std::string& mode, GuidingMode guiding,
+                                                                          uint32_t spp) {
+  const fs::path dir = fs::temp_directory_path() / ("exitance-relight-guided-" + mode + "-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path baked = dir / "guided.bake", output = dir / "guided-relit.bake";
-  bake_to_relight("cornell_room", baked, 4, 12, [](BakeOptions& b) {
+  bake_to_relight("cornell_room", baked, 4, spp, [&](BakeOptions& b) {
     b.lighting.integrator = IntegratorMode::Path;
-    b.lighting.guiding = GuidingMode::Grid;
+    b.lighting.guiding = guiding;
+    b.guiding_auto_given = guiding == GuidingMode::Auto;
     b.integrator_auto = false;
   });
+  const nlohmann::json manifest = nlohmann::json::parse(file_bytes(baked / "manifest.json"));
   RelightOptions options;
   options.bundle = baked.string();
   options.output = output.string();
   options.seed = 9;
-  options.spp = 12;
-  options.guiding = "grid";
+  options.spp = spp;
+  options.guiding = mode;
   const nlohmann::json report = relight_bundle(options);
   EXPECT_EQ(report["integrator"], "path");
-  EXPECT_EQ(report["guiding"], "grid");
+  EXPECT_EQ(report["guiding"], mode);
   EXPECT_GT(report["rays"].get<uint64_t>(), 0u);
-  EXPECT_GE(expect_same_pages(baked, output, "the guided bake's"), 1u);
+  EXPECT_GE(expect_same_pages(baked, output, "the guided bake's"), 1u) << mode;
   options.output = (dir / "refused.bake").string();
   options.frames = 2;
   EXPECT_THROW(relight_bundle(options), RelightInputError);
@@ -261,42 +264,24 @@ TEST(Relight, ReproducesAVulkanGuidedBakeBitForBit) {
   EXPECT_THROW(relight_bundle(options), RelightInputError);
   EXPECT_FALSE(fs::exists(dir / "refused.bake"));
   fs::remove_all(dir);
+  return {report, manifest};
 }
 
-// --guiding auto: a bundle baked with the measured choice on the Vulkan backend (bake --backend vulkan
-// --guiding auto) is relit with it from scene.bin bit for bit (the same pilot, sums, choice and
-// seed), and the report's guiding_auto is the bake manifest's stats.guiding; refused with --frames.
+// Grid guiding (--guiding grid).
+TEST(Relight, ReproducesAVulkanGuidedBakeBitForBit) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  expect_guided_relight_bit_for_bit("grid", GuidingMode::Grid, 12);
+}
+
+// --guiding auto (bake --backend vulkan --guiding auto): the report's guiding_auto is the bake
+// manifest's stats.guiding (a pilot of 4 samples, decided within 16).
 TEST(Relight, ReproducesAVulkanAutoGuidedBakeBitForBit) {
   if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
-  const fs::path dir = fs::temp_directory_path() / ("exitance-relight-auto-" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  const fs::path baked = dir / "auto.bake", output = dir / "auto-relit.bake";
-  bake_to_relight("cornell_room", baked, 4, 16, [](BakeOptions& b) {
-    b.lighting.integrator = IntegratorMode::Path;
-    b.lighting.guiding = GuidingMode::Auto;
-    b.guiding_auto_given = true;
-    b.integrator_auto = false;
-  });
-  const nlohmann::json manifest = nlohmann::json::parse(file_bytes(baked / "manifest.json"));
+  const auto [report, manifest] = expect_guided_relight_bit_for_bit("auto", GuidingMode::Auto, 16);
   ASSERT_TRUE(manifest["stats"].contains("guiding")) << "the bake ran no measured choice";
-  RelightOptions options;
-  options.bundle = baked.string();
-  options.output = output.string();
-  options.seed = 9;
-  options.spp = 16;
-  options.guiding = "auto";
-  const nlohmann::json report = relight_bundle(options);
-  EXPECT_EQ(report["guiding"], "auto");
   ASSERT_TRUE(report.contains("guiding_auto"));
-  EXPECT_EQ(report["guiding_auto"]["decided"], true);  // a pilot of 4 samples, complete within 16
+  EXPECT_EQ(report["guiding_auto"]["decided"], true);
   EXPECT_EQ(report["guiding_auto"], manifest["stats"]["guiding"]);
-  EXPECT_GE(expect_same_pages(baked, output, "the auto-guided bake's"), 1u);
-  options.output = (dir / "refused.bake").string();
-  options.frames = 2;
-  EXPECT_THROW(relight_bundle(options), RelightInputError);
-  EXPECT_FALSE(fs::exists(dir / "refused.bake"));
-  fs::remove_all(dir);
 }
 
 // Emitter guiding (--emitter-guiding on): a bundle baked emitter-guided on the Vulkan backend is
