@@ -18,7 +18,8 @@ GuidingChoice::GuidingChoice(std::vector<uint32_t> texel_region, uint32_t region
       pilot_(pilot),
       statistics_from_(std::min(statistics_from, pilot)),
       seed_(seed),
-      measuring_below_(measuring_share >= 1 ? UINT64_MAX : uint64_t(std::max(0.0, measuring_share) * 0x1.0p64)) {
+      measuring_below_(measuring_share >= 1 ? UINT64_MAX : uint64_t(std::max(0.0, measuring_share) * 0x1.0p64)),
+      measuring_share_(std::clamp(measuring_share, 0.0, 1.0)) {
   if (pilot_ < 2 || (pilot_ & (pilot_ - 1)) != 0) throw std::invalid_argument("GuidingChoice: the pilot must be a power of two >= 2");
   for (uint32_t r : texel_region_) {
     if (r >= region_count) throw std::invalid_argument("GuidingChoice: a texel's region is out of range");
@@ -53,6 +54,7 @@ void GuidingChoice::abandon() {
   if (!candidate_half_second_) throw std::logic_error("GuidingChoice::abandon: candidate samples may have been taken");
   abandoned_ = decided_ = true;
   texel_guided_.assign(texel_region_.size(), 0);
+  texels_guided_ = 0;
 }
 
 void GuidingChoice::record(size_t texel, uint32_t sample, bool guided, double luminance, uint64_t rays,
@@ -188,6 +190,7 @@ void GuidingChoice::decide(double floor) {
   }
   // Each texel: its region's and the scene's evidence without its own samples (see the header).
   texel_guided_.assign(texel_region_.size(), 0);
+  texels_guided_ = 0;
   for (size_t i = 0; i < texel_region_.size(); ++i) {
     EfficiencyEvidence others = region[texel_region_[i]], everyone_else = scene_;
     add(others, texel[i], -1);
@@ -195,15 +198,16 @@ void GuidingChoice::decide(double floor) {
     bool guided = false;
     choose(others, everyone_else, guided);
     texel_guided_[i] = guided;
+    texels_guided_ += guided;
     regions_[texel_region_[i]].texels_guided += guided;
   }
   decided_ = true;
 }
 
-size_t GuidingChoice::texels_guided() const {
-  size_t n = 0;
-  for (uint8_t g : texel_guided_) n += g;
-  return n;
+double GuidingChoice::candidate_share(uint32_t begin, uint32_t samples) const {
+  if (decided_) return guided_share();
+  const uint32_t from = std::max(begin, pilot_ / 2), to = std::min(begin + samples, pilot_);
+  return to > from ? measuring_share_ * double(to - from) / double(samples) : 0.0;
 }
 
 size_t GuidingChoice::regions_guided() const {

@@ -374,7 +374,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   const LightSubpathSampling subpath_start =
       settings.light_subpaths || auto_guiding ? light_subpath_start(*impl_->lighting) : light_subpaths_none();
   const bool scene_starts_subpaths = light_subpaths_start_anywhere(subpath_start);
-  const bool long_enough = settings.spp == 0 || settings.spp >= kLightSubpathPilots * kLightSubpathPilotSamples;
+  const bool long_enough = light_subpath_pilots_fit(settings.spp);
   const bool auto_light_subpaths =
       auto_guiding_may_measure_light_subpaths(settings) &&
       (settings.guiding_auto_candidate == AutoGuidingCandidate::LightSubpaths || (scene_starts_subpaths && long_enough));
@@ -460,9 +460,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
   // kept connections (connected_share).
   double connected_share = light_subpaths && !auto_light_subpaths ? 1.0 : 0.0;
   auto pass_connected_share = [&](uint32_t begin, uint32_t samples) -> double {
-    if (!light_subpaths || !auto_light_subpaths || choice->decided()) return connected_share;
-    const uint32_t from = std::max(begin, choice->pilot() / 2), to = std::min(begin + samples, choice->pilot());
-    return to > from ? kPilotMeasuringShare * double(to - from) / double(samples) : 0.0;
+    return light_subpaths && auto_light_subpaths ? choice->candidate_share(begin, samples) : connected_share;
   };
   // Per texel, pilot samples dropped when it began to connect (their sample indices stay used).
   std::vector<uint32_t> dropped;
@@ -656,8 +654,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
         passes.samples_done() >= 4 && passes.samples_done() <= choice->pilot() / 2) {
       const double elapsed = passes.elapsed_seconds();
       const double per_sample = (elapsed - loop_start) / double(passes.samples_done());
-      const double expected = double(passes.samples_done()) + (settings.time_budget_seconds - elapsed) / per_sample;
-      if (!(expected >= double(kLightSubpathPilots) * double(choice->pilot()))) {
+      if (!light_subpath_pilots_promised(passes.samples_done(), per_sample, settings.time_budget_seconds - elapsed, choice->pilot())) {
         choice->abandon();
         estimate.guiding_auto_abandoned_at = passes.samples_done();
         if (adaptive && !planning) pilot = std::max(passes.samples_done(), usual_pilot);
@@ -670,7 +667,7 @@ LightmapEstimate CpuReferenceIntegrator::bake(const TexelGBuffer& gbuffer, const
         choice->set_guided_sample_cost(double(pool_rays) / double(estimate.light_subpaths) * settings.light_subpaths_per_sample);
       choice->decide();
       if (auto_light_subpaths && light_subpaths) {
-        connected_share = double(choice->texels_guided()) / double(std::max<size_t>(texel_count, 1));
+        connected_share = choice->guided_share();
         if (room_after_pilot(passes, choice->pilot())) drop_pilot_of_connecting_texels();
       }
       if (adaptive && !planning && plan_from > 0) {

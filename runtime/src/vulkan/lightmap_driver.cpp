@@ -323,8 +323,8 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   bool auto_light_subpaths = false;
   if (auto_guiding && settings.guiding_auto_candidate != AutoGuidingCandidate::Grid && guiding_scene_.lighting) {
     const bool starts = light_subpaths_start_anywhere(light_subpath_start(*guiding_scene_.lighting));
-    const bool long_enough = settings.spp == 0 || settings.spp >= kLightSubpathPilots * kLightSubpathPilotSamples;
-    auto_light_subpaths = starts && (settings.guiding_auto_candidate == AutoGuidingCandidate::LightSubpaths || long_enough);
+    auto_light_subpaths =
+        starts && (settings.guiding_auto_candidate == AutoGuidingCandidate::LightSubpaths || light_subpath_pilots_fit(settings.spp));
   }
   if (settings.light_subpaths || auto_light_subpaths) {
     IntegratorSettings pool_settings = settings;
@@ -453,22 +453,11 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   std::future<ReadBackSpace> space = std::async(std::launch::async, &LightmapDriver::read_back_space, this,
                                                 whole_here ? a.texel_count : a.work_list.size(), a.work_list.size(), a.recorded,
                                                 a.directional, a.light_layers);
-  // Light subpaths as auto's candidate: the share of a pass's samples that connect. In the pilot's
-  // second half the measuring texels' (kPilotMeasuringShare of them); after the choice the texels that
-  // kept connections (none once abandoned).
-  auto pass_connected_share = [&](uint32_t begin, uint32_t samples) -> double {
-    if (choice->decided()) return double(choice->texels_guided()) / double(std::max<size_t>(a.texel_count, 1));
-    const uint32_t from = std::max(begin, choice->pilot() / 2), to = std::min(begin + samples, choice->pilot());
-    return to > from ? kPilotMeasuringShare * double(to - from) / double(std::max(samples, 1u)) : 0.0;
-  };
   // Once no texel connects (the candidate abandoned, or no region kept connections) the pools go: the
   // batches then have the unguided bake's layout and cost (before, an abandoned 1 s bake of the Cornell
   // room at 64 texels/m still traced a pool per batch and took half the unguided samples on an H100).
   auto drop_unread_pools = [&] {
-    if (!auto_light_subpaths || !a.light_pools || settings.light_subpaths || choice->texels_guided() > 0) return;
-    a.light_pools.reset();
-    a.params.light_subpaths = 0;
-    a.params.shadow_slots = runner_.bake_params(IntegratorSettings{}, a.params.recorded, a.params.item_count_total).shadow_slots;
+    if (auto_light_subpaths && !settings.light_subpaths && choice->texels_guided() == 0) drop_light_pools(a);
   };
   double elapsed_at_4 = -1;   // the budget's seconds when 4 samples per texel were done
   uint32_t abandoned_at = 0;  // samples per texel when the light-subpath candidate was abandoned
@@ -485,7 +474,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     if (choice && choice->decided() && choice->texels_guided() == 0)
       a.params.guiding = kGuidingAuto | (auto_light_subpaths ? kGuidingAutoSubpaths : 0u);  // no path connects either
     // Light subpaths as the candidate: the pool serves the pass's connecting samples only.
-    if (auto_light_subpaths && a.light_pools) a.light_pools->set_connected_share(pass_connected_share(first, pass));
+    if (auto_light_subpaths && a.light_pools) a.light_pools->set_connected_share(choice->candidate_share(first, pass));
     if (!a.work_list.empty()) {
       const size_t chunk = std::min(a.work_list.size(), a.max_work);
       pass = std::min<uint32_t>(pass, uint32_t(std::max<size_t>(1, a.max_work / chunk)));
@@ -524,8 +513,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
         done_here >= std::min(16u, choice->pilot() / 2) && done_here > 4 && done_here <= choice->pilot() / 2) {
       const double elapsed = passes.elapsed_seconds();
       const double per_sample = (elapsed - elapsed_at_4) / double(done_here - 4);
-      const double expected = double(done_here) + (settings.time_budget_seconds - elapsed) / per_sample;
-      if (!(expected >= double(kLightSubpathPilots) * double(choice->pilot()))) {
+      if (!light_subpath_pilots_promised(done_here, per_sample, settings.time_budget_seconds - elapsed, choice->pilot())) {
         choice->abandon();
         abandoned_at = done_here;
         auto_words = strategy_words(*choice, a.texel_count);
@@ -655,6 +643,10 @@ void LightmapDriver::set_light_subpaths(const IntegratorSettings& settings) {
     make_light_pools(a, settings);
     return;
   }
+  drop_light_pools(a);
+}
+
+void LightmapDriver::drop_light_pools(Accumulation& a) {
   if (!a.light_pools) return;
   a.light_pools.reset();
   a.params.light_subpaths = 0;  // before_batch set it for the pools' last batch

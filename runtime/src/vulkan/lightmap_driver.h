@@ -106,6 +106,8 @@ class LightmapDriver {
   void upload_items(const Accumulation& a);
   // `a`'s batches trace light subpaths (settings.light_subpaths) from the integrator's current scene.
   void make_light_pools(Accumulation& a, const IntegratorSettings& settings);
+  // `a`'s pools gone, its batches back to the path tracer's shadow slots (no connection slot).
+  void drop_light_pools(Accumulation& a);
   void run_pass(Accumulation& a, uint32_t first, uint32_t pass);
   // What a read-back fills, made ahead of time (bake(): on a thread while the passes run): the
   // estimate's per-texel arrays for `host_texels`, zero (their memory touched), and a pinned

@@ -58,6 +58,7 @@
 // light-subpath pool, its rays count the connections' shadow rays, and each such sample also pays
 // its share of the pool's rays (set_guided_sample_cost).
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -87,6 +88,14 @@ constexpr uint32_t kLightSubpathPilotSamples = 256;
 // in the means of texels that do not connect: at 0.25 texels/m and 20 s (~140 spp, inside the pilot)
 // the city read 1.4x the unguided relMSE (bench/results/guiding-auto-light-paths.md).
 constexpr uint32_t kLightSubpathPilots = 4;
+// Whether a bake of `spp` samples per texel (0: unlimited) has room for kLightSubpathPilots pilots.
+inline bool light_subpath_pilots_fit(uint32_t spp) { return spp == 0 || spp >= kLightSubpathPilots * kLightSubpathPilotSamples; }
+// Whether a time budget promises kLightSubpathPilots pilots of `pilot` samples: `samples_done`, then
+// `seconds_left` at `seconds_per_sample` (each backend measures its rate). False for a NaN rate.
+inline bool light_subpath_pilots_promised(double samples_done, double seconds_per_sample, double seconds_left, uint32_t pilot) {
+  const double expected = samples_done + seconds_left / seconds_per_sample;
+  return expected >= double(kLightSubpathPilots) * double(pilot);
+}
 // The share of texels that measure both strategies in the pilot (the rest take unguided samples):
 // the pilot's cost on QMC-friendly scenes scales with it; a region of 16 texels keeps ~4 measuring
 // ones, so regions mostly follow the scene's evidence.
@@ -163,6 +172,12 @@ class GuidingChoice {
   // measured (the bake is then the unguided one). regions() stay unmeasured.
   void abandon();
   bool abandoned() const { return abandoned_; }
+  // With set_candidate_half_second: the share of the texel samples [begin, begin + samples) that run
+  // the candidate. In the pilot, the measuring texels' samples in its second half; after the choice
+  // (or abandon()), guided_share(). What a light-subpath pool serves, on both backends.
+  double candidate_share(uint32_t begin, uint32_t samples) const;
+  // After the choice: the share of texels guided from here (0 once abandoned).
+  double guided_share() const { return double(texels_guided_) / double(std::max<size_t>(texel_region_.size(), 1)); }
 
   uint32_t pilot() const { return pilot_; }
   bool decided() const { return decided_; }
@@ -196,7 +211,7 @@ class GuidingChoice {
   const std::vector<RegionChoice>& regions() const { return regions_; }
   // The whole scene's evidence (every measured texel), which regions without their own follow.
   const EfficiencyEvidence& scene() const { return scene_; }
-  size_t texels_guided() const;
+  size_t texels_guided() const { return texels_guided_; }
   size_t regions_guided() const;
   bool any_guided() const { return regions_guided() > 0; }
   const StrategySums& sums(size_t texel, bool guided) const { return sums_[texel * 2 + (guided ? 1 : 0)]; }
@@ -206,11 +221,13 @@ class GuidingChoice {
   std::vector<StrategySums> sums_;  // [texel][unguided, guided]
   std::vector<RegionChoice> regions_;
   std::vector<uint8_t> texel_guided_;  // after decide()
+  size_t texels_guided_ = 0;           // their sum
   EfficiencyEvidence scene_;
   uint32_t pilot_;
   uint32_t statistics_from_;
   uint64_t seed_;
   uint64_t measuring_below_;  // hash threshold: measuring_share x 2^64
+  double measuring_share_;
   double guided_vertex_cost_ = kGuidedVertexCostInRays;
   double guided_sample_cost_ = 0;
   bool candidate_half_second_ = false;
