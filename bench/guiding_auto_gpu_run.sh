@@ -20,7 +20,7 @@ run() {  # NAME ARGS...: one relight, its lighting time, samples and what auto c
   $R $B -o /tmp/w/$scene-$name.bake --seed 1 --json "$@" > /tmp/w/r.json
   python3 -c "
 import json; r=json.load(open('/tmp/w/r.json')); g=r.get('guiding_auto')
-c='' if g is None else ' auto: candidate %s decided %s abandoned_at %s chose %s pilot %s texels_guided %.4f regions %s/%s scene_ratio %s' % (g.get('candidate'), g.get('decided'), g.get('abandoned_at_samples_per_texel'), g.get('chose'), g.get('pilot_samples_per_texel'), g.get('texels_guided_fraction', 0), g.get('regions_guided'), g.get('regions'), g.get('efficiency_ratio', {}).get('scene'))
+c='' if g is None else ' auto: candidate %s decided %s abandoned_at %s chose %s pilot %s texels_guided %.4f regions %s/%s scene_ratio %s setup %s s' % (g.get('candidate'), g.get('decided'), g.get('abandoned_at_samples_per_texel'), g.get('chose'), g.get('pilot_samples_per_texel'), g.get('texels_guided_fraction', 0), g.get('regions_guided'), g.get('regions'), g.get('efficiency_ratio', {}).get('scene'), g.get('setup_seconds'))
 print('$scene $name: lighting %.3f s, spp %s, rays %s, whole %.2f s%s' % (r['lighting_seconds'], r['spp'], r['rays'], sum(v for v in r['seconds'].values() if isinstance(v, (int, float))), c))" >> $S
   tests="$tests /tmp/w/$scene-$name.bake"
 }

@@ -11,9 +11,9 @@
 namespace exitance {
 
 GuidingChoice::GuidingChoice(std::vector<uint32_t> texel_region, uint32_t region_count, uint32_t pilot,
-                             uint32_t statistics_from, uint64_t seed, double measuring_share)
+                             uint32_t statistics_from, uint64_t seed, double measuring_share, bool records_on_host)
     : texel_region_(std::move(texel_region)),
-      sums_(texel_region_.size() * 2),
+      sums_(records_on_host ? texel_region_.size() * 2 : 0),
       regions_(region_count),
       pilot_(pilot),
       statistics_from_(std::min(statistics_from, pilot)),
@@ -60,6 +60,7 @@ void GuidingChoice::abandon() {
 void GuidingChoice::record(size_t texel, uint32_t sample, bool guided, double luminance, uint64_t rays,
                            uint64_t guided_vertices) {
   if (decided_ || sample < statistics_from_ || sample >= pilot_) return;
+  if (sums_.empty()) throw std::logic_error("GuidingChoice::record: made for sums recorded elsewhere (add_sums)");
   StrategySums& s = sums_[texel * 2 + (guided ? 1 : 0)];
   const double y2 = luminance * luminance;
   ++s.samples;
@@ -73,6 +74,7 @@ void GuidingChoice::record(size_t texel, uint32_t sample, bool guided, double lu
 
 void GuidingChoice::add_sums(size_t texel, bool guided, const StrategySums& add) {
   if (decided_) return;
+  if (sums_.empty()) sums_.resize(texel_region_.size() * 2);
   StrategySums& s = sums_[texel * 2 + (guided ? 1 : 0)];
   s.samples += add.samples;
   s.sum += add.sum;
@@ -81,6 +83,11 @@ void GuidingChoice::add_sums(size_t texel, bool guided, const StrategySums& add)
   s.sum_fourth += add.sum_fourth;
   s.rays += add.rays;
   s.guided_vertices += add.guided_vertices;
+}
+
+const StrategySums& GuidingChoice::sums(size_t texel, bool guided) const {
+  static const StrategySums none;
+  return sums_.empty() ? none : sums_[texel * 2 + (guided ? 1 : 0)];
 }
 
 uint32_t GuidingChoice::pilot_for(uint32_t spp, uint32_t learning_samples) {
@@ -152,6 +159,7 @@ void add(EfficiencyEvidence& to, const EfficiencyEvidence& e, double sign = 1) {
 }  // namespace
 
 void GuidingChoice::decide(double floor) {
+  if (sums_.empty()) sums_.resize(texel_region_.size() * 2);  // nothing was added: every texel unmeasured
   // Serial, in texel order: the same sums give the same doubles on every run and thread count.
   std::vector<EfficiencyEvidence> texel(texel_region_.size()), region(regions_.size());
   scene_ = {};

@@ -102,6 +102,8 @@ void GuideBuffer::pack_front(const GridGuidingCache& cache) {
   }
 }
 
+GuideBuffer::GuideBuffer() : words_(kGuideHeaderWords, 0u) {}  // kGuideLocatorKind 0: no locator, no records
+
 void GuideBuffer::upload(WavefrontBatchRunner& runner) const {
   upload_guide_words(runner, words_, "grid", "use fewer --guiding-grid-cells", sum_words_);
 }

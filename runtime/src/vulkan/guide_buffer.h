@@ -34,6 +34,10 @@ class GuideBuffer {
  public:
   // Lays out and packs the sections of `cache` (its front table as it is now).
   explicit GuideBuffer(const GridGuidingCache& cache);
+  // The header alone, no locator (every record lookup finds none): for --guiding auto with light
+  // subpaths as its candidate, which reads only the auto sections (add_auto_sections). The grid's
+  // tables, never sampled there, were most of the buffer (the open city at 1.5 texels/m: 148 MB).
+  GuideBuffer();
 
   // The whole buffer onto the device (growing and rebinding the binding), back sums at 0.
   void upload(WavefrontBatchRunner& runner) const;

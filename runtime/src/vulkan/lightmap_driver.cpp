@@ -321,6 +321,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   // kGuidingAutoSubpaths); the grid's records are the regions and its buffer carries the strategy
   // words and sums, but no vertex samples its table.
   bool auto_light_subpaths = false;
+  const auto auto_setup_start = Clock::now();
   if (auto_guiding && settings.guiding_auto_candidate != AutoGuidingCandidate::Grid && guiding_scene_.lighting) {
     const bool starts = light_subpaths_start_anywhere(light_subpath_start(*guiding_scene_.lighting));
     auto_light_subpaths =
@@ -340,7 +341,9 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     config.cells_on_longest_axis = settings.guiding_grid_cells;
     guide = std::make_unique<GridGuidingCache>(guiding_scene_.bounds_lo, guiding_scene_.bounds_hi,
                                                guiding_scene_.reference_radiance, gbuffer, config);
-    guide_buffer.emplace(*guide);
+    // Light subpaths as auto's candidate: the grid's records are only the regions, its tables unread.
+    if (auto_light_subpaths) guide_buffer.emplace();
+    else guide_buffer.emplace(*guide);
     if (auto_guiding) {
       // Regions: the guide's records (grid cell x normal class), texels without one in one more (as on the CPU).
       const uint32_t pilot =
@@ -356,7 +359,9 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
       // Light subpaths: statistics from the first sample (nothing learns), the connected half of the
       // pilot second, so that a short bake can abandon them unmeasured (as on the CPU).
       const uint32_t statistics_from = auto_light_subpaths ? 0 : pilot / 4;
-      choice = std::make_unique<GuidingChoice>(std::move(region), guide->record_count() + 1, pilot, statistics_from, settings.seed);
+      // Its sums are the device's (reduce.comp), read back once at the pilot's end.
+      choice = std::make_unique<GuidingChoice>(std::move(region), guide->record_count() + 1, pilot, statistics_from, settings.seed,
+                                               kPilotMeasuringShare, false);
       choice->set_guided_vertex_cost(kGuidedVertexCostInRaysVulkan);
       if (auto_light_subpaths) choice->set_candidate_half_second();
       auto_words = strategy_words(*choice, a.texel_count);
@@ -364,6 +369,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     }
     guide_buffer->upload(runner_);
   }
+  const double auto_setup_seconds = auto_guiding ? std::chrono::duration<double>(Clock::now() - auto_setup_start).count() : 0.0;
   // SVO guiding (svo_guide_buffer.h): the CPU reference's fields and schedule. The first pass is
   // unguided (no bins yet) unless the octree holds exitance; the passes that reach 1, 2, 4, ...
   // samples per texel count their vertices on the device, then the host rebuilds the fields from the
@@ -565,6 +571,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     estimate.guiding_auto_light_subpaths = auto_light_subpaths;
     estimate.guiding_auto_pilot = choice->pilot();
     estimate.guiding_auto_abandoned_at = abandoned_at;
+    estimate.guiding_auto_setup_seconds = auto_setup_seconds;
     if (choice->decided() && !choice->abandoned()) estimate.guiding_regions = choice->regions(), estimate.guiding_scene = choice->scene();
   }
   if (guide && !auto_light_subpaths && settings.inspect_guiding) {

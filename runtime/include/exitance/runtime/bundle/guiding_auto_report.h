@@ -21,6 +21,8 @@ inline nlohmann::json guiding_auto_json(const LightmapEstimate& estimate, const 
                         // Light subpaths: the pilot's samples of texels that then connected, dropped (cpu_reference_integrator.cpp).
                         {"pilot_samples_dropped", estimate.pilot_samples_dropped},
                         {"guided_vertices", estimate.guided_vertices}};
+  // Vulkan: the host's setup before the first pass (a time: differs run to run).
+  if (estimate.guiding_auto_setup_seconds > 0) out["setup_seconds"] = estimate.guiding_auto_setup_seconds;
   const std::vector<RegionChoice>& regions = estimate.guiding_regions;
   if (regions.empty()) {
     out["decided"] = false;  // the bake ended within the pilot: every sample tossed the pilot's coin

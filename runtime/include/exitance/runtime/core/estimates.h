@@ -79,6 +79,9 @@ struct LightmapEstimate {
   // Light subpaths under a time budget: the samples per texel at which the pilot was abandoned
   // unmeasured (the pass rate promised too few samples for it to pay); 0: it was not.
   uint32_t guiding_auto_abandoned_at = 0;
+  // Host seconds the bake spent setting the choice up before its first pass (the guide, the regions,
+  // the strategy words, the pools and their uploads): inside the timed bake, so a short --time feels it.
+  double guiding_auto_setup_seconds = 0;
   std::vector<RegionChoice> guiding_regions;
   EfficiencyEvidence guiding_scene;  // the whole scene's evidence, which regions without their own follow
   // Emitter guiding (core/emitter_guiding_cache.h): what the cache held at the end of the bake;

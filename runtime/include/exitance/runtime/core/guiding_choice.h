@@ -149,9 +149,11 @@ class GuidingChoice {
  public:
   // `texel_region`: the region of every texel, in [0, region_count). `pilot`: samples per texel before
   // the choice, a power of two (so its halves are stratified blocks); statistics come from samples [statistics_from, pilot) (earlier ones see a guide that
-  // has barely learned, which would understate guiding).
+  // has barely learned, which would understate guiding). `records_on_host` false: the samples are
+  // summed elsewhere (the Vulkan device) and come once through add_sums, so the host's table of sums
+  // (112 B per texel) is made then, not before the bake's first pass.
   GuidingChoice(std::vector<uint32_t> texel_region, uint32_t region_count, uint32_t pilot, uint32_t statistics_from,
-                uint64_t seed, double measuring_share = kPilotMeasuringShare);
+                uint64_t seed, double measuring_share = kPilotMeasuringShare, bool records_on_host = true);
 
   // The pilot of a bake of `spp` samples per texel (0: unlimited) whose guide learns `learning_samples`:
   // all of them; a bake of fewer spp gets the largest power of two up to a quarter of them, at least 4
@@ -200,7 +202,8 @@ class GuidingChoice {
   // Texels are independent: concurrent calls for different texels are safe.
   void record(size_t texel, uint32_t sample, bool guided, double luminance, uint64_t rays, uint64_t guided_vertices);
   // Adds sums of samples recorded elsewhere (the Vulkan backend's device, which sums the pilot's
-  // samples [statistics_from, pilot) itself) to a texel's strategy (ignored after the choice).
+  // samples [statistics_from, pilot) itself) to a texel's strategy (ignored after the choice). From
+  // one thread.
   void add_sums(size_t texel, bool guided, const StrategySums& sums);
   // Every region picks its strategy from the sums (deterministic given them). `floor`: the epsilon of
   // the relative variance, in luminance of E/pi (kErrorFloorFraction x the mean, as the EXR's error layer).
@@ -214,11 +217,11 @@ class GuidingChoice {
   size_t texels_guided() const { return texels_guided_; }
   size_t regions_guided() const;
   bool any_guided() const { return regions_guided() > 0; }
-  const StrategySums& sums(size_t texel, bool guided) const { return sums_[texel * 2 + (guided ? 1 : 0)]; }
+  const StrategySums& sums(size_t texel, bool guided) const;
 
  private:
   std::vector<uint32_t> texel_region_;
-  std::vector<StrategySums> sums_;  // [texel][unguided, guided]
+  std::vector<StrategySums> sums_;  // [texel][unguided, guided]; empty until add_sums without records_on_host
   std::vector<RegionChoice> regions_;
   std::vector<uint8_t> texel_guided_;  // after decide()
   size_t texels_guided_ = 0;           // their sum
