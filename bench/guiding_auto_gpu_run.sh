@@ -5,7 +5,9 @@
 # Carry .gl and .replay; .replay/ga.txz comes from bench/guiding_auto_gpu_pack.sh. Per scene: a
 # two-seed 4096-spp unguided reference, then unguided and auto runs at equal lighting time (--time,
 # TIMES seconds) and at equal samples (SPPS), each timed (lighting seconds, pilot included) with what
-# auto chose, and compared with the reference (relMSE, the reference's own noise subtracted).
+# auto chose, and compared with the reference (relMSE, the reference's own noise subtracted). "off" is
+# the refresh calls' unguided run, "whole" the unguided whole run (--whole-run) that bake --backend
+# vulkan makes and that auto's whole runs compare with on equal terms.
 # Writes $OUT/summary.txt.
 #   bash .replay/guiding_auto_gpu_run.sh        (SCENES, TIMES, SPPS override the lists)
 set -e
@@ -27,16 +29,18 @@ print('$scene $name: lighting %.3f s, spp %s, rays %s, whole %.2f s%s' % (r['lig
 for scene in ${SCENES:-cornell courtyard city ajar}; do
   B=/tmp/w/$scene.bake
   $R $B -o /tmp/w/warm.bake --spp 4 --seed 1 --json > /dev/null                 # shader and driver caches
-  $R $B -o /tmp/w/warm.bake --spp 8 --seed 1 --guiding auto --json > /dev/null
+  $R $B -o /tmp/w/warm.bake --spp 4 --seed 1 --light-paths on --json > /dev/null  # the light-subpath kernels
   $R $B -o /tmp/w/$scene-refA.bake --spp 4096 --seed 101 --json > /dev/null
   $R $B -o /tmp/w/$scene-refB.bake --spp 4096 --seed 202 --json > /dev/null
   tests=""
   for t in ${TIMES:-0.25 1 4}; do
     run off-${t}s --spp 0 --time $t
+    run whole-${t}s --spp 0 --time $t --whole-run
     run auto-${t}s --spp 0 --time $t --guiding auto
   done
   for spp in ${SPPS:-256 1024}; do
     run off-${spp}spp --spp $spp
+    run whole-${spp}spp --spp $spp --whole-run
     run auto-${spp}spp --spp $spp --guiding auto
   done
   LD_LIBRARY_PATH=/tmp/w/rt/lib /tmp/w/rt/bin/bench_bundle_rel_mse /tmp/w/$scene-refA.bake /tmp/w/$scene-refB.bake $tests | sed "s#/tmp/w/##" >> $S

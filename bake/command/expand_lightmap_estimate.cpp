@@ -33,7 +33,7 @@ std::vector<T> scatter_per_texel(const std::vector<T>& traced, const std::vector
 // A new per-texel field of LightmapEstimate (estimates.h) must be added below: the copy at the top
 // carries every other field over unchanged, which for a per-texel vector would leave it indexed by
 // traced texel. The static_assert is there to make a new field fail the build here until it is.
-static_assert(sizeof(LightmapEstimate) == 488,  // guiding_*, emitter_guiding, light_subpath*, pilot_samples_dropped: not per texel
+static_assert(sizeof(LightmapEstimate) == 496,  // guiding_*, emitter_guiding, light_subpath*, pilot_samples_dropped: not per texel
               "LightmapEstimate changed: scatter its new per-texel fields in expand_lightmap_estimate, then update "
               "this size");
 

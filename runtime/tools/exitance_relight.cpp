@@ -83,6 +83,10 @@ int main(int argc, char** argv) {
                  "--time, --frames or --budget-ms in the progressive refresh's passes, else the whole lightmap in one "
                  "run; not with --guiding, --emitter-guiding on or --integrator bounces)")
       ->check(CLI::IsMember({"off", "on"}));
+  app.add_flag("--whole-run", options.whole_run,
+               "path trace the whole lightmap in one run as bake --backend vulkan does (its passes, --time counted from "
+               "the run's start, the read-back inside the lighting) instead of refresh calls: what --guiding and "
+               "--emitter-guiding runs compare with; not with --frames, --budget-ms, --guiding or --integrator bounces");
   app.add_option("--seed", seed, "random seed (default: the bake's); results are deterministic per seed and device");
   app.add_option("--device", options.device_index, "Vulkan device index (see --list-devices)")->check(CLI::NonNegativeNumber);
   app.add_flag("--list-devices", list_devices, "print the Vulkan devices and exit");

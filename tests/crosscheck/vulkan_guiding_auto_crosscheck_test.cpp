@@ -257,8 +257,8 @@ TEST(VulkanGuidingAuto, LightSubpathCandidateAgreesWithUnguided) {
 // The same bake twice with one seed is the same bits (the pools, the pilot's sums and the choice
 // included); the seed matters. Under a time budget too short for kLightSubpathPilots pilots the
 // candidate is abandoned in the pilot's first half, before any connected sample, and nothing is
-// reported as measured. The scene's candidate is light subpaths under --time and grid guiding in a
-// bake of fewer spp than four pilots.
+// reported as measured. The scene's candidate is light subpaths under --time; a bake of fewer spp
+// than four pilots measures nothing on this backend (grid guiding only where named).
 TEST(VulkanGuidingAuto, LightSubpathCandidateIsBitIdenticalPerSeedAndAbandonedInShortBakes) {
   const PreparedScene p = ajar_room();
   CREATE_VULKAN_OR_SKIP(vk, p.scene);
@@ -295,15 +295,28 @@ TEST(VulkanGuidingAuto, LightSubpathCandidateIsBitIdenticalPerSeedAndAbandonedIn
     differ += std::memcmp(t.texels[i].total, plain.texels[i].total, sizeof(t.texels[i].total)) != 0;
   EXPECT_EQ(differ, 0u) << "of " << t.texels.size() << " texels differ from the unguided bake of " << taken << " samples";
 
+  // 64 spp: fewer than four light-subpath pilots, and on this backend grid guiding is measured only
+  // where named: nothing is measured, and the bake is the unguided one bit for bit.
   IntegratorSettings short_bake = settings(64, 5, GuidingMode::Auto);
   short_bake.guiding_auto_candidate = AutoGuidingCandidate::Scene;
   const LightmapEstimate g = vk->bake(p.gbuffer, short_bake);
-  EXPECT_FALSE(g.guiding_auto_light_subpaths) << "64 spp: fewer than four light-subpath pilots, so grid guiding";
+  EXPECT_TRUE(g.guiding_auto && g.guiding_auto_unmeasured);
+  EXPECT_FALSE(g.guiding_auto_light_subpaths);
   EXPECT_EQ(g.light_subpaths, 0u);
+  EXPECT_EQ(g.guided_vertices, 0u);
+  EXPECT_TRUE(g.guiding_regions.empty());
+  const LightmapEstimate unguided = vk->bake(p.gbuffer, settings(64, 5, GuidingMode::Off));
+  ASSERT_EQ(g.texels.size(), unguided.texels.size());
+  differ = 0;
+  for (size_t i = 0; i < g.texels.size(); ++i)
+    differ += std::memcmp(g.texels[i].total, unguided.texels[i].total, sizeof(g.texels[i].total)) != 0 ||
+              g.texels[i].samples != unguided.texels[i].samples;
+  EXPECT_EQ(differ, 0u) << "of " << g.texels.size() << " texels differ from the unguided bake";
 }
 
 // bake --backend vulkan: `--guiding auto` given runs the measured choice and reports it (stats.guiding,
-// with Vulkan's guided-vertex price); by default a Vulkan bake stays unguided (no pilot, no report).
+// with Vulkan's guided-vertex price; at 16 spp only with grid guiding named as the candidate by
+// --light-paths off, else candidate "none"); by default a Vulkan bake stays unguided (no pilot, no report).
 TEST(VulkanGuidingAuto, BakeRunsItOnlyWhenGiven) {
   const PreparedScene p = cornell_room();
   {
@@ -321,8 +334,14 @@ TEST(VulkanGuidingAuto, BakeRunsItOnlyWhenGiven) {
     std::ifstream in(out / "manifest.json");
     return nlohmann::json::parse(in);
   };
-  const nlohmann::json given = bake("--guiding auto");
+  // 16 spp: too few for light subpaths' pilots; grid guiding is measured here only where named.
+  const nlohmann::json unmeasured = bake("--guiding auto");
+  ASSERT_TRUE(unmeasured["stats"].contains("guiding"));
+  EXPECT_EQ(unmeasured["stats"]["guiding"]["candidate"], "none");
+  EXPECT_EQ(unmeasured["stats"]["guiding"]["decided"], false);
+  const nlohmann::json given = bake("--guiding auto --light-paths off");
   ASSERT_TRUE(given["stats"].contains("guiding"));
+  EXPECT_EQ(given["stats"]["guiding"]["candidate"], "grid");
   EXPECT_EQ(given["stats"]["guiding"]["mode"], "auto");
   EXPECT_EQ(given["stats"]["guiding"]["decided"], true);
   EXPECT_EQ(given["stats"]["guiding"]["pilot_samples_per_texel"], 4) << "16 spp: a pilot of 4";

@@ -228,17 +228,50 @@ TEST(Relight, ReproducesAVulkanPerBounceBakeBitForBit) {
   fs::remove_all(dir);
 }
 
+// --whole-run: unguided path tracing of the whole lightmap in one run (the runs guided ones are
+// compared with) is the Vulkan bake's, bit for bit; refused with --frames and with --guiding.
+TEST(Relight, WholeRunReproducesTheVulkanBakeBitForBit) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  const fs::path dir = fs::temp_directory_path() / ("exitance-relight-whole-run-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path baked = dir / "path.bake", output = dir / "path-relit.bake";
+  bake_to_relight("cornell_room", baked, 4, 12, [](BakeOptions& b) {
+    b.lighting.integrator = IntegratorMode::Path;
+    b.lighting.guiding = GuidingMode::Off;
+    b.integrator_auto = false;
+  });
+  RelightOptions options;
+  options.bundle = baked.string();
+  options.output = output.string();
+  options.seed = 9;
+  options.spp = 12;
+  options.whole_run = true;
+  const nlohmann::json report = relight_bundle(options);
+  EXPECT_EQ(report["integrator"], "path");
+  EXPECT_GT(report["rays"].get<uint64_t>(), 0u);
+  EXPECT_GE(expect_same_pages(baked, output, "the path-traced bake's"), 1u);
+  options.output = (dir / "refused.bake").string();
+  options.frames = 2;
+  EXPECT_THROW(relight_bundle(options), RelightInputError);
+  options.frames = 0;
+  options.guiding = "grid";
+  EXPECT_THROW(relight_bundle(options), RelightInputError);
+  EXPECT_FALSE(fs::exists(dir / "refused.bake"));
+  fs::remove_all(dir);
+}
+
 // A bundle baked guided (`mode`: grid or auto) on the Vulkan backend at `spp` is relit with
 // --guiding `mode` from scene.bin bit for bit (the same texels, grid, learning or pilot passes, choice
 // and seed); the report says so; it is refused with --frames (not progressive) and with
 // --integrator bounces. Returns the report and the bake's manifest.
 std::pair<nlohmann::json, nlohmann::json> expect_guided_relight_bit_for_bit(const std::string& mode, GuidingMode guiding,
-                                                                          uint32_t spp) {
+                                                                          uint32_t spp, float density = 4) {
   const fs::path dir = fs::temp_directory_path() / ("exitance-relight-guided-" + mode + "-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path baked = dir / "guided.bake", output = dir / "guided-relit.bake";
-  bake_to_relight("cornell_room", baked, 4, spp, [&](BakeOptions& b) {
+  bake_to_relight("cornell_room", baked, density, spp, [&](BakeOptions& b) {
     b.lighting.integrator = IntegratorMode::Path;
     b.lighting.guiding = guiding;
     b.guiding_auto_given = guiding == GuidingMode::Auto;
@@ -274,12 +307,14 @@ TEST(Relight, ReproducesAVulkanGuidedBakeBitForBit) {
 }
 
 // --guiding auto (bake --backend vulkan --guiding auto): the report's guiding_auto is the bake
-// manifest's stats.guiding (a pilot of 4 samples, decided within 16).
+// manifest's stats.guiding. At 1024 spp light subpaths are its candidate (four 256-sample pilots):
+// measured and decided, the same choice. At 16 spp none fits: nothing measured, the unguided bake.
 TEST(Relight, ReproducesAVulkanAutoGuidedBakeBitForBit) {
   if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
-  const auto [report, manifest] = expect_guided_relight_bit_for_bit("auto", GuidingMode::Auto, 16);
+  const auto [report, manifest] = expect_guided_relight_bit_for_bit("auto", GuidingMode::Auto, 1024, 1.0f);
   ASSERT_TRUE(manifest["stats"].contains("guiding")) << "the bake ran no measured choice";
   ASSERT_TRUE(report.contains("guiding_auto"));
+  EXPECT_EQ(report["guiding_auto"]["candidate"], "light-paths");
   EXPECT_EQ(report["guiding_auto"]["decided"], true);
   // Equal but for the setup's seconds, a time each run measures.
   nlohmann::json relit = report["guiding_auto"], baked = manifest["stats"]["guiding"];
@@ -287,6 +322,11 @@ TEST(Relight, ReproducesAVulkanAutoGuidedBakeBitForBit) {
   relit.erase("setup_seconds");
   baked.erase("setup_seconds");
   EXPECT_EQ(relit, baked);
+
+  const auto [short_report, short_manifest] = expect_guided_relight_bit_for_bit("auto", GuidingMode::Auto, 16);
+  EXPECT_EQ(short_report["guiding_auto"], short_manifest["stats"]["guiding"]);
+  EXPECT_EQ(short_report["guiding_auto"]["candidate"], "none");
+  EXPECT_EQ(short_report["guiding_auto"]["decided"], false);
 }
 
 // Emitter guiding (--emitter-guiding on): a bundle baked emitter-guided on the Vulkan backend is

@@ -170,6 +170,7 @@ void GuidingChoice::decide(double floor) {
       t.samples[k] = s[k].samples;
       t.cost[k] = double(s[k].rays) + guided_vertex_cost_ * double(s[k].guided_vertices) +
                   (k == 1 ? guided_sample_cost_ * double(s[k].samples) : 0.0);
+      if (k == 1) t.cost[k] *= guided_cost_factor_;
     }
     // Both strategies' variances are weighted by the same (pooled mean + floor)^2, so the comparison
     // is the one relMSE makes, and bright texels do not outvote dim ones.

@@ -66,18 +66,23 @@ json relight_bundle(const RelightOptions& options) {
   // does (RefreshSessionOptions::light_subpaths: the session's passes connect, edits keep their
   // rules); with --spp alone, or with --emitter-guiding on (a whole run itself), one whole run, bake
   // --backend vulkan --light-paths on's bit for bit.
+  if (options.whole_run && (per_bounce || guided || options.frames > 0 || options.frame_budget_ms > 0))
+    throw RelightInputError("--whole-run path traces the whole lightmap in one run: it takes no --frames, --budget-ms, --guiding "
+                            "or --integrator bounces");
   const bool whole_run_light_paths =
-      light_paths && (emitter_guided || (options.frames == 0 && options.frame_budget_ms == 0 && options.time_budget_seconds == 0));
+      light_paths && (emitter_guided || options.whole_run ||
+                      (options.frames == 0 && options.frame_budget_ms == 0 && options.time_budget_seconds == 0));
+  const bool whole_run = options.whole_run;
 
   const bool share = options.share_ranks > 0;
   if (share) {
     if (options.share_rank < 0 || options.share_rank >= options.share_ranks)
       throw RelightInputError("--share " + std::to_string(options.share_rank) + "/" + std::to_string(options.share_ranks) +
                               ": expected R/N with 0 <= R < N");
-    if (per_bounce || guided || emitter_guided || light_paths || options.frames > 0 || options.frame_budget_ms > 0 || options.time_budget_seconds > 0 ||
+    if (per_bounce || guided || emitter_guided || light_paths || whole_run || options.frames > 0 || options.frame_budget_ms > 0 || options.time_budget_seconds > 0 ||
         !options.edits_file.empty() || !options.output.empty() || !options.spp || *options.spp == 0)
       throw RelightInputError("--share measures one rank's share of path tracing at a fixed --spp: it takes no --integrator bounces, "
-                              "--guiding, --emitter-guiding, --light-paths, --frames, --budget-ms, --time, --edits or -o (it writes nothing)");
+                              "--guiding, --emitter-guiding, --light-paths, --whole-run, --frames, --budget-ms, --time, --edits or -o (it writes nothing)");
   }
   const fs::path bundle(options.bundle);
   const fs::path out = options.output.empty() ? bundle : fs::path(options.output);
@@ -196,7 +201,7 @@ json relight_bundle(const RelightOptions& options) {
   }
   // One path-traced run of the whole lightmap: --emitter-guiding on, or --light-paths on with --spp alone (or both).
   json emitter_guiding_report, light_paths_report;
-  if (emitter_guided || whole_run_light_paths) {
+  if (emitter_guided || whole_run_light_paths || whole_run) {
     report("lighting", 0, 0);
     const LightmapEstimate* run = nullptr;
     try {
@@ -221,7 +226,7 @@ json relight_bundle(const RelightOptions& options) {
     share_texels = rank_alone.work.texel_samples / spp;
     report("lighting", 1, rays);
   }
-  for (uint32_t frame = 0; !per_bounce && !guided && !emitter_guided && !whole_run_light_paths && !share && (options.frames == 0 || frame < options.frames); ++frame) {
+  for (uint32_t frame = 0; !per_bounce && !guided && !emitter_guided && !whole_run_light_paths && !whole_run && !share && (options.frames == 0 || frame < options.frames); ++frame) {
     RefreshBudget budget;
     budget.max_samples_per_texel = spp;
     budget.milliseconds = options.frame_budget_ms;

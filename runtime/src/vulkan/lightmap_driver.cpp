@@ -288,7 +288,22 @@ std::vector<uint32_t> LightmapDriver::unconverged(const std::vector<uint32_t>& w
   return still;
 }
 
+bool LightmapDriver::auto_measures_light_subpaths(const IntegratorSettings& settings) const {
+  if (settings.guiding_auto_candidate == AutoGuidingCandidate::Grid || !guiding_scene_.lighting) return false;
+  const bool starts = light_subpaths_start_anywhere(light_subpath_start(*guiding_scene_.lighting));
+  return starts && (settings.guiding_auto_candidate == AutoGuidingCandidate::LightSubpaths || light_subpath_pilots_fit(settings.spp));
+}
+
 LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings) {
+  // --guiding auto with no candidate for this bake (below): the unguided bake, bit for bit, no pilot.
+  if (settings.guiding == GuidingMode::Auto && settings.guiding_auto_candidate != AutoGuidingCandidate::Grid &&
+      !auto_measures_light_subpaths(settings)) {
+    IntegratorSettings unguided = settings;
+    unguided.guiding = GuidingMode::Off;
+    LightmapEstimate estimate = bake(gbuffer, unguided);
+    estimate.guiding_auto = estimate.guiding_auto_unmeasured = true;
+    return estimate;
+  }
   const auto start_time = Clock::now();
   progressive_.reset();  // the buffers are this bake's now
   runner_.statistics().clear();
@@ -313,20 +328,20 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   // which a hashed quarter of the texels take guided and unguided halves; the device sums each
   // strategy's samples per texel (gpu_layout.h kGuidingAuto), read back once when the pilot is
   // complete; GuidingChoice decides per region, and the texels' verdicts go back as strategy words.
-  const bool auto_guiding = settings.guiding == GuidingMode::Auto;
   // Its candidate (AutoGuidingCandidate), as on the CPU: light subpaths where a light starts them
   // and the bake is long enough for their pilot (--spp of kLightSubpathPilots pilots, or unlimited:
-  // under --time the pass rate decides below), or where they are named; grid guiding otherwise. A
-  // "guided" sample is then one whose path connects to the batch's pool (gpu_layout.h
-  // kGuidingAutoSubpaths); the grid's records are the regions and its buffer carries the strategy
-  // words and sums, but no vertex samples its table.
-  bool auto_light_subpaths = false;
+  // under --time the pass rate decides below), or where they are named. A "guided" sample is then
+  // one whose path connects to the batch's pool (gpu_layout.h kGuidingAutoSubpaths); the grid's
+  // records are the regions and the guide buffer carries the strategy words and sums only.
+  // Unlike the CPU, the scene's candidate is never grid guiding here: on the GPU its learning
+  // samples cost 1.7-2.6x an unguided one and it lost at equal time on every scene measured
+  // (bench/results/guiding-gpu.md), so its pilot only cost time (an H100 at 256 spp: 3-4x the
+  // unguided bake's, every region then unguided: bench/results/guiding-auto-gpu.md). A bake that
+  // light subpaths do not fit measures nothing and is the unguided one; grid guiding is measured
+  // only where named (AutoGuidingCandidate::Grid: bake --guiding auto --light-paths off).
+  const bool auto_guiding = settings.guiding == GuidingMode::Auto;
+  const bool auto_light_subpaths = auto_guiding && auto_measures_light_subpaths(settings);
   const auto auto_setup_start = Clock::now();
-  if (auto_guiding && settings.guiding_auto_candidate != AutoGuidingCandidate::Grid && guiding_scene_.lighting) {
-    const bool starts = light_subpaths_start_anywhere(light_subpath_start(*guiding_scene_.lighting));
-    auto_light_subpaths =
-        starts && (settings.guiding_auto_candidate == AutoGuidingCandidate::LightSubpaths || light_subpath_pilots_fit(settings.spp));
-  }
   if (settings.light_subpaths || auto_light_subpaths) {
     IntegratorSettings pool_settings = settings;
     pool_settings.light_subpaths = true;
@@ -363,7 +378,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
       choice = std::make_unique<GuidingChoice>(std::move(region), guide->record_count() + 1, pilot, statistics_from, settings.seed,
                                                kPilotMeasuringShare, false);
       choice->set_guided_vertex_cost(kGuidedVertexCostInRaysVulkan);
-      if (auto_light_subpaths) choice->set_candidate_half_second();
+      if (auto_light_subpaths) choice->set_candidate_half_second(), choice->set_guided_cost_factor(kConnectedSampleCostFactorVulkan);
       auto_words = strategy_words(*choice, a.texel_count);
       guide_buffer->add_auto_sections(auto_words, pilot, statistics_from);
     }
@@ -570,6 +585,7 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     estimate.guiding_auto = true;
     estimate.guiding_auto_light_subpaths = auto_light_subpaths;
     estimate.guiding_auto_pilot = choice->pilot();
+    estimate.guiding_auto_cost_factor = choice->guided_cost_factor();
     estimate.guiding_auto_abandoned_at = abandoned_at;
     estimate.guiding_auto_setup_seconds = auto_setup_seconds;
     if (choice->decided() && !choice->abandoned()) estimate.guiding_regions = choice->regions(), estimate.guiding_scene = choice->scene();

@@ -37,6 +37,10 @@ class LightmapDriver {
   void set_guiding_scene(const GuidingScene& scene) { guiding_scene_ = scene; }
   const GuidingScene& guiding_scene() const { return guiding_scene_; }
   LightmapEstimate bake(const TexelGBuffer& gbuffer, const IntegratorSettings& settings);
+  // --guiding auto: whether its candidate in this bake is light subpaths (a light starts them and
+  // the bake fits their pilots, or they are named). Where it is not and grid guiding is not named,
+  // bake() measures nothing (lightmap_driver.cpp says why).
+  bool auto_measures_light_subpaths(const IntegratorSettings& settings) const;
 
   // `changed_light_pairs` > 0: the accumulation estimates the change of direct light from that many
   // edited punctual lights (GpuParams::changed_light_pairs; their records set on the scene first).

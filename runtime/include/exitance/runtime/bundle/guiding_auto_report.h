@@ -15,6 +15,8 @@ namespace exitance {
 
 // stats.guiding (--guiding auto): what the measured choice kept, and why (core/guiding_choice.h).
 inline nlohmann::json guiding_auto_json(const LightmapEstimate& estimate, const std::string& backend) {
+  // Vulkan, no candidate for this bake: the unguided bake, no pilot.
+  if (estimate.guiding_auto_unmeasured) return {{"mode", "auto"}, {"candidate", "none"}, {"decided", false}};
   nlohmann::json out = {{"mode", "auto"},
                         {"candidate", estimate.guiding_auto_light_subpaths ? "light-paths" : "grid"},
                         {"pilot_samples_per_texel", estimate.guiding_auto_pilot},
@@ -64,6 +66,7 @@ inline nlohmann::json guiding_auto_json(const LightmapEstimate& estimate, const 
   out["cost_per_sample_rays"] = {{"unguided", scene.cost_per_sample(0)}, {"guided", scene.cost_per_sample(1)}};
   // Each backend's price of a guided vertex (core/guiding_choice.h).
   out["guided_vertex_cost_rays"] = backend == "vulkan" ? kGuidedVertexCostInRaysVulkan : kGuidedVertexCostInRays;
+  out["guided_cost_factor"] = estimate.guiding_auto_cost_factor;  // on a guided sample's counted cost (Vulkan's connections)
   out["choice_z"] = kChoiceZ;
   return out;
 }

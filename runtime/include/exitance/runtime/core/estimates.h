@@ -75,7 +75,11 @@ struct LightmapEstimate {
   // otherwise or when the bake ended before the pilot did (then every sample tossed its coin).
   bool guiding_auto = false;
   bool guiding_auto_light_subpaths = false;  // what it measured against unguided: light subpaths (else grid guiding)
+  // Vulkan: no candidate fits the bake (light subpaths need kLightSubpathPilots pilots and a light
+  // that starts them; grid guiding is measured there only where named), so nothing was measured.
+  bool guiding_auto_unmeasured = false;
   uint32_t guiding_auto_pilot = 0;  // samples per texel before the choice
+  double guiding_auto_cost_factor = 1;  // GuidingChoice::guided_cost_factor (Vulkan's connected samples)
   // Light subpaths under a time budget: the samples per texel at which the pilot was abandoned
   // unmeasured (the pass rate promised too few samples for it to pay); 0: it was not.
   uint32_t guiding_auto_abandoned_at = 0;

@@ -73,6 +73,12 @@ constexpr double kGuidedVertexCostInRays = 0.65;
 // The same price on the Vulkan backend (docs/lighting-core.md, "`--guiding auto` on the Vulkan
 // backend", says why this value): a constant, not a clock, so the choice stays deterministic per seed.
 constexpr double kGuidedVertexCostInRaysVulkan = 1.0;
+// On the Vulkan backend a connected sample (light subpaths as the candidate) costs more GPU time than
+// its counted rays and pool share say (its connection's MIS weights, the pool's reads, less coherent
+// shading): measured on an H100 at 1024 spp as time per connected texel-sample over its counted
+// cost, 1.54 on the Cornell room and 1.60 on ajar_room at 64 texels/m (bench/results/guiding-auto-gpu.md).
+// Its counted cost is multiplied by this constant (no clock: the choice stays deterministic per seed).
+constexpr double kConnectedSampleCostFactorVulkan = 1.55;
 // Standard errors a difference of efficiency must exceed to count (one-sided 1.3e-3 under a normal).
 constexpr double kChoiceZ = 3.0;
 
@@ -166,6 +172,10 @@ class GuidingChoice {
   // A fixed price per guided sample in rays, besides its own rays and vertices (default 0): the
   // light-subpath candidate's share of the pool it connects to (traced once for many samples).
   void set_guided_sample_cost(double rays) { guided_sample_cost_ = rays; }
+  // A factor on a guided sample's whole counted cost (default 1): a backend whose guided samples
+  // take more time per counted ray than unguided ones (kConnectedSampleCostFactorVulkan).
+  void set_guided_cost_factor(double factor) { guided_cost_factor_ = factor; }
+  double guided_cost_factor() const { return guided_cost_factor_; }
   // Every measuring texel takes its candidate half of the pilot second (not by the hashed coin):
   // until half the pilot the bake is then an unguided one, which abandon() can keep. Before any sample.
   void set_candidate_half_second() { candidate_half_second_ = true; }
@@ -233,6 +243,7 @@ class GuidingChoice {
   double measuring_share_;
   double guided_vertex_cost_ = kGuidedVertexCostInRays;
   double guided_sample_cost_ = 0;
+  double guided_cost_factor_ = 1;
   bool candidate_half_second_ = false;
   bool abandoned_ = false;
   bool decided_ = false;

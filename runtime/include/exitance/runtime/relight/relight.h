@@ -57,6 +57,12 @@ struct RelightOptions {
   // --emitter-guiding on, --guiding or integrator "bounces"). With a time, frame count or frame budget
   // the progressive refresh's passes connect (RefreshSessionOptions::light_subpaths); else one whole run.
   std::string light_paths = "off";
+  // Path tracing (unguided, or with light_paths "on") of the whole lightmap in one run, as `bake
+  // --backend vulkan` lights it (RefreshSession::bake_path: its passes, --time counted from the run's
+  // start, the read-back inside the lighting), instead of refresh calls: what the guided whole runs
+  // (guiding, emitter_guiding) are compared with. Not with frames, a frame budget, guiding, the
+  // per-bounce integrator or a share.
+  bool whole_run = false;
   // With integrator "bounces": where the layer caches are built, "device" or "host" (the path before
   // the device built them, for A/B timing; the same results bit for bit).
   std::string bounce_caches = "device";
