@@ -9,12 +9,15 @@
 # the refresh calls' unguided run, "whole" the unguided whole run (--whole-run) that bake --backend
 # vulkan makes and that auto's whole runs compare with on equal terms.
 # Writes $OUT/summary.txt.
-#   bash .replay/guiding_auto_gpu_run.sh        (SCENES, TIMES, SPPS override the lists)
+#   bash .replay/guiding_auto_gpu_run.sh        (SCENES, TIMES, SPPS override the lists; STAGES=1 adds
+#                                                the GPU seconds per stage at the largest SPPS)
 set -e
 for f in .gl/*.deb; do dpkg -x $f / ; done; ldconfig
 export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
 mkdir -p /tmp/w && tar -C /tmp/w -xJf .replay/ga.txz
 S=$OUT/summary.txt
+TIMES=${TIMES:-0.25 1 4}
+SPPS=${SPPS:-256 1024}
 { nvidia-smi --query-gpu=name,driver_version --format=csv,noheader; nproc; } > $S
 R=/tmp/w/rt/bin/exitance-relight
 run() {  # NAME ARGS...: one relight, its lighting time, samples and what auto chose
@@ -33,16 +36,27 @@ for scene in ${SCENES:-cornell courtyard city ajar}; do
   $R $B -o /tmp/w/$scene-refA.bake --spp 4096 --seed 101 --json > /dev/null
   $R $B -o /tmp/w/$scene-refB.bake --spp 4096 --seed 202 --json > /dev/null
   tests=""
-  for t in ${TIMES:-0.25 1 4}; do
+  for t in $TIMES; do
     run off-${t}s --spp 0 --time $t
     run whole-${t}s --spp 0 --time $t --whole-run
     run auto-${t}s --spp 0 --time $t --guiding auto
   done
-  for spp in ${SPPS:-256 1024}; do
+  for spp in $SPPS; do
     run off-${spp}spp --spp $spp
     run whole-${spp}spp --spp $spp --whole-run
     run auto-${spp}spp --spp $spp --guiding auto
   done
+  # Where a whole run's GPU time goes (STAGES=1): the stages' GPU seconds of the unguided whole run and
+  # auto at the largest --spp.
+  if [ -n "${STAGES:-}" ]; then
+    for mode in "--whole-run" "--guiding auto"; do
+      $R $B -o /tmp/w/stages.bake --spp ${SPPS##* } --seed 1 --stage-statistics --json $mode > /tmp/w/s.json
+      python3 -c "
+import json; r=json.load(open('/tmp/w/s.json'))
+st=' '.join('%s %.3f' % (s['stage'], s['gpu_seconds']) for s in r.get('stages', []))
+print('$scene stages ${SPPS##* }spp $mode: lighting %.3f s, GPU %.3f s: %s' % (r['lighting_seconds'], sum(s['gpu_seconds'] for s in r.get('stages', [])), st))" >> $S
+    done
+  fi
   LD_LIBRARY_PATH=/tmp/w/rt/lib /tmp/w/rt/bin/bench_bundle_rel_mse /tmp/w/$scene-refA.bake /tmp/w/$scene-refB.bake $tests | sed "s#/tmp/w/##" >> $S
   rm -rf /tmp/w/$scene-*.bake
 done
