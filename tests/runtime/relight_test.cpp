@@ -228,45 +228,12 @@ TEST(Relight, ReproducesAVulkanPerBounceBakeBitForBit) {
   fs::remove_all(dir);
 }
 
-// --whole-run: unguided path tracing of the whole lightmap in one run (the runs guided ones are
-// compared with) is the Vulkan bake's, bit for bit; refused with --frames and with --guiding.
-TEST(Relight, WholeRunReproducesTheVulkanBakeBitForBit) {
-  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
-  const fs::path dir = fs::temp_directory_path() / ("exitance-relight-whole-run-" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  const fs::path baked = dir / "path.bake", output = dir / "path-relit.bake";
-  bake_to_relight("cornell_room", baked, 4, 12, [](BakeOptions& b) {
-    b.lighting.integrator = IntegratorMode::Path;
-    b.lighting.guiding = GuidingMode::Off;
-    b.integrator_auto = false;
-  });
-  RelightOptions options;
-  options.bundle = baked.string();
-  options.output = output.string();
-  options.seed = 9;
-  options.spp = 12;
-  options.whole_run = true;
-  const nlohmann::json report = relight_bundle(options);
-  EXPECT_EQ(report["integrator"], "path");
-  EXPECT_GT(report["rays"].get<uint64_t>(), 0u);
-  EXPECT_GE(expect_same_pages(baked, output, "the path-traced bake's"), 1u);
-  options.output = (dir / "refused.bake").string();
-  options.frames = 2;
-  EXPECT_THROW(relight_bundle(options), RelightInputError);
-  options.frames = 0;
-  options.guiding = "grid";
-  EXPECT_THROW(relight_bundle(options), RelightInputError);
-  EXPECT_FALSE(fs::exists(dir / "refused.bake"));
-  fs::remove_all(dir);
-}
-
 // A bundle baked guided (`mode`: grid or auto) on the Vulkan backend at `spp` is relit with
 // --guiding `mode` from scene.bin bit for bit (the same texels, grid, learning or pilot passes, choice
 // and seed); the report says so; it is refused with --frames (not progressive) and with
 // --integrator bounces. Returns the report and the bake's manifest.
 std::pair<nlohmann::json, nlohmann::json> expect_guided_relight_bit_for_bit(const std::string& mode, GuidingMode guiding,
-                                                                          uint32_t spp, float density = 4) {
+                                                                          uint32_t spp, float density = 4, bool whole_run = false) {
   const fs::path dir = fs::temp_directory_path() / ("exitance-relight-guided-" + mode + "-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
@@ -284,9 +251,11 @@ std::pair<nlohmann::json, nlohmann::json> expect_guided_relight_bit_for_bit(cons
   options.seed = 9;
   options.spp = spp;
   options.guiding = mode;
+  options.whole_run = whole_run;
   const nlohmann::json report = relight_bundle(options);
   EXPECT_EQ(report["integrator"], "path");
-  EXPECT_EQ(report["guiding"], mode);
+  if (whole_run) EXPECT_EQ(report["whole_run"], true);
+  else EXPECT_EQ(report["guiding"], mode);
   EXPECT_GT(report["rays"].get<uint64_t>(), 0u);
   EXPECT_GE(expect_same_pages(baked, output, "the guided bake's"), 1u) << mode;
   options.output = (dir / "refused.bake").string();
@@ -327,6 +296,13 @@ TEST(Relight, ReproducesAVulkanAutoGuidedBakeBitForBit) {
   EXPECT_EQ(short_report["guiding_auto"], short_manifest["stats"]["guiding"]);
   EXPECT_EQ(short_report["guiding_auto"]["candidate"], "none");
   EXPECT_EQ(short_report["guiding_auto"]["decided"], false);
+}
+
+// --whole-run (what the guided runs are compared with): unguided path tracing of the whole lightmap
+// in one run is the Vulkan bake's, bit for bit; refused with --frames and --integrator bounces.
+TEST(Relight, WholeRunReproducesTheVulkanBakeBitForBit) {
+  if (!has_vulkan_device()) GTEST_SKIP() << "no Vulkan device";
+  expect_guided_relight_bit_for_bit("off", GuidingMode::Off, 12, 4, true);
 }
 
 // Emitter guiding (--emitter-guiding on): a bundle baked emitter-guided on the Vulkan backend is

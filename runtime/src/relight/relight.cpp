@@ -299,6 +299,7 @@ json relight_bundle(const RelightOptions& options) {
   json run;
   run["integrator"] = per_bounce ? "bounces" : "path";
   if (guided) run["guiding"] = options.guiding;
+  if (whole_run) run["whole_run"] = true;  // --whole-run: one run as bake lights it, not refresh calls
   if (!guiding_auto_report.is_null()) run["guiding_auto"] = guiding_auto_report;  // bake's stats.guiding
   if (emitter_guided) run["emitter_guiding"] = emitter_guiding_report;
   if (whole_run_light_paths) run["light_paths"] = light_paths_report;  // else write_refreshed_bundle's, from the accumulation
