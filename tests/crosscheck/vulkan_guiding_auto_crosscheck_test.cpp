@@ -295,6 +295,25 @@ TEST(VulkanGuidingAuto, LightSubpathCandidateIsBitIdenticalPerSeedAndAbandonedIn
     differ += std::memcmp(t.texels[i].total, plain.texels[i].total, sizeof(t.texels[i].total)) != 0;
   EXPECT_EQ(differ, 0u) << "of " << t.texels.size() << " texels differ from the unguided bake of " << taken << " samples";
 
+  // A budget that promises the pilots: the candidate's setup, deferred to the rate's check (at 16
+  // samples or more), is made there, and the pilot measured and decided (ajar_room at 1 texel/m,
+  // capped at 1024 spp: a few seconds on lavapipe, far inside the budget).
+  {
+    const PreparedScene small = sample_scene("ajar_room", 1);
+    CREATE_VULKAN_OR_SKIP(vk_small, small.scene);
+    IntegratorSettings promised = settings(1024, 5, GuidingMode::Auto);
+    promised.guiding_auto_candidate = AutoGuidingCandidate::Scene;
+    promised.time_budget_seconds = 600;
+    const LightmapEstimate m = vk_small->bake(small.gbuffer, promised);
+    EXPECT_TRUE(m.guiding_auto_light_subpaths);
+    EXPECT_EQ(m.guiding_auto_abandoned_at, 0u);
+    EXPECT_FALSE(m.guiding_regions.empty()) << "measured and decided";
+    EXPECT_GT(m.guiding_auto_setup_seconds, 0.0) << "set up at the rate's check";
+    EXPECT_GT(m.light_subpaths, 0u);
+    EXPECT_EQ(m.nonfinite_samples, 0u);
+    for (const TexelAccumulator& texel : m.texels) ASSERT_EQ(texel.samples, 1024u);
+  }
+
   // 64 spp: fewer than four light-subpath pilots, and on this backend grid guiding is measured only
   // where named: nothing is measured, and the bake is the unguided one bit for bit.
   IntegratorSettings short_bake = settings(64, 5, GuidingMode::Auto);

@@ -341,50 +341,64 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   // only where named (AutoGuidingCandidate::Grid: bake --guiding auto --light-paths off).
   const bool auto_guiding = settings.guiding == GuidingMode::Auto;
   const bool auto_light_subpaths = auto_guiding && auto_measures_light_subpaths(settings);
-  const auto auto_setup_start = Clock::now();
-  if (settings.light_subpaths || auto_light_subpaths) {
-    IntegratorSettings pool_settings = settings;
-    pool_settings.light_subpaths = true;
-    make_light_pools(a, pool_settings);
-  }
+  // Under --time the light-subpath candidate's setup (the pools, the regions, the choice, the words
+  // and their upload: 0.05-0.08 s at 0.4-1 M texels on an H100 host) waits for the pass rate's check
+  // below: a bake that then abandons the candidate never pays it, and until then the bake is the
+  // unguided one (the pilot's first half is all unguided samples at their own indices anyway). The
+  // pilot's statistics then start where the setup is made. Not with emitter guiding, whose section
+  // follows the auto sections in the guide buffer.
+  const bool defer_auto_setup = auto_light_subpaths && settings.time_budget_seconds > 0 && !settings.emitter_guiding &&
+                                !settings.light_subpaths;
+  double auto_setup_seconds = 0;
+  const uint32_t light_subpath_pilot = GuidingChoice::pilot_for(settings.spp, kLightSubpathPilotSamples);
   std::unique_ptr<GuidingChoice> choice;
   std::vector<uint32_t> auto_words;
-  if (settings.guiding == GuidingMode::Grid || auto_guiding) {
-    if (share) throw std::invalid_argument("Vulkan backend: guiding runs in one process only, not under mpirun with several ranks");
-    GridGuidingConfig config;
-    config.mix = settings.guiding_mix;
-    config.cells_on_longest_axis = settings.guiding_grid_cells;
-    guide = std::make_unique<GridGuidingCache>(guiding_scene_.bounds_lo, guiding_scene_.bounds_hi,
-                                               guiding_scene_.reference_radiance, gbuffer, config);
-    // Light subpaths as auto's candidate: the grid's records are only the regions, its tables unread.
-    if (auto_light_subpaths) guide_buffer.emplace();
-    else guide_buffer.emplace(*guide);
-    if (auto_guiding) {
-      // Regions: the guide's records (grid cell x normal class), texels without one in one more (as on the CPU).
-      const uint32_t pilot =
-          GuidingChoice::pilot_for(settings.spp, auto_light_subpaths ? kLightSubpathPilotSamples : GridGuidingCache::kLearningSamples);
-      // On all host cores: the lookups are independent, and at a million texels this is inside the timed bake.
-      std::vector<uint32_t> region(a.texel_count);
-      for_each_chunk(a.texel_count, [&](size_t begin, size_t end) {
-        for (size_t i = begin; i < end; ++i) {
-          const uint32_t r = guide->record_of(gbuffer.texels[i].position, gbuffer.texels[i].shading_normal);
-          region[i] = r == GridGuidingCache::kNoRecord ? guide->record_count() : r;
-        }
-      });
-      // Light subpaths: statistics from the first sample (nothing learns), the connected half of the
-      // pilot second, so that a short bake can abandon them unmeasured (as on the CPU).
-      const uint32_t statistics_from = auto_light_subpaths ? 0 : pilot / 4;
-      // Its sums are the device's (reduce.comp), read back once at the pilot's end.
-      choice = std::make_unique<GuidingChoice>(std::move(region), guide->record_count() + 1, pilot, statistics_from, settings.seed,
-                                               kPilotMeasuringShare, false);
-      choice->set_guided_vertex_cost(kGuidedVertexCostInRaysVulkan);
-      if (auto_light_subpaths) choice->set_candidate_half_second(), choice->set_guided_cost_factor(kConnectedSampleCostFactorVulkan);
-      auto_words = strategy_words(*choice, a.texel_count);
-      guide_buffer->add_auto_sections(auto_words, pilot, statistics_from);
+  auto set_up_guide = [&](uint32_t statistics_from_light_subpaths) {
+    const auto setup_start = Clock::now();
+    if (settings.light_subpaths || auto_light_subpaths) {
+      IntegratorSettings pool_settings = settings;
+      pool_settings.light_subpaths = true;
+      make_light_pools(a, pool_settings);
     }
-    guide_buffer->upload(runner_);
-  }
-  const double auto_setup_seconds = auto_guiding ? std::chrono::duration<double>(Clock::now() - auto_setup_start).count() : 0.0;
+    if (settings.guiding == GuidingMode::Grid || auto_guiding) {
+      if (share) throw std::invalid_argument("Vulkan backend: guiding runs in one process only, not under mpirun with several ranks");
+      GridGuidingConfig config;
+      config.mix = settings.guiding_mix;
+      config.cells_on_longest_axis = settings.guiding_grid_cells;
+      guide = std::make_unique<GridGuidingCache>(guiding_scene_.bounds_lo, guiding_scene_.bounds_hi,
+                                                 guiding_scene_.reference_radiance, gbuffer, config);
+      // Light subpaths as auto's candidate: the grid's records are only the regions, its tables unread.
+      if (auto_light_subpaths) guide_buffer.emplace();
+      else guide_buffer.emplace(*guide);
+      if (auto_guiding) {
+        // Regions: the guide's records (grid cell x normal class), texels without one in one more (as on the CPU).
+        const uint32_t pilot =
+            GuidingChoice::pilot_for(settings.spp, auto_light_subpaths ? kLightSubpathPilotSamples : GridGuidingCache::kLearningSamples);
+        // On all host cores: the lookups are independent, and at a million texels this is inside the timed bake.
+        std::vector<uint32_t> region(a.texel_count);
+        for_each_chunk(a.texel_count, [&](size_t begin, size_t end) {
+          for (size_t i = begin; i < end; ++i) {
+            const uint32_t r = guide->record_of(gbuffer.texels[i].position, gbuffer.texels[i].shading_normal);
+            region[i] = r == GridGuidingCache::kNoRecord ? guide->record_count() : r;
+          }
+        });
+        // Light subpaths: statistics from the first sample (nothing learns; from the deferred setup's
+        // sample under --time), the connected half of the pilot second, so that a short bake can
+        // abandon them unmeasured (as on the CPU).
+        const uint32_t statistics_from = auto_light_subpaths ? statistics_from_light_subpaths : pilot / 4;
+        // Its sums are the device's (reduce.comp), read back once at the pilot's end.
+        choice = std::make_unique<GuidingChoice>(std::move(region), guide->record_count() + 1, pilot, statistics_from, settings.seed,
+                                                 kPilotMeasuringShare, false);
+        choice->set_guided_vertex_cost(kGuidedVertexCostInRaysVulkan);
+        if (auto_light_subpaths) choice->set_candidate_half_second(), choice->set_guided_cost_factor(kConnectedSampleCostFactorVulkan);
+        auto_words = strategy_words(*choice, a.texel_count);
+        guide_buffer->add_auto_sections(auto_words, pilot, statistics_from);
+      }
+      guide_buffer->upload(runner_);
+    }
+    auto_setup_seconds = std::chrono::duration<double>(Clock::now() - setup_start).count();
+  };
+  if (!defer_auto_setup) set_up_guide(0);
   // SVO guiding (svo_guide_buffer.h): the CPU reference's fields and schedule. The first pass is
   // unguided (no bins yet) unless the octree holds exitance; the passes that reach 1, 2, 4, ...
   // samples per texel count their vertices on the device, then the host rebuilds the fields from the
@@ -529,17 +543,22 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     // passes, of one sample each, carry a pass's fixed costs (from them an H100 promised the Cornell
     // room at 64 texels/m 400 samples in 4 s, where it took 2 900-3 900).
     const uint32_t done_here = first + pass;
-    if (choice && auto_light_subpaths && done_here == 4) elapsed_at_4 = passes.elapsed_seconds();
-    if (choice && auto_light_subpaths && !choice->decided() && settings.time_budget_seconds > 0 && elapsed_at_4 >= 0 &&
-        done_here >= std::min(16u, choice->pilot() / 2) && done_here > 4 && done_here <= choice->pilot() / 2) {
+    if (auto_light_subpaths && done_here == 4) elapsed_at_4 = passes.elapsed_seconds();
+    const bool undecided = choice ? auto_light_subpaths && !choice->decided() : defer_auto_setup && abandoned_at == 0;
+    if (undecided && settings.time_budget_seconds > 0 && elapsed_at_4 >= 0 && done_here >= std::min(16u, light_subpath_pilot / 2) &&
+        done_here > 4 && done_here <= light_subpath_pilot / 2) {
       const double elapsed = passes.elapsed_seconds();
       const double per_sample = (elapsed - elapsed_at_4) / double(done_here - 4);
-      if (!light_subpath_pilots_promised(done_here, per_sample, settings.time_budget_seconds - elapsed, choice->pilot())) {
-        choice->abandon();
+      if (!light_subpath_pilots_promised(done_here, per_sample, settings.time_budget_seconds - elapsed, light_subpath_pilot)) {
         abandoned_at = done_here;
-        auto_words = strategy_words(*choice, a.texel_count);
-        guide_buffer->upload_auto_words(runner_, auto_words);
-        drop_unread_pools();
+        if (choice) {
+          choice->abandon();
+          auto_words = strategy_words(*choice, a.texel_count);
+          guide_buffer->upload_auto_words(runner_, auto_words);
+          drop_unread_pools();
+        }
+      } else if (!choice) {
+        set_up_guide(done_here);  // the candidate will be measured: set up now, its statistics from here
       }
     }
     if (choice && !choice->decided() && first + pass >= choice->pilot()) {  // the pilot is complete on every texel
@@ -581,6 +600,11 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   // Under a split only this rank's texels are read back: in place on rank 0, which gathers the
   // others' below; packed on the others, which send them.
   LightmapEstimate estimate = download(a, share ? &own_runs : nullptr, space.get(), /*packed=*/!whole_here);
+  if (!choice && defer_auto_setup) {  // never set up: the bake ended before the rate's check, or abandoned there
+    estimate.guiding_auto = estimate.guiding_auto_light_subpaths = true;
+    estimate.guiding_auto_pilot = light_subpath_pilot;
+    estimate.guiding_auto_abandoned_at = abandoned_at;
+  }
   if (choice) {
     estimate.guiding_auto = true;
     estimate.guiding_auto_light_subpaths = auto_light_subpaths;
