@@ -361,7 +361,6 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
       make_light_pools(a, pool_settings);
     }
     if (settings.guiding == GuidingMode::Grid || auto_guiding) {
-      if (share) throw std::invalid_argument("Vulkan backend: guiding runs in one process only, not under mpirun with several ranks");
       GridGuidingConfig config;
       config.mix = settings.guiding_mix;
       config.cells_on_longest_axis = settings.guiding_grid_cells;
@@ -398,6 +397,8 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
     }
     auto_setup_seconds = std::chrono::duration<double>(Clock::now() - setup_start).count();
   };
+  if (share && (settings.guiding == GuidingMode::Grid || auto_guiding))  // before any pass, deferred setup or not
+    throw std::invalid_argument("Vulkan backend: guiding runs in one process only, not under mpirun with several ranks");
   if (!defer_auto_setup) set_up_guide(0);
   // SVO guiding (svo_guide_buffer.h): the CPU reference's fields and schedule. The first pass is
   // unguided (no bins yet) unless the octree holds exitance; the passes that reach 1, 2, 4, ...
