@@ -601,18 +601,16 @@ LightmapEstimate LightmapDriver::bake(const TexelGBuffer& gbuffer, const Integra
   // Under a split only this rank's texels are read back: in place on rank 0, which gathers the
   // others' below; packed on the others, which send them.
   LightmapEstimate estimate = download(a, share ? &own_runs : nullptr, space.get(), /*packed=*/!whole_here);
-  if (!choice && defer_auto_setup) {  // never set up: the bake ended before the rate's check, or abandoned there
-    estimate.guiding_auto = estimate.guiding_auto_light_subpaths = true;
-    estimate.guiding_auto_pilot = light_subpath_pilot;
-    estimate.guiding_auto_abandoned_at = abandoned_at;
-  }
-  if (choice) {
+  // Without a choice under a deferred setup: the bake ended before the rate's check, or abandoned there.
+  if (choice || defer_auto_setup) {
     estimate.guiding_auto = true;
     estimate.guiding_auto_light_subpaths = auto_light_subpaths;
-    estimate.guiding_auto_pilot = choice->pilot();
-    estimate.guiding_auto_cost_factor = choice->guided_cost_factor();
+    estimate.guiding_auto_pilot = choice ? choice->pilot() : light_subpath_pilot;
     estimate.guiding_auto_abandoned_at = abandoned_at;
     estimate.guiding_auto_setup_seconds = auto_setup_seconds;
+  }
+  if (choice) {
+    estimate.guiding_auto_cost_factor = choice->guided_cost_factor();
     if (choice->decided() && !choice->abandoned()) estimate.guiding_regions = choice->regions(), estimate.guiding_scene = choice->scene();
   }
   if (guide && !auto_light_subpaths && settings.inspect_guiding) {
